@@ -1,0 +1,11 @@
+"""Command line: ``stickslip <command>``. Parse → library call → write; no physics here.
+
+Each command lives in its own module and registers itself on :data:`app` when imported.
+"""
+
+from ._app import app
+
+from . import simulate  # noqa: E402,F401  (registers `stickslip simulate`)
+from . import stability  # noqa: E402,F401
+
+__all__ = ["app"]

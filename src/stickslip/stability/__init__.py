@@ -1,0 +1,9 @@
+"""Steady sliding: equilibrium (Eq. 14), linear stability (Eq. 15) and (N, Ω) stability maps."""
+
+from .analysis import StabilityResult, linearization, stability
+from .equilibrium import EquilibriumError, equilibrium, equilibrium_residual
+from .maps import StabilityMap, load_stability_map, stability_map
+
+__all__ = ["equilibrium", "equilibrium_residual", "EquilibriumError",
+           "stability", "StabilityResult", "linearization",
+           "stability_map", "StabilityMap", "load_stability_map"]

@@ -1,0 +1,245 @@
+"""Linear stability of steady sliding (paper Sect. 4.1, Eq. 15): eigen analysis of the Jacobian."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+
+from ..model import kernels
+from ..model.parameters import PARAMETER_UNITS, Parameters
+from ..model.system import System, assemble
+from ..model.variants import DOF_NAMES
+from . import linearize
+from .equilibrium import EquilibriumError, solve_equilibrium
+
+__all__ = ["StabilityResult", "stability", "linearization"]
+
+_DOF_UNITS = {"x1": "m", "y1": "m", "x2": "m", "y2": "m", "phi": "rad", "psi": "rad"}
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class StabilityResult:
+    """Linear stability of the steady-sliding equilibrium (paper Sect. 4.1).
+
+    Attributes
+    ----------
+    params : Parameters
+    model : str
+        Variant name (``full``, ``x``, ``y``, ``rotation`` or ``custom:...``).
+    dofs : tuple of str
+        The free DOFs, in q order; the reduced state is [dofs, d(dofs)/dt].
+    equilibrium : ndarray (6,)
+        q_e = [x1, y1, x2, y2, φ, ψ] [m, rad]; locked DOFs are 0.
+    residual : float
+        Relative residual of Eq. (14) at ``equilibrium`` (simulator kernel).
+    jacobian : ndarray (2k, 2k)
+        ∂(ds/dt)/∂s of the slip equations at (q_e, q̇ = 0), reduced to the k free DOFs [1/s, 1/s²].
+    stiffness, damping : ndarray (k, k)
+        K_L and C_L of Eq. (15) on the free DOFs (M_L is diagonal: ``mass``).
+    mass : ndarray (k,)
+        Diagonal of M_L on the free DOFs [kg, kg m²].
+    eigenvalues : ndarray (2k,) complex
+        Sorted by real part, descending (conjugate pairs: positive imaginary part first) [1/s].
+    mode_shapes : ndarray (2k, k) complex
+        Displacement part of each eigenvector, scaled so that its largest entry is 1 (real).
+    """
+
+    params: Parameters
+    model: str
+    dofs: tuple[str, ...]
+    equilibrium: np.ndarray
+    residual: float
+    jacobian: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    mass: np.ndarray
+    eigenvalues: np.ndarray
+    mode_shapes: np.ndarray
+
+    # ------------------------------------------------------------------ derived
+    @property
+    def growth_rates(self) -> np.ndarray:
+        """Real parts of the eigenvalues [1/s] (positive: the mode grows)."""
+        return self.eigenvalues.real
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Damped frequencies |Im λ| / 2π [Hz]."""
+        return np.abs(self.eigenvalues.imag) / (2.0 * math.pi)
+
+    @property
+    def max_real_part(self) -> float:
+        """Largest real part of the eigenvalues [1/s]."""
+        return float(self.eigenvalues.real[0])
+
+    @property
+    def stable(self) -> bool:
+        """True when every eigenvalue has a negative real part (asymptotically stable sliding)."""
+        return self.max_real_part < 0.0
+
+    @property
+    def equilibrium_dict(self) -> dict[str, float]:
+        """``{dof name: value}`` of the equilibrium, all six DOFs."""
+        return {name: float(v) for name, v in zip(DOF_NAMES, self.equilibrium)}
+
+    def modes(self, *, one_per_pair: bool = True) -> list[dict]:
+        """One dict per mode: eigenvalue, growth rate [1/s], frequency [Hz], dominant DOF, shape.
+
+        With ``one_per_pair`` only the member with Im λ ≥ 0 of each conjugate pair is listed.
+        """
+        rows = []
+        for j, lam in enumerate(self.eigenvalues):
+            if one_per_pair and lam.imag < 0.0:
+                continue
+            shape = self.mode_shapes[j]
+            rows.append({
+                "index": j,
+                "eigenvalue": complex(lam),
+                "growth_rate": float(lam.real),
+                "frequency_hz": float(abs(lam.imag) / (2.0 * math.pi)),
+                "dominant_dof": self.dofs[int(np.argmax(np.abs(shape)))],
+                "shape": {d: complex(c) for d, c in zip(self.dofs, shape)},
+            })
+        return rows
+
+    def summary(self) -> dict:
+        """JSON-ready summary: equilibrium (names → values), eigenvalues [[re, im], ...],
+        max_real_part, stable."""
+        return {
+            "model": self.model,
+            "equilibrium": self.equilibrium_dict,
+            "eigenvalues": [[float(v.real), float(v.imag)] for v in self.eigenvalues],
+            "max_real_part": self.max_real_part,
+            "stable": bool(self.stable),
+        }
+
+    def to_xarray(self):
+        """``xarray.Dataset`` with units, long names and the full parameter set in attrs."""
+        import xarray as xr
+
+        from .. import __version__
+
+        k = len(self.dofs)
+        states = list(self.dofs) + ["d" + d for d in self.dofs]
+        data = {
+            "equilibrium": ("dof_all", self.equilibrium,
+                            {"long_name": "steady-sliding equilibrium q_e (Eq. 14)", "units": "m or rad"}),
+            "eigenvalue_real": ("mode", self.eigenvalues.real, {"units": "1/s", "long_name": "growth rate Re(lambda)"}),
+            "eigenvalue_imag": ("mode", self.eigenvalues.imag, {"units": "rad/s", "long_name": "Im(lambda)"}),
+            "frequency": ("mode", self.frequencies_hz, {"units": "Hz", "long_name": "damped frequency |Im(lambda)|/(2 pi)"}),
+            "mode_shape_real": (("mode", "dof"), self.mode_shapes.real, {"long_name": "mode shape (displacements), real part"}),
+            "mode_shape_imag": (("mode", "dof"), self.mode_shapes.imag, {"long_name": "mode shape (displacements), imaginary part"}),
+            "jacobian": (("state", "state_col"), self.jacobian, {"long_name": "Jacobian of the slip equations at q_e"}),
+            "stiffness_L": (("dof", "dof_col"), self.stiffness, {"long_name": "K_L of Eq. (15)"}),
+            "damping_L": (("dof", "dof_col"), self.damping, {"long_name": "C_L of Eq. (15)"}),
+            "mass_L": ("dof", self.mass, {"long_name": "diagonal of M_L of Eq. (15)"}),
+        }
+        coords = {
+            "mode": ("mode", np.arange(2 * k)),
+            "dof": ("dof", list(self.dofs)),
+            "dof_col": ("dof_col", list(self.dofs)),
+            "dof_all": ("dof_all", list(DOF_NAMES)),
+            "state": ("state", states),
+            "state_col": ("state_col", states),
+        }
+        attrs = {
+            "title": "stickslip linear stability of steady sliding",
+            "stickslip_version": __version__,
+            "model": self.model,
+            "max_real_part": self.max_real_part,
+            "max_real_part_units": "1/s",
+            "stable": int(self.stable),
+            "equilibrium_residual": self.residual,
+            "parameters": json.dumps(self.params.to_dict()),
+        }
+        for name, value in self.params.to_dict().items():
+            attrs[f"param_{name}"] = value
+            if PARAMETER_UNITS[name]:
+                attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def linearization(system: System, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Reduced Jacobian, K_L and C_L (Eq. 15) of the slip equations about (q, q̇ = 0).
+
+    Returns
+    -------
+    jacobian : ndarray (2k, 2k)
+    K_L, C_L : ndarray (k, k)
+        −∂Q/∂q and −∂Q/∂q̇ on the free DOFs (Q = Gᵀ F − C q̇ − K q).
+    """
+    free = system.variant.free_indices.astype(np.int64)
+    k = free.size
+    s = np.zeros(12)
+    s[:6] = q
+    cols = np.concatenate([free, 6 + free]).astype(np.int64)
+    dQ = np.empty((6, 2 * k))
+    linearize.force_jacobian(s, system.damp, system.stiff, system.p, cols, dQ)
+    J = linearize.reduced_jacobian(np.asarray(q, dtype=float), free, system.minv, system.damp, system.stiff, system.p)
+    return J, -dQ[free, :k], -dQ[free, k:]
+
+
+def stability(params: Parameters, model="full") -> StabilityResult:
+    """Linear stability of steady sliding (paper Sect. 4.1).
+
+    Finds the equilibrium of Eq. (14), linearises the slip equations about it (Eq. 15) with the
+    exact Jacobian of the simulator's right-hand side (complex-step differentiation, see
+    :mod:`stickslip.stability.linearize`), and takes the eigenvalues.
+
+    Parameters
+    ----------
+    params : Parameters
+    model : str, iterable of DOF names or Variant
+        ``full`` (Model 1), ``x`` (2), ``y`` (3), ``rotation`` (4), or the DOFs to free. The
+        Jacobian is reduced to the free DOFs.
+
+    Returns
+    -------
+    StabilityResult
+
+    Raises
+    ------
+    EquilibriumError
+        No steady sliding (Ω = 0, Newton failure), or a sliding speed |Ω| R at equilibrium
+        inside the simulator's low-speed band, where its slip direction is not v_r/|v_r|.
+    """
+    if not isinstance(params, Parameters):
+        raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
+    system = assemble(params, model)
+    q, residual, _ = solve_equilibrium(system)
+    X = q[0] - q[2] + params.r * math.cos(q[4])
+    Y = q[1] - q[3] + params.r * math.sin(q[4])
+    speed = abs(params.Omega) * math.hypot(X, Y)
+    if speed <= system.p[kernels.P_SLIP_BAND]:
+        raise EquilibriumError(
+            f"sliding speed at equilibrium |Omega| R = {speed:.3g} m/s is inside the simulator's low-speed band "
+            f"({system.p[kernels.P_SLIP_BAND]:g} m/s), where the slip direction is not v_r/|v_r|; increase |Omega|"
+        )
+    J, K_L, C_L = linearization(system, q)
+    lam, vec = np.linalg.eig(J)
+    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
+    lam = lam[order]
+    vec = vec[:, order]
+    free = system.variant.free_indices
+    k = free.size
+    shapes = vec[:k, :].T.copy()
+    for j in range(shapes.shape[0]):
+        m = int(np.argmax(np.abs(shapes[j])))
+        if shapes[j, m] != 0:
+            shapes[j] /= shapes[j, m]
+    return StabilityResult(
+        params=params,
+        model=system.variant.name,
+        dofs=tuple(DOF_NAMES[i] for i in free),
+        equilibrium=q,
+        residual=residual,
+        jacobian=J,
+        stiffness=K_L,
+        damping=C_L,
+        mass=system.mass[free],
+        eigenvalues=lam,
+        mode_shapes=shapes,
+    )

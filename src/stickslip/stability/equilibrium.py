@@ -1,0 +1,128 @@
+"""Steady-sliding equilibrium K x = b(x) (paper Eq. 14, Appendix A.1).
+
+Solved by damped Newton from x = 0 with the exact Jacobian −K_L of the slip right-hand side
+(complex-step differentiation, :mod:`stickslip.stability.linearize`), then checked with the
+simulator's own kernel (:func:`equilibrium_residual`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model import kernels
+from ..model.parameters import Parameters
+from ..model.system import System, assemble
+from . import linearize
+
+__all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "solve_equilibrium", "RESIDUAL_TOL"]
+
+#: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved (Eq. 14). Newton reaches
+#: ~1e-16 (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while
+#: still pinning x far below any physical resolution.
+RESIDUAL_TOL = 1e-10
+
+#: Newton iterations allowed. Converging cases take 3–8 from x = 0 (quadratic convergence);
+#: 60 leaves room for the damped phase of strongly deflected cases.
+MAX_ITER = 60
+
+
+class EquilibriumError(RuntimeError):
+    """No steady-sliding equilibrium could be found."""
+
+
+def equilibrium_residual(system: System, q: np.ndarray) -> np.ndarray:
+    """Force residual K q − Gᵀ F(v_r = Ω(Y, −X)) at rest (q̇ = 0), shape (6,) [N or N m].
+
+    This is −M q̈ of the slip equations at q̇ = 0, evaluated by the simulator's own kernel, so
+    its zero is exactly the steady sliding state the simulator sees. Locked DOFs give 0.
+    """
+    s = np.zeros(12)
+    s[:6] = q
+    ds = np.zeros(12)
+    Fx, Fy = kernels.contact_force(s, kernels.MODE_SLIP, 1.0, 0.0, system.minv, system.damp, system.stiff, system.p)
+    kernels.dynamics(s, Fx, Fy, system.minv, system.damp, system.stiff, system.p, ds)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(system.minv > 0, -ds[6:] / np.where(system.minv > 0, system.minv, 1.0), 0.0)
+
+
+def solve_equilibrium(system: System) -> tuple[np.ndarray, float, int]:
+    """Newton solution of Eq. (14) for an assembled system.
+
+    Returns
+    -------
+    q : ndarray (6,)
+        Equilibrium [m, m, m, m, rad, rad]; locked DOFs are 0.
+    relative_residual : float
+        max|K x − b| / max(|K x|, |b|), evaluated with the simulator's kernel.
+    iterations : int
+
+    Raises
+    ------
+    EquilibriumError
+        See :func:`equilibrium`.
+    """
+    P = system.params
+    if P.Omega == 0.0:
+        raise EquilibriumError(
+            "no steady sliding at Omega = 0: the relative velocity vanishes at rest and the friction "
+            "direction is undefined; choose Omega != 0"
+        )
+    free = system.variant.free_indices.astype(np.int64)
+    q, status, rel, iterations = linearize.newton_equilibrium(free, system.damp, system.stiff, system.p, MAX_ITER)
+    # independent check with the simulator's kernel (not the differentiated copy)
+    res = equilibrium_residual(system, q)[free]
+    scale = max(float(np.max(np.abs(system.stiff[free] * q[free]))),
+                float(np.max(np.abs(system.stiff[free] * q[free] - res))))
+    kernel_rel = 0.0 if not np.any(res) else (float(np.max(np.abs(res))) / scale if scale > 0 else math.inf)
+    if not np.all(np.isfinite(q)) or not (kernel_rel <= RESIDUAL_TOL):
+        X = q[0] - q[2] + P.r * math.cos(q[4])
+        Y = q[1] - q[3] + P.r * math.sin(q[4])
+        reason = {
+            linearize.NEWTON_MAX_ITER: f"Newton did not converge in {MAX_ITER} iterations",
+            linearize.NEWTON_SINGULAR: "the Jacobian K_L became singular (is a free DOF without stiffness?)",
+            linearize.NEWTON_NOT_FINITE: "the iteration produced non-finite values",
+            linearize.NEWTON_NO_DESCENT: "Newton stalled (no step reduces the residual)",
+        }.get(int(status), "the residual check failed")
+        hint = ""
+        if math.hypot(X, Y) < 0.5 * P.r:
+            hint = (f"; the iterate has the contact point at R = {math.hypot(X, Y):.3g} m from the centre O2 "
+                    f"(r = {P.r:g} m): at this large N / small Omega steady sliding probably does not exist")
+        raise EquilibriumError(
+            f"no steady-sliding equilibrium found for N = {P.N:g} N, Omega = {P.Omega:g} rad/s, model "
+            f"{system.variant.name!r}: {reason} (relative residual {max(rel, kernel_rel):.2e} > {RESIDUAL_TOL:g})"
+            f"{hint}"
+        )
+    return q, kernel_rel, int(iterations)
+
+
+def equilibrium(params: Parameters, model="full") -> np.ndarray:
+    """Steady-sliding equilibrium q_e of the free DOFs (locked DOFs are 0), shape (6,).
+
+    Solves K x = b(x) (paper Eq. 14, b from Appendix A.1) by damped Newton from x = 0 with the
+    exact Jacobian and checks the residual with the simulator's kernel.
+
+    Parameters
+    ----------
+    params : Parameters
+    model : str, iterable of DOF names or Variant
+        ``full`` (Model 1), ``x``, ``y``, ``rotation`` (Model 4), or the DOFs to free.
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        [x1, y1, x2, y2, φ, ψ] at equilibrium [m, m, m, m, rad, rad].
+
+    Raises
+    ------
+    EquilibriumError
+        When Ω = 0 (v_r vanishes at rest, the friction direction is undefined: no steady
+        sliding), or when Newton does not reach a relative residual of :data:`RESIDUAL_TOL`
+        (e.g. at large N and small Ω, where the contact point is dragged to the centre of the
+        lower plate and steady sliding ceases to exist).
+    """
+    if not isinstance(params, Parameters):
+        raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
+    q, _, _ = solve_equilibrium(assemble(params, model))
+    return q
