@@ -71,6 +71,14 @@ def solve_equilibrium(system: System) -> tuple[np.ndarray, float, int]:
         )
     free = system.variant.free_indices.astype(np.int64)
     q, status, rel, iterations = linearize.newton_equilibrium(free, system.damp, system.stiff, system.p, MAX_ITER)
+    band = system.p[kernels.P_SLIP_BAND]
+    speed = abs(P.Omega) * math.hypot(q[0] - q[2] + P.r * math.cos(q[4]), q[1] - q[3] + P.r * math.sin(q[4]))
+    if rel <= RESIDUAL_TOL and speed <= band:
+        raise EquilibriumError(
+            f"sliding speed at equilibrium |Omega| R = {speed:.3g} m/s is inside the simulator's low-speed band "
+            f"({band:g} m/s), where its slip direction is not v_r/|v_r| and steady sliding is not an equilibrium "
+            "of the simulated equations; increase |Omega|"
+        )
     # independent check with the simulator's kernel (not the differentiated copy)
     res = equilibrium_residual(system, q)[free]
     scale = max(float(np.max(np.abs(system.stiff[free] * q[free]))),
@@ -120,7 +128,8 @@ def equilibrium(params: Parameters, model="full") -> np.ndarray:
         When Ω = 0 (v_r vanishes at rest, the friction direction is undefined: no steady
         sliding), or when Newton does not reach a relative residual of :data:`RESIDUAL_TOL`
         (e.g. at large N and small Ω, where the contact point is dragged to the centre of the
-        lower plate and steady sliding ceases to exist).
+        lower plate and steady sliding ceases to exist), or when the sliding speed |Ω| R at
+        equilibrium is inside the simulator's low-speed band (``kernels.DEFAULT_SLIP_BAND``).
     """
     if not isinstance(params, Parameters):
         raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..model.kernels import LAW_COULOMB, P_ALPHA, P_DELTA_MU, P_LAW, P_MU_K, P_N, P_OMEGA, P_R
+from ..model.kernels import LAW_COULOMB, P_ALPHA, P_DELTA_MU, P_LAW, P_MU_K, P_N, P_OMEGA, P_R, P_SLIP_BAND
 
 __all__ = ["slip_forces", "slip_rhs", "force_jacobian", "state_jacobian", "newton_equilibrium",
            "reduced_jacobian", "equilibrium_jacobian", "jacobian_grid", "STEP"]
@@ -298,10 +298,16 @@ def newton_equilibrium(free, damp, stiff, p, max_iter):
 def equilibrium_jacobian(free, minv, damp, stiff, p, max_iter, tol, J):
     """Newton equilibrium, then the reduced Jacobian there written into ``J`` (2k×2k).
 
-    Returns True when Newton reached the relative residual ``tol``; otherwise ``J`` is NaN.
+    Returns True when Newton reached the relative residual ``tol`` at a sliding speed above the
+    simulator's low-speed band; otherwise ``J`` is NaN (no steady sliding of the simulated equations).
     """
     q, status, rel, _ = newton_equilibrium(free, damp, stiff, p, max_iter)
-    if not (rel <= tol):
+    r = p[P_R]
+    X = q[0] - q[2] + r * np.cos(q[4])
+    Y = q[1] - q[3] + r * np.sin(q[4])
+    speed = abs(p[P_OMEGA]) * np.sqrt(X * X + Y * Y)
+    # inside the low-speed band the simulator's slip direction is not v_r/|v_r| (kernels.py)
+    if not (rel <= tol) or speed <= p[P_SLIP_BAND]:
         J[:, :] = np.nan
         return False
     J[:, :] = reduced_jacobian(q, free, minv, damp, stiff, p)
