@@ -1,0 +1,28 @@
+"""stickslip: exact 2-D stick-slip simulation of two rigid plates in point frictional contact.
+
+==========================  ==============================================================
+``Parameters``              physical parameters (paper Table 1), validated, TOML I/O
+``simulate``                run a simulation, returns a ``Trajectory``
+``Trajectory``              typed result: samples, modes, forces, transitions, ``.to_xarray()``
+``load_trajectory``         read a run written with ``Trajectory.to_netcdf``
+``equilibrium``             steady-sliding equilibrium (Eq. 14)
+``MODELS``                  the paper's Models 1–4 as free DOFs
+==========================  ==============================================================
+"""
+
+__version__ = "0.1.0"
+
+from .integrate.driver import SimulationError, simulate
+from .integrate.result import FileFormatError, Trajectory, load_trajectory
+from .model.parameters import ParameterError, Parameters
+from .model.variants import DOF_NAMES, MODELS, STATE_NAMES, VariantError
+from .stability.equilibrium import EquilibriumError, equilibrium
+
+__all__ = [
+    "__version__",
+    "Parameters", "ParameterError",
+    "simulate", "SimulationError",
+    "Trajectory", "load_trajectory", "FileFormatError",
+    "equilibrium", "EquilibriumError",
+    "MODELS", "DOF_NAMES", "STATE_NAMES", "VariantError",
+]

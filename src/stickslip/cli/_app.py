@@ -1,0 +1,73 @@
+"""The typer application and helpers shared by the commands."""
+
+from __future__ import annotations
+
+import sys
+from contextlib import contextmanager
+
+import typer
+from rich.console import Console
+
+app = typer.Typer(
+    name="stickslip",
+    help="Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+console = Console()
+err_console = Console(stderr=True)
+
+#: Errors that are the user's to fix: printed as one line, exit code 2.
+USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, FileNotFoundError, RuntimeError)
+
+
+@contextmanager
+def user_errors():
+    """Turn library errors into a one-line message and exit code 2."""
+    try:
+        yield
+    except USER_ERRORS as exc:
+        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        sys.exit(2)
+
+
+def parse_assignments(items: list[str] | None) -> dict:
+    """``["N=50", "friction_law=coulomb"]`` → ``{"N": 50.0, "friction_law": "coulomb"}``."""
+    values: dict = {}
+    for item in items or []:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ValueError(f"--set expects NAME=VALUE, got {item!r}; e.g. --set k_px=400")
+        text = text.strip()
+        try:
+            values[name] = float(text)
+        except ValueError:
+            values[name] = text
+    return values
+
+
+def build_parameters(config, assignments, **named):
+    """Parameters from an optional TOML file, then ``--set`` pairs, then the named options (not None)."""
+    from ..model.parameters import Parameters
+
+    params = Parameters.load_toml(config) if config is not None else Parameters()
+    changes = parse_assignments(assignments)
+    changes.update({k: v for k, v in named.items() if v is not None})
+    return params.replace(**changes) if changes else params
+
+
+def _version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        console.print(f"stickslip {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit."),
+) -> None:
+    """Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact."""

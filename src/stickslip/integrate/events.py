@@ -1,0 +1,151 @@
+"""Transition logic shared by all integrators (DESIGN.md §1, "Transitions").
+
+Event functions are evaluated on a state vector; the root finder works on any callable-free
+"dense output" described by a polynomial ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1]
+(the form of every Runge–Kutta interpolant used here; a linear interpolant is Q with one column).
+
+* slip → stick: ``slip_event`` is the projection of v_r on its direction at the start of the step.
+  A sign change means the 2-D velocity passed (near) zero; at the located root, if |v_r| is below
+  :data:`STICK_SPEED_TOL` and the stick force is admissible (|F| ≤ μs N, Eq. 10), stick begins.
+* stick → slip: ``stick_event`` = μs N − |F_stick|; its root is breakaway (Eq. 10). Slip starts
+  with v_r = 0 in the direction e = −F_stick/|F_stick|, so F is continuous.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ..model import kernels as K
+
+EVENT_SLIP = 0   # slip → stick candidate: v_r · e0
+EVENT_STICK = 1  # stick → slip: μs N − |F_stick|
+
+TRANSITION_TO_STICK = 1
+TRANSITION_TO_SLIP = -1
+
+#: Time resolution [s] to which transition instants are located on the dense output.
+EVENT_TIME_TOL = 1e-12
+
+#: |v_r| [m/s] below which a root of the projected slip velocity counts as v_r = 0. A true
+#: approach to stick reaches |v_r| ~ integration error (≪ 1e-6); a mere turn of the slip
+#: direction keeps |v_r| of the order of the sliding speed (0.1–1 m/s in the paper's cases).
+STICK_SPEED_TOL = 1e-6
+
+#: Sub-intervals of a step on which the event function is sampled for a sign change.
+EVENT_CHECKS = 4
+
+
+@njit(cache=True)
+def dense_state(y0, Q, h, theta, out):
+    """Evaluate ``out = y0 + h Σ_j Q[:, j] θ^(j+1)`` (Horner)."""
+    n, m = Q.shape
+    for i in range(n):
+        acc = Q[i, m - 1]
+        for j in range(m - 2, -1, -1):
+            acc = Q[i, j] + theta * acc
+        out[i] = y0[i] + h * theta * acc
+
+
+@njit(cache=True)
+def event_value(kind, y, e0x, e0y, minv, damp, stiff, p):
+    """Event function of ``kind`` at state ``y`` (see module docstring)."""
+    if kind == EVENT_SLIP:
+        vx, vy = K.relative_velocity(y, p)
+        return vx * e0x + vy * e0y
+    Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
+    return K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy)
+
+
+@njit(cache=True)
+def first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work):
+    """First θ ∈ (0, 1] where the event function turns ≤ 0, located to EVENT_TIME_TOL.
+
+    The function is positive at θ = 0 by construction. Returns -1.0 if no sign change is seen
+    at the EVENT_CHECKS sample points. Root refinement: Illinois regula falsi.
+    """
+    a = 0.0
+    ga = event_value(kind, y0, e0x, e0y, minv, damp, stiff, p)
+    b = -1.0
+    gb = 0.0
+    for j in range(1, EVENT_CHECKS + 1):
+        theta = j / EVENT_CHECKS
+        dense_state(y0, Q, h, theta, work)
+        g = event_value(kind, work, e0x, e0y, minv, damp, stiff, p)
+        if g <= 0.0:
+            b = theta
+            gb = g
+            break
+        a = theta
+        ga = g
+    if b < 0.0:
+        return -1.0
+    tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
+    side = 0
+    for _ in range(200):
+        if gb == 0.0 or (b - a) <= tol:
+            break
+        c = b - gb * (b - a) / (gb - ga)
+        # keep c strictly inside the bracket
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        dense_state(y0, Q, h, c, work)
+        gc = event_value(kind, work, e0x, e0y, minv, damp, stiff, p)
+        if gc > 0.0:
+            a, ga = c, gc
+            if side == 1:  # Illinois: the same end moved twice, halve the other end's value
+                gb *= 0.5
+            side = 1
+        else:
+            b, gb = c, gc
+            if side == -1:
+                ga *= 0.5
+            side = -1
+    return b
+
+
+@njit(cache=True)
+def breakaway_direction(Fx, Fy):
+    """Slip direction at breakaway e = −F_stick/|F_stick| (DESIGN.md §1)."""
+    norm = math.sqrt(Fx * Fx + Fy * Fy)
+    if norm == 0.0:
+        return 1.0, 0.0
+    return -Fx / norm, -Fy / norm
+
+
+@njit(cache=True)
+def try_stick(y, minv, damp, stiff, p):
+    """At a zero of the slip velocity: project and test stick admissibility (Eq. 10).
+
+    On success ``y`` is projected onto v_r = 0 in place and ``(True, ex, ey)`` is returned; else
+    ``y`` is left as it is and the breakaway direction of the inadmissible stick force is
+    returned, along which slip continues.
+    """
+    vx, vy = K.relative_velocity(y, p)
+    if math.sqrt(vx * vx + vy * vy) > STICK_SPEED_TOL:
+        return False, 0.0, 0.0
+    saved = y[6:12].copy()
+    K.project_velocity(y, minv, p)
+    Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
+    if math.sqrt(Fx * Fx + Fy * Fy) <= K.static_limit(p):
+        return True, 0.0, 0.0
+    y[6:12] = saved
+    ex, ey = breakaway_direction(Fx, Fy)
+    return False, ex, ey
+
+
+@njit(cache=True)
+def initial_mode(y, minv, damp, stiff, p):
+    """Mode a state starts in: stick if v_r = 0 (to STICK_SPEED_TOL) and stick is admissible.
+
+    Returns (mode, ex, ey); in slip, (ex, ey) is the direction used while |v_r| is ~0.
+    """
+    stick, ex, ey = try_stick(y, minv, damp, stiff, p)
+    if stick:
+        return K.MODE_STICK, 0.0, 0.0
+    vx, vy = K.relative_velocity(y, p)
+    speed = math.sqrt(vx * vx + vy * vy)
+    if speed > K.SPEED_FLOOR:
+        return K.MODE_SLIP, vx / speed, vy / speed
+    return K.MODE_SLIP, ex, ey

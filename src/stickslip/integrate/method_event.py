@@ -1,0 +1,311 @@
+"""The ``event`` integrator: adaptive Dormand–Prince 5(4) with exact stick and located transitions.
+
+One compiled loop (no Python per step):
+
+* slip: Eq. (1) with the slip force Eq. (3); stick: all 12 states with the exact stick
+  multiplier (DESIGN.md §1), q̇ re-projected onto v_r = 0 after each step to remove drift;
+* error control on the free DOFs with ``rtol``/``atol`` (RMS norm, as scipy's RK45);
+* transitions located on the 4th-order dense output to ``events.EVENT_TIME_TOL``; a step
+  whose dense output shows slip velocity through zero is re-taken to end at the root, so no
+  stage ever straddles the non-smooth point;
+* uniform samples written from the dense output.
+
+State layout inside the loop: 12 physical states, then the accumulated work of friction and of
+damping [J] (``kernels.dynamics``), integrated with the same steps as quadratures.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..model import kernels as K
+from . import events as E
+
+N_STATE = 14  # 12 states + work of friction + work of damping
+
+STATUS_OK = 0
+STATUS_STEP_UNDERFLOW = 1
+STATUS_NOT_FINITE = 2
+STATUS_MAX_STEPS = 3
+
+# Dormand–Prince 5(4) tableau and 4th-order dense output (Dormand & Prince 1980; Shampine 1986),
+# the coefficients used by scipy.integrate.RK45.
+_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
+_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
+])
+_B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
+_E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
+_P = np.array([
+    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
+    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
+    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
+    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
+    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
+])
+
+SAFETY = 0.9        # standard step-size safety factor
+MIN_FACTOR = 0.2    # largest step reduction after a rejection
+MAX_FACTOR = 5.0    # largest step growth after an acceptance
+MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick root
+
+
+@njit(cache=True)
+def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
+    """One Dormand–Prince step from y (with k1 = f(y) in Kst[0]); fills Kst[1:7] and ynew."""
+    n = y.shape[0]
+    for i in range(n):
+        Kst[0, i] = k1[i]
+    for s in range(1, 6):
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += _A[s, j] * Kst[j, i]
+            ytmp[i] = y[i] + h * acc
+        K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, Kst[s])
+    for i in range(n):
+        acc = 0.0
+        for j in range(6):
+            acc += _B[j] * Kst[j, i]
+        ynew[i] = y[i] + h * acc
+    K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
+
+
+@njit(cache=True)
+def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
+    """RMS of the embedded error estimate over the free DOFs' positions and velocities."""
+    total = 0.0
+    count = 0
+    for d in range(6):
+        if minv[d] == 0.0:
+            continue
+        for i in (d, d + 6):
+            err = 0.0
+            for j in range(7):
+                err += _E[j] * Kst[j, i]
+            err *= h
+            scale = atol + rtol * max(abs(y[i]), abs(ynew[i]))
+            total += (err / scale) ** 2
+            count += 1
+    if count == 0:
+        return 0.0
+    return math.sqrt(total / count)
+
+
+@njit(cache=True)
+def _dense_coefficients(Kst, Q):
+    """Q = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ."""
+    n = Q.shape[0]
+    for i in range(n):
+        for c in range(4):
+            acc = 0.0
+            for j in range(7):
+                acc += Kst[j, i] * _P[j, c]
+            Q[i, c] = acc
+
+
+@njit(cache=True)
+def _write_samples(idx, t_from, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff, p,
+                   sample_times, out_s, out_mode, out_F, work):
+    """Write the samples with t_from < t ≤ t_to (within the step starting at t_step)."""
+    n_samples = sample_times.shape[0]
+    while idx < n_samples and sample_times[idx] <= t_to:
+        ts = sample_times[idx]
+        if ts >= t_from:
+            theta = (ts - t_step) / h if h > 0.0 else 0.0
+            E.dense_state(y0, Q, h, theta, work)
+            for i in range(work.shape[0]):
+                out_s[idx, i] = work[i]
+            out_mode[idx] = mode
+            Fx, Fy = K.contact_force(work, mode, ex, ey, minv, damp, stiff, p)
+            out_F[idx, 0] = Fx
+            out_F[idx, 1] = Fy
+        idx += 1
+    return idx
+
+
+@njit(cache=True)
+def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
+    """Append a transition, growing the buffers when full; returns the (possibly new) buffers."""
+    if n == tr_t.shape[0]:
+        cap = 2 * n + 16
+        new_t = np.empty(cap)
+        new_kind = np.empty(cap, dtype=np.int8)
+        new_s = np.empty((cap, tr_s.shape[1]))
+        new_t[:n] = tr_t[:n]
+        new_kind[:n] = tr_kind[:n]
+        new_s[:n] = tr_s[:n]
+        tr_t, tr_kind, tr_s = new_t, new_kind, new_s
+    tr_t[n] = t
+    tr_kind[n] = kind
+    for i in range(tr_s.shape[1]):
+        tr_s[n, i] = y[i]
+    return tr_t, tr_kind, tr_s
+
+
+@njit(cache=True)
+def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_max, max_steps,
+                    sample_times, out_s, out_mode, out_F):
+    """Integrate from ``y0`` (length N_STATE) over [t0, t_end]; see the module docstring.
+
+    Returns
+    -------
+    status : int
+    t : float
+        Time reached.
+    y : ndarray (N_STATE,)
+        Final state.
+    mode, ex, ey :
+        Final mode and stored slip direction.
+    tr_t, tr_kind, tr_s :
+        Transition instants [s], kinds (+1 to stick, −1 to slip) and states (trimmed).
+    stats : ndarray (6,) int64
+        accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
+        slip → stick transitions, stick → slip transitions.
+    """
+    n = y0.shape[0]
+    y = y0.copy()
+    ynew = np.empty(n)
+    ytmp = np.empty(n)
+    work = np.empty(n)
+    Kst = np.empty((7, n))
+    Q = np.empty((n, 4))
+    k1 = np.empty(n)
+    tr_t = np.empty(16)
+    tr_kind = np.empty(16, dtype=np.int8)
+    tr_s = np.empty((16, n))
+    n_tr = 0
+    stats = np.zeros(6, dtype=np.int64)
+
+    mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
+    K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+    stats[2] += 1
+    t = t0
+    h = min(h_init, h_max)
+    idx = 0
+    # samples at exactly t0
+    while idx < sample_times.shape[0] and sample_times[idx] <= t0:
+        for i in range(n):
+            out_s[idx, i] = y[i]
+        out_mode[idx] = mode
+        Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
+        out_F[idx, 0] = Fx
+        out_F[idx, 1] = Fy
+        idx += 1
+
+    status = STATUS_OK
+    retakes = 0
+    n_steps = 0
+    while t < t_end:
+        if n_steps >= max_steps:
+            status = STATUS_MAX_STEPS
+            break
+        n_steps += 1
+        h = min(h, h_max, t_end - t)
+        if h <= 1e-14 * max(1.0, abs(t)):  # below round-off of t: no progress possible
+            status = STATUS_STEP_UNDERFLOW
+            break
+        _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp)
+        stats[2] += 6
+        err = _error_norm(y, ynew, Kst, h, minv, rtol, atol)
+        if not math.isfinite(err):
+            if h < 1e-10:
+                status = STATUS_NOT_FINITE
+                break
+            h *= MIN_FACTOR
+            stats[1] += 1
+            continue
+        if err > 1.0:
+            h *= max(MIN_FACTOR, SAFETY * err ** -0.2)
+            stats[1] += 1
+            retakes = 0
+            continue
+        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** -0.2)
+        _dense_coefficients(Kst, Q)
+
+        if mode == K.MODE_SLIP:
+            vx, vy = K.relative_velocity(y, p)
+            speed = math.sqrt(vx * vx + vy * vy)
+            theta = -1.0
+            if speed > K.SPEED_FLOOR:  # just after breakaway (v_r = 0) there is nothing to detect
+                theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, vx / speed, vy / speed,
+                                         minv, damp, stiff, p, work)
+            if theta > 0.0 and (1.0 - theta) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
+                # the slip velocity passes zero inside the step: re-take it to end at the root
+                h *= theta
+                retakes += 1
+                stats[3] += 1
+                continue
+            idx = _write_samples(idx, t, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                                 sample_times, out_s, out_mode, out_F, work)
+            t += h
+            for i in range(n):
+                y[i] = ynew[i]
+            stats[0] += 1
+            ex, ey = K.slip_direction(y, ex, ey, minv, damp, stiff, p)
+            if theta > 0.0 or retakes > 0:
+                stick, nex, ney = E.try_stick(y, minv, damp, stiff, p)
+                if stick:
+                    mode = K.MODE_STICK
+                    stats[4] += 1
+                    tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_STICK, y, tr_t, tr_kind, tr_s)
+                    n_tr += 1
+                    K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+                    stats[2] += 1
+                elif nex != 0.0 or ney != 0.0:
+                    ex, ey = nex, ney  # slip goes on through v_r ≈ 0 along the breakaway direction
+                    for i in range(n):
+                        k1[i] = Kst[6, i]
+                else:
+                    for i in range(n):
+                        k1[i] = Kst[6, i]
+            else:
+                for i in range(n):
+                    k1[i] = Kst[6, i]
+            retakes = 0
+        else:
+            theta = E.first_crossing(E.EVENT_STICK, y, Q, h, 0.0, 0.0, minv, damp, stiff, p, work)
+            if theta > 0.0:
+                # breakaway inside the step: the stick flow is smooth, so cut the step at the root
+                t_root = t + theta * h
+                idx = _write_samples(idx, t, t_root, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                                     sample_times, out_s, out_mode, out_F, work)
+                E.dense_state(y, Q, h, theta, work)
+                for i in range(n):
+                    y[i] = work[i]
+                K.project_velocity(y, minv, p)
+                t = t_root
+                Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
+                ex, ey = E.breakaway_direction(Fx, Fy)
+                mode = K.MODE_SLIP
+                stats[5] += 1
+                tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_SLIP, y, tr_t, tr_kind, tr_s)
+                n_tr += 1
+            else:
+                idx = _write_samples(idx, t, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                                     sample_times, out_s, out_mode, out_F, work)
+                t += h
+                for i in range(n):
+                    y[i] = ynew[i]
+                K.project_velocity(y, minv, p)  # remove constraint drift
+            stats[0] += 1
+            K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+            stats[2] += 1
+        for i in range(n):
+            if not math.isfinite(y[i]):
+                status = STATUS_NOT_FINITE
+        if status != STATUS_OK:
+            break
+        h *= factor
+    return (status, t, y, mode, ex, ey, tr_t[:n_tr].copy(), tr_kind[:n_tr].copy(),
+            tr_s[:n_tr].copy(), stats)

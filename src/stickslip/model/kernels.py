@@ -1,0 +1,330 @@
+"""Compiled model kernels (numba), shared by every integrator and by the analysis.
+
+All kernels are module-level functions on flat float64 arrays:
+
+``s``      state (≥ 12): q = [x1, y1, x2, y2, φ, ψ] then dq/dt; extra entries are ignored.
+``minv``   (6,) inverse masses/inertias, 0 for a locked DOF (DESIGN.md §1.1).
+``damp``   (6,) viscous damping, diagonal of C.
+``stiff``  (6,) stiffness, diagonal of K.
+``p``      (8,) contact and friction data, indexed by the ``P_*`` constants.
+
+The model in matrix form (DESIGN.md §1): M q̈ = f + Gᵀ F, f = −C q̇ − K q, with the 2×6
+contact Jacobian
+
+    G = [[1, 0, −1,  0, −r sin φ,  Y],
+         [0, 1,  0, −1,  r cos φ, −X]],
+
+X = x1 − x2 + r cos φ, Y = y1 − y2 + r sin φ, and relative velocity v_r = G q̇ + Ω (Y, −X)
+(paper Eq. 9). Gᵀ F reproduces the right-hand sides of Eq. (1).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# Indices into the packed contact/friction array ``p``.
+P_R, P_N, P_OMEGA, P_MU_K, P_DELTA_MU, P_ALPHA, P_LAW, P_SLIP_BAND = range(8)
+N_P = 8
+LAW_EXPONENTIAL = 0  # paper Eq. (4)
+LAW_COULOMB = 1      # μ = μk in slip, μs = μk + Δμ in stick
+
+MODE_SLIP = 0
+MODE_STICK = 1
+
+#: Speed [m/s] below which v_r counts as exactly zero (round-off after projection, ~1e-16 of
+#: the sliding speed Ω r of the paper's cases, is far below it).
+SPEED_FLOOR = 1e-13
+
+#: Default low-speed band [m/s]: below it the slip direction is the quasi-static one
+#: (:func:`quasi_static_direction`) instead of v_r/|v_r|. Near v_r = 0 the direction of 2-D
+#: friction relaxes on the time scale |v_r| / (λ μ N) → 0 (a stiff mode that forces explicit
+#: steps of that size); inside the band the direction sits on its slow manifold, an O(|v_r|)
+#: approximation. Measured at Ω = 0.5 rad/s, N = 30/50/70 N (100 s, rtol 1e-8): bands 1e-4 and
+#: 1e-5 give steady frequencies equal to 1e-8 relative, 1e-4 with half the steps, and stays
+#: robust at rtol = 1e-6 where 1e-5 needs 20x more steps (docs/numerics.md).
+DEFAULT_SLIP_BAND = 1e-4
+
+#: Relative size below which the smaller eigenvalue of G M⁻¹ Gᵀ counts as zero (rank 1,
+#: DESIGN.md §1.2). In Model 4 it is exactly 0 up to round-off (~1e-16 relative).
+RANK_TOL = 1e-10
+
+
+@njit(cache=True)
+def contact_position(s, p):
+    """Contact point relative to O2, (X, Y) [m] (paper Eq. 2 components)."""
+    r = p[P_R]
+    return s[0] - s[2] + r * math.cos(s[4]), s[1] - s[3] + r * math.sin(s[4])
+
+
+@njit(cache=True)
+def relative_velocity(s, p):
+    """Relative velocity v_r of the upper plate against the lower one at the contact, Eq. (9) [m/s]."""
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    X = s[0] - s[2] + r * cphi
+    Y = s[1] - s[3] + r * sphi
+    w = p[P_OMEGA] + s[11]
+    vx = s[6] - s[8] - r * sphi * s[10] + w * Y
+    vy = s[7] - s[9] + r * cphi * s[10] - w * X
+    return vx, vy
+
+
+@njit(cache=True)
+def friction_coefficient(speed, p):
+    """Kinetic friction coefficient μ(|v_r|) [-]: Eq. (4), or μk for the Coulomb law."""
+    if p[P_LAW] == LAW_COULOMB:
+        return p[P_MU_K]
+    return p[P_MU_K] + p[P_DELTA_MU] * math.exp(-p[P_ALPHA] * speed)
+
+
+@njit(cache=True)
+def static_limit(p):
+    """Largest admissible stick force μs N [N], Eq. (10)."""
+    return (p[P_MU_K] + p[P_DELTA_MU]) * p[P_N]
+
+
+@njit(cache=True)
+def slip_force(speed, dx, dy, p):
+    """Slip friction force F = −μ(|v_r|) N e along the unit slip direction e = (dx, dy), Eq. (3) [N]."""
+    scale = -friction_coefficient(speed, p) * p[P_N]
+    return scale * dx, scale * dy
+
+
+@njit(cache=True)
+def solve_psd_2x2(a11, a12, a22, b1, b2):
+    """Minimal-norm solution of the symmetric positive semi-definite system A x = b.
+
+    Full rank: the exact inverse. Rank 1 (smaller eigenvalue below RANK_TOL of the larger,
+    Model 4): x = u (u·b)/λ1 along the eigenvector u of the non-zero eigenvalue λ1.
+    Rank 0: x = 0. Returns (x1, x2, rank).
+    """
+    tr = a11 + a22
+    if tr <= 0.0:
+        return 0.0, 0.0, 0
+    half_gap = math.sqrt(0.25 * (a11 - a22) ** 2 + a12 * a12)
+    lam1 = 0.5 * tr + half_gap
+    lam2 = 0.5 * tr - half_gap
+    if lam2 > RANK_TOL * lam1:
+        det = a11 * a22 - a12 * a12
+        return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det, 2
+    # eigenvector of lam1: choose the better conditioned of the two row forms
+    u1, u2 = a12, lam1 - a11
+    w1, w2 = lam1 - a22, a12
+    if w1 * w1 + w2 * w2 > u1 * u1 + u2 * u2:
+        u1, u2 = w1, w2
+    norm2 = u1 * u1 + u2 * u2
+    if norm2 == 0.0:  # A = lam1 * I_1 along an axis (a12 = 0, one diagonal entry zero)
+        if a11 >= a22:
+            u1, u2, norm2 = 1.0, 0.0, 1.0
+        else:
+            u1, u2, norm2 = 0.0, 1.0, 1.0
+    c = (u1 * b1 + u2 * b2) / (lam1 * norm2)
+    return c * u1, c * u2, 1
+
+
+@njit(cache=True)
+def constraint_metric(s, minv, p):
+    """Entries (a11, a12, a22) of A = G M⁻¹ Gᵀ (2×2, symmetric PSD) [1/kg]."""
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    X = s[0] - s[2] + r * cphi
+    Y = s[1] - s[3] + r * sphi
+    a11 = minv[0] + minv[2] + minv[4] * (r * sphi) ** 2 + minv[5] * Y * Y
+    a12 = -minv[4] * r * r * sphi * cphi - minv[5] * X * Y
+    a22 = minv[1] + minv[3] + minv[4] * (r * cphi) ** 2 + minv[5] * X * X
+    return a11, a12, a22
+
+
+@njit(cache=True)
+def stick_force(s, minv, damp, stiff, p):
+    """Friction force that keeps v_r = 0, the Lagrange multiplier of the stick constraint [N].
+
+    From dv_r/dt = G q̈ + h = 0 with M q̈ = f + Gᵀ F (DESIGN.md §1):
+    (G M⁻¹ Gᵀ) F = −(h + G M⁻¹ f), h = Ġ q̇ + Ω d(Y, −X)/dt, solved minimal-norm (rank-1 safe).
+    Returns (Fx, Fy, rank).
+    """
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    X = s[0] - s[2] + r * cphi
+    Y = s[1] - s[3] + r * sphi
+    dphi = s[10]
+    dX = s[6] - s[8] - r * sphi * dphi
+    dY = s[7] - s[9] + r * cphi * dphi
+    w = p[P_OMEGA] + s[11]
+    h1 = -r * cphi * dphi * dphi + w * dY
+    h2 = -r * sphi * dphi * dphi - w * dX
+    # a = M⁻¹ f (accelerations without friction)
+    a0 = minv[0] * (-damp[0] * s[6] - stiff[0] * s[0])
+    a1 = minv[1] * (-damp[1] * s[7] - stiff[1] * s[1])
+    a2 = minv[2] * (-damp[2] * s[8] - stiff[2] * s[2])
+    a3 = minv[3] * (-damp[3] * s[9] - stiff[3] * s[3])
+    a4 = minv[4] * (-damp[4] * s[10] - stiff[4] * s[4])
+    a5 = minv[5] * (-damp[5] * s[11] - stiff[5] * s[5])
+    g1 = a0 - a2 - r * sphi * a4 + Y * a5
+    g2 = a1 - a3 + r * cphi * a4 - X * a5
+    a11, a12, a22 = constraint_metric(s, minv, p)
+    return solve_psd_2x2(a11, a12, a22, -(h1 + g1), -(h2 + g2))
+
+
+@njit(cache=True)
+def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
+    """Time derivative of the state under friction force (Fx, Fy), Eq. (1) as M q̈ = f + Gᵀ F.
+
+    Writes ``ds[0:12]``; if ``len(ds) >= 14`` also the power of friction on the plates,
+    F·(G q̇) [W], into ``ds[12]`` and the (negative) damping power −q̇ᵀ C q̇ [W] into ``ds[13]``,
+    so that integrating them gives the energy balance ΔE = W_friction + W_damping.
+    """
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    X = s[0] - s[2] + r * cphi
+    Y = s[1] - s[3] + r * sphi
+    # generalised friction forces Gᵀ F
+    Q0 = Fx
+    Q1 = Fy
+    Q2 = -Fx
+    Q3 = -Fy
+    Q4 = r * (-sphi * Fx + cphi * Fy)
+    Q5 = Y * Fx - X * Fy
+    for i in range(6):
+        ds[i] = s[6 + i]
+    ds[6] = minv[0] * (Q0 - damp[0] * s[6] - stiff[0] * s[0])
+    ds[7] = minv[1] * (Q1 - damp[1] * s[7] - stiff[1] * s[1])
+    ds[8] = minv[2] * (Q2 - damp[2] * s[8] - stiff[2] * s[2])
+    ds[9] = minv[3] * (Q3 - damp[3] * s[9] - stiff[3] * s[3])
+    ds[10] = minv[4] * (Q4 - damp[4] * s[10] - stiff[4] * s[4])
+    ds[11] = minv[5] * (Q5 - damp[5] * s[11] - stiff[5] * s[5])
+    if ds.shape[0] >= 14:
+        power_friction = 0.0
+        power_damping = 0.0
+        for i, Q in enumerate((Q0, Q1, Q2, Q3, Q4, Q5)):
+            if minv[i] != 0.0:
+                power_friction += Q * s[6 + i]
+                power_damping -= damp[i] * s[6 + i] * s[6 + i]
+        ds[12] = power_friction
+        ds[13] = power_damping
+
+
+@njit(cache=True)
+def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
+    """Slip direction e on the slow manifold of the direction dynamics at |v_r| → 0.
+
+    With F = −μ N e, dv_r/dt = −A (μ N e + F_s), A = G M⁻¹ Gᵀ, F_s the stick force. The
+    direction angle θ obeys θ̇ = −g(θ)/|v_r| with g = e × A (μ N e + F_s), so for small |v_r| it
+    sits at a stable root g = 0 (g' > 0), where v_r grows or shrinks along e itself. At breakaway
+    e = −F_s/|F_s| is such a root. Newton from the previous direction (ex, ey).
+    """
+    a11, a12, a22 = constraint_metric(s, minv, p)
+    Fx, Fy, _ = stick_force(s, minv, damp, stiff, p)
+    wx = a11 * Fx + a12 * Fy
+    wy = a12 * Fx + a22 * Fy
+    vx, vy = relative_velocity(s, p)
+    muN = friction_coefficient(math.sqrt(vx * vx + vy * vy), p) * p[P_N]
+    theta = math.atan2(ey, ex)
+    for _ in range(8):
+        c2 = math.cos(2.0 * theta)
+        s2 = math.sin(2.0 * theta)
+        c = math.cos(theta)
+        sn = math.sin(theta)
+        g = muN * (a12 * c2 + 0.5 * (a22 - a11) * s2) + (c * wy - sn * wx)
+        dg = muN * (-2.0 * a12 * s2 + (a22 - a11) * c2) - (c * wx + sn * wy)
+        if dg <= 0.0:  # not near a stable root: keep the previous direction
+            break
+        step = g / dg
+        theta -= step
+        if abs(step) < 1e-14:  # converged to round-off of an angle
+            break
+    return math.cos(theta), math.sin(theta)
+
+
+@njit(cache=True)
+def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
+    """Friction force in the given mode [N]: the stick multiplier, or Eq. (3) in slip.
+
+    The slip direction is v_r/|v_r| above the low-speed band ``p[P_SLIP_BAND]`` and the
+    quasi-static direction inside it, found from the last known direction ``(ex, ey)``.
+    """
+    if mode == MODE_STICK:
+        Fx, Fy, _ = stick_force(s, minv, damp, stiff, p)
+        return Fx, Fy
+    vx, vy = relative_velocity(s, p)
+    speed = math.sqrt(vx * vx + vy * vy)
+    if speed > p[P_SLIP_BAND]:
+        return slip_force(speed, vx / speed, vy / speed, p)
+    dx, dy = quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
+    return slip_force(speed, dx, dy, p)
+
+
+@njit(cache=True)
+def slip_direction(s, ex, ey, minv, damp, stiff, p):
+    """Unit slip direction: v_r/|v_r| above the low-speed band, the quasi-static one inside."""
+    vx, vy = relative_velocity(s, p)
+    speed = math.sqrt(vx * vx + vy * vy)
+    if speed > p[P_SLIP_BAND]:
+        return vx / speed, vy / speed
+    return quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
+
+
+@njit(cache=True)
+def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
+    """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N]."""
+    Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
+    dynamics(s, Fx, Fy, minv, damp, stiff, p, ds)
+    return Fx, Fy
+
+
+@njit(cache=True)
+def project_velocity(s, minv, p):
+    """Project q̇ onto v_r = 0 in the M-metric, in place (DESIGN.md §1).
+
+    Δq̇ = −M⁻¹ Gᵀ (G M⁻¹ Gᵀ)⁺ v_r, the smallest kinetic-energy change that removes v_r;
+    locked DOFs (zero inverse mass) are not touched.
+    """
+    vx, vy = relative_velocity(s, p)
+    a11, a12, a22 = constraint_metric(s, minv, p)
+    l1, l2, _ = solve_psd_2x2(a11, a12, a22, vx, vy)
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    X = s[0] - s[2] + r * cphi
+    Y = s[1] - s[3] + r * sphi
+    s[6] -= minv[0] * l1
+    s[7] -= minv[1] * l2
+    s[8] += minv[2] * l1
+    s[9] += minv[3] * l2
+    s[10] -= minv[4] * r * (-sphi * l1 + cphi * l2)
+    s[11] -= minv[5] * (Y * l1 - X * l2)
+
+
+@njit(cache=True)
+def mechanical_energy(s, minv, stiff):
+    """Kinetic plus elastic energy of the free DOFs, ½ q̇ᵀ M q̇ + ½ qᵀ K q [J]."""
+    e = 0.0
+    for i in range(6):
+        if minv[i] != 0.0:
+            e += 0.5 * s[6 + i] * s[6 + i] / minv[i] + 0.5 * stiff[i] * s[i] * s[i]
+    return e
+
+
+@njit(cache=True)
+def sliding_angle(s, p):
+    """Angle of v_r against the circumferential sliding direction −e_n2 [rad] (Fig. 11).
+
+    e_n2 = (−Y, X)/R is the direction of motion of the lower plate's surface at the contact
+    (Eq. 8); in steady sliding v_r = −Ω R e_n2, so the angle is 0 there, and it is always 0 in
+    the reduced model. Positive counter-clockwise; NaN when v_r = 0 (stick).
+    """
+    vx, vy = relative_velocity(s, p)
+    X, Y = contact_position(s, p)
+    # reference direction −e_n2 = (Y, −X)/R
+    dot = vx * Y - vy * X
+    cross = Y * vy + X * vx  # (Y, −X) × (vx, vy) = Y vy + X vx
+    if vx == 0.0 and vy == 0.0:
+        return np.nan
+    return math.atan2(cross, dot)
