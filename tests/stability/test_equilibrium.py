@@ -78,3 +78,16 @@ def test_bad_params_type():
         equilibrium({"N": 50})
     with pytest.raises(stickslip.VariantError):
         equilibrium(Parameters(), model="nonsense")
+
+
+def test_continuation_finds_the_equilibrium_near_the_fold():
+    # N = 178 N, Omega = 0.5 rad/s: an equilibrium exists (the branch from N = 0 folds at
+    # N ≈ 184.5 N) but Newton from x = 0 stalls; the load continuation reaches it
+    P = Parameters(N=178.0, Omega=0.5)
+    system = assemble(P)
+    q = equilibrium(P)
+    res = equilibrium_residual(system, q)
+    assert np.max(np.abs(res)) <= RESIDUAL_TOL * np.max(np.abs(system.stiff * q))
+    # the neighbours on the same branch, found by plain Newton, bracket it smoothly
+    q_lo, q_hi = equilibrium(Parameters(N=177.0, Omega=0.5)), equilibrium(Parameters(N=179.0, Omega=0.5))
+    assert np.all(np.abs(q - 0.5 * (q_lo + q_hi)) < 0.05 * np.abs(q_hi - q_lo) + 1e-12)

@@ -1,7 +1,8 @@
 """Steady-sliding equilibrium K x = b(x) (paper Eq. 14, Appendix A.1).
 
 Solved by damped Newton from x = 0 with the exact Jacobian −K_L of the slip right-hand side
-(complex-step differentiation, :mod:`stickslip.stability.linearize`), then checked with the
+(complex-step differentiation, :mod:`stickslip.stability.linearize`) — with continuation in the
+load N as a fallback near the fold where steady sliding ceases to exist — then checked with the
 simulator's own kernel (:func:`equilibrium_residual`).
 """
 
@@ -23,8 +24,8 @@ __all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "solve_equ
 #: still pinning x far below any physical resolution.
 RESIDUAL_TOL = 1e-10
 
-#: Newton iterations allowed. Converging cases take 3–8 from x = 0 (quadratic convergence);
-#: 60 leaves room for the damped phase of strongly deflected cases.
+#: Newton iterations allowed per solve. Converging cases take 3–8 from x = 0 (quadratic
+#: convergence); 60 leaves room for the damped phase of strongly deflected cases.
 MAX_ITER = 60
 
 
@@ -96,7 +97,9 @@ def solve_equilibrium(system: System) -> tuple[np.ndarray, float, int]:
         hint = ""
         if math.hypot(X, Y) < 0.5 * P.r:
             hint = (f"; the iterate has the contact point at R = {math.hypot(X, Y):.3g} m from the centre O2 "
-                    f"(r = {P.r:g} m): at this large N / small Omega steady sliding probably does not exist")
+                    f"(r = {P.r:g} m): the friction load mu N drags the contact point onto the centre of the "
+                    "lower plate and steady sliding does not exist beyond that load (a fold of Eq. 14); "
+                    "reduce N or mu")
         raise EquilibriumError(
             f"no steady-sliding equilibrium found for N = {P.N:g} N, Omega = {P.Omega:g} rad/s, model "
             f"{system.variant.name!r}: {reason} (relative residual {max(rel, kernel_rel):.2e} > {RESIDUAL_TOL:g})"
@@ -109,7 +112,8 @@ def equilibrium(params: Parameters, model="full") -> np.ndarray:
     """Steady-sliding equilibrium q_e of the free DOFs (locked DOFs are 0), shape (6,).
 
     Solves K x = b(x) (paper Eq. 14, b from Appendix A.1) by damped Newton from x = 0 with the
-    exact Jacobian and checks the residual with the simulator's kernel.
+    exact Jacobian (falling back to continuation in N from a fraction of the load when Newton
+    from 0 stalls) and checks the residual with the simulator's kernel.
 
     Parameters
     ----------

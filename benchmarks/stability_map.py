@@ -1,0 +1,130 @@
+"""Benchmark: (N, Ω) stability maps (paper Figs. 3, 4).
+
+1. A 200 × 200 (N, Ω) map of the largest real part of the eigenvalues (goal ≤ 10 s, one core).
+2. Boundary curves Ω_c(N) by brentq for five family members (goal ≤ 5 s).
+3. A baseline in the same run: scipy ``root`` (hybr) on the simulator kernel's residual for the
+   equilibrium, a central-difference Jacobian of the kernel and ``numpy.linalg.eigvals``, per
+   point on a subset, to give the speed-up ratio of the compiled Newton + complex-step path.
+
+Run: ``python benchmarks/stability_map.py``; writes benchmarks/results/stability_map.json.
+"""
+
+import os
+
+# one core: set before numpy/numba load their thread pools
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ[var] = "1"
+
+import json  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+from scipy import optimize  # noqa: E402
+
+import stickslip  # noqa: E402
+from stickslip import Parameters  # noqa: E402
+from stickslip.model import assemble, kernels  # noqa: E402
+from stickslip.stability import stability_map  # noqa: E402
+from stickslip.stability.equilibrium import equilibrium_residual  # noqa: E402
+
+GOAL_MAP_S = 10.0
+GOAL_BOUNDARY_S = 5.0
+
+
+def baseline_point(system, N, Omega):
+    """max Re λ the straightforward way: scipy root + finite differences + numpy eigvals."""
+    P = system.params.replace(N=N, Omega=Omega)
+    sy = assemble(P, system.variant)
+    free = sy.variant.free_indices
+
+    def residual(x):
+        q = np.zeros(6)
+        q[free] = x
+        return equilibrium_residual(sy, q)[free]
+
+    sol = optimize.root(residual, np.zeros(free.size), method="hybr", options={"xtol": 1e-14})
+    s0 = np.zeros(12)
+    s0[free] = sol.x
+
+    def f(s):
+        ds = np.zeros(12)
+        kernels.rhs(s, kernels.MODE_SLIP, 1.0, 0.0, sy.minv, sy.damp, sy.stiff, sy.p, ds)
+        return ds
+
+    idx = np.concatenate([free, 6 + free])
+    J = np.zeros((idx.size, idx.size))
+    for b, j in enumerate(idx):
+        e = np.zeros(12)
+        e[j] = 1e-6
+        J[:, b] = ((f(s0 + e) - f(s0 - e)) / 2e-6)[idx]
+    return float(np.max(np.linalg.eigvals(J).real))
+
+
+def main():
+    P = Parameters()
+    N = np.linspace(2.0, 200.0, 200)
+    W = np.linspace(0.2, 20.0, 200)
+
+    t = time.perf_counter()
+    stability_map(P, N[:3], W[:3], family=("delta_mu", [0.1]))  # numba compile / cache load
+    compile_s = time.perf_counter() - t
+
+    t = time.perf_counter()
+    smap = stability_map(P, N, W, boundary=False)
+    map_s = time.perf_counter() - t
+
+    fam = ("delta_mu", [0.05, 0.1, 0.15, 0.2, 0.3])
+    Nb = np.linspace(2.0, 200.0, 100)
+    Wb = np.linspace(0.2, 20.0, 40)
+    t = time.perf_counter()
+    bmap = stability_map(P, Nb, Wb, family=fam, boundary=True)
+    boundary_s = time.perf_counter() - t
+    n_roots = int(np.isfinite(bmap.boundary).sum())
+
+    system = assemble(P)
+    rng = np.random.default_rng(0)
+    picks = [(rng.integers(N.size), rng.integers(W.size)) for _ in range(300)]
+    t = time.perf_counter()
+    base = [baseline_point(system, N[a], W[b]) for a, b in picks]
+    base_per_point = (time.perf_counter() - t) / len(picks)
+    ours = np.array([smap.max_real_part[0, a, b] for a, b in picks])
+    both = np.isfinite(ours)
+    agree = float(np.max(np.abs(np.array(base)[both] - ours[both])))
+    ours_per_point = map_s / smap.max_real_part.size
+
+    result = {
+        "machine": {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
+                    "python": platform.python_version(), "cores_used": 1},
+        "stickslip_version": stickslip.__version__,
+        "compile_or_cache_load_s": compile_s,
+        "map_200x200": {"seconds": map_s, "goal_s": GOAL_MAP_S, "ratio_to_goal": map_s / GOAL_MAP_S,
+                        "points": int(smap.max_real_part.size), "us_per_point": 1e6 * ours_per_point,
+                        "no_equilibrium_points": int(np.isnan(smap.max_real_part).sum())},
+        "boundary_5_families": {"seconds": boundary_s, "goal_s": GOAL_BOUNDARY_S,
+                                "ratio_to_goal": boundary_s / GOAL_BOUNDARY_S, "family": fam[0],
+                                "values": fam[1], "N_points": int(Nb.size), "Omega_bracket_points": int(Wb.size),
+                                "roots": n_roots, "grid_s": bmap.timings["grid_s"],
+                                "brentq_s": bmap.timings["boundary_s"]},
+        "baseline": {"method": "scipy root(hybr) on kernel residual + central FD Jacobian + numpy eigvals",
+                     "us_per_point": 1e6 * base_per_point, "points_timed": len(picks),
+                     "speedup_ours_vs_baseline": base_per_point / ours_per_point,
+                     "max_abs_difference_of_max_real_part": agree},
+    }
+    print(f"compile / cache load           {compile_s:8.2f} s")
+    print(f"200 x 200 map                  {map_s:8.2f} s   goal {GOAL_MAP_S:g} s   ratio {map_s / GOAL_MAP_S:.2f}"
+          f"   ({1e6 * ours_per_point:.1f} us/point)")
+    print(f"boundaries, 5 families         {boundary_s:8.2f} s   goal {GOAL_BOUNDARY_S:g} s   ratio "
+          f"{boundary_s / GOAL_BOUNDARY_S:.2f}   ({n_roots} roots; grid {bmap.timings['grid_s']:.2f} s, "
+          f"brentq {bmap.timings['boundary_s']:.2f} s)")
+    print(f"baseline (scipy root + FD)     {1e6 * base_per_point:8.1f} us/point   speed-up "
+          f"{base_per_point / ours_per_point:.1f}x   max |difference| {agree:.2e} 1/s")
+    out = Path(__file__).parent / "results"
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "stability_map.json").write_text(json.dumps(result, indent=2))
+    print(f"wrote {out / 'stability_map.json'}")
+
+
+if __name__ == "__main__":
+    main()
