@@ -137,3 +137,17 @@ def test_boundary_matches_direct_simulation_on_both_sides(side):
                                                   t_from=20.0)
     assert np.sign(measured) == np.sign(predicted)
     assert measured == pytest.approx(predicted, rel=0.05)
+
+
+@pytest.mark.parametrize("N", [10.0, 50.0, 150.0])
+def test_reduced_model_boundary_is_the_closed_form(N):
+    # Model 4: R = r always, so the friction torque is r mu(r (Omega + psi' - phi')) N. With
+    # a = N r^2 alpha dmu exp(-alpha Omega r): C_L = [[c - a, a], [a, c - a]], and with equal
+    # k/J of phi and psi (Table 1: 200 1/s^2) the mode (1, -1) has a purely imaginary eigenvalue
+    # exactly when c = 2a, i.e. Omega_c = ln(2 N r^2 alpha dmu / c) / (alpha r)
+    P = Parameters()
+    expected = math.log(2 * N * P.r**2 * P.alpha * P.delta_mu / P.c_pphi) / (P.alpha * P.r)
+    m = stability_map(P, [N], np.linspace(0.2, 20.0, 30), model="rotation")
+    # brentq to BOUNDARY_XTOL; 1e-9 allows for the round-off of max Re λ near the root
+    assert m.boundary[0, 0, 0] == pytest.approx(expected, rel=1e-9)
+    assert np.isnan(m.boundary[0, 0, 1:]).all()
