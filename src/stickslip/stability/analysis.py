@@ -12,12 +12,9 @@ from ..model.parameters import PARAMETER_UNITS, Parameters
 from ..model.system import System, assemble
 from ..model.variants import DOF_NAMES
 from . import linearize
-from .equilibrium import EquilibriumError, solve_equilibrium
+from .equilibrium import solve_equilibrium
 
 __all__ = ["StabilityResult", "stability", "linearization"]
-
-_DOF_UNITS = {"x1": "m", "y1": "m", "x2": "m", "y2": "m", "phi": "rad", "psi": "rad"}
-
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class StabilityResult:
