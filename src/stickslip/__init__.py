@@ -6,6 +6,8 @@
 ``Trajectory``              typed result: samples, modes, forces, transitions, ``.to_xarray()``
 ``load_trajectory``         read a run written with ``Trajectory.to_netcdf``
 ``equilibrium``             steady-sliding equilibrium (Eq. 14)
+``stability``               linear stability of steady sliding (Eq. 15), returns ``StabilityResult``
+``stability_map``           (N, Ω) stability map with boundary by root finding (Figs. 3, 4)
 ``MODELS``                  the paper's Models 1–4 as free DOFs
 ==========================  ==============================================================
 """
@@ -16,6 +18,7 @@ from .integrate.driver import SimulationError, simulate
 from .integrate.result import FileFormatError, Trajectory, load_trajectory
 from .model.parameters import ParameterError, Parameters
 from .model.variants import DOF_NAMES, MODELS, STATE_NAMES, VariantError
+from .stability import StabilityMap, StabilityResult, load_stability_map, stability, stability_map
 from .stability.equilibrium import EquilibriumError, equilibrium
 
 __all__ = [
@@ -24,5 +27,6 @@ __all__ = [
     "simulate", "SimulationError",
     "Trajectory", "load_trajectory", "FileFormatError",
     "equilibrium", "EquilibriumError",
+    "stability", "StabilityResult", "stability_map", "StabilityMap", "load_stability_map",
     "MODELS", "DOF_NAMES", "STATE_NAMES", "VariantError",
 ]

@@ -226,9 +226,9 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             stats[1] += 1
             continue
         if err > 1.0:
+            # a rejected re-take keeps homing: the root found before still lies ahead
             h *= max(MIN_FACTOR, SAFETY * err ** -0.2)
             stats[1] += 1
-            retakes = 0
             continue
         factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** -0.2)
         _dense_coefficients(Kst, Q)

@@ -280,12 +280,25 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
 
 
 @njit(cache=True)
-def project_velocity(s, minv, p):
-    """Project q̇ onto v_r = 0 in the M-metric, in place (DESIGN.md §1).
+def _kinetic_energy(s, minv):
+    e = 0.0
+    for i in range(6):
+        if minv[i] != 0.0:
+            e += 0.5 * s[6 + i] * s[6 + i] / minv[i]
+    return e
 
-    Δq̇ = −M⁻¹ Gᵀ (G M⁻¹ Gᵀ)⁺ v_r, the smallest kinetic-energy change that removes v_r;
-    locked DOFs (zero inverse mass) are not touched.
+
+@njit(cache=True)
+def project_velocity(s, minv, p):
+    """Project q̇ onto v_r = 0 in the M-metric, in place (DESIGN.md §1); returns ΔE_kin [J].
+
+    Δq̇ = −M⁻¹ Gᵀ (G M⁻¹ Gᵀ)⁺ v_r, the smallest kinetic-energy change that removes v_r: an
+    impulsive friction force Gᵀλ that stops the residual slip (a perfectly plastic tangential
+    impact, ΔE_kin = −½ v_rᵀ A⁺ v_r ≤ 0). If ``s`` carries the work accumulators (length ≥ 14)
+    the energy change is booked as work of friction, so the energy balance stays exact.
+    Locked DOFs (zero inverse mass) are not touched.
     """
+    e_before = _kinetic_energy(s, minv)
     vx, vy = relative_velocity(s, p)
     a11, a12, a22 = constraint_metric(s, minv, p)
     l1, l2, _ = solve_psd_2x2(a11, a12, a22, vx, vy)
@@ -300,16 +313,10 @@ def project_velocity(s, minv, p):
     s[9] += minv[3] * l2
     s[10] -= minv[4] * r * (-sphi * l1 + cphi * l2)
     s[11] -= minv[5] * (Y * l1 - X * l2)
-
-
-@njit(cache=True)
-def mechanical_energy(s, minv, stiff):
-    """Kinetic plus elastic energy of the free DOFs, ½ q̇ᵀ M q̇ + ½ qᵀ K q [J]."""
-    e = 0.0
-    for i in range(6):
-        if minv[i] != 0.0:
-            e += 0.5 * s[6 + i] * s[6 + i] / minv[i] + 0.5 * stiff[i] * s[i] * s[i]
-    return e
+    delta = _kinetic_energy(s, minv) - e_before
+    if s.shape[0] >= 14:
+        s[12] += delta
+    return delta
 
 
 @njit(cache=True)
