@@ -93,5 +93,9 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
     for key, value in rows:
         table.add_row(key, value)
     console.print(table)
-    if math.isnan(s.fundamental_frequency_hz) is False and not s.periodic:
-        console.print("[dim]not periodic within the window: frequency is the highest spectral peak[/]")
+    if not math.isnan(s.fundamental_frequency_hz) and not s.periodic:
+        console.print("[dim]not periodic within the window: the frequency is the mean cycle rate "
+                      "(up-crossings of the mid level of φ)[/]")
+    if traj.stats.compile_time_s > 0:
+        console.print(f"[dim]first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
+                      "(not included in the wall time)[/]")

@@ -58,6 +58,7 @@ SAFETY = 0.9        # standard step-size safety factor
 MIN_FACTOR = 0.2    # largest step reduction after a rejection
 MAX_FACTOR = 5.0    # largest step growth after an acceptance
 MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick root
+MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.36 s shortest natural period of Table 1
 
 
 @njit(cache=True)
@@ -126,7 +127,7 @@ def _write_samples(idx, t_from, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp
             E.dense_state(y0, Q, h, theta, work)
             for i in range(work.shape[0]):
                 out_s[idx, i] = work[i]
-            out_mode[idx] = mode
+            out_mode[idx] = 1 if mode == K.MODE_STICK else 0
             Fx, Fy = K.contact_force(work, mode, ex, ey, minv, damp, stiff, p)
             out_F[idx, 0] = Fx
             out_F[idx, 1] = Fy
@@ -197,7 +198,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     while idx < sample_times.shape[0] and sample_times[idx] <= t0:
         for i in range(n):
             out_s[idx, i] = y[i]
-        out_mode[idx] = mode
+        out_mode[idx] = 1 if mode == K.MODE_STICK else 0
         Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
         out_F[idx, 0] = Fx
         out_F[idx, 1] = Fy
@@ -205,6 +206,8 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
 
     status = STATUS_OK
     retakes = 0
+    homing = 0          # homing steps taken towards v_r = 0 since the last event
+    h_override = -1.0   # step length imposed on the next step (homing), if > 0
     n_steps = 0
     while t < t_end:
         if n_steps >= max_steps:
@@ -233,11 +236,11 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
         factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** -0.2)
         _dense_coefficients(Kst, Q)
 
-        if mode == K.MODE_SLIP:
-            vx, vy = K.relative_velocity(y, p)
-            speed = math.sqrt(vx * vx + vy * vy)
+        if mode != K.MODE_STICK:
             theta = -1.0
-            if speed > K.SPEED_FLOOR:  # just after breakaway (v_r = 0) there is nothing to detect
+            if mode == K.MODE_SLIP_EXACT:  # while departing from v_r = 0 there is nothing to detect
+                vx, vy = K.relative_velocity(y, p)
+                speed = math.sqrt(vx * vx + vy * vy)
                 theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, vx / speed, vy / speed,
                                          minv, damp, stiff, p, work)
             if theta > 0.0 and (1.0 - theta) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
@@ -251,27 +254,36 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             t += h
             for i in range(n):
                 y[i] = ynew[i]
+                k1[i] = Kst[6, i]
             stats[0] += 1
             ex, ey = K.slip_direction(y, ex, ey, minv, damp, stiff, p)
-            if theta > 0.0 or retakes > 0:
-                stick, nex, ney = E.try_stick(y, minv, damp, stiff, p)
-                if stick:
-                    mode = K.MODE_STICK
-                    stats[4] += 1
-                    tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_STICK, y, tr_t, tr_kind, tr_s)
-                    n_tr += 1
-                    K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
-                    stats[2] += 1
-                elif nex != 0.0 or ney != 0.0:
-                    ex, ey = nex, ney  # slip goes on through v_r ≈ 0 along the breakaway direction
-                    for i in range(n):
-                        k1[i] = Kst[6, i]
+            vx, vy = K.relative_velocity(y, p)
+            speed = math.sqrt(vx * vx + vy * vy)
+            if mode == K.MODE_SLIP:
+                if speed > p[K.P_SLIP_BAND]:
+                    mode = K.MODE_SLIP_EXACT  # same force above the band: k1 stays valid
+            elif theta > 0.0 or retakes > 0 or homing > 0 or speed <= E.STICK_SPEED_TOL:
+                tau = E.time_to_zero(y, k1, p)
+                if theta <= 0.0 and E.EVENT_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES:
+                    # short of v_r = 0 (a re-take landed early, or a step ended close to it):
+                    # one more step, of the extrapolated length
+                    h_override = tau
+                    homing += 1
                 else:
-                    for i in range(n):
-                        k1[i] = Kst[6, i]
-            else:
-                for i in range(n):
-                    k1[i] = Kst[6, i]
+                    homing = 0
+                    stick, nex, ney = E.try_stick(y, minv, damp, stiff, p)
+                    if stick:
+                        mode = K.MODE_STICK
+                        stats[4] += 1
+                        tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_STICK, y, tr_t, tr_kind, tr_s)
+                        n_tr += 1
+                    elif nex != 0.0 or ney != 0.0:
+                        # v_r reached zero but stick cannot hold: slip departs again (reversal)
+                        mode = K.MODE_SLIP
+                        ex, ey = nex, ney
+                    if stick or nex != 0.0 or ney != 0.0:
+                        K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+                        stats[2] += 1
             retakes = 0
         else:
             theta = E.first_crossing(E.EVENT_STICK, y, Q, h, 0.0, 0.0, minv, damp, stiff, p, work)
@@ -306,6 +318,10 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 status = STATUS_NOT_FINITE
         if status != STATUS_OK:
             break
-        h *= factor
+        if h_override > 0.0:
+            h = h_override
+            h_override = -1.0
+        else:
+            h *= factor
     return (status, t, y, mode, ex, ey, tr_t[:n_tr].copy(), tr_kind[:n_tr].copy(),
             tr_s[:n_tr].copy(), stats)

@@ -35,7 +35,11 @@ class FileFormatError(ValueError):
 
 @dataclasses.dataclass(frozen=True)
 class Stats:
-    """Integrator statistics."""
+    """Integrator statistics.
+
+    ``wall_time_s`` is the integration alone; ``compile_time_s`` the one-off JIT compilation
+    (or cache load) of the kernels when this run was the first in the process, else 0.
+    """
 
     accepted_steps: int = 0
     rejected_steps: int = 0
@@ -44,6 +48,7 @@ class Stats:
     slip_to_stick: int = 0
     stick_to_slip: int = 0
     wall_time_s: float = 0.0
+    compile_time_s: float = 0.0
 
     @property
     def steps(self) -> int:

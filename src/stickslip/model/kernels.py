@@ -31,8 +31,9 @@ N_P = 8
 LAW_EXPONENTIAL = 0  # paper Eq. (4)
 LAW_COULOMB = 1      # μ = μk in slip, μs = μk + Δμ in stick
 
-MODE_SLIP = 0
-MODE_STICK = 1
+MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
+MODE_STICK = 1       # stick: friction is the constraint force
+MODE_SLIP_EXACT = 2  # slip with the exact direction v_r/|v_r| at every speed (approach to stick)
 
 #: Speed [m/s] below which v_r counts as exactly zero (round-off after projection, ~1e-16 of
 #: the sliding speed Ω r of the paper's cases, is far below it).
@@ -71,6 +72,23 @@ def relative_velocity(s, p):
     vx = s[6] - s[8] - r * sphi * s[10] + w * Y
     vy = s[7] - s[9] + r * cphi * s[10] - w * X
     return vx, vy
+
+
+@njit(cache=True)
+def relative_acceleration(s, ds, p):
+    """dv_r/dt [m/s²] along the state derivative ``ds`` (time derivative of Eq. 9)."""
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    X = s[0] - s[2] + r * cphi
+    Y = s[1] - s[3] + r * sphi
+    dphi = s[10]
+    dX = s[6] - s[8] - r * sphi * dphi
+    dY = s[7] - s[9] + r * cphi * dphi
+    w = p[P_OMEGA] + s[11]
+    ax = ds[6] - ds[8] - r * (cphi * dphi * dphi + sphi * ds[10]) + ds[11] * Y + w * dY
+    ay = ds[7] - ds[9] + r * (cphi * ds[10] - sphi * dphi * dphi) - ds[11] * X - w * dX
+    return ax, ay
 
 
 @njit(cache=True)
@@ -247,15 +265,18 @@ def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
 def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
     """Friction force in the given mode [N]: the stick multiplier, or Eq. (3) in slip.
 
-    The slip direction is v_r/|v_r| above the low-speed band ``p[P_SLIP_BAND]`` and the
-    quasi-static direction inside it, found from the last known direction ``(ex, ey)``.
+    The slip direction is v_r/|v_r| above the low-speed band ``p[P_SLIP_BAND]``. Inside it,
+    ``MODE_SLIP`` takes the quasi-static direction found from the last known direction
+    ``(ex, ey)`` (right after breakaway, where |v_r| grows like t² and the direction relaxes
+    onto that manifold at once), ``MODE_SLIP_EXACT`` keeps v_r/|v_r| (on the approach to stick,
+    where |v_r| falls linearly and the direction only relaxes logarithmically).
     """
     if mode == MODE_STICK:
         Fx, Fy, _ = stick_force(s, minv, damp, stiff, p)
         return Fx, Fy
     vx, vy = relative_velocity(s, p)
     speed = math.sqrt(vx * vx + vy * vy)
-    if speed > p[P_SLIP_BAND]:
+    if speed > p[P_SLIP_BAND] or (mode == MODE_SLIP_EXACT and speed > SPEED_FLOOR):
         return slip_force(speed, vx / speed, vy / speed, p)
     dx, dy = quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
     return slip_force(speed, dx, dy, p)
