@@ -210,8 +210,12 @@ def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     Q3 = -Fy
     Q4 = r * (-sphi * Fx + cphi * Fy)
     Q5 = Y * Fx - X * Fy
-    for i in range(6):
-        ds[i] = s[6 + i]
+    ds[0] = s[6]
+    ds[1] = s[7]
+    ds[2] = s[8]
+    ds[3] = s[9]
+    ds[4] = s[10]
+    ds[5] = s[11]
     ds[6] = minv[0] * (Q0 - damp[0] * s[6] - stiff[0] * s[0])
     ds[7] = minv[1] * (Q1 - damp[1] * s[7] - stiff[1] * s[1])
     ds[8] = minv[2] * (Q2 - damp[2] * s[8] - stiff[2] * s[2])
@@ -219,14 +223,10 @@ def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     ds[10] = minv[4] * (Q4 - damp[4] * s[10] - stiff[4] * s[4])
     ds[11] = minv[5] * (Q5 - damp[5] * s[11] - stiff[5] * s[5])
     if ds.shape[0] >= 14:
-        power_friction = 0.0
-        power_damping = 0.0
-        for i, Q in enumerate((Q0, Q1, Q2, Q3, Q4, Q5)):
-            if minv[i] != 0.0:
-                power_friction += Q * s[6 + i]
-                power_damping -= damp[i] * s[6 + i] * s[6 + i]
-        ds[12] = power_friction
-        ds[13] = power_damping
+        # locked DOFs have q̇ = 0 at all times, so they add nothing to either power
+        ds[12] = Q0 * s[6] + Q1 * s[7] + Q2 * s[8] + Q3 * s[9] + Q4 * s[10] + Q5 * s[11]
+        ds[13] = -(damp[0] * s[6] * s[6] + damp[1] * s[7] * s[7] + damp[2] * s[8] * s[8]
+                   + damp[3] * s[9] * s[9] + damp[4] * s[10] * s[10] + damp[5] * s[11] * s[11])
 
 
 @njit(cache=True)
