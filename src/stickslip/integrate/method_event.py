@@ -208,6 +208,8 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     retakes = 0
     homing = 0          # homing steps taken towards v_r = 0 since the last event
     h_override = -1.0   # step length imposed on the next step (homing), if > 0
+    h_free = -1.0       # step size before a homing episode, if > 0
+    rejected = False    # whether the last attempt was rejected
     n_steps = 0
     while t < t_end:
         if n_steps >= max_steps:
@@ -232,8 +234,12 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             # a rejected re-take keeps homing: the root found before still lies ahead
             h *= max(MIN_FACTOR, SAFETY * err ** -0.2)
             stats[1] += 1
+            rejected = True
             continue
         factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** -0.2)
+        if rejected:
+            factor = min(factor, 1.0)  # no growth right after a rejection (Hairer's DOPRI5 rule)
+            rejected = False
         _dense_coefficients(Kst, Q)
 
         if mode != K.MODE_STICK:
@@ -245,6 +251,8 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                                          minv, damp, stiff, p, work)
             if theta > 0.0 and (1.0 - theta) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
                 # the slip velocity passes zero inside the step: re-take it to end at the root
+                if retakes == 0 and homing == 0:
+                    h_free = h  # the error controller's step, restored after the event
                 h *= theta
                 retakes += 1
                 stats[3] += 1
@@ -262,14 +270,19 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             if mode == K.MODE_SLIP:
                 if speed > p[K.P_SLIP_BAND]:
                     mode = K.MODE_SLIP_EXACT  # same force above the band: k1 stays valid
-            elif theta > 0.0 or retakes > 0 or homing > 0 or speed <= E.STICK_SPEED_TOL:
+            else:
+                near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= E.STICK_SPEED_TOL
                 tau = E.time_to_zero(y, k1, p)
-                if theta <= 0.0 and E.EVENT_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES:
-                    # short of v_r = 0 (a re-take landed early, or a step ended close to it):
-                    # one more step, of the extrapolated length
+                if (theta <= 0.0 and E.EVENT_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES
+                        and (near or tau < h * factor)):
+                    # v_r heads for zero within the next step (or a re-take landed short of it):
+                    # step exactly the extrapolated time instead of letting the stiff direction
+                    # dynamics near v_r = 0 shrink the steps geometrically
+                    if retakes == 0 and homing == 0:
+                        h_free = h
                     h_override = tau
                     homing += 1
-                else:
+                elif near:
                     homing = 0
                     stick, nex, ney = E.try_stick(y, minv, damp, stiff, p)
                     if stick:
@@ -284,6 +297,11 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     if stick or nex != 0.0 or ney != 0.0:
                         K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
                         stats[2] += 1
+                    if h_free > 0.0:
+                        # the homing steps were short by construction, not by the error
+                        # estimate: resume from the step size before them
+                        h_override = max(h * factor, h_free)
+                        h_free = -1.0
             retakes = 0
         else:
             theta = E.first_crossing(E.EVENT_STICK, y, Q, h, 0.0, 0.0, minv, damp, stiff, p, work)
