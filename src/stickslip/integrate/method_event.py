@@ -125,14 +125,20 @@ def _write_samples(idx, t_from, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp
         if ts >= t_from:
             theta = (ts - t_step) / h if h > 0.0 else 0.0
             E.dense_state(y0, Q, h, theta, work)
-            for i in range(work.shape[0]):
-                out_s[idx, i] = work[i]
-            out_mode[idx] = 1 if mode == K.MODE_STICK else 0
-            Fx, Fy = K.contact_force(work, mode, ex, ey, minv, damp, stiff, p)
-            out_F[idx, 0] = Fx
-            out_F[idx, 1] = Fy
+            _store_sample(idx, work, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
     return idx
+
+
+@njit(cache=True)
+def _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F):
+    """Write state, mode flag (1 = stick) and friction force of sample ``idx``."""
+    for i in range(y.shape[0]):
+        out_s[idx, i] = y[i]
+    out_mode[idx] = 1 if mode == K.MODE_STICK else 0
+    Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
+    out_F[idx, 0] = Fx
+    out_F[idx, 1] = Fy
 
 
 @njit(cache=True)
@@ -196,12 +202,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     idx = 0
     # samples at exactly t0
     while idx < sample_times.shape[0] and sample_times[idx] <= t0:
-        for i in range(n):
-            out_s[idx, i] = y[i]
-        out_mode[idx] = 1 if mode == K.MODE_STICK else 0
-        Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
-        out_F[idx, 0] = Fx
-        out_F[idx, 1] = Fy
+        _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
 
     status = STATUS_OK

@@ -54,37 +54,44 @@ RANK_TOL = 1e-10
 
 
 @njit(cache=True)
+def contact_kinematics(s, p):
+    """(sin φ, cos φ, X, Y): the contact point relative to O2 [m] (paper Eqs. 2, 8)."""
+    r = p[P_R]
+    sphi = math.sin(s[4])
+    cphi = math.cos(s[4])
+    return sphi, cphi, s[0] - s[2] + r * cphi, s[1] - s[3] + r * sphi
+
+
+@njit(cache=True)
+def contact_rates(s, p, sphi, cphi):
+    """(dX/dt, dY/dt) of the contact point relative to O2 [m/s]."""
+    r = p[P_R]
+    return s[6] - s[8] - r * sphi * s[10], s[7] - s[9] + r * cphi * s[10]
+
+
+@njit(cache=True)
 def contact_position(s, p):
     """Contact point relative to O2, (X, Y) [m] (paper Eq. 2 components)."""
-    r = p[P_R]
-    return s[0] - s[2] + r * math.cos(s[4]), s[1] - s[3] + r * math.sin(s[4])
+    _, _, X, Y = contact_kinematics(s, p)
+    return X, Y
 
 
 @njit(cache=True)
 def relative_velocity(s, p):
     """Relative velocity v_r of the upper plate against the lower one at the contact, Eq. (9) [m/s]."""
-    r = p[P_R]
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
-    X = s[0] - s[2] + r * cphi
-    Y = s[1] - s[3] + r * sphi
+    sphi, cphi, X, Y = contact_kinematics(s, p)
+    dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
-    vx = s[6] - s[8] - r * sphi * s[10] + w * Y
-    vy = s[7] - s[9] + r * cphi * s[10] - w * X
-    return vx, vy
+    return dX + w * Y, dY - w * X
 
 
 @njit(cache=True)
 def relative_acceleration(s, ds, p):
     """dv_r/dt [m/s²] along the state derivative ``ds`` (time derivative of Eq. 9)."""
     r = p[P_R]
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
-    X = s[0] - s[2] + r * cphi
-    Y = s[1] - s[3] + r * sphi
+    sphi, cphi, X, Y = contact_kinematics(s, p)
     dphi = s[10]
-    dX = s[6] - s[8] - r * sphi * dphi
-    dY = s[7] - s[9] + r * cphi * dphi
+    dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
     ax = ds[6] - ds[8] - r * (cphi * dphi * dphi + sphi * ds[10]) + ds[11] * Y + w * dY
     ay = ds[7] - ds[9] + r * (cphi * ds[10] - sphi * dphi * dphi) - ds[11] * X - w * dX
@@ -148,10 +155,7 @@ def solve_psd_2x2(a11, a12, a22, b1, b2):
 def constraint_metric(s, minv, p):
     """Entries (a11, a12, a22) of A = G M⁻¹ Gᵀ (2×2, symmetric PSD) [1/kg]."""
     r = p[P_R]
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
-    X = s[0] - s[2] + r * cphi
-    Y = s[1] - s[3] + r * sphi
+    sphi, cphi, X, Y = contact_kinematics(s, p)
     a11 = minv[0] + minv[2] + minv[4] * (r * sphi) ** 2 + minv[5] * Y * Y
     a12 = -minv[4] * r * r * sphi * cphi - minv[5] * X * Y
     a22 = minv[1] + minv[3] + minv[4] * (r * cphi) ** 2 + minv[5] * X * X
@@ -167,13 +171,9 @@ def stick_force(s, minv, damp, stiff, p):
     Returns (Fx, Fy, rank).
     """
     r = p[P_R]
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
-    X = s[0] - s[2] + r * cphi
-    Y = s[1] - s[3] + r * sphi
+    sphi, cphi, X, Y = contact_kinematics(s, p)
     dphi = s[10]
-    dX = s[6] - s[8] - r * sphi * dphi
-    dY = s[7] - s[9] + r * cphi * dphi
+    dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
     h1 = -r * cphi * dphi * dphi + w * dY
     h2 = -r * sphi * dphi * dphi - w * dX
@@ -199,10 +199,7 @@ def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     so that integrating them gives the energy balance ΔE = W_friction + W_damping.
     """
     r = p[P_R]
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
-    X = s[0] - s[2] + r * cphi
-    Y = s[1] - s[3] + r * sphi
+    sphi, cphi, X, Y = contact_kinematics(s, p)
     # generalised friction forces Gᵀ F
     Q0 = Fx
     Q1 = Fy
@@ -324,10 +321,7 @@ def project_velocity(s, minv, p):
     a11, a12, a22 = constraint_metric(s, minv, p)
     l1, l2, _ = solve_psd_2x2(a11, a12, a22, vx, vy)
     r = p[P_R]
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
-    X = s[0] - s[2] + r * cphi
-    Y = s[1] - s[3] + r * sphi
+    sphi, cphi, X, Y = contact_kinematics(s, p)
     s[6] -= minv[0] * l1
     s[7] -= minv[1] * l2
     s[8] += minv[2] * l1
