@@ -29,6 +29,11 @@ TRANSITION_TO_SLIP = -1
 #: Time resolution [s] to which transition instants are located on the dense output.
 EVENT_TIME_TOL = 1e-12
 
+#: Extrapolated time [s] to v_r = 0 below which slip counts as arrived (the issue's resolution of
+#: transition instants); homing steps shorter than this are dominated by the direction
+#: singularity of v_r/|v_r| at zero and get rejected.
+ARRIVAL_TIME_TOL = 1e-10
+
 #: |v_r| [m/s] at or below which slip has reached v_r = 0 (at a root of the projected slip
 #: velocity or at a step end). On the approach the step sizes fall geometrically with |v_r|, so
 #: it is reached in a few steps; the residual is removed by the projection, an instant error of

@@ -274,7 +274,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             else:
                 near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= E.STICK_SPEED_TOL
                 tau = E.time_to_zero(y, k1, p)
-                if (theta <= 0.0 and E.EVENT_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES
+                if (theta <= 0.0 and E.ARRIVAL_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES
                         and (near or tau < h * factor)):
                     # v_r heads for zero within the next step (or a re-take landed short of it):
                     # step exactly the extrapolated time instead of letting the stiff direction
