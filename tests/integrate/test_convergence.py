@@ -40,3 +40,13 @@ def test_event_times_converge():
     d1 = np.abs(first[0] - first[2]).max()
     d2 = np.abs(first[1] - first[2]).max()
     assert d2 < d1 and d2 < 1e-5
+
+
+def test_tight_tolerances_finish_and_agree():
+    """Regression: at rtol 1e-11 the approach to stick once underflowed the step size."""
+    P = Parameters()
+    runs = [simulate(P, 100.0, rtol=rtol, atol=rtol * 1e-2, sample_rate=200) for rtol in (1e-10, 1e-11)]
+    assert all(r.status == "success" for r in runs)
+    f = [r.steady.fundamental_frequency_hz for r in runs]
+    assert abs(f[0] - f[1]) < 1e-8 * f[1]
+    assert len(runs[0].transitions) == len(runs[1].transitions)
