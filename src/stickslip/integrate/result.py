@@ -159,8 +159,7 @@ class Trajectory:
     def mechanical_energy(self) -> np.ndarray:
         """½ q̇ᵀ M q̇ + ½ qᵀ K q of the free DOFs (n,) [J]."""
         system = assemble(self.params, self.model)
-        with np.errstate(divide="ignore"):
-            mass = np.where(system.minv > 0, 1.0 / np.where(system.minv > 0, system.minv, 1.0), 0.0)
+        mass = np.where(system.variant.mask, system.mass, 0.0)  # locked DOFs: q̇ = 0, no energy
         q, dq = self.states[:, :6], self.states[:, 6:]
         return 0.5 * (dq**2 @ mass) + 0.5 * (q**2 @ system.stiff)
 
