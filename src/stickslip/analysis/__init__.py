@@ -1,5 +1,14 @@
-"""Analysis of trajectories: steady state, spectra."""
+"""Analysis of trajectories: steady state, event-located peaks, classification, spectra,
+intensity (Eq. 16) and the relative-motion angle (Fig. 11)."""
 
+from .classify import KINDS, Classification, classify, classify_response, kind_code
+from .intensity import angle_range, intensity, relative_motion_angle, trajectory_intensities
+from .peaks import Peaks, find_peaks, hermite_value, trajectory_peaks
 from .steady import SteadyState, fundamental_frequency, spectrum, stick_time, summarize
 
-__all__ = ["SteadyState", "fundamental_frequency", "spectrum", "stick_time", "summarize"]
+__all__ = [
+    "SteadyState", "fundamental_frequency", "spectrum", "stick_time", "summarize",
+    "Peaks", "find_peaks", "hermite_value", "trajectory_peaks",
+    "KINDS", "Classification", "classify", "classify_response", "kind_code",
+    "intensity", "trajectory_intensities", "relative_motion_angle", "angle_range",
+]

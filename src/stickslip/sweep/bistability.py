@@ -1,0 +1,150 @@
+"""Bistability regions over (N, Ω) (paper Sect. 4.2.2, Fig. 8) and stick-slip domains (Fig. 9).
+
+Each (model, N, Ω) is simulated from the two initial conditions of Sect. 4.2.2 (the paper does
+not print them; ours are :data:`~stickslip.sweep.spec.NAMED_ICS`):
+
+``far``   q = 0 with the upper plate carried along by the lower plate (v_r = 0 at t = 0):
+          ẏ1 = Ω r when y1 is free, else φ̇ = Ω. Plates at rest (``zero``) is not far enough:
+          at N = 50 N, Ω = 8.5 rad/s it decays to the equilibrium, while this one reaches the
+          stick-slip oscillation that coexists with it (Fig. 7(c)).
+``near``  the equilibrium of Eq. (14) with φ raised by 1e-3 rad.
+
+Each steady state is classified (:mod:`stickslip.analysis.classify`); a response is
+*stick-slip* when it is not ``equilibrium`` and sticks in the steady window. Then
+
+=========  ====================================================================
+region 1   I: stick-slip from both initial conditions (stick-slip only)
+region 2   II: stick-slip from one, equilibrium from the other (coexistence)
+region 3   III: equilibrium from both (equilibrium only)
+region 0   anything else (a run failed, or a slip-only oscillation)
+=========  ====================================================================
+
+The stick-slip domain of Fig. 9 is regions I ∪ II; its upper boundary Ω_ss(N) is reported as
+the largest grid Ω at which stick-slip occurs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ..model.parameters import Parameters
+from .engine import SweepResult, sweep
+from .spec import SweepError
+from .store import load_sweep
+
+__all__ = ["RegionMap", "regions", "load_region_map", "REGION_NAMES", "classify_regions"]
+
+REGION_NAMES = {0: "other", 1: "I: stick-slip only", 2: "II: coexistence", 3: "III: equilibrium only"}
+
+
+def classify_regions(kind: np.ndarray, stick_fraction: np.ndarray) -> np.ndarray:
+    """Region codes (0–3) from kind codes and stick fractions with the two ICs on the last axis."""
+    stick_slip = (kind != 0) & (kind >= 0) & (stick_fraction > 0)
+    equilibrium = kind == 0
+    a_ss, b_ss = stick_slip[..., 0], stick_slip[..., 1]
+    a_eq, b_eq = equilibrium[..., 0], equilibrium[..., 1]
+    region = np.zeros(a_ss.shape, dtype=np.int8)
+    region[a_ss & b_ss] = 1
+    region[(a_ss & b_eq) | (a_eq & b_ss)] = 2
+    region[a_eq & b_eq] = 3
+    return region
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class RegionMap:
+    """Regions I/II/III over (model, N, Ω) and the stick-slip boundary.
+
+    Attributes
+    ----------
+    dataset : xarray.Dataset
+        The sweep (dims model, N, Omega, ic) plus ``region`` (model, N, Omega) and
+        ``stick_slip_omega_max`` (model, N) [rad/s].
+    path : Path or None
+    timings : dict
+    """
+
+    dataset: object
+    path: Path | None
+    timings: dict
+
+    @property
+    def region(self) -> np.ndarray:
+        return self.dataset["region"].values
+
+    @property
+    def models(self) -> list[str]:
+        return [str(m) for m in self.dataset["model"].values]
+
+    def to_xarray(self):
+        return self.dataset
+
+    def plot(self, **kwargs):
+        from ..plot.regions import plot_regions
+
+        return plot_regions(self, **kwargs)
+
+
+def _with_regions(ds):
+    import xarray as xr
+
+    kind = ds["kind"].transpose("model", "N", "Omega", "ic").values
+    sf = ds["stick_fraction"].transpose("model", "N", "Omega", "ic").values
+    region = classify_regions(np.where(np.isfinite(kind), kind, -1), np.nan_to_num(sf))
+    omega = ds["Omega"].values
+    ss = (region == 1) | (region == 2)
+    omax = np.where(ss.any(axis=-1), np.max(np.where(ss, omega, -np.inf), axis=-1), np.nan)
+    return ds.assign(
+        region=(("model", "N", "Omega"), region, {
+            "long_name": "steady-state region (Fig. 8)", "flag_values": "0 1 2 3",
+            "flag_meanings": "other I_stick_slip_only II_coexistence III_equilibrium_only"}),
+        stick_slip_omega_max=(("model", "N"), omax, {
+            "units": "rad/s", "long_name": "largest grid Omega with stick-slip (upper edge of the Fig. 9 domain)"}),
+    ) if isinstance(ds, xr.Dataset) else ds
+
+
+def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | None = None, *,
+            models: Sequence[str] = ("full",), out=None, t_end: float = 200.0, t_from: float | None = None,
+            **sweep_options) -> RegionMap:
+    """Classify (N, Ω) into regions I, II, III (Fig. 8) for each model (Fig. 9 with all four).
+
+    Parameters
+    ----------
+    N, Omega : sequences
+        Grid of normal loads [N] and lower-plate speeds [rad/s] (increasing).
+    params : Parameters, optional
+        Base parameters (μk = 0.2, Δμ = 0.1, α = 5 by default, as in Figs. 8–9).
+    models : sequence of str
+        ``full``, ``x``, ``y``, ``rotation`` (Models 1–4).
+    out : path, optional
+        NetCDF output; resumable like :func:`~stickslip.sweep.sweep`.
+    t_end, t_from : float
+        Run length and start of the steady window [s].
+    **sweep_options
+        Passed to :func:`~stickslip.sweep.sweep` (executor, workers, progress, sample_rate, ...).
+    """
+    if "ic" in sweep_options:
+        raise SweepError("regions() uses the two initial conditions 'far' and 'near'; do not pass ic")
+    grid = {"model": list(models), "N": list(N), "Omega": list(Omega), "ic": ["far", "near"]}
+    res: SweepResult = sweep(grid, params, out=out, t_end=t_end, t_from=t_from, **sweep_options)
+    ds = _with_regions(res.dataset)
+    path = None
+    if out is not None:
+        path = Path(out)
+        if "region" not in res.dataset:
+            ds[["region", "stick_slip_omega_max"]].to_netcdf(path, engine="h5netcdf", mode="a")
+    return RegionMap(ds, path, res.timings)
+
+
+def load_region_map(path) -> RegionMap:
+    """Read a region map written by :func:`regions` (``out=``)."""
+    ds = load_sweep(path)
+    if not {"model", "N", "Omega", "ic"} <= set(ds.dims):
+        raise SweepError(f"{path} is a stickslip sweep but not a region map (dims {tuple(ds.dims)}); "
+                         "give a file written by `stickslip regions`")
+    if "region" not in ds:
+        ds = _with_regions(ds)
+    return RegionMap(ds, Path(path), {})

@@ -1,0 +1,213 @@
+"""The sweep driver: grid → batches → executor → journal → NetCDF (:class:`SweepResult`)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tempfile
+import time
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from ..model.parameters import Parameters
+from .executors import default_workers, run_batches
+from .spec import SweepError, SweepSpec, evaluate_batch
+from .store import Journal, assemble, journal_dir, load_sweep
+
+__all__ = ["SweepResult", "sweep", "TARGET_BATCH_S"]
+
+#: Wall time aimed at per batch [s], by executor. A process-pool task costs ~1 ms of pickling
+#: and IPC and a dask task ~5–20 ms of scheduling, so these keep the scheduler overhead below
+#: 1–2 % of the work (the requirement is 5 %) while leaving ≥ 4 batches per worker for balance.
+TARGET_BATCH_S = {"serial": 1.0, "processes": 1.0, "dask": 2.0}
+
+#: Smallest number of batches per worker (load balance: the last batch finishes at most
+#: ~1/4 of a worker's share after the others).
+MIN_BATCHES_PER_WORKER = 4
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class SweepResult:
+    """A finished sweep.
+
+    Attributes
+    ----------
+    path : Path
+        The NetCDF file (``format = stickslip-sweep-1``).
+    spec : SweepSpec
+    dataset : xarray.Dataset
+        Dimensions: the swept names in order (plus ``peak`` for ``peaks``); variables as listed in
+        :data:`stickslip.sweep.spec.COLUMNS` with units and long names, and ``done``.
+    timings : dict
+        ``total_s``, ``compute_s``, ``points_computed``, ``points_resumed``, ``batch_size``,
+        ``batches``, ``executor``, ``workers`` and the executor's start-up times.
+    """
+
+    path: Path
+    spec: SweepSpec
+    dataset: object
+    timings: dict
+
+    def to_xarray(self):
+        """The result as an ``xarray.Dataset``."""
+        return self.dataset
+
+    def kinds(self) -> np.ndarray:
+        """Steady-state kind names over the grid (``failed`` for −1)."""
+        from ..analysis.classify import KINDS
+
+        code = self.dataset["kind"].values
+        names = np.array(KINDS + ("failed",), dtype=object)
+        return names[np.where(np.isfinite(code), code, -1).astype(int)]
+
+
+def _auto_batch(t_point: float, remaining: int, workers: int, executor: str) -> int:
+    size = max(1, math.ceil(TARGET_BATCH_S[executor] / max(t_point, 1e-6)))
+    if executor != "serial":
+        size = min(size, max(1, remaining // (MIN_BATCHES_PER_WORKER * workers)))
+    return size
+
+
+def _progress_bar():
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskProgressColumn, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    return Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TaskProgressColumn(),
+                    TextColumn("{task.fields[rate]}"), TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+                    transient=False)
+
+
+def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = None, *, out=None,
+          executor: str = "processes", workers: int | None = None, address: str | None = None,
+          batch_size: int | str = "auto", progress: bool = False, overwrite: bool = False,
+          snapshot_interval: float = 60.0, keep_journal: bool = False, t_end: float = 200.0,
+          t_from: float | None = None, **options) -> SweepResult:
+    """Simulate every point of a grid and keep its reductions, streaming them to disk.
+
+    Parameters
+    ----------
+    grid : dict of name → values, or SweepSpec
+        Swept dimensions in order: parameter names (``N`` [N], ``Omega`` [rad/s], ``delta_mu``,
+        ``alpha`` [s/m], any field of :class:`~stickslip.Parameters`), ``model``, ``ic`` (named
+        initial conditions, :data:`~stickslip.sweep.spec.NAMED_ICS`) or ``perturb_<state>``.
+    params : Parameters, optional
+        Base parameters (default Table 1 with N = 50 N, Ω = 5 rad/s).
+    out : path, optional
+        NetCDF output (``.nc``). Finished points are journaled beside it (``OUT.nc.journal``) as
+        they arrive; a sweep killed and restarted with the same arguments recomputes nothing it
+        had finished. Default: a temporary file (the dataset is returned loaded).
+    executor : {"serial", "processes", "dask"}
+    workers : int, optional
+        Worker processes (default: all cores). For ``dask`` without ``address``, the LocalCluster size.
+    address : str, optional
+        ``dask.distributed`` scheduler address (``tcp://host:8786``); default a LocalCluster.
+    batch_size : int or "auto"
+        Points per task. ``auto`` times the first point in this process (which also compiles the
+        kernels) and aims at :data:`TARGET_BATCH_S` per batch.
+    progress : bool
+        Show a rich progress bar with rate and ETA.
+    overwrite : bool
+        Discard an existing output or journal of another sweep instead of refusing.
+    snapshot_interval : float
+        Seconds between NetCDF snapshots of the partial result while running [s].
+    keep_journal : bool
+        Keep the journal after the final NetCDF is written.
+    t_end, t_from : float
+        Run length and start of the steady window of every point [s] (default t_end/2).
+    **options
+        ``model``, ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
+        ``n_peaks``, ``method``: see :class:`~stickslip.sweep.spec.SweepSpec`.
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    SweepError
+        For an invalid grid or option, or an output that belongs to a different sweep.
+    """
+    t_start = time.perf_counter()
+    spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
+    if executor not in TARGET_BATCH_S:
+        raise SweepError(f"unknown executor {executor!r}; choose serial, processes or dask")
+    workers = default_workers() if workers is None else int(workers)
+    tmpdir = None
+    if out is None:
+        tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-sweep-")
+        out = Path(tmpdir.name) / "sweep.nc"
+    out = Path(out)
+    if out.suffix != ".nc":
+        raise SweepError(f"output {out}: give a path ending in .nc")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.exists() and not journal_dir(out).exists() and not overwrite:
+        try:
+            ds = load_sweep(out)
+        except SweepError as exc:
+            raise SweepError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
+        if ds.attrs.get("digest") == spec.digest and int(ds.attrs.get("complete", 0)):
+            return SweepResult(out, spec, ds, {"total_s": time.perf_counter() - t_start, "points_computed": 0,
+                                               "points_resumed": spec.size, "executor": executor, "workers": workers})
+        if ds.attrs.get("digest") != spec.digest:
+            raise SweepError(f"{out} holds a different sweep; pass overwrite=True (--overwrite) or choose another output")
+    journal = Journal(out, spec, overwrite=overwrite)
+    info: dict = {"executor": executor, "workers": workers}
+    try:
+        todo = np.flatnonzero(~journal.done_mask())
+        info["points_resumed"] = int(spec.size - todo.size)
+        info["points_computed"] = int(todo.size)
+        bar = _progress_bar() if progress else None
+        task = None
+        if bar is not None:
+            bar.start()
+            task = bar.add_task(f"sweep {'×'.join(map(str, spec.shape))}", total=spec.size,
+                                completed=spec.size - todo.size, rate="")
+        compute_start = time.perf_counter()
+        n_done = 0
+        last_snapshot = time.perf_counter()
+
+        def record(idx, rows):
+            nonlocal n_done, last_snapshot
+            journal.append(idx, rows)
+            n_done += len(idx)
+            if bar is not None:
+                rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
+                bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
+            if time.perf_counter() - last_snapshot > snapshot_interval:
+                assemble(journal, out)
+                last_snapshot = time.perf_counter()
+
+        if todo.size:
+            # the first point runs here: it compiles/loads the kernels and times a point
+            t = time.perf_counter()
+            record(*evaluate_batch(spec, todo[:1]))
+            t_point = time.perf_counter() - t
+            rest = todo[1:]
+            size = _auto_batch(t_point, rest.size, workers, executor) if batch_size == "auto" else int(batch_size)
+            if size < 1:
+                raise SweepError(f"batch_size must be >= 1 or 'auto', got {batch_size!r}")
+            batches = [rest[i : i + size] for i in range(0, rest.size, size)]
+            info.update(batch_size=size, batches=len(batches), first_point_s=t_point)
+            if batches:
+                for idx, rows in run_batches(spec, batches, executor=executor, workers=workers, address=address, info=info):
+                    record(idx, rows)
+        info["compute_s"] = time.perf_counter() - compute_start
+        if bar is not None:
+            bar.stop()
+        assemble(journal, out, extra_attrs={"executor": executor})
+        if not keep_journal:
+            journal.remove()
+        else:
+            journal.close()
+    except BaseException:
+        journal.close()
+        raise
+    ds = load_sweep(out)
+    info["total_s"] = time.perf_counter() - t_start
+    result = SweepResult(out, spec, ds, info)
+    if tmpdir is not None:
+        tmpdir.cleanup()
+    return result
+
