@@ -15,7 +15,8 @@ Fixed-step classic RK4 on all six DOF in both modes, in one compiled loop:
     (``kernels.solve_psd_2x2`` on the normal equations);
   - start value: linear extrapolation of the last two steps' forces (O(Δt²) accurate), or the
     exact multiplier ``kernels.stick_force`` at the first step of a stick phase;
-  - stop when |v_r(t_n)| ≤ :data:`VR_TOL`; after :data:`MAX_NEWTON` iterations the run stops
+  - stop when |v_r(t_n)| ≤ :data:`VR_TOL`, or when the Newton correction would change v_r(t_n)
+    by less than that (the rest of v_r is out of the force's reach, rank-deficient G); after :data:`MAX_NEWTON` iterations the run stops
     with ``STATUS_SOLVE_FAILED`` and the runner raises :class:`~stickslip.SimulationError`.
 
   No projection is needed: v_r = 0 holds at every step end to ``VR_TOL`` by construction;
@@ -142,6 +143,16 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
         b1 = -(j11 * vx + j21 * vy)
         b2 = -(j12 * vx + j22 * vy)
         dFx, dFy, _ = K.solve_psd_2x2(n11, n12, n22, b1, b2)
+        # the part of v_r the force can still change, J ΔF: when it is below VR_TOL the rest of
+        # v_r lies outside the range of J (rank-deficient G, e.g. Model 3 at φ ≈ 0, where no
+        # friction force acts on v_r·e_x) and the least-squares solve has converged
+        cx = j11 * dFx + j12 * dFy
+        cy = j21 * dFx + j22 * dFy
+        if math.sqrt(cx * cx + cy * cy) <= VR_TOL:
+            stats[6] += it
+            if it > stats[7]:
+                stats[7] = it
+            return Fx, Fy, it
         Fx += dFx
         Fy += dFy
         res_prev = res
