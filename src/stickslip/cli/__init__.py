@@ -7,5 +7,6 @@ from ._app import app
 
 from . import simulate  # noqa: E402,F401  (registers `stickslip simulate`)
 from . import stability  # noqa: E402,F401
+from . import study  # noqa: E402,F401  (registers `stickslip study timestep`)
 
 __all__ = ["app"]
