@@ -229,7 +229,7 @@ def after_slip_root(ynew, ex, ey, minv, damp, stiff, p):
     vx, vy = K.relative_velocity(ynew, p)
     if math.sqrt(vx * vx + vy * vy) <= max(E.STICK_SPEED_TOL, p[K.P_SLIP_BAND]):
         K.project_velocity(ynew, minv, p)
-    stick, nex, ney = E.try_stick(ynew, minv, damp, stiff, p)
+    stick, nex, ney = E.try_stick(ynew, minv, damp, stiff, p, E.STICK_SPEED_TOL)
     if stick:
         return True, ex, ey
     if nex != 0.0 or ney != 0.0:

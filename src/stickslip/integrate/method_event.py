@@ -272,7 +272,8 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 if speed > p[K.P_SLIP_BAND]:
                     mode = K.MODE_SLIP_EXACT  # same force above the band: k1 stays valid
             else:
-                near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= E.STICK_SPEED_TOL
+                v_arrive = E.arrival_speed(y, rtol, atol)
+                near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= v_arrive
                 tau = E.time_to_zero(y, k1, p)
                 if (theta <= 0.0 and E.ARRIVAL_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES
                         and (near or tau < h * factor)):
@@ -285,7 +286,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     homing += 1
                 elif near:
                     homing = 0
-                    stick, nex, ney = E.try_stick(y, minv, damp, stiff, p)
+                    stick, nex, ney = E.try_stick(y, minv, damp, stiff, p, v_arrive)
                     if stick:
                         mode = K.MODE_STICK
                         stats[4] += 1
