@@ -198,8 +198,14 @@ def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     F·(G q̇) [W], into ``ds[12]`` and the (negative) damping power −q̇ᵀ C q̇ [W] into ``ds[13]``,
     so that integrating them gives the energy balance ΔE = W_friction + W_damping.
     """
-    r = p[P_R]
     sphi, cphi, X, Y = contact_kinematics(s, p)
+    dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
+
+
+@njit(cache=True)
+def dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds):
+    """:func:`dynamics` with the contact kinematics (sin φ, cos φ, X, Y) already computed."""
+    r = p[P_R]
     # generalised friction forces Gᵀ F
     Q0 = Fx
     Q1 = Fy
@@ -291,9 +297,26 @@ def slip_direction(s, ex, ey, minv, damp, stiff, p):
 
 @njit(cache=True)
 def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
-    """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N]."""
-    Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
-    dynamics(s, Fx, Fy, minv, damp, stiff, p, ds)
+    """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N].
+
+    The common case, slip above the low-speed band, is computed with one evaluation of the
+    contact kinematics (this function is the integrators' inner loop).
+    """
+    sphi, cphi, X, Y = contact_kinematics(s, p)
+    Fx = Fy = 0.0
+    fused = False
+    if mode != MODE_STICK:
+        dX, dY = contact_rates(s, p, sphi, cphi)
+        w = p[P_OMEGA] + s[11]
+        vx = dX + w * Y
+        vy = dY - w * X
+        speed = math.sqrt(vx * vx + vy * vy)
+        if speed > p[P_SLIP_BAND] or (mode == MODE_SLIP_EXACT and speed > SPEED_FLOOR):
+            Fx, Fy = slip_force(speed, vx / speed, vy / speed, p)
+            fused = True
+    if not fused:
+        Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
+    dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
     return Fx, Fy
 
 
