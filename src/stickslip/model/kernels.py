@@ -154,8 +154,14 @@ def solve_psd_2x2(a11, a12, a22, b1, b2):
 @njit(cache=True)
 def constraint_metric(s, minv, p):
     """Entries (a11, a12, a22) of A = G M⁻¹ Gᵀ (2×2, symmetric PSD) [1/kg]."""
-    r = p[P_R]
     sphi, cphi, X, Y = contact_kinematics(s, p)
+    return constraint_metric_at(sphi, cphi, X, Y, minv, p)
+
+
+@njit(cache=True)
+def constraint_metric_at(sphi, cphi, X, Y, minv, p):
+    """:func:`constraint_metric` with the contact kinematics already computed."""
+    r = p[P_R]
     a11 = minv[0] + minv[2] + minv[4] * (r * sphi) ** 2 + minv[5] * Y * Y
     a12 = -minv[4] * r * r * sphi * cphi - minv[5] * X * Y
     a22 = minv[1] + minv[3] + minv[4] * (r * cphi) ** 2 + minv[5] * X * X
@@ -170,8 +176,14 @@ def stick_force(s, minv, damp, stiff, p):
     (G M⁻¹ Gᵀ) F = −(h + G M⁻¹ f), h = Ġ q̇ + Ω d(Y, −X)/dt, solved minimal-norm (rank-1 safe).
     Returns (Fx, Fy, rank).
     """
-    r = p[P_R]
     sphi, cphi, X, Y = contact_kinematics(s, p)
+    return stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
+
+
+@njit(cache=True)
+def stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p):
+    """:func:`stick_force` with the contact kinematics already computed."""
+    r = p[P_R]
     dphi = s[10]
     dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
@@ -186,7 +198,7 @@ def stick_force(s, minv, damp, stiff, p):
     a5 = minv[5] * (-damp[5] * s[11] - stiff[5] * s[5])
     g1 = a0 - a2 - r * sphi * a4 + Y * a5
     g2 = a1 - a3 + r * cphi * a4 - X * a5
-    a11, a12, a22 = constraint_metric(s, minv, p)
+    a11, a12, a22 = constraint_metric_at(sphi, cphi, X, Y, minv, p)
     return solve_psd_2x2(a11, a12, a22, -(h1 + g1), -(h2 + g2))
 
 
@@ -299,13 +311,16 @@ def slip_direction(s, ex, ey, minv, damp, stiff, p):
 def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N].
 
-    The common case, slip above the low-speed band, is computed with one evaluation of the
-    contact kinematics (this function is the integrators' inner loop).
+    Stick and slip above the low-speed band use one evaluation of the contact kinematics
+    (this function is the integrators' inner loop); the band goes through :func:`contact_force`.
     """
     sphi, cphi, X, Y = contact_kinematics(s, p)
     Fx = Fy = 0.0
-    fused = False
-    if mode != MODE_STICK:
+    done = False
+    if mode == MODE_STICK:
+        Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
+        done = True
+    else:
         dX, dY = contact_rates(s, p, sphi, cphi)
         w = p[P_OMEGA] + s[11]
         vx = dX + w * Y
@@ -313,8 +328,8 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
         speed = math.sqrt(vx * vx + vy * vy)
         if speed > p[P_SLIP_BAND] or (mode == MODE_SLIP_EXACT and speed > SPEED_FLOOR):
             Fx, Fy = slip_force(speed, vx / speed, vy / speed, p)
-            fused = True
-    if not fused:
+            done = True
+    if not done:
         Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
     dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
     return Fx, Fy
