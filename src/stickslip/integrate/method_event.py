@@ -116,16 +116,14 @@ def _dense_coefficients(Kst, Q):
 
 
 @njit(cache=True)
-def _write_samples(idx, t_from, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff, p,
+def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff, p,
                    sample_times, out_s, out_mode, out_F, work):
-    """Write the samples with t_from < t ≤ t_to (within the step starting at t_step)."""
+    """Write the samples from index ``idx`` up to time t_to, from the step starting at t_step."""
     n_samples = sample_times.shape[0]
     while idx < n_samples and sample_times[idx] <= t_to:
-        ts = sample_times[idx]
-        if ts >= t_from:
-            theta = (ts - t_step) / h if h > 0.0 else 0.0
-            E.dense_state(y0, Q, h, theta, work)
-            _store_sample(idx, work, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
+        theta = (sample_times[idx] - t_step) / h if h > 0.0 else 0.0
+        E.dense_state(y0, Q, h, theta, work)
+        _store_sample(idx, work, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
     return idx
 
@@ -258,7 +256,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 retakes += 1
                 stats[3] += 1
                 continue
-            idx = _write_samples(idx, t, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+            idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
                                  sample_times, out_s, out_mode, out_F, work)
             t += h
             for i in range(n):
@@ -310,7 +308,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             if theta > 0.0:
                 # breakaway inside the step: the stick flow is smooth, so cut the step at the root
                 t_root = t + theta * h
-                idx = _write_samples(idx, t, t_root, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                idx = _write_samples(idx, t_root, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
                                      sample_times, out_s, out_mode, out_F, work)
                 E.dense_state(y, Q, h, theta, work)
                 for i in range(n):
@@ -324,7 +322,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_SLIP, y, tr_t, tr_kind, tr_s)
                 n_tr += 1
             else:
-                idx = _write_samples(idx, t, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
                                      sample_times, out_s, out_mode, out_F, work)
                 t += h
                 for i in range(n):
