@@ -1,0 +1,331 @@
+"""``stickslip sweep``, ``stickslip bifurcation`` and ``stickslip regions``: parameter sweeps.
+
+Parse → library call (:mod:`stickslip.sweep`) → write NetCDF and a figure; no physics here.
+Every command resumes: run it again with the same arguments and it computes only what is
+missing (nothing, if the output is complete).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import List, Optional
+
+import numpy as np
+import typer
+from rich.table import Table
+
+from ._app import app, build_parameters, console, user_errors
+
+_CATEGORICAL = ("model", "ic")
+
+_EXECUTOR_HELP = "serial | processes | dask (default processes; dask when --scheduler is given)."
+_WORKERS_HELP = "Worker processes (default: all cores); with dask and no --scheduler, the LocalCluster size."
+_SCHEDULER_HELP = "dask.distributed scheduler address, e.g. tcp://head-node:8786 (implies --executor dask)."
+_TEND_HELP = "Simulated time of every grid point [s]."
+_TFROM_HELP = "Start of the steady-state window [s] (default t_end/2)."
+_SET_HELP = "Any base parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."
+_CONFIG_HELP = "TOML file with a [parameters] table (base parameters)."
+_OVERWRITE_HELP = "Replace an output (or journal) that belongs to a different sweep instead of refusing."
+
+
+def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
+    """Values of one grid axis from ``start:stop:count`` or a comma list.
+
+    Numbers for parameters (``10:130:13`` → 13 evenly spaced values from 10 to 130 inclusive;
+    ``0.5,5,8.5``); names for ``model`` and ``ic`` (``full,rotation``).
+
+    Raises
+    ------
+    ValueError
+        With a one-line message naming the fix.
+    """
+    text = text.strip()
+    example = f"{option} {name}=10:130:13 or {option} {name}=30,50,70"
+    if not text:
+        raise ValueError(f"{option} {name}= has no values; e.g. {example}")
+    if name in _CATEGORICAL:
+        values = [v.strip() for v in text.split(",")]
+        if not all(values):
+            raise ValueError(f"{option} {name}={text}: empty name in the list; e.g. {option} {name}=full,rotation")
+        return values
+    if ":" in text:
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise ValueError(f"{option} {name}={text}: a range is start:stop:count; e.g. {example}")
+        try:
+            start, stop = float(parts[0]), float(parts[1])
+            count = int(parts[2])
+        except ValueError:
+            raise ValueError(f"{option} {name}={text}: start and stop must be numbers and count an integer; "
+                             f"e.g. {example}") from None
+        if not (math.isfinite(start) and math.isfinite(stop)):
+            raise ValueError(f"{option} {name}={text}: start and stop must be finite numbers")
+        if count < 2:
+            raise ValueError(f"{option} {name}={text}: count must be >= 2 (for one value write {option} {name}={parts[0]})")
+        if start == stop:
+            raise ValueError(f"{option} {name}={text}: start equals stop; give different ends or a single value")
+        return np.linspace(start, stop, count).tolist()
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise ValueError(f"{option} {name}={text}: give numbers separated by commas or start:stop:count; "
+                         f"e.g. {example}") from None
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{option} {name}={text}: values must be finite numbers")
+    return values
+
+
+def parse_grid(items: list[str] | None) -> dict:
+    """``["N=10:130:13", "Omega=0.5,5"]`` → ``{"N": [...], "Omega": [0.5, 5.0]}`` (order kept)."""
+    grid: dict = {}
+    for item in items or []:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ValueError(f"--grid expects NAME=VALUES, got {item!r}; e.g. --grid N=10:130:13 --grid Omega=0.5,5,8.5")
+        if name in grid:
+            raise ValueError(f"--grid {name} given twice; give each dimension once")
+        grid[name] = parse_values(name, text)
+    if not grid:
+        raise ValueError("give at least one --grid NAME=VALUES, e.g. --grid N=10:130:13")
+    return grid
+
+
+def _executor(executor: str | None, scheduler: str | None) -> str:
+    if executor is None:
+        return "dask" if scheduler else "processes"
+    if scheduler and executor != "dask":
+        raise ValueError(f"--scheduler needs --executor dask (got --executor {executor})")
+    return executor
+
+
+def _check_out(out: Path) -> None:
+    if out.suffix != ".nc":
+        raise ValueError(f"--out {out}: give a path ending in .nc")
+
+
+def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
+    if workers is not None and workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {workers}")
+    for flag, value in (("--t-end", t_end), ("--sample-rate", sample_rate), ("--rtol", rtol), ("--atol", atol)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+    if t_from is not None and not math.isfinite(t_from):
+        raise ValueError(f"--t-from must be a finite number, got {t_from}")
+    return dict(executor=_executor(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
+                overwrite=overwrite, t_end=t_end, t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
+
+
+def _kind_counts(ds) -> dict:
+    from ..analysis.classify import KINDS
+
+    code = ds["kind"].values
+    code = np.where(np.isfinite(code), code, -1).astype(int)
+    names = list(KINDS) + ["failed"]
+    return {names[c]: int(np.sum(code == c)) for c in (-1, 0, 1, 2, 3) if np.any(code == c)}
+
+
+def _report(title: str, out: Path, figure, timings: dict, ds, as_json: bool, extra: dict | None = None) -> None:
+    summary = {
+        "out": str(out), "figure": None if figure is None else str(figure),
+        "shape": {d: int(ds.sizes[d]) for d in ds["done"].dims},
+        "points_computed": int(timings.get("points_computed", 0)), "points_resumed": int(timings.get("points_resumed", 0)),
+        "total_s": float(timings.get("total_s", float("nan"))), "kinds": _kind_counts(ds), **(extra or {}),
+    }
+    if as_json:
+        print(json.dumps(summary))
+        return
+    table = Table(title=title, show_header=False)
+    table.add_row("grid", " × ".join(f"{d} {n}" for d, n in summary["shape"].items()))
+    table.add_row("points computed / resumed", f"{summary['points_computed']} / {summary['points_resumed']}")
+    executor = timings.get("executor", "?")
+    workers = "1 process" if executor == "serial" else f"{timings.get('workers', '?')} workers"
+    table.add_row("wall time", f"{summary['total_s']:.2f} s ({executor}, {workers})")
+    table.add_row("steady states", ", ".join(f"{k} {v}" for k, v in summary["kinds"].items()))
+    for key, value in (extra or {}).items():
+        table.add_row(key.replace("_", " "), str(value))
+    table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
+    console.print(table)
+
+
+# ----------------------------------------------------------------------------- stickslip sweep
+@app.command("sweep")
+def sweep_command(
+    grid: Optional[List[str]] = typer.Option(None, "--grid", help="Swept dimension NAME=start:stop:count or NAME=v1,v2,... "
+                                             "(repeatable; order = dimension order). NAME: a parameter (N, Omega, "
+                                             "delta_mu, alpha, mu_k, k_px, ...), model, ic or perturb_<state>."),
+    model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) when not swept."),
+    ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium (see docs/sweeps.md) when not swept."),
+    t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
+    t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
+    sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
+    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
+    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
+    config: Optional[Path] = typer.Option(None, "--config", help=_CONFIG_HELP),
+    executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
+    workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
+    out: Path = typer.Option(Path("sweep.nc"), "--out", help="NetCDF output (resumes if it or its journal exists); "
+                                                           "the figure goes beside it as .png."),
+    plot_var: str = typer.Option("frequency", "--plot", help="Reduction drawn in the figure: frequency, amplitude, "
+                                                            "stick_fraction, kind, intensity_r_phi, ..."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=_OVERWRITE_HELP),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+) -> None:
+    """Simulate every point of a grid over any parameters, models and initial conditions and keep
+    its steady-state reductions (peaks, kind, frequency, intensity, stick fraction)."""
+    from ..sweep import sweep as run_sweep
+    from ..sweep.spec import COLUMNS
+
+    with user_errors():
+        params = build_parameters(config, set_)
+        values = parse_grid(grid)
+        _check_out(out)
+        if plot_var not in COLUMNS or plot_var == "peaks":
+            raise ValueError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
+        options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+        result = run_sweep(values, params, out=out, model=model, ic=ic, **options)
+        figure = None
+        if not no_plot:
+            from ..plot.sweep import save_sweep_figure
+
+            figure = save_sweep_figure(result, out.with_suffix(".png"), var=plot_var)
+    _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
+            result.dataset, as_json)
+
+
+# ----------------------------------------------------------------------------- stickslip bifurcation
+@app.command("bifurcation")
+def bifurcation(
+    param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter."),
+    range_: str = typer.Option("10:130:121", "--range", help="Its values: start:stop:count or v1,v2,..."),
+    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not the control parameter (default 50)."),
+    omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not the control parameter "
+                                                                "(default 0.5, as in Figs. 12(a), 13, 14)."),
+    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
+    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
+    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
+    model: str = typer.Option("full", "--model", help="full | x | y | rotation, or a comma list (one panel each, Fig. 14)."),
+    ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium."),
+    t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
+    t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
+    n_peaks: int = typer.Option(64, "--peaks", help="Last peak values of φ kept per point."),
+    sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
+    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
+    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
+    config: Optional[Path] = typer.Option(None, "--config", help=_CONFIG_HELP),
+    executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
+    workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
+    out: Path = typer.Option(Path("bifurcation.nc"), "--out", help="NetCDF output (resumable); figure beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=_OVERWRITE_HELP),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+) -> None:
+    """Bifurcation diagram of φ: steady-state peak values against one parameter (Figs. 12–14)."""
+    from ..sweep import sweep as run_sweep
+
+    with user_errors():
+        if param in _CATEGORICAL:
+            raise ValueError(f"--param {param}: the control parameter must be numeric; use --model full,x,y,rotation "
+                             "for one panel per model")
+        named = dict(N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+        flags = dict(N="--N", Omega="--omega", mu_k="--mu-k", delta_mu="--delta-mu", alpha="--alpha")
+        if named.get(param) is not None:
+            raise ValueError(f"{flags[param]} conflicts with --param {param}; drop {flags[param]} (the range sets it)")
+        params = _bifurcation_parameters(config, set_, named, param)
+        values = parse_values(param, range_, option="--range")
+        models = parse_values("model", model, option="--model") if "," in model else [model]
+        grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
+        _check_out(out)
+        if n_peaks < 1:
+            raise ValueError(f"--peaks must be >= 1, got {n_peaks}")
+        options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+        result = run_sweep(grid, params, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
+        figure = None
+        if not no_plot:
+            from ..plot.sweep import save_bifurcation_figure
+
+            figure = save_bifurcation_figure(result, out.with_suffix(".png"))
+    _report(f"bifurcation diagram of φ against {param}", out, figure, result.timings, result.dataset, as_json)
+
+
+#: Base values of the paper's bifurcation diagrams (Figs. 12–14): N = 50 N and Ω = 0.5 rad/s
+#: unless swept (Fig. 12(b) and 14(b, d, f) sweep Ω at N = 50 N).
+BIFURCATION_BASE = {"N": 50.0, "Omega": 0.5}
+
+
+def _bifurcation_parameters(config, assignments, named: dict, param: str):
+    """Base parameters: :data:`BIFURCATION_BASE` for N and Ω unless the config file, ``--set`` or
+    the named options give them, then everything as in :func:`build_parameters`."""
+    import tomllib
+
+    params = build_parameters(config, assignments, **named)
+    given = {k for k, v in named.items() if v is not None}
+    given |= {item.partition("=")[0].strip() for item in assignments or []}
+    if config is not None:
+        data = tomllib.loads(Path(config).read_text())
+        given |= set(data.get("parameters", data))
+    changes = {k: v for k, v in BIFURCATION_BASE.items() if k != param and k not in given}
+    return params.replace(**changes) if changes else params
+
+
+# ----------------------------------------------------------------------------- stickslip regions
+@app.command("regions")
+def regions_command(
+    N: str = typer.Option("10:130:13", "--N", help="Normal loads [N]: start:stop:count or v1,v2,..."),
+    omega: str = typer.Option("1:15:15", "--omega", help="Ω values [rad/s]: start:stop:count or v1,v2,..."),
+    model: str = typer.Option("full", "--model", help="Comma list of full, x, y, rotation (Fig. 9 compares all four)."),
+    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
+    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
+    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
+    t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
+    t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
+    sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
+    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
+    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
+    config: Optional[Path] = typer.Option(None, "--config", help=_CONFIG_HELP),
+    executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
+    workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
+    out: Path = typer.Option(Path("regions.nc"), "--out", help="NetCDF output (resumable); figure beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=_OVERWRITE_HELP),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+) -> None:
+    """Regions I/II/III over (N, Ω) from the 'far' and 'near' initial conditions (Fig. 8) and the
+    stick-slip domain of each model (Fig. 9)."""
+    from ..sweep import regions as run_regions
+
+    with user_errors():
+        params = build_parameters(config, set_, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+        n_values = parse_values("N", N, option="--N")
+        w_values = parse_values("Omega", omega, option="--omega")
+        models = parse_values("model", model, option="--model")
+        _check_out(out)
+        options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+        rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
+        figure = None
+        if not no_plot:
+            from ..plot.regions import save_regions_figure
+
+            figure = save_regions_figure(rmap, out.with_suffix(".png"))
+    from ..sweep.bistability import REGION_NAMES
+
+    region = rmap.region
+    counts = {REGION_NAMES[c]: int(np.sum(region == c)) for c in sorted(REGION_NAMES) if np.any(region == c)}
+    omax = rmap.dataset["stick_slip_omega_max"]
+    edges = {m: [None if not np.isfinite(v) else float(v) for v in omax.sel(model=m).values] for m in rmap.models}
+    extra = {"regions": ", ".join(f"{k}: {v}" for k, v in counts.items())}
+    if as_json:
+        extra = {"regions": counts, "stick_slip_omega_max": edges}
+    _report("regions of steady states over (N, Ω)", out, figure, rmap.timings, rmap.dataset, as_json, extra)
