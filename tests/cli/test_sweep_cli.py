@@ -183,3 +183,25 @@ def test_bad_input_gives_one_line_error(args, words, tmp_path, monkeypatch):
 def test_unknown_option_is_refused(command):
     res = run(command, "--bogus", "1")
     assert res.exit_code == 2 and "No such option" in res.output
+
+
+def test_bifurcation_takes_omega_from_a_config_file(tmp_path):
+    cfg = tmp_path / "p.toml"
+    cfg.write_text("[parameters]\nOmega = 1.0\nalpha = 4\n")
+    out = tmp_path / "c.nc"
+    summary(run("bifurcation", "--range", "30,50", "--config", str(cfg), "--t-end", str(T_END), "--executor", "serial",
+                "--no-plot", "--no-progress", "--out", str(out), "--json"))
+    ds = load_sweep(out)
+    # the file's Ω wins over the paper's 0.5 rad/s; N is swept, the rest comes from the file
+    assert (ds.attrs["param_Omega"], ds.attrs["param_alpha"]) == (1.0, 4.0)
+    assert not out.with_suffix(".png").exists()
+
+
+@pytest.mark.parametrize("var", ["kind", "frequency", "intensity_r_phi"])
+def test_sweep_figures_of_other_reductions(swept, tmp_path, var):
+    from stickslip.plot.sweep import save_sweep_figure
+
+    path = save_sweep_figure(load_sweep(swept[0]), tmp_path / f"{var}.png", var=var)
+    assert path.stat().st_size > 10_000  # a drawn figure, not an empty canvas
+    with pytest.raises(ValueError, match="choose one of"):
+        save_sweep_figure(load_sweep(swept[0]), tmp_path / "x.png", var="peaks")

@@ -91,8 +91,8 @@ def plot_regions(rmap, ax=None, *, model: str | None = None, boundary: bool = Tr
     ax.set_xlabel("normal load N [N]")
     ax.set_ylabel("Ω [rad/s]")
     ax.set_title(MODEL_LABELS.get(model, f"model {model}") if title is None else title, fontsize=10)
-    if legend:
-        ax.legend(handles=handles, fontsize=7, loc="upper left", framealpha=0.9)
+    if legend:  # below the map, so that no cell is hidden
+        ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
     return ax
 
 
@@ -143,7 +143,7 @@ def save_regions_figure(rmap, path, *, dpi: int = 110) -> Path:
         plot_regions(ds, ax, model=model)
     if len(models) > 1:
         plot_stick_slip_domains(ds, axes[-1])
-    fig.suptitle(f"Steady-state regions over (N, Ω) — {_params_line(ds)}", fontsize=10)
+    fig.suptitle(f"Steady-state regions over (N, Ω)\n{_params_line(ds)}", fontsize=10)
     path = Path(path)
     fig.savefig(path, dpi=dpi)
     return path

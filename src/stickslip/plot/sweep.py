@@ -241,7 +241,7 @@ def _control_dim(ds) -> str:
     return numeric[0]
 
 
-def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: bool = True, marker_size: float = 1.5):
+def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: bool = True, marker_size: float = 3.0):
     """Bifurcation diagram: the steady-state peak values of φ (events φ̇ = 0) against the control
     parameter, as dots (paper Figs. 12–14).
 
