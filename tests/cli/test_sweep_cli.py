@@ -120,7 +120,7 @@ def test_regions_of_known_cases_and_direct_run(tmp_path):
     # Sect. 4.2.2, N = 50 N: coexistence (II) at Ω = 8.5 rad/s, equilibrium only (III) at 12 rad/s;
     # 60 s runs settle both (the library test uses the same case)
     out = tmp_path / "r.nc"
-    s = summary(run("regions", "--N", "50", "--omega", "8.5,12", "--t-end", "60", "--executor", "serial",
+    s = summary(run("regions", "--N", "50", "--omega", "8.5,12", "--t-end", "60", "--t-from", "30", "--executor", "serial",
                     "--out", str(out), "--json"))
     assert s["regions"] == {"II: coexistence": 1, "III: equilibrium only": 1}
     assert s["stick_slip_omega_max"] == {"full": [8.5]}
@@ -131,7 +131,7 @@ def test_regions_of_known_cases_and_direct_run(tmp_path):
     kind = ds["kind"].transpose("model", "N", "Omega", "ic").values
     sf = ds["stick_fraction"].transpose("model", "N", "Omega", "ic").values
     assert np.array_equal(classify_regions(kind, sf), rm.region)
-    assert ds.attrs["t_end"] == 60.0 and list(ds["ic"].values) == ["far", "near"]
+    assert (ds.attrs["t_end"], ds.attrs["t_from"]) == (60.0, 30.0) and list(ds["ic"].values) == ["far", "near"]
 
 
 @pytest.mark.parametrize("args, words", [
@@ -205,3 +205,10 @@ def test_sweep_figures_of_other_reductions(swept, tmp_path, var):
     assert path.stat().st_size > 10_000  # a drawn figure, not an empty canvas
     with pytest.raises(ValueError, match="choose one of"):
         save_sweep_figure(load_sweep(swept[0]), tmp_path / "x.png", var="peaks")
+
+
+def test_regions_window_defaults_to_the_last_100_s_or_half(tmp_path):
+    out = tmp_path / "w.nc"
+    summary(run("regions", "--N", "50", "--omega", "12", "--t-end", "20", "--executor", "serial", "--no-plot",
+                "--no-progress", "--out", str(out), "--json"))
+    assert load_sweep(out).attrs["t_from"] == 10.0  # half of a run shorter than 200 s

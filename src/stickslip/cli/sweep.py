@@ -177,8 +177,11 @@ def sweep_command(
     no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
 ) -> None:
-    """Simulate every point of a grid over any parameters, models and initial conditions and keep
-    its steady-state reductions (peaks, kind, frequency, intensity, stick fraction)."""
+    """Simulate every point of a grid and keep its steady-state reductions.
+
+    Grid over any parameters, models and initial conditions; kept per point: peaks of φ, kind,
+    frequency, stick fraction, intensity (Eq. 16), relative-motion angle.
+    """
     from ..sweep import sweep as run_sweep
     from ..sweep.spec import COLUMNS
 
@@ -278,6 +281,11 @@ def _bifurcation_parameters(config, assignments, named: dict, param: str):
 
 
 # ----------------------------------------------------------------------------- stickslip regions
+#: Default length of the steady window of region maps [s]: the window of the maps in
+#: docs/sweeps.md, ≥ 80 cycles of the slowest stick-slip measured there (dominant frequency
+#: ~0.8 Hz at 120 N, Ω = 0.5 rad/s, Fig. 12(a)), enough for the return-map classification.
+REGIONS_WINDOW_S = 100.0
+
 @app.command("regions")
 def regions_command(
     N: str = typer.Option("10:130:13", "--N", help="Normal loads [N]: start:stop:count or v1,v2,..."),
@@ -286,8 +294,12 @@ def regions_command(
     mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
-    t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
+    # 300 s: the 'near' start leaves a weakly unstable equilibrium slowly (growth rate
+    # 0.05 1/s at N = 50 N, Ω = 5 rad/s: ~150 s until stick-slip), see docs/sweeps.md
+    t_end: float = typer.Option(300.0, "--t-end", help=_TEND_HELP + " Long, because the 'near' start leaves a "
+                                                     "weakly unstable equilibrium slowly."),
+    t_from: Optional[float] = typer.Option(None, "--t-from", help="Start of the steady-state window [s] "
+                                                                 "(default: the last 100 s, or the last half of shorter runs)."),
     sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
@@ -302,8 +314,10 @@ def regions_command(
     no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
 ) -> None:
-    """Regions I/II/III over (N, Ω) from the 'far' and 'near' initial conditions (Fig. 8) and the
-    stick-slip domain of each model (Fig. 9)."""
+    """Regions I/II/III over (N, Ω) (Fig. 8) and stick-slip domains of several models (Fig. 9).
+
+    Every (model, N, Ω) is run from the 'far' and the 'near' initial condition (docs/sweeps.md).
+    """
     from ..sweep import regions as run_regions
 
     with user_errors():
@@ -312,6 +326,8 @@ def regions_command(
         w_values = parse_values("Omega", omega, option="--omega")
         models = parse_values("model", model, option="--model")
         _check_out(out)
+        if t_from is None and math.isfinite(t_end):
+            t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
         options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
         rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
         figure = None
