@@ -34,12 +34,15 @@ EVENT_TIME_TOL = 1e-12
 #: singularity of v_r/|v_r| at zero and get rejected.
 ARRIVAL_TIME_TOL = 1e-10
 
-#: |v_r| [m/s] at or below which slip has reached v_r = 0 (at a root of the projected slip
-#: velocity or at a step end). On the approach the step sizes fall geometrically with |v_r|, so
-#: it is reached in a few steps; the residual is removed by the projection, an instant error of
-#: ≤ 1e-8 / |dv_r/dt| ≈ 1e-9 s at the paper's decelerations (~10 m/s²). A mere turn of the slip
+#: |v_r| [m/s] at or below which slip is close enough to v_r = 0 to finish the approach. When
+#: v_r heads for zero (within 60° of head-on) the last steps are homed onto it until the
+#: extrapolated time left is below ARRIVAL_TIME_TOL; when it spirals in (anisotropic
+#: G M⁻¹ Gᵀ: the stiff direction dynamics turn v_r faster than it shrinks, and explicit steps
+#: at their stability limit can hover, seen at |v_r| ~ 2e-8 m/s for N = 80 N, Ω = 1 rad/s)
+#: the residual ≤ 1e-6 m/s is removed by the projection at once: an impulse of at most
+#: 1e-6 m/s × mass and an instant error of ≤ 1e-6 / |dv_r/dt| (~1e-7 s). A mere turn of the slip
 #: direction keeps |v_r| of the order of the sliding speed (0.1–1 m/s in the paper's cases).
-STICK_SPEED_TOL = 1e-8
+STICK_SPEED_TOL = 1e-6
 
 #: Sub-intervals of a step on which the event function is sampled for a sign change.
 EVENT_CHECKS = 4
