@@ -13,6 +13,8 @@
 ``intensity``               intensity index I of Eq. (16)
 ``sweep``                   parameter grids → resumable NetCDF of reductions (serial, processes, dask)
 ``regions``                 bistability regions I/II/III (Fig. 8) and stick-slip domains (Fig. 9)
+``periodic_orbit``          periodic orbit by shooting on a Poincaré section, Floquet multipliers
+``lyapunov_exponent``       largest Lyapunov exponent (Benettin, across events)
 ``MODELS``                  the paper's Models 1–4 as free DOFs
 ==========================  ==============================================================
 """
@@ -24,6 +26,7 @@ from .integrate.driver import SimulationError, simulate
 from .integrate.result import FileFormatError, Trajectory, load_trajectory
 from .model.parameters import ParameterError, Parameters
 from .model.variants import DOF_NAMES, MODELS, STATE_NAMES, VariantError
+from .orbits import LyapunovResult, OrbitError, PeriodicOrbit, lyapunov_exponent, periodic_orbit
 from .stability import StabilityMap, StabilityResult, load_stability_map, stability, stability_map
 from .stability.equilibrium import EquilibriumError, equilibrium
 from .sweep import RegionMap, SweepError, SweepResult, load_region_map, load_sweep, regions, sweep
@@ -37,5 +40,6 @@ __all__ = [
     "stability", "StabilityResult", "stability_map", "StabilityMap", "load_stability_map",
     "classify", "Classification", "find_peaks", "intensity",
     "sweep", "SweepResult", "SweepError", "load_sweep", "regions", "RegionMap", "load_region_map",
+    "periodic_orbit", "PeriodicOrbit", "lyapunov_exponent", "LyapunovResult", "OrbitError",
     "MODELS", "DOF_NAMES", "STATE_NAMES", "VariantError",
 ]

@@ -56,3 +56,18 @@ def test_stick_is_exact_on_the_belt():
     phi = traj.states[stick, 4]
     torque = P.r * (-np.sin(phi) * traj.friction[stick, 0] + np.cos(phi) * traj.friction[stick, 1])
     assert np.allclose(torque, P.k_pphi * phi, rtol=1e-9, atol=1e-12)
+
+
+def test_run_that_starts_sliding_just_short_of_stick():
+    """Regression: a run starting in slip with |v_r| < 1e-3 m/s once slid through v_r = 0 unseen
+    and then chattered at the low-speed band for 5e7 steps."""
+    P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
+    ic = np.zeros(12)
+    ic[4], ic[10] = 0.00946034184785673, 0.49777818470226337  # v_r = r (φ̇ − Ω) ≈ −4.4e-4 m/s
+    traj = simulate(P, 1.0, model="phi", ic=ic, rtol=1e-10, atol=1e-13, max_steps=100_000)
+    assert traj.status == "success"
+    t_stick, t_slip = closed_form(P)
+    tt = traj.transitions.time
+    assert traj.transitions.kind[0] == 1 and len(tt) >= 4
+    assert np.allclose(np.diff(tt)[0::2][:2], t_stick, rtol=1e-8)
+    assert np.allclose(np.diff(tt)[1::2][:1], t_slip, rtol=1e-8)

@@ -193,6 +193,10 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     stats = np.zeros(6, dtype=np.int64)
 
     mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
+    vx, vy = K.relative_velocity(y, p)
+    if mode == K.MODE_SLIP and math.sqrt(vx * vx + vy * vy) > E.STICK_SPEED_TOL:
+        # a run that starts sliding is not departing from v_r = 0: watch it for stick at once
+        mode = K.MODE_SLIP_EXACT
     K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
     stats[2] += 1
     t = t0
