@@ -33,10 +33,10 @@ def test_bad_options():
         lyapunov_exponent(Parameters(), t_transient=1.0, t_average=0.1, chunk=1.0)
 
 
-@pytest.mark.slow
 def test_belt_orbit_exponent_vanishes():
     """1-DOF belt oscillator (stick collapses every other direction): λ → 0 like 1/t.
-    Slow (~65 s): chunks starting just before stick cost the event integrator 10⁵+ steps."""
+    (Once slow, ~65 s: chunks starting just before stick cost 10⁵+ steps before a fix of the
+    event integrator's initial mode; now ~1 s.)"""
     P = Parameters(Omega=0.5)
     ic = np.zeros(12)
     ic[10] = 0.5
