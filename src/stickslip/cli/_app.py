@@ -18,6 +18,9 @@ app = typer.Typer(
 console = Console()
 err_console = Console(stderr=True)
 
+#: Help text of every --config option (the backslash keeps rich from reading [parameters] as markup).
+CONFIG_HELP = "TOML file with a \\[parameters] table (names not given keep their defaults)."
+
 #: Errors that are the user's to fix: printed as one line, exit code 2.
 USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, FileNotFoundError, RuntimeError)
 

@@ -10,7 +10,7 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
 
 
 def _parse_ic(text: str):
@@ -41,7 +41,7 @@ def simulate(
     sample_rate: float = typer.Option(1000.0, "--sample-rate", help="Output samples per second [Hz]."),
     steady_from: Optional[float] = typer.Option(None, "--steady-from", help="Start of the steady-state window [s] (default: last half)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."),
-    config: Optional[Path] = typer.Option(None, "--config", help="TOML file with a [parameters] table."),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("run.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     as_json: bool = typer.Option(False, "--json", help="Print the steady-state summary as one JSON object."),

@@ -13,7 +13,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
 
 _N_HELP = "Normal preload N [N] (default 50)."
 _OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
@@ -28,7 +28,7 @@ def stability(
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."),
-    config: Optional[Path] = typer.Option(None, "--config", help="TOML file with a [parameters] table."),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
     """Equilibrium of steady sliding (Eq. 14) and its eigenvalues (Eq. 15)."""
@@ -82,7 +82,7 @@ def stability_map(
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation or DOFs (ignored with --family model=...)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
-    config: Optional[Path] = typer.Option(None, "--config", help="TOML file with a [parameters] table."),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     no_boundary: bool = typer.Option(False, "--no-boundary", help="Skip the root-finding of the boundary Ω_c(N)."),
     out: Path = typer.Option(Path("stability_map.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),

@@ -16,7 +16,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
 
 _CATEGORICAL = ("model", "ic")
 
@@ -26,7 +26,6 @@ _SCHEDULER_HELP = "dask.distributed scheduler address, e.g. tcp://head-node:8786
 _TEND_HELP = "Simulated time of every grid point [s]."
 _TFROM_HELP = "Start of the steady-state window [s] (default t_end/2)."
 _SET_HELP = "Any base parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."
-_CONFIG_HELP = "TOML file with a [parameters] table (base parameters)."
 _OVERWRITE_HELP = "Replace an output (or journal) that belongs to a different sweep instead of refusing."
 
 
@@ -164,7 +163,7 @@ def sweep_command(
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=_CONFIG_HELP),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
     workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
@@ -222,7 +221,7 @@ def bifurcation(
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=_CONFIG_HELP),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
     workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
@@ -304,7 +303,7 @@ def regions_command(
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=_CONFIG_HELP),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
     workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
