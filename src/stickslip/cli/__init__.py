@@ -8,6 +8,7 @@ from ._app import app
 from . import simulate  # noqa: E402,F401  (registers `stickslip simulate`)
 from . import stability  # noqa: E402,F401
 from . import study  # noqa: E402,F401  (registers `stickslip study timestep`)
+from . import reproduce  # noqa: E402,F401  (registers `stickslip reproduce`)
 from . import sweep  # noqa: E402,F401  (registers `stickslip sweep`, `bifurcation`, `regions`)
 
 __all__ = ["app"]

@@ -1,0 +1,33 @@
+"""``stickslip reproduce``: regenerate the paper's figures and Table 2 with a Markdown report.
+Parse → library call → write; no physics here."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from ._app import app, console, err_console, user_errors
+
+
+@app.command("reproduce")
+def reproduce(
+    out: Path = typer.Option(Path("paper"), "--out", help="Output directory: report.md, PNGs, results.json."),
+    quick: bool = typer.Option(False, "--quick", help="Coarse grids and short runs (a few minutes on 2 cores)."),
+    only: list[str] = typer.Option(None, "--only", help="Run only these figures (repeatable): "
+                                   "fig3, fig4, table2, fig7, fig10, fig11, fig12a."),
+) -> None:
+    """Paper Sects. 4.1–4.2: Figs. 3, 4, 7, 10, 11, 12(a), Table 2 / Figs. 5–6 beside the paper's
+    statements, with a table "paper says / we measure / agrees?" (OUT/report.md)."""
+    from ..studies.reproduce import recipe_names
+    from ..studies.reproduce import reproduce as run_reproduce
+
+    with user_errors():
+        if only:
+            unknown = [n for n in only if n not in recipe_names()]
+            if unknown:
+                raise ValueError(f"unknown figure {', '.join(map(repr, unknown))} for --only; "
+                                 f"choose from {', '.join(recipe_names())}")
+        report = run_reproduce(out, "quick" if quick else "full", only=only or None,
+                               progress=lambda msg: err_console.print(f"[dim]{msg}[/]", highlight=False))
+    console.print(f"wrote {report}", highlight=False, markup=False)
