@@ -32,8 +32,8 @@ class SteadyState:
     t_from, t_to : float
         Window analysed [s].
     fundamental_frequency_hz : float
-        1 / (smallest period) of φ [Hz] when periodic (section return map); otherwise the mean
-        rate of up-crossings of the mid level (cycles per second); NaN at rest.
+        1 / (smallest period) of φ [Hz] when periodic (section return map); otherwise the
+        highest peak of the spectrum (dominant frequency); NaN at rest.
     periodic : bool
         Whether φ repeats on the section (within :data:`RECURRENCE_TOL`).
     period_multiplicity : int
@@ -125,8 +125,8 @@ def fundamental_frequency(t, phi, dphi):
     Section: up-crossings of the mid level (φmin + φmax)/2, located on the cubic Hermite
     interpolant of the samples (φ, φ̇). The signature of a crossing is φ̇ there; the smallest k
     for which crossings k apart repeat (to RECURRENCE_TOL) gives the period as the mean time
-    of k crossings. Non-periodic responses get the mean crossing rate (cycles per second), or
-    the highest peak of the Hann spectrum when there are fewer than 3 crossings.
+    of k crossings. Non-periodic responses get the highest peak of the Hann spectrum, refined
+    by parabolic interpolation.
     """
     t = np.asarray(t, dtype=float)
     phi = np.asarray(phi, dtype=float)
@@ -143,7 +143,9 @@ def fundamental_frequency(t, phi, dphi):
                 n_periods = (times.size - 1) // k
                 period = (times[n_periods * k] - times[0]) / n_periods
                 return 1.0 / period, True, k
-        return (times.size - 1) / (times[-1] - times[0]), False, 0
+    # not periodic (or too few crossings): the dominant frequency. The mean crossing rate is no
+    # substitute: a waveform with two humps per cycle crosses the mid level twice (N = 120 N,
+    # Ω = 0.5 rad/s: 1.59 Hz crossing rate against a 0.797 Hz spectral peak)
     return _spectral_peak(t, phi), False, 0
 
 

@@ -94,8 +94,8 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
         table.add_row(key, value)
     console.print(table)
     if not math.isnan(s.fundamental_frequency_hz) and not s.periodic:
-        console.print("[dim]not periodic within the window: the frequency is the mean cycle rate "
-                      "(up-crossings of the mid level of φ)[/]")
+        console.print("[dim]not periodic within the window: the frequency is the highest peak of "
+                      "the φ spectrum[/]")
     if traj.stats.compile_time_s > 0:
         console.print(f"[dim]first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
                       "(not included in the wall time)[/]")
