@@ -60,6 +60,16 @@ def dense_state(y0, Q, h, theta, out):
 
 
 @njit(cache=True)
+def store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F):
+    """Write the state, the mode flag (1 = stick, 0 = slip) and the friction force of sample ``idx``."""
+    for i in range(y.shape[0]):
+        out_s[idx, i] = y[i]
+    out_mode[idx] = 1 if mode == K.MODE_STICK else 0
+    out_F[idx, 0] = Fx
+    out_F[idx, 1] = Fy
+
+
+@njit(cache=True)
 def event_value(kind, y, e0x, e0y, minv, damp, stiff, p):
     """Event function of ``kind`` at state ``y`` (see module docstring)."""
     if kind == EVENT_SLIP:

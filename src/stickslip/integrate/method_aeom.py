@@ -128,18 +128,17 @@ def write_samples(idx, t, h, y0, f0, y1, f1, mode, ex, ey, fixed_force, Fx, Fy, 
     while idx < n_samples and sample_times[idx] <= t_to:
         theta = (sample_times[idx] - t) / h
         E.dense_state(y0, Q, h, theta, work)
-        for i in range(work.shape[0]):
-            out_s[idx, i] = work[i]
-        out_mode[idx] = mode
-        if fixed_force:
-            out_F[idx, 0] = Fx
-            out_F[idx, 1] = Fy
-        else:
-            gx, gy = K.contact_force(work, mode, ex, ey, minv, damp, stiff, p)
-            out_F[idx, 0] = gx
-            out_F[idx, 1] = gy
+        _store(idx, work, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
     return idx
+
+
+@njit(cache=True)
+def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F):
+    """Write sample ``idx``: the given force if ``fixed_force``, else the contact force of ``mode``."""
+    if not fixed_force:
+        Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
+    E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
 
 
 @njit(cache=True)
@@ -148,16 +147,7 @@ def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, 
     """Samples at t ≤ t0 (the initial state). Returns the next sample index."""
     idx = 0
     while idx < sample_times.shape[0] and sample_times[idx] <= t0:
-        for i in range(y.shape[0]):
-            out_s[idx, i] = y[i]
-        out_mode[idx] = mode
-        if fixed_force:
-            out_F[idx, 0] = Fx
-            out_F[idx, 1] = Fy
-        else:
-            gx, gy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
-            out_F[idx, 0] = gx
-            out_F[idx, 1] = gy
+        _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
     return idx
 

@@ -130,13 +130,9 @@ def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff,
 
 @njit(cache=True)
 def _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F):
-    """Write state, mode flag (1 = stick) and friction force of sample ``idx``."""
-    for i in range(y.shape[0]):
-        out_s[idx, i] = y[i]
-    out_mode[idx] = 1 if mode == K.MODE_STICK else 0
+    """Write sample ``idx`` with the friction force of ``mode`` at state ``y``."""
     Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
-    out_F[idx, 0] = Fx
-    out_F[idx, 1] = Fy
+    E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
 
 
 @njit(cache=True)
