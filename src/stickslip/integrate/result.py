@@ -13,7 +13,7 @@ from numba import njit
 from .. import __version__
 from ..analysis.steady import SteadyState, summarize
 from ..model import kernels
-from ..model.parameters import PARAMETER_UNITS, Parameters
+from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import assemble
 from ..model.variants import STATE_NAMES, resolve_variant
 
@@ -231,10 +231,7 @@ class Trajectory:
             "stats": json.dumps(dataclasses.asdict(self.stats)),
             "parameters": json.dumps(self.params.to_dict()),
         }
-        for name, value in self.params.to_dict().items():
-            attrs[f"param_{name}"] = value
-            if PARAMETER_UNITS[name]:
-                attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+        attrs.update(parameter_attrs(self.params.to_dict()))
         for key, value in self.steady.to_dict().items():
             attrs[f"steady_{key}"] = int(value) if isinstance(value, bool) else value
         ds = xr.Dataset(data, coords=coords, attrs=attrs)

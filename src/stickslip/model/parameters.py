@@ -17,7 +17,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - exercised only on Python 3.10
     import tomli as tomllib
 
-__all__ = ["Parameters", "PARAMETER_UNITS", "PARAMETER_DESCRIPTIONS", "FRICTION_LAWS"]
+__all__ = ["Parameters", "PARAMETER_UNITS", "PARAMETER_DESCRIPTIONS", "FRICTION_LAWS", "parameter_attrs"]
 
 #: Friction laws understood by the kernels. ``exponential`` is paper Eq. (4),
 #: μ(v) = μk + Δμ exp(−α v); ``coulomb`` is the classic static/kinetic law, μ = μk in slip.
@@ -65,6 +65,16 @@ _NON_NEGATIVE = (
     "c_px", "k_px", "c_py", "k_py", "c_dx", "k_dx", "c_dy", "k_dy",
     "c_pphi", "k_pphi", "c_dpsi", "k_dpsi", "mu_k", "delta_mu", "alpha",
 )
+
+
+def parameter_attrs(values: Mapping[str, Any]) -> dict[str, Any]:
+    """NetCDF attributes ``param_<name>`` (and ``param_<name>_units``) for a parameter mapping."""
+    attrs: dict[str, Any] = {}
+    for name, value in values.items():
+        attrs[f"param_{name}"] = value
+        if PARAMETER_UNITS.get(name):
+            attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+    return attrs
 
 
 class ParameterError(ValueError):

@@ -25,7 +25,7 @@ from .. import __version__
 from ..integrate.driver import SimulationError, initial_state, simulate
 from ..integrate.result import Trajectory
 from ..model.kernels import DEFAULT_SLIP_BAND
-from ..model.parameters import PARAMETER_UNITS, Parameters
+from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import assemble
 from ..model.variants import STATE_NAMES
 from .section import OrbitError, Section, flow, land_on_section, resolve_section, section_crossings, vector_field
@@ -169,10 +169,7 @@ class PeriodicOrbit:
             "options": json.dumps(self.options),
             "parameters": json.dumps(self.params.to_dict()),
         }
-        for name, value in self.params.to_dict().items():
-            attrs[f"param_{name}"] = value
-            if PARAMETER_UNITS[name]:
-                attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+        attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from ..model.parameters import PARAMETER_UNITS, Parameters
+from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import System, assemble
 from ..model.variants import DOF_NAMES
 from . import linearize
@@ -151,10 +151,7 @@ class StabilityResult:
             "equilibrium_residual": self.residual,
             "parameters": json.dumps(self.params.to_dict()),
         }
-        for name, value in self.params.to_dict().items():
-            attrs[f"param_{name}"] = value
-            if PARAMETER_UNITS[name]:
-                attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+        attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from scipy import optimize
 
 from ..model import kernels
-from ..model.parameters import PARAMETER_UNITS, ParameterError, Parameters
+from ..model.parameters import PARAMETER_UNITS, ParameterError, Parameters, parameter_attrs
 from ..model.system import System, assemble
 from ..model.variants import resolve_variant
 from . import linearize
@@ -254,10 +254,7 @@ class StabilityMap:
             "boundary_xtol": BOUNDARY_XTOL,
             "boundary_xtol_units": "rad/s",
         }
-        for name, value in self.params.to_dict().items():
-            attrs[f"param_{name}"] = value
-            if PARAMETER_UNITS[name]:
-                attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+        attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def to_netcdf(self, path: str | Path) -> Path:

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..model.parameters import PARAMETER_UNITS
+from ..model.parameters import PARAMETER_UNITS, parameter_attrs
 from .spec import NAMED_ICS, SweepError, SweepSpec
 
 __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir"]
@@ -174,10 +174,7 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
         "points": spec.size, "points_done": int(done.sum()),
         "complete": int(done.all()),
     }
-    for name, value in spec.params.items():
-        attrs[f"param_{name}"] = value
-        if PARAMETER_UNITS.get(name):
-            attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+    attrs.update(parameter_attrs(spec.params))
     attrs.update(extra_attrs or {})
     coords = _coords(spec)
     base = xr.Dataset({"done": (spec.names, done.reshape(spec.shape).astype(np.int8),
