@@ -13,12 +13,13 @@ from ._app import app, console, err_console, user_errors
 @app.command("reproduce")
 def reproduce(
     out: Path = typer.Option(Path("paper"), "--out", help="Output directory: report.md, PNGs, results.json."),
-    quick: bool = typer.Option(False, "--quick", help="Coarse grids and short runs (a few minutes on 2 cores)."),
+    quick: bool = typer.Option(False, "--quick", help="Coarse grids (about 10 minutes on 2 cores)."),
     only: list[str] = typer.Option(None, "--only", help="Run only these figures (repeatable): "
-                                   "fig3, fig4, table2, fig7, fig10, fig11, fig12a."),
+                                   "fig3, fig4, table2, fig7, fig8, fig9, fig10, fig11, fig12a, "
+                                   "fig12b, fig13, fig14, fig15, fig16."),
 ) -> None:
-    """Paper Sects. 4.1–4.2: Figs. 3, 4, 7, 10, 11, 12(a), Table 2 / Figs. 5–6 beside the paper's
-    statements, with a table "paper says / we measure / agrees?" (OUT/report.md)."""
+    """Paper Sects. 4.1–4.2: Figs. 3–16 and Table 2 beside the paper's statements, with a table
+    "paper says / we measure / agrees?" (OUT/report.md)."""
     from ..studies.reproduce import recipe_names
     from ..studies.reproduce import reproduce as run_reproduce
 
