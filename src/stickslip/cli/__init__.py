@@ -10,5 +10,6 @@ from . import stability  # noqa: E402,F401
 from . import study  # noqa: E402,F401  (registers `stickslip study timestep`)
 from . import reproduce  # noqa: E402,F401  (registers `stickslip reproduce`)
 from . import sweep  # noqa: E402,F401  (registers `stickslip sweep`, `bifurcation`, `regions`)
+from . import continue_  # noqa: E402,F401  (registers `stickslip continue`)
 
 __all__ = ["app"]

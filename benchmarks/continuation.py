@@ -1,0 +1,92 @@
+"""Continuation benchmarks (issue 6): a 200-orbit branch with multipliers on one core, and the
+Region II edge (end of the stick-slip branch) over 20 values of N on 2 cores.
+
+Goals: branch ≤ 60 s (one core); edge curve ≤ 300 s (2 cores).
+
+    python benchmarks/continuation.py [--quick] [--workers 2] [--curve-out /tmp/fold_curve.nc]
+
+Prints measured times against the goals and writes benchmarks/results/continuation.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+from stickslip import Parameters, simulate
+from stickslip.orbits import periodic_orbit
+from stickslip.orbits.continuation import continue_orbit, fold_curve
+from stickslip.sweep.spec import initial_condition
+
+BRANCH_GOAL_S, CURVE_GOAL_S = 60.0, 300.0
+
+
+def start_orbit(N=50.0, Omega=8.0):
+    """The stick-slip orbit from the `far` initial condition (not timed)."""
+    p = Parameters(N=N, Omega=Omega)
+    ic, pert = initial_condition("far", p, "full")
+    run = simulate(p, 60.0, ic=ic, perturbation=pert, sample_rate=2000.0, rtol=1e-10, atol=1e-13)
+    return periodic_orbit(p, run)
+
+
+def bench_branch(points: int) -> dict:
+    orbit = start_orbit()
+    t0 = time.perf_counter()
+    b = continue_orbit(start=orbit, param="Omega", step=0.02, max_step=0.05, max_points=points,
+                       bounds=(8.0, 40.0), min_stick_fraction=0.0, amplitude=False)
+    wall = time.perf_counter() - t0
+    return {"points": len(b), "wall_s": wall, "goal_s": BRANCH_GOAL_S, "per_point_s": wall / len(b),
+            "simulations": b.timings["simulations"], "omega_range": [float(b.values[0]), float(b.values[-1])],
+            "stop_reason": b.stop_reason, "all_stable": bool(b.stable.all()),
+            "max_abs_trivial_minus_1": float(np.max(np.min(np.abs(b.multipliers - 1.0), axis=1)))}
+
+
+def bench_curve(n: int, workers: int, out: str | None) -> dict:
+    N = np.linspace(10.0, 130.0, n)
+    t0 = time.perf_counter()
+    fc = fold_curve(N, workers=workers)
+    wall = time.perf_counter() - t0
+    if out:
+        fc.to_xarray().to_netcdf(out, engine="h5netcdf")
+    return {"n": n, "workers": workers, "wall_s": wall, "goal_s": CURVE_GOAL_S,
+            "N": N.tolist(), "edge": [None if not np.isfinite(e) else float(e) for e in fc.edge],
+            "kind": list(fc.kind), "points": fc.points.tolist(), "seconds": fc.seconds.tolist()}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="50-point branch, 4 values of N")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--curve-out", default=None, help="also write the edge curve as NetCDF")
+    ap.add_argument("--only", choices=["branch", "curve"], default=None)
+    args = ap.parse_args()
+    start_orbit(N=50.0, Omega=8.0)  # compile/load the kernels outside the timings
+    res = {"machine": f"{platform.machine()}, {os.cpu_count()} cores (shared), {platform.python_version()}"}
+    if args.only in (None, "branch"):
+        res["branch"] = bench_branch(50 if args.quick else 200)
+        b = res["branch"]
+        print(f"branch: {b['points']} orbits with multipliers in {b['wall_s']:.1f} s (goal {BRANCH_GOAL_S:.0f} s; "
+              f"{b['per_point_s'] * 1e3:.0f} ms/orbit, {b['simulations']} simulations) -> "
+              f"{'met' if b['wall_s'] <= BRANCH_GOAL_S else 'MISSED'}")
+    if args.only in (None, "curve"):
+        res["curve"] = bench_curve(4 if args.quick else 20, args.workers, args.curve_out)
+        c = res["curve"]
+        print(f"edge curve: {c['n']} values of N on {c['workers']} processes in {c['wall_s']:.1f} s "
+              f"(goal {CURVE_GOAL_S:.0f} s) -> {'met' if c['wall_s'] <= CURVE_GOAL_S else 'MISSED'}")
+    if not args.quick:
+        out = Path(__file__).parent / "results" / "continuation.json"
+        out.parent.mkdir(exist_ok=True)
+        old = json.loads(out.read_text()) if out.exists() else {}
+        old.update(res)
+        out.write_text(json.dumps(old, indent=1))
+        print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()

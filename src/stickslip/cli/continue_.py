@@ -1,0 +1,123 @@
+"""``stickslip continue``: a branch of periodic orbits in one parameter (pseudo-arclength).
+
+Parse → library call (:func:`stickslip.orbits.continuation.continue_orbit`) → write NetCDF and a
+figure; no physics here.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+from rich.table import Table
+
+from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+
+_ICS = ("far", "near", "zero", "equilibrium")
+
+
+def _check(param: str, start: float, stop: float, out: Path, ic: str, max_points: int, step: float,
+           max_step: float, search_time: float, rtol: float, tol: float, stop_on: list[str]) -> None:
+    """Validate the options before anything is computed (one-line ValueError naming the fix)."""
+    from ..model.parameters import Parameters
+    from ..orbits.continuation import SPECIAL_KINDS
+
+    numeric = [n for n in Parameters.names() if n != "friction_law"]
+    if param not in numeric:
+        raise ValueError(f"--param {param}: not a numeric parameter; choose one of {', '.join(numeric)}")
+    for flag, value in (("--from", start), ("--to", stop)):
+        if not math.isfinite(value):
+            raise ValueError(f"{flag} must be a finite number, got {value}")
+    if start == stop:
+        raise ValueError(f"--from and --to are both {start:g}; give the end of the range to continue to")
+    if out.suffix != ".nc":
+        raise ValueError(f"--out {out}: give a path ending in .nc")
+    if ic not in _ICS:
+        raise ValueError(f"--ic {ic}: choose one of {', '.join(_ICS)}")
+    if max_points < 2:
+        raise ValueError(f"--max-points must be >= 2, got {max_points}")
+    for flag, value in (("--step", step), ("--max-step", max_step), ("--search-time", search_time),
+                        ("--rtol", rtol), ("--tol", tol)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+    if step > max_step:
+        raise ValueError(f"--step {step:g} is larger than --max-step {max_step:g}")
+    bad = [k for k in stop_on if k not in SPECIAL_KINDS]
+    if bad:
+        raise ValueError(f"--stop-on {', '.join(bad)}: choose from {', '.join(SPECIAL_KINDS)}")
+
+
+@app.command("continue")
+def continue_command(
+    param: str = typer.Option("Omega", "--param", help="Parameter to vary: N, Omega, delta_mu, alpha, mu_k, k_px, ..."),
+    start: float = typer.Option(..., "--from", help="Start value of the parameter (where the first orbit is found)."),
+    stop: float = typer.Option(..., "--to", help="End of the range; the branch goes from --from towards it."),
+    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
+    omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
+    model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4)."),
+    ic: str = typer.Option("far", "--ic", help="Start run: far | near | zero | equilibrium (docs/sweeps.md)."),
+    search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run [s]."),
+    max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
+    step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
+    max_step: float = typer.Option(0.2, "--max-step", help="Largest step in scaled arclength."),
+    stop_on: Optional[List[str]] = typer.Option(None, "--stop-on", help="Stop after this special point (repeatable): "
+                                                "fold, period-doubling, neimark-sacker, stick-phases."),
+    rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map."),
+    tol: float = typer.Option(1e-8, "--tol", help="Corrector tolerance (scaled shooting residual)."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
+    out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
+    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+) -> None:
+    """Continue a periodic orbit in one parameter; mark stability, folds, period doubling and
+    changes of the stick phases.
+
+    The first orbit is found by shooting from a run of --search-time seconds from --ic at
+    --from; the branch then follows the orbit towards --to (pseudo-arclength, so it passes
+    folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes.
+    """
+    from ..orbits.continuation import continue_orbit, start_run
+
+    with user_errors():
+        stop_on = list(stop_on or [])
+        _check(param, start, stop, out, ic, max_points, step, max_step, search_time, rtol, tol, stop_on)
+        params = build_parameters(config, set_, N=N, Omega=omega).replace(**{param: start})
+        progress = None if (no_progress or as_json) else (
+            lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
+                                              f"{'stable' if st else 'unstable'}", highlight=False))
+        run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol)
+        branch = continue_orbit(params, param, start=run, direction=1 if stop > start else -1, step=step,
+                                max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
+                                stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        branch.to_netcdf(out)
+        figure = None
+        if not no_plot:
+            from ..plot.continuation import save_branch_figure
+
+            figure = save_branch_figure(branch, out.with_suffix(".png"))
+    summary = {
+        "out": str(out), "figure": None if figure is None else str(figure), "param": param,
+        "points": len(branch), "from": float(branch.values[0]), "to": float(branch.values[-1]),
+        "stable_points": int(branch.stable.sum()), "stop_reason": branch.stop_reason,
+        "special": [{"kind": p.kind, "value": p.value, "located": p.located} for p in branch.special],
+        "total_s": branch.timings["total_s"], "simulations": branch.timings["simulations"],
+    }
+    if as_json:
+        print(json.dumps(summary))
+        return
+    table = Table(title=f"stickslip continue ({branch.model}, in {param})", show_header=False)
+    table.add_row("orbits", f"{summary['points']} ({summary['stable_points']} stable)")
+    table.add_row(f"{param} range", f"{summary['from']:.6g} → {summary['to']:.6g}")
+    table.add_row("period range", f"{branch.periods.min():.6g} – {branch.periods.max():.6g} s")
+    table.add_row("stopped", summary["stop_reason"])
+    for p in branch.special:
+        table.add_row(p.label, f"{param} = {p.value:.6g}" + ("" if p.located else " (not located to tolerance)"))
+    table.add_row("wall time", f"{summary['total_s']:.2f} s ({summary['simulations']} simulations)")
+    table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
+    console.print(table)

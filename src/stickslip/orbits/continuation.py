@@ -1,0 +1,1041 @@
+"""Pseudo-arclength continuation of periodic stick-slip orbits in one parameter.
+
+The orbit is the zero of the shooting map of :mod:`stickslip.orbits.shooting`, now with the
+parameter λ (any field of :class:`~stickslip.Parameters`: ``N``, ``Omega``, ``delta_mu``, ...)
+as an extra unknown. In scaled unknowns v = (z, T/T_s, λ/λ_s) — z the free states on the
+Poincaré section except the coordinate the section fixes, in units of their scales σ — the
+2 n_free equations are
+
+    F(v) = (Φ(s(z), T; λ) − s(z))[free] / σ = 0,
+
+Φ the exact flow map of the ``event`` integrator over T seconds (paper Eqs. 1–10, 13). One
+more equation closes the system: the pseudo-arclength condition τ_kᵀ (v − v_k) = h, τ_k the unit
+tangent of the branch at the last point (the null vector of ∂F/∂v there) and h the step.
+
+Each point costs one finite-difference Jacobian ∂F/∂v (2 n_free + 1 columns, each two
+simulations; the column of the section coordinate is added so that the same differences give the
+full monodromy matrix and the Floquet multipliers) plus a few corrector simulations: the corrector
+is Newton's method started with the Jacobian of the previous point and kept current by Broyden
+rank-one updates, so it needs no new differences. The same Jacobian gives the tangent.
+
+Special points between two consecutive points are detected from sign changes of test functions
+and located by the Illinois (modified regula falsi) method on the arclength:
+
+``fold``              τ_λ (the parameter component of the tangent) changes sign: a fold (saddle-node)
+                      of cycles, where two orbits meet and disappear (the edge of bistability).
+``period-doubling``   det(M + I) changes sign: a real multiplier crosses −1.
+``neimark-sacker``    the number of complex multipliers outside the unit circle changes
+                      (located by bisection).
+``stick-phases``      the number of stick phases per period changes (grazing/sliding: a stick
+                      phase appears or disappears; located by bisection).
+``stick-vanishing``   the total stick time per period falls towards 0 and the branch ends: the
+                      stick-slip orbit loses its stick phase (it meets the unstable pure-slip
+                      cycle, a non-smooth fold). Located by extrapolating τ_stick² linearly in λ
+                      to 0 over the last three points (τ_stick ∝ √(λ* − λ) measured).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .. import __version__
+from ..integrate.driver import SimulationError, simulate
+from ..integrate.result import Trajectory
+from ..model.kernels import DEFAULT_SLIP_BAND
+from ..model.parameters import ParameterError, Parameters, parameter_attrs
+from ..model.system import assemble
+from ..model.variants import STATE_NAMES
+from .section import OrbitError, Section, resolve_section, vector_field
+from .shooting import PeriodicOrbit, periodic_orbit
+
+__all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run", "load_branch",
+           "ContinuationError", "SPECIAL_KINDS"]
+
+#: Kinds of special points, in the order they are reported.
+SPECIAL_KINDS = ("fold", "period-doubling", "neimark-sacker", "stick-phases", "stick-vanishing")
+
+#: A branch stops when the stick time per period falls below this fraction of the period: the
+#: stick phase is vanishing (measured at N = 50 N: τ_stick² falls linearly to 0 with Ω, so the
+#: orbit ends where its stick phase shrinks to an instant; the finite-difference Jacobian is
+#: meaningless once the perturbations reach the edge, ~1e-5 σ).
+MIN_STICK_FRACTION = 1e-3
+
+#: Corrector convergence: max |F| (residual in units of σ), as :data:`.shooting.DEFAULT_TOL`.
+DEFAULT_TOL = 1e-8
+
+#: Relative finite-difference step (of σ for states, of λ_s for the parameter). Central
+#: differences: truncation ~ step², integration noise ~ rtol/step = 1e-5 at rtol 1e-10.
+DEFAULT_FD_STEP = 1e-5
+
+#: Corrector iterations before a step counts as failed (then halved). Broyden from the previous
+#: point's Jacobian reduces the residual ~5× per iteration (measured on Model 1, N = 50 N: the
+#: 0.997 multipliers make M − I nearly singular, so the FD Jacobian's noise limits the rate) and
+#: converges in 4–6 iterations from a predictor error of ~5e-4 σ.
+MAX_CORRECTOR = 8
+
+#: Corrector iterations at or below which the next step grows, and the growth/shrink factors.
+EASY_ITERATIONS, GROW, SHRINK = 4, 1.5, 0.5
+
+#: Corrector iterations above which the next step shrinks (between the two it is kept).
+HARD_ITERATIONS = 6
+
+#: Smallest cosine between consecutive tangents accepted: a larger turn means the step jumped
+#: over a sharp feature (or onto another branch); the step is halved instead.
+MIN_TANGENT_COS = 0.9
+
+#: Steps of a flow map allowed per simulated second: a period of Model 1 takes ~1e3 steps at
+#: rtol 1e-10; a stalled integration (approach to stick, docs/orbits.md) fails fast instead of
+#: running 5e7 steps.
+MAX_STEPS_PER_SECOND = 2e5
+
+#: Location of a special point stops when the bracket in arclength is below this fraction of
+#: the step it was found in, or after :data:`MAX_LOCATE` evaluations.
+LOCATE_RTOL, MAX_LOCATE = 1e-3, 12
+
+#: Samples per period of the run that measures the amplitude of φ of each point.
+AMPLITUDE_SAMPLES = 400
+
+
+class ContinuationError(OrbitError):
+    """Continuation could not start or go on (the message says why)."""
+
+
+# --------------------------------------------------------------------------- the problem
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Problem:
+    """Everything fixed along a branch: base parameters, parameter name, section, scales."""
+
+    base: Parameters
+    param: str
+    model: str
+    section: Section
+    free: np.ndarray  # state indices of the free states (2 n_free,)
+    cols: np.ndarray  # positions in ``free`` of the unknown section states (2 n_free − 1,)
+    sigma: np.ndarray  # scales of the free states [SI]
+    T_scale: float  # [s]
+    p_scale: float  # [unit of the parameter]
+    rtol: float
+    atol: float
+    slip_band: float
+    fd_step: float
+    counter: dict = dataclasses.field(default_factory=lambda: {"simulations": 0})
+
+    def params_at(self, lam: float) -> Parameters:
+        """Parameters with the continuation parameter set to ``lam``."""
+        return self.base.replace(**{self.param: float(lam)})
+
+    def unpack(self, v: np.ndarray):
+        """Scaled unknowns (2 n_free + 1,) → (state on the section (12,), T [s], λ)."""
+        s = np.zeros(12)
+        s[self.free[self.cols]] = v[:-2] * self.sigma[self.cols]
+        s[self.section.index] = self.section.value
+        return s, float(v[-2] * self.T_scale), float(v[-1] * self.p_scale)
+
+    def pack(self, s: np.ndarray, T: float, lam: float) -> np.ndarray:
+        """Inverse of :meth:`unpack`."""
+        return np.concatenate([s[self.free[self.cols]] / self.sigma[self.cols], [T / self.T_scale, lam / self.p_scale]])
+
+
+def _flow(problem: _Problem, params: Parameters, s0: np.ndarray, T: float):
+    """Φ(s0, T) (12,) and the transitions of the run (as :func:`.section.flow`, with a step cap)."""
+    if not np.isfinite(T) or T <= 0.0:
+        raise OrbitError(f"return time T = {T} s is not positive")
+    problem.counter["simulations"] += 1
+    rate = 1.0 / T
+    T_exact = 1.0 / rate  # the last sample time the driver computes, so the run ends on it
+    traj = simulate(params, T_exact, model=problem.model, ic=s0, rtol=problem.rtol, atol=problem.atol,
+                    sample_rate=rate, slip_band=problem.slip_band,
+                    max_steps=int(MAX_STEPS_PER_SECOND * max(T, 1.0)))
+    if traj.status != "success" or traj.t[-1] != T_exact:
+        raise OrbitError(f"the flow map over T = {T} s failed: {traj.status}")
+    return traj.final_state, traj.transitions
+
+
+def _residual(problem: _Problem, v: np.ndarray):
+    """F(v) (2 n_free,) in units of σ, the end state and the transitions of the run."""
+    s, T, lam = problem.unpack(v)
+    end, tr = _flow(problem, problem.params_at(lam), s, T)
+    return (end[problem.free] - s[problem.free]) / problem.sigma, end, tr
+
+
+def _jacobian(problem: _Problem, v: np.ndarray, end: np.ndarray):
+    """Finite-difference Jacobian ∂F/∂v (2 n_free × 2 n_free + 1) and the monodromy matrix.
+
+    Central differences in every free state (the section coordinate too: its column is not part
+    of ∂F/∂v but completes the monodromy ∂Φ/∂s0, whose eigenvalues are the Floquet multipliers)
+    and in λ; the T column is exact, f(Φ) from the vector field. 2 (2 n_free + 1) simulations.
+
+    Returns
+    -------
+    J : ndarray (2 n_free, 2 n_free + 1)
+        In scaled units (rows / σ, columns × σ, T_s, λ_s).
+    M : ndarray (2 n_free, 2 n_free)
+        ∂Φ(s0, T)/∂s0 on the free states [SI].
+    """
+    s, T, lam = problem.unpack(v)
+    params = problem.params_at(lam)
+    free, sigma = problem.free, problem.sigma
+    n = free.size
+    M = np.empty((n, n))
+    for k, j in enumerate(free):
+        h = problem.fd_step * sigma[k]
+        sp, sm = s.copy(), s.copy()
+        sp[j] += h
+        sm[j] -= h
+        M[:, k] = (_flow(problem, params, sp, T)[0][free] - _flow(problem, params, sm, T)[0][free]) / (2.0 * h)
+    J = np.empty((n, n + 1))
+    J[:, :-2] = (M[:, problem.cols] - np.eye(n)[:, problem.cols]) * sigma[problem.cols][None, :] / sigma[:, None]
+    system = assemble(params, problem.model, problem.slip_band)
+    J[:, -2] = vector_field(system, end)[free] / sigma * problem.T_scale
+    dl = problem.fd_step * problem.p_scale
+    ep = _flow(problem, problem.params_at(lam + dl), s, T)[0][free]
+    em = _flow(problem, problem.params_at(lam - dl), s, T)[0][free]
+    J[:, -1] = (ep - em) / (2.0 * dl) / sigma * problem.p_scale
+    return J, M
+
+
+def _tangent(J: np.ndarray, previous: np.ndarray | None = None, direction: float = 1.0) -> np.ndarray:
+    """Unit null vector of J (n × n + 1), oriented along ``previous`` (or with sign(τ_λ) = direction)."""
+    t = np.linalg.svd(J)[2][-1]
+    ref = float(t @ previous) if previous is not None else direction * t[-1]
+    return -t if ref < 0.0 else t
+
+
+def _correct(problem: _Problem, v: np.ndarray, J: np.ndarray, row: np.ndarray, target: float, tol: float):
+    """Newton–Broyden corrector on F(v) = 0, rowᵀ v = target.
+
+    Starts from ``J`` (a Jacobian near ``v``) and keeps it current by Broyden's rank-one updates,
+    so each iteration costs one simulation.
+
+    Returns
+    -------
+    (v, R, end, transitions, iterations, J)
+        At convergence; ``J`` the updated Jacobian.
+
+    Raises
+    ------
+    OrbitError, SimulationError
+        No convergence in :data:`MAX_CORRECTOR` iterations, growing residual, or a failed run.
+    """
+    R, end, tr = _residual(problem, v)
+    J = J.copy()
+    history = [float(np.max(np.abs(R)))]
+    for it in range(MAX_CORRECTOR + 1):
+        c = float(row @ v - target)
+        if history[-1] <= tol and abs(c) <= tol:
+            return v, R, end, tr, it, J
+        if it == MAX_CORRECTOR:
+            break
+        A = np.vstack([J, row])
+        dv = np.linalg.solve(A, -np.concatenate([R, [c]]))
+        v_new = v + dv
+        R_new, end, tr = _residual(problem, v_new)
+        J += np.outer(R_new - R - J @ dv, dv) / float(dv @ dv)  # Broyden's good update
+        v, R = v_new, R_new
+        history.append(float(np.max(np.abs(R))))
+        if it >= 1 and history[-1] > 0.5 * history[-2] and history[-1] > 10 * tol:
+            break  # not contracting: give the step back
+    raise OrbitError(f"corrector did not converge (residuals {', '.join(f'{r:.1e}' for r in history)})")
+
+
+# --------------------------------------------------------------------------- points
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Point:
+    """One converged orbit of a branch (internal)."""
+
+    v: np.ndarray
+    J: np.ndarray
+    M: np.ndarray
+    tangent: np.ndarray
+    multipliers: np.ndarray
+    stick_phases: int
+    stick_time: float
+    residual: float
+    iterations: int
+
+
+def _stick_time(tr) -> float:
+    """Total time in stick over one period [s] from the run's transitions (it starts in slip)."""
+    t_in = tr.time[tr.kind == 1]
+    t_out = tr.time[tr.kind == -1]
+    n = min(t_in.size, t_out.size)
+    return float(np.sum(t_out[:n] - t_in[:n]))
+
+
+def _sorted_multipliers(M: np.ndarray) -> np.ndarray:
+    mu = np.linalg.eigvals(M)
+    return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+
+def nontrivial(multipliers: np.ndarray) -> np.ndarray:
+    """Multipliers without the one closest to 1 (the shift along the orbit)."""
+    k = int(np.argmin(np.abs(np.asarray(multipliers) - 1.0)))
+    return np.delete(np.asarray(multipliers), k)
+
+
+def unstable_count(multipliers: np.ndarray) -> int:
+    """Number of non-trivial multipliers outside the unit circle."""
+    return int(np.sum(np.abs(nontrivial(multipliers)) > 1.0))
+
+
+def _test_values(point: _Point) -> dict:
+    """Test functions of the special points at one point (continuous ones are floats)."""
+    mu = nontrivial(point.multipliers)
+    return {
+        "fold": float(point.tangent[-1]),
+        "period-doubling": float(np.real(np.prod(mu + 1.0))),
+        "neimark-sacker": int(np.sum((np.abs(mu) > 1.0) & (np.abs(mu.imag) > 1e-9 * np.abs(mu)))),
+        "stick-phases": int(point.stick_phases),
+    }
+
+
+def _make_point(problem: _Problem, v, R, end, tr, iterations, previous_tangent, direction) -> _Point:
+    J, M = _jacobian(problem, v, end)
+    t = _tangent(J, previous_tangent, direction)
+    return _Point(v=v, J=J, M=M, tangent=t, multipliers=_sorted_multipliers(M),
+                  stick_phases=int(np.sum(tr.kind == 1)), stick_time=_stick_time(tr), residual=float(np.max(np.abs(R))), iterations=iterations)
+
+
+def _step_from(problem: _Problem, point: _Point, h: float, tol: float, with_jacobian: bool = True) -> _Point:
+    """The branch point at arclength ``h`` from ``point`` (predictor along its tangent + corrector)."""
+    v_pred = point.v + h * point.tangent
+    v, R, end, tr, it, J = _correct(problem, v_pred, point.J, point.tangent, float(point.tangent @ v_pred), tol)
+    if not with_jacobian:
+        return _Point(v=v, J=J, M=point.M, tangent=point.tangent, multipliers=point.multipliers,
+                      stick_phases=int(np.sum(tr.kind == 1)), stick_time=_stick_time(tr), residual=float(np.max(np.abs(R))), iterations=it)
+    return _make_point(problem, v, R, end, tr, it, point.tangent, 1.0)
+
+
+# --------------------------------------------------------------------------- results
+@dataclasses.dataclass(frozen=True)
+class SpecialPoint:
+    """A special point located on a branch.
+
+    Attributes
+    ----------
+    kind : str
+        ``fold``, ``period-doubling``, ``neimark-sacker`` or ``stick-phases`` (:data:`SPECIAL_KINDS`).
+    index : int
+        The special point lies between branch points ``index`` and ``index + 1``.
+    value : float
+        Parameter value at the special point [unit of the parameter].
+    period : float
+        Period there [s].
+    state : ndarray (12,)
+        State on the section there.
+    multipliers : ndarray complex
+        Floquet multipliers there (at the nearest evaluated point for discrete tests) [-].
+    before, after : float
+        Test function on either side (τ_λ; det(M + I); complex multipliers outside the unit
+        circle; stick phases per period).
+    bracket : float
+        Width of the final bracket in λ [unit of the parameter] (0 if found exactly).
+    located : bool
+        False if the location stopped before the bracket tolerance was met.
+    """
+
+    kind: str
+    index: int
+    value: float
+    period: float
+    state: np.ndarray
+    multipliers: np.ndarray
+    before: float
+    after: float
+    bracket: float
+    located: bool
+
+    @property
+    def label(self) -> str:
+        """Short description, e.g. ``fold at Omega = 8.73``."""
+        extra = f" ({self.before:g} → {self.after:g})" if self.kind in ("stick-phases", "neimark-sacker") else ""
+        return f"{self.kind}{extra}"
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Branch:
+    """A branch of periodic orbits computed by :func:`continue_orbit`.
+
+    Attributes
+    ----------
+    param : str
+        Name of the continuation parameter (a :class:`~stickslip.Parameters` field).
+    values : ndarray (n,)
+        Parameter value of each orbit [unit of the parameter].
+    periods : ndarray (n,)
+        Periods [s].
+    states : ndarray (n, 12)
+        States on the Poincaré section [m, rad, m/s, rad/s].
+    multipliers : ndarray (n, 2 n_free) complex
+        Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus.
+    stable : ndarray (n,) bool
+        Every non-trivial multiplier inside the unit circle.
+    n_unstable : ndarray (n,) int
+        Non-trivial multipliers outside the unit circle.
+    stick_phases : ndarray (n,) int
+        Slip → stick transitions per period (0: pure slip).
+    stick_time : ndarray (n,)
+        Total time in stick per period [s].
+    amplitude : ndarray (n,)
+        Peak-to-peak range of φ over one period [rad].
+    arclength : ndarray (n,)
+        Scaled pseudo-arclength from the first point [-].
+    residuals : ndarray (n,)
+        max |Φ(s0, T) − s0| / σ at each point [-].
+    iterations : ndarray (n,) int
+        Corrector iterations of each point (0 for the start).
+    special : list of SpecialPoint
+    stop_reason : str
+        Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``, ...).
+    params : Parameters
+        Base parameters (the continuation parameter at its start value).
+    model : str
+    section : Section
+    options : dict
+        Numerical options (rtol, atol, tol, fd_step, step bounds, scales).
+    timings : dict
+        ``total_s``, ``simulations``, ``points``.
+    """
+
+    param: str
+    values: np.ndarray
+    periods: np.ndarray
+    states: np.ndarray
+    multipliers: np.ndarray
+    stable: np.ndarray
+    n_unstable: np.ndarray
+    stick_phases: np.ndarray
+    stick_time: np.ndarray
+    amplitude: np.ndarray
+    arclength: np.ndarray
+    residuals: np.ndarray
+    iterations: np.ndarray
+    special: list
+    stop_reason: str
+    params: Parameters
+    model: str
+    section: Section
+    options: dict
+    timings: dict
+
+    def __len__(self) -> int:
+        return int(self.values.size)
+
+    def folds(self) -> list:
+        """The special points of kind ``fold``."""
+        return [p for p in self.special if p.kind == "fold"]
+
+    def orbit_params(self, i: int) -> Parameters:
+        """Parameters of orbit ``i``."""
+        return self.params.replace(**{self.param: float(self.values[i])})
+
+    def trajectory(self, i: int, periods: float = 1.0, sample_rate: float = 1000.0) -> Trajectory:
+        """Simulate orbit ``i`` from its section state (for plots)."""
+        o = self.options
+        return simulate(self.orbit_params(i), periods * float(self.periods[i]), model=self.model, ic=self.states[i],
+                        rtol=o["rtol"], atol=o["atol"], sample_rate=sample_rate, slip_band=o["slip_band"])
+
+    def to_xarray(self):
+        """``xarray.Dataset`` with dims ``point``, ``state``, ``multiplier`` and ``special``."""
+        import xarray as xr
+
+        from ..model.parameters import PARAMETER_UNITS
+
+        unit = PARAMETER_UNITS.get(self.param, "")
+        sp = self.special
+        data = {
+            "value": ("point", self.values, {"long_name": f"continuation parameter {self.param}", "units": unit}),
+            "period": ("point", self.periods, {"long_name": "period", "units": "s"}),
+            "state_on_section": (("point", "state"), self.states, {"long_name": "state on the Poincaré section",
+                                                                   "units": "m m m m rad rad m/s m/s m/s m/s rad/s rad/s"}),
+            "multiplier_real": (("point", "multiplier"), self.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
+            "multiplier_imag": (("point", "multiplier"), self.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
+            "stable": ("point", self.stable.astype(np.int8), {"long_name": "1 if every non-trivial multiplier is inside the unit circle"}),
+            "n_unstable": ("point", self.n_unstable.astype(np.int16), {"long_name": "non-trivial multipliers outside the unit circle"}),
+            "stick_phases": ("point", self.stick_phases.astype(np.int16), {"long_name": "stick phases per period"}),
+            "stick_time": ("point", self.stick_time, {"long_name": "time in stick per period", "units": "s"}),
+            "amplitude": ("point", self.amplitude, {"long_name": "peak-to-peak range of phi over one period", "units": "rad"}),
+            "arclength": ("point", self.arclength, {"long_name": "scaled pseudo-arclength", "units": "1"}),
+            "residual": ("point", self.residuals, {"long_name": "scaled shooting residual", "units": "1"}),
+            "iterations": ("point", self.iterations.astype(np.int16), {"long_name": "corrector iterations"}),
+            "special_kind": ("special", np.array([p.kind for p in sp], dtype=str), {"long_name": "kind of special point"}),
+            "special_index": ("special", np.array([p.index for p in sp], dtype=np.int32),
+                              {"long_name": "lies between branch points index and index + 1"}),
+            "special_value": ("special", np.array([p.value for p in sp], dtype=float), {"long_name": f"{self.param} at the special point", "units": unit}),
+            "special_period": ("special", np.array([p.period for p in sp], dtype=float), {"long_name": "period at the special point", "units": "s"}),
+            "special_before": ("special", np.array([p.before for p in sp], dtype=float), {"long_name": "test function before"}),
+            "special_after": ("special", np.array([p.after for p in sp], dtype=float), {"long_name": "test function after"}),
+            "special_bracket": ("special", np.array([p.bracket for p in sp], dtype=float), {"long_name": "final bracket width", "units": unit}),
+            "special_located": ("special", np.array([p.located for p in sp], dtype=np.int8), {"long_name": "1 if located to tolerance"}),
+            "special_state": (("special", "state"), np.array([p.state for p in sp], dtype=float).reshape(len(sp), 12),
+                              {"long_name": "state on the section at the special point"}),
+        }
+        coords = {"point": np.arange(len(self)), "state": list(STATE_NAMES),
+                  "multiplier": np.arange(self.multipliers.shape[1]), "special": np.arange(len(sp))}
+        attrs = {
+            "title": f"stickslip branch of periodic orbits in {self.param} (pseudo-arclength continuation)",
+            "format": "stickslip-branch-1",
+            "stickslip_version": __version__,
+            "param": self.param, "param_units": unit,
+            "model": self.model, "section": self.section.name,
+            "stop_reason": self.stop_reason,
+            "options": json.dumps(self.options),
+            "timings": json.dumps(self.timings),
+            "parameters": json.dumps(self.params.to_dict()),
+        }
+        attrs.update(parameter_attrs(self.params.to_dict()))
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    def to_netcdf(self, path) -> Path:
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf)."""
+        path = Path(path)
+        self.to_xarray().to_netcdf(path, engine="h5netcdf")
+        return path
+
+
+def load_branch(path):
+    """Read a branch written by :meth:`Branch.to_netcdf` as an ``xarray.Dataset``.
+
+    Raises
+    ------
+    ValueError
+        If the file is not a stickslip branch.
+    """
+    import xarray as xr
+
+    ds = xr.load_dataset(path, engine="h5netcdf")
+    if ds.attrs.get("format") != "stickslip-branch-1":
+        raise ValueError(f"{path} is not a stickslip branch file (written by `stickslip continue` / Branch.to_netcdf)")
+    return ds
+
+
+# --------------------------------------------------------------------------- location
+def _locate(problem: _Problem, left: _Point, right_test, kind: str, h: float, tol: float, index: int) -> SpecialPoint:
+    """Locate a sign change (or count change) of test ``kind`` between ``left`` and arclength ``h``.
+
+    Continuous tests (fold, period-doubling): Illinois regula falsi on the arclength s ∈ (0, h).
+    Discrete tests (neimark-sacker, stick-phases): bisection. Every evaluation is a corrector
+    from ``left`` along its tangent (and a Jacobian when the test needs multipliers).
+    """
+    continuous = kind in ("fold", "period-doubling")
+    need_jac = kind != "stick-phases"
+    f_left = _test_values(left)[kind]
+    f_right = right_test
+    a, b, fa, fb = 0.0, h, f_left, f_right
+    side = 0
+    best = left
+    evaluations = 0
+    while abs(b - a) > LOCATE_RTOL * abs(h) and evaluations < MAX_LOCATE:
+        if continuous and fa != fb:
+            s = (a * fb - b * fa) / (fb - fa)
+            if not (min(a, b) < s < max(a, b)):
+                s = 0.5 * (a + b)
+        else:
+            s = 0.5 * (a + b)
+        try:
+            p = _step_from(problem, left, s, tol, with_jacobian=need_jac)
+        except (OrbitError, SimulationError):
+            break
+        evaluations += 1
+        fs = _test_values(p)[kind]
+        best = p
+        same_as_left = (np.sign(fs) == np.sign(fa)) if continuous else (fs == f_left)
+        if same_as_left:
+            a, fa = s, fs
+            if continuous and side == -1:
+                fb *= 0.5  # Illinois: halve the retained end's value
+            side = -1
+        else:
+            b, fb = s, fs
+            if continuous and side == 1:
+                fa *= 0.5
+            side = 1
+        if continuous and fs == 0.0:
+            a = b = s
+            break
+    s_best, T_best, lam_best = problem.unpack(best.v)
+    la = problem.unpack(left.v + a * left.tangent)[2]
+    lb = problem.unpack(left.v + b * left.tangent)[2]
+    return SpecialPoint(kind=kind, index=index, value=lam_best, period=T_best, state=s_best,
+                        multipliers=best.multipliers, before=float(f_left), after=float(f_right),
+                        bracket=float(abs(lb - la)), located=bool(abs(b - a) <= LOCATE_RTOL * abs(h)))
+
+
+# --------------------------------------------------------------------------- driver
+def _start_orbit(params, param, start, model, section, rtol, atol, slip_band) -> PeriodicOrbit:
+    if isinstance(start, PeriodicOrbit):
+        return start
+    try:
+        return periodic_orbit(params, start, model=model, section=section, rtol=rtol, atol=atol, slip_band=slip_band)
+    except (OrbitError, SimulationError) as exc:
+        raise ContinuationError(f"no periodic orbit to start from at {param} = {getattr(params, param):g}: {exc}") from exc
+
+
+def _problem(orbit: PeriodicOrbit, param: str, fd_step: float, param_scale: float | None) -> _Problem:
+    if param not in Parameters.names() or param == "friction_law":
+        raise ContinuationError(f"cannot continue in {param!r}; choose a numeric parameter: "
+                                + ", ".join(n for n in Parameters.names() if n != "friction_law"))
+    lam0 = float(getattr(orbit.params, param))
+    scale = abs(lam0) if param_scale is None else float(param_scale)
+    if not (np.isfinite(scale) and scale > 0.0):
+        scale = 1.0  # λ0 = 0: work in the parameter's own unit
+    system = assemble(orbit.params, orbit.model, orbit.options["slip_band"])
+    free_dofs = system.variant.free_indices
+    free = np.concatenate([free_dofs, free_dofs + 6])
+    cols = np.array([k for k, j in enumerate(free) if j != orbit.section.index])
+    return _Problem(base=orbit.params, param=param, model=orbit.model, section=orbit.section, free=free, cols=cols,
+                    sigma=np.asarray(orbit.scale, dtype=float), T_scale=float(orbit.period), p_scale=scale,
+                    rtol=orbit.options["rtol"], atol=orbit.options["atol"], slip_band=orbit.options["slip_band"],
+                    fd_step=fd_step)
+
+
+def _amplitude(problem: _Problem, s: np.ndarray, T: float, lam: float) -> float:
+    """Peak-to-peak φ over one period [rad] from a sampled run (NaN if it fails)."""
+    try:
+        traj = simulate(problem.params_at(lam), T, model=problem.model, ic=s, rtol=problem.rtol, atol=problem.atol,
+                        sample_rate=AMPLITUDE_SAMPLES / T, slip_band=problem.slip_band,
+                        max_steps=int(MAX_STEPS_PER_SECOND * max(T, 1.0)))
+    except SimulationError:
+        return float("nan")
+    return float(np.ptp(traj.states[:, 4])) if traj.status == "success" else float("nan")
+
+
+def continue_orbit(
+    params: Parameters | None = None,
+    param: str = "Omega",
+    start=None,
+    *,
+    direction: int = 1,
+    step: float = 0.02,
+    min_step: float = 1e-4,
+    max_step: float = 0.2,
+    max_points: int = 200,
+    bounds: tuple[float, float] | None = None,
+    stop_on: Sequence[str] = (),
+    locate: bool = True,
+    model: str = "full",
+    section="phi_max",
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    tol: float = DEFAULT_TOL,
+    fd_step: float = DEFAULT_FD_STEP,
+    param_scale: float | None = None,
+    slip_band: float = DEFAULT_SLIP_BAND,
+    amplitude: bool = True,
+    min_stick_fraction: float = MIN_STICK_FRACTION,
+    callback=None,
+) -> Branch:
+    """Continue a periodic orbit in one parameter by pseudo-arclength continuation.
+
+    Unknowns: the free states on the Poincaré section (except the section coordinate), the period T
+    and the parameter λ; equations: the shooting equations Φ(s0, T; λ) − s0 = 0 on the free states
+    (Φ the exact stick-slip flow of paper Eqs. 1–13, integrated by the ``event`` method) and the
+    arclength condition τᵀ (v − v_k) = h in scaled unknowns v = (s0/σ, T/T_0, λ/λ_s).
+
+    Parameters
+    ----------
+    params : Parameters, optional
+        Parameters of the start orbit (default: those of ``start`` if it is a PeriodicOrbit).
+    param : str
+        The parameter to vary: any numeric :class:`~stickslip.Parameters` field (``N`` [N],
+        ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...).
+    start : PeriodicOrbit, Trajectory, array-like (12,) or "equilibrium"
+        The first orbit, or a guess handed to :func:`~stickslip.orbits.periodic_orbit`.
+    direction : {+1, −1}
+        Start towards increasing (+1) or decreasing (−1) λ.
+    step, min_step, max_step : float
+        Initial, smallest and largest step in scaled arclength (≈ relative change of λ where the
+        branch is steep in λ) [-]. The step grows by 1.5 after a corrector converges in ≤ 3
+        iterations and halves after a failure; below ``min_step`` the continuation stops.
+    max_points : int
+        Branch points to compute (the start included).
+    bounds : (lo, hi), optional
+        Interval of λ; the continuation ends on its edge (the last point is corrected at λ = edge).
+    stop_on : sequence of str
+        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``.
+    locate : bool
+        Locate special points (Illinois/bisection); otherwise they are reported at the next point.
+    model, section, rtol, atol, slip_band
+        As :func:`~stickslip.orbits.periodic_orbit` (used when ``start`` is not an orbit).
+    tol : float
+        Corrector convergence: max |Φ(s0, T) − s0| / σ ≤ tol [-].
+    fd_step : float
+        Relative finite-difference step of the Jacobian columns [-].
+    param_scale : float, optional
+        λ_s, the unit of λ in the arclength (default |λ0|, or 1 if λ0 = 0).
+    amplitude : bool
+        Measure the peak-to-peak φ of every orbit (one extra run per point).
+    min_stick_fraction : float
+        Stop when the stick time per period of a stick-slip orbit falls below this fraction of
+        the period (the stick phase vanishes; a ``stick-vanishing`` point is reported) [-].
+    callback : callable, optional
+        ``callback(i, value, period, stable)`` after each accepted point (progress).
+
+    Returns
+    -------
+    Branch
+
+    Raises
+    ------
+    ContinuationError
+        If ``param`` is not numeric, the start orbit cannot be found, or the first Jacobian fails.
+    """
+    t_start = time.perf_counter()
+    if direction not in (1, -1):
+        raise ContinuationError(f"direction must be +1 or -1, got {direction}")
+    if not (0.0 < min_step <= step <= max_step):
+        raise ContinuationError(f"need 0 < min_step <= step <= max_step, got {min_step}, {step}, {max_step}")
+    if max_points < 1:
+        raise ContinuationError(f"max_points must be >= 1, got {max_points}")
+    unknown = sorted(set(stop_on) - set(SPECIAL_KINDS))
+    if unknown:
+        raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
+    if isinstance(start, PeriodicOrbit) and params is None:
+        params = start.params
+    params = Parameters() if params is None else params
+    if param not in Parameters.names() or param == "friction_law":
+        raise ContinuationError(f"cannot continue in {param!r}; choose a numeric parameter: "
+                                + ", ".join(n for n in Parameters.names() if n != "friction_law"))
+    if bounds is not None:
+        lo, hi = float(bounds[0]), float(bounds[1])
+        lam_start = float(getattr(params if not isinstance(start, PeriodicOrbit) else start.params, param))
+        if not (lo < hi) or not (lo <= lam_start <= hi):
+            raise ContinuationError(f"bounds ({lo:g}, {hi:g}) must satisfy lo < hi and contain the start "
+                                    f"{param} = {lam_start:g}")
+    atol = 1e-3 * rtol if atol is None else float(atol)
+    orbit = _start_orbit(params, param, start, model, resolve_section(section), rtol, atol, slip_band)
+    problem = _problem(orbit, param, fd_step, param_scale)
+
+    v0 = problem.pack(orbit.state, orbit.period, float(getattr(orbit.params, param)))
+    try:
+        R, end, tr = _residual(problem, v0)
+        points = [_make_point(problem, v0, R, end, tr, 0, None, float(direction))]
+    except (OrbitError, SimulationError) as exc:
+        raise ContinuationError(f"the Jacobian at the start orbit failed: {exc}") from exc
+    arclength = [0.0]
+    special: list[SpecialPoint] = []
+    h = float(step)
+    stop_reason = "max_points"
+    while len(points) < max_points:
+        last = points[-1]
+        try:
+            new = _step_from(problem, last, h, tol)
+            if float(new.tangent @ last.tangent) < MIN_TANGENT_COS:
+                raise OrbitError("tangent turned too far")
+        except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+            h *= SHRINK
+            if h < min_step:
+                stop_reason = "min_step"
+                break
+            continue
+        lam_new = problem.unpack(new.v)[2]
+        if bounds is not None and not (lo <= lam_new <= hi):
+            edge = hi if lam_new > hi else lo
+            try:
+                e = np.zeros_like(new.v)
+                e[-1] = 1.0
+                v, R, end, tr, it, _ = _correct(problem, last.v + (edge / problem.p_scale - last.v[-1]) / last.tangent[-1]
+                                                * last.tangent if abs(last.tangent[-1]) > 1e-12 else new.v,
+                                                last.J, e, edge / problem.p_scale, tol)
+                new = _make_point(problem, v, R, end, tr, it, last.tangent, 1.0)
+            except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+                stop_reason = "bounds (last point before the edge)"
+                break
+            stop_reason = "bounds"
+        points.append(new)
+        arclength.append(arclength[-1] + float(np.linalg.norm(new.v - last.v)))
+        if last.stick_time > 0.0 and new.stick_time < min_stick_fraction * problem.unpack(new.v)[1]:
+            # its multipliers are not trusted: the differences cross the edge of the stick phase
+            special.append(_stick_vanishing(problem, points, len(points) - 2))
+            stop_reason = "stick phase vanishing"
+            break
+        found = _detect(problem, last, new, h, tol, len(points) - 2, locate)
+        special.extend(found)
+        if callback is not None:
+            _s, T_new, lam_cb = problem.unpack(new.v)
+            callback(len(points) - 1, lam_cb, T_new, unstable_count(new.multipliers) == 0)
+        if stop_reason == "bounds":
+            break
+        if any(p.kind in stop_on for p in found):
+            stop_reason = "stop_on " + ",".join(sorted({p.kind for p in found if p.kind in stop_on}))
+            break
+        if new.iterations <= EASY_ITERATIONS:
+            h = min(h * GROW, max_step)
+        elif new.iterations >= HARD_ITERATIONS:
+            h = max(h * SHRINK, min_step)
+
+    return _assemble_branch(problem, orbit, points, arclength, special, stop_reason, amplitude,
+                            dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
+                                 max_step=max_step, max_points=max_points, slip_band=problem.slip_band,
+                                 param_scale=problem.p_scale, period_scale=problem.T_scale,
+                                 bounds=None if bounds is None else [lo, hi], direction=direction),
+                            t_start)
+
+
+def _stick_vanishing(problem: _Problem, points: list, index: int) -> SpecialPoint:
+    """Where the stick time of the last points extrapolates to zero (τ_stick² linear in λ)."""
+    use = [p for p in points[-3:] if p.stick_time > 0.0]
+    lam = np.array([problem.unpack(p.v)[2] for p in use])
+    tau2 = np.array([p.stick_time ** 2 for p in use])
+    last = points[-1]
+    s, T, lam_last = problem.unpack(last.v)
+    value, located = lam_last, False
+    if lam.size >= 2 and np.ptp(lam) > 0.0:
+        slope, intercept = np.polyfit(lam, tau2, 1)
+        if slope != 0.0:
+            root = -intercept / slope
+            # accept if it lies ahead of the last point by less than the last λ step
+            ahead = (root - lam_last) * np.sign(lam[-1] - lam[0])
+            if 0.0 <= ahead <= 2.0 * abs(lam[-1] - lam[-2]):
+                value, located = float(root), True
+    return SpecialPoint(kind="stick-vanishing", index=index, value=value, period=T, state=s,
+                        multipliers=last.multipliers, before=float(points[-2].stick_time),
+                        after=float(last.stick_time), bracket=float(abs(value - lam_last)), located=located)
+
+
+def _detect(problem: _Problem, last: _Point, new: _Point, h: float, tol: float, index: int, locate: bool) -> list:
+    """Special points between two consecutive branch points (located when ``locate``)."""
+    a, b = _test_values(last), _test_values(new)
+    found = []
+    h_actual = float(last.tangent @ (new.v - last.v))  # arclength of ``new`` along the last tangent
+    for kind in SPECIAL_KINDS[:4]:  # stick-vanishing ends the branch (see continue_orbit)
+        changed = (np.sign(a[kind]) != np.sign(b[kind])) if kind in ("fold", "period-doubling") else a[kind] != b[kind]
+        if not changed:
+            continue
+        if locate:
+            found.append(_locate(problem, last, b[kind], kind, h_actual, tol, index))
+        else:
+            s, T, lam = problem.unpack(new.v)
+            found.append(SpecialPoint(kind, index, lam, T, s, new.multipliers, float(a[kind]), float(b[kind]),
+                                      float(abs(lam - problem.unpack(last.v)[2])), False))
+    return found
+
+
+def _assemble_branch(problem, orbit, points, arclength, special, stop_reason, with_amplitude, options, t_start) -> Branch:
+    unpacked = [problem.unpack(p.v) for p in points]
+    states = np.array([u[0] for u in unpacked])
+    periods = np.array([u[1] for u in unpacked])
+    values = np.array([u[2] for u in unpacked])
+    mult = np.array([p.multipliers for p in points])
+    n_unst = np.array([unstable_count(m) for m in mult])
+    amp = np.array([_amplitude(problem, s, T, lam) if with_amplitude else np.nan for s, T, lam in unpacked])
+    return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
+                  stable=n_unst == 0, n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
+                  stick_time=np.array([p.stick_time for p in points]),
+                  amplitude=amp, arclength=np.array(arclength), residuals=np.array([p.residual for p in points]),
+                  iterations=np.array([p.iterations for p in points]), special=special, stop_reason=stop_reason,
+                  params=orbit.params, model=problem.model, section=problem.section, options=options,
+                  timings={"total_s": time.perf_counter() - t_start, "points": len(points),
+                           "simulations": problem.counter["simulations"]})
+
+
+# --------------------------------------------------------------------------- Region II edge
+@dataclasses.dataclass(frozen=True, eq=False)
+class FoldCurve:
+    """The upper edge of the stick-slip domain over N: where the stable stick-slip orbit ends.
+
+    For each N the stick-slip orbit found from the ``far`` initial condition at ``omega_start``
+    is continued in Ω (:func:`continue_orbit`) until it ends, at a fold of cycles (``fold``) or
+    where its stick phase vanishes (``stick-vanishing``). Above the edge no stick-slip orbit of
+    this branch exists; between the linear-stability boundary Ω_c(N) and the edge it coexists with
+    the stable equilibrium (Region II of paper Fig. 8).
+
+    Attributes
+    ----------
+    N : ndarray (n,)
+        Normal loads [N].
+    edge : ndarray (n,)
+        Ω at the end of the branch [rad/s] (NaN if none was found).
+    kind : tuple of str
+        ``fold``, ``stick-vanishing``, ``bounds`` (the branch reached ``omega_max``) or ``failed``.
+    located : ndarray (n,) bool
+        The edge was located to tolerance.
+    period : ndarray (n,)
+        Period at the edge [s].
+    omega_stable_max : ndarray (n,)
+        Largest Ω of a stable orbit on the branch [rad/s].
+    points : ndarray (n,) int
+        Branch points computed.
+    seconds : ndarray (n,)
+        Wall time of each N [s].
+    message : tuple of str
+        Stop reason or error of each N.
+    omega_start : float
+        Ω of the start orbits [rad/s].
+    params : Parameters
+    model : str
+    timings : dict
+    """
+
+    N: np.ndarray
+    edge: np.ndarray
+    kind: tuple
+    located: np.ndarray
+    period: np.ndarray
+    omega_stable_max: np.ndarray
+    points: np.ndarray
+    seconds: np.ndarray
+    message: tuple
+    omega_start: float
+    params: Parameters
+    model: str
+    timings: dict
+
+    def to_xarray(self):
+        """``xarray.Dataset`` over ``N``."""
+        import xarray as xr
+
+        data = {
+            "edge": ("N", self.edge, {"long_name": "Omega where the stick-slip branch ends", "units": "rad/s"}),
+            "kind": ("N", np.array(self.kind, dtype=str), {"long_name": "fold | stick-vanishing | bounds | failed"}),
+            "located": ("N", self.located.astype(np.int8), {"long_name": "1 if located to tolerance"}),
+            "period": ("N", self.period, {"long_name": "period at the edge", "units": "s"}),
+            "omega_stable_max": ("N", self.omega_stable_max, {"long_name": "largest Omega of a stable orbit", "units": "rad/s"}),
+            "points": ("N", self.points.astype(np.int32), {"long_name": "branch points"}),
+            "seconds": ("N", self.seconds, {"long_name": "wall time", "units": "s"}),
+            "message": ("N", np.array(self.message, dtype=str), {"long_name": "stop reason or error"}),
+        }
+        attrs = {"title": "stickslip: end of the stick-slip branch over N (upper edge of Region II, Fig. 8)",
+                 "format": "stickslip-foldcurve-1", "stickslip_version": __version__, "model": self.model,
+                 "omega_start": self.omega_start, "timings": json.dumps(self.timings),
+                 "parameters": json.dumps(self.params.to_dict())}
+        attrs.update(parameter_attrs(self.params.to_dict()))
+        return xr.Dataset(data, coords={"N": ("N", self.N, {"units": "N", "long_name": "normal load"})}, attrs=attrs)
+
+
+#: Length [s] and sample rate [Hz] of the run from the ``far`` initial condition that gives the
+#: start orbit of each N (the stick-slip oscillation settles within ~20 s at Ω = 5 rad/s).
+START_RUN, START_RATE = 60.0, 2000.0
+
+#: If the ``far`` start at ``omega_start`` gives no stick-slip orbit (N = 10 N, Ω = 5 rad/s reaches a
+#: slip-only oscillation), the start is retried at this fraction of ``omega_start`` (Region I).
+START_FALLBACK = 0.6
+
+
+#: Integration tolerance and corrector tolerance of :func:`fold_curve`: a flow map costs 1.4 ms
+#: instead of 2.2 ms at rtol 1e-10 (Model 1, N = 50 N, measured), and the edge Ω, fixed by where
+#: the stick time vanishes, moves by < 1e-3 rad/s (docs/continuation.md).
+FOLD_RTOL, FOLD_TOL = 1e-9, 1e-7
+
+
+def start_run(params: Parameters, ic: str = "far", *, model: str = "full", t_end: float = START_RUN,
+              rtol: float = 1e-10) -> Trajectory:
+    """A run from a named initial condition, to hand to :func:`continue_orbit` as ``start``.
+
+    Parameters
+    ----------
+    params : Parameters
+    ic : str
+        ``far``, ``near``, ``zero`` or ``equilibrium`` (:data:`stickslip.sweep.NAMED_ICS`).
+    model : str
+    t_end : float
+        Run length [s]; the orbit guess is taken from its last section crossings.
+    rtol : float
+        Integration tolerance (``atol`` = 1e-3 rtol).
+    """
+    from ..sweep.spec import initial_condition
+
+    state, pert = initial_condition(ic, params, model)
+    run = simulate(params, t_end, model=model, ic=state, perturbation=pert, sample_rate=START_RATE,
+                   rtol=rtol, atol=1e-3 * rtol)
+    if run.status != "success":
+        raise ContinuationError(f"the start run from ic {ic!r} failed: {run.status}")
+    return run
+
+
+def branch_edge(branch: Branch) -> tuple:
+    """(Ω at the end, kind, located, period) of a branch continued until it ends."""
+    for p in branch.special:
+        if p.kind in ("fold", "stick-vanishing"):
+            return p.value, p.kind, p.located, p.period
+    if branch.stop_reason.startswith("bounds"):
+        return float("nan"), "bounds", False, float("nan")
+    return float("nan"), "failed", False, float("nan")
+
+
+def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float, model: str, options: dict):
+    """One N of :func:`fold_curve` (runs in a worker process)."""
+    t0 = time.perf_counter()
+    rtol = options.get("rtol", 1e-10)
+    errors = []
+    for omega in (omega_start, START_FALLBACK * omega_start):
+        p = params.replace(N=float(N), Omega=float(omega))
+        try:
+            run = start_run(p, "far", model=model, rtol=rtol)
+            orbit = periodic_orbit(p, run, rtol=rtol)
+            if orbit.stick_phases == 0:
+                raise ContinuationError(f"the start orbit at Omega = {omega:g} rad/s has no stick phase")
+            break
+        except (OrbitError, SimulationError) as exc:
+            errors.append(str(exc).splitlines()[0][:200])
+    else:
+        return (float("nan"), "failed", False, float("nan"), float("nan"), 0, time.perf_counter() - t0,
+                "; ".join(errors))
+    try:
+        branch = continue_orbit(start=orbit, param="Omega", bounds=(omega, omega_max), stop_on=("fold",),
+                                amplitude=False, **options)
+    except (OrbitError, SimulationError) as exc:
+        return (float("nan"), "failed", False, float("nan"), float("nan"), 0, time.perf_counter() - t0,
+                str(exc).splitlines()[0][:200])
+    edge, kind, located, period = branch_edge(branch)
+    stable = branch.values[branch.stable]
+    return (edge, kind, located, period, float(stable.max()) if stable.size else float("nan"), len(branch),
+            time.perf_counter() - t0, branch.stop_reason)
+
+
+def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_start: float = 5.0,
+               omega_max: float = 40.0, model: str = "full", workers: int = 1, step: float = 0.05,
+               max_step: float = 1.0, max_points: int = 400, rtol: float = FOLD_RTOL, tol: float = FOLD_TOL,
+               **options) -> FoldCurve:
+    """Ω where the stick-slip orbit ends, for each N: the upper edge of Region II (paper Fig. 8).
+
+    Parameters
+    ----------
+    N : sequence of float
+        Normal loads [N].
+    params : Parameters, optional
+        Base parameters (Table 1, μk = 0.2, Δμ = 0.1, α = 5 by default, as in Fig. 8).
+    omega_start : float
+        Ω of the start orbit [rad/s]: it must lie where the ``far`` initial condition reaches a
+        period-1 stick-slip orbit (Region I or II of Fig. 8).
+    omega_max : float
+        Upper bound of the continuation [rad/s].
+    model : str
+    workers : int
+        Processes (one N per task).
+    step, max_step, max_points, rtol, tol, **options
+        Passed to :func:`continue_orbit` (``rtol``/``tol`` are looser than its defaults: the
+        edge needs the branch, not 1e-8 orbits; see :data:`FOLD_RTOL`).
+
+    Returns
+    -------
+    FoldCurve
+    """
+    from concurrent.futures import ProcessPoolExecutor
+    import multiprocessing
+
+    t0 = time.perf_counter()
+    params = Parameters() if params is None else params
+    Ns = [float(n) for n in N]
+    options = dict(options, step=step, max_step=max_step, max_points=max_points, rtol=rtol, tol=tol)
+    args = [(n, params, omega_start, omega_max, model, options) for n in Ns]
+    if workers <= 1:
+        rows = [_edge_at(*a) for a in args]
+    else:
+        methods = multiprocessing.get_all_start_methods()
+        ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+            rows = list(pool.map(_edge_at, *zip(*args)))
+    cols = list(zip(*rows))
+    return FoldCurve(N=np.array(Ns), edge=np.array(cols[0], dtype=float), kind=tuple(cols[1]),
+                     located=np.array(cols[2], dtype=bool), period=np.array(cols[3], dtype=float),
+                     omega_stable_max=np.array(cols[4], dtype=float), points=np.array(cols[5], dtype=int),
+                     seconds=np.array(cols[6], dtype=float), message=tuple(cols[7]), omega_start=float(omega_start),
+                     params=params, model=model,
+                     timings={"total_s": time.perf_counter() - t0, "workers": int(workers), "n": len(Ns)})

@@ -1,0 +1,220 @@
+"""Pseudo-arclength continuation of periodic orbits: a constructed problem with a known fold and
+period doubling, the belt oscillator's analytic branch, an orbit found independently by shooting,
+and the end of the stick-slip branch (Region II edge) against brute-force simulation."""
+
+import math
+import types
+
+import numpy as np
+import pytest
+
+from stickslip import Parameters, simulate
+from stickslip.orbits import PeriodicOrbit, periodic_orbit, resolve_section
+from stickslip.orbits import continuation as C
+from stickslip.orbits.continuation import ContinuationError, continue_orbit, load_branch, start_run
+
+
+# --------------------------------------------------------------------------- constructed problem
+def _constructed_orbit():
+    """A PeriodicOrbit of model ``rotation`` whose shooting map is replaced by an algebraic one.
+
+    Free states (phi, psi, phi_dot, psi_dot); the section fixes phi_dot, so the scaled unknowns are
+    v = (phi/σ0, psi/σ1, psi_dot/σ3, T/T0, alpha/alpha0). With alpha0 = 5 the start is v = (1, 0.1, 0, 1, 1).
+    """
+    sigma = np.array([0.01, 0.02, 0.3, 0.4])
+    state = np.zeros(12)
+    state[4], state[5] = sigma[0] * 1.0, sigma[1] * 0.1
+    return PeriodicOrbit(state=state, period=0.5, multiplicity=1, stick_phases=1, residual=0.0, iterations=0,
+                         residual_history=np.zeros(1), multipliers=np.ones(4, complex), monodromy=np.eye(4),
+                         free_states=("phi", "psi", "phi_dot", "psi_dot"), scale=sigma,
+                         params=Parameters(alpha=5.0), model="rotation", section=resolve_section("phi_max"),
+                         options=dict(rtol=1e-10, atol=1e-13, slip_band=1e-12, tol=1e-8, fd_step=1e-5, max_iter=20))
+
+
+def _algebraic(v):
+    """F(v): v0² + v4 − 2 (a fold at v4 = 2, i.e. alpha = 10), v1 = 0.1 v4, v2 = 0, v3 = 1."""
+    return np.array([v[0] ** 2 + v[4] - 2.0, v[1] - 0.1 * v[4], v[2], v[3] - 1.0])
+
+
+def _monodromy(v):
+    """diag(1, m, 0.5, 0.2), m = −0.5 − 0.75 (1 − v0): m = −1 at v0 = 1/3 (alpha = 5 (2 − 1/9))."""
+    return np.diag([1.0, -0.5 - 0.75 * (1.0 - v[0]), 0.5, 0.2])
+
+
+@pytest.fixture
+def constructed(monkeypatch):
+    stick = types.SimpleNamespace(kind=np.array([1, -1], dtype=np.int8), time=np.array([0.1, 0.2]))
+
+    def residual(problem, v):
+        return _algebraic(v), np.zeros(12), stick
+
+    def jacobian(problem, v, end):
+        J = np.array([[2 * v[0], 0, 0, 0, 1.0], [0, 1.0, 0, 0, -0.1], [0, 0, 1.0, 0, 0], [0, 0, 0, 1.0, 0]])
+        return J, _monodromy(v)
+
+    monkeypatch.setattr(C, "_residual", residual)
+    monkeypatch.setattr(C, "_jacobian", jacobian)
+    return _constructed_orbit()
+
+
+def test_constructed_fold_and_period_doubling_are_found_where_they_are(constructed):
+    b = continue_orbit(start=constructed, param="alpha", step=0.05, max_step=0.2, max_points=200,
+                       bounds=(4.0, 20.0), amplitude=False)
+    kinds = [p.kind for p in b.special]
+    assert kinds == ["period-doubling", "fold"]
+    pd, fold = b.special
+    assert fold.located and pd.located
+    # the fold of v0² + v4 = 2 is at v4 = 2: alpha = 10; λ is quadratic in arclength there, so the
+    # location to 1e-3 of the step in arclength gives λ to (1e-3 · 0.2)² · 5 ≈ 2e-7
+    assert fold.value == pytest.approx(10.0, abs=1e-6)
+    assert abs(fold.state[4] / 0.01) < 1e-3                     # v0 = 0 at the fold
+    # m = −1 at v0 = 1/3: alpha = 5 (2 − 1/9); λ is linear in arclength there: 1e-3 · 0.2 · 5 = 1e-3
+    assert pd.value == pytest.approx(5.0 * (2.0 - 1.0 / 9.0), abs=1e-3)
+    # stable until the period doubling, then one multiplier outside the unit circle
+    i_pd = pd.index
+    assert b.stable[: i_pd + 1].all() and not b.stable[i_pd + 1:].any()
+    # past the fold alpha decreases again, to the lower bound, where the last point is corrected exactly
+    assert b.stop_reason == "bounds"
+    assert b.values[-1] == pytest.approx(4.0, abs=1e-12)
+    assert b.states[-1][4] / 0.01 == pytest.approx(-math.sqrt(2.0 - 4.0 / 5.0), abs=1e-8)
+    assert np.max(b.values) <= 10.0 + 1e-6
+
+
+def test_bad_requests_are_refused_before_computing(constructed):
+    with pytest.raises(ContinuationError, match="numeric parameter"):
+        continue_orbit(start=constructed, param="friction_law")
+    with pytest.raises(ContinuationError, match="bounds"):
+        continue_orbit(start=constructed, param="alpha", bounds=(6.0, 8.0))
+    with pytest.raises(ContinuationError, match="stop_on"):
+        continue_orbit(start=constructed, param="alpha", stop_on=("cusp",))
+    with pytest.raises(ContinuationError, match="direction"):
+        continue_orbit(start=constructed, param="alpha", direction=0)
+
+
+# --------------------------------------------------------------------------- the belt oscillator
+def _belt(Omega):
+    """1-DOF belt oscillator (model ``phi``, Coulomb, no damping): closed-form period and φ max."""
+    P = Parameters(c_pphi=0.0, Omega=Omega, friction_law="coulomb")
+    omega = math.sqrt(P.k_pphi / P.J_p)
+    D = P.delta_mu * P.N * P.r / P.k_pphi
+    beta = math.atan2(Omega / omega, D)
+    return 2 * D / Omega + (math.pi + 2 * beta) / omega, P.mu_k * P.N * P.r / P.k_pphi + math.hypot(D, Omega / omega)
+
+
+def test_belt_branch_follows_the_analytic_stick_slip_orbits():
+    P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
+    ic = np.zeros(12)
+    ic[10] = P.Omega  # stuck to the belt at φ = 0
+    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    b = continue_orbit(start=orbit, param="Omega", step=0.05, max_step=0.2, max_points=8, bounds=(0.5, 2.0),
+                       amplitude=False)
+    assert len(b) == 8 and b.values[-1] > 0.7  # it moved along the branch
+    for Om, T, s in zip(b.values, b.periods, b.states):
+        T_exact, phi_max = _belt(Om)
+        # flow maps at rtol 1e-10, corrector to 1e-8 σ: 1e-8 relative leaves room for both
+        assert T == pytest.approx(T_exact, rel=1e-8)
+        assert s[4] == pytest.approx(phi_max, rel=1e-8)
+    # stick collapses φ̇: multipliers {1, 0} (finite differences good to ~1e-6, docs/orbits.md)
+    assert np.abs(b.multipliers[:, 0] - 1.0).max() < 1e-6 and np.abs(b.multipliers[:, 1]).max() < 1e-6
+    assert b.stable.all() and (b.stick_phases == 1).all() and not b.special
+
+
+# --------------------------------------------------------------------------- Model 4 (rotation only)
+@pytest.fixture(scope="module")
+def rotation_branch():
+    """Model 4, N = 50 N: the stick-slip orbit from the ``far`` start at Ω = 3 rad/s, continued up
+    in Ω until it ends (stick phase vanishing at Ω ≈ 6.06 rad/s; ~2 s)."""
+    p = Parameters(N=50.0, Omega=3.0)
+    orbit = periodic_orbit(p, start_run(p, "far", model="rotation", t_end=30.0))
+    return continue_orbit(start=orbit, param="Omega", step=0.05, max_step=1.0, max_points=200, bounds=(3.0, 20.0),
+                          amplitude=False)
+
+
+def test_branch_passes_through_an_orbit_found_independently(rotation_branch):
+    b = rotation_branch
+    i = len(b) // 2
+    Om = float(b.values[i])
+    assert 3.5 < Om < 6.0  # an intermediate orbit, far from the start
+    p = Parameters(N=50.0, Omega=Om)
+    # the `far` start reaches the equilibrium here (Region "III" of brute force, docs/continuation.md),
+    # so the independent guess is a 20 s run from the branch state with φ displaced by 1e-3 rad
+    # (~40 % of the orbit's φ range): shooting then starts from its own crossings, scales and period
+    guess = simulate(p, 20.0, model="rotation", ic=b.states[i], perturbation=1e-3, sample_rate=2000.0,
+                     rtol=1e-10, atol=1e-13)
+    ref = periodic_orbit(p, guess)
+    assert ref.stick_phases == b.stick_phases[i] == 1
+    # both converged to 1e-8 σ at rtol 1e-10; the slowest multiplier (~0.99) amplifies the
+    # residual ~100× in the state, hence 1e-6 relative in T and 1e-6 σ in the states
+    assert b.periods[i] == pytest.approx(ref.period, rel=1e-6)
+    free = [4, 5, 11]
+    assert np.abs((b.states[i][free] - ref.state[free]) / ref.scale[[0, 1, 3]]).max() < 1e-6
+    # multipliers agree to the FD accuracy (1e-5) and one of them is 1 (autonomous orbit)
+    assert np.allclose(np.sort(np.abs(b.multipliers[i])), np.sort(np.abs(ref.multipliers)), atol=1e-5)
+    assert np.min(np.abs(b.multipliers[i] - 1.0)) < 1e-6
+
+
+def _sticks_after(p, state, t_end=200.0, window=100.0):
+    """Brute force: does a run from ``state`` still stick in its last ``window`` seconds?"""
+    traj = simulate(p, t_end, model="rotation", ic=state, sample_rate=100.0)
+    assert traj.status == "success"
+    return bool(traj.mode[traj.t >= t_end - window].any())
+
+
+def test_end_of_branch_matches_brute_force_within_the_grid_spacing(rotation_branch):
+    """The edge of Region II from continuation against brute force on an Ω grid of spacing 0.1 rad/s.
+
+    Brute force cannot use the `far`/`near` starts here: at N = 50 N both reach the equilibrium at
+    every Ω ≥ 5.5 rad/s of Model 4 (the basin of the stick-slip orbit shrinks to nothing at the edge;
+    docs/continuation.md). So each grid point is simulated from a state on the orbit just below the
+    edge: stick-slip persists at every grid Ω below the edge and is gone above it.
+    """
+    b = rotation_branch
+    edge = [p for p in b.special if p.kind == "stick-vanishing"]
+    assert b.stop_reason == "stick phase vanishing" and len(edge) == 1 and edge[0].located
+    edge = edge[0].value
+    spacing = 0.1
+    grid = np.round(np.arange(np.floor(edge / spacing) * spacing - 2 * spacing, edge + 2.5 * spacing, spacing), 10)
+    start = b.states[-2]  # the last orbit whose stick phase is resolved (≥ 1e-3 of the period)
+    sticks = [_sticks_after(Parameters(N=50.0, Omega=float(Om)), start) for Om in grid]
+    assert sticks[0] and not sticks[-1]
+    last = float(grid[np.flatnonzero(sticks)[-1]])
+    assert all(sticks[: np.flatnonzero(sticks)[-1] + 1])  # no gap below the brute-force edge
+    assert last <= edge < last + spacing
+
+
+def test_branch_writes_and_reads_netcdf(rotation_branch, tmp_path):
+    b = rotation_branch
+    ds = load_branch(b.to_netcdf(tmp_path / "b.nc"))
+    assert np.array_equal(ds["value"].values, b.values)
+    assert np.array_equal(ds["period"].values, b.periods)
+    assert np.array_equal(ds["multiplier_real"].values + 1j * ds["multiplier_imag"].values, b.multipliers)
+    assert list(ds["special_kind"].values) == [p.kind for p in b.special]
+    assert ds.attrs["param"] == "Omega" and ds.attrs["model"] == "rotation" and ds.attrs["param_N"] == 50.0
+    with pytest.raises(ValueError, match="not a stickslip branch"):
+        ds.attrs["format"] = "other"
+        ds.to_netcdf(tmp_path / "x.nc", engine="h5netcdf")
+        load_branch(tmp_path / "x.nc")
+
+
+# --------------------------------------------------------------------------- Model 1, slow
+@pytest.mark.slow
+def test_model1_edge_at_N50_matches_brute_force():
+    """Model 1, N = 50 N: the stick-slip orbit from the `far` start at Ω = 8 rad/s ends at
+    Ω ≈ 15.78 rad/s (its stick phase vanishes); brute force on a 0.25 rad/s grid from a state on
+    the orbit agrees within the spacing (~30 s)."""
+    p = Parameters(N=50.0, Omega=8.0)
+    orbit = periodic_orbit(p, start_run(p, "far", t_end=60.0))
+    b = continue_orbit(start=orbit, param="Omega", step=0.05, max_step=1.0, max_points=400, bounds=(8.0, 30.0),
+                       amplitude=False)
+    assert b.stable[:-1].all()
+    edge = [q.value for q in b.special if q.kind == "stick-vanishing"]
+    assert b.stop_reason == "stick phase vanishing" and len(edge) == 1
+    spacing = 0.25
+    grid = np.arange(np.floor(edge[0] / spacing) * spacing - spacing, edge[0] + 1.5 * spacing, spacing)
+    sticks = []
+    for Om in grid:
+        traj = simulate(Parameters(N=50.0, Omega=float(Om)), 300.0, ic=b.states[-2], sample_rate=100.0)
+        sticks.append(bool(traj.mode[traj.t >= 200.0].any()))
+    assert sticks[0] and not sticks[-1]
+    last = float(grid[np.flatnonzero(sticks)[-1]])
+    assert last <= edge[0] < last + spacing
