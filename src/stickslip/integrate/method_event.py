@@ -19,9 +19,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..model import kernels as K
+from ..model.jit import kernel, loop
 from . import events as E
 
 N_STATE = 14  # 12 states + work of friction + work of damping
@@ -61,7 +61,7 @@ MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick r
 MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.36 s shortest natural period of Table 1
 
 
-@njit(cache=True)
+@kernel
 def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
     """One Dormand–Prince step from y (with k1 = f(y) in Kst[0]); fills Kst[1:7] and ynew."""
     n = y.shape[0]
@@ -82,7 +82,7 @@ def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
     K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
 
 
-@njit(cache=True)
+@kernel
 def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
     """RMS of the embedded error estimate over the free DOFs' positions and velocities."""
     total = 0.0
@@ -103,7 +103,7 @@ def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
     return math.sqrt(total / count)
 
 
-@njit(cache=True)
+@kernel
 def _dense_coefficients(Kst, Q):
     """Q = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ."""
     n = Q.shape[0]
@@ -115,7 +115,7 @@ def _dense_coefficients(Kst, Q):
             Q[i, c] = acc
 
 
-@njit(cache=True)
+@kernel
 def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff, p,
                    sample_times, out_s, out_mode, out_F, work):
     """Write the samples from index ``idx`` up to time t_to, from the step starting at t_step."""
@@ -128,14 +128,14 @@ def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff,
     return idx
 
 
-@njit(cache=True)
+@kernel
 def _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F):
     """Write sample ``idx`` with the friction force of ``mode`` at state ``y``."""
     Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
     E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
 
 
-@njit(cache=True)
+@loop
 def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
     """Append a transition, growing the buffers when full; returns the (possibly new) buffers."""
     if n == tr_t.shape[0]:
@@ -154,7 +154,7 @@ def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
     return tr_t, tr_kind, tr_s
 
 
-@njit(cache=True)
+@loop
 def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_max, max_steps,
                     sample_times, out_s, out_mode, out_F):
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end]; see the module docstring.
@@ -203,11 +203,13 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
         _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
 
+    n_samples = sample_times.shape[0]
     status = STATUS_OK
     retakes = 0
     homing = 0          # homing steps taken towards v_r = 0 since the last event
     h_override = -1.0   # step length imposed on the next step (homing), if > 0
     h_free = -1.0       # step size before a homing episode, if > 0
+    tau_start = math.inf  # extrapolated time to v_r = 0 at the start of the step (approach)
     rejected = False    # whether the last attempt was rejected
     n_steps = 0
     while t < t_end:
@@ -239,15 +241,23 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
         if rejected:
             factor = min(factor, 1.0)  # no growth right after a rejection (Hairer's DOPRI5 rule)
             rejected = False
-        _dense_coefficients(Kst, Q)
+        q_ready = False  # the dense-output coefficients are formed only when needed
 
         if mode != K.MODE_STICK:
             theta = -1.0
+            # v_r and dv_r/dt at the end of the step: the event pre-check, and after acceptance
+            # the new slip direction and the time to v_r = 0
+            v1x, v1y, a1x, a1y = K.relative_velocity_acceleration(ynew, Kst[6], p)
             if mode == K.MODE_SLIP_EXACT:  # while departing from v_r = 0 there is nothing to detect
-                vx, vy = K.relative_velocity(y, p)
-                speed = math.sqrt(vx * vx + vy * vy)
-                theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, vx / speed, vy / speed,
-                                         minv, damp, stiff, p, work)
+                v0x, v0y, a0x, a0y = K.relative_velocity_acceleration(y, k1, p)
+                speed0 = math.sqrt(v0x * v0x + v0y * v0y)
+                e0x = v0x / speed0
+                e0y = v0y / speed0
+                if E.slip_event_possible(speed0, h * (a0x * e0x + a0y * e0y), v1x * e0x + v1y * e0y,
+                                         h * (a1x * e0x + a1y * e0y)):
+                    _dense_coefficients(Kst, Q)
+                    q_ready = True
+                    theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, e0x, e0y, minv, damp, stiff, p, work)
             if theta > 0.0 and (1.0 - theta) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
                 # the slip velocity passes zero inside the step: re-take it to end at the root
                 if retakes == 0 and homing == 0:
@@ -256,23 +266,35 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 retakes += 1
                 stats[3] += 1
                 continue
-            idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
-                                 sample_times, out_s, out_mode, out_F, work)
+            if idx < n_samples and sample_times[idx] <= t + h:
+                if not q_ready:
+                    _dense_coefficients(Kst, Q)
+                idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                                     sample_times, out_s, out_mode, out_F, work)
             t += h
             for i in range(n):
                 y[i] = ynew[i]
                 k1[i] = Kst[6, i]
             stats[0] += 1
-            ex, ey = K.slip_direction(y, ex, ey, minv, damp, stiff, p)
-            vx, vy = K.relative_velocity(y, p)
-            speed = math.sqrt(vx * vx + vy * vy)
+            speed = math.sqrt(v1x * v1x + v1y * v1y)
+            if speed > p[K.P_SLIP_BAND]:
+                ex = v1x / speed
+                ey = v1y / speed
+            else:
+                ex, ey = K.quasi_static_direction(y, ex, ey, minv, damp, stiff, p)
             if mode == K.MODE_SLIP:
                 if speed > p[K.P_SLIP_BAND]:
                     mode = K.MODE_SLIP_EXACT  # same force above the band: k1 stays valid
             else:
                 v_arrive = E.arrival_speed(y, rtol, atol)
                 near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= v_arrive
-                tau = E.time_to_zero(y, k1, p)
+                tau = E.time_to_zero_of(v1x, v1y, a1x, a1y)
+                if tau_start < math.inf and tau < math.inf:
+                    # approach to stick: the local error of the stiff direction dynamics is a
+                    # function of h/τ (self-similar), so control that ratio, not h: the next
+                    # step is the same fraction of the time left (no accept/reject ping-pong)
+                    factor = min(factor, factor * tau / tau_start)
+                tau_start = tau
                 if (theta <= 0.0 and E.ARRIVAL_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES
                         and (near or tau < h * factor)):
                     # v_r heads for zero within the next step (or a re-take landed short of it):
@@ -303,7 +325,10 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                         h_override = max(h * factor, h_free)
                         h_free = -1.0
             retakes = 0
+            if mode != K.MODE_SLIP_EXACT:
+                tau_start = math.inf
         else:
+            _dense_coefficients(Kst, Q)
             theta = E.first_crossing(E.EVENT_STICK, y, Q, h, 0.0, 0.0, minv, damp, stiff, p, work)
             if theta > 0.0:
                 # breakaway inside the step: the stick flow is smooth, so cut the step at the root
