@@ -32,27 +32,22 @@ STATUS_NOT_FINITE = 2
 STATUS_MAX_STEPS = 3
 
 # Dormand–Prince 5(4) tableau and 4th-order dense output (Dormand & Prince 1980; Shampine 1986),
-# the coefficients used by scipy.integrate.RK45.
-_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
-_A = np.array([
-    [0.0, 0.0, 0.0, 0.0, 0.0],
-    [1 / 5, 0.0, 0.0, 0.0, 0.0],
-    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
-    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
-    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
-    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
-])
-_B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
-_E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
-_P = np.array([
-    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
-    [0.0, 0.0, 0.0, 0.0],
-    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
-    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
-    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
-    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
-    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
-])
+# the coefficients used by scipy.integrate.RK45, as scalar constants so that the compiled stage
+# loops below are fully unrolled (A_ij: stage i from stage j; B: 5th-order weights; E: error
+# weights, 5th minus 4th order; P_jc: dense output, stage j, power θ^(c+1)).
+A21 = 1 / 5
+A31, A32 = 3 / 40, 9 / 40
+A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
+A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+E1, E3, E4, E5, E6, E7 = -71 / 57600, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40
+P10, P11, P12, P13 = 1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432
+P31, P32, P33 = 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799
+P41, P42, P43 = -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072
+P51, P52, P53 = 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632
+P61, P62, P63 = -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844
+P71, P72, P73 = 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423
 
 SAFETY = 0.9        # standard step-size safety factor
 MIN_FACTOR = 0.2    # largest step reduction after a rejection
@@ -63,22 +58,31 @@ MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.
 
 @kernel
 def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
-    """One Dormand–Prince step from y (with k1 = f(y) in Kst[0]); fills Kst[1:7] and ynew."""
+    """One Dormand–Prince step from y with k1 = f(y); fills the stages Kst[0:7] and ynew."""
     n = y.shape[0]
+    k2 = Kst[1]
+    k3 = Kst[2]
+    k4 = Kst[3]
+    k5 = Kst[4]
+    k6 = Kst[5]
     for i in range(n):
         Kst[0, i] = k1[i]
-    for s in range(1, 6):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += _A[s, j] * Kst[j, i]
-            ytmp[i] = y[i] + h * acc
-        K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, Kst[s])
+        ytmp[i] = y[i] + h * A21 * k1[i]
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k2)
     for i in range(n):
-        acc = 0.0
-        for j in range(6):
-            acc += _B[j] * Kst[j, i]
-        ynew[i] = y[i] + h * acc
+        ytmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k3)
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k4)
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k5)
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k6)
+    for i in range(n):
+        ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
     K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
 
 
@@ -91,10 +95,8 @@ def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
         if minv[d] == 0.0:
             continue
         for i in (d, d + 6):
-            err = 0.0
-            for j in range(7):
-                err += _E[j] * Kst[j, i]
-            err *= h
+            err = h * (E1 * Kst[0, i] + E3 * Kst[2, i] + E4 * Kst[3, i] + E5 * Kst[4, i]
+                       + E6 * Kst[5, i] + E7 * Kst[6, i])
             scale = atol + rtol * max(abs(y[i]), abs(ynew[i]))
             total += (err / scale) ** 2
             count += 1
@@ -106,13 +108,17 @@ def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
 @kernel
 def _dense_coefficients(Kst, Q):
     """Q = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ."""
-    n = Q.shape[0]
-    for i in range(n):
-        for c in range(4):
-            acc = 0.0
-            for j in range(7):
-                acc += Kst[j, i] * _P[j, c]
-            Q[i, c] = acc
+    for i in range(Q.shape[0]):
+        k1 = Kst[0, i]
+        k3 = Kst[2, i]
+        k4 = Kst[3, i]
+        k5 = Kst[4, i]
+        k6 = Kst[5, i]
+        k7 = Kst[6, i]
+        Q[i, 0] = P10 * k1
+        Q[i, 1] = P11 * k1 + P31 * k3 + P41 * k4 + P51 * k5 + P61 * k6 + P71 * k7
+        Q[i, 2] = P12 * k1 + P32 * k3 + P42 * k4 + P52 * k5 + P62 * k6 + P72 * k7
+        Q[i, 3] = P13 * k1 + P33 * k3 + P43 * k4 + P53 * k5 + P63 * k6 + P73 * k7
 
 
 @kernel

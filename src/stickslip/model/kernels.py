@@ -44,9 +44,10 @@ SPEED_FLOOR = 1e-13
 #: (:func:`quasi_static_direction`) instead of v_r/|v_r|. Near v_r = 0 the direction of 2-D
 #: friction relaxes on the time scale |v_r| / (λ μ N) → 0 (a stiff mode that forces explicit
 #: steps of that size); inside the band the direction sits on its slow manifold, an O(|v_r|)
-#: approximation. Measured at Ω = 0.5 rad/s, N = 30/50/70 N (100 s, rtol 1e-8): bands 1e-4 and
-#: 1e-5 give steady frequencies equal to 1e-8 relative, 1e-4 with half the steps, and stays
-#: robust at rtol = 1e-6 where 1e-5 needs 20x more steps (docs/numerics.md).
+#: approximation. Measured at N = 50 N, Ω = 5 rad/s and Ω = 0.5 rad/s, N = 30/50/70/120 N
+#: (100 s, rtol 1e-8, against band 1e-5 at rtol 1e-11): bands 1e-5, 1e-4 and 1e-3 give the
+#: same errors (≤ 6e-9 in frequency), 3e-3 and above show the band (docs/numerics.md);
+#: 1e-3 takes 15–40 % fewer steps than 1e-4.
 DEFAULT_SLIP_BAND = 1e-3
 
 #: Relative size below which the smaller eigenvalue of G M⁻¹ Gᵀ counts as zero (rank 1,
