@@ -114,9 +114,9 @@ def _run_event(system: System, y0: np.ndarray, t0: float, t_end: float, sample_t
     h_max = dt if dt is not None else (t_end - t0)
     h_init = min(1e-3, h_max)  # ~1/100 of the fastest natural period of Table 1 (0.36 s)
     n = sample_times.size
-    out_s = np.zeros((n, method_event.N_STATE))
-    out_mode = np.zeros(n, dtype=np.int8)
-    out_F = np.zeros((n, 2))
+    out_s = np.empty((n, method_event.N_STATE))  # every kept sample is written
+    out_mode = np.empty(n, dtype=np.int8)
+    out_F = np.empty((n, 2))
     y = np.zeros(method_event.N_STATE)
     y[:12] = y0
     compile_time = _warm_up(method_event.integrate_event, y, t0, system, out_s, out_mode, out_F)
@@ -232,15 +232,16 @@ def simulate(
     options = {"rtol": rtol, "atol": atol, "dt": dt, "sample_rate": sample_rate, "ic": ic_text,
                "perturbation": None if perturbation is None else np.asarray(perturbation, dtype=float).tolist(),
                "t0": t0, "t_end": t_end, "slip_band": slip_band}
-    t_samples = sample_times[keep]
+    n_kept = int(np.count_nonzero(keep))  # the samples up to the time reached: a prefix, so views
+    t_samples = sample_times[:n_kept]
     if steady_from is None:
         steady_from = t0 + 0.5 * (t_samples[-1] - t0)
     return Trajectory(
         t=t_samples,
-        states=out_s[keep, :12],
-        mode=out_mode[keep],
-        friction=out_F[keep],
-        work=out_s[keep, 12:14],
+        states=out_s[:n_kept, :12],
+        mode=out_mode[:n_kept],
+        friction=out_F[:n_kept],
+        work=out_s[:n_kept, 12:14],
         transitions=transitions,
         stats=Stats(**stats, wall_time_s=wall),
         status=status,

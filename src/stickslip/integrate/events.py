@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
 
 from ..model import kernels as K
+from ..model.jit import kernel
 
 EVENT_SLIP = 0   # slip → stick candidate: v_r · e0
 EVENT_STICK = 1  # stick → slip: μs N − |F_stick|
@@ -48,10 +48,14 @@ STICK_SPEED_TOL = 1e-6
 EVENT_CHECKS = 4
 
 
-@njit(cache=True)
+@kernel
 def dense_state(y0, Q, h, theta, out):
     """Evaluate ``out = y0 + h Σ_j Q[:, j] θ^(j+1)`` (Horner)."""
     n, m = Q.shape
+    if m == 4:  # Dormand–Prince dense output: unrolled (the samples' inner loop)
+        for i in range(n):
+            out[i] = y0[i] + h * theta * (Q[i, 0] + theta * (Q[i, 1] + theta * (Q[i, 2] + theta * Q[i, 3])))
+        return
     for i in range(n):
         acc = Q[i, m - 1]
         for j in range(m - 2, -1, -1):
@@ -59,7 +63,7 @@ def dense_state(y0, Q, h, theta, out):
         out[i] = y0[i] + h * theta * acc
 
 
-@njit(cache=True)
+@kernel
 def store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F):
     """Write the state, the mode flag (1 = stick, 0 = slip) and the friction force of sample ``idx``."""
     for i in range(y.shape[0]):
@@ -69,7 +73,7 @@ def store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F):
     out_F[idx, 1] = Fy
 
 
-@njit(cache=True)
+@kernel
 def event_value(kind, y, e0x, e0y, minv, damp, stiff, p):
     """Event function of ``kind`` at state ``y`` (see module docstring)."""
     if kind == EVENT_SLIP:
@@ -79,7 +83,7 @@ def event_value(kind, y, e0x, e0y, minv, damp, stiff, p):
     return K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy)
 
 
-@njit(cache=True)
+@kernel
 def first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work):
     """First θ ∈ (0, 1] where the event function turns ≤ 0, located to EVENT_TIME_TOL.
 
@@ -126,23 +130,58 @@ def first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work):
     return b
 
 
-@njit(cache=True)
+@kernel
 def time_to_zero(y, dy, p):
     """Time [s] to the closest approach of v_r to zero, extrapolating dv_r/dt linearly.
 
-    −(v·v)/(v·a) with a = dv_r/dt from the state derivative ``dy``; +inf unless v_r heads
-    for zero within 60° of head-on (a turning slip direction is not an approach). Used to home
-    the last step of an approach onto v_r = 0.
+    State ``y`` with derivative ``dy``; see :func:`time_to_zero_of`.
     """
-    vx, vy = K.relative_velocity(y, p)
-    ax, ay = K.relative_acceleration(y, dy, p)
+    vx, vy, ax, ay = K.relative_velocity_acceleration(y, dy, p)
+    return time_to_zero_of(vx, vy, ax, ay)
+
+
+@kernel
+def time_to_zero_of(vx, vy, ax, ay):
+    """Time [s] to the closest approach of v_r = (vx, vy) to zero under constant dv_r/dt = (ax, ay).
+
+    −(v·v)/(v·a); +inf unless v_r heads for zero within 60° of head-on (a turning slip
+    direction is not an approach). Used to home the last step of an approach onto v_r = 0
+    and to scale the steps of the approach.
+    """
     va = vx * ax + vy * ay
     if va >= -0.5 * math.sqrt((vx * vx + vy * vy) * (ax * ax + ay * ay)):  # cos 60° = 0.5
         return math.inf
     return -(vx * vx + vy * vy) / va
 
 
-@njit(cache=True)
+@kernel
+def slip_event_possible(g0, dg0, g1, dg1):
+    """Whether the slip event g = v_r·e0 may reach zero inside a step (cheap pre-check).
+
+    ``g0, g1`` are its values at the ends of the step and ``dg0, dg1`` its derivatives with
+    respect to θ ∈ [0, 1] (h × dv_r/dt · e0). The cubic Hermite interpolant of these four
+    numbers is checked at θ = 1/4, 1/2, 3/4 and at the end; a possible crossing is any value
+    at or below half the smaller end value (so a dip towards zero that the cubic only
+    approximates still gets the full check on the step's dense output by
+    :func:`first_crossing`). A monotone approach (g falls from g0 to g1 > 0) needs no check.
+    """
+    if g1 <= 0.0:
+        return True
+    floor = 0.5 * min(g0, g1)
+    for j in range(1, 4):
+        th = 0.25 * j
+        th2 = th * th
+        th3 = th2 * th
+        h00 = 2.0 * th3 - 3.0 * th2 + 1.0
+        h10 = th3 - 2.0 * th2 + th
+        h01 = -2.0 * th3 + 3.0 * th2
+        h11 = th3 - th2
+        if h00 * g0 + h10 * dg0 + h01 * g1 + h11 * dg1 <= floor:
+            return True
+    return False
+
+
+@kernel
 def breakaway_direction(Fx, Fy):
     """Slip direction at breakaway e = −F_stick/|F_stick| (DESIGN.md §1)."""
     norm = math.sqrt(Fx * Fx + Fy * Fy)
@@ -151,7 +190,7 @@ def breakaway_direction(Fx, Fy):
     return -Fx / norm, -Fy / norm
 
 
-@njit(cache=True)
+@kernel
 def arrival_speed(y, rtol, atol):
     """|v_r| [m/s] at or below which slip has arrived at v_r = 0 for an integration at (rtol, atol).
 
@@ -165,7 +204,7 @@ def arrival_speed(y, rtol, atol):
     return max(STICK_SPEED_TOL, 10.0 * (atol + rtol * qd))
 
 
-@njit(cache=True)
+@kernel
 def try_stick(y, minv, damp, stiff, p, speed_tol):
     """At a zero of the slip velocity: project and test stick admissibility (Eq. 10).
 
@@ -186,7 +225,7 @@ def try_stick(y, minv, damp, stiff, p, speed_tol):
     return False, ex, ey
 
 
-@njit(cache=True)
+@kernel
 def initial_mode(y, minv, damp, stiff, p):
     """Mode a state starts in: stick if v_r = 0 (to STICK_SPEED_TOL) and stick is admissible.
 

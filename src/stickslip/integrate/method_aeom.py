@@ -47,9 +47,9 @@ import math
 import time
 
 import numpy as np
-from numba import njit
 
 from ..model import kernels as K
+from ..model.jit import kernel, loop
 from . import events as E
 from .method_event import (N_STATE, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_OK,
                            STATUS_STEP_UNDERFLOW, _record)
@@ -75,7 +75,7 @@ MAX_BISECTIONS = 200
 
 
 # --------------------------------------------------------------------------- shared RK4 pieces
-@njit(cache=True)
+@kernel
 def rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
     """One classic RK4 step of length ``h`` [s] in slip (Eq. 1 with Eq. 3), k1 = f(y) given.
 
@@ -98,7 +98,7 @@ def rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4
     return 3
 
 
-@njit(cache=True)
+@kernel
 def hermite_coefficients(y0, f0, y1, f1, h, Q):
     """Cubic Hermite interpolant of a step as ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)`` (3 columns).
 
@@ -112,7 +112,7 @@ def hermite_coefficients(y0, f0, y1, f1, h, Q):
         Q[i, 2] = f0[i] + f1[i] - 2.0 * d
 
 
-@njit(cache=True)
+@kernel
 def write_samples(idx, t, h, y0, f0, y1, f1, mode, ex, ey, fixed_force, Fx, Fy, minv, damp, stiff, p,
                   sample_times, out_s, out_mode, out_F, Q, work):
     """Write the samples with t < ts ≤ t + h from the Hermite interpolant of the step.
@@ -133,7 +133,7 @@ def write_samples(idx, t, h, y0, f0, y1, f1, mode, ex, ey, fixed_force, Fx, Fy, 
     return idx
 
 
-@njit(cache=True)
+@kernel
 def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F):
     """Write sample ``idx``: the given force if ``fixed_force``, else the contact force of ``mode``."""
     if not fixed_force:
@@ -141,7 +141,7 @@ def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_
     E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
 
 
-@njit(cache=True)
+@kernel
 def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p,
                           sample_times, out_s, out_mode, out_F):
     """Samples at t ≤ t0 (the initial state). Returns the next sample index."""
@@ -152,7 +152,7 @@ def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, 
     return idx
 
 
-@njit(cache=True)
+@kernel
 def slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
     """A slip step with the slip → stick event located by bisection on re-stepping.
 
@@ -199,7 +199,7 @@ def slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew, ytm
     return b * h, True
 
 
-@njit(cache=True)
+@kernel
 def after_slip_root(ynew, ex, ey, minv, damp, stiff, p):
     """At a located zero of the projected slip velocity: arrival at v_r = 0, then
     ``events.try_stick`` (projection + Eq. 10 test).
@@ -227,7 +227,7 @@ def after_slip_root(ynew, ex, ey, minv, damp, stiff, p):
     return False, ex, ey
 
 
-@njit(cache=True)
+@kernel
 def next_step(t, t0, dt, k_grid, t_end):
     """Length of the next step: up to the grid point t0 + k Δt (or t_end), skipping grid points
     closer than ``events.EVENT_TIME_TOL`` (a transition that fell just before one).
@@ -243,7 +243,7 @@ def next_step(t, t0, dt, k_grid, t_end):
 
 
 # --------------------------------------------------------------------------- AEOM stick step
-@njit(cache=True)
+@kernel
 def _trapezoid_base(y, p):
     """u = x2 − x1, w = y2 − y1 and their rates from v_r = 0 (Eq. 11) at the step start."""
     r = p[K.P_R]
@@ -255,7 +255,7 @@ def _trapezoid_base(y, p):
     return y[2] - y[0], y[3] - y[1], a0, b0
 
 
-@njit(cache=True)
+@kernel
 def dependent_states(s, tau, u0, w0, a0, b0, minv, p):
     """Set x2, y2 by the trapezoidal rule (Eqs. 11–12) and ẋ2, ẏ2 from v_r = 0 (Eq. 11), in place.
 
@@ -304,7 +304,7 @@ def dependent_states(s, tau, u0, w0, a0, b0, minv, p):
         s[9] = s[7] + r * dphi * cphi - wt * (s[0] - s[2] + r * cphi)
 
 
-@njit(cache=True)
+@kernel
 def aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
     """One AEOM stick step of length ``h`` [s]: RK4 on x1, y1, φ, ψ (Eq. 13), x2, y2 by Eq. (12).
 
@@ -337,7 +337,7 @@ def aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
     return 3
 
 
-@njit(cache=True)
+@loop
 def integrate_aeom(y0, t0, t_end, dt, minv, damp, stiff, p, max_steps, sample_times, out_s, out_mode, out_F):
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end] with the fixed step ``dt`` [s].
 
@@ -487,7 +487,7 @@ def step_band(system, dt: float) -> float:
     In slip the direction of v_r relaxes on the time scale |v_r| / (μ N λ), λ an eigenvalue of
     A = G M⁻¹ Gᵀ (``kernels.DEFAULT_SLIP_BAND``'s note). An explicit step resolves it only when
     |v_r| ≳ Δt μ N λ; below that speed RK4 makes the direction chatter (measured at Δt = 1e-4 s
-    with the default band 1e-4 m/s: stick entries late by up to 2.5e-4 s and a 1.2 % error of
+    with a band of 1e-4 m/s: stick entries late by up to 2.5e-4 s and a 1.2 % error of
     φ's amplitude). There the direction must sit on its slow manifold, which is what the
     low-speed band does, so the fixed-step methods use max(slip_band, this). λ is bounded by
     tr(A) taken at R = r (contact at its nominal radius). Table 1: 3.4e-3 m/s at Δt = 1e-4 s.

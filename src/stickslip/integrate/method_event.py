@@ -19,9 +19,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..model import kernels as K
+from ..model.jit import kernel, loop
 from . import events as E
 
 N_STATE = 14  # 12 states + work of friction + work of damping
@@ -32,27 +32,22 @@ STATUS_NOT_FINITE = 2
 STATUS_MAX_STEPS = 3
 
 # Dormand–Prince 5(4) tableau and 4th-order dense output (Dormand & Prince 1980; Shampine 1986),
-# the coefficients used by scipy.integrate.RK45.
-_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
-_A = np.array([
-    [0.0, 0.0, 0.0, 0.0, 0.0],
-    [1 / 5, 0.0, 0.0, 0.0, 0.0],
-    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
-    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
-    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
-    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
-])
-_B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
-_E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
-_P = np.array([
-    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
-    [0.0, 0.0, 0.0, 0.0],
-    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
-    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
-    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
-    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
-    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
-])
+# the coefficients used by scipy.integrate.RK45, as scalar constants so that the compiled stage
+# loops below are fully unrolled (A_ij: stage i from stage j; B: 5th-order weights; E: error
+# weights, 5th minus 4th order; P_jc: dense output, stage j, power θ^(c+1)).
+A21 = 1 / 5
+A31, A32 = 3 / 40, 9 / 40
+A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
+A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+E1, E3, E4, E5, E6, E7 = -71 / 57600, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40
+P10, P11, P12, P13 = 1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432
+P31, P32, P33 = 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799
+P41, P42, P43 = -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072
+P51, P52, P53 = 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632
+P61, P62, P63 = -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844
+P71, P72, P73 = 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423
 
 SAFETY = 0.9        # standard step-size safety factor
 MIN_FACTOR = 0.2    # largest step reduction after a rejection
@@ -61,28 +56,37 @@ MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick r
 MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.36 s shortest natural period of Table 1
 
 
-@njit(cache=True)
+@kernel
 def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
-    """One Dormand–Prince step from y (with k1 = f(y) in Kst[0]); fills Kst[1:7] and ynew."""
+    """One Dormand–Prince step from y with k1 = f(y); fills the stages Kst[0:7] and ynew."""
     n = y.shape[0]
+    k2 = Kst[1]
+    k3 = Kst[2]
+    k4 = Kst[3]
+    k5 = Kst[4]
+    k6 = Kst[5]
     for i in range(n):
         Kst[0, i] = k1[i]
-    for s in range(1, 6):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += _A[s, j] * Kst[j, i]
-            ytmp[i] = y[i] + h * acc
-        K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, Kst[s])
+        ytmp[i] = y[i] + h * A21 * k1[i]
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k2)
     for i in range(n):
-        acc = 0.0
-        for j in range(6):
-            acc += _B[j] * Kst[j, i]
-        ynew[i] = y[i] + h * acc
+        ytmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k3)
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k4)
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k5)
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k6)
+    for i in range(n):
+        ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
     K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
 
 
-@njit(cache=True)
+@kernel
 def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
     """RMS of the embedded error estimate over the free DOFs' positions and velocities."""
     total = 0.0
@@ -91,10 +95,8 @@ def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
         if minv[d] == 0.0:
             continue
         for i in (d, d + 6):
-            err = 0.0
-            for j in range(7):
-                err += _E[j] * Kst[j, i]
-            err *= h
+            err = h * (E1 * Kst[0, i] + E3 * Kst[2, i] + E4 * Kst[3, i] + E5 * Kst[4, i]
+                       + E6 * Kst[5, i] + E7 * Kst[6, i])
             scale = atol + rtol * max(abs(y[i]), abs(ynew[i]))
             total += (err / scale) ** 2
             count += 1
@@ -103,19 +105,23 @@ def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
     return math.sqrt(total / count)
 
 
-@njit(cache=True)
+@kernel
 def _dense_coefficients(Kst, Q):
     """Q = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ."""
-    n = Q.shape[0]
-    for i in range(n):
-        for c in range(4):
-            acc = 0.0
-            for j in range(7):
-                acc += Kst[j, i] * _P[j, c]
-            Q[i, c] = acc
+    for i in range(Q.shape[0]):
+        k1 = Kst[0, i]
+        k3 = Kst[2, i]
+        k4 = Kst[3, i]
+        k5 = Kst[4, i]
+        k6 = Kst[5, i]
+        k7 = Kst[6, i]
+        Q[i, 0] = P10 * k1
+        Q[i, 1] = P11 * k1 + P31 * k3 + P41 * k4 + P51 * k5 + P61 * k6 + P71 * k7
+        Q[i, 2] = P12 * k1 + P32 * k3 + P42 * k4 + P52 * k5 + P62 * k6 + P72 * k7
+        Q[i, 3] = P13 * k1 + P33 * k3 + P43 * k4 + P53 * k5 + P63 * k6 + P73 * k7
 
 
-@njit(cache=True)
+@kernel
 def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff, p,
                    sample_times, out_s, out_mode, out_F, work):
     """Write the samples from index ``idx`` up to time t_to, from the step starting at t_step."""
@@ -128,14 +134,14 @@ def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff,
     return idx
 
 
-@njit(cache=True)
+@kernel
 def _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F):
     """Write sample ``idx`` with the friction force of ``mode`` at state ``y``."""
     Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
     E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
 
 
-@njit(cache=True)
+@loop
 def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
     """Append a transition, growing the buffers when full; returns the (possibly new) buffers."""
     if n == tr_t.shape[0]:
@@ -154,7 +160,7 @@ def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
     return tr_t, tr_kind, tr_s
 
 
-@njit(cache=True)
+@loop
 def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_max, max_steps,
                     sample_times, out_s, out_mode, out_F):
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end]; see the module docstring.
@@ -203,11 +209,13 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
         _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
 
+    n_samples = sample_times.shape[0]
     status = STATUS_OK
     retakes = 0
     homing = 0          # homing steps taken towards v_r = 0 since the last event
     h_override = -1.0   # step length imposed on the next step (homing), if > 0
     h_free = -1.0       # step size before a homing episode, if > 0
+    tau_start = math.inf  # extrapolated time to v_r = 0 at the start of the step (approach)
     rejected = False    # whether the last attempt was rejected
     n_steps = 0
     while t < t_end:
@@ -239,15 +247,23 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
         if rejected:
             factor = min(factor, 1.0)  # no growth right after a rejection (Hairer's DOPRI5 rule)
             rejected = False
-        _dense_coefficients(Kst, Q)
+        q_ready = False  # the dense-output coefficients are formed only when needed
 
         if mode != K.MODE_STICK:
             theta = -1.0
+            # v_r and dv_r/dt at the end of the step: the event pre-check, and after acceptance
+            # the new slip direction and the time to v_r = 0
+            v1x, v1y, a1x, a1y = K.relative_velocity_acceleration(ynew, Kst[6], p)
             if mode == K.MODE_SLIP_EXACT:  # while departing from v_r = 0 there is nothing to detect
-                vx, vy = K.relative_velocity(y, p)
-                speed = math.sqrt(vx * vx + vy * vy)
-                theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, vx / speed, vy / speed,
-                                         minv, damp, stiff, p, work)
+                v0x, v0y, a0x, a0y = K.relative_velocity_acceleration(y, k1, p)
+                speed0 = math.sqrt(v0x * v0x + v0y * v0y)
+                e0x = v0x / speed0
+                e0y = v0y / speed0
+                if E.slip_event_possible(speed0, h * (a0x * e0x + a0y * e0y), v1x * e0x + v1y * e0y,
+                                         h * (a1x * e0x + a1y * e0y)):
+                    _dense_coefficients(Kst, Q)
+                    q_ready = True
+                    theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, e0x, e0y, minv, damp, stiff, p, work)
             if theta > 0.0 and (1.0 - theta) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
                 # the slip velocity passes zero inside the step: re-take it to end at the root
                 if retakes == 0 and homing == 0:
@@ -256,23 +272,35 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 retakes += 1
                 stats[3] += 1
                 continue
-            idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
-                                 sample_times, out_s, out_mode, out_F, work)
+            if idx < n_samples and sample_times[idx] <= t + h:
+                if not q_ready:
+                    _dense_coefficients(Kst, Q)
+                idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
+                                     sample_times, out_s, out_mode, out_F, work)
             t += h
             for i in range(n):
                 y[i] = ynew[i]
                 k1[i] = Kst[6, i]
             stats[0] += 1
-            ex, ey = K.slip_direction(y, ex, ey, minv, damp, stiff, p)
-            vx, vy = K.relative_velocity(y, p)
-            speed = math.sqrt(vx * vx + vy * vy)
+            speed = math.sqrt(v1x * v1x + v1y * v1y)
+            if speed > p[K.P_SLIP_BAND]:
+                ex = v1x / speed
+                ey = v1y / speed
+            else:
+                ex, ey = K.quasi_static_direction(y, ex, ey, minv, damp, stiff, p)
             if mode == K.MODE_SLIP:
                 if speed > p[K.P_SLIP_BAND]:
                     mode = K.MODE_SLIP_EXACT  # same force above the band: k1 stays valid
             else:
                 v_arrive = E.arrival_speed(y, rtol, atol)
                 near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= v_arrive
-                tau = E.time_to_zero(y, k1, p)
+                tau = E.time_to_zero_of(v1x, v1y, a1x, a1y)
+                if tau_start < math.inf and tau < math.inf:
+                    # approach to stick: the local error of the stiff direction dynamics is a
+                    # function of h/τ (self-similar), so control that ratio, not h: the next
+                    # step is the same fraction of the time left (no accept/reject ping-pong)
+                    factor = min(factor, factor * tau / tau_start)
+                tau_start = tau
                 if (theta <= 0.0 and E.ARRIVAL_TIME_TOL < tau < MAX_HOMING_STEP and homing < MAX_RETAKES
                         and (near or tau < h * factor)):
                     # v_r heads for zero within the next step (or a re-take landed short of it):
@@ -303,7 +331,10 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                         h_override = max(h * factor, h_free)
                         h_free = -1.0
             retakes = 0
+            if mode != K.MODE_SLIP_EXACT:
+                tau_start = math.inf
         else:
+            _dense_coefficients(Kst, Q)
             theta = E.first_crossing(E.EVENT_STICK, y, Q, h, 0.0, 0.0, minv, damp, stiff, p, work)
             if theta > 0.0:
                 # breakaway inside the step: the stick flow is smooth, so cut the step at the root

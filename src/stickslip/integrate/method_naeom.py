@@ -32,9 +32,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..model import kernels as K
+from ..model.jit import kernel, loop
 from . import events as E
 from .method_aeom import (MAX_BISECTIONS, N_STATE, _messages, after_slip_root, check_step, kernel_parameters,
                           next_step,
@@ -66,7 +66,7 @@ FD_REL_STEP = 1.5e-8
 STATUS_SOLVE_FAILED = 4
 
 
-@njit(cache=True)
+@kernel
 def rk4_force_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4):
     """RK4 step of Eq. (1) with the friction force (Fx, Fy) [N] held constant; writes ``ynew``."""
     n = y.shape[0]
@@ -86,7 +86,7 @@ def rk4_force_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k
         ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
 
 
-@njit(cache=True)
+@kernel
 def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4, stats):
     """Find the constant force over a step of length ``h`` [s] that makes v_r(t_n) = 0.
 
@@ -160,7 +160,7 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
     return Fx, Fy, -1
 
 
-@njit(cache=True)
+@loop
 def integrate_naeom(y0, t0, t_end, dt, minv, damp, stiff, p, max_steps, sample_times, out_s, out_mode, out_F):
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end] with the fixed step ``dt`` [s].
 

@@ -23,7 +23,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 # Indices into the packed contact/friction array ``p``.
 P_R, P_N, P_OMEGA, P_MU_K, P_DELTA_MU, P_ALPHA, P_LAW, P_SLIP_BAND = range(8)
@@ -43,17 +44,18 @@ SPEED_FLOOR = 1e-13
 #: (:func:`quasi_static_direction`) instead of v_r/|v_r|. Near v_r = 0 the direction of 2-D
 #: friction relaxes on the time scale |v_r| / (λ μ N) → 0 (a stiff mode that forces explicit
 #: steps of that size); inside the band the direction sits on its slow manifold, an O(|v_r|)
-#: approximation. Measured at Ω = 0.5 rad/s, N = 30/50/70 N (100 s, rtol 1e-8): bands 1e-4 and
-#: 1e-5 give steady frequencies equal to 1e-8 relative, 1e-4 with half the steps, and stays
-#: robust at rtol = 1e-6 where 1e-5 needs 20x more steps (docs/numerics.md).
-DEFAULT_SLIP_BAND = 1e-4
+#: approximation. Measured at N = 50 N, Ω = 5 rad/s and Ω = 0.5 rad/s, N = 30/50/70/120 N
+#: (100 s, rtol 1e-8, against band 1e-5 at rtol 1e-11): bands 1e-5, 1e-4 and 1e-3 give the
+#: same errors (≤ 6e-9 in frequency), 3e-3 and above show the band (docs/numerics.md);
+#: 1e-3 takes 15–40 % fewer steps than 1e-4.
+DEFAULT_SLIP_BAND = 1e-3
 
 #: Relative size below which the smaller eigenvalue of G M⁻¹ Gᵀ counts as zero (rank 1,
 #: DESIGN.md §1.2). In Model 4 it is exactly 0 up to round-off (~1e-16 relative).
 RANK_TOL = 1e-10
 
 
-@njit(cache=True)
+@kernel
 def contact_kinematics(s, p):
     """(sin φ, cos φ, X, Y): the contact point relative to O2 [m] (paper Eqs. 2, 8)."""
     r = p[P_R]
@@ -62,21 +64,21 @@ def contact_kinematics(s, p):
     return sphi, cphi, s[0] - s[2] + r * cphi, s[1] - s[3] + r * sphi
 
 
-@njit(cache=True)
+@kernel
 def contact_rates(s, p, sphi, cphi):
     """(dX/dt, dY/dt) of the contact point relative to O2 [m/s]."""
     r = p[P_R]
     return s[6] - s[8] - r * sphi * s[10], s[7] - s[9] + r * cphi * s[10]
 
 
-@njit(cache=True)
+@kernel
 def contact_position(s, p):
     """Contact point relative to O2, (X, Y) [m] (paper Eq. 2 components)."""
     _, _, X, Y = contact_kinematics(s, p)
     return X, Y
 
 
-@njit(cache=True)
+@kernel
 def relative_velocity(s, p):
     """Relative velocity v_r of the upper plate against the lower one at the contact, Eq. (9) [m/s]."""
     sphi, cphi, X, Y = contact_kinematics(s, p)
@@ -85,9 +87,13 @@ def relative_velocity(s, p):
     return dX + w * Y, dY - w * X
 
 
-@njit(cache=True)
-def relative_acceleration(s, ds, p):
-    """dv_r/dt [m/s²] along the state derivative ``ds`` (time derivative of Eq. 9)."""
+@kernel
+def relative_velocity_acceleration(s, ds, p):
+    """(v_r, dv_r/dt) [m/s, m/s²] at state ``s`` along the state derivative ``ds``, Eq. (9).
+
+    One evaluation of the contact kinematics for both (the event integrator needs them
+    together after every step).
+    """
     r = p[P_R]
     sphi, cphi, X, Y = contact_kinematics(s, p)
     dphi = s[10]
@@ -95,10 +101,17 @@ def relative_acceleration(s, ds, p):
     w = p[P_OMEGA] + s[11]
     ax = ds[6] - ds[8] - r * (cphi * dphi * dphi + sphi * ds[10]) + ds[11] * Y + w * dY
     ay = ds[7] - ds[9] + r * (cphi * ds[10] - sphi * dphi * dphi) - ds[11] * X - w * dX
+    return dX + w * Y, dY - w * X, ax, ay
+
+
+@kernel
+def relative_acceleration(s, ds, p):
+    """dv_r/dt [m/s²] along the state derivative ``ds`` (time derivative of Eq. 9)."""
+    _, _, ax, ay = relative_velocity_acceleration(s, ds, p)
     return ax, ay
 
 
-@njit(cache=True)
+@kernel
 def friction_coefficient(speed, p):
     """Kinetic friction coefficient μ(|v_r|) [-]: Eq. (4), or μk for the Coulomb law."""
     if p[P_LAW] == LAW_COULOMB:
@@ -106,20 +119,20 @@ def friction_coefficient(speed, p):
     return p[P_MU_K] + p[P_DELTA_MU] * math.exp(-p[P_ALPHA] * speed)
 
 
-@njit(cache=True)
+@kernel
 def static_limit(p):
     """Largest admissible stick force μs N [N], Eq. (10)."""
     return (p[P_MU_K] + p[P_DELTA_MU]) * p[P_N]
 
 
-@njit(cache=True)
+@kernel
 def slip_force(speed, dx, dy, p):
     """Slip friction force F = −μ(|v_r|) N e along the unit slip direction e = (dx, dy), Eq. (3) [N]."""
     scale = -friction_coefficient(speed, p) * p[P_N]
     return scale * dx, scale * dy
 
 
-@njit(cache=True)
+@kernel
 def solve_psd_2x2(a11, a12, a22, b1, b2):
     """Minimal-norm solution of the symmetric positive semi-definite system A x = b.
 
@@ -151,14 +164,14 @@ def solve_psd_2x2(a11, a12, a22, b1, b2):
     return c * u1, c * u2, 1
 
 
-@njit(cache=True)
+@kernel
 def constraint_metric(s, minv, p):
     """Entries (a11, a12, a22) of A = G M⁻¹ Gᵀ (2×2, symmetric PSD) [1/kg]."""
     sphi, cphi, X, Y = contact_kinematics(s, p)
     return constraint_metric_at(sphi, cphi, X, Y, minv, p)
 
 
-@njit(cache=True)
+@kernel
 def constraint_metric_at(sphi, cphi, X, Y, minv, p):
     """:func:`constraint_metric` with the contact kinematics already computed."""
     r = p[P_R]
@@ -168,7 +181,7 @@ def constraint_metric_at(sphi, cphi, X, Y, minv, p):
     return a11, a12, a22
 
 
-@njit(cache=True)
+@kernel
 def stick_force(s, minv, damp, stiff, p):
     """Friction force that keeps v_r = 0, the Lagrange multiplier of the stick constraint [N].
 
@@ -180,7 +193,7 @@ def stick_force(s, minv, damp, stiff, p):
     return stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
 
 
-@njit(cache=True)
+@kernel
 def stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p):
     """:func:`stick_force` with the contact kinematics already computed."""
     r = p[P_R]
@@ -202,7 +215,7 @@ def stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p):
     return solve_psd_2x2(a11, a12, a22, -(h1 + g1), -(h2 + g2))
 
 
-@njit(cache=True)
+@kernel
 def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     """Time derivative of the state under friction force (Fx, Fy), Eq. (1) as M q̈ = f + Gᵀ F.
 
@@ -214,7 +227,7 @@ def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
 
 
-@njit(cache=True)
+@kernel
 def dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds):
     """:func:`dynamics` with the contact kinematics (sin φ, cos φ, X, Y) already computed."""
     r = p[P_R]
@@ -244,7 +257,7 @@ def dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds):
                    + damp[3] * s[9] * s[9] + damp[4] * s[10] * s[10] + damp[5] * s[11] * s[11])
 
 
-@njit(cache=True)
+@kernel
 def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
     """Slip direction e on the slow manifold of the direction dynamics at |v_r| → 0.
 
@@ -276,7 +289,7 @@ def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
     return math.cos(theta), math.sin(theta)
 
 
-@njit(cache=True)
+@kernel
 def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
     """Friction force in the given mode [N]: the stick multiplier, or Eq. (3) in slip.
 
@@ -297,7 +310,7 @@ def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
     return slip_force(speed, dx, dy, p)
 
 
-@njit(cache=True)
+@kernel
 def slip_direction(s, ex, ey, minv, damp, stiff, p):
     """Unit slip direction: v_r/|v_r| above the low-speed band, the quasi-static one inside."""
     vx, vy = relative_velocity(s, p)
@@ -307,7 +320,7 @@ def slip_direction(s, ex, ey, minv, damp, stiff, p):
     return quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
 
 
-@njit(cache=True)
+@kernel
 def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N].
 
@@ -335,7 +348,7 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     return Fx, Fy
 
 
-@njit(cache=True)
+@kernel
 def _kinetic_energy(s, minv):
     e = 0.0
     for i in range(6):
@@ -344,7 +357,7 @@ def _kinetic_energy(s, minv):
     return e
 
 
-@njit(cache=True)
+@kernel
 def project_velocity(s, minv, p):
     """Project q̇ onto v_r = 0 in the M-metric, in place (DESIGN.md §1); returns ΔE_kin [J].
 
@@ -372,7 +385,7 @@ def project_velocity(s, minv, p):
     return delta
 
 
-@njit(cache=True)
+@kernel
 def sliding_angle(s, p):
     """Angle of v_r against the circumferential sliding direction −e_n2 [rad] (Fig. 11).
 
