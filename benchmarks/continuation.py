@@ -38,8 +38,10 @@ def start_orbit(N=50.0, Omega=8.0):
 def bench_branch(points: int) -> dict:
     orbit = start_orbit()
     t0 = time.perf_counter()
-    b = continue_orbit(start=orbit, param="Omega", step=0.02, max_step=0.05, max_points=points,
-                       bounds=(8.0, 40.0), min_stick_fraction=0.0, amplitude=False)
+    # steps of 0.02 in scaled arclength (the adaptive step would reach the end of the branch,
+    # Ω ≈ 15.8 rad/s, in ~140 orbits): 200 orbits with multipliers from Ω = 8 rad/s
+    b = continue_orbit(start=orbit, param="Omega", step=0.02, max_step=0.02, max_points=points,
+                       bounds=(8.0, 40.0), amplitude=False)
     wall = time.perf_counter() - t0
     return {"points": len(b), "wall_s": wall, "goal_s": BRANCH_GOAL_S, "per_point_s": wall / len(b),
             "simulations": b.timings["simulations"], "omega_range": [float(b.values[0]), float(b.values[-1])],

@@ -54,7 +54,8 @@ from ..model.variants import STATE_NAMES
 from .section import OrbitError, Section, resolve_section, vector_field
 from .shooting import PeriodicOrbit, periodic_orbit
 
-__all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run", "load_branch",
+__all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run", "crossings_per_stick",
+           "start_orbit_from_run", "load_branch",
            "ContinuationError", "SPECIAL_KINDS"]
 
 #: Kinds of special points, in the order they are reported.
@@ -259,6 +260,11 @@ class _Point:
     residual: float
     iterations: int
 
+    @property
+    def fresh(self) -> bool:
+        """True if J is a finite-difference Jacobian at this point (multipliers known)."""
+        return bool(np.all(np.isfinite(self.multipliers)))
+
 
 def _stick_time(tr) -> float:
     """Total time in stick over one period [s] from the run's transitions (it starts in slip)."""
@@ -285,12 +291,14 @@ def unstable_count(multipliers: np.ndarray) -> int:
 
 
 def _test_values(point: _Point) -> dict:
-    """Test functions of the special points at one point (continuous ones are floats)."""
-    mu = nontrivial(point.multipliers)
+    """Test functions of the special points at one point (continuous ones are floats; None where
+    the point has no multipliers, see ``jacobian_every``)."""
+    fresh = point.fresh
+    mu = nontrivial(point.multipliers) if fresh else None
     return {
         "fold": float(point.tangent[-1]),
-        "period-doubling": float(np.real(np.prod(mu + 1.0))),
-        "neimark-sacker": int(np.sum((np.abs(mu) > 1.0) & (np.abs(mu.imag) > 1e-9 * np.abs(mu)))),
+        "period-doubling": float(np.real(np.prod(mu + 1.0))) if fresh else None,
+        "neimark-sacker": int(np.sum((np.abs(mu) > 1.0) & (np.abs(mu.imag) > 1e-9 * np.abs(mu)))) if fresh else None,
         "stick-phases": int(point.stick_phases),
     }
 
@@ -306,9 +314,10 @@ def _step_from(problem: _Problem, point: _Point, h: float, tol: float, with_jaco
     """The branch point at arclength ``h`` from ``point`` (predictor along its tangent + corrector)."""
     v_pred = point.v + h * point.tangent
     v, R, end, tr, it, J = _correct(problem, v_pred, point.J, point.tangent, float(point.tangent @ v_pred), tol)
-    if not with_jacobian:
-        return _Point(v=v, J=J, M=point.M, tangent=point.tangent, multipliers=point.multipliers,
-                      stick_phases=int(np.sum(tr.kind == 1)), stick_time=_stick_time(tr), residual=float(np.max(np.abs(R))), iterations=it)
+    if not with_jacobian:  # Broyden-updated Jacobian: tangent, but no multipliers
+        n = point.M.shape[0]
+        return _Point(v=v, J=J, M=np.full((n, n), np.nan), tangent=_tangent(J, point.tangent),
+                      multipliers=np.full(n, np.nan + 0j), stick_phases=int(np.sum(tr.kind == 1)), stick_time=_stick_time(tr), residual=float(np.max(np.abs(R))), iterations=it)
     return _make_point(problem, v, R, end, tr, it, point.tangent, 1.0)
 
 
@@ -373,11 +382,12 @@ class Branch:
     states : ndarray (n, 12)
         States on the Poincaré section [m, rad, m/s, rad/s].
     multipliers : ndarray (n, 2 n_free) complex
-        Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus.
+        Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus
+        (NaN at points without a finite-difference Jacobian, see ``jacobian_every``).
     stable : ndarray (n,) bool
         Every non-trivial multiplier inside the unit circle.
     n_unstable : ndarray (n,) int
-        Non-trivial multipliers outside the unit circle.
+        Non-trivial multipliers outside the unit circle (−1 where not computed, ``jacobian_every``).
     stick_phases : ndarray (n,) int
         Slip → stick transitions per period (0: pure slip).
     stick_time : ndarray (n,)
@@ -629,6 +639,7 @@ def continue_orbit(
     slip_band: float = DEFAULT_SLIP_BAND,
     amplitude: bool = True,
     min_stick_fraction: float = MIN_STICK_FRACTION,
+    jacobian_every: int = 1,
     callback=None,
 ) -> Branch:
     """Continue a periodic orbit in one parameter by pseudo-arclength continuation.
@@ -674,6 +685,12 @@ def continue_orbit(
     min_stick_fraction : float
         Stop when the stick time per period of a stick-slip orbit falls below this fraction of
         the period (the stick phase vanishes; a ``stick-vanishing`` point is reported) [-].
+    jacobian_every : int
+        Recompute the finite-difference Jacobian (2 (2 n_free + 1) simulations) at every
+        ``jacobian_every``-th point only; in between, the corrector's Broyden-updated Jacobian gives
+        the tangent, and the points have no multipliers (NaN; ``n_unstable`` −1). Period doubling
+        and Neimark–Sacker are then detected between points with multipliers. 1 (default): every
+        point has multipliers.
     callback : callable, optional
         ``callback(i, value, period, stable)`` after each accepted point (progress).
 
@@ -693,6 +710,9 @@ def continue_orbit(
         raise ContinuationError(f"need 0 < min_step <= step <= max_step, got {min_step}, {step}, {max_step}")
     if max_points < 1:
         raise ContinuationError(f"max_points must be >= 1, got {max_points}")
+    if int(jacobian_every) < 1:
+        raise ContinuationError(f"jacobian_every must be >= 1, got {jacobian_every}")
+    jacobian_every = int(jacobian_every)
     unknown = sorted(set(stop_on) - set(SPECIAL_KINDS))
     if unknown:
         raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
@@ -722,13 +742,23 @@ def continue_orbit(
     special: list[SpecialPoint] = []
     h = float(step)
     stop_reason = "max_points"
+    fresh_index = 0  # the last point with a finite-difference Jacobian
     while len(points) < max_points:
         last = points[-1]
+        fresh = (len(points) - fresh_index) >= jacobian_every
         try:
-            new = _step_from(problem, last, h, tol)
+            new = _step_from(problem, last, h, tol, with_jacobian=fresh)
             if float(new.tangent @ last.tangent) < MIN_TANGENT_COS:
                 raise OrbitError("tangent turned too far")
         except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+            if not last.fresh:  # first renew the Broyden-updated Jacobian, then shrink
+                try:
+                    R, end, tr = _residual(problem, last.v)
+                    points[-1] = _make_point(problem, last.v, R, end, tr, last.iterations, last.tangent, 1.0)
+                    fresh_index = len(points) - 1
+                    continue
+                except (OrbitError, SimulationError):
+                    pass
             h *= SHRINK
             if h < min_step:
                 stop_reason = "min_step"
@@ -755,11 +785,18 @@ def continue_orbit(
             special.append(_stick_vanishing(problem, points, len(points) - 2))
             stop_reason = "stick phase vanishing"
             break
-        found = _detect(problem, last, new, h, tol, len(points) - 2, locate)
-        special.extend(found)
+        found = _detect(problem, last, new, tol, len(points) - 2, locate, ("fold", "stick-phases"))
+        if new.fresh and jacobian_every > 1:
+            found += _detect(problem, points[fresh_index], new, tol, fresh_index, locate,
+                             ("period-doubling", "neimark-sacker"))
+        elif new.fresh:
+            found += _detect(problem, last, new, tol, len(points) - 2, locate, ("period-doubling", "neimark-sacker"))
+        if new.fresh:
+            fresh_index = len(points) - 1
+        special.extend(sorted(found, key=lambda q: SPECIAL_KINDS.index(q.kind)))
         if callback is not None:
             _s, T_new, lam_cb = problem.unpack(new.v)
-            callback(len(points) - 1, lam_cb, T_new, unstable_count(new.multipliers) == 0)
+            callback(len(points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
         if stop_reason == "bounds":
             break
         if any(p.kind in stop_on for p in found):
@@ -774,7 +811,8 @@ def continue_orbit(
                             dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
                                  max_step=max_step, max_points=max_points, slip_band=problem.slip_band,
                                  param_scale=problem.p_scale, period_scale=problem.T_scale,
-                                 bounds=None if bounds is None else [lo, hi], direction=direction),
+                                 bounds=None if bounds is None else [lo, hi], direction=direction,
+                                 jacobian_every=jacobian_every),
                             t_start)
 
 
@@ -799,12 +837,14 @@ def _stick_vanishing(problem: _Problem, points: list, index: int) -> SpecialPoin
                         after=float(last.stick_time), bracket=float(abs(value - lam_last)), located=located)
 
 
-def _detect(problem: _Problem, last: _Point, new: _Point, h: float, tol: float, index: int, locate: bool) -> list:
-    """Special points between two consecutive branch points (located when ``locate``)."""
+def _detect(problem: _Problem, last: _Point, new: _Point, tol: float, index: int, locate: bool, kinds) -> list:
+    """Special points of ``kinds`` between two branch points (located when ``locate``)."""
     a, b = _test_values(last), _test_values(new)
     found = []
     h_actual = float(last.tangent @ (new.v - last.v))  # arclength of ``new`` along the last tangent
-    for kind in SPECIAL_KINDS[:4]:  # stick-vanishing ends the branch (see continue_orbit)
+    for kind in kinds:
+        if a[kind] is None or b[kind] is None:
+            continue
         changed = (np.sign(a[kind]) != np.sign(b[kind])) if kind in ("fold", "period-doubling") else a[kind] != b[kind]
         if not changed:
             continue
@@ -823,7 +863,7 @@ def _assemble_branch(problem, orbit, points, arclength, special, stop_reason, wi
     periods = np.array([u[1] for u in unpacked])
     values = np.array([u[2] for u in unpacked])
     mult = np.array([p.multipliers for p in points])
-    n_unst = np.array([unstable_count(m) for m in mult])
+    n_unst = np.array([unstable_count(p.multipliers) if p.fresh else -1 for p in points])
     amp = np.array([_amplitude(problem, s, T, lam) if with_amplitude else np.nan for s, T, lam in unpacked])
     return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
                   stable=n_unst == 0, n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
@@ -923,6 +963,10 @@ START_FALLBACK = 0.6
 #: the stick time vanishes, moves by < 1e-3 rad/s (docs/continuation.md).
 FOLD_RTOL, FOLD_TOL = 1e-9, 1e-7
 
+#: Finite-difference Jacobian every this many points in :func:`fold_curve` (Broyden in between):
+#: the edge needs the tangent and the stick time, not the multipliers of every point.
+FOLD_JACOBIAN_EVERY = 4
+
 
 def start_run(params: Parameters, ic: str = "far", *, model: str = "full", t_end: float = START_RUN,
               rtol: float = 1e-10) -> Trajectory:
@@ -949,6 +993,50 @@ def start_run(params: Parameters, ic: str = "far", *, model: str = "full", t_end
     return run
 
 
+def crossings_per_stick(run: Trajectory, section="phi_max") -> int:
+    """Section crossings between the last two stick onsets of a run (≥ 1): the period
+    multiplicity to shoot with when the orbit has one stick phase per period (at low N the
+    stick-slip orbit of Model 1 has several maxima of φ per period)."""
+    from .section import section_crossings
+
+    sec = resolve_section(section)
+    onsets = run.transitions.time[run.transitions.kind == 1]
+    if onsets.size < 2:
+        return 1
+    system = assemble(run.params, run.model)
+    times, _ = section_crossings(system, sec, run.t, run.states, run.mode)
+    return max(int(np.sum((times > onsets[-2]) & (times <= onsets[-1]))), 1)
+
+
+def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e-10) -> PeriodicOrbit:
+    """Shoot the stick-slip orbit a run has settled on, with one stick onset per period.
+
+    The period multiplicity is :func:`crossings_per_stick`. Where some section crossings lie in
+    stick, the run is cut back one sample period at a time (up to one orbit period) until the
+    first crossing used by :func:`~stickslip.orbits.periodic_orbit` lies in slip.
+
+    Raises
+    ------
+    OrbitError
+        If no cut gives a converged orbit.
+    """
+    k = crossings_per_stick(run, section)
+    onsets = run.transitions.time[run.transitions.kind == 1]
+    span = float(onsets[-1] - onsets[-2]) if onsets.size >= 2 else 1.0
+    cut_step = max(int(round(span / (run.t[1] - run.t[0]) / (4 * k))), 1)  # a quarter of a crossing interval
+    error = None
+    for cut in range(0, 4 * k + 1):
+        m = run.t.size - cut * cut_step
+        part = dataclasses.replace(run, t=run.t[:m], states=run.states[:m], mode=run.mode[:m])
+        try:
+            return periodic_orbit(run.params, part, section=section, rtol=rtol, period_multiplicity=k)
+        except OrbitError as exc:
+            error = exc
+            if "crossed in stick" not in str(exc):
+                break
+    raise OrbitError(f"no stick-slip orbit from the run ({error})")
+
+
 def branch_edge(branch: Branch) -> tuple:
     """(Ω at the end, kind, located, period) of a branch continued until it ends."""
     for p in branch.special:
@@ -968,7 +1056,7 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
         p = params.replace(N=float(N), Omega=float(omega))
         try:
             run = start_run(p, "far", model=model, rtol=rtol)
-            orbit = periodic_orbit(p, run, rtol=rtol)
+            orbit = start_orbit_from_run(run, rtol=rtol)
             if orbit.stick_phases == 0:
                 raise ContinuationError(f"the start orbit at Omega = {omega:g} rad/s has no stick phase")
             break
@@ -992,7 +1080,7 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
 def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_start: float = 5.0,
                omega_max: float = 40.0, model: str = "full", workers: int = 1, step: float = 0.05,
                max_step: float = 1.0, max_points: int = 400, rtol: float = FOLD_RTOL, tol: float = FOLD_TOL,
-               **options) -> FoldCurve:
+               jacobian_every: int = FOLD_JACOBIAN_EVERY, **options) -> FoldCurve:
     """Ω where the stick-slip orbit ends, for each N: the upper edge of Region II (paper Fig. 8).
 
     Parameters
@@ -1023,7 +1111,8 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     t0 = time.perf_counter()
     params = Parameters() if params is None else params
     Ns = [float(n) for n in N]
-    options = dict(options, step=step, max_step=max_step, max_points=max_points, rtol=rtol, tol=tol)
+    options = dict(options, step=step, max_step=max_step, max_points=max_points, rtol=rtol, tol=tol,
+                   jacobian_every=jacobian_every)
     args = [(n, params, omega_start, omega_max, model, options) for n in Ns]
     if workers <= 1:
         rows = [_edge_at(*a) for a in args]
