@@ -1,5 +1,6 @@
 """Sweeps: executors agree, a killed sweep resumes to the identical dataset, files are checked."""
 
+import importlib
 import os
 import signal
 import subprocess
@@ -152,3 +153,64 @@ def test_region_one_at_omega_5():
     # the near IC departs the unstable equilibrium (growth rate 0.05 1/s) only after ~150 s
     rm = regions([50.0], [5.0], t_end=300.0, t_from=200.0, executor="serial")
     assert rm.region[0, 0, 0] == 1
+
+
+# ----------------------------------------------------------------------------- bounded-memory assembly
+@pytest.mark.parametrize("shape", [(7,), (3, 5), (2, 3, 4), (1, 6, 1, 5)])
+def test_flat_hyperslabs_tile_any_range_in_c_order(shape):
+    from stickslip.sweep.store import flat_hyperslabs
+
+    size = int(np.prod(shape))
+    expected = np.arange(size).reshape(shape)           # C order by definition
+    for a in range(size):
+        for b in range(a + 1, size + 1):
+            got = np.full(shape, -1)
+            slabs = flat_hyperslabs(shape, a, b)
+            assert len(slabs) <= 2 * len(shape) - 1
+            assert [lo for _, lo, _ in slabs][0] == a and slabs[-1][2] == b
+            for index, lo, hi in slabs:
+                block_shape = tuple(s.stop - s.start for s in index)
+                got[index] = np.arange(lo, hi).reshape(block_shape)
+            assert np.array_equal(got[got >= 0], expected.ravel()[a:b])
+
+
+def test_assembly_in_slabs_places_out_of_order_rows(tmp_path, monkeypatch):
+    store = importlib.import_module("stickslip.sweep.store")
+    from stickslip.sweep.spec import SweepSpec
+
+    monkeypatch.setattr(store, "SLAB_POINTS", 4)        # several slabs, ranges that split the grid rows
+    monkeypatch.setattr(store, "READ_ROWS", 3)          # several journal blocks
+    spec = SweepSpec.build({"N": [10.0, 20.0, 30.0], "Omega": [1.0, 2.0, 3.0, 4.0, 5.0]}, t_end=2.0, n_peaks=3)
+    journal = store.Journal(tmp_path / "j.nc", spec)
+    rng = np.random.default_rng(1)
+    rows = rng.normal(size=(spec.size, spec.row_width))
+    done = [i for i in range(spec.size) if i != 7]      # point 7 (N = 20, Ω = 3) never computed
+    order = rng.permutation(done)
+    for chunk in np.array_split(order, 5):
+        journal.append(chunk, rows[chunk])
+    store.assemble(journal, tmp_path / "j.nc")
+    ds = load_sweep(tmp_path / "j.nc")
+    names = [c[0] for c in spec.columns]
+    kind_col = 0
+    peaks_col = sum(c[1] for c in spec.columns[: names.index("peaks")])
+    for i in range(spec.size):
+        n, w = divmod(i, 5)
+        if i == 7:
+            assert ds["done"].values[n, w] == 0 and np.isnan(ds["kind"].values[n, w])
+            assert np.all(np.isnan(ds["peaks"].values[n, w]))
+        else:
+            assert ds["done"].values[n, w] == 1
+            assert ds["kind"].values[n, w] == rows[i, kind_col]
+            assert np.array_equal(ds["peaks"].values[n, w], rows[i, peaks_col : peaks_col + 3])
+    assert not (journal.dir / "ordered.f64").exists()   # scratch file removed
+
+
+def test_large_sweeps_are_returned_lazily(tmp_path, monkeypatch):
+    store = importlib.import_module("stickslip.sweep.store")
+
+    monkeypatch.setattr(store, "LOAD_LIMIT_POINTS", 2)
+    lazy = sweep({"N": [30.0, 50.0, 70.0]}, out=tmp_path / "lazy.nc", executor="serial", t_end=2.0)
+    var = lazy.dataset["kind"].variable
+    assert not isinstance(var._data, np.ndarray)        # backed by the file, not read yet
+    loaded = load_sweep(tmp_path / "lazy.nc")
+    _assert_same(loaded, lazy.dataset)

@@ -135,13 +135,16 @@ def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | Non
     if out is not None:
         path = Path(out)
         if "region" not in res.dataset:
-            ds[["region", "stick_slip_omega_max"]].to_netcdf(path, engine="h5netcdf", mode="a")
+            extra = ds[["region", "stick_slip_omega_max"]].load()
+            res.dataset.close()  # a large sweep is open lazily from this very file
+            extra.to_netcdf(path, engine="h5netcdf", mode="a")
+            ds = load_sweep(path, load="auto")
     return RegionMap(ds, path, res.timings)
 
 
 def load_region_map(path) -> RegionMap:
     """Read a region map written by :func:`regions` (``out=``)."""
-    ds = load_sweep(path)
+    ds = load_sweep(path, load="auto")
     if not {"model", "N", "Omega", "ic"} <= set(ds.dims):
         raise SweepError(f"{path} is a stickslip sweep but not a region map (dims {tuple(ds.dims)}); "
                          "give a file written by `stickslip regions`")

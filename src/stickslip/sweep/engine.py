@@ -39,7 +39,9 @@ class SweepResult:
     spec : SweepSpec
     dataset : xarray.Dataset
         Dimensions: the swept names in order (plus ``peak`` for ``peaks``); variables as listed in
-        :data:`stickslip.sweep.spec.COLUMNS` with units and long names, and ``done``.
+        :data:`stickslip.sweep.spec.COLUMNS` with units and long names, and ``done``. Loaded into
+        memory up to :data:`~stickslip.sweep.store.LOAD_LIMIT_POINTS` points (or without ``out``),
+        opened lazily from ``path`` above.
     timings : dict
         ``total_s``, ``compute_s``, ``points_computed``, ``points_resumed``, ``batch_size``,
         ``batches``, ``executor``, ``workers`` and the executor's start-up times.
@@ -63,8 +65,14 @@ class SweepResult:
         return names[np.where(np.isfinite(code), code, -1).astype(int)]
 
 
+#: Most points per automatic batch: a batch's rows are held in memory until journaled, so this
+#: bounds them (4096 × ~88 float64 = 2.9 MB) for very cheap points; any point costing ≥ 0.25 ms
+#: still fills :data:`TARGET_BATCH_S`.
+MAX_BATCH_POINTS = 4096
+
+
 def _auto_batch(t_point: float, remaining: int, workers: int, executor: str) -> int:
-    size = max(1, math.ceil(TARGET_BATCH_S[executor] / max(t_point, 1e-6)))
+    size = min(MAX_BATCH_POINTS, max(1, math.ceil(TARGET_BATCH_S[executor] / max(t_point, 1e-6))))
     if executor != "serial":
         size = min(size, max(1, remaining // (MIN_BATCHES_PER_WORKER * workers)))
     return size
@@ -144,7 +152,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     out.parent.mkdir(parents=True, exist_ok=True)
     if out.exists() and not journal_dir(out).exists() and not overwrite:
         try:
-            ds = load_sweep(out)
+            ds = load_sweep(out, load="auto")
         except SweepError as exc:
             raise SweepError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
         if ds.attrs.get("digest") == spec.digest and int(ds.attrs.get("complete", 0)):
@@ -204,7 +212,9 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     except BaseException:
         journal.close()
         raise
-    ds = load_sweep(out)
+    # a temporary output is deleted below, so its dataset must be in memory; otherwise large
+    # grids stay on disk (opened lazily) so that memory does not grow with the grid
+    ds = load_sweep(out, load=True if tmpdir is not None else "auto")
     info["total_s"] = time.perf_counter() - t_start
     result = SweepResult(out, spec, ds, info)
     if tmpdir is not None:
