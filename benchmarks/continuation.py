@@ -69,7 +69,8 @@ def main():
     ap.add_argument("--only", choices=["branch", "curve"], default=None)
     args = ap.parse_args()
     start_orbit(N=50.0, Omega=8.0)  # compile/load the kernels outside the timings
-    res = {"machine": f"{platform.machine()}, {os.cpu_count()} cores (shared), {platform.python_version()}"}
+    res = {"machine": f"{platform.machine()}, {os.cpu_count()} cores (shared), {platform.python_version()}",
+           "load_average_start": os.getloadavg()}
     if args.only in (None, "branch"):
         res["branch"] = bench_branch(50 if args.quick else 200)
         b = res["branch"]
@@ -81,6 +82,9 @@ def main():
         c = res["curve"]
         print(f"edge curve: {c['n']} values of N on {c['workers']} processes in {c['wall_s']:.1f} s "
               f"(goal {CURVE_GOAL_S:.0f} s) -> {'met' if c['wall_s'] <= CURVE_GOAL_S else 'MISSED'}")
+    res["load_average_end"] = os.getloadavg()
+    print(f"load average (1, 5, 15 min) at start {res['load_average_start']}, at end {res['load_average_end']} "
+          "(other jobs share the 2 cores: times are upper bounds)")
     if not args.quick:
         out = Path(__file__).parent / "results" / "continuation.json"
         out.parent.mkdir(exist_ok=True)

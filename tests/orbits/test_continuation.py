@@ -120,12 +120,18 @@ def test_belt_branch_follows_the_analytic_stick_slip_orbits():
 
 
 # --------------------------------------------------------------------------- Model 4 (rotation only)
+#: Slip band [m/s] of the Model 4 cases: with the default 1e-3 m/s one Newton flow of the start
+#: orbit's shooting (`periodic_orbit`, whose flows have no step cap) stalls for 27 s (an
+#: integrator issue, reported); with 1e-5 the whole shooting takes 2 s.
+BAND = 1e-5
+
+
 @pytest.fixture(scope="module")
 def rotation_branch():
     """Model 4, N = 50 N: the stick-slip orbit from the ``far`` start at Ω = 3 rad/s, continued up
     in Ω until it ends (stick phase vanishing at Ω ≈ 6.06 rad/s; ~2 s)."""
     p = Parameters(N=50.0, Omega=3.0)
-    orbit = periodic_orbit(p, start_run(p, "far", model="rotation", t_end=30.0))
+    orbit = periodic_orbit(p, start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND), slip_band=BAND)
     return continue_orbit(start=orbit, param="Omega", step=0.05, max_step=1.0, max_points=200, bounds=(3.0, 20.0),
                           amplitude=False)
 
@@ -140,8 +146,8 @@ def test_branch_passes_through_an_orbit_found_independently(rotation_branch):
     # so the independent guess is a 20 s run from the branch state with φ displaced by 1e-3 rad
     # (~40 % of the orbit's φ range): shooting then starts from its own crossings, scales and period
     guess = simulate(p, 20.0, model="rotation", ic=b.states[i], perturbation=1e-3, sample_rate=2000.0,
-                     rtol=1e-10, atol=1e-13)
-    ref = periodic_orbit(p, guess)
+                     rtol=1e-10, atol=1e-13, slip_band=BAND)
+    ref = periodic_orbit(p, guess, slip_band=BAND)
     assert ref.stick_phases == b.stick_phases[i] == 1
     # both converged to 1e-8 σ at rtol 1e-10; the slowest multiplier (~0.99) amplifies the
     # residual ~100× in the state, hence 1e-6 relative in T and 1e-6 σ in the states
@@ -155,7 +161,7 @@ def test_branch_passes_through_an_orbit_found_independently(rotation_branch):
 
 def _sticks_after(p, state, t_end=200.0, window=100.0):
     """Brute force: does a run from ``state`` still stick in its last ``window`` seconds?"""
-    traj = simulate(p, t_end, model="rotation", ic=state, sample_rate=100.0)
+    traj = simulate(p, t_end, model="rotation", ic=state, sample_rate=100.0, slip_band=BAND)
     assert traj.status == "success"
     return bool(traj.mode[traj.t >= t_end - window].any())
 

@@ -67,6 +67,8 @@ def continue_command(
                                                 "fold, period-doubling, neimark-sacker, stick-phases."),
     rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map."),
     tol: float = typer.Option(1e-8, "--tol", help="Corrector tolerance (scaled shooting residual)."),
+    slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction [m/s] "
+                                              "(default: that of stickslip.simulate)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
@@ -86,14 +88,17 @@ def continue_command(
     with user_errors():
         stop_on = list(stop_on or [])
         _check(param, start, stop, out, ic, max_points, step, max_step, search_time, rtol, tol, stop_on)
+        if slip_band is not None and not (math.isfinite(slip_band) and slip_band > 0):
+            raise ValueError(f"--slip-band must be a finite number > 0, got {slip_band}")
+        band = {} if slip_band is None else {"slip_band": slip_band}
         params = build_parameters(config, set_, N=N, Omega=omega).replace(**{param: start})
         progress = None if (no_progress or as_json) else (
             lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
                                               f"{'stable' if st else 'unstable'}", highlight=False))
-        run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol)
+        run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
         branch = continue_orbit(params, param, start=run, direction=1 if stop > start else -1, step=step,
                                 max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
-                                stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress)
+                                stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress, **band)
         out.parent.mkdir(parents=True, exist_ok=True)
         branch.to_netcdf(out)
         figure = None

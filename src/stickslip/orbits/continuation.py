@@ -969,7 +969,7 @@ FOLD_JACOBIAN_EVERY = 4
 
 
 def start_run(params: Parameters, ic: str = "far", *, model: str = "full", t_end: float = START_RUN,
-              rtol: float = 1e-10) -> Trajectory:
+              rtol: float = 1e-10, slip_band: float = DEFAULT_SLIP_BAND) -> Trajectory:
     """A run from a named initial condition, to hand to :func:`continue_orbit` as ``start``.
 
     Parameters
@@ -982,12 +982,14 @@ def start_run(params: Parameters, ic: str = "far", *, model: str = "full", t_end
         Run length [s]; the orbit guess is taken from its last section crossings.
     rtol : float
         Integration tolerance (``atol`` = 1e-3 rtol).
+    slip_band : float
+        Low-speed band of the slip direction [m/s] (see :func:`stickslip.simulate`).
     """
     from ..sweep.spec import initial_condition
 
     state, pert = initial_condition(ic, params, model)
     run = simulate(params, t_end, model=model, ic=state, perturbation=pert, sample_rate=START_RATE,
-                   rtol=rtol, atol=1e-3 * rtol)
+                   rtol=rtol, atol=1e-3 * rtol, slip_band=slip_band)
     if run.status != "success":
         raise ContinuationError(f"the start run from ic {ic!r} failed: {run.status}")
     return run
@@ -1008,7 +1010,8 @@ def crossings_per_stick(run: Trajectory, section="phi_max") -> int:
     return max(int(np.sum((times > onsets[-2]) & (times <= onsets[-1]))), 1)
 
 
-def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e-10) -> PeriodicOrbit:
+def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e-10,
+                         slip_band: float = DEFAULT_SLIP_BAND) -> PeriodicOrbit:
     """Shoot the stick-slip orbit a run has settled on, with one stick onset per period.
 
     The period multiplicity is :func:`crossings_per_stick`. Where some section crossings lie in
@@ -1029,7 +1032,8 @@ def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e
         m = run.t.size - cut * cut_step
         part = dataclasses.replace(run, t=run.t[:m], states=run.states[:m], mode=run.mode[:m])
         try:
-            return periodic_orbit(run.params, part, section=section, rtol=rtol, period_multiplicity=k)
+            return periodic_orbit(run.params, part, section=section, rtol=rtol, period_multiplicity=k,
+                                  slip_band=slip_band)
         except OrbitError as exc:
             error = exc
             if "crossed in stick" not in str(exc):
@@ -1051,12 +1055,13 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
     """One N of :func:`fold_curve` (runs in a worker process)."""
     t0 = time.perf_counter()
     rtol = options.get("rtol", 1e-10)
+    band = options.get("slip_band", DEFAULT_SLIP_BAND)
     errors = []
     for omega in (omega_start, START_FALLBACK * omega_start):
         p = params.replace(N=float(N), Omega=float(omega))
         try:
-            run = start_run(p, "far", model=model, rtol=rtol)
-            orbit = start_orbit_from_run(run, rtol=rtol)
+            run = start_run(p, "far", model=model, rtol=rtol, slip_band=band)
+            orbit = start_orbit_from_run(run, rtol=rtol, slip_band=band)
             if orbit.stick_phases == 0:
                 raise ContinuationError(f"the start orbit at Omega = {omega:g} rad/s has no stick phase")
             break
