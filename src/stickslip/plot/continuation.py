@@ -23,17 +23,21 @@ SPECIAL_MARKERS = {
 }
 
 
+_YLABELS = {"period": "period T [s]", "amplitude": "peak-to-peak φ [rad]", "stick_time": "time in stick per period [s]"}
+
+
 def _branch_data(branch) -> dict:
     """Arrays of a Branch or of its dataset, in one form."""
     if hasattr(branch, "to_xarray") and hasattr(branch, "values"):
         sp = branch.special
         return {"param": branch.param, "value": branch.values, "period": branch.periods,
-                "amplitude": branch.amplitude, "stable": branch.stable.astype(bool),
+                "amplitude": branch.amplitude, "stick_time": branch.stick_time, "stable": branch.stable.astype(bool),
                 "special": [(p.kind, p.index, p.value) for p in sp], "model": branch.model,
                 "N": branch.params.N, "Omega": branch.params.Omega}
     ds = branch
     return {"param": ds.attrs["param"], "value": ds["value"].values, "period": ds["period"].values,
-            "amplitude": ds["amplitude"].values, "stable": ds["stable"].values.astype(bool),
+            "amplitude": ds["amplitude"].values, "stick_time": ds["stick_time"].values,
+            "stable": ds["stable"].values.astype(bool),
             "special": [(str(k), int(i), float(v)) for k, i, v in zip(ds["special_kind"].values, ds["special_index"].values,
                                                                        ds["special_value"].values)],
             "model": ds.attrs["model"], "N": ds.attrs.get("param_N"), "Omega": ds.attrs.get("param_Omega")}
@@ -61,8 +65,8 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
     ----------
     branch : Branch or xarray.Dataset
     ax : matplotlib Axes, optional
-    y : {"period", "amplitude"}
-        Period [s] or peak-to-peak φ [rad].
+    y : {"period", "amplitude", "stick_time"}
+        Period [s], peak-to-peak φ [rad] or time in stick per period [s].
     legend : bool
 
     Returns
@@ -71,8 +75,8 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
     """
     from matplotlib.lines import Line2D
 
-    if y not in ("period", "amplitude"):
-        raise ValueError(f"y = {y!r}: choose 'period' or 'amplitude'")
+    if y not in _YLABELS:
+        raise ValueError(f"y = {y!r}: choose one of {', '.join(_YLABELS)}")
     d = _branch_data(branch)
     if ax is None:
         import matplotlib.pyplot as plt
@@ -91,8 +95,11 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
         if kind not in seen:
             handles.append(Line2D([], [], marker=marker, color=colour, ls="", mfc="none", mew=1.8, label=kind))
             seen.add(kind)
-    ax.set_xlabel(f"{d['param']}")
-    ax.set_ylabel("period T [s]" if y == "period" else "peak-to-peak φ [rad]")
+    from ..model.parameters import PARAMETER_UNITS
+
+    unit = PARAMETER_UNITS.get(d["param"], "")
+    ax.set_xlabel(f"{d['param']} [{unit}]" if unit else d["param"])
+    ax.set_ylabel(_YLABELS[y])
     ax.grid(alpha=0.3)
     if legend:
         ax.legend(handles=handles, fontsize=7, loc="best")
@@ -100,13 +107,14 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
 
 
 def save_branch_figure(branch, path, *, dpi: int = 110) -> Path:
-    """Period and amplitude against the parameter, side by side, to ``path`` (PNG)."""
+    """Period, amplitude and stick time against the parameter, side by side, to ``path`` (PNG)."""
     import matplotlib.pyplot as plt
 
     d = _branch_data(branch)
-    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained")
+    fig, axes = plt.subplots(1, 3, figsize=(14.0, 4.2), layout="constrained")
     plot_branch(branch, axes[0], y="period")
     plot_branch(branch, axes[1], y="amplitude", legend=False)
+    plot_branch(branch, axes[2], y="stick_time", legend=False)
     fixed = ", ".join(f"{k} = {v:g}" for k, v in (("N", d["N"]), ("Omega", d["Omega"]))
                       if k != d["param"] and v is not None)
     fig.suptitle(f"Branch of periodic orbits in {d['param']} (model {d['model']}; {fixed})", fontsize=10)
