@@ -5,9 +5,10 @@ from .classify import KINDS, Classification, classify, classify_response, kind_c
 from .intensity import angle_range, intensity, relative_motion_angle, trajectory_intensities
 from .peaks import Peaks, find_peaks, hermite_value, trajectory_peaks
 from .steady import SteadyState, fundamental_frequency, spectrum, stick_time, summarize
+from .period import Periodicity, detect_period
 
 __all__ = [
-    "SteadyState", "fundamental_frequency", "spectrum", "stick_time", "summarize",
+    "SteadyState", "fundamental_frequency", "spectrum", "stick_time", "summarize", "Periodicity", "detect_period",
     "Peaks", "find_peaks", "hermite_value", "trajectory_peaks",
     "KINDS", "Classification", "classify", "classify_response", "kind_code",
     "intensity", "trajectory_intensities", "relative_motion_angle", "angle_range",

@@ -4,12 +4,14 @@ The decision uses the window t ≥ t_from (the transient before it is discarded)
 
 1. **At rest** – peak-to-peak φ below :data:`~stickslip.analysis.steady.REST_AMPLITUDE`:
    ``equilibrium``.
-2. **Return map of the peaks** – the peaks of φ (events φ̇ = 0, φ̈ < 0, :mod:`.peaks`) form the
-   sequence p_i at times τ_i. The response is periodic with multiplicity k (peaks per period)
-   for the smallest k ≤ :data:`MAX_MULTIPLICITY` with |p_{i+k} − p_i| ≤ :data:`PEAK_RTOL` · A and
-   |(τ_{i+k} − τ_i) − T| ≤ :data:`PEAK_RTOL` · T for all i, A the peak-to-peak amplitude of φ
-   and T the mean of τ_{i+k} − τ_i (the period). At least :data:`MIN_REPEATS` periods must fit.
-   Periodic: ``periodic-stick-slip`` if any stick occurs in the window, else ``periodic-slip``.
+2. **Return map of the peaks** – :func:`~stickslip.analysis.period.detect_period`, the one
+   period detection shared with the steady-state summary (``Trajectory.steady``): the peaks of φ
+   (events φ̇ = 0, φ̈ < 0) form the sequence p_i at times τ_i; the response is periodic with
+   multiplicity k (peaks per period) for the smallest k ≤ :data:`MAX_MULTIPLICITY` with
+   |p_{i+k} − p_i| ≤ :data:`PEAK_RTOL` · A and |(τ_{i+k} − τ_i) − T| ≤ :data:`PEAK_RTOL` · T for
+   all i, A the peak-to-peak amplitude of φ and T the period; at least :data:`MIN_REPEATS`
+   periods must fit. Periodic: ``periodic-stick-slip`` if any stick occurs in the window, else
+   ``periodic-slip``.
 3. **Decay** – not periodic, no stick, and the peak-to-peak amplitude in the last quarter of the
    window below :data:`DECAY_RATIO` times that of the first quarter, in φ and in every other free
    DOF: ``equilibrium`` (converging to steady sliding, Eq. 14). A slip-only response that grows
@@ -28,26 +30,15 @@ import math
 
 import numpy as np
 
-from .peaks import Peaks, find_peaks
+from .peaks import Peaks
+from .period import MAX_MULTIPLICITY, MIN_REPEATS, PEAK_RTOL, detect_period
 from .steady import REST_AMPLITUDE, _spectral_peak, stick_time
 
-__all__ = ["KINDS", "Classification", "classify_response", "classify", "kind_code"]
+__all__ = ["KINDS", "Classification", "classify_response", "classify", "kind_code",
+           "PEAK_RTOL", "MAX_MULTIPLICITY", "MIN_REPEATS"]
 
 #: Steady-state kinds; their index is the integer code stored in sweeps (−1: the run failed).
 KINDS = ("equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic")
-
-#: Tolerance of the return map relative to the peak-to-peak amplitude A (values) and to the
-#: period (times). 1e-3 · A is the resolution at which a bifurcation diagram (Fig. 12) can show
-#: distinct peak values; the lightly damped translation modes (decay time 2 m_d / c_dx = 200 s)
-#: leave drifts of that order after 100–200 s, so a tighter value reports settled periodic
-#: orbits as non-periodic within the paper's run lengths.
-PEAK_RTOL = 1e-3
-
-#: Largest number of peaks per period searched for.
-MAX_MULTIPLICITY = 16
-
-#: Periods that must repeat inside the window before a response counts as periodic.
-MIN_REPEATS = 3
 
 #: A slip-only, non-periodic oscillation whose last-quarter amplitude is below this fraction of
 #: the first quarter's is decaying onto the equilibrium (a settled slip limit cycle is caught as
@@ -123,20 +114,6 @@ class Classification:
         return d
 
 
-def _return_map_period(peaks: Peaks, amplitude: float):
-    """(multiplicity, period) of the peak sequence, or (0, NaN)."""
-    p, tau = peaks.value, peaks.time
-    for k in range(1, MAX_MULTIPLICITY + 1):
-        if p.size < MIN_REPEATS * k + 1:
-            break
-        dp = np.abs(p[k:] - p[:-k])
-        dtau = tau[k:] - tau[:-k]
-        period = float(np.mean(dtau))
-        if np.max(dp) <= PEAK_RTOL * amplitude and np.max(np.abs(dtau - period)) <= PEAK_RTOL * period:
-            return k, period
-    return 0, math.nan
-
-
 def _ptp(x):
     return float(np.max(x) - np.min(x)) if x.size else 0.0
 
@@ -178,13 +155,13 @@ def classify_response(t, phi, dphi, *, stick_fraction: float = 0.0, t_from: floa
     if t.size < 8:
         raise ValueError("classification needs at least 8 samples in the window; choose an earlier t_from")
     t0, t1 = float(t[0]), float(t[-1])
-    amp = _ptp(phi)
-    pk = find_peaks(t, phi, dphi)
+    per = detect_period(t, phi, dphi)
+    amp, pk = per.amplitude, per.peaks
     base = dict(stick_fraction=float(stick_fraction), amplitude=amp, peaks=pk, t_from=t0, t_to=t1)
     if amp < REST_AMPLITUDE:
         return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, **base)
     fft_f = _spectral_peak(t, phi)
-    k, period = _return_map_period(pk, amp)
+    k, period = per.multiplicity, per.period_s
     if k:
         kind = "periodic-stick-slip" if stick_fraction > 0.0 else "periodic-slip"
         return Classification(kind, k, period, 1.0 / period, fft_f, settled=True, **base)

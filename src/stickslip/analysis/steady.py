@@ -13,14 +13,6 @@ __all__ = ["SteadyState", "fundamental_frequency", "stick_time", "summarize", "s
 #: far below any stick-slip amplitude (~1e-2 rad in the paper) and above integration noise.
 REST_AMPLITUDE = 1e-7
 
-#: Relative mismatch of crossing signatures under which two section crossings k apart are the
-#: same point of a periodic orbit. Converged periodic runs repeat to ~1e-6; 1e-3 let slowly
-#: modulated responses (lightly damped translation modes, time constants up to 2 m_d/c_dx =
-#: 200 s) pass as period-24 at one tolerance and not at another, so it is kept tight.
-RECURRENCE_TOL = 1e-4
-
-#: Largest period multiplicity searched for.
-MAX_MULTIPLICITY = 32
 
 
 @dataclasses.dataclass(frozen=True)
@@ -32,12 +24,14 @@ class SteadyState:
     t_from, t_to : float
         Window analysed [s].
     fundamental_frequency_hz : float
-        1 / (smallest period) of φ [Hz] when periodic (section return map); otherwise the
-        highest peak of the spectrum (dominant frequency); NaN at rest.
+        1 / (smallest period) of φ [Hz] when periodic (return map on the peak section,
+        :func:`stickslip.analysis.period.detect_period`); otherwise the highest peak of the
+        spectrum (dominant frequency); NaN at rest.
     periodic : bool
-        Whether φ repeats on the section (within :data:`RECURRENCE_TOL`).
+        Whether φ repeats on the section (within :data:`stickslip.analysis.period.PEAK_RTOL`);
+        the same decision as :func:`stickslip.analysis.classify.classify`.
     period_multiplicity : int
-        Number of up-crossings of the mid level per period (0 when not periodic).
+        Section crossings (peaks of φ) per period (0 when not periodic).
     stick_fraction : float
         Fraction of the window spent in stick [-].
     n_transitions : int
@@ -122,28 +116,28 @@ def _spectral_peak(t, x):
 def fundamental_frequency(t, phi, dphi):
     """Fundamental frequency of φ(t) [Hz], whether it is periodic, and its multiplicity.
 
-    Section: up-crossings of the mid level (φmin + φmax)/2, located on the cubic Hermite
-    interpolant of the samples (φ, φ̇). The signature of a crossing is φ̇ there; the smallest k
-    for which crossings k apart repeat (to RECURRENCE_TOL) gives the period as the mean time
-    of k crossings. Non-periodic responses get the highest peak of the Hann spectrum, refined
-    by parabolic interpolation.
+    Periodicity, multiplicity (peaks per period) and period come from
+    :func:`stickslip.analysis.period.detect_period` (peak section, tolerance
+    :data:`~stickslip.analysis.period.PEAK_RTOL`), the rule :func:`~stickslip.analysis.classify.classify`
+    uses. Non-periodic responses get the highest peak of the Hann spectrum, refined by parabolic
+    interpolation; at rest (peak-to-peak below :data:`REST_AMPLITUDE`) NaN.
+
+    Returns
+    -------
+    (float, bool, int)
+        Frequency [Hz], periodic, multiplicity.
     """
+    from .period import detect_period  # period imports peaks, which imports this module
+
     t = np.asarray(t, dtype=float)
     phi = np.asarray(phi, dtype=float)
     dphi = np.asarray(dphi, dtype=float)
-    lo, hi = float(phi.min()), float(phi.max())
-    if hi - lo < REST_AMPLITUDE:
+    per = detect_period(t, phi, dphi)
+    if per.amplitude < REST_AMPLITUDE:
         return math.nan, False, 0
-    times, i = _hermite_crossings(t, phi, dphi, 0.5 * (lo + hi))
-    if times.size >= 3:
-        sig = dphi[i] + (dphi[i + 1] - dphi[i]) * (times - t[i]) / (t[i + 1] - t[i])
-        scale = max(float(np.max(np.abs(dphi))), 1e-300)
-        for k in range(1, min(MAX_MULTIPLICITY, (times.size - 1) // 2) + 1):
-            if np.max(np.abs(sig[k:] - sig[:-k])) <= RECURRENCE_TOL * scale:
-                n_periods = (times.size - 1) // k
-                period = (times[n_periods * k] - times[0]) / n_periods
-                return 1.0 / period, True, k
-    # not periodic (or too few crossings): the dominant frequency. The mean crossing rate is no
+    if per.periodic:
+        return 1.0 / per.period_s, True, per.multiplicity
+    # not periodic: the dominant frequency. The mean rate of mid-level crossings is no
     # substitute: a waveform with two humps per cycle crosses the mid level twice (N = 120 N,
     # Ω = 0.5 rad/s: 1.59 Hz crossing rate against a 0.797 Hz spectral peak)
     return _spectral_peak(t, phi), False, 0
