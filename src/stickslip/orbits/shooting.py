@@ -9,15 +9,17 @@ so the jumps of the variational equations at stick↔slip transitions — the sa
 are contained in it implicitly) and the exact column ∂Φ/∂T = f(Φ) from the vector field.
 
 At the converged orbit the full-state monodromy matrix ∂Φ/∂s0 (2 n_free × 2 n_free) is
-differenced once more; its eigenvalues are the Floquet multipliers. One of them is 1 (a shift
-along the orbit); stick phases collapse the directions that violate v_r = 0, which gives
-multipliers 0.
+computed from the variational equations with saltation matrices (:mod:`.variational`; default)
+or differenced once more (``monodromy="finite-difference"``); its eigenvalues are the Floquet
+multipliers. One of them is 1 (a shift along the orbit); stick phases collapse the directions
+that violate v_r = 0, which gives multipliers 0.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import warnings
 
 import numpy as np
 
@@ -28,6 +30,7 @@ from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import assemble
 from ..model.variants import STATE_NAMES
+from . import variational as _var
 from .section import OrbitError, Section, flow, land_on_section, resolve_section, section_crossings, vector_field
 
 __all__ = ["PeriodicOrbit", "periodic_orbit"]
@@ -82,7 +85,8 @@ class PeriodicOrbit:
     multipliers : ndarray (2 n_free,) complex
         Floquet multipliers (eigenvalues of :attr:`monodromy`), by decreasing modulus [-].
     monodromy : ndarray (2 n_free, 2 n_free)
-        ∂Φ(s0, T)/∂s0 on the free states (central differences), in SI units.
+        ∂Φ(s0, T)/∂s0 on the free states, in SI units, by ``options["monodromy"]``
+        (``"saltation"``: variational equations with jump matrices; ``"finite-difference"``).
     free_states : tuple of str
         Names of the free states (rows/columns of :attr:`monodromy`).
     scale : ndarray (2 n_free,)
@@ -91,7 +95,7 @@ class PeriodicOrbit:
     model : str
     section : Section
     options : dict
-        rtol, atol, tol, fd_step, slip_band.
+        rtol, atol, tol, fd_step, slip_band, max_iter, monodromy (the method used).
     """
 
     state: np.ndarray
@@ -148,7 +152,8 @@ class PeriodicOrbit:
             "multiplier_imag": ("multiplier", self.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
             "multiplier_abs": ("multiplier", np.abs(self.multipliers), {"long_name": "Floquet multiplier modulus", "units": "1"}),
             "monodromy": (("free_state", "free_state_0"), self.monodromy,
-                          {"long_name": "finite-difference monodromy matrix d s(T) / d s(0) on the free states", "units": "SI"}),
+                          {"long_name": f"monodromy matrix d s(T) / d s(0) on the free states ({self.options.get('monodromy', 'finite-difference')})",
+                           "units": "SI"}),
             "scale": ("free_state", self.scale, {"long_name": "state scale sigma of residual and differences", "units": "SI"}),
             "residual_history": ("iteration", self.residual_history, {"long_name": "scaled Newton residual", "units": "1"}),
         }
@@ -208,16 +213,8 @@ def _scales(ptp: np.ndarray, free: np.ndarray) -> np.ndarray:
 
 def _monodromy(params, model, s0, T, free, cols, h, *, rtol, atol, slip_band):
     """Central-difference columns ∂Φ(s0, T)/∂s0[j] for j in ``cols`` (free-state rows)."""
-    out = np.empty((free.size, len(cols)))
-    for k, j in enumerate(cols):
-        sp = s0.copy()
-        sm = s0.copy()
-        sp[j] += h[j]
-        sm[j] -= h[j]
-        fp, _ = flow(params, model, sp, T, rtol=rtol, atol=atol, slip_band=slip_band)
-        fm, _ = flow(params, model, sm, T, rtol=rtol, atol=atol, slip_band=slip_band)
-        out[:, k] = (fp[free] - fm[free]) / (2.0 * h[j])
-    return out
+    return _var.fd_monodromy(params, model, s0, T, free, h[free], rtol=rtol, atol=atol,
+                             slip_band=slip_band, cols=cols)
 
 
 def periodic_orbit(
@@ -234,6 +231,7 @@ def periodic_orbit(
     fd_step: float = DEFAULT_FD_STEP,
     search_time: float = SEARCH_TIME,
     slip_band: float = DEFAULT_SLIP_BAND,
+    monodromy: str = "saltation",
 ) -> PeriodicOrbit:
     """Find a periodic orbit by Newton shooting on a Poincaré section.
 
@@ -268,6 +266,12 @@ def periodic_orbit(
         Length of the search run from a state guess [s].
     slip_band : float
         Low-speed band of the slip direction [m/s] (see :func:`stickslip.simulate`).
+    monodromy : {"saltation", "finite-difference"}
+        How the monodromy matrix of the converged orbit is computed: variational equations with
+        saltation matrices (:func:`stickslip.orbits.variational.monodromy`; default; falls back
+        to finite differences with a warning if the re-integration does not reproduce the
+        orbit's event sequence), or central differences of the flow map. The Newton iteration
+        itself always uses finite differences.
 
     Returns
     -------
@@ -286,6 +290,8 @@ def periodic_orbit(
     k = int(period_multiplicity)
     if k < 1:
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")
+    if monodromy not in _var.METHODS:
+        raise OrbitError(f"unknown monodromy method {monodromy!r}; use one of {_var.METHODS}")
     atol = 1e-3 * rtol if atol is None else float(atol)
     sec = resolve_section(section)
     system = assemble(params, model, slip_band)
@@ -356,13 +362,21 @@ def periodic_orbit(
         history.append(float(np.max(np.abs(R))))
         it += 1
 
-    M = _monodromy(params, model, s0, T, free, list(free), h, **opts)
-    mult = np.linalg.eigvals(M)
-    mult = mult[np.argsort(-np.abs(mult), kind="stable")]
+    method = monodromy
+    if method == "saltation":
+        try:
+            M = _var.flow_jacobian(params, model, s0, T, scale=sigma, **opts).matrix[np.ix_(free, free)]
+        except OrbitError as exc:
+            warnings.warn(f"saltation monodromy failed ({exc}); using finite differences", RuntimeWarning,
+                          stacklevel=2)
+            method = "finite-difference"
+    if method == "finite-difference":
+        M = _monodromy(params, model, s0, T, free, list(free), h, **opts)
+    mult = _var.sorted_eigenvalues(M)
     sticks = int(np.sum(tr.kind == 1))
     return PeriodicOrbit(
         state=s0, period=float(T), multiplicity=k, stick_phases=sticks, residual=history[-1],
         iterations=it, residual_history=np.array(history), multipliers=mult, monodromy=M,
         free_states=tuple(STATE_NAMES[j] for j in free), scale=sigma, params=params, model=model,
-        section=sec, options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter),
+        section=sec, options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method),
     )

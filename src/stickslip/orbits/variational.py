@@ -1,0 +1,821 @@
+"""Monodromy matrices from the variational equations with saltation matrices (issue 6).
+
+The linearised flow ∂Φ(s0, t)/∂s0 of the non-smooth stick-slip system is the product of the
+linearised flows of the smooth segments between transitions and of one jump matrix per
+transition (docs/orbits.md, "Saltation monodromy", has the derivation):
+
+* **smooth segments**: δṡ = J(s) δs, J the Jacobian of the right-hand side of the segment's
+  mode (slip: paper Eq. 1 with Eq. 3 and the direction v_r/|v_r| of Eq. 9; stick: Eq. 1 with
+  the stick multiplier, DESIGN.md §1; the low-speed band after breakaway: the quasi-static
+  direction of :func:`stickslip.model.kernels.quasi_static_direction`). The slip Jacobian is
+  analytic in the friction force (its 1/|v_r| direction term makes the approach to stick
+  stiff, so the segments are integrated with an implicit Runge–Kutta method, Radau IIA);
+  the smooth parts (A = G M⁻¹ Gᵀ, the stick multiplier, the residual of the quasi-static
+  direction) are differenced centrally.
+* **stick → slip** (breakaway, h = μs N − |F_stick| = 0, paper Eq. 10): the saltation matrix
+  S = I + (f⁺ − f⁻) ∇hᵀ / (∇h · f⁻).
+* **leaving the low-speed band** (h = |v_r| − band, kernel switch from the quasi-static to the
+  exact direction): the same formula with the two slip fields.
+* **slip → stick** (v_r → 0, two conditions): the transverse slip-velocity variation
+  β = u·δv_r (u ⊥ the arrival direction e) is removed by the friction impulse along u that the
+  1/|v_r| direction dynamics deliver in the limit, then the saltation matrix with the scalar
+  event function h = e·v_r (the event integrator's own), then the linearised projection onto
+  the stick manifold v_r = 0 (in the M-metric, as :func:`kernels.project_velocity`).
+
+The nominal trajectory and its transitions come from the ``event`` integrator
+(:func:`stickslip.simulate`); each smooth segment is re-integrated together with its
+variational equations from the integrator's state at the segment start, and the
+re-integrated segment end is checked against the integrator's.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time as _time
+
+import numpy as np
+from numba import njit
+from scipy.integrate import solve_ivp
+
+from .. import __version__
+from ..integrate.events import STICK_SPEED_TOL
+from ..model import kernels as K
+from ..model.kernels import DEFAULT_SLIP_BAND
+from ..model.parameters import Parameters, parameter_attrs
+from ..model.system import System, assemble
+from ..model.variants import STATE_NAMES
+from .section import OrbitError, flow
+
+__all__ = ["FlowJacobian", "Monodromy", "flow_jacobian", "monodromy", "state_jacobian",
+           "saltation_matrix"]
+
+#: |v_r| [m/s] at which the integration of an approach to stick stops and the arrival jump is
+#: applied. What the linearised flow misses over the remaining τ = ρ_c/|dv_r/dt| (~1e-8 s for
+#: |dv_r/dt| ~ 10 m/s²) is O(τ · |J|) ~ 1e-6 of δs (|J| ~ ω² ~ 300 1/s² acting over τ);
+#: the nominal v_r is resolved to ~1e-11 m/s at rtol 1e-11, so its direction is still exact.
+ARRIVAL_SPEED = 1e-7
+
+#: Relative central-difference step for the smooth parts of the Jacobian (stick multiplier,
+#: quasi-static direction residual): ε^(1/3) ≈ 6e-6 balances truncation (step²) and round-off
+#: (ε/step) at ~4e-11 relative.
+FD_REL_STEP = 6e-6
+
+#: Integration tolerances of the variational segments. rtol 1e-11 keeps the re-integrated
+#: nominal state within ~1e-10 of the event integrator's at segment ends; atol on the
+#: variations (entries O(1) to O(10) in SI) 1e-12.
+VAR_RTOL = 1e-10
+VAR_ATOL_STATE = 1e-13
+VAR_ATOL_PHI = 1e-10
+
+#: Largest mismatch between the re-integrated segment end and the event integrator's, scaled by
+#: the state scale σ, and of the transition instants [s], before the result is refused: a larger
+#: one means the two integrations followed different event sequences (e.g. a velocity reversal
+#: through v_r = 0 that the integrator does not record as a transition).
+MATCH_TOL = 1e-6
+MATCH_TIME_TOL = 1e-6
+
+
+# --------------------------------------------------------------------------------------------
+# Compiled Jacobian kernels (state (≥ 12,), SI units)
+# --------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def velocity_gradient(s, p, Dv):
+    """∂v_r/∂s (2 × 12) of the relative velocity, paper Eq. (9) [1/s, m/s per rad, 1, m]."""
+    r = p[K.P_R]
+    sphi, cphi, X, Y = K.contact_kinematics(s, p)
+    w = p[K.P_OMEGA] + s[11]
+    dphi = s[10]
+    for i in range(2):
+        for j in range(12):
+            Dv[i, j] = 0.0
+    # v_x = dX + w Y,  dX = ẋ1 − ẋ2 − r sin φ φ̇,  Y = y1 − y2 + r sin φ
+    Dv[0, 1] = w
+    Dv[0, 3] = -w
+    Dv[0, 4] = -r * cphi * dphi + w * r * cphi
+    Dv[0, 6] = 1.0
+    Dv[0, 8] = -1.0
+    Dv[0, 10] = -r * sphi
+    Dv[0, 11] = Y
+    # v_y = dY − w X,  dY = ẏ1 − ẏ2 + r cos φ φ̇,  X = x1 − x2 + r cos φ
+    Dv[1, 0] = -w
+    Dv[1, 2] = w
+    Dv[1, 4] = -r * sphi * dphi + w * r * sphi
+    Dv[1, 7] = 1.0
+    Dv[1, 9] = -1.0
+    Dv[1, 10] = r * cphi
+    Dv[1, 11] = -X
+
+
+@njit(cache=True)
+def friction_slope(speed, p):
+    """dμ/d|v_r| of the kinetic friction coefficient [s/m]: Eq. (4), 0 for Coulomb."""
+    if p[K.P_LAW] == K.LAW_COULOMB:
+        return 0.0
+    return -p[K.P_ALPHA] * p[K.P_DELTA_MU] * math.exp(-p[K.P_ALPHA] * speed)
+
+
+@njit(cache=True)
+def fixed_force_jacobian(s, Fx, Fy, minv, damp, stiff, p, J):
+    """∂f/∂s (12 × 12) of Eq. (1) at a fixed friction force (Fx, Fy) [N]."""
+    r = p[K.P_R]
+    sphi, cphi, _, _ = K.contact_kinematics(s, p)
+    for i in range(12):
+        for j in range(12):
+            J[i, j] = 0.0
+    for i in range(6):
+        J[i, 6 + i] = 1.0
+        J[6 + i, 6 + i] = -minv[i] * damp[i]
+        J[6 + i, i] = -minv[i] * stiff[i]
+    # Q4 = r (−sin φ Fx + cos φ Fy)
+    J[10, 4] += minv[4] * r * (-cphi * Fx - sphi * Fy)
+    # Q5 = Y Fx − X Fy, ∂X/∂q = (1, 0, −1, 0, −r sin φ, 0), ∂Y/∂q = (0, 1, 0, −1, r cos φ, 0)
+    J[11, 0] += -minv[5] * Fy
+    J[11, 1] += minv[5] * Fx
+    J[11, 2] += minv[5] * Fy
+    J[11, 3] += -minv[5] * Fx
+    J[11, 4] += minv[5] * r * (cphi * Fx + sphi * Fy)
+
+
+@njit(cache=True)
+def force_input(s, minv, p, B):
+    """∂f/∂F (12 × 2) of Eq. (1): the rows M⁻¹ Gᵀ of the velocity equations [1/kg, 1/(kg m)]."""
+    r = p[K.P_R]
+    sphi, cphi, X, Y = K.contact_kinematics(s, p)
+    for i in range(12):
+        B[i, 0] = 0.0
+        B[i, 1] = 0.0
+    B[6, 0] = minv[0]
+    B[7, 1] = minv[1]
+    B[8, 0] = -minv[2]
+    B[9, 1] = -minv[3]
+    B[10, 0] = -minv[4] * r * sphi
+    B[10, 1] = minv[4] * r * cphi
+    B[11, 0] = minv[5] * Y
+    B[11, 1] = -minv[5] * X
+
+
+@njit(cache=True)
+def stick_force_gradient(s, minv, damp, stiff, p, steps, dF):
+    """∂F_stick/∂s (2 × 12) by central differences (the multiplier is smooth in s) [N per unit]."""
+    sp = s[:12].copy()
+    for j in range(12):
+        h = steps[j]
+        if h == 0.0:
+            dF[0, j] = 0.0
+            dF[1, j] = 0.0
+            continue
+        sp[j] = s[j] + h
+        fxp, fyp, _ = K.stick_force(sp, minv, damp, stiff, p)
+        sp[j] = s[j] - h
+        fxm, fym, _ = K.stick_force(sp, minv, damp, stiff, p)
+        sp[j] = s[j]
+        dF[0, j] = (fxp - fxm) / (2.0 * h)
+        dF[1, j] = (fyp - fym) / (2.0 * h)
+
+
+@njit(cache=True)
+def slip_force_gradient(s, p, Dv, dF):
+    """∂F/∂s (2 × 12) of the slip force F = −μ(|v_r|) N v_r/|v_r| (Eq. 3), analytic:
+    −N [μ' e eᵀ + μ (I − e eᵀ)/|v_r|] ∂v_r/∂s."""
+    vx, vy = K.relative_velocity(s, p)
+    speed = math.sqrt(vx * vx + vy * vy)
+    ex = vx / speed
+    ey = vy / speed
+    mu = K.friction_coefficient(speed, p)
+    dmu = friction_slope(speed, p)
+    N = p[K.P_N]
+    c = mu / speed
+    m11 = -N * (dmu * ex * ex + c * (1.0 - ex * ex))
+    m12 = -N * (dmu * ex * ey - c * ex * ey)
+    m22 = -N * (dmu * ey * ey + c * (1.0 - ey * ey))
+    for j in range(12):
+        dF[0, j] = m11 * Dv[0, j] + m12 * Dv[1, j]
+        dF[1, j] = m12 * Dv[0, j] + m22 * Dv[1, j]
+
+
+@njit(cache=True)
+def _direction_residual(s, theta, muN, minv, damp, stiff, p):
+    """g(θ) = e × A (μN e + F_stick), e = (cos θ, sin θ): zero on the quasi-static direction."""
+    a11, a12, a22 = K.constraint_metric(s, minv, p)
+    Fx, Fy, _ = K.stick_force(s, minv, damp, stiff, p)
+    wx = a11 * Fx + a12 * Fy
+    wy = a12 * Fx + a22 * Fy
+    c2 = math.cos(2.0 * theta)
+    s2 = math.sin(2.0 * theta)
+    return muN * (a12 * c2 + 0.5 * (a22 - a11) * s2) + (math.cos(theta) * wy - math.sin(theta) * wx)
+
+
+@njit(cache=True)
+def band_force_gradient(s, ex, ey, minv, damp, stiff, p, steps, Dv, dF):
+    """∂F/∂s (2 × 12) inside the low-speed band, F = −μ(|v_r|) N e_q(s), e_q the quasi-static
+    direction (root of g(θ) = 0, kernels.quasi_static_direction): ∂θ/∂s = −(∂g/∂s)/(∂g/∂θ),
+    ∂g/∂s by central differences at fixed θ and μ, plus the μ(|v_r|) dependence analytically."""
+    qx, qy = K.quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
+    theta = math.atan2(qy, qx)
+    vx, vy = K.relative_velocity(s, p)
+    speed = math.sqrt(vx * vx + vy * vy)
+    if speed > 0.0:
+        ux, uy = vx / speed, vy / speed
+    else:
+        ux, uy = qx, qy
+    N = p[K.P_N]
+    mu = K.friction_coefficient(speed, p)
+    dmu = friction_slope(speed, p)
+    muN = mu * N
+    a11, a12, a22 = K.constraint_metric(s, minv, p)
+    Fx, Fy, _ = K.stick_force(s, minv, damp, stiff, p)
+    wx = a11 * Fx + a12 * Fy
+    wy = a12 * Fx + a22 * Fy
+    c2 = math.cos(2.0 * theta)
+    s2 = math.sin(2.0 * theta)
+    dg_dtheta = muN * (-2.0 * a12 * s2 + (a22 - a11) * c2) - (math.cos(theta) * wx + math.sin(theta) * wy)
+    dg_dmuN = a12 * c2 + 0.5 * (a22 - a11) * s2
+    sp = s[:12].copy()
+    for j in range(12):
+        dspeed = ux * Dv[0, j] + uy * Dv[1, j]
+        h = steps[j]
+        dg = dg_dmuN * N * dmu * dspeed
+        if h != 0.0:
+            sp[j] = s[j] + h
+            gp = _direction_residual(sp, theta, muN, minv, damp, stiff, p)
+            sp[j] = s[j] - h
+            gm = _direction_residual(sp, theta, muN, minv, damp, stiff, p)
+            sp[j] = s[j]
+            dg += (gp - gm) / (2.0 * h)
+        # the kernel keeps the previous direction where g has no stable root (g' ≤ 0: rank 1,
+        # where the friction only acts along A's range, or the breakaway instant itself)
+        dtheta = -dg / dg_dtheta if dg_dtheta > 0.0 else 0.0
+        # F = −μ N (cos θ, sin θ)
+        dF[0, j] = -N * dmu * dspeed * qx + muN * math.sin(theta) * dtheta
+        dF[1, j] = -N * dmu * dspeed * qy - muN * math.cos(theta) * dtheta
+
+
+@njit(cache=True)
+def state_jacobian(s, mode, ex, ey, minv, damp, stiff, p, steps, J):
+    """Jacobian ∂f/∂s (12 × 12) of the right-hand side :func:`kernels.rhs` in ``mode``.
+
+    Same branch logic as the kernel: stick multiplier in ``MODE_STICK``; the exact direction
+    v_r/|v_r| above the low-speed band (or in ``MODE_SLIP_EXACT`` above ``SPEED_FLOOR``); the
+    quasi-static direction inside the band. ``steps`` (12,) are the central-difference steps
+    of the smooth parts [SI units], 0 for locked states.
+    """
+    Dv = np.empty((2, 12))
+    B = np.empty((12, 2))
+    dF = np.empty((2, 12))
+    velocity_gradient(s, p, Dv)
+    vx, vy = K.relative_velocity(s, p)
+    speed = math.sqrt(vx * vx + vy * vy)
+    if mode == K.MODE_STICK:
+        Fx, Fy, _ = K.stick_force(s, minv, damp, stiff, p)
+        stick_force_gradient(s, minv, damp, stiff, p, steps, dF)
+    elif speed > p[K.P_SLIP_BAND] or (mode == K.MODE_SLIP_EXACT and speed > K.SPEED_FLOOR):
+        Fx, Fy = K.slip_force(speed, vx / speed, vy / speed, p)
+        slip_force_gradient(s, p, Dv, dF)
+    else:
+        Fx, Fy = K.contact_force(s, mode, ex, ey, minv, damp, stiff, p)
+        band_force_gradient(s, ex, ey, minv, damp, stiff, p, steps, Dv, dF)
+    fixed_force_jacobian(s, Fx, Fy, minv, damp, stiff, p, J)
+    force_input(s, minv, p, B)
+    for i in range(6, 12):
+        for j in range(12):
+            J[i, j] += B[i, 0] * dF[0, j] + B[i, 1] * dF[1, j]
+
+
+@njit(cache=True)
+def variational_rhs(y, mode, ex, ey, minv, damp, stiff, p, steps, dy, J):
+    """d/dt of y = [s (12), Φ (12 × 12, row-major)]: ṡ = f(s), Φ̇ = J(s) Φ. Fills ``J``."""
+    s = y[:12]
+    ds = np.empty(12)
+    K.rhs(s, mode, ex, ey, minv, damp, stiff, p, ds)
+    state_jacobian(s, mode, ex, ey, minv, damp, stiff, p, steps, J)
+    for i in range(12):
+        dy[i] = ds[i]
+    for i in range(12):
+        for k in range(12):
+            acc = 0.0
+            for j in range(12):
+                acc += J[i, j] * y[12 + 12 * j + k]
+            dy[12 + 12 * i + k] = acc
+
+
+# --------------------------------------------------------------------------------------------
+# Jump matrices (pure functions of states; numpy)
+# --------------------------------------------------------------------------------------------
+
+
+def field(system: System, s: np.ndarray, mode: int, e=(1.0, 0.0)) -> np.ndarray:
+    """Right-hand side f(s) (12,) of :func:`kernels.rhs` in ``mode`` (e: stored slip direction)."""
+    ds = np.zeros(12)
+    K.rhs(np.ascontiguousarray(s[:12], dtype=float), int(mode), float(e[0]), float(e[1]), system.minv,
+          system.damp, system.stiff, system.p, ds)
+    return ds
+
+
+def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray) -> np.ndarray:
+    """S = I + (f⁺ − f⁻) ∇hᵀ / (∇h · f⁻) (12 × 12) for a transversal crossing of h(s) = 0.
+
+    Parameters
+    ----------
+    f_minus, f_plus : ndarray (12,)
+        Vector fields before and after the event at the event state [SI units / s].
+    grad_h : ndarray (12,)
+        Gradient of the event function [unit of h per SI unit].
+
+    Raises
+    ------
+    OrbitError
+        If the crossing is tangential (∇h · f⁻ = 0): no saltation matrix exists (grazing).
+    """
+    rate = float(grad_h @ f_minus)
+    if rate == 0.0 or not np.isfinite(rate):
+        raise OrbitError("tangential event crossing (dh/dt = 0): grazing, no saltation matrix")
+    return np.eye(f_minus.size) + np.outer(f_plus - f_minus, grad_h) / rate
+
+
+def _velocity_gradient(system: System, s: np.ndarray) -> np.ndarray:
+    Dv = np.empty((2, 12))
+    velocity_gradient(np.ascontiguousarray(s[:12], dtype=float), system.p, Dv)
+    return Dv
+
+
+def _force_input(system: System, s: np.ndarray) -> np.ndarray:
+    B = np.empty((12, 2))
+    force_input(np.ascontiguousarray(s[:12], dtype=float), system.minv, system.p, B)
+    return B
+
+
+def _metric(system: System, s: np.ndarray) -> np.ndarray:
+    a11, a12, a22 = K.constraint_metric(np.ascontiguousarray(s[:12], dtype=float), system.minv, system.p)
+    return np.array([[a11, a12], [a12, a22]])
+
+
+def stick_projection(system: System, s: np.ndarray) -> np.ndarray:
+    """Linearised projection onto the stick manifold v_r = 0 at a state on it (12 × 12):
+    P = I − [0; M⁻¹ Gᵀ A⁺ ∂v_r/∂s] (the derivative of :func:`kernels.project_velocity`; the
+    derivative of A⁺ multiplies v_r = 0). A⁺ is the minimal-norm inverse (rank 1 in Model 4)."""
+    A = _metric(system, s)
+    Ainv = np.linalg.pinv(A, rcond=K.RANK_TOL, hermitian=True)
+    return np.eye(12) - _force_input(system, s) @ Ainv @ _velocity_gradient(system, s)
+
+
+def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray) -> np.ndarray:
+    """Jump matrix (12 × 12) of the variations at slip → stick (docs/orbits.md).
+
+    Parameters
+    ----------
+    s_c : ndarray (12,)
+        Slip state where the approach integration stopped (|v_r| = ARRIVAL_SPEED), direction
+        e = v_r/|v_r| ≈ the arrival direction.
+    s_stick : ndarray (12,)
+        The integrator's state at the onset of stick (on v_r = 0).
+
+    Three factors, applied right to left: (1) the transverse slip-velocity variation
+    β = u·δv_r, u ⊥ e, is removed by the friction impulse M⁻¹ Gᵀ u J, J = −β/(uᵀ A u), that
+    the direction dynamics (rate μN uᵀAu/|v_r| → ∞) deliver before arrival; (2) the saltation
+    matrix of h = e·v_r with f⁻ the slip and f⁺ the stick field; (3) the linearised projection
+    onto v_r = 0 (removes the residual O(|v_r|) of the first two).
+    """
+    vx, vy = K.relative_velocity(np.ascontiguousarray(s_c[:12], dtype=float), system.p)
+    speed = math.hypot(vx, vy)
+    e = np.array([vx, vy]) / speed
+    u = np.array([-e[1], e[0]])
+    A = _metric(system, s_c)
+    Dv = _velocity_gradient(system, s_c)
+    B = _force_input(system, s_c)
+    kill = np.eye(12)
+    auu = float(u @ A @ u)
+    if auu > K.RANK_TOL * np.trace(A):  # rank 1 (Model 4, belt): friction cannot act along u
+        kill -= np.outer(B @ u, u @ Dv) / auu
+    f_minus = field(system, s_c, K.MODE_SLIP_EXACT)
+    f_plus = field(system, s_c, K.MODE_STICK)
+    grad_h = e @ Dv
+    # the rest of the approach, τ = |v_r| / (−e · dv_r/dt), with the regular part of the slip
+    # Jacobian (direction frozen at e; its 1/|v_r| part is the impulse above): first order in τ
+    tau = speed / -float(grad_h @ f_minus)
+    Fx, Fy = K.slip_force(speed, e[0], e[1], system.p)
+    J = np.empty((12, 12))
+    fixed_force_jacobian(np.ascontiguousarray(s_c[:12], dtype=float), Fx, Fy, system.minv, system.damp,
+                         system.stiff, system.p, J)
+    J += B @ (-system.p[K.P_N] * friction_slope(speed, system.p) * np.outer(e, grad_h))
+    S = saltation_matrix(f_minus, f_plus, grad_h)
+    return stick_projection(system, s_stick) @ S @ (np.eye(12) + tau * J) @ kill
+
+
+def breakaway_jump(system: System, s_b: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """Saltation matrix (12 × 12) at stick → slip, h = μs N − |F_stick| (Eq. 10), at the
+    breakaway state ``s_b``; f⁺ is the slip field with the breakaway direction
+    e = −F_stick/|F_stick|. Returns (S, e)."""
+    s = np.ascontiguousarray(s_b[:12], dtype=float)
+    Fx, Fy, _ = K.stick_force(s, system.minv, system.damp, system.stiff, system.p)
+    norm = math.hypot(Fx, Fy)
+    e = (-Fx / norm, -Fy / norm)
+    dF = np.empty((2, 12))
+    stick_force_gradient(s, system.minv, system.damp, system.stiff, system.p, steps, dF)
+    grad_h = -(Fx * dF[0] + Fy * dF[1]) / norm
+    f_minus = field(system, s, K.MODE_STICK)
+    f_plus = field(system, s, K.MODE_SLIP, e)
+    return saltation_matrix(f_minus, f_plus, grad_h) @ stick_projection(system, s), e
+
+
+def band_exit_jump(system: System, s: np.ndarray, e) -> np.ndarray:
+    """Saltation matrix (12 × 12) where |v_r| leaves the low-speed band (h = |v_r| − band):
+    the kernel's slip force switches from the quasi-static to the exact direction."""
+    s = np.ascontiguousarray(s[:12], dtype=float)
+    vx, vy = K.relative_velocity(s, system.p)
+    speed = math.hypot(vx, vy)
+    grad_h = (np.array([vx, vy]) / speed) @ _velocity_gradient(system, s)
+    # the quasi-static side, evaluated as the kernel does just inside the band
+    f_minus = _band_field(system, s, e)
+    f_plus = field(system, s, K.MODE_SLIP_EXACT)
+    return saltation_matrix(f_minus, f_plus, grad_h)
+
+
+def _band_field(system: System, s: np.ndarray, e) -> np.ndarray:
+    vx, vy = K.relative_velocity(s, system.p)
+    speed = math.hypot(vx, vy)
+    qx, qy = K.quasi_static_direction(s, e[0], e[1], system.minv, system.damp, system.stiff, system.p)
+    Fx, Fy = K.slip_force(speed, qx, qy, system.p)
+    ds = np.zeros(12)
+    K.dynamics(s, Fx, Fy, system.minv, system.damp, system.stiff, system.p, ds)
+    return ds
+
+
+# --------------------------------------------------------------------------------------------
+# Segment integration
+# --------------------------------------------------------------------------------------------
+
+
+def _integrate_segment(system, y0, t_span, mode, e, steps, *, events=(), rtol=VAR_RTOL, method="DOP853"):
+    """solve_ivp (Radau IIA, order 5) of [s, Φ] over ``t_span`` in ``mode``; returns the
+    solve_ivp result (terminal ``events`` stop it)."""
+    J = np.empty((12, 12))
+    dy = np.empty(156)
+    args = (int(mode), float(e[0]), float(e[1]), system.minv, system.damp, system.stiff, system.p, steps)
+
+    def fun(t, y):
+        variational_rhs(y, *args, dy, J)
+        return dy.copy()
+
+    def jac(t, y):
+        state_jacobian(y[:12].copy(), *args, J)
+        out = np.zeros((156, 156))
+        out[:12, :12] = J
+        out[12:, 12:] = np.kron(J, np.eye(12))
+        return out
+
+    atol = np.full(156, VAR_ATOL_PHI)
+    atol[:12] = VAR_ATOL_STATE
+    sol = solve_ivp(fun, t_span, y0, method=method, rtol=rtol, atol=atol, events=list(events),
+                    **({"jac": jac} if method in ("Radau", "BDF", "LSODA") else {}))
+    if sol.status < 0:
+        raise OrbitError(f"variational integration failed in mode {mode}: {sol.message}")
+    return sol
+
+
+def _speed_event(system, level, direction):
+    def ev(t, y):
+        vx, vy = K.relative_velocity(y[:12].copy(), system.p)
+        return math.hypot(vx, vy) - level
+    ev.terminal = True
+    ev.direction = direction
+    return ev
+
+
+def _breakaway_event(system):
+    limit = K.static_limit(system.p)
+
+    def ev(t, y):
+        Fx, Fy, _ = K.stick_force(y[:12].copy(), system.minv, system.damp, system.stiff, system.p)
+        return limit - math.hypot(Fx, Fy)
+    ev.terminal = True
+    ev.direction = -1
+    return ev
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class FlowJacobian:
+    """Linearised flow ∂Φ(s0, t)/∂s0 across stick↔slip transitions.
+
+    Attributes
+    ----------
+    matrix : ndarray (12, 12)
+        ∂s(t)/∂s0 in SI units (rows and columns of locked states are zero).
+    state0, state : ndarray (12,)
+        Initial and final state [SI].
+    duration : float
+        t [s].
+    events : tuple of (float, str)
+        (instant [s], kind) of every jump applied: "stick", "breakaway", "band".
+    mismatch : float
+        Largest scaled difference between a re-integrated segment end and the event
+        integrator's state there [-] (a consistency check).
+    wall_time : float
+        Seconds taken.
+    """
+
+    matrix: np.ndarray
+    state0: np.ndarray
+    state: np.ndarray
+    duration: float
+    events: tuple
+    mismatch: float
+    wall_time: float
+
+
+def _default_steps(system: System, scale) -> np.ndarray:
+    """Difference steps (12,) of the smooth Jacobian parts: FD_REL_STEP × a state scale."""
+    free = np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
+    steps = np.zeros(12)
+    if scale is None:
+        # characteristic magnitudes of the paper's cases: 1e-3 m / 1e-2 rad, 1e-2 m/s / 0.1 rad/s
+        scale12 = np.array([1e-3, 1e-3, 1e-3, 1e-3, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2, 1e-1, 1e-1])
+        steps[free] = FD_REL_STEP * scale12[free]
+    else:
+        steps[free] = FD_REL_STEP * np.asarray(scale, dtype=float)
+    return steps
+
+
+def flow_jacobian(params: Parameters, model, s0, duration: float, *, rtol: float = 1e-10,
+                  atol: float | None = None, slip_band: float = DEFAULT_SLIP_BAND,
+                  scale=None) -> FlowJacobian:
+    """Linearised flow map ∂Φ(s0, t)/∂s0 from the variational equations with saltation matrices.
+
+    Parameters
+    ----------
+    params : Parameters
+    model : str
+        Model variant.
+    s0 : array-like (12,)
+        Initial state [SI]. If it sticks (|v_r| ≤ STICK_SPEED_TOL and the stick force is
+        admissible) the variations start projected onto v_r = 0.
+    duration : float
+        t [s].
+    rtol, atol : float
+        Tolerances of the ``event`` run that gives the transitions (``atol`` default 1e-3 rtol).
+    slip_band : float
+        Low-speed band [m/s] (as in :func:`stickslip.simulate`).
+    scale : array-like (2 n_free,), optional
+        State scales σ of the free states [SI] for the difference steps and the consistency
+        check (default: typical magnitudes of the paper's cases).
+
+    Returns
+    -------
+    FlowJacobian
+
+    Raises
+    ------
+    OrbitError
+        If a run fails, an event is grazing, or the re-integration departs from the event
+        integrator's trajectory (different event sequence).
+    """
+    t_start = _time.perf_counter()
+    atol = 1e-3 * rtol if atol is None else float(atol)
+    system = assemble(params, model, slip_band)
+    free = np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
+    steps = _default_steps(system, scale)
+    sigma = steps / FD_REL_STEP
+    sigma[sigma == 0.0] = 1.0
+    s0 = np.asarray(s0, dtype=float).copy()
+    end, tr = flow(params, model, s0, float(duration), rtol=rtol, atol=atol, slip_band=slip_band)
+
+    Phi = np.zeros((12, 12))
+    Phi[free, free] = 1.0
+    events = []
+    mismatch = 0.0
+
+    def check(s_var, s_ref, which=free):
+        nonlocal mismatch
+        d = float(np.max(np.abs(s_var[which] - s_ref[which]) / sigma[which]))
+        mismatch = max(mismatch, d)
+        if d > MATCH_TOL:
+            raise OrbitError(
+                f"the variational re-integration left the event integrator's trajectory (scaled "
+                f"difference {d:.1e} > {MATCH_TOL:.0e}): the event sequence differs (grazing or "
+                "a velocity reversal through v_r = 0?)"
+            )
+
+    y = s0.copy()
+    vx, vy = K.relative_velocity(y, system.p)
+    Fx, Fy, _ = K.stick_force(y, system.minv, system.damp, system.stiff, system.p)
+    if math.hypot(vx, vy) <= STICK_SPEED_TOL and math.hypot(Fx, Fy) <= K.static_limit(system.p):
+        mode, e = K.MODE_STICK, (0.0, 0.0)
+        yy = np.zeros(14)
+        yy[:12] = y
+        K.project_velocity(yy, system.minv, system.p)
+        y = yy[:12].copy()
+        Phi = stick_projection(system, y) @ Phi
+    elif math.hypot(vx, vy) > STICK_SPEED_TOL:
+        mode, e = K.MODE_SLIP_EXACT, (vx, vy)
+    else:
+        mode, e = K.MODE_SLIP, (-Fx, -Fy)  # departs along the breakaway direction
+    t = 0.0
+    T = float(duration)
+    k = 0  # next transition
+    n_tr = len(tr)
+    while True:
+        t_next = float(tr.time[k]) if k < n_tr else T
+        yv = np.concatenate([y, Phi.ravel()])
+        if mode == K.MODE_STICK:
+            if k >= n_tr:
+                sol = _integrate_segment(system, yv, (t, T), mode, e, steps)
+                y, Phi = sol.y[:12, -1], sol.y[12:, -1].reshape(12, 12)
+                break
+            sol = _integrate_segment(system, yv, (t, t_next + 1.0), mode, e, steps,
+                                     events=[_breakaway_event(system)])
+            if sol.status != 1 or abs(sol.t_events[0][0] - t_next) > MATCH_TIME_TOL:
+                raise OrbitError(f"breakaway of the re-integration at {sol.t[-1]:.9f} s, event integrator {t_next:.9f} s")
+            s_b = tr.state[k]
+            check(sol.y[:12, -1], s_b)
+            Phi = sol.y[12:, -1].reshape(12, 12)
+            Sb, e = breakaway_jump(system, s_b, steps)
+            Phi = Sb @ Phi
+            events.append((t_next, "breakaway"))
+            y, t, mode, k = s_b.copy(), t_next, K.MODE_SLIP, k + 1
+        elif mode == K.MODE_SLIP:
+            # departure inside the low-speed band: quasi-static direction until |v_r| = band
+            sol = _integrate_segment(system, yv, (t, t_next), mode, e, steps,
+                                     events=[_speed_event(system, system.p[K.P_SLIP_BAND], 1)])
+            y, Phi = sol.y[:12, -1].copy(), sol.y[12:, -1].reshape(12, 12)
+            if sol.status == 1:
+                t = float(sol.t[-1])
+                Phi = band_exit_jump(system, y, e) @ Phi
+                events.append((t, "band"))
+                mode = K.MODE_SLIP_EXACT
+            else:
+                t = t_next
+                if k >= n_tr:
+                    break
+                raise OrbitError("slip → stick inside the low-speed band is not supported")
+        else:
+            if k >= n_tr:
+                sol = _integrate_segment(system, yv, (t, T), mode, e, steps,
+                                         events=[_speed_event(system, ARRIVAL_SPEED, -1)])
+                if sol.status == 1:
+                    raise OrbitError(f"the re-integration reaches v_r = 0 at {sol.t[-1]:.9f} s; the event integrator does not")
+                y, Phi = sol.y[:12, -1], sol.y[12:, -1].reshape(12, 12)
+                break
+            sol = _integrate_segment(system, yv, (t, t_next + 1.0), mode, e, steps,
+                                     events=[_speed_event(system, ARRIVAL_SPEED, -1)])
+            if sol.status != 1 or abs(sol.t_events[0][0] - t_next) > MATCH_TIME_TOL:
+                raise OrbitError(f"arrival at stick of the re-integration at {sol.t[-1]:.9f} s, "
+                                 f"event integrator {t_next:.9f} s")
+            s_c = sol.y[:12, -1].copy()
+            s_s = tr.state[k]
+            # positions only: the velocities differ by the O(τ) rest of the approach and by the
+            # integrator's projection of its arrival residual (≤ STICK_SPEED_TOL)
+            # (positions extrapolated over the rest of the approach to the integrator's instant)
+            s_x = s_c + (t_next - float(sol.t[-1])) * field(system, s_c, K.MODE_SLIP_EXACT)
+            check(s_x, s_s, system.variant.free_indices)
+            Phi = arrival_jump(system, s_c, s_s) @ sol.y[12:, -1].reshape(12, 12)
+            events.append((t_next, "stick"))
+            y, t, mode, e, k = s_s.copy(), t_next, K.MODE_STICK, (0.0, 0.0), k + 1
+    check(y, end)
+    M = np.zeros((12, 12))
+    M[np.ix_(free, free)] = Phi[np.ix_(free, free)]
+    return FlowJacobian(matrix=M, state0=s0, state=np.asarray(end).copy(), duration=T, events=tuple(events),
+                        mismatch=mismatch, wall_time=_time.perf_counter() - t_start)
+
+
+# --------------------------------------------------------------------------------------------
+# Monodromy of a periodic orbit
+# --------------------------------------------------------------------------------------------
+
+METHODS = ("saltation", "finite-difference")
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Monodromy:
+    """Monodromy matrix and Floquet multipliers of a periodic orbit.
+
+    Attributes
+    ----------
+    matrix : ndarray (2 n_free, 2 n_free)
+        ∂Φ(s0, T)/∂s0 on the free states [SI units].
+    multipliers : ndarray (2 n_free,) complex
+        Its eigenvalues by decreasing modulus [-].
+    method : str
+        ``"saltation"`` (variational equations with jump matrices) or ``"finite-difference"``.
+    period : float
+        T [s].
+    free_states : tuple of str
+    events : tuple of (float, str)
+        Jumps applied (saltation only): (instant [s], "stick" | "breakaway" | "band").
+    wall_time : float
+        Seconds taken.
+    params : Parameters
+    model : str
+    """
+
+    matrix: np.ndarray
+    multipliers: np.ndarray
+    method: str
+    period: float
+    free_states: tuple
+    events: tuple
+    wall_time: float
+    params: Parameters
+    model: str
+
+    @property
+    def trivial_multiplier(self) -> complex:
+        """The multiplier closest to 1 (the shift along the orbit) [-]."""
+        return complex(self.multipliers[np.argmin(np.abs(self.multipliers - 1.0))])
+
+    @property
+    def nontrivial_multipliers(self) -> np.ndarray:
+        """All multipliers but the trivial one, by decreasing modulus [-]."""
+        return np.delete(self.multipliers, int(np.argmin(np.abs(self.multipliers - 1.0))))
+
+    @property
+    def stable(self) -> bool:
+        """True if every non-trivial multiplier lies inside the unit circle."""
+        return bool(np.all(np.abs(self.nontrivial_multipliers) < 1.0))
+
+    def to_xarray(self):
+        """``xarray.Dataset``: matrix and multipliers, method and period as attributes."""
+        import xarray as xr
+
+        data = {
+            "monodromy": (("free_state", "free_state_0"), self.matrix,
+                          {"long_name": f"monodromy matrix d s(T) / d s(0) ({self.method})", "units": "SI"}),
+            "multiplier_real": ("multiplier", self.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
+            "multiplier_imag": ("multiplier", self.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
+            "multiplier_abs": ("multiplier", np.abs(self.multipliers), {"long_name": "Floquet multiplier modulus", "units": "1"}),
+        }
+        attrs = {"title": "stickslip monodromy matrix", "stickslip_version": __version__, "model": self.model,
+                 "method": self.method, "period": self.period, "period_units": "s",
+                 "wall_time_s": self.wall_time, "events": json.dumps(self.events),
+                 "parameters": json.dumps(self.params.to_dict())}
+        attrs.update(parameter_attrs(self.params.to_dict()))
+        coords = {"free_state": list(self.free_states), "free_state_0": list(self.free_states)}
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def sorted_eigenvalues(M: np.ndarray) -> np.ndarray:
+    """Eigenvalues of M by decreasing modulus (stable order for equal moduli)."""
+    mult = np.linalg.eigvals(M)
+    return mult[np.argsort(-np.abs(mult), kind="stable")]
+
+
+def monodromy(orbit, method: str = "saltation", *, fd_step: float | None = None) -> Monodromy:
+    """Monodromy matrix of a periodic orbit on its free states.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        From :func:`stickslip.orbits.periodic_orbit` (state, period, params, model, scale,
+        options rtol/atol/slip_band/fd_step are used).
+    method : {"saltation", "finite-difference"}
+        ``saltation``: variational equations along the orbit with jump matrices at every
+        stick↔slip transition (:func:`flow_jacobian`). ``finite-difference``: central
+        differences of the flow map, two ``event`` runs per column (perturbed shooting).
+    fd_step : float, optional
+        Relative step of the finite differences (default: the orbit's).
+
+    Returns
+    -------
+    Monodromy
+    """
+    if method not in METHODS:
+        raise OrbitError(f"unknown monodromy method {method!r}; use one of {METHODS}")
+    t0 = _time.perf_counter()
+    opt = orbit.options
+    system = assemble(orbit.params, orbit.model, opt["slip_band"])
+    free = np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
+    events: tuple = ()
+    if method == "saltation":
+        fj = flow_jacobian(orbit.params, orbit.model, orbit.state, orbit.period, rtol=opt["rtol"],
+                           atol=opt["atol"], slip_band=opt["slip_band"], scale=orbit.scale)
+        M = fj.matrix[np.ix_(free, free)]
+        events = fj.events
+    else:
+        step = opt.get("fd_step", 1e-5) if fd_step is None else fd_step
+        M = fd_monodromy(orbit.params, orbit.model, orbit.state, orbit.period, free,
+                         step * np.asarray(orbit.scale), rtol=opt["rtol"], atol=opt["atol"],
+                         slip_band=opt["slip_band"])
+    return Monodromy(matrix=M, multipliers=sorted_eigenvalues(M), method=method, period=float(orbit.period),
+                     free_states=tuple(STATE_NAMES[j] for j in free), events=events,
+                     wall_time=_time.perf_counter() - t0, params=orbit.params, model=orbit.model)
+
+
+def fd_monodromy(params, model, s0, T, free, h_free, *, rtol, atol, slip_band, cols=None) -> np.ndarray:
+    """Central-difference columns ∂Φ(s0, T)/∂s0[j] (free-state rows) for the state indices
+    ``cols`` (default: all free states), steps ``h_free`` (2 n_free,) on the free states [SI]."""
+    free = np.asarray(free)
+    cols = list(free) if cols is None else list(cols)
+    h = np.zeros(12)
+    h[free] = h_free
+    out = np.empty((free.size, len(cols)))
+    for k, j in enumerate(cols):
+        sp = np.asarray(s0, dtype=float).copy()
+        sm = sp.copy()
+        sp[j] += h[j]
+        sm[j] -= h[j]
+        fp, _ = flow(params, model, sp, T, rtol=rtol, atol=atol, slip_band=slip_band)
+        fm, _ = flow(params, model, sm, T, rtol=rtol, atol=atol, slip_band=slip_band)
+        out[:, k] = (fp[free] - fm[free]) / (2.0 * h[j])
+    return out

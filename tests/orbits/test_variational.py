@@ -1,0 +1,168 @@
+"""Monodromy from the variational equations with saltation matrices (issue 6).
+
+Evidence: the Jacobian kernels against central differences of the kernels' own vector field;
+the linearised flow of a linear oscillator against its closed form; the monodromy of the
+belt oscillator against a closed form derived from the stick collapse; Model 1 multipliers
+against the finite-difference (perturbed-shooting) monodromy.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import linear_sum_assignment
+
+from stickslip import Parameters
+from stickslip.model import kernels as K
+from stickslip.model.system import assemble
+from stickslip.orbits import OrbitError, periodic_orbit
+from stickslip.orbits.variational import (Monodromy, field, flow_jacobian, monodromy, saltation_matrix,
+                                          state_jacobian)
+
+
+def matched_distance(a, b):
+    """Largest |a_i − b_π(i)| over the best pairing π of two multiplier sets."""
+    C = np.abs(a[:, None] - b[None, :])
+    r, c = linear_sum_assignment(C)
+    return float(C[r, c].max())
+
+
+def fd_field_jacobian(system, s, mode, e, free, h=1e-8):
+    """Central differences of kernels.rhs (12 × 12 on the free columns), step h [SI]."""
+    J = np.zeros((12, 12))
+    for j in free:
+        sp, sm = s.copy(), s.copy()
+        sp[j] += h
+        sm[j] -= h
+        J[:, j] = (field(system, sp, mode, e) - field(system, sm, mode, e)) / (2 * h)
+    return J
+
+
+@pytest.mark.parametrize("mode", [K.MODE_SLIP_EXACT, K.MODE_STICK])
+def test_state_jacobian_against_differences_of_the_vector_field(mode):
+    P = Parameters(N=50.0, Omega=0.5)
+    system = assemble(P, "full")
+    rng = np.random.default_rng(1)
+    s = np.concatenate([rng.normal(0, 1e-3, 4), rng.normal(0, 1e-2, 2), rng.normal(0, 1e-2, 4), rng.normal(0, 0.1, 2)])
+    vx, vy = K.relative_velocity(s, system.p)
+    assert math.hypot(vx, vy) > 1e-2      # a slip state well outside the low-speed band
+    steps = 6e-6 * np.array([1e-3] * 4 + [1e-2] * 2 + [1e-2] * 4 + [1e-1] * 2)
+    J = np.empty((12, 12))
+    state_jacobian(s, mode, 1.0, 0.0, system.minv, system.damp, system.stiff, system.p, steps, J)
+    Jfd = fd_field_jacobian(system, s, mode, (1.0, 0.0), range(12))
+    # central differences with h = 1e-8 are good to ~1e-7 relative of the largest entry (~300)
+    assert np.max(np.abs(J - Jfd)) < 1e-6 * np.max(np.abs(Jfd))
+
+
+def test_saltation_matrix_maps_the_field_across_the_event():
+    rng = np.random.default_rng(2)
+    fm, fp, g = rng.normal(size=12), rng.normal(size=12), rng.normal(size=12)
+    S = saltation_matrix(fm, fp, g)
+    assert np.allclose(S @ fm, fp, rtol=1e-13, atol=1e-13)         # S f⁻ = f⁺
+    v = rng.normal(size=12)
+    v -= (g @ v) / (g @ g) * g                                        # tangent to the surface
+    assert np.allclose(S @ v, v, rtol=1e-13, atol=1e-13)
+    with pytest.raises(OrbitError, match="grazing"):
+        saltation_matrix(np.zeros(12), fp, g)
+
+
+def test_linear_oscillator_flow():
+    """Belt model, Coulomb, no damping, pure slip: φ̈ = −ω² (φ − φk); the linearised flow is
+    [[cos ωt, sin ωt / ω], [−ω sin ωt, cos ωt]]."""
+    P = Parameters(c_pphi=0.0, Omega=5.0, friction_law="coulomb")
+    omega = math.sqrt(P.k_pphi / P.J_p)
+    s0 = np.zeros(12)
+    s0[4] = P.mu_k * P.N * P.r / P.k_pphi + 0.01
+    t = 0.3
+    fj = flow_jacobian(P, "phi", s0, t)
+    M = fj.matrix[np.ix_([4, 10], [4, 10])]
+    c, s = math.cos(omega * t), math.sin(omega * t)
+    exact = np.array([[c, s / omega], [-omega * s, c]])
+    assert np.allclose(M, exact, rtol=0, atol=1e-8)   # variational rtol 1e-10 over 0.7 periods
+    assert fj.events == ()
+
+
+def belt_coulomb():
+    P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
+    ic = np.zeros(12)
+    ic[10] = P.Omega
+    return P, periodic_orbit(P, ic, model="phi", search_time=3.0)
+
+
+def test_belt_coulomb_monodromy_closed_form():
+    """Undamped belt oscillator with Coulomb friction, section φ̇ = 0 (φ maximum).
+
+    After the stick phase the perturbed motion is the nominal one delayed by δ, so
+    M = −f(s0) ∇δᵀ. Slip from (φ0, φ̇0): φ = φk + a cos ωt + (b/ω) sin ωt (a = φ0 − φk,
+    b = φ̇0); stick starts where φ̇ = Ω and ends at the fixed breakaway angle, so
+    δ = −(cos ωts δa + sin ωts δb / ω)/Ω. With f(s0) = (0, −ω² a), −aω sin ωts = Ω and
+    (aω)² = (ωD)² + Ω² (D = Δμ N r / k), M = [[0, 0], [ω² D / Ω, 1]]: multipliers {1, 0}.
+    """
+    P, orbit = belt_coulomb()
+    assert orbit.options["monodromy"] == "saltation"            # the default
+    omega2 = P.k_pphi / P.J_p
+    D = P.delta_mu * P.N * P.r / P.k_pphi
+    exact = np.array([[0.0, 0.0], [omega2 * D / P.Omega, 1.0]])
+    M = orbit.monodromy
+    assert orbit.free_states == ("phi", "dphi")
+    # the orbit itself is exact to ~1e-11 (test_shooting); 1e-8 leaves room for the
+    # variational integration (rtol 1e-10)
+    assert np.allclose(M, exact, rtol=0, atol=1e-8 * np.abs(exact).max())
+    assert matched_distance(orbit.multipliers, np.array([1.0, 0.0])) < 1e-8
+
+
+def test_belt_exponential_law_rank_one_collapse():
+    """Belt with the exponential law and damping (Table 1): the stick phase still collapses
+    the state, so M = f(s0) wᵀ with wᵀ f(s0) = 1 (the same argument as above, any friction
+    law): the φ row is zero (f(s0) = (0, φ̈0) on the section) and the trace is 1."""
+    P = Parameters(Omega=0.5)
+    ic = np.zeros(12)
+    ic[10] = P.Omega
+    orbit = periodic_orbit(P, ic, model="phi", search_time=10.0)
+    m = monodromy(orbit)
+    M = m.matrix
+    scale = np.abs(M).max()
+    assert np.abs(M[0]).max() < 1e-5 * scale      # measured 2e-7 relative
+    assert abs(np.trace(M) - 1.0) < 1e-5          # measured 3e-7
+    assert matched_distance(m.multipliers, np.array([1.0, 0.0])) < 1e-5
+    assert [k for _, k in m.events] == ["stick", "breakaway", "band"]
+
+
+@pytest.fixture(scope="module")
+def orbit50():
+    """Model 1, N = 50 N, Ω = 0.5 rad/s (Fig. 10(b)), FD monodromy as the reference."""
+    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0,
+                          monodromy="finite-difference")
+
+
+def test_model1_saltation_matches_finite_differences(orbit50):
+    o = orbit50
+    assert o.period == pytest.approx(0.6501543, abs=1e-7)
+    assert o.options["monodromy"] == "finite-difference"
+    m = monodromy(o, "saltation")
+    assert isinstance(m, Monodromy) and m.matrix.shape == (12, 12)
+    assert [k for _, k in m.events] == ["stick", "breakaway", "band"]
+    # measured: 2.8e-8 between the two sets; the FD matrix is good to ~1e-8 (trivial multiplier)
+    assert matched_distance(m.multipliers, o.multipliers) < 1e-5
+    assert abs(m.trivial_multiplier - 1.0) < 1e-5                 # measured 2.7e-8
+    # v_r = 0 is two conditions: stick collapses two directions exactly
+    assert np.sum(np.abs(m.multipliers) < 1e-10) == 2
+    assert m.stable == o.stable
+    ds = m.to_xarray()
+    assert ds.attrs["method"] == "saltation" and ds["multiplier_abs"].size == 12
+
+
+def test_model1_second_case_n40():
+    """Model 1, N = 40 N, Ω = 0.5 rad/s: the default (saltation) orbit against FD."""
+    o = periodic_orbit(Parameters(N=40.0, Omega=0.5), "equilibrium", model="full", search_time=30.0)
+    assert o.options["monodromy"] == "saltation" and o.stick_phases == 1
+    fd = monodromy(o, "finite-difference")
+    assert matched_distance(o.multipliers, fd.multipliers) < 1e-5
+    assert abs(o.trivial_multiplier - 1.0) < 1e-5
+
+
+def test_bad_method(orbit50):
+    with pytest.raises(OrbitError, match="unknown monodromy"):
+        monodromy(orbit50, "nonsense")
+    with pytest.raises(OrbitError, match="unknown monodromy"):
+        periodic_orbit(Parameters(), np.zeros(12), monodromy="nonsense")
