@@ -55,7 +55,7 @@ def _stability_segments(x, y, stable):
     return runs
 
 
-def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
+def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True, color: str = "k", label: str | None = None):
     """One branch: period (or amplitude) against the parameter; stable solid, unstable dashed.
 
     Special points are marked (fold ○, period doubling □, Neimark–Sacker ◇, change of the number
@@ -68,6 +68,10 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
     y : {"period", "amplitude", "stick_time"}
         Period [s], peak-to-peak φ [rad] or time in stick per period [s].
     legend : bool
+    color : str
+        Colour of the branch.
+    label : str, optional
+        Name of the branch in the legend (then stable/unstable entries carry it).
 
     Returns
     -------
@@ -84,8 +88,10 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True):
         _, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
     x, yv, stable = d["value"], d[y], d["stable"]
     for xs, ys, st in _stability_segments(x, yv, stable):
-        ax.plot(xs, ys, "-" if st else "--", color="k", lw=1.4)
-    handles = [Line2D([], [], color="k", ls="-", label="stable"), Line2D([], [], color="k", ls="--", label="unstable")]
+        ax.plot(xs, ys, "-" if st else "--", color=color, lw=1.4)
+    prefix = "" if label is None else f"{label}: "
+    handles = [Line2D([], [], color=color, ls=ls, label=prefix + name)
+               for ls, name, on in (("-", "stable", stable.any()), ("--", "unstable", (~stable).any())) if on or label is None]
     seen = set()
     for kind, i, value in d["special"]:
         marker, colour = SPECIAL_MARKERS.get(kind, ("x", "k"))
