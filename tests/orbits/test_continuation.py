@@ -224,3 +224,47 @@ def test_model1_edge_at_N50_matches_brute_force():
     assert sticks[0] and not sticks[-1]
     last = float(grid[np.flatnonzero(sticks)[-1]])
     assert last <= edge[0] < last + spacing
+
+
+def _omega_c_rotation(N=50.0):
+    """Linear-stability boundary of Model 4 (unstable below) by bisection on the eigenvalues of the
+    linearised slip equations (:func:`stickslip.stability.stability`, independent of the orbits)."""
+    from stickslip.stability import stability
+
+    lo, hi = 0.5, 6.0
+    growth = lambda W: stability(Parameters(N=N, Omega=W), "rotation").max_real_part
+    assert growth(lo) > 0 > growth(hi)
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if growth(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def _phi_range(orbit_like, i=-1):
+    tr = orbit_like.trajectory(i, sample_rate=4000.0) if isinstance(i, int) else orbit_like.trajectory()
+    return float(np.ptp(tr.states[:, 4]))
+
+
+def test_unstable_slip_cycle_joins_the_hopf_point_and_the_end_of_the_stick_slip_orbit(rotation_branch):
+    """Region II is bounded by the unstable pure-slip cycle: found by edge tracking between the
+    equilibrium and the stick-slip orbit at Ω ≈ 5 rad/s, continued down it shrinks to zero at the
+    Hopf point Ω_c of the linear stability analysis; continued up it ends where the stick-slip
+    orbit's stick phase vanishes, with the same amplitude (the two cycles merge there)."""
+    b = rotation_branch
+    i = int(np.argmin(np.abs(b.values - 5.0)))
+    cycle = C.unstable_cycle(b.orbit_params(i), b.states[i], model="rotation", slip_band=BAND)
+    assert cycle.stick_phases == 0
+    assert int(np.sum(np.abs(cycle.nontrivial_multipliers) > 1.0)) == 1  # a saddle: one unstable direction
+    up = continue_orbit(start=cycle, param="Omega", step=0.05, max_step=1.0, max_points=100, bounds=(b.values[i], 20.0),
+                        amplitude=False)
+    down = continue_orbit(start=cycle, param="Omega", direction=-1, step=0.05, max_step=1.0, max_points=100,
+                          bounds=(0.2, b.values[i]), amplitude=False)
+    edge = b.special[-1].value
+    # both branches end at the same Ω (the slip cycle's steps shrink to min_step at the merger)
+    assert up.stop_reason == "min_step" and abs(up.values[-1] - edge) < 0.01
+    assert _phi_range(up) == pytest.approx(_phi_range(b), rel=0.01)
+    # down: the cycle shrinks to the Hopf point, where its branch turns (reported as a fold)
+    omega_c = _omega_c_rotation()
+    assert np.min(down.values) == pytest.approx(omega_c, abs=0.01)
+    k = int(np.argmin(down.values))
+    assert _phi_range(down, k) < 0.1 * _phi_range(down, 0)

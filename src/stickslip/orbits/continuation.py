@@ -55,7 +55,7 @@ from .section import OrbitError, Section, resolve_section, vector_field
 from .shooting import PeriodicOrbit, periodic_orbit
 
 __all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run", "crossings_per_stick",
-           "start_orbit_from_run", "load_branch",
+           "start_orbit_from_run", "unstable_cycle", "load_branch",
            "ContinuationError", "SPECIAL_KINDS"]
 
 #: Kinds of special points, in the order they are reported.
@@ -1048,6 +1048,79 @@ def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e
             if "crossed in stick" not in str(exc):
                 break
     raise OrbitError(f"no stick-slip orbit from the run ({error})")
+
+
+#: Edge tracking of :func:`unstable_cycle`: bisection steps on the segment equilibrium → orbit
+#: (2⁻⁴⁰ ≈ 1e-12 of the segment, near the round-off of the states), the length of each probe run
+#: [s] and the window at its end in which sticking means "reached the stick-slip orbit" [s].
+EDGE_BISECTIONS, EDGE_PROBE, EDGE_WINDOW = 40, 60.0, 20.0
+
+#: The two bracketing edge trajectories count as separated once their φ differ by this fraction of
+#: the φ range of the stable orbit; the orbit guess is the part of the run before 0.9 × that time.
+EDGE_SEPARATION = 0.05
+
+
+def unstable_cycle(params: Parameters, orbit_state: np.ndarray, *, model: str = "full", rtol: float = 1e-10,
+                   slip_band: float = DEFAULT_SLIP_BAND, section="phi_max") -> PeriodicOrbit:
+    """The saddle cycle on the boundary between the basins of a stable orbit and the equilibrium.
+
+    Edge tracking: on the segment s(a) = s_eq + a (s_orbit − s_eq), a ∈ [0, 1], from the
+    equilibrium of Eq. (14) to a state on the stable stick-slip orbit, bisection on a finds the
+    basin boundary (runs from a below it stop sticking, from above they reach stick-slip). The run
+    from the boundary lingers near the saddle cycle whose stable manifold the boundary is (in
+    Region II, the unstable pure-slip cycle of the subcritical Hopf bifurcation at Ω_c); its part
+    before the bracketing runs separate is the guess for :func:`~stickslip.orbits.periodic_orbit`.
+
+    Parameters
+    ----------
+    params : Parameters
+    orbit_state : ndarray (12,)
+        A state on the stable stick-slip orbit (e.g. ``Branch.states[i]``).
+    model, rtol, slip_band, section
+        As :func:`~stickslip.orbits.periodic_orbit`.
+
+    Returns
+    -------
+    PeriodicOrbit
+
+    Raises
+    ------
+    ContinuationError
+        If the equilibrium end does not go to the equilibrium or the orbit end does not stick.
+    """
+    from ..stability import equilibrium
+
+    system = assemble(params, model, slip_band)
+    s_eq = np.zeros(12)
+    s_eq[:6] = equilibrium(params, model)
+    s_orb = np.asarray(orbit_state, dtype=float)
+    atol = 1e-3 * rtol
+
+    def run(a, t_end=EDGE_PROBE, rate=100.0):
+        return simulate(params, t_end, model=model, ic=s_eq + a * (s_orb - s_eq), sample_rate=rate, rtol=rtol,
+                        atol=atol, slip_band=slip_band)
+
+    def sticks(a):
+        tr = run(a)
+        return bool(tr.mode[tr.t >= EDGE_PROBE - EDGE_WINDOW].any())
+
+    lo, hi = 0.0, 1.0
+    if not sticks(hi) or sticks(1e-3):
+        raise ContinuationError("edge tracking needs a stable stick-slip orbit and a stable equilibrium "
+                                f"(Region II) at {params.N:g} N, {params.Omega:g} rad/s")
+    for _ in range(EDGE_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if sticks(mid) else (mid, hi)
+    a_lo, a_hi = run(lo, rate=START_RATE), run(hi, rate=START_RATE)
+    scale = max(float(np.ptp(a_hi.states[a_hi.t >= EDGE_PROBE - EDGE_WINDOW, 4])), 1e-12)
+    apart = np.flatnonzero(np.abs(a_lo.states[:, 4] - a_hi.states[:, 4]) > EDGE_SEPARATION * scale)
+    t_sep = a_lo.t[apart[0]] if apart.size else EDGE_PROBE
+    m = int(np.searchsorted(a_lo.t, 0.9 * t_sep))
+    guess = dataclasses.replace(a_lo, t=a_lo.t[:m], states=a_lo.states[:m], mode=a_lo.mode[:m])
+    try:
+        return periodic_orbit(params, guess, section=section, rtol=rtol, slip_band=slip_band, max_iter=40)
+    except (OrbitError, SimulationError) as exc:
+        raise ContinuationError(f"no saddle cycle from the edge run (it lingered {0.9 * t_sep:.1f} s): {exc}") from exc
 
 
 def branch_edge(branch: Branch) -> tuple:
