@@ -1090,7 +1090,6 @@ def unstable_cycle(params: Parameters, orbit_state: np.ndarray, *, model: str = 
     """
     from ..stability import equilibrium
 
-    system = assemble(params, model, slip_band)
     s_eq = np.zeros(12)
     s_eq[:6] = equilibrium(params, model)
     s_orb = np.asarray(orbit_state, dtype=float)
