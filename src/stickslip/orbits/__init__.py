@@ -5,13 +5,18 @@
 ``PeriodicOrbit``           state on the section, period, stick phases, Floquet multipliers
 ``Section``                 a Poincaré section (``"phi_max"``, ``("phi", level)``)
 ``lyapunov_exponent``       largest Lyapunov exponent (Benettin) → ``LyapunovResult``
+``lyapunov_spectrum``       all Lyapunov exponents (variational + saltation + QR) → ``LyapunovSpectrum``
+``monodromy``               monodromy matrix of an orbit, saltation or FD → ``Monodromy``
+``flow_jacobian``           linearised flow ∂Φ(s0, t)/∂s0 across transitions → ``FlowJacobian``
 ``OrbitError``              shooting or Lyapunov computation failed (message says why)
 ==========================  ==============================================================
 """
 
-from .lyapunov import LyapunovResult, lyapunov_exponent
+from .lyapunov import LyapunovResult, LyapunovSpectrum, lyapunov_exponent, lyapunov_spectrum
 from .section import OrbitError, Section, resolve_section
 from .shooting import PeriodicOrbit, periodic_orbit
+from .variational import FlowJacobian, Monodromy, flow_jacobian, monodromy
 
 __all__ = ["periodic_orbit", "PeriodicOrbit", "Section", "resolve_section", "lyapunov_exponent",
-           "LyapunovResult", "OrbitError"]
+           "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum", "monodromy", "Monodromy",
+           "flow_jacobian", "FlowJacobian", "OrbitError"]

@@ -575,17 +575,62 @@ def flow_jacobian(params: Parameters, model, s0, duration: float, *, rtol: float
     t_start = _time.perf_counter()
     atol = 1e-3 * rtol if atol is None else float(atol)
     system = assemble(params, model, slip_band)
-    free = np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
+    free = free_states(system)
+    s0 = np.asarray(s0, dtype=float).copy()
+    end, tr = flow(params, model, s0, float(duration), rtol=rtol, atol=atol, slip_band=slip_band)
+    Phi = np.zeros((12, 12))
+    Phi[free, free] = 1.0
+    Phi, events, mismatch = propagate(system, s0, float(duration), tr, end, Phi, scale=scale)
+    M = np.zeros((12, 12))
+    M[np.ix_(free, free)] = Phi[np.ix_(free, free)]
+    return FlowJacobian(matrix=M, state0=s0, state=np.asarray(end).copy(), duration=float(duration),
+                        events=tuple(events), mismatch=mismatch, wall_time=_time.perf_counter() - t_start)
+
+
+def free_states(system: System) -> np.ndarray:
+    """Indices (2 n_free,) of the free states of the system's variant (positions, velocities)."""
+    return np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
+
+
+def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, after=None,
+              max_interval: float = np.inf):
+    """Carry the variations ``Phi`` (12 × k) along the event integrator's run from ``s0``.
+
+    Parameters
+    ----------
+    system : System
+    s0 : ndarray (12,)
+        Initial state [SI].
+    T : float
+        Duration [s].
+    tr : Transitions
+        The run's transitions (instants, kinds, states).
+    end : ndarray (12,)
+        The run's final state (checked against the re-integration).
+    Phi : ndarray (12, k)
+        Initial variations (columns) [SI].
+    scale : array-like (2 n_free,), optional
+        State scales σ (difference steps, consistency checks).
+    after : callable (t, Phi) -> Phi, optional
+        Called after every smooth piece and every jump (e.g. QR re-orthonormalisation).
+    max_interval : float
+        Longest smooth piece integrated in one call [s] (``after`` is called at least that often).
+
+    Returns
+    -------
+    Phi : ndarray (12, k)
+    events : list of (float, str)
+    mismatch : float
+        Largest scaled difference between re-integrated and recorded states [-].
+    """
+    free = free_states(system)
     steps = _default_steps(system, scale)
     sigma = steps / FD_REL_STEP
     sigma[sigma == 0.0] = 1.0
-    s0 = np.asarray(s0, dtype=float).copy()
-    end, tr = flow(params, model, s0, float(duration), rtol=rtol, atol=atol, slip_band=slip_band)
-
-    Phi = np.zeros((12, 12))
-    Phi[free, free] = 1.0
+    after = (lambda t, P: P) if after is None else after
     events = []
     mismatch = 0.0
+    k_cols = Phi.shape[1]
 
     def check(s_var, s_ref, which=free):
         nonlocal mismatch
@@ -598,7 +643,13 @@ def flow_jacobian(params: Parameters, model, s0, duration: float, *, rtol: float
                 "a velocity reversal through v_r = 0?)"
             )
 
-    y = s0.copy()
+    def run(y, P, t0, t1, mode, e, evs=()):
+        yv = np.concatenate([y, P.ravel()]) if k_cols == 12 else np.concatenate([y, _pad(P).ravel()])
+        sol = _integrate_segment(system, yv, (t0, t1), mode, e, steps, events=evs)
+        P_new = sol.y[12:, -1].reshape(12, 12)
+        return sol, sol.y[:12, -1].copy(), (P_new if k_cols == 12 else P_new[:, :k_cols])
+
+    y = np.asarray(s0, dtype=float).copy()
     vx, vy = K.relative_velocity(y, system.p)
     Fx, Fy, _ = K.stick_force(y, system.minv, system.damp, system.stiff, system.p)
     if math.hypot(vx, vy) <= STICK_SPEED_TOL and math.hypot(Fx, Fy) <= K.static_limit(system.p):
@@ -613,71 +664,71 @@ def flow_jacobian(params: Parameters, model, s0, duration: float, *, rtol: float
     else:
         mode, e = K.MODE_SLIP, (-Fx, -Fy)  # departs along the breakaway direction
     t = 0.0
-    T = float(duration)
     k = 0  # next transition
     n_tr = len(tr)
-    while True:
+    while t < T:
         t_next = float(tr.time[k]) if k < n_tr else T
-        yv = np.concatenate([y, Phi.ravel()])
+        t_cap = t + max_interval
         if mode == K.MODE_STICK:
-            if k >= n_tr:
-                sol = _integrate_segment(system, yv, (t, T), mode, e, steps)
-                y, Phi = sol.y[:12, -1], sol.y[12:, -1].reshape(12, 12)
-                break
-            sol = _integrate_segment(system, yv, (t, t_next + 1.0), mode, e, steps,
-                                     events=[_breakaway_event(system)])
+            if t_cap < t_next or k >= n_tr:
+                t1 = min(t_cap, t_next)
+                sol, y, Phi = run(y, Phi, t, t1, mode, e)
+                t = t1
+                Phi = after(t, Phi)
+                continue
+            sol, y_b, Phi = run(y, Phi, t, t_next + 1.0, mode, e, [_breakaway_event(system)])
             if sol.status != 1 or abs(sol.t_events[0][0] - t_next) > MATCH_TIME_TOL:
                 raise OrbitError(f"breakaway of the re-integration at {sol.t[-1]:.9f} s, event integrator {t_next:.9f} s")
             s_b = tr.state[k]
-            check(sol.y[:12, -1], s_b)
-            Phi = sol.y[12:, -1].reshape(12, 12)
+            check(y_b, s_b)
             Sb, e = breakaway_jump(system, s_b, steps)
-            Phi = Sb @ Phi
+            Phi = after(t_next, Sb @ Phi)
             events.append((t_next, "breakaway"))
             y, t, mode, k = s_b.copy(), t_next, K.MODE_SLIP, k + 1
         elif mode == K.MODE_SLIP:
             # departure inside the low-speed band: quasi-static direction until |v_r| = band
-            sol = _integrate_segment(system, yv, (t, t_next), mode, e, steps,
-                                     events=[_speed_event(system, system.p[K.P_SLIP_BAND], 1)])
-            y, Phi = sol.y[:12, -1].copy(), sol.y[12:, -1].reshape(12, 12)
+            t1 = min(t_cap, t_next)
+            sol, y, Phi = run(y, Phi, t, t1, mode, e, [_speed_event(system, system.p[K.P_SLIP_BAND], 1)])
             if sol.status == 1:
                 t = float(sol.t[-1])
                 Phi = band_exit_jump(system, y, e) @ Phi
                 events.append((t, "band"))
                 mode = K.MODE_SLIP_EXACT
-            else:
-                t = t_next
-                if k >= n_tr:
-                    break
+            elif t1 == t_next and k < n_tr:
                 raise OrbitError("slip → stick inside the low-speed band is not supported")
+            else:
+                t = t1
+            Phi = after(t, Phi)
         else:
-            if k >= n_tr:
-                sol = _integrate_segment(system, yv, (t, T), mode, e, steps,
-                                         events=[_speed_event(system, ARRIVAL_SPEED, -1)])
+            if t_cap < t_next or k >= n_tr:
+                t1 = min(t_cap, t_next)
+                sol, y, Phi = run(y, Phi, t, t1, mode, e, [_speed_event(system, ARRIVAL_SPEED, -1)])
                 if sol.status == 1:
                     raise OrbitError(f"the re-integration reaches v_r = 0 at {sol.t[-1]:.9f} s; the event integrator does not")
-                y, Phi = sol.y[:12, -1], sol.y[12:, -1].reshape(12, 12)
-                break
-            sol = _integrate_segment(system, yv, (t, t_next + 1.0), mode, e, steps,
-                                     events=[_speed_event(system, ARRIVAL_SPEED, -1)])
+                t = t1
+                Phi = after(t, Phi)
+                continue
+            sol, s_c, Phi = run(y, Phi, t, t_next + 1.0, mode, e, [_speed_event(system, ARRIVAL_SPEED, -1)])
             if sol.status != 1 or abs(sol.t_events[0][0] - t_next) > MATCH_TIME_TOL:
                 raise OrbitError(f"arrival at stick of the re-integration at {sol.t[-1]:.9f} s, "
                                  f"event integrator {t_next:.9f} s")
-            s_c = sol.y[:12, -1].copy()
             s_s = tr.state[k]
-            # positions only: the velocities differ by the O(τ) rest of the approach and by the
-            # integrator's projection of its arrival residual (≤ STICK_SPEED_TOL)
-            # (positions extrapolated over the rest of the approach to the integrator's instant)
+            # positions only (extrapolated over the rest of the approach to the integrator's
+            # instant): the velocities differ by that O(τ) rest and by the integrator's
+            # projection of its arrival residual (≤ STICK_SPEED_TOL)
             s_x = s_c + (t_next - float(sol.t[-1])) * field(system, s_c, K.MODE_SLIP_EXACT)
             check(s_x, s_s, system.variant.free_indices)
-            Phi = arrival_jump(system, s_c, s_s) @ sol.y[12:, -1].reshape(12, 12)
+            Phi = after(t_next, arrival_jump(system, s_c, s_s) @ Phi)
             events.append((t_next, "stick"))
             y, t, mode, e, k = s_s.copy(), t_next, K.MODE_STICK, (0.0, 0.0), k + 1
     check(y, end)
-    M = np.zeros((12, 12))
-    M[np.ix_(free, free)] = Phi[np.ix_(free, free)]
-    return FlowJacobian(matrix=M, state0=s0, state=np.asarray(end).copy(), duration=T, events=tuple(events),
-                        mismatch=mismatch, wall_time=_time.perf_counter() - t_start)
+    return Phi, events, mismatch
+
+
+def _pad(P: np.ndarray) -> np.ndarray:
+    out = np.zeros((12, 12))
+    out[:, :P.shape[1]] = P
+    return out
 
 
 # --------------------------------------------------------------------------------------------
