@@ -55,11 +55,11 @@ def continue_command(
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: N, Omega, delta_mu, alpha, mu_k, k_px, ..."),
     start: float = typer.Option(..., "--from", help="Start value of the parameter (where the first orbit is found)."),
     stop: float = typer.Option(..., "--to", help="End of the range; the branch goes from --from towards it."),
-    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
-    omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
+    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N \\[N] when not continued (default 50)."),
+    omega: Optional[float] = typer.Option(None, "--omega", help="Ω \\[rad/s] when not continued (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4)."),
     ic: str = typer.Option("far", "--ic", help="Start run: far | near | zero | equilibrium (docs/sweeps.md)."),
-    search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run [s]."),
+    search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run \\[s]."),
     max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
     step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
     max_step: float = typer.Option(0.2, "--max-step", help="Largest step in scaled arclength."),
@@ -67,7 +67,7 @@ def continue_command(
                                                 "fold, period-doubling, neimark-sacker, stick-phases."),
     rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map."),
     tol: float = typer.Option(1e-8, "--tol", help="Corrector tolerance (scaled shooting residual)."),
-    slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction [m/s] "
+    slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction \\[m/s] "
                                               "(default: that of stickslip.simulate)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
@@ -76,12 +76,9 @@ def continue_command(
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
 ) -> None:
-    """Continue a periodic orbit in one parameter; mark stability, folds, period doubling and
-    changes of the stick phases.
+    """Continue a periodic orbit in one parameter, with stability, folds and stick-phase changes.
 
-    The first orbit is found by shooting from a run of --search-time seconds from --ic at
-    --from; the branch then follows the orbit towards --to (pseudo-arclength, so it passes
-    folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes.
+    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes.
     """
     from ..orbits.continuation import continue_orbit, start_run
 
