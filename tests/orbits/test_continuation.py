@@ -268,3 +268,25 @@ def test_unstable_slip_cycle_joins_the_hopf_point_and_the_end_of_the_stick_slip_
     assert np.min(down.values) == pytest.approx(omega_c, abs=0.01)
     k = int(np.argmin(down.values))
     assert _phi_range(down, k) < 0.1 * _phi_range(down, 0)
+
+
+def test_region_edge_figure_draws_the_curve_and_marks_its_kind():
+    """plot_region_edge from a FoldCurve dataset (no simulation): the edge line through the finite
+    values, one marker per kind, the Ω_c curve, and a legend entry for each."""
+    import matplotlib.pyplot as plt
+
+    from stickslip.plot.continuation import plot_region_edge
+
+    fc = C.FoldCurve(N=np.array([10.0, 50.0, 90.0]), edge=np.array([11.0, np.nan, 16.0]),
+                     kind=("stick-vanishing", "failed", "fold"), located=np.array([True, False, True]),
+                     period=np.full(3, 0.36), omega_stable_max=np.array([11.0, np.nan, 16.0]),
+                     points=np.array([10, 0, 12]), seconds=np.ones(3), message=("", "x", ""), omega_start=5.0,
+                     params=Parameters(), model="full", timings={})
+    ax = plot_region_edge(fc, omega_c=(np.array([10.0, 90.0]), np.array([4.5, 7.0])))
+    xs = [tuple(ln.get_xdata()) for ln in ax.get_lines()]
+    assert (10.0, 90.0) in xs  # the edge curve skips the failed N
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("stick-vanishing" in t for t in labels) and any("(fold)" in t for t in labels)
+    assert any("Ω_c" in t for t in labels)
+    assert ax.get_ylim()[1] >= 16.0
+    plt.close(ax.figure)
