@@ -193,7 +193,7 @@ def integrate_naeom(y0, t0, t_end, dt, minv, damp, stiff, p, max_steps, sample_t
     tr_t = np.empty(16)
     tr_kind = np.empty(16, dtype=np.int8)
     tr_s = np.empty((16, n))
-    n_tr = 0
+    n_tr = np.int64(0)  # not a literal: one compiled version of the callees
     stats = np.zeros(8, dtype=np.int64)
 
     mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
