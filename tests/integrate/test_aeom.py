@@ -135,7 +135,7 @@ def test_agrees_with_event_100s():
 
 
 def test_step_band_formula():
-    from stickslip.integrate.method_aeom import kernel_parameters, step_band
+    from stickslip.integrate.fixed_step import kernel_parameters, step_band
 
     system = assemble(Parameters(), "full")
     # Δt μs N tr(G M⁻¹ Gᵀ) at R = r: 1e-4 * 15 * (1 + 1 + 0.1 + 0.1 + 0.04/0.5 + 0.04/5)

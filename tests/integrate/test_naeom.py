@@ -6,6 +6,7 @@ import pytest
 
 import stickslip
 from stickslip import Parameters, SimulationError
+from stickslip.integrate import fixed_step as F
 from stickslip.integrate import method_naeom as N
 from stickslip.model import assemble
 from stickslip.model import kernels as K
@@ -45,8 +46,8 @@ def test_iteration_cap_raises_clear_error(monkeypatch):
     def failing(*args):
         status = N.STATUS_SOLVE_FAILED
         return status, 1.234, np.zeros(14), np.zeros(0), np.zeros(0, np.int8), np.zeros((0, 14)), np.zeros(8, np.int64)
-    monkeypatch.setattr(N, "integrate_naeom", failing)
-    monkeypatch.setattr(N, "warm_up", lambda *a: 0.0)
+    monkeypatch.setattr(F, "integrate_fixed_step", failing)
+    monkeypatch.setattr(F, "warm_up", lambda *a: 0.0)
     with pytest.raises(SimulationError, match=r"stick-force solve did not reach \|v_r\| ≤ 1e-12 m/s in 50 Newton iterations at t = 1.234 s"):
         stickslip.simulate(t_end=2.0, method="naeom", dt=1e-3)
 

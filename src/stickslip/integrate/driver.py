@@ -14,8 +14,7 @@ from ..model.parameters import Parameters
 from ..model.system import System, assemble
 from ..model.variants import STATE_NAMES
 from . import method_event
-from .method_aeom import run_aeom
-from .method_naeom import run_naeom
+from .fixed_step import run_aeom, run_naeom
 from .result import Stats, Trajectory, Transitions, load_trajectory
 
 __all__ = ["simulate", "initial_state", "SimulationError", "METHODS"]

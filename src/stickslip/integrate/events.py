@@ -44,6 +44,11 @@ ARRIVAL_TIME_TOL = 1e-10
 #: direction keeps |v_r| of the order of the sliding speed (0.1–1 m/s in the paper's cases).
 STICK_SPEED_TOL = 1e-6
 
+#: Largest number of bisections of one transition bracket (fixed-step methods): the bracket
+#: halves each time, so 200 is far more than the ~40 needed to go from Δt = 0.1 s to
+#: EVENT_TIME_TOL.
+MAX_BISECTIONS = 200
+
 #: Sub-intervals of a step on which the event function is sampled for a sign change.
 EVENT_CHECKS = 4
 

@@ -1,18 +1,12 @@
-"""The ``aeom`` integrator: the paper's method of alternated equations of motion (Sect. 3).
+"""The stick step of ``aeom``, the paper's method of alternated equations of motion (Sect. 3).
 
-Fixed-step classic Runge–Kutta 4 (paper ref. [43]) on the model kernels, in one compiled loop:
+The fixed-step loop, the slip steps and the samples are shared with ``naeom``
+(:mod:`~stickslip.integrate.fixed_step`); what is specific to AEOM is the stick phase:
 
-* slip: RK4 on all twelve states with the slip force, Eq. (3);
 * stick: RK4 on the four "free" DOFs x1, y1, φ, ψ (Eq. 13), with x2, y2 taken from the
   trapezoidal rule of Eq. (12) and ẋ2, ẏ2 from the velocity constraint v_r = 0 (Eq. 11,
   first two lines), at every RK4 stage and at the step end;
-* transitions monitored at every step end with the shared event functions
-  (:mod:`stickslip.integrate.events`) and located by **bisection on re-stepping** (the paper's
-  choice): a step whose end shows the event is re-taken from its start with θ Δt, θ bisected
-  until the bracket is shorter than ``events.EVENT_TIME_TOL``. After a transition the next step
-  is the remainder up to the grid point t0 + k Δt, so the time grid is kept;
-* uniform samples from the cubic Hermite interpolant of each step (state and derivative at both
-  ends), written in the polynomial form that ``events.dense_state`` evaluates.
+* breakaway (Eq. 10) at a step end is located by bisection on re-taken stick steps.
 
 The 4-DOF stick equations, Eq. (13), are Eq. (1) with F eliminated using the acceleration-level
 constraint (Eq. 11, lines 3–4). That elimination is exactly the multiplier solve of
@@ -36,210 +30,17 @@ Whenever a component of v_r = 0 is not enforced by construction (the last two ca
 velocities are projected onto v_r = 0 in the M-metric after the step (``kernels.project_velocity``,
 the same drift removal as ``event``); no division by a zero mass happens anywhere, so no NaN.
 
-State layout as in :mod:`~stickslip.integrate.method_event`: 12 states, then the work of
-friction and of damping [J], integrated with the same steps as quadratures.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import time
-
-import numpy as np
 
 from ..model import kernels as K
-from ..model.jit import kernel, loop
+from ..model.jit import kernel
 from . import events as E
-from .method_event import (N_STATE, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_OK,
-                           STATUS_STEP_UNDERFLOW, _record)
 
-__all__ = ["integrate_aeom", "run_aeom", "check_step", "STABILITY_LIMIT", "N_STATE"]
-
-#: Largest ω_max Δt accepted for fixed-step RK4, ω_max the highest natural angular frequency
-#: √(k/m) of the free DOFs. Classic RK4 is stable for an undamped oscillator only while
-#: ω Δt < 2√2 ≈ 2.83; 2.0 (Δt ≤ T_min/π) keeps a margin for the negative damping of the
-#: falling friction law and the frictional coupling, and still admits the paper's largest step
-#: Δt = 0.1 s for Table 1 (ω_max = 17.3 rad/s, ω_max Δt = 1.73).
-STABILITY_LIMIT = 2.0
-
-#: Cap [m/s] of the step-adapted low-speed band (:func:`step_band`). A wider band would put the
-#: quasi-static slip direction in place of v_r/|v_r| over a sizable part of the sliding range
-#: (Ω r = 1 m/s in Sect. 4.2.1) and change the model rather than the numerics; measured at
-#: Δt = 1e-4 s, a band of 1e-2 m/s still changes φ's amplitude by only 9e-5 relative.
-MAX_STEP_BAND = 1e-2
-
-#: Largest number of bisections of one transition bracket: the bracket halves each time, so 200
-#: is far more than the ~40 needed to go from Δt = 0.1 s to events.EVENT_TIME_TOL = 1e-12 s.
-MAX_BISECTIONS = 200
-
-
-# --------------------------------------------------------------------------- shared RK4 pieces
-@kernel
-def rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
-    """One classic RK4 step of length ``h`` [s] in slip (Eq. 1 with Eq. 3), k1 = f(y) given.
-
-    Writes ``ynew``; ``ytmp``, ``k2``…``k4`` are work arrays. Returns the rhs calls made (3).
-    """
-    n = y.shape[0]
-    half = 0.5 * h
-    for i in range(n):
-        ytmp[i] = y[i] + half * k1[i]
-    K.rhs(ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k2)
-    for i in range(n):
-        ytmp[i] = y[i] + half * k2[i]
-    K.rhs(ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k3)
-    for i in range(n):
-        ytmp[i] = y[i] + h * k3[i]
-    K.rhs(ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k4)
-    sixth = h / 6.0
-    for i in range(n):
-        ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-    return 3
-
-
-@kernel
-def hermite_coefficients(y0, f0, y1, f1, h, Q):
-    """Cubic Hermite interpolant of a step as ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)`` (3 columns).
-
-    Matches y and dy/dt = f at both ends (θ = 0, 1); 3rd order in h, the form used by
-    ``events.dense_state``.
-    """
-    for i in range(y0.shape[0]):
-        d = (y1[i] - y0[i]) / h
-        Q[i, 0] = f0[i]
-        Q[i, 1] = 3.0 * d - 2.0 * f0[i] - f1[i]
-        Q[i, 2] = f0[i] + f1[i] - 2.0 * d
-
-
-@kernel
-def write_samples(idx, t, h, y0, f0, y1, f1, mode, ex, ey, fixed_force, Fx, Fy, minv, damp, stiff, p,
-                  sample_times, out_s, out_mode, out_F, Q, work):
-    """Write the samples with t < ts ≤ t + h from the Hermite interpolant of the step.
-
-    The friction force written is (Fx, Fy) if ``fixed_force`` (NAEOM's per-step force in stick),
-    else ``kernels.contact_force`` at the sample. Returns the next sample index.
-    """
-    n_samples = sample_times.shape[0]
-    t_to = t + h
-    if idx >= n_samples or sample_times[idx] > t_to:
-        return idx
-    hermite_coefficients(y0, f0, y1, f1, h, Q)
-    while idx < n_samples and sample_times[idx] <= t_to:
-        theta = (sample_times[idx] - t) / h
-        E.dense_state(y0, Q, h, theta, work)
-        _store(idx, work, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
-        idx += 1
-    return idx
-
-
-@kernel
-def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F):
-    """Write sample ``idx``: the given force if ``fixed_force``, else the contact force of ``mode``."""
-    if not fixed_force:
-        Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
-    E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
-
-
-@kernel
-def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p,
-                          sample_times, out_s, out_mode, out_F):
-    """Samples at t ≤ t0 (the initial state). Returns the next sample index."""
-    idx = 0
-    while idx < sample_times.shape[0] and sample_times[idx] <= t0:
-        _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
-        idx += 1
-    return idx
-
-
-@kernel
-def slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
-    """A slip step with the slip → stick event located by bisection on re-stepping.
-
-    The event function is the projection of v_r on its direction at the step start
-    (``events.EVENT_SLIP``). If it has turned ≤ 0 at the step end, θ ∈ (0, 1] is bisected, each
-    trial re-taking the RK4 step with θ h from ``y``, until the bracket is shorter than
-    ``events.EVENT_TIME_TOL``; the step is then the one that ends on the ≤ 0 side of the root.
-
-    Returns (h_taken, crossed): the step length actually taken [s] and whether it ends at a
-    zero of the slip velocity. ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is
-    updated (rhs calls at index 2, re-taken steps at 3).
-    """
-    vx, vy = K.relative_velocity(y, p)
-    speed = math.sqrt(vx * vx + vy * vy)
-    stats[2] += rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    if speed <= K.SPEED_FLOOR:  # just after breakaway (v_r = 0) there is nothing to detect
-        K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
-        stats[2] += 1
-        return h, False
-    e0x = vx / speed
-    e0y = vy / speed
-    g_end = E.event_value(E.EVENT_SLIP, ynew, e0x, e0y, minv, damp, stiff, p)
-    if g_end > 0.0:
-        K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
-        stats[2] += 1
-        return h, False
-    a = 0.0
-    b = 1.0
-    for _ in range(MAX_BISECTIONS):
-        if (b - a) * h <= E.EVENT_TIME_TOL:
-            break
-        c = 0.5 * (a + b)
-        stats[2] += rk4_slip_step(y, k1, c * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-        stats[3] += 1
-        if E.event_value(E.EVENT_SLIP, ynew, e0x, e0y, minv, damp, stiff, p) > 0.0:
-            a = c
-        else:
-            b = c
-    if b < 1.0:
-        stats[2] += rk4_slip_step(y, k1, b * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-        stats[3] += 1
-    K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
-    stats[2] += 1
-    return b * h, True
-
-
-@kernel
-def after_slip_root(ynew, ex, ey, minv, damp, stiff, p):
-    """At a located zero of the projected slip velocity: arrival at v_r = 0, then
-    ``events.try_stick`` (projection + Eq. 10 test).
-
-    The root of v_r·e0 leaves the component of v_r across e0. A fixed step cannot resolve the
-    direction of v_r below |v_r| ~ Δt μ N |G M⁻¹ Gᵀ| (~1e-3 m/s at Δt = 1e-4 s: the direction
-    relaxes on the time scale |v_r| / (μ N |G M⁻¹ Gᵀ|)), and inside the low-speed band the slip
-    direction is the quasi-static one, which misses the origin by O(band). So a root with
-    |v_r| ≤ the low-speed band ``p[P_SLIP_BAND]`` counts as arrival: the residual is removed by
-    the M-metric projection (an impulsive friction force, booked as friction work) before
-    ``try_stick`` tests admissibility. A larger |v_r| is a mere turn of the slip direction.
-
-    Returns (stick, ex, ey): stick True with ``ynew`` projected onto v_r = 0; else the slip
-    direction to continue with (the breakaway direction of an inadmissible stick force, or the
-    current one after a turn).
-    """
-    vx, vy = K.relative_velocity(ynew, p)
-    if math.sqrt(vx * vx + vy * vy) <= max(E.STICK_SPEED_TOL, p[K.P_SLIP_BAND]):
-        K.project_velocity(ynew, minv, p)
-    stick, nex, ney = E.try_stick(ynew, minv, damp, stiff, p, E.STICK_SPEED_TOL)
-    if stick:
-        return True, ex, ey
-    if nex != 0.0 or ney != 0.0:
-        return False, nex, ney
-    return False, ex, ey
-
-
-@kernel
-def next_step(t, t0, dt, k_grid, t_end):
-    """Length of the next step: up to the grid point t0 + k Δt (or t_end), skipping grid points
-    closer than ``events.EVENT_TIME_TOL`` (a transition that fell just before one).
-
-    Returns (h, k_grid).
-    """
-    while True:
-        t_next = min(t0 + k_grid * dt, t_end)
-        h = t_next - t
-        if h > E.EVENT_TIME_TOL or t_next >= t_end:
-            return h, k_grid
-        k_grid += 1
+__all__ = ["aeom_stick_branch", "aeom_stick_step", "dependent_states"]
 
 
 # --------------------------------------------------------------------------- AEOM stick step
@@ -337,225 +138,38 @@ def aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
     return 3
 
 
-@loop
-def integrate_aeom(y0, t0, t_end, dt, minv, damp, stiff, p, max_steps, sample_times, out_s, out_mode, out_F):
-    """Integrate from ``y0`` (length N_STATE) over [t0, t_end] with the fixed step ``dt`` [s].
+@kernel
+def aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
+    """An AEOM stick step of length ``h`` [s] with breakaway located by bisection on re-stepping.
 
-    Returns
-    -------
-    status : int
-        ``method_event.STATUS_*``.
-    t : float
-        Time reached [s].
-    y : ndarray (N_STATE,)
-        Final state.
-    tr_t, tr_kind, tr_s :
-        Transition instants [s], kinds (+1 to stick, −1 to slip) and states.
-    stats : ndarray (6,) int64
-        steps, 0 (no rejections), rhs calls, re-taken (bisection) steps, slip → stick and
-        stick → slip transitions.
+    If the stick force at the step end violates Eq. (10), θ ∈ (0, 1] is bisected, each trial
+    re-taking the stick step with θ h from ``y``, until the bracket is shorter than
+    ``events.EVENT_TIME_TOL``; the step then ends on the slip side of the root.
+
+    Returns (h_taken, transition): the step length taken [s] and 0 or
+    ``events.TRANSITION_TO_SLIP``. ``ynew`` and ``fnew`` = f(ynew) (stick) hold the step end;
+    ``stats`` counts rhs calls (index 2) and re-taken steps (index 3).
     """
-    n = y0.shape[0]
-    y = y0.copy()
-    ynew = np.empty(n)
-    ytmp = np.empty(n)
-    work = np.empty(n)
-    k1 = np.empty(n)
-    fnew = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    Q = np.empty((n, 3))
-    tr_t = np.empty(16)
-    tr_kind = np.empty(16, dtype=np.int8)
-    tr_s = np.empty((16, n))
-    n_tr = 0
-    stats = np.zeros(6, dtype=np.int64)
-    static = K.static_limit(p)
-
-    mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
-    if mode == K.MODE_STICK:
-        dependent_states(y, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, minv, p)
-    K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+    stats[2] += aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+    Fx, Fy = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    idx = write_initial_samples(y, t0, mode, ex, ey, 0.0, 0.0, False, minv, damp, stiff, p,
-                                sample_times, out_s, out_mode, out_F)
-    t = t0
-    k_grid = 1
-    status = STATUS_OK
-    n_steps = 0
-    while t < t_end:
-        if n_steps >= max_steps:
-            status = STATUS_MAX_STEPS
+    if K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
+        return h, 0
+    a = 0.0
+    b = 1.0
+    for _ in range(E.MAX_BISECTIONS):
+        if (b - a) * h <= E.EVENT_TIME_TOL:
             break
-        n_steps += 1
-        h, k_grid = next_step(t, t0, dt, k_grid, t_end)
-        if h <= 0.0:
-            status = STATUS_STEP_UNDERFLOW
-            break
-        transition = 0
-        if mode == K.MODE_SLIP:
-            h, crossed = slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew,
-                                              ytmp, k2, k3, k4, stats)
-            idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, False, 0.0, 0.0, minv, damp,
-                                stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
-            ex, ey = K.slip_direction(ynew, ex, ey, minv, damp, stiff, p)
-            if crossed:
-                stick, ex, ey = after_slip_root(ynew, ex, ey, minv, damp, stiff, p)
-                if stick:
-                    transition = E.TRANSITION_TO_STICK
+        c = 0.5 * (a + b)
+        stats[2] += aeom_stick_step(y, k1, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[3] += 1
+        if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
+            a = c
         else:
-            stats[2] += aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-            Fx, Fy = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
-            stats[2] += 1
-            if static - math.sqrt(Fx * Fx + Fy * Fy) <= 0.0:
-                # breakaway (Eq. 10) inside the step: bisect θ on re-taken stick steps
-                a = 0.0
-                b = 1.0
-                for _ in range(MAX_BISECTIONS):
-                    if (b - a) * h <= E.EVENT_TIME_TOL:
-                        break
-                    c = 0.5 * (a + b)
-                    stats[2] += aeom_stick_step(y, k1, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-                    stats[3] += 1
-                    if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
-                        a = c
-                    else:
-                        b = c
-                if b < 1.0:
-                    stats[2] += aeom_stick_step(y, k1, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-                    stats[3] += 1
-                h = b * h
-                Fx, Fy = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
-                stats[2] += 1
-                transition = E.TRANSITION_TO_SLIP
-            idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, False, 0.0, 0.0, minv, damp,
-                                stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
-            if transition == E.TRANSITION_TO_SLIP:
-                ex, ey = E.breakaway_direction(Fx, Fy)
-        t += h
-        stats[0] += 1
-        for i in range(n):
-            y[i] = ynew[i]
-            k1[i] = fnew[i]
-        if transition != 0:
-            mode = K.MODE_STICK if transition == E.TRANSITION_TO_STICK else K.MODE_SLIP
-            stats[4 if transition == E.TRANSITION_TO_STICK else 5] += 1
-            tr_t, tr_kind, tr_s = _record(n_tr, t, transition, y, tr_t, tr_kind, tr_s)
-            n_tr += 1
-            K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)  # projected state / new mode
-            stats[2] += 1
-        for i in range(n):
-            if not math.isfinite(y[i]):
-                status = STATUS_NOT_FINITE
-        if status != STATUS_OK:
-            break
-    return status, t, y, tr_t[:n_tr].copy(), tr_kind[:n_tr].copy(), tr_s[:n_tr].copy(), stats
-
-
-# --------------------------------------------------------------------------- Python runners
-def check_step(method: str, system, dt) -> float:
-    """Validate the fixed step of ``method`` for ``system``; returns it [s].
-
-    Raises
-    ------
-    SimulationError
-        If ``dt`` is missing, or larger than ``STABILITY_LIMIT / ω_max`` with ω_max the highest
-        natural angular frequency √(k/m) of the free DOFs (RK4 would be unstable or wrong).
-    """
-    from .driver import SimulationError
-
-    if dt is None:
-        raise SimulationError(
-            f"method {method!r} is a fixed-step method: give the step dt in seconds, e.g. dt=1e-4 "
-            "(the paper's converged step; CLI: --dt 1e-4)"
-        )
-    omega = np.sqrt(system.stiff * system.minv)
-    omega_max = float(omega.max())
-    if omega_max > 0.0 and dt * omega_max > STABILITY_LIMIT:
-        raise SimulationError(
-            f"dt = {dt:g} s is too large for fixed-step RK4 ({method}): the shortest natural period of "
-            f"the free DOFs is {2 * math.pi / omega_max:.4g} s and the step must satisfy "
-            f"ω_max·dt ≤ {STABILITY_LIMIT:g}, i.e. dt ≤ {STABILITY_LIMIT / omega_max:.4g} s; give a smaller dt"
-        )
-    return float(dt)
-
-
-def step_band(system, dt: float) -> float:
-    """Low-speed band [m/s] the fixed step ``dt`` [s] needs: Δt μs N tr(G M⁻¹ Gᵀ).
-
-    In slip the direction of v_r relaxes on the time scale |v_r| / (μ N λ), λ an eigenvalue of
-    A = G M⁻¹ Gᵀ (``kernels.DEFAULT_SLIP_BAND``'s note). An explicit step resolves it only when
-    |v_r| ≳ Δt μ N λ; below that speed RK4 makes the direction chatter (measured at Δt = 1e-4 s
-    with a band of 1e-4 m/s: stick entries late by up to 2.5e-4 s and a 1.2 % error of
-    φ's amplitude). There the direction must sit on its slow manifold, which is what the
-    low-speed band does, so the fixed-step methods use max(slip_band, this). λ is bounded by
-    tr(A) taken at R = r (contact at its nominal radius). Table 1: 3.4e-3 m/s at Δt = 1e-4 s.
-    Capped at :data:`MAX_STEP_BAND`.
-    """
-    m = system.minv
-    r = system.p[K.P_R]
-    trace = m[0] + m[1] + m[2] + m[3] + (m[4] + m[5]) * r * r
-    return float(min(dt * K.static_limit(system.p) * trace, MAX_STEP_BAND))
-
-
-def kernel_parameters(system, dt: float) -> np.ndarray:
-    """``system.p`` with the low-speed band raised to :func:`step_band` where that is larger."""
-    p = system.p.copy()
-    p[K.P_SLIP_BAND] = max(p[K.P_SLIP_BAND], step_band(system, dt))
-    return p
-
-
-def _messages(status: int, t_reached: float) -> str:
-    return {
-        STATUS_OK: "success",
-        STATUS_STEP_UNDERFLOW: f"step size underflow at t = {t_reached:.6g} s",
-        STATUS_NOT_FINITE: f"state became non-finite at t = {t_reached:.6g} s",
-        STATUS_MAX_STEPS: f"max_steps reached at t = {t_reached:.6g} s",
-    }[status]
-
-
-def stats_dict(st, compile_time: float) -> dict:
-    """The integrator counters as keyword arguments of ``result.Stats``."""
-    from .result import Stats
-
-    stats = dict(accepted_steps=int(st[0]), rejected_steps=int(st[1]), rhs_calls=int(st[2]),
-                 retaken_steps=int(st[3]), slip_to_stick=int(st[4]), stick_to_slip=int(st[5]))
-    if "compile_time_s" in {f.name for f in dataclasses.fields(Stats)}:
-        stats["compile_time_s"] = compile_time
-    return stats
-
-
-def warm_up(kernel, system, t0, dt) -> float:
-    """Compile (or load from cache) ``kernel`` on a one-step run; seconds spent, 0 if compiled."""
-    if kernel.signatures:
-        return 0.0
-    start = time.perf_counter()
-    y = np.zeros(N_STATE)
-    kernel(y, t0, t0 + dt, dt, system.minv, system.damp, system.stiff, system.p, 10,
-           np.array([t0]), np.zeros((1, N_STATE)), np.zeros(1, dtype=np.int8), np.zeros((1, 2)))
-    return time.perf_counter() - start
-
-
-def run_aeom(system, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
-             rtol: float, atol: float, dt: float | None, max_steps: int):
-    """Runner of ``method="aeom"`` for :func:`stickslip.simulate` (signature of ``_run_event``).
-
-    ``rtol``/``atol`` are not used (fixed step ``dt`` [s], validated by :func:`check_step`).
-    """
-    from .result import Transitions
-
-    dt = check_step("aeom", system, dt)
-    compile_time = warm_up(integrate_aeom, system, t0, dt)
-    n = sample_times.size
-    out_s = np.zeros((n, N_STATE))
-    out_mode = np.zeros(n, dtype=np.int8)
-    out_F = np.zeros((n, 2))
-    y = np.zeros(N_STATE)
-    y[:12] = y0
-    status, t_reached, _, tr_t, tr_kind, tr_s, st = integrate_aeom(
-        y, t0, t_end, dt, system.minv, system.damp, system.stiff, kernel_parameters(system, dt), max_steps,
-        sample_times, out_s, out_mode, out_F)
-    keep = sample_times <= t_reached
-    return (_messages(status, t_reached), keep, out_s, out_mode, out_F,
-            Transitions(tr_t, tr_kind, tr_s[:, :12]), stats_dict(st, compile_time))
+            b = c
+    if b < 1.0:
+        stats[2] += aeom_stick_step(y, k1, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[3] += 1
+    K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
+    stats[2] += 1
+    return b * h, E.TRANSITION_TO_SLIP

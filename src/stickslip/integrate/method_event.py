@@ -191,7 +191,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     tr_t = np.empty(16)
     tr_kind = np.empty(16, dtype=np.int8)
     tr_s = np.empty((16, n))
-    n_tr = 0
+    n_tr = np.int64(0)  # not a literal: one compiled version of the callees
     stats = np.zeros(6, dtype=np.int64)
 
     mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
@@ -203,7 +203,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     stats[2] += 1
     t = t0
     h = min(h_init, h_max)
-    idx = 0
+    idx = np.int64(0)
     # samples at exactly t0
     while idx < sample_times.shape[0] and sample_times[idx] <= t0:
         _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
