@@ -263,8 +263,10 @@ def test_unstable_slip_cycle_joins_the_hopf_point_and_the_end_of_the_stick_slip_
     # both branches end at the same Ω (the slip cycle's steps shrink to min_step at the merger)
     assert up.stop_reason == "min_step" and abs(up.values[-1] - edge) < 0.01
     assert _phi_range(up) == pytest.approx(_phi_range(b), rel=0.01)
-    # down: the cycle shrinks to the Hopf point, where its branch turns (reported as a fold)
+    # down: the cycle shrinks onto the equilibrium at the Hopf point of the linearisation
     omega_c = _omega_c_rotation()
+    assert down.stop_reason.startswith("hopf") and [q.kind for q in down.special] == ["hopf"]
+    assert down.special[0].value == pytest.approx(omega_c, abs=0.01)
     assert np.min(down.values) == pytest.approx(omega_c, abs=0.01)
     k = int(np.argmin(down.values))
     assert _phi_range(down, k) < 0.1 * _phi_range(down, 0)

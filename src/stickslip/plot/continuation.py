@@ -20,6 +20,7 @@ SPECIAL_MARKERS = {
     "neimark-sacker": ("D", "#2ca02c"),
     "stick-phases": ("^", "#ff7f0e"),
     "stick-vanishing": ("v", "#ff7f0e"),
+    "hopf": ("*", "#8c564b"),
 }
 
 
@@ -59,7 +60,7 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True, colo
     """One branch: period (or amplitude) against the parameter; stable solid, unstable dashed.
 
     Special points are marked (fold ○, period doubling □, Neimark–Sacker ◇, change of the number
-    of stick phases △, stick phase vanishing ▽) at the interpolated branch value.
+    of stick phases △, stick phase vanishing ▽, Hopf ☆) at the interpolated branch value.
 
     Parameters
     ----------
