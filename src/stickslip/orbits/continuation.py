@@ -596,6 +596,9 @@ def _start_orbit(params, param, start, model, section, rtol, atol, slip_band) ->
     if isinstance(start, PeriodicOrbit):
         return start
     try:
+        if isinstance(start, Trajectory):  # one stick onset per period (several φ maxima at low N)
+            run = start if start.params == params else dataclasses.replace(start, params=params)
+            return start_orbit_from_run(run, section=section, rtol=rtol, atol=atol, slip_band=slip_band)
         return periodic_orbit(params, start, model=model, section=section, rtol=rtol, atol=atol, slip_band=slip_band)
     except (OrbitError, SimulationError) as exc:
         raise ContinuationError(f"no periodic orbit to start from at {param} = {getattr(params, param):g}: {exc}") from exc
@@ -671,7 +674,8 @@ def continue_orbit(
         The parameter to vary: any numeric :class:`~stickslip.Parameters` field (``N`` [N],
         ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...).
     start : PeriodicOrbit, Trajectory, array-like (12,) or "equilibrium"
-        The first orbit, or a guess handed to :func:`~stickslip.orbits.periodic_orbit`.
+        The first orbit; or a run that settled on it (shot by :func:`start_orbit_from_run`, one
+        stick onset per period); or a state handed to :func:`~stickslip.orbits.periodic_orbit`.
     direction : {+1, −1}
         Start towards increasing (+1) or decreasing (−1) λ.
     step, min_step, max_step : float
@@ -730,7 +734,7 @@ def continue_orbit(
     unknown = sorted(set(stop_on) - set(SPECIAL_KINDS))
     if unknown:
         raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
-    if isinstance(start, PeriodicOrbit) and params is None:
+    if isinstance(start, (PeriodicOrbit, Trajectory)) and params is None:
         params = start.params
     params = Parameters() if params is None else params
     if param not in Parameters.names() or param == "friction_law":
@@ -1051,7 +1055,7 @@ def crossings_per_stick(run: Trajectory, section="phi_max") -> int:
     return max(int(np.sum((times > onsets[-2]) & (times <= onsets[-1]))), 1)
 
 
-def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e-10,
+def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e-10, atol: float | None = None,
                          slip_band: float = DEFAULT_SLIP_BAND) -> PeriodicOrbit:
     """Shoot the stick-slip orbit a run has settled on, with one stick onset per period.
 
@@ -1073,7 +1077,7 @@ def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e
         m = run.t.size - cut * cut_step
         part = dataclasses.replace(run, t=run.t[:m], states=run.states[:m], mode=run.mode[:m])
         try:
-            return periodic_orbit(run.params, part, section=section, rtol=rtol, period_multiplicity=k,
+            return periodic_orbit(run.params, part, section=section, rtol=rtol, atol=atol, period_multiplicity=k,
                                   slip_band=slip_band)
         except OrbitError as exc:
             error = exc
