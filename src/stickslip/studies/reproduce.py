@@ -16,9 +16,9 @@ as failed (with the error) and the next one runs.
 Resolutions (:data:`RESOLUTIONS`): ``full`` is the paper's (stability maps 100 × 100, 100 s
 time-step study down to Δt = 1e-5 s, 121-point bifurcation diagrams over N and 100-point ones
 over Ω, Δμ, α, 100 × 100 region maps of 300 s runs from two ICs for four models), ``quick`` uses
-coarse grids (7 × 8 region maps, 15–41-point bifurcation diagrams; measured 9–10 minutes on the
-shared 2-core machine, most of it Figs. 9 and 14, whose Model 3 runs take up to 60 s each),
-``micro`` is for tests.
+coarse grids (7 × 8 region maps, 11–41-point bifurcation diagrams; measured 406 s for all
+figures on the shared 2-core machine, 327 s of it Figs. 9 and 14, whose Model 3 runs take up to
+60 s each; docs/reproduce.md), ``micro`` is for tests.
 """
 
 from __future__ import annotations
