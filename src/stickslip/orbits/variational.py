@@ -34,6 +34,7 @@ import dataclasses
 import json
 import math
 import time as _time
+import types
 
 import numpy as np
 from numba import njit
@@ -302,6 +303,175 @@ def variational_rhs(y, mode, ex, ey, minv, damp, stiff, p, steps, dy, J):
             dy[12 + 12 * i + k] = acc
 
 
+# Dormand–Prince 5(4) with the 4th-order dense output (Dormand & Prince 1980; Shampine 1986):
+# the tableau of scipy's RK45 and of the event integrator (integrate/method_event.py), copied
+# here so the variational integrator does not depend on that module's private names.
+_DP_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
+_DP_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
+])
+_DP_B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
+_DP_E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
+_DP_P = np.array([
+    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
+    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
+    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
+    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
+    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
+])
+
+EV_NONE = 0
+EV_SPEED = 1      # |v_r| − level
+EV_BREAKAWAY = 2  # μs N − |F_stick|
+
+#: Points per step at which the dense output is checked for an event (as events.EVENT_CHECKS):
+#: a step may carry |v_r| through a minimum without ending below the level.
+EV_CHECKS = 4
+
+#: Event instants are located on the dense output to this time [s] (events.EVENT_TIME_TOL).
+EV_TIME_TOL = 1e-13
+
+
+@njit(cache=True)
+def _ev_value(kind, y, level, minv, damp, stiff, p):
+    if kind == EV_SPEED:
+        vx, vy = K.relative_velocity(y, p)
+        return math.sqrt(vx * vx + vy * vy) - level
+    if kind == EV_BREAKAWAY:
+        Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
+        return K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy)
+    return 0.0
+
+
+@njit(cache=True)
+def _dense(y0, Q, h, theta, out):
+    n = y0.shape[0]
+    for i in range(n):
+        acc = Q[i, 3]
+        for j in range(2, -1, -1):
+            acc = Q[i, j] + theta * acc
+        out[i] = y0[i] + h * theta * acc
+
+
+@njit(cache=True)
+def integrate_variational(y0, t0, t1, mode, ex, ey, minv, damp, stiff, p, steps, rtol, atol,
+                          ev_kind, ev_level, ev_dir, max_steps):
+    """Dormand–Prince 5(4) on y = [s, Φ] (156,) from t0 towards t1, stopping at an event.
+
+    Event ``ev_kind`` (EV_SPEED: |v_r| − ev_level; EV_BREAKAWAY: μsN − |F_stick|) crossing zero
+    in direction ``ev_dir`` (+1 upward, −1 downward), checked at EV_CHECKS points of each
+    accepted step's dense output and located by Illinois regula falsi to EV_TIME_TOL.
+    Error control: RMS over all components with ``atol`` (156,) + rtol·|y| (as scipy).
+
+    Returns (status, t, y): status 0 reached t1, 1 event at t, 2 step underflow, 3 max_steps.
+    """
+    n = y0.shape[0]
+    y = y0.copy()
+    ynew = np.empty(n)
+    ytmp = np.empty(n)
+    work = np.empty(n)
+    Kst = np.empty((7, n))
+    Q = np.empty((n, 4))
+    J = np.empty((12, 12))
+    variational_rhs(y, mode, ex, ey, minv, damp, stiff, p, steps, Kst[0], J)
+    t = t0
+    h = min(1e-4, t1 - t0)  # the controller grows it ×5 per step
+    g0 = _ev_value(ev_kind, y, ev_level, minv, damp, stiff, p)
+    n_steps = 0
+    while t < t1:
+        if n_steps >= max_steps:
+            return 3, t, y
+        n_steps += 1
+        h = min(h, t1 - t)
+        if h <= 1e-15 * max(1.0, abs(t)):
+            return 2, t, y
+        for s in range(1, 7):
+            for i in range(n):
+                acc = 0.0
+                for j in range(s if s < 6 else 6):
+                    acc += (_DP_A[s, j] if s < 6 else _DP_B[j]) * Kst[j, i]
+                ytmp[i] = y[i] + h * acc
+            if s < 6:
+                variational_rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, steps, Kst[s], J)
+            else:
+                for i in range(n):
+                    ynew[i] = ytmp[i]
+                variational_rhs(ynew, mode, ex, ey, minv, damp, stiff, p, steps, Kst[6], J)
+        total = 0.0
+        for i in range(n):
+            err = 0.0
+            for j in range(7):
+                err += _DP_E[j] * Kst[j, i]
+            sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
+            total += (h * err / sc) ** 2
+        err_norm = math.sqrt(total / n)
+        if not math.isfinite(err_norm) or err_norm > 1.0:
+            fac = 0.2 if not math.isfinite(err_norm) else max(0.2, 0.9 * err_norm ** -0.2)
+            h *= fac
+            continue
+        if ev_kind != EV_NONE:
+            for i in range(n):
+                for c in range(4):
+                    acc = 0.0
+                    for j in range(7):
+                        acc += Kst[j, i] * _DP_P[j, c]
+                    Q[i, c] = acc
+            a = 0.0
+            ga = g0
+            b = -1.0
+            gb = 0.0
+            for k in range(1, EV_CHECKS + 1):
+                th = k / EV_CHECKS
+                if k == EV_CHECKS:
+                    g = _ev_value(ev_kind, ynew, ev_level, minv, damp, stiff, p)
+                else:
+                    _dense(y, Q, h, th, work)
+                    g = _ev_value(ev_kind, work, ev_level, minv, damp, stiff, p)
+                if ev_dir * ga < 0.0 and ev_dir * g >= 0.0:
+                    b = th
+                    gb = g
+                    break
+                a = th
+                ga = g
+            if b > 0.0:
+                tol = EV_TIME_TOL / h
+                side = 0
+                for _ in range(200):
+                    if gb == 0.0 or (b - a) <= tol:
+                        break
+                    c = b - gb * (b - a) / (gb - ga)
+                    if not (a < c < b):
+                        c = 0.5 * (a + b)
+                    _dense(y, Q, h, c, work)
+                    gc = _ev_value(ev_kind, work, ev_level, minv, damp, stiff, p)
+                    if ev_dir * gc < 0.0:
+                        a, ga = c, gc
+                        if side == 1:
+                            gb *= 0.5
+                        side = 1
+                    else:
+                        b, gb = c, gc
+                        if side == -1:
+                            ga *= 0.5
+                        side = -1
+                _dense(y, Q, h, b, work)
+                return 1, t + b * h, work.copy()
+            g0 = _ev_value(ev_kind, ynew, ev_level, minv, damp, stiff, p)
+        t += h
+        for i in range(n):
+            y[i] = ynew[i]
+            Kst[0, i] = Kst[6, i]
+        h *= 5.0 if err_norm == 0.0 else min(5.0, 0.9 * err_norm ** -0.2)
+    return 0, t, y
+
+
 # --------------------------------------------------------------------------------------------
 # Jump matrices (pure functions of states; numpy)
 # --------------------------------------------------------------------------------------------
@@ -449,9 +619,36 @@ def _band_field(system: System, s: np.ndarray, e) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 
 
-def _integrate_segment(system, y0, t_span, mode, e, steps, *, events=(), rtol=VAR_RTOL, method="DOP853"):
-    """solve_ivp (Radau IIA, order 5) of [s, Φ] over ``t_span`` in ``mode``; returns the
-    solve_ivp result (terminal ``events`` stop it)."""
+#: Integrator of the variational segments: "compiled" (:func:`integrate_variational`, Dormand–Prince
+#: 5(4) in numba) or a scipy ``solve_ivp`` method name (e.g. "DOP853", used as a cross-check).
+SEGMENT_METHOD = "compiled"
+
+#: Step cap of one compiled segment (a 1 s piece takes ~10³ steps at rtol 1e-10).
+MAX_SEGMENT_STEPS = 1_000_000
+
+
+def _integrate_segment(system, y0, t_span, mode, e, steps, *, events=(), rtol=None, method=None):
+    """Integrate [s, Φ] over ``t_span`` in ``mode``; stop at the (single) terminal event.
+
+    Returns an object with ``status`` (0 end reached, 1 event), ``t`` (array, last = end time),
+    ``y`` (156, 1+) and ``t_events`` (list of one array), like ``solve_ivp``'s result.
+    """
+    rtol = VAR_RTOL if rtol is None else rtol
+    method = SEGMENT_METHOD if method is None else method
+    atol = np.full(156, VAR_ATOL_PHI)
+    atol[:12] = VAR_ATOL_STATE
+    if method == "compiled":
+        kind, level, direction = (EV_NONE, 0.0, 1) if not events else (events[0].kind, events[0].level,
+                                                                         events[0].direction)
+        status, t_end, y_end = integrate_variational(
+            np.ascontiguousarray(y0, dtype=float), float(t_span[0]), float(t_span[1]), int(mode), float(e[0]),
+            float(e[1]), system.minv, system.damp, system.stiff, system.p, steps, rtol, atol, kind, float(level),
+            float(direction), MAX_SEGMENT_STEPS)
+        if status > 1:
+            raise OrbitError(f"variational integration failed in mode {mode} at t = {t_end} s "
+                             f"({'step underflow' if status == 2 else 'too many steps'})")
+        return types.SimpleNamespace(status=status, t=np.array([t_span[0], t_end]), y=y_end[:, None],
+                                     t_events=[np.array([t_end]) if status == 1 else np.array([])])
     J = np.empty((12, 12))
     dy = np.empty(156)
     args = (int(mode), float(e[0]), float(e[1]), system.minv, system.damp, system.stiff, system.p, steps)
@@ -460,17 +657,7 @@ def _integrate_segment(system, y0, t_span, mode, e, steps, *, events=(), rtol=VA
         variational_rhs(y, *args, dy, J)
         return dy.copy()
 
-    def jac(t, y):
-        state_jacobian(y[:12].copy(), *args, J)
-        out = np.zeros((156, 156))
-        out[:12, :12] = J
-        out[12:, 12:] = np.kron(J, np.eye(12))
-        return out
-
-    atol = np.full(156, VAR_ATOL_PHI)
-    atol[:12] = VAR_ATOL_STATE
-    sol = solve_ivp(fun, t_span, y0, method=method, rtol=rtol, atol=atol, events=list(events),
-                    **({"jac": jac} if method in ("Radau", "BDF", "LSODA") else {}))
+    sol = solve_ivp(fun, t_span, y0, method=method, rtol=rtol, atol=atol, events=list(events))
     if sol.status < 0:
         raise OrbitError(f"variational integration failed in mode {mode}: {sol.message}")
     return sol
@@ -482,6 +669,7 @@ def _speed_event(system, level, direction):
         return math.hypot(vx, vy) - level
     ev.terminal = True
     ev.direction = direction
+    ev.kind, ev.level = EV_SPEED, float(level)
     return ev
 
 
@@ -493,6 +681,7 @@ def _breakaway_event(system):
         return limit - math.hypot(Fx, Fy)
     ev.terminal = True
     ev.direction = -1
+    ev.kind, ev.level = EV_BREAKAWAY, 0.0
     return ev
 
 
