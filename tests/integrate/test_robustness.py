@@ -24,3 +24,14 @@ def test_random_cases_finish(N, Omega, model, law, ic):
     stick = traj.mode == 1
     muN = traj.params.mu_s * traj.params.N
     assert (traj.friction_magnitude[stick] <= muN * (1 + 1e-9)).all()
+
+
+def test_near_singular_contact_metric_model_3():
+    # Model 3 near φ = 0: G M⁻¹ Gᵀ has eigenvalues ~1e-3 and 1.2 1/kg and |v_r| creeps along the
+    # edge of the low-speed band; this case used to run into max_steps at t ≈ 3.6 s
+    ic = np.zeros(12)
+    ic[7] = 0.6  # ẏ1 [m/s]
+    traj = simulate(Parameters(N=70, Omega=3), 20.0, model="y", ic=ic, sample_rate=100, max_steps=500_000)
+    assert traj.status == "success", traj.status
+    assert traj.stats.slip_to_stick > 0  # it reaches stick-slip
+    assert np.isfinite(traj.states).all()

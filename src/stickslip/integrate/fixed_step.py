@@ -135,7 +135,7 @@ def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, 
 
 
 @kernel
-def slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
+def slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
     """A slip step with the slip → stick event located by bisection on re-stepping.
 
     The event function is the projection of v_r on its direction at the step start
@@ -143,24 +143,22 @@ def slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew, ytm
     trial re-taking the RK4 step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step is then the one that ends on the ≤ 0 side of the root.
 
-    Returns (h_taken, crossed): the step length actually taken [s] and whether it ends at a
-    zero of the slip velocity. ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is
-    updated (rhs calls at index 2, re-taken steps at 3).
+    ``(vx, vy)`` is v_r at ``y`` [m/s]. Returns (h_taken, crossed, v1x, v1y): the step length
+    actually taken [s], whether it ends at a zero of the slip velocity, and v_r at the step end.
+    ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is updated (rhs calls at index 2,
+    re-taken steps at 3).
     """
-    vx, vy = K.relative_velocity(y, p)
     speed = math.sqrt(vx * vx + vy * vy)
     stats[2] += rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+    K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    stats[2] += 1
+    v1x, v1y = K.relative_velocity(ynew, p)
     if speed <= K.SPEED_FLOOR:  # just after breakaway (v_r = 0) there is nothing to detect
-        K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
-        stats[2] += 1
-        return h, False
+        return h, False, v1x, v1y
     e0x = vx / speed
     e0y = vy / speed
-    g_end = E.event_value(E.EVENT_SLIP, ynew, e0x, e0y, minv, damp, stiff, p)
-    if g_end > 0.0:
-        K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
-        stats[2] += 1
-        return h, False
+    if v1x * e0x + v1y * e0y > 0.0:  # the slip event (events.EVENT_SLIP) stays positive
+        return h, False, v1x, v1y
     a = 0.0
     b = 1.0
     for _ in range(E.MAX_BISECTIONS):
@@ -178,7 +176,8 @@ def slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew, ytm
         stats[3] += 1
     K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    return b * h, True
+    v1x, v1y = K.relative_velocity(ynew, p)
+    return b * h, True, v1x, v1y
 
 
 @kernel
@@ -270,6 +269,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
         dependent_states(y, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, minv, p)
     K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
     stats[2] += 1
+    vx, vy = K.relative_velocity(y, p)
     idx = write_initial_samples(y, t0, mode, ex, ey, 0.0, 0.0, False, minv, damp, stiff, p,
                                 sample_times, out_s, out_mode, out_F)
     t = t0
@@ -287,11 +287,16 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             break
         transition = 0
         if mode == K.MODE_SLIP:
-            h, crossed = slip_step_with_event(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, fnew,
-                                              ytmp, k2, k3, k4, stats)
+            h, crossed, vx, vy = slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, fnew,
+                                                      ytmp, k2, k3, k4, stats)
             idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, False, 0.0, 0.0, minv, damp,
                                 stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
-            ex, ey = K.slip_direction(ynew, ex, ey, minv, damp, stiff, p)
+            speed = math.sqrt(vx * vx + vy * vy)
+            if speed > p[K.P_SLIP_BAND]:
+                ex = vx / speed
+                ey = vy / speed
+            else:
+                ex, ey = K.quasi_static_direction(ynew, ex, ey, minv, damp, stiff, p)
             if crossed:
                 stick, ex, ey = after_slip_root(ynew, ex, ey, minv, damp, stiff, p)
                 if stick:
@@ -331,6 +336,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             n_tr += 1
             K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)  # projected state / new mode
             stats[2] += 1
+            vx, vy = K.relative_velocity(y, p)
         for i in range(n):
             if not math.isfinite(y[i]):
                 status = STATUS_NOT_FINITE

@@ -53,6 +53,7 @@ SAFETY = 0.9        # standard step-size safety factor
 MIN_FACTOR = 0.2    # largest step reduction after a rejection
 MAX_FACTOR = 5.0    # largest step growth after an acceptance
 MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick root
+DEPARTURE_OVERSHOOT = 2.0  # a departure step may end at most this many low-speed bands above v_r = 0
 MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.36 s shortest natural period of Table 1
 
 
@@ -196,9 +197,12 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
 
     mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
     vx, vy = K.relative_velocity(y, p)
-    if mode == K.MODE_SLIP and math.sqrt(vx * vx + vy * vy) > E.STICK_SPEED_TOL:
-        # a run that starts sliding is not departing from v_r = 0: watch it for stick at once
-        mode = K.MODE_SLIP_EXACT
+    if mode == K.MODE_SLIP:
+        if math.sqrt(vx * vx + vy * vy) > E.STICK_SPEED_TOL:
+            # a run that starts sliding is not departing from v_r = 0: watch it for stick at once
+            mode = K.MODE_SLIP_EXACT
+        else:
+            mode = K.MODE_SLIP_QUASI_STATIC
     K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
     stats[2] += 1
     t = t0
@@ -254,6 +258,15 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             # v_r and dv_r/dt at the end of the step: the event pre-check, and after acceptance
             # the new slip direction and the time to v_r = 0
             v1x, v1y, a1x, a1y = K.relative_velocity_acceleration(ynew, Kst[6], p)
+            if mode == K.MODE_SLIP_QUASI_STATIC and retakes < MAX_RETAKES:
+                speed1 = math.sqrt(v1x * v1x + v1y * v1y)
+                if speed1 > DEPARTURE_OVERSHOOT * p[K.P_SLIP_BAND]:
+                    # the quasi-static direction is an O(|v_r|) approximation: leave it near the
+                    # band's edge, not far above it; |v_r| grows like t² after breakaway
+                    h *= max(MIN_FACTOR, math.sqrt(p[K.P_SLIP_BAND] / speed1))
+                    retakes += 1
+                    stats[3] += 1
+                    continue
             if mode == K.MODE_SLIP_EXACT:  # while departing from v_r = 0 there is nothing to detect
                 v0x, v0y, a0x, a0y = K.relative_velocity_acceleration(y, k1, p)
                 speed0 = math.sqrt(v0x * v0x + v0y * v0y)
@@ -288,9 +301,13 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 ey = v1y / speed
             else:
                 ex, ey = K.quasi_static_direction(y, ex, ey, minv, damp, stiff, p)
-            if mode == K.MODE_SLIP:
+            if mode == K.MODE_SLIP_QUASI_STATIC:
                 if speed > p[K.P_SLIP_BAND]:
-                    mode = K.MODE_SLIP_EXACT  # same force above the band: k1 stays valid
+                    # departed: the exact direction from the next step on (the force law
+                    # changes between steps, never inside one)
+                    mode = K.MODE_SLIP_EXACT
+                    K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+                    stats[2] += 1
             else:
                 v_arrive = E.arrival_speed(y, rtol, atol)
                 near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= v_arrive
@@ -320,7 +337,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                         n_tr += 1
                     elif nex != 0.0 or ney != 0.0:
                         # v_r reached zero but stick cannot hold: slip departs again (reversal)
-                        mode = K.MODE_SLIP
+                        mode = K.MODE_SLIP_QUASI_STATIC
                         ex, ey = nex, ney
                     if stick or nex != 0.0 or ney != 0.0:
                         K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
@@ -348,7 +365,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 t = t_root
                 Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
                 ex, ey = E.breakaway_direction(Fx, Fy)
-                mode = K.MODE_SLIP
+                mode = K.MODE_SLIP_QUASI_STATIC
                 stats[5] += 1
                 tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_SLIP, y, tr_t, tr_kind, tr_s)
                 n_tr += 1

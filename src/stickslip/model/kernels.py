@@ -35,6 +35,7 @@ LAW_COULOMB = 1      # μ = μk in slip, μs = μk + Δμ in stick
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
 MODE_SLIP_EXACT = 2  # slip with the exact direction v_r/|v_r| at every speed (approach to stick)
+MODE_SLIP_QUASI_STATIC = 3  # slip with the quasi-static direction at every speed (see below)
 
 #: Speed [m/s] below which v_r counts as exactly zero (round-off after projection, ~1e-16 of
 #: the sliding speed Ω r of the paper's cases, is far below it).
@@ -45,10 +46,10 @@ SPEED_FLOOR = 1e-13
 #: friction relaxes on the time scale |v_r| / (λ μ N) → 0 (a stiff mode that forces explicit
 #: steps of that size); inside the band the direction sits on its slow manifold, an O(|v_r|)
 #: approximation. Measured at N = 50 N, Ω = 5 rad/s and Ω = 0.5 rad/s, N = 30/50/70/120 N
-#: (100 s, rtol 1e-8, against band 1e-5 at rtol 1e-11): bands 1e-5, 1e-4 and 1e-3 give the
-#: same errors (≤ 6e-9 in frequency), 3e-3 and above show the band (docs/numerics.md);
-#: 1e-3 takes 15–40 % fewer steps than 1e-4.
-DEFAULT_SLIP_BAND = 1e-3
+#: (100 s, rtol 1e-8, against band 1e-5 at rtol 1e-11): bands 1e-5, 1e-4 and 5e-4 give the
+#: same errors (≤ 6e-9 in frequency), 1e-3 and above start to show the band
+#: (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
+DEFAULT_SLIP_BAND = 5e-4
 
 #: Relative size below which the smaller eigenvalue of G M⁻¹ Gᵀ counts as zero (rank 1,
 #: DESIGN.md §1.2). In Model 4 it is exactly 0 up to round-off (~1e-16 relative).
@@ -290,21 +291,36 @@ def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
 
 
 @kernel
-def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
-    """Friction force in the given mode [N]: the stick multiplier, or Eq. (3) in slip.
+def exact_direction(mode, speed, p):
+    """Whether slip in ``mode`` at |v_r| = ``speed`` [m/s] takes the direction v_r/|v_r|.
 
-    The slip direction is v_r/|v_r| above the low-speed band ``p[P_SLIP_BAND]``. Inside it,
-    ``MODE_SLIP`` takes the quasi-static direction found from the last known direction
-    ``(ex, ey)`` (right after breakaway, where |v_r| grows like t² and the direction relaxes
-    onto that manifold at once), ``MODE_SLIP_EXACT`` keeps v_r/|v_r| (on the approach to stick,
-    where |v_r| falls linearly and the direction only relaxes logarithmically).
+    Otherwise it takes the quasi-static direction (:func:`quasi_static_direction`), found from
+    the last known direction. ``MODE_SLIP``: exact above the low-speed band ``p[P_SLIP_BAND]``,
+    quasi-static inside it (right after breakaway |v_r| grows like t² and the direction relaxes
+    onto that manifold at once). ``MODE_SLIP_EXACT``: exact at every speed (on the approach to
+    stick |v_r| falls linearly and the direction only relaxes logarithmically).
+    ``MODE_SLIP_QUASI_STATIC``: quasi-static at every speed — the event integrator's steps that
+    start inside the band, so that the force law does not switch inside a step when |v_r|
+    creeps along the band's edge (seen in Model 3 near φ = 0, where G M⁻¹ Gᵀ is nearly
+    singular: the switch made every step straddling the edge fail its error test).
     """
+    if mode == MODE_SLIP_EXACT:
+        return speed > SPEED_FLOOR
+    if mode == MODE_SLIP:
+        return speed > p[P_SLIP_BAND]
+    return False
+
+
+@kernel
+def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
+    """Friction force in the given mode [N]: the stick multiplier, or Eq. (3) in slip with the
+    direction of :func:`exact_direction` (``(ex, ey)``: the last known direction)."""
     if mode == MODE_STICK:
         Fx, Fy, _ = stick_force(s, minv, damp, stiff, p)
         return Fx, Fy
     vx, vy = relative_velocity(s, p)
     speed = math.sqrt(vx * vx + vy * vy)
-    if speed > p[P_SLIP_BAND] or (mode == MODE_SLIP_EXACT and speed > SPEED_FLOOR):
+    if exact_direction(mode, speed, p):
         return slip_force(speed, vx / speed, vy / speed, p)
     dx, dy = quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
     return slip_force(speed, dx, dy, p)
@@ -339,7 +355,7 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
         vx = dX + w * Y
         vy = dY - w * X
         speed = math.sqrt(vx * vx + vy * vy)
-        if speed > p[P_SLIP_BAND] or (mode == MODE_SLIP_EXACT and speed > SPEED_FLOOR):
+        if exact_direction(mode, speed, p):
             Fx, Fy = slip_force(speed, vx / speed, vy / speed, p)
             done = True
     if not done:
