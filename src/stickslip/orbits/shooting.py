@@ -217,6 +217,17 @@ def _monodromy(params, model, s0, T, free, cols, h, *, rtol, atol, slip_band):
                              slip_band=slip_band, cols=cols)
 
 
+def _newton_columns(params, model, s0, T, free, cols, h, sigma, method, opts):
+    """∂Φ(s0, T)/∂s0 on the free rows and the ``cols`` columns, by ``method`` (saltation with a
+    finite-difference fallback)."""
+    if method == "saltation":
+        try:
+            return _var.flow_jacobian(params, model, s0, T, scale=sigma, **opts).matrix[np.ix_(free, cols)]
+        except OrbitError:
+            pass
+    return _monodromy(params, model, s0, T, free, cols, h, **opts)
+
+
 def periodic_orbit(
     params: Parameters | None = None,
     guess=None,
@@ -232,6 +243,7 @@ def periodic_orbit(
     search_time: float = SEARCH_TIME,
     slip_band: float = DEFAULT_SLIP_BAND,
     monodromy: str = "saltation",
+    newton_jacobian: str = "saltation",
 ) -> PeriodicOrbit:
     """Find a periodic orbit by Newton shooting on a Poincaré section.
 
@@ -270,8 +282,11 @@ def periodic_orbit(
         How the monodromy matrix of the converged orbit is computed: variational equations with
         saltation matrices (:func:`stickslip.orbits.variational.monodromy`; default; falls back
         to finite differences with a warning if the re-integration does not reproduce the
-        orbit's event sequence), or central differences of the flow map. The Newton iteration
-        itself always uses finite differences.
+        orbit's event sequence), or central differences of the flow map.
+    newton_jacobian : {"saltation", "finite-difference"}
+        Jacobian ∂Φ/∂s0 of the Newton iteration: one variational integration (default; an
+        iteration where it fails, e.g. because the iterate's event sequence differs from the
+        integrator's, uses finite differences) or 2 (2 n_free − 1) flow maps.
 
     Returns
     -------
@@ -292,6 +307,8 @@ def periodic_orbit(
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")
     if monodromy not in _var.METHODS:
         raise OrbitError(f"unknown monodromy method {monodromy!r}; use one of {_var.METHODS}")
+    if newton_jacobian not in _var.METHODS:
+        raise OrbitError(f"unknown newton_jacobian {newton_jacobian!r}; use one of {_var.METHODS}")
     atol = 1e-3 * rtol if atol is None else float(atol)
     sec = resolve_section(section)
     system = assemble(params, model, slip_band)
@@ -333,7 +350,7 @@ def periodic_orbit(
                 "non-periodic, or the guess too far: give a guess closer to the orbit or raise max_iter"
             )
         A = np.empty((free.size, free.size))
-        A[:, :-1] = _monodromy(params, model, s0, T, free, cols, h, **opts)
+        A[:, :-1] = _newton_columns(params, model, s0, T, free, cols, h, sigma, newton_jacobian, opts)
         A[:, :-1] -= np.eye(free.size)[:, [list(free).index(j) for j in cols]]
         A[:, :-1] *= sigma[[list(free).index(j) for j in cols]][None, :]  # unknowns in σ units
         A[:, :-1] /= sigma[:, None]
@@ -378,5 +395,6 @@ def periodic_orbit(
         state=s0, period=float(T), multiplicity=k, stick_phases=sticks, residual=history[-1],
         iterations=it, residual_history=np.array(history), multipliers=mult, monodromy=M,
         free_states=tuple(STATE_NAMES[j] for j in free), scale=sigma, params=params, model=model,
-        section=sec, options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method),
+        section=sec, options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method,
+                                  newton_jacobian=newton_jacobian),
     )
