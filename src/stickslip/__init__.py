@@ -14,10 +14,19 @@
 ``sweep``                   parameter grids → resumable NetCDF of reductions (serial, processes, dask)
 ``regions``                 bistability regions I/II/III (Fig. 8) and stick-slip domains (Fig. 9)
 ``periodic_orbit``          periodic orbit by shooting on a Poincaré section, Floquet multipliers
+``monodromy``               monodromy matrix of an orbit (variational equations + saltation, or FD)
 ``lyapunov_exponent``       largest Lyapunov exponent (Benettin, across events)
+``lyapunov_spectrum``       all Lyapunov exponents (variational equations + saltation + QR)
+``continue_orbit``          pseudo-arclength continuation of periodic orbits in one parameter
+``fold_curve``              end of the stick-slip branch (edge of Region II) over N
 ``MODELS``                  the paper's Models 1–4 as free DOFs
 ==========================  ==============================================================
+
+The simulation core is imported at once; stability, sweeps and orbit tools are imported on
+first use (PEP 562), so ``import stickslip`` stays fast.
 """
+
+import importlib
 
 __version__ = "0.1.0"
 
@@ -26,10 +35,32 @@ from .integrate.driver import SimulationError, simulate
 from .integrate.result import FileFormatError, Trajectory, load_trajectory
 from .model.parameters import ParameterError, Parameters
 from .model.variants import DOF_NAMES, MODELS, STATE_NAMES, VariantError
-from .orbits import LyapunovResult, OrbitError, PeriodicOrbit, lyapunov_exponent, periodic_orbit
-from .stability import StabilityMap, StabilityResult, load_stability_map, stability, stability_map
-from .stability.equilibrium import EquilibriumError, equilibrium
-from .sweep import RegionMap, SweepError, SweepResult, load_region_map, load_sweep, regions, sweep
+
+#: Public names imported on first access, by the module that defines them.
+_LAZY = {
+    **dict.fromkeys(["StabilityMap", "StabilityResult", "load_stability_map", "stability", "stability_map"],
+                    ".stability"),
+    **dict.fromkeys(["EquilibriumError", "equilibrium"], ".stability.equilibrium"),
+    **dict.fromkeys(["RegionMap", "SweepError", "SweepResult", "load_region_map", "load_sweep", "regions", "sweep"],
+                    ".sweep"),
+    **dict.fromkeys(["LyapunovResult", "LyapunovSpectrum", "OrbitError", "PeriodicOrbit", "Monodromy",
+                     "lyapunov_exponent", "lyapunov_spectrum", "monodromy", "periodic_orbit"], ".orbits"),
+    **dict.fromkeys(["Branch", "ContinuationError", "FoldCurve", "SpecialPoint", "continue_orbit", "fold_curve",
+                     "load_branch", "unstable_cycle"], ".orbits.continuation"),
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(__all__)
+
 
 __all__ = [
     "__version__",
@@ -40,6 +71,9 @@ __all__ = [
     "stability", "StabilityResult", "stability_map", "StabilityMap", "load_stability_map",
     "classify", "Classification", "find_peaks", "intensity",
     "sweep", "SweepResult", "SweepError", "load_sweep", "regions", "RegionMap", "load_region_map",
-    "periodic_orbit", "PeriodicOrbit", "lyapunov_exponent", "LyapunovResult", "OrbitError",
+    "periodic_orbit", "PeriodicOrbit", "monodromy", "Monodromy", "OrbitError",
+    "lyapunov_exponent", "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum",
+    "continue_orbit", "Branch", "SpecialPoint", "fold_curve", "FoldCurve", "unstable_cycle", "load_branch",
+    "ContinuationError",
     "MODELS", "DOF_NAMES", "STATE_NAMES", "VariantError",
 ]
