@@ -3,7 +3,14 @@ period doubling, the belt oscillator's analytic branch, an orbit found independe
 and the end of the stick-slip branch (Region II edge) against brute-force simulation."""
 
 import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
 import types
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -292,3 +299,84 @@ def test_region_edge_figure_draws_the_curve_and_marks_its_kind():
     assert any("Ω_c" in t for t in labels)
     assert ax.get_ylim()[1] >= 16.0
     plt.close(ax.figure)
+
+
+# --------------------------------------------------------------------------- interrupted runs
+class _Interrupt(Exception):
+    """Raised by the progress callback to stop a run as a kill would (after a journaled point)."""
+
+
+def _fields_equal(a, b):
+    """Every array of two branches identical (bit for bit, NaNs equal) and the same special points."""
+    for name in ("values", "periods", "states", "multipliers", "stable", "n_unstable", "stick_phases", "stick_time",
+                 "amplitude", "arclength", "residuals", "iterations"):
+        assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=True), name
+    assert [(p.kind, p.index, p.value, p.period, p.located, p.bracket) for p in a.special] == \
+        [(p.kind, p.index, p.value, p.period, p.located, p.bracket) for p in b.special]
+    for p, q in zip(a.special, b.special):
+        assert np.array_equal(p.state, q.state) and np.array_equal(p.multipliers, q.multipliers, equal_nan=True)
+    assert a.stop_reason == b.stop_reason and a.digest == b.digest
+
+
+@pytest.mark.parametrize("jacobian_every", [1, 2])
+def test_constructed_branch_interrupted_after_any_point_resumes_to_the_same_branch(constructed, tmp_path,
+                                                                                  jacobian_every):
+    """Interrupted after point k (every third k, and on both sides of each special point; with
+    jacobian_every = 2 Broyden points and Jacobians renewed after a failed step are journaled too),
+    the resumed run reads k + 1 points from the journal and ends with the uninterrupted branch,
+    identical (each resume writes a NetCDF, ~0.2 s, hence not every k)."""
+    opts = dict(start=constructed, param="alpha", step=0.05, max_step=0.2, max_points=200, bounds=(4.0, 20.0),
+                amplitude=False, jacobian_every=jacobian_every)
+    full = continue_orbit(**opts)
+    assert "period-doubling" in [p.kind for p in full.special] and full.stop_reason == "bounds"
+    n = len(full)
+    ks = sorted(({*range(1, n - 1, 3)} | {q.index + d for q in full.special for d in (0, 1)}) & {*range(1, n - 1)})
+    for k in ks:
+        out = tmp_path / f"b{k}.nc"
+
+        def stop_after(i, *_):
+            if i == k:
+                raise _Interrupt
+
+        with pytest.raises(_Interrupt):
+            continue_orbit(out=out, callback=stop_after, **opts)
+        assert not out.exists() and Path(str(out) + ".journal").exists()
+        seen = []
+        resumed = continue_orbit(out=out, on_resume=seen.append, **opts)
+        assert seen == [k + 1] and resumed.timings["points_resumed"] == k + 1
+        _fields_equal(full, resumed)
+        assert not Path(str(out) + ".journal").exists()  # removed once the NetCDF is written
+        _fields_equal(full, C.Branch.from_xarray(load_branch(out)))
+
+
+def test_finished_output_is_returned_and_other_settings_are_refused(constructed, tmp_path):
+    out = tmp_path / "b.nc"
+    opts = dict(start=constructed, param="alpha", step=0.05, max_step=0.2, bounds=(4.0, 20.0), amplitude=False)
+    first = continue_orbit(out=out, max_points=12, **opts)
+    seen = []
+    again = continue_orbit(out=out, max_points=12, on_resume=seen.append, **opts)
+    assert seen == [12]
+    _fields_equal(first, again)
+    with pytest.raises(C.OrbitError, match="different settings or start.*choose another output"):
+        continue_orbit(out=out, max_points=13, **opts)
+    # a journal of other settings is refused too, and a torn last record is dropped
+    journal = Path(str(out) + ".journal")
+
+    def stop_after(i, *_):
+        if i == 5:
+            raise _Interrupt
+
+    out.unlink()
+    with pytest.raises(_Interrupt):
+        continue_orbit(out=out, max_points=12, callback=stop_after, **opts)
+    with pytest.raises(C.OrbitError, match="journal of a different branch run"):
+        continue_orbit(out=out, max_points=13, **opts)
+    text = journal.read_bytes()
+    journal.write_bytes(text[: len(text) - 40])  # as if killed while writing point 5
+    seen = []
+    resumed = continue_orbit(out=out, max_points=12, on_resume=seen.append, **opts)
+    assert seen == [5]  # points 0-4
+    _fields_equal(first, resumed)
+    # resume=False starts over
+    fresh = continue_orbit(out=out, max_points=13, resume=False, **opts)
+    assert len(fresh) == 13 and "points_resumed" in fresh.timings and fresh.timings["points_resumed"] == 0

@@ -54,11 +54,12 @@ from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import ParameterError, Parameters, parameter_attrs
 from ..model.system import assemble
 from ..model.variants import STATE_NAMES
+from . import branch_store as store
 from .section import OrbitError, Section, resolve_section, vector_field
 from .shooting import PeriodicOrbit, periodic_orbit
 
 __all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run", "crossings_per_stick",
-           "start_orbit_from_run", "unstable_cycle", "load_branch",
+           "start_orbit_from_run", "unstable_cycle", "load_branch", "load_fold_curve",
            "ContinuationError", "SPECIAL_KINDS"]
 
 #: Kinds of special points, in the order they are reported.
@@ -335,6 +336,23 @@ def _step_from(problem: _Problem, point: _Point, h: float, tol: float, with_jaco
     return _make_point(problem, v, R, end, tr, it, point.tangent, 1.0)
 
 
+def _point_record(point: _Point) -> dict:
+    """A branch point as a JSON-ready dict (exact floats: a resumed run restarts bit for bit)."""
+    enc = store.encode_array
+    return {"v": enc(point.v), "J": enc(point.J), "M": enc(point.M), "tangent": enc(point.tangent),
+            "multipliers": enc(point.multipliers), "stick_phases": int(point.stick_phases),
+            "stick_time": float(point.stick_time), "residual": float(point.residual), "iterations": int(point.iterations)}
+
+
+def _point_from_record(rec: dict) -> _Point:
+    """Inverse of :func:`_point_record`."""
+    dec = store.decode_array
+    return _Point(v=dec(rec["v"]), J=dec(rec["J"]), M=dec(rec["M"]), tangent=dec(rec["tangent"]),
+                  multipliers=dec(rec["multipliers"]).astype(complex), stick_phases=int(rec["stick_phases"]),
+                  stick_time=float(rec["stick_time"]), residual=float(rec["residual"]),
+                  iterations=int(rec["iterations"]))
+
+
 # --------------------------------------------------------------------------- results
 @dataclasses.dataclass(frozen=True)
 class SpecialPoint:
@@ -380,6 +398,21 @@ class SpecialPoint:
         extra = f" ({self.before:g} → {self.after:g})" if self.kind in ("stick-phases", "neimark-sacker") else ""
         return f"{self.kind}{extra}"
 
+    def to_record(self) -> dict:
+        """JSON-ready dict (exact floats), for the journal of :func:`continue_orbit`."""
+        return {"kind": self.kind, "index": int(self.index), "value": float(self.value), "period": float(self.period),
+                "state": store.encode_array(self.state), "multipliers": store.encode_array(self.multipliers),
+                "before": float(self.before), "after": float(self.after), "bracket": float(self.bracket),
+                "located": bool(self.located)}
+
+    @classmethod
+    def from_record(cls, rec: dict) -> "SpecialPoint":
+        """Inverse of :meth:`to_record`."""
+        return cls(kind=rec["kind"], index=int(rec["index"]), value=float(rec["value"]), period=float(rec["period"]),
+                   state=store.decode_array(rec["state"]), multipliers=store.decode_array(rec["multipliers"]).astype(complex),
+                   before=float(rec["before"]), after=float(rec["after"]), bracket=float(rec["bracket"]),
+                   located=bool(rec["located"]))
+
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Branch:
@@ -424,7 +457,10 @@ class Branch:
     options : dict
         Numerical options (rtol, atol, tol, fd_step, step bounds, scales).
     timings : dict
-        ``total_s``, ``simulations``, ``points``.
+        ``total_s``, ``simulations``, ``points`` (and ``points_resumed`` when written to ``out``).
+    digest : str
+        Digest of everything that determines the branch (start and settings); a run writing to
+        the same ``out`` with another digest is refused.
     """
 
     param: str
@@ -447,6 +483,7 @@ class Branch:
     section: Section
     options: dict
     timings: dict
+    digest: str = ""
 
     def __len__(self) -> int:
         return int(self.values.size)
@@ -499,6 +536,12 @@ class Branch:
             "special_located": ("special", np.array([p.located for p in sp], dtype=np.int8), {"long_name": "1 if located to tolerance"}),
             "special_state": (("special", "state"), np.array([p.state for p in sp], dtype=float).reshape(len(sp), 12),
                               {"long_name": "state on the section at the special point"}),
+            "special_multiplier_real": (("special", "multiplier"), np.array([np.real(p.multipliers) for p in sp], dtype=float)
+                                        .reshape(len(sp), self.multipliers.shape[1]),
+                                        {"long_name": "Floquet multiplier at the special point, real part", "units": "1"}),
+            "special_multiplier_imag": (("special", "multiplier"), np.array([np.imag(p.multipliers) for p in sp], dtype=float)
+                                        .reshape(len(sp), self.multipliers.shape[1]),
+                                        {"long_name": "Floquet multiplier at the special point, imaginary part", "units": "1"}),
         }
         coords = {"point": np.arange(len(self)), "state": list(STATE_NAMES),
                   "multiplier": np.arange(self.multipliers.shape[1]), "special": np.arange(len(sp))}
@@ -508,6 +551,8 @@ class Branch:
             "stickslip_version": __version__,
             "param": self.param, "param_units": unit,
             "model": self.model, "section": self.section.name,
+            "section_spec": json.dumps([self.section.index, self.section.value, self.section.direction, self.section.name]),
+            "digest": self.digest,
             "stop_reason": self.stop_reason,
             "options": json.dumps(self.options),
             "timings": json.dumps(self.timings),
@@ -517,10 +562,34 @@ class Branch:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def to_netcdf(self, path) -> Path:
-        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf)."""
-        path = Path(path)
-        self.to_xarray().to_netcdf(path, engine="h5netcdf")
-        return path
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
+        ds = self.to_xarray()
+        return store.write_atomically(Path(path), lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+    @classmethod
+    def from_xarray(cls, ds) -> "Branch":
+        """The branch of a dataset written by :meth:`to_xarray` (files of this version: with
+        ``section_spec`` and the special points' multipliers)."""
+        index, value, direction, name = json.loads(ds.attrs["section_spec"])
+        mult = ds["multiplier_real"].values + 1j * ds["multiplier_imag"].values
+        smult = ds["special_multiplier_real"].values + 1j * ds["special_multiplier_imag"].values
+        special = [SpecialPoint(kind=str(ds["special_kind"].values[k]), index=int(ds["special_index"].values[k]),
+                                value=float(ds["special_value"].values[k]), period=float(ds["special_period"].values[k]),
+                                state=ds["special_state"].values[k], multipliers=smult[k],
+                                before=float(ds["special_before"].values[k]), after=float(ds["special_after"].values[k]),
+                                bracket=float(ds["special_bracket"].values[k]),
+                                located=bool(ds["special_located"].values[k]))
+                   for k in range(ds.sizes.get("special", 0))]
+        return cls(param=ds.attrs["param"], values=ds["value"].values, periods=ds["period"].values,
+                   states=ds["state_on_section"].values, multipliers=mult, stable=ds["stable"].values.astype(bool),
+                   n_unstable=ds["n_unstable"].values.astype(int), stick_phases=ds["stick_phases"].values.astype(int),
+                   stick_time=ds["stick_time"].values, amplitude=ds["amplitude"].values,
+                   arclength=ds["arclength"].values, residuals=ds["residual"].values,
+                   iterations=ds["iterations"].values.astype(int), special=special, stop_reason=ds.attrs["stop_reason"],
+                   params=Parameters.from_dict(json.loads(ds.attrs["parameters"])), model=ds.attrs["model"],
+                   section=Section(index=int(index), value=float(value), direction=int(direction), name=name),
+                   options=json.loads(ds.attrs["options"]), timings=json.loads(ds.attrs["timings"]),
+                   digest=str(ds.attrs.get("digest", "")))
 
 
 def load_branch(path):
@@ -604,7 +673,48 @@ def _start_orbit(params, param, start, model, section, rtol, atol, slip_band) ->
         raise ContinuationError(f"no periodic orbit to start from at {param} = {getattr(params, param):g}: {exc}") from exc
 
 
-def _problem(orbit: PeriodicOrbit, param: str, fd_step: float, param_scale: float | None) -> _Problem:
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Start:
+    """What a branch needs of its start orbit (internal; journaled so a resumed run needs no shooting)."""
+
+    state: np.ndarray  # (12,) on the section
+    period: float  # [s]
+    stick_phases: int
+    scale: np.ndarray  # σ of the free states
+    params: Parameters
+    model: str
+    section: Section
+    options: dict  # rtol, atol, slip_band
+
+
+def _start_of(orbit: PeriodicOrbit) -> _Start:
+    """The :class:`_Start` of a periodic orbit."""
+    o = orbit.options
+    return _Start(state=np.asarray(orbit.state, dtype=float), period=float(orbit.period),
+                  stick_phases=int(orbit.stick_phases), scale=np.asarray(orbit.scale, dtype=float),
+                  params=orbit.params, model=orbit.model, section=orbit.section,
+                  options={"rtol": o["rtol"], "atol": o["atol"], "slip_band": o["slip_band"]})
+
+
+def _start_record(start: _Start) -> dict:
+    """:class:`_Start` as a JSON-ready dict (exact floats)."""
+    sec = start.section
+    return {"state": start.state.tolist(), "period": start.period, "stick_phases": start.stick_phases,
+            "scale": start.scale.tolist(), "params": start.params.to_dict(), "model": start.model,
+            "section": [sec.index, sec.value, sec.direction, sec.name], "options": start.options}
+
+
+def _start_from_record(rec: dict) -> _Start:
+    """Inverse of :func:`_start_record`."""
+    index, value, direction, name = rec["section"]
+    return _Start(state=np.array(rec["state"], dtype=float), period=float(rec["period"]),
+                  stick_phases=int(rec["stick_phases"]), scale=np.array(rec["scale"], dtype=float),
+                  params=Parameters.from_dict(rec["params"]), model=rec["model"],
+                  section=Section(index=int(index), value=float(value), direction=int(direction), name=name),
+                  options=dict(rec["options"]))
+
+
+def _problem(orbit: _Start, param: str, fd_step: float, param_scale: float | None) -> _Problem:
     if param not in Parameters.names() or param == "friction_law":
         raise ContinuationError(f"cannot continue in {param!r}; choose a numeric parameter: "
                                 + ", ".join(n for n in Parameters.names() if n != "friction_law"))
@@ -658,6 +768,9 @@ def continue_orbit(
     min_stick_fraction: float = MIN_STICK_FRACTION,
     jacobian_every: int = 1,
     callback=None,
+    out=None,
+    resume: bool = True,
+    on_resume=None,
 ) -> Branch:
     """Continue a periodic orbit in one parameter by pseudo-arclength continuation.
 
@@ -710,7 +823,21 @@ def continue_orbit(
         and Neimark–Sacker are then detected between points with multipliers. 1 (default): every
         point has multipliers.
     callback : callable, optional
-        ``callback(i, value, period, stable)`` after each accepted point (progress).
+        ``callback(i, value, period, stable)`` after each accepted point (progress), once the
+        point is journaled when writing to ``out``.
+    out : path, optional
+        NetCDF output (``.nc``) written as the branch is computed: the start orbit and every
+        accepted point (with its special points and the step after it) are appended to the journal
+        ``OUT.nc.journal`` as they are found (:mod:`.branch_store`); at the end the branch is
+        written to ``out`` (:meth:`Branch.to_netcdf`) and the journal removed.
+    resume : bool
+        With ``out``: continue an interrupted run from its journal (the last journaled point, its
+        Jacobian, tangent and step: the resumed branch is the uninterrupted one), or return the
+        branch of a finished ``out``, when they were written with the same start and settings
+        (the same digest). False: delete ``out`` and its journal and start over.
+    on_resume : callable, optional
+        ``on_resume(k)`` once, before any computation, when ``k`` points are read from ``out`` or
+        its journal.
 
     Returns
     -------
@@ -720,6 +847,9 @@ def continue_orbit(
     ------
     ContinuationError
         If ``param`` is not numeric, the start orbit cannot be found, or the first Jacobian fails.
+    stickslip.orbits.branch_store.JournalMismatch
+        If ``out`` or its journal was written with another start or other settings (an
+        :class:`~stickslip.orbits.OrbitError`, like ContinuationError).
     """
     t_start = time.perf_counter()
     if direction not in (1, -1):
@@ -740,6 +870,7 @@ def continue_orbit(
     if param not in Parameters.names() or param == "friction_law":
         raise ContinuationError(f"cannot continue in {param!r}; choose a numeric parameter: "
                                 + ", ".join(n for n in Parameters.names() if n != "friction_law"))
+    lo = hi = None
     if bounds is not None:
         lo, hi = float(bounds[0]), float(bounds[1])
         lam_start = float(getattr(params if not isinstance(start, PeriodicOrbit) else start.params, param))
@@ -747,97 +878,230 @@ def continue_orbit(
             raise ContinuationError(f"bounds ({lo:g}, {hi:g}) must satisfy lo < hi and contain the start "
                                     f"{param} = {lam_start:g}")
     atol = 1e-3 * rtol if atol is None else float(atol)
-    orbit = _start_orbit(params, param, start, model, resolve_section(section), rtol, atol, slip_band)
-    problem = _problem(orbit, param, fd_step, param_scale)
-
-    v0 = problem.pack(orbit.state, orbit.period, float(getattr(orbit.params, param)))
-    try:
-        R, end, tr = _residual(problem, v0)
-        points = [_make_point(problem, v0, R, end, tr, 0, None, float(direction))]
-    except (OrbitError, SimulationError) as exc:
-        raise ContinuationError(f"the Jacobian at the start orbit failed: {exc}") from exc
-    arclength = [0.0]
-    special: list[SpecialPoint] = []
-    size0 = _distance_from_equilibrium(problem, orbit.state, problem.unpack(v0)[2]) if orbit.stick_phases == 0 else None
-    h = float(step)
-    stop_reason = "max_points"
-    fresh_index = 0  # the last point with a finite-difference Jacobian
-    while len(points) < max_points:
-        last = points[-1]
-        fresh = (len(points) - fresh_index) >= jacobian_every
+    section = resolve_section(section)
+    numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
+                    bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
+                    tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
+                    min_stick_fraction=min_stick_fraction, jacobian_every=jacobian_every)
+    settings = _branch_settings(params, param, start, model, section, rtol, atol, slip_band, numerics)
+    digest = store.digest_of(settings)
+    journal = None
+    if out is not None:
+        journal, finished = store.open_output(out, "branch", digest, settings, resume, _read_branch)
+        if finished is not None:
+            if on_resume is not None:
+                on_resume(len(finished))
+            return finished
+    records = [] if journal is None else journal.records
+    start_rec = next((r["start"] for r in records if "start" in r), None)
+    if start_rec is None:
+        begin = _start_of(_start_orbit(params, param, start, model, section, rtol, atol, slip_band))
+        if journal is not None:
+            journal.append({"start": _start_record(begin)})
+    else:
+        begin = _start_from_record(start_rec)
+    problem = _problem(begin, param, fd_step, param_scale)
+    measure = (lambda p: _amplitude(problem, *problem.unpack(p.v))) if amplitude else (lambda p: float("nan"))
+    walk = _walk_from_records(records)
+    resumed = 0 if walk is None else len(walk.points)
+    if walk is None:
+        v0 = problem.pack(begin.state, begin.period, float(getattr(begin.params, param)))
         try:
-            new = _step_from(problem, last, h, tol, with_jacobian=fresh)
+            R, end, tr = _residual(problem, v0)
+            p0 = _make_point(problem, v0, R, end, tr, 0, None, float(direction))
+        except (OrbitError, SimulationError) as exc:
+            raise ContinuationError(f"the Jacobian at the start orbit failed: {exc}") from exc
+        walk = _Walk(points=[p0], arclength=[0.0], amplitudes=[measure(p0)], special=[], h=float(step))
+        _journal_point(journal, walk, problem, [], 0.0, t_start)
+    else:
+        problem.counter["simulations"] = walk.simulations
+        if on_resume is not None:
+            on_resume(len(walk.points))
+    size0 = _distance_from_equilibrium(problem, begin.state, problem.unpack(walk.points[0].v)[2]) \
+        if begin.stick_phases == 0 else None
+    while walk.stop is None and len(walk.points) < max_points:
+        last = walk.points[-1]
+        fresh = (len(walk.points) - walk.fresh_index) >= jacobian_every
+        try:
+            new = _step_from(problem, last, walk.h, tol, with_jacobian=fresh)
             if float(new.tangent @ last.tangent) < MIN_TANGENT_COS:
                 raise OrbitError("tangent turned too far")
         except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+            # step changes are not journaled: a resumed run repeats these deterministic retries
             if not last.fresh:  # first renew the Broyden-updated Jacobian, then shrink
                 try:
                     R, end, tr = _residual(problem, last.v)
-                    points[-1] = _make_point(problem, last.v, R, end, tr, last.iterations, last.tangent, 1.0)
-                    fresh_index = len(points) - 1
+                    walk.points[-1] = _make_point(problem, last.v, R, end, tr, last.iterations, last.tangent, 1.0)
+                    walk.fresh_index = len(walk.points) - 1
+                    _journal_point(journal, walk, problem, [], walk.elapsed, t_start)  # replaces the record
                     continue
                 except (OrbitError, SimulationError):
                     pass
-            h *= SHRINK
-            if h < min_step:
-                stop_reason = "min_step"
-                break
+            walk.h *= SHRINK
+            if walk.h < min_step:
+                walk.stop = "min_step"
             continue
+        stop = None
         lam_new = problem.unpack(new.v)[2]
         if bounds is not None and not (lo <= lam_new <= hi):
-            edge = hi if lam_new > hi else lo
             try:
-                e = np.zeros_like(new.v)
-                e[-1] = 1.0
-                v, R, end, tr, it, _ = _correct(problem, last.v + (edge / problem.p_scale - last.v[-1]) / last.tangent[-1]
-                                                * last.tangent if abs(last.tangent[-1]) > 1e-12 else new.v,
-                                                last.J, e, edge / problem.p_scale, tol)
-                new = _make_point(problem, v, R, end, tr, it, last.tangent, 1.0)
+                new = _correct_onto_bound(problem, last, new, hi if lam_new > hi else lo, tol)
             except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
-                stop_reason = "bounds (last point before the edge)"
+                walk.stop = "bounds (last point before the edge)"
                 break
-            stop_reason = "bounds"
-        points.append(new)
-        arclength.append(arclength[-1] + float(np.linalg.norm(new.v - last.v)))
-        if last.stick_time > 0.0 and new.stick_time < min_stick_fraction * problem.unpack(new.v)[1]:
-            # its multipliers are not trusted: the differences cross the edge of the stick phase
-            special.append(_stick_vanishing(problem, points, len(points) - 2))
-            stop_reason = "stick phase vanishing"
-            break
-        found = _detect(problem, last, new, tol, len(points) - 2, locate, ("fold", "stick-phases"))
-        if new.fresh and jacobian_every > 1:
-            found += _detect(problem, points[fresh_index], new, tol, fresh_index, locate,
-                             ("period-doubling", "neimark-sacker"))
-        elif new.fresh:
-            found += _detect(problem, last, new, tol, len(points) - 2, locate, ("period-doubling", "neimark-sacker"))
-        if new.fresh:
-            fresh_index = len(points) - 1
-        found = [_as_hopf(problem, q, size0) if q.kind == "fold" and size0 is not None
-                 and new.stick_phases == 0 else q for q in found]
-        special.extend(sorted(found, key=lambda q: SPECIAL_KINDS.index(q.kind)))
-        if any(q.kind == "hopf" for q in found):
-            stop_reason = "hopf (the cycle shrinks onto the equilibrium)"
-            break
-        if callback is not None:
+            stop = "bounds"
+        walk.points.append(new)
+        walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
+        walk.amplitudes.append(measure(new))
+        found, stop, quiet = _after_point(problem, walk, last, new, stop, tol, locate, jacobian_every,
+                                          min_stick_fraction, size0, stop_on)
+        walk.special.extend(found)
+        walk.stop = stop
+        if stop is None:
+            if new.iterations <= EASY_ITERATIONS:
+                walk.h = min(walk.h * GROW, max_step)
+            elif new.iterations >= HARD_ITERATIONS:
+                walk.h = max(walk.h * SHRINK, min_step)
+        _journal_point(journal, walk, problem, found, walk.elapsed, t_start)
+        if callback is not None and not quiet:
             _s, T_new, lam_cb = problem.unpack(new.v)
-            callback(len(points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
-        if stop_reason == "bounds":
-            break
-        if any(p.kind in stop_on for p in found):
-            stop_reason = "stop_on " + ",".join(sorted({p.kind for p in found if p.kind in stop_on}))
-            break
-        if new.iterations <= EASY_ITERATIONS:
-            h = min(h * GROW, max_step)
-        elif new.iterations >= HARD_ITERATIONS:
-            h = max(h * SHRINK, min_step)
+            callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
+    stop_reason = walk.stop or "max_points"
+    if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
+        journal.append({"end": stop_reason})
+    branch = _assemble_branch(problem, begin, walk, stop_reason,
+                              dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
+                                   max_step=max_step, max_points=max_points, slip_band=problem.slip_band,
+                                   param_scale=problem.p_scale, period_scale=problem.T_scale,
+                                   bounds=None if bounds is None else [lo, hi], direction=direction,
+                                   jacobian_every=jacobian_every),
+                              walk.elapsed + time.perf_counter() - t_start, resumed if out is not None else None, digest)
+    if journal is not None:
+        branch.to_netcdf(out)
+        journal.remove()
+    return branch
 
-    return _assemble_branch(problem, orbit, points, arclength, special, stop_reason, amplitude,
-                            dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
-                                 max_step=max_step, max_points=max_points, slip_band=problem.slip_band,
-                                 param_scale=problem.p_scale, period_scale=problem.T_scale,
-                                 bounds=None if bounds is None else [lo, hi], direction=direction,
-                                 jacobian_every=jacobian_every),
-                            t_start)
+
+@dataclasses.dataclass(eq=False)
+class _Walk:
+    """The state of a continuation between two points (internal): what the journal records."""
+
+    points: list
+    arclength: list
+    amplitudes: list
+    special: list
+    h: float  # the next step
+    fresh_index: int = 0  # the last point with a finite-difference Jacobian
+    stop: str | None = None  # why it ends after the last point (None: it goes on)
+    simulations: int = 0  # flow maps up to the last journaled point
+    elapsed: float = 0.0  # wall time of earlier (interrupted) runs [s]
+
+
+def _journal_point(journal, walk: _Walk, problem: _Problem, found: list, elapsed: float, t_start: float) -> None:
+    """Append the last point of ``walk``, the special points ``found`` with it and the state
+    after it (nothing if not writing)."""
+    if journal is None:
+        return
+    k = len(walk.points) - 1
+    rec = {"point": k, **_point_record(walk.points[k]), "amplitude": float(walk.amplitudes[k]),
+           "arclength": float(walk.arclength[k]), "special": [q.to_record() for q in found], "h": float(walk.h),
+           "fresh_index": int(walk.fresh_index), "simulations": int(problem.counter["simulations"]),
+           "elapsed": float(elapsed + time.perf_counter() - t_start)}
+    if walk.stop is not None:
+        rec["stop"] = walk.stop
+    journal.append(rec)
+
+
+def _walk_from_records(records: list) -> _Walk | None:
+    """The :class:`_Walk` after the last journaled point (None if no point was journaled).
+
+    A later record of the same point (its Jacobian renewed) replaces the earlier one.
+    """
+    every = [r for r in records if "point" in r]
+    if not every:
+        return None
+    last = every[-1]
+    pts = list({int(r["point"]): r for r in every}.values())  # the last record of each point, in point order
+    ends = [r["end"] for r in records if "end" in r]
+    return _Walk(points=[_point_from_record(r) for r in pts], arclength=[float(r["arclength"]) for r in pts],
+                 amplitudes=[float(r["amplitude"]) for r in pts],
+                 special=[SpecialPoint.from_record(q) for r in every for q in r["special"]], h=float(last["h"]),
+                 fresh_index=int(last["fresh_index"]), stop=last.get("stop") or (ends[-1] if ends else None),
+                 simulations=int(last["simulations"]), elapsed=float(last["elapsed"]))
+
+
+def _correct_onto_bound(problem: _Problem, last: _Point, new: _Point, edge: float, tol: float) -> _Point:
+    """The branch point at λ = ``edge`` (a bound the step ``last`` → ``new`` crossed)."""
+    e = np.zeros_like(new.v)
+    e[-1] = 1.0
+    guess = last.v + (edge / problem.p_scale - last.v[-1]) / last.tangent[-1] * last.tangent \
+        if abs(last.tangent[-1]) > 1e-12 else new.v
+    v, R, end, tr, it, _ = _correct(problem, guess, last.J, e, edge / problem.p_scale, tol)
+    return _make_point(problem, v, R, end, tr, it, last.tangent, 1.0)
+
+
+def _after_point(problem: _Problem, walk: _Walk, last: _Point, new: _Point, stop: str | None, tol: float,
+                 locate: bool, jacobian_every: int, min_stick_fraction: float, size0, stop_on) -> tuple:
+    """Special points between ``last`` and the new last point of ``walk``, and whether to stop.
+
+    Returns
+    -------
+    (found, stop, quiet)
+        The special points (in :data:`SPECIAL_KINDS` order), the stop reason (None: go on; the
+        ``stop`` passed in is kept unless the branch ends here for another reason), and whether
+        the point is left out of the progress callback (the branch ended before it: stick phase
+        vanishing, Hopf point). Updates ``walk.fresh_index``.
+    """
+    points = walk.points
+    if last.stick_time > 0.0 and new.stick_time < min_stick_fraction * problem.unpack(new.v)[1]:
+        # its multipliers are not trusted: the differences cross the edge of the stick phase
+        return [_stick_vanishing(problem, points, len(points) - 2)], "stick phase vanishing", True
+    found = _detect(problem, last, new, tol, len(points) - 2, locate, ("fold", "stick-phases"))
+    if new.fresh and jacobian_every > 1:
+        found += _detect(problem, points[walk.fresh_index], new, tol, walk.fresh_index, locate,
+                         ("period-doubling", "neimark-sacker"))
+    elif new.fresh:
+        found += _detect(problem, last, new, tol, len(points) - 2, locate, ("period-doubling", "neimark-sacker"))
+    if new.fresh:
+        walk.fresh_index = len(points) - 1
+    found = [_as_hopf(problem, q, size0) if q.kind == "fold" and size0 is not None
+             and new.stick_phases == 0 else q for q in found]
+    found = sorted(found, key=lambda q: SPECIAL_KINDS.index(q.kind))
+    if any(q.kind == "hopf" for q in found):
+        return found, "hopf (the cycle shrinks onto the equilibrium)", True
+    if stop is None and any(q.kind in stop_on for q in found):
+        stop = "stop_on " + ",".join(sorted({q.kind for q in found if q.kind in stop_on}))
+    return found, stop, False
+
+
+def _start_digest(start, params: Parameters, model: str) -> str:
+    """Digest of the ``start`` argument of :func:`continue_orbit` (an orbit, a run or a state)."""
+    if isinstance(start, PeriodicOrbit):
+        sec = start.section
+        return store.digest_of({"orbit": store.array_digest(start.state, np.array([start.period]), start.scale),
+                                "params": start.params.to_dict(), "model": start.model,
+                                "section": [sec.index, sec.value, sec.direction, sec.name],
+                                "options": {k: start.options.get(k) for k in ("rtol", "atol", "slip_band")}})
+    if isinstance(start, Trajectory):
+        return store.digest_of({"run": store.array_digest(start.t, start.states, start.mode),
+                                "params": start.params.to_dict(), "model": start.model})
+    if start is None or isinstance(start, str):
+        return store.digest_of({"start": repr(start), "params": params.to_dict(), "model": model})
+    return store.digest_of({"state": store.array_digest(np.asarray(start, dtype=float)), "params": params.to_dict(),
+                            "model": model})
+
+
+def _branch_settings(params, param, start, model, section, rtol, atol, slip_band, numerics: dict) -> dict:
+    """Everything that determines a branch (its digest; the journal header)."""
+    return {"start": _start_digest(start, params, model), "params": params.to_dict(), "param": param,
+            "model": model, "section": [section.index, section.value, section.direction, section.name],
+            "rtol": rtol, "atol": atol, "slip_band": slip_band, **numerics}
+
+
+def _read_branch(path) -> tuple:
+    """(attrs, Branch) of a branch file, for :func:`.branch_store.open_output`."""
+    ds = load_branch(path)
+    return ds.attrs, Branch.from_xarray(ds)
 
 
 def _distance_from_equilibrium(problem: _Problem, state: np.ndarray, lam: float) -> float:
@@ -902,22 +1166,27 @@ def _detect(problem: _Problem, last: _Point, new: _Point, tol: float, index: int
     return found
 
 
-def _assemble_branch(problem, orbit, points, arclength, special, stop_reason, with_amplitude, options, t_start) -> Branch:
+def _assemble_branch(problem: _Problem, begin: _Start, walk: _Walk, stop_reason: str, options: dict,
+                     total_s: float, resumed: int | None, digest: str) -> Branch:
+    """The :class:`Branch` of a finished walk (``resumed``: points read from a journal, None if not writing)."""
+    points = walk.points
     unpacked = [problem.unpack(p.v) for p in points]
     states = np.array([u[0] for u in unpacked])
     periods = np.array([u[1] for u in unpacked])
     values = np.array([u[2] for u in unpacked])
     mult = np.array([p.multipliers for p in points])
     n_unst = np.array([unstable_count(p.multipliers) if p.fresh else -1 for p in points])
-    amp = np.array([_amplitude(problem, s, T, lam) if with_amplitude else np.nan for s, T, lam in unpacked])
+    timings = {"total_s": total_s, "points": len(points), "simulations": problem.counter["simulations"]}
+    if resumed is not None:
+        timings["points_resumed"] = resumed
     return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
                   stable=n_unst == 0, n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
                   stick_time=np.array([p.stick_time for p in points]),
-                  amplitude=amp, arclength=np.array(arclength), residuals=np.array([p.residual for p in points]),
-                  iterations=np.array([p.iterations for p in points]), special=special, stop_reason=stop_reason,
-                  params=orbit.params, model=problem.model, section=problem.section, options=options,
-                  timings={"total_s": time.perf_counter() - t_start, "points": len(points),
-                           "simulations": problem.counter["simulations"]})
+                  amplitude=np.array(walk.amplitudes, dtype=float), arclength=np.array(walk.arclength),
+                  residuals=np.array([p.residual for p in points]),
+                  iterations=np.array([p.iterations for p in points]), special=list(walk.special),
+                  stop_reason=stop_reason, params=begin.params, model=problem.model, section=problem.section,
+                  options=options, timings=timings, digest=digest)
 
 
 # --------------------------------------------------------------------------- Region II edge
