@@ -203,3 +203,16 @@ def test_flow_jacobian_of_a_transient_against_finite_differences(model, N, durat
                        slip_band=1e-4)
     # measured 7.9e-7 (Model 2) and 2.1e-6 (Model 1) relative to the largest entry
     assert np.max(np.abs(M - Mfd)) < 1e-5 * np.max(np.abs(Mfd))
+
+
+def test_newton_with_the_saltation_jacobian_converges_to_the_same_orbit(orbit50):
+    """periodic_orbit's default Newton Jacobian (saltation) against the FD Newton (orbit50 was
+    found with the default): same period and section state, to the shooting tolerance."""
+    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0,
+                       newton_jacobian="finite-difference", monodromy="finite-difference")
+    assert orbit50.options["newton_jacobian"] == "saltation"
+    assert o.options["newton_jacobian"] == "finite-difference"
+    assert o.period == pytest.approx(orbit50.period, rel=1e-9)
+    assert np.allclose(o.state, orbit50.state, rtol=0, atol=1e-8 * np.abs(orbit50.state).max())
+    ds = flow_jacobian(o.params, o.model, o.state, o.period, scale=o.scale).to_xarray()
+    assert ds["flow_jacobian"].shape == (12, 12) and ds.attrs["duration"] == o.period

@@ -716,6 +716,22 @@ class FlowJacobian:
     mismatch: float
     wall_time: float
 
+    def to_xarray(self):
+        """``xarray.Dataset``: the matrix (12 × 12, SI), initial and final state, the jumps."""
+        import xarray as xr
+
+        data = {
+            "flow_jacobian": (("state", "state_0"), self.matrix,
+                              {"long_name": "linearised flow d s(t) / d s(0) (variational equations + saltation)",
+                               "units": "SI"}),
+            "state_initial": ("state", self.state0, {"long_name": "initial state", "units": "SI"}),
+            "state_final": ("state", self.state, {"long_name": "final state", "units": "SI"}),
+        }
+        attrs = {"title": "stickslip linearised flow map", "stickslip_version": __version__,
+                 "duration": self.duration, "duration_units": "s", "events": json.dumps(self.events),
+                 "mismatch": self.mismatch, "wall_time_s": self.wall_time}
+        return xr.Dataset(data, coords={"state": list(STATE_NAMES), "state_0": list(STATE_NAMES)}, attrs=attrs)
+
 
 def _default_steps(system: System, scale) -> np.ndarray:
     """Difference steps (12,) of the smooth Jacobian parts: FD_REL_STEP × a state scale."""
