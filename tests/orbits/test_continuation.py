@@ -380,3 +380,51 @@ def test_finished_output_is_returned_and_other_settings_are_refused(constructed,
     # resume=False starts over
     fresh = continue_orbit(out=out, max_points=13, resume=False, **opts)
     assert len(fresh) == 13 and "points_resumed" in fresh.timings and fresh.timings["points_resumed"] == 0
+
+
+_BELT_CHILD = textwrap.dedent("""
+    import sys, time
+    import numpy as np
+    from stickslip import Parameters
+    from stickslip.orbits import periodic_orbit
+    from stickslip.orbits.continuation import continue_orbit
+    P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
+    ic = np.zeros(12)
+    ic[10] = P.Omega
+    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    # the pause after each journaled point only leaves the parent time to kill between points
+    continue_orbit(start=orbit, param="Omega", out=sys.argv[1], callback=lambda *a: time.sleep(0.3), **{opts!r})
+""")
+
+
+def test_killed_belt_branch_resumes_to_the_uninterrupted_branch(tmp_path):
+    """A real kill: the belt branch (model ``phi``, 10 points) run in a subprocess that is killed
+    (SIGKILL) once 4 points are journaled; the resumed run reads them and its branch equals the
+    uninterrupted one bit for bit (it restarts from the journaled Jacobian, tangent and step)."""
+    opts = dict(step=0.05, max_step=0.2, max_points=10, bounds=(0.5, 2.0), amplitude=True)
+    out = tmp_path / "belt.nc"
+    journal = Path(str(out) + ".journal")
+    proc = subprocess.Popen([sys.executable, "-c", _BELT_CHILD.format(opts=opts), str(out)])
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        if journal.exists() and journal.read_bytes().count(b'"point"') >= 4:
+            os.kill(proc.pid, signal.SIGKILL)
+            break
+        if proc.poll() is not None:
+            break
+        time.sleep(0.01)
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL, "the child finished before it could be killed"
+    assert not out.exists()
+    P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
+    ic = np.zeros(12)
+    ic[10] = P.Omega
+    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    seen = []
+    resumed = continue_orbit(start=orbit, param="Omega", out=out, on_resume=seen.append, **opts)
+    assert 4 <= seen[0] < 10 and resumed.timings["points_resumed"] == seen[0]
+    full = continue_orbit(start=orbit, param="Omega", **opts)
+    assert len(full) == 10 and np.all(np.isfinite(full.amplitude))
+    _fields_equal(full, resumed)
+    assert not journal.exists()
+    _fields_equal(full, C.Branch.from_xarray(load_branch(out)))
