@@ -73,3 +73,49 @@ def test_continue_writes_the_library_branch_and_a_figure(tmp_path):
     assert np.array_equal(b.values, values)
     assert np.array_equal(b.periods, ds["period"].values)
     assert np.array_equal(b.stable.astype(np.int8), ds["stable"].values)
+
+
+_ARGS = ["continue", "--param", "Omega", "--from", "3", "--to", "3.3", "--N", "50", "--model", "rotation",
+         "--search-time", "30", "--max-points", "4", "--slip-band", str(BAND), "--no-plot", "--json"]
+
+
+class _Interrupt(Exception):
+    """Raised by the progress callback: the run stops as if killed after a journaled orbit."""
+
+
+def test_same_command_resumes_and_other_settings_are_refused(tmp_path):
+    """An interrupted run (3 orbits journaled by the library with the command's settings) is
+    resumed by the command: one note line, then the branch of an uninterrupted run; the same
+    command again reads the finished file; another --max-points with the same --out exits 2."""
+    out = tmp_path / "branch.nc"
+    p = Parameters(N=50.0, Omega=3.0)
+    opts = dict(max_points=4, bounds=(3.0, 3.3), model="rotation", slip_band=BAND)
+
+    def stop_after_two(i, *_):
+        if i == 2:
+            raise _Interrupt
+
+    with pytest.raises(_Interrupt):
+        continue_orbit(p, "Omega", start=start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND),
+                       out=out, callback=stop_after_two, **opts)
+    assert not out.exists()
+    res = runner.invoke(app, _ARGS + ["--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert res.stderr.strip() == "resuming from 3 points"
+    summary = json.loads(res.stdout.strip().splitlines()[-1])
+    assert summary["points"] == 4 and summary["points_resumed"] == 3
+    b = continue_orbit(p, "Omega", start=start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND), **opts)
+    ds = load_branch(out)
+    assert np.array_equal(b.values, ds["value"].values) and np.array_equal(b.periods, ds["period"].values)
+    assert np.array_equal(b.states, ds["state_on_section"].values)
+    assert np.array_equal(b.amplitude, ds["amplitude"].values)
+
+    again = runner.invoke(app, _ARGS + ["--out", str(out)])
+    assert again.exit_code == 0 and again.stderr.strip() == "resuming from 4 points", again.output
+    assert json.loads(again.stdout.strip().splitlines()[-1])["points_resumed"] == 4
+
+    other = runner.invoke(app, [a if a != "4" else "5" for a in _ARGS] + ["--out", str(out)])
+    assert other.exit_code == 2, other.output
+    lines = [ln for ln in other.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:") and "choose another output (--out) or delete" in lines[0]
+    assert load_branch(out)["value"].size == 4  # the finished file is left as it was

@@ -14,7 +14,7 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, console, err_console, user_errors
 
 _ICS = ("far", "near", "zero", "equilibrium")
 
@@ -50,6 +50,11 @@ def _check(param: str, start: float, stop: float, out: Path, ic: str, max_points
         raise ValueError(f"--stop-on {', '.join(bad)}: choose from {', '.join(SPECIAL_KINDS)}")
 
 
+def _note_resume(k: int) -> None:
+    """One line on stderr (stdout stays clean for --json) when a run picks up earlier work."""
+    err_console.print(f"resuming from {k} points", highlight=False)
+
+
 @app.command("continue")
 def continue_command(
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: N, Omega, delta_mu, alpha, mu_k, k_px, ..."),
@@ -71,14 +76,15 @@ def continue_command(
                                               "(default: that of stickslip.simulate)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output, journaled as it goes (OUT.nc.journal): "
+                             "the same command again resumes; the figure goes beside it as .png."),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
 ) -> None:
     """Continue a periodic orbit in one parameter, with stability, folds and stick-phase changes.
 
-    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes.
+    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused).
     """
     from ..orbits.continuation import continue_orbit, start_run
 
@@ -93,11 +99,11 @@ def continue_command(
             lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
                                               f"{'stable' if st else 'unstable'}", highlight=False))
         run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
+        out.parent.mkdir(parents=True, exist_ok=True)
         branch = continue_orbit(params, param, start=run, direction=1 if stop > start else -1, step=step,
                                 max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
-                                stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress, **band)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        branch.to_netcdf(out)
+                                stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress, out=out,
+                                on_resume=_note_resume, **band)
         figure = None
         if not no_plot:
             from ..plot.continuation import save_branch_figure
@@ -109,6 +115,7 @@ def continue_command(
         "stable_points": int(branch.stable.sum()), "stop_reason": branch.stop_reason,
         "special": [{"kind": p.kind, "value": p.value, "located": p.located} for p in branch.special],
         "total_s": branch.timings["total_s"], "simulations": branch.timings["simulations"],
+        "points_resumed": branch.timings.get("points_resumed", 0),
     }
     if as_json:
         print(json.dumps(summary))

@@ -888,10 +888,10 @@ def continue_orbit(
     journal = None
     if out is not None:
         journal, finished = store.open_output(out, "branch", digest, settings, resume, _read_branch)
-        if finished is not None:
+        if finished is not None:  # nothing left to compute
             if on_resume is not None:
                 on_resume(len(finished))
-            return finished
+            return dataclasses.replace(finished, timings={**finished.timings, "points_resumed": len(finished)})
     records = [] if journal is None else journal.records
     start_rec = next((r["start"] for r in records if "start" in r), None)
     if start_rec is None:
