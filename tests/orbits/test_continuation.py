@@ -428,3 +428,47 @@ def test_killed_belt_branch_resumes_to_the_uninterrupted_branch(tmp_path):
     _fields_equal(full, resumed)
     assert not journal.exists()
     _fields_equal(full, C.Branch.from_xarray(load_branch(out)))
+
+
+#: N at which :func:`_fake_edge` raises (a module global, so forked workers see it too).
+_FAIL_AT: set = set()
+
+
+def _fake_edge(N, params, omega_start, omega_max, model, options):
+    """Stands in for one N of fold_curve (a row that depends on N only; no simulation)."""
+    if N in _FAIL_AT:
+        raise _Interrupt
+    return (10.0 + np.sqrt(N), "stick-vanishing", N != 30.0, 0.36, 9.0 + np.sqrt(N), int(N), 0.0, "stick phase vanishing")
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_fold_curve_writes_each_N_and_skips_them_on_restart(monkeypatch, tmp_path, workers):
+    """fold_curve(out=...) journals each N as it finishes; a run stopped by a failure at one N
+    keeps the others, and the restart computes only the missing N (the result is that of one
+    uninterrupted run); a finished file is read back, and more N are added to it."""
+    calls = []
+    monkeypatch.setattr(C, "_edge_at", lambda *a: calls.append(a[0]) or _fake_edge(*a))
+    Ns = [10.0, 20.0, 30.0, 40.0]
+    full = C.fold_curve(Ns)
+    out = tmp_path / "fc.nc"
+    monkeypatch.setattr(C, "_edge_at", _fake_edge)  # forked workers need a picklable function
+    monkeypatch.setattr(sys.modules[__name__], "_FAIL_AT", {30.0})
+    with pytest.raises(_Interrupt):
+        C.fold_curve(Ns, out=out, workers=workers)
+    journal = Path(str(out) + ".journal")
+    written = len(journal.read_text().splitlines()) - 1  # records after the header
+    assert written == (2 if workers == 1 else 3) and not out.exists()  # processes: every other N is kept
+    monkeypatch.setattr(sys.modules[__name__], "_FAIL_AT", set())
+    calls.clear()
+    monkeypatch.setattr(C, "_edge_at", lambda *a: calls.append(a[0]) or _fake_edge(*a))
+    fc = C.fold_curve(Ns, out=out)
+    assert 30.0 in calls and len(calls) == 4 - written and fc.timings["n_resumed"] == written
+    for name in ("N", "edge", "located", "period", "omega_stable_max", "points", "seconds"):
+        assert np.array_equal(getattr(fc, name), getattr(full, name)), name
+    assert fc.kind == full.kind and fc.message == full.message
+    assert not journal.exists() and C.load_fold_curve(out).rows() == fc.rows()
+    calls.clear()
+    more = C.fold_curve(Ns + [50.0], out=out)  # only the new N is computed
+    assert calls == [50.0] and more.timings["n_resumed"] == 4 and C.load_fold_curve(out).N.tolist() == Ns + [50.0]
+    with pytest.raises(C.OrbitError, match="different settings or start.*choose another output"):
+        C.fold_curve(Ns, out=out, omega_max=30.0)

@@ -1225,6 +1225,9 @@ class FoldCurve:
     params : Parameters
     model : str
     timings : dict
+        ``total_s``, ``workers``, ``n`` (and ``n_resumed``, the N read back, when written to ``out``).
+    digest : str
+        Digest of the settings that determine each N's result (see :func:`fold_curve`).
     """
 
     N: np.ndarray
@@ -1240,6 +1243,7 @@ class FoldCurve:
     params: Parameters
     model: str
     timings: dict
+    digest: str = ""
 
     def to_xarray(self):
         """``xarray.Dataset`` over ``N``."""
@@ -1258,9 +1262,50 @@ class FoldCurve:
         attrs = {"title": "stickslip: end of the stick-slip branch over N (upper edge of Region II, Fig. 8)",
                  "format": "stickslip-foldcurve-1", "stickslip_version": __version__, "model": self.model,
                  "omega_start": self.omega_start, "timings": json.dumps(self.timings),
-                 "parameters": json.dumps(self.params.to_dict())}
+                 "parameters": json.dumps(self.params.to_dict()), "digest": self.digest}
         attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords={"N": ("N", self.N, {"units": "N", "long_name": "normal load"})}, attrs=attrs)
+
+    def to_netcdf(self, path) -> Path:
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
+        ds = self.to_xarray()
+        return store.write_atomically(Path(path), lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+    def rows(self) -> dict:
+        """``{N: row}`` with row = (edge, kind, located, period, omega_stable_max, points, seconds,
+        message), the per-N result of :func:`fold_curve`, as plain Python values."""
+        return {float(n): _plain_row((self.edge[i], self.kind[i], self.located[i], self.period[i],
+                                      self.omega_stable_max[i], self.points[i], self.seconds[i], self.message[i]))
+                for i, n in enumerate(self.N)}
+
+
+def _plain_row(row) -> list:
+    """A row of :func:`fold_curve` (see :meth:`FoldCurve.rows`) as JSON-ready Python values."""
+    edge, kind, located, period, stable_max, points, seconds, message = row
+    return [float(edge), str(kind), bool(located), float(period), float(stable_max), int(points), float(seconds),
+            str(message)]
+
+
+def load_fold_curve(path) -> FoldCurve:
+    """Read a :class:`FoldCurve` written by :meth:`FoldCurve.to_netcdf`.
+
+    Raises
+    ------
+    ValueError
+        If the file is not a stickslip fold curve.
+    """
+    import xarray as xr
+
+    ds = xr.load_dataset(path, engine="h5netcdf")
+    if ds.attrs.get("format") != "stickslip-foldcurve-1":
+        raise ValueError(f"{path} is not a stickslip fold-curve file (written by FoldCurve.to_netcdf)")
+    return FoldCurve(N=ds["N"].values, edge=ds["edge"].values, kind=tuple(str(k) for k in ds["kind"].values),
+                     located=ds["located"].values.astype(bool), period=ds["period"].values,
+                     omega_stable_max=ds["omega_stable_max"].values, points=ds["points"].values.astype(int),
+                     seconds=ds["seconds"].values, message=tuple(str(m) for m in ds["message"].values),
+                     omega_start=float(ds.attrs["omega_start"]),
+                     params=Parameters.from_dict(json.loads(ds.attrs["parameters"])), model=ds.attrs["model"],
+                     timings=json.loads(ds.attrs["timings"]), digest=str(ds.attrs.get("digest", "")))
 
 
 #: Length [s] and sample rate [Hz] of the run from the ``far`` initial condition that gives the
@@ -1471,7 +1516,7 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
 def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_start: float = 5.0,
                omega_max: float = 40.0, model: str = "full", workers: int = 1, step: float = 0.05,
                max_step: float = 1.0, max_points: int = 400, rtol: float = FOLD_RTOL, tol: float = FOLD_TOL,
-               jacobian_every: int = FOLD_JACOBIAN_EVERY, **options) -> FoldCurve:
+               jacobian_every: int = FOLD_JACOBIAN_EVERY, out=None, resume: bool = True, **options) -> FoldCurve:
     """Ω where the stick-slip orbit ends, for each N: the upper edge of Region II (paper Fig. 8).
 
     Parameters
@@ -1491,31 +1536,97 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     step, max_step, max_points, rtol, tol, **options
         Passed to :func:`continue_orbit` (``rtol``/``tol`` are looser than its defaults: the
         edge needs the branch, not 1e-8 orbits; see :data:`FOLD_RTOL`).
+    out : path, optional
+        NetCDF output (:meth:`FoldCurve.to_netcdf`). Each N's result is appended to the journal
+        ``OUT.nc.journal`` as soon as it finishes; a later call with the same settings (base
+        parameters, ``omega_start``, ``omega_max``, model, options: the digest; the N list may
+        differ) skips the N already in the journal or in a finished ``out``.
+    resume : bool
+        False: delete ``out`` and its journal and start over.
 
     Returns
     -------
     FoldCurve
-    """
-    from concurrent.futures import ProcessPoolExecutor
-    import multiprocessing
 
+    Raises
+    ------
+    stickslip.orbits.branch_store.JournalMismatch
+        If ``out`` or its journal was written with other settings.
+    """
     t0 = time.perf_counter()
     params = Parameters() if params is None else params
     Ns = [float(n) for n in N]
     options = dict(options, step=step, max_step=max_step, max_points=max_points, rtol=rtol, tol=tol,
                    jacobian_every=jacobian_every)
-    args = [(n, params, omega_start, omega_max, model, options) for n in Ns]
-    if workers <= 1:
-        rows = [_edge_at(*a) for a in args]
-    else:
-        methods = multiprocessing.get_all_start_methods()
-        ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-            rows = list(pool.map(_edge_at, *zip(*args)))
-    cols = list(zip(*rows))
-    return FoldCurve(N=np.array(Ns), edge=np.array(cols[0], dtype=float), kind=tuple(cols[1]),
-                     located=np.array(cols[2], dtype=bool), period=np.array(cols[3], dtype=float),
-                     omega_stable_max=np.array(cols[4], dtype=float), points=np.array(cols[5], dtype=int),
-                     seconds=np.array(cols[6], dtype=float), message=tuple(cols[7]), omega_start=float(omega_start),
-                     params=params, model=model,
-                     timings={"total_s": time.perf_counter() - t0, "workers": int(workers), "n": len(Ns)})
+    settings = {"params": params.to_dict(), "omega_start": float(omega_start), "omega_max": float(omega_max),
+                "model": model, "options": options}
+    digest = store.digest_of(settings)
+    done: dict = {}
+    journal = None
+    if out is not None:
+        journal, finished = store.open_output(out, "fold-curve", digest, settings, resume,
+                                              lambda path: _fold_curve_attrs_and_rows(path))
+        if finished is not None:
+            done = finished
+            if not all(n in done for n in Ns):  # more N than the finished file: journal it, go on
+                journal = store.Journal(out, "fold-curve", digest, settings)
+                for n, row in done.items():
+                    journal.append({"N": n, "row": row})
+        else:
+            done = {float(r["N"]): r["row"] for r in journal.records}
+    todo = [n for n in dict.fromkeys(Ns) if n not in done]
+
+    def record(n, row):
+        done[n] = _plain_row(row)
+        if journal is not None:
+            journal.append({"N": n, "row": done[n]})
+
+    _edges(todo, params, omega_start, omega_max, model, options, workers, record)
+    rows = [done[n] for n in Ns]
+    cols = list(zip(*rows)) if rows else [()] * 8
+    timings = {"total_s": time.perf_counter() - t0, "workers": int(workers), "n": len(Ns)}
+    if out is not None:
+        timings["n_resumed"] = len(set(Ns)) - len(todo)
+    fc = FoldCurve(N=np.array(Ns), edge=np.array(cols[0], dtype=float), kind=tuple(cols[1]),
+                   located=np.array(cols[2], dtype=bool), period=np.array(cols[3], dtype=float),
+                   omega_stable_max=np.array(cols[4], dtype=float), points=np.array(cols[5], dtype=int),
+                   seconds=np.array(cols[6], dtype=float), message=tuple(cols[7]), omega_start=float(omega_start),
+                   params=params, model=model, timings=timings, digest=digest)
+    if journal is not None:
+        fc.to_netcdf(out)
+        journal.remove()
+    return fc
+
+
+def _fold_curve_attrs_and_rows(path) -> tuple:
+    """(attrs, {N: row}) of a finished fold-curve file, for :func:`.branch_store.open_output`."""
+    fc = load_fold_curve(path)
+    return {"digest": fc.digest}, fc.rows()
+
+
+def _edges(Ns: list, params, omega_start, omega_max, model, options, workers: int, record) -> None:
+    """:func:`_edge_at` for each N (in ``workers`` processes), ``record(N, row)`` as each finishes.
+
+    With processes, an N whose task raises is re-raised after every other N is recorded.
+    """
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    import multiprocessing
+
+    if workers <= 1 or len(Ns) <= 1:
+        for n in Ns:
+            record(n, _edge_at(n, params, omega_start, omega_max, model, options))
+        return
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = {pool.submit(_edge_at, n, params, omega_start, omega_max, model, options): n for n in Ns}
+        error = None
+        for fut in as_completed(futures):  # an N that raises does not lose the others: they are recorded first
+            try:
+                row = fut.result()
+            except Exception as exc:
+                error = error or exc
+                continue
+            record(futures[fut], row)
+    if error is not None:
+        raise error
