@@ -13,7 +13,7 @@ from ._app import app, console, err_console, user_errors
 @app.command("reproduce")
 def reproduce(
     out: Path = typer.Option(Path("paper"), "--out", help="Output directory: report.md, PNGs, results.json."),
-    quick: bool = typer.Option(False, "--quick", help="Coarse grids (about 7 minutes on 2 cores)."),
+    quick: bool = typer.Option(False, "--quick", help="Coarse grids (3-7 minutes on 2 cores)."),
     only: list[str] = typer.Option(None, "--only", help="Run only these figures (repeatable): "
                                    "fig3, fig4, table2, fig7, fig8, fig9, fig10, fig11, fig12a, "
                                    "fig12b, fig13, fig14, fig15, fig16."),

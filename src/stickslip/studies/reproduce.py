@@ -16,9 +16,9 @@ as failed (with the error) and the next one runs.
 Resolutions (:data:`RESOLUTIONS`): ``full`` is the paper's (stability maps 100 × 100, 100 s
 time-step study down to Δt = 1e-5 s, 121-point bifurcation diagrams over N and 100-point ones
 over Ω, Δμ, α, 100 × 100 region maps of 300 s runs from two ICs for four models), ``quick`` uses
-coarse grids (7 × 8 region maps, 11–41-point bifurcation diagrams; measured 406 s for all
-figures on the shared 2-core machine, 327 s of it Figs. 9 and 14, whose Model 3 runs take up to
-60 s each; docs/reproduce.md), ``micro`` is for tests.
+coarse grids (7 × 8 region maps, 11–41-point bifurcation diagrams; measured 189 s for all
+figures on the shared 2-core machine, 406 s under heavier load and before the event integrator's
+change of the slip force law; docs/reproduce.md), ``micro`` is for tests.
 """
 
 from __future__ import annotations
@@ -574,6 +574,7 @@ def _recipe_fig9(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     cells = {m: int(ss[i].sum()) for i, m in enumerate(models)}
     kinds = _kind_names(ds.transpose("model", "N", "Omega", "ic", ...))
     slip_only = {m: int(np.sum(kinds[i] == "periodic-slip")) for i, m in enumerate(models)}
+    failed = {m: int(np.sum(kinds[i] == "failed")) for i, m in enumerate(models)}
     smaller = all(cells[m] > 0 and cells["rotation"] <= 0.75 * cells[m] for m in ("full", "x", "y"))
     inside = bool(np.all(ss[0][ss[3]])) and cells["full"] > cells["rotation"]
     measured = "; ".join(f"{MODEL_LABELS[m].split(' (')[0]}: {cells[m]} cells" for m in models)
@@ -581,7 +582,8 @@ def _recipe_fig9(out: Path, res: Resolution, cache: dict) -> RecipeResult:
         Row("Fig. 9, Model 4", "“the ‘stick-slip’ domain for the reduced model with only rotational motion is "
             "significantly smaller than those for other three models”",
             measured + f" with stick-slip (of {ss[0].size}); periodic slip-only runs: "
-            + ", ".join(f"{m} {slip_only[m]}" for m in models),
+            + ", ".join(f"{m} {slip_only[m]}" for m in models) + "; failed runs: "
+            + ", ".join(f"{m} {failed[m]}" for m in models),
             _yes(smaller), "stick-slip cells of Model 4 at most 3/4 of those of each of Models 1, 2 and 3 (each with some)"),
         Row("Fig. 9, translation", "“the addition of the translational motion increases the possibility of "
             "occurrence of stick-slip oscillation”",
@@ -589,7 +591,8 @@ def _recipe_fig9(out: Path, res: Resolution, cache: dict) -> RecipeResult:
             f"Model 1 {cells['full']} cells",
             _yes(inside), "every stick-slip cell of Model 4 is stick-slip in Model 1, and Model 1 has more"),
     ]
-    return RecipeResult(["fig9.png"], rows, {"stick_slip_cells": cells, "periodic_slip_runs": slip_only})
+    return RecipeResult(["fig9.png"], rows, {"stick_slip_cells": cells, "periodic_slip_runs": slip_only,
+                                             "failed_runs": failed})
 
 
 def _recipe_fig16(out: Path, res: Resolution, cache: dict) -> RecipeResult:
@@ -637,8 +640,9 @@ def _recipe_fig12b(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     upper = ss & (Om > 0.5 * (Om[0] + top))
     rows = [
         Row("Fig. 12(b), period", "periodic stick-slip “with growing period … with the … decrease of Ω” (N = 50 N)",
-            f"stick-slip at {int(ss.sum())} of {Om.size} Ω up to {_fmt(top)} rad/s; dominant frequency {_fmt(f[ss][0] if ss.any() else math.nan)} Hz "
-            f"at {Om[0]:g} rad/s … {_fmt(f[ss][-1] if ss.any() else math.nan)} Hz at {_fmt(top)} rad/s; Spearman ρ(Ω, f) = {_fmt(rho)}",
+            f"stick-slip at {int(ss.sum())} of {Om.size} Ω up to {_fmt(top)} rad/s; dominant frequency "
+            f"{_fmt(f[ss][0] if ss.any() else math.nan)} Hz at {_fmt(Om[ss][0] if ss.any() else math.nan)} rad/s … "
+            f"{_fmt(f[ss][-1] if ss.any() else math.nan)} Hz at {_fmt(top)} rad/s; Spearman ρ(Ω, f) = {_fmt(rho)}",
             _yes(rho > 0.9), "Spearman rank correlation of the dominant frequency with Ω above 0.9 over the stick-slip points"),
         Row("Fig. 12(b), kind", "“changes from periodic stick-slip … to non-periodic stick-slip … with the decrease of Ω”",
             "regimes along Ω: " + _regimes_text(_regimes(Om, kinds)),
