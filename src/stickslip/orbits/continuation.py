@@ -35,6 +35,10 @@ and located by the Illinois (modified regula falsi) method on the arclength:
                       stick-slip orbit loses its stick phase (it meets the unstable pure-slip
                       cycle, a non-smooth fold). Located by extrapolating τ_stick² linearly in λ
                       to 0 over the last three points (τ_stick ∝ √(λ* − λ) measured).
+
+Long runs write as they go: with ``out=PATH`` :func:`continue_orbit` journals every accepted point
+(with its Jacobian, tangent and the next step) and :func:`fold_curve` every finished N to
+``PATH.journal`` (:mod:`.branch_store`), and the same call again resumes from there.
 """
 
 from __future__ import annotations
