@@ -87,6 +87,20 @@ def test_constructed_fold_and_period_doubling_are_found_where_they_are(construct
     assert np.max(b.values) <= 10.0 + 1e-6
 
 
+@pytest.mark.parametrize("jacobian_every", [2, 3, 4])
+def test_constructed_special_points_are_found_between_broyden_points(constructed, jacobian_every):
+    """With finite differences only at every k-th point, a Broyden point keeps its predecessor's
+    tangent (the updates lie along the corrector steps), so the fold shows up only when a failed
+    step renews that point's Jacobian: it is tested then, and located as with k = 1."""
+    b = continue_orbit(start=constructed, param="alpha", step=0.05, max_step=0.2, max_points=200,
+                       bounds=(4.0, 20.0), amplitude=False, jacobian_every=jacobian_every)
+    assert [p.kind for p in b.special] == ["period-doubling", "fold"]
+    pd, fold = b.special
+    assert fold.located and fold.value == pytest.approx(10.0, abs=1e-6)          # as with k = 1
+    assert pd.located and pd.value == pytest.approx(5.0 * (2.0 - 1.0 / 9.0), abs=1e-3)
+    assert b.stop_reason == "bounds" and np.max(b.values) <= 10.0 + 1e-6
+
+
 def test_bad_requests_are_refused_before_computing(constructed):
     with pytest.raises(ContinuationError, match="numeric parameter"):
         continue_orbit(start=constructed, param="friction_law")
@@ -328,7 +342,7 @@ def test_constructed_branch_interrupted_after_any_point_resumes_to_the_same_bran
     opts = dict(start=constructed, param="alpha", step=0.05, max_step=0.2, max_points=200, bounds=(4.0, 20.0),
                 amplitude=False, jacobian_every=jacobian_every)
     full = continue_orbit(**opts)
-    assert "period-doubling" in [p.kind for p in full.special] and full.stop_reason == "bounds"
+    assert [p.kind for p in full.special] == ["period-doubling", "fold"] and full.stop_reason == "bounds"
     n = len(full)
     ks = sorted(({*range(1, n - 1, 3)} | {q.index + d for q in full.special for d in (0, 1)}) & {*range(1, n - 1)})
     for k in ks:

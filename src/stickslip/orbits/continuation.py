@@ -936,8 +936,10 @@ def continue_orbit(
                 try:
                     R, end, tr = _residual(problem, last.v)
                     walk.points[-1] = _make_point(problem, last.v, R, end, tr, last.iterations, last.tangent, 1.0)
+                    found, walk.stop = _after_renewal(problem, walk, tol, locate, size0, stop_on)
                     walk.fresh_index = len(walk.points) - 1
-                    _journal_point(journal, walk, problem, [], walk.elapsed, t_start)  # replaces the record
+                    walk.special.extend(found)
+                    _journal_point(journal, walk, problem, found, walk.elapsed, t_start)  # replaces the record
                     continue
                 except (OrbitError, SimulationError):
                     pass
@@ -1051,7 +1053,7 @@ def _after_point(problem: _Problem, walk: _Walk, last: _Point, new: _Point, stop
     Returns
     -------
     (found, stop, quiet)
-        The special points (in :data:`SPECIAL_KINDS` order), the stop reason (None: go on; the
+        The special points (along the branch; at one index in :data:`SPECIAL_KINDS` order), the stop reason (None: go on; the
         ``stop`` passed in is kept unless the branch ends here for another reason), and whether
         the point is left out of the progress callback (the branch ended before it: stick phase
         vanishing, Hopf point). Updates ``walk.fresh_index``.
@@ -1070,12 +1072,43 @@ def _after_point(problem: _Problem, walk: _Walk, last: _Point, new: _Point, stop
         walk.fresh_index = len(points) - 1
     found = [_as_hopf(problem, q, size0) if q.kind == "fold" and size0 is not None
              and new.stick_phases == 0 else q for q in found]
-    found = sorted(found, key=lambda q: SPECIAL_KINDS.index(q.kind))
+    found = sorted(found, key=lambda q: (q.index, SPECIAL_KINDS.index(q.kind)))
     if any(q.kind == "hopf" for q in found):
         return found, "hopf (the cycle shrinks onto the equilibrium)", True
     if stop is None and any(q.kind in stop_on for q in found):
         stop = "stop_on " + ",".join(sorted({q.kind for q in found if q.kind in stop_on}))
     return found, stop, False
+
+
+def _after_renewal(problem: _Problem, walk: _Walk, tol: float, locate: bool, size0, stop_on) -> tuple:
+    """Special points hidden by a Broyden point, found once its Jacobian is renewed.
+
+    Broyden's updates lie along the corrector steps, nearly orthogonal to the tangent, so a point
+    without finite differences keeps its predecessor's tangent; τ_λ then changes sign only when
+    the Jacobian of the last point is renewed (after a failed step), and the renewed point has
+    multipliers. Test ``fold`` between the previous point and the renewed one, and the multiplier
+    tests between the last point with multipliers (``walk.fresh_index``, not yet moved) and it.
+
+    Returns
+    -------
+    (found, stop)
+        Special points (along the branch, as in :func:`_after_point`; ``hopf`` for a fold of a slip branch on
+        the equilibrium) and the stop reason (or None).
+    """
+    if len(walk.points) < 2:
+        return [], None
+    k = len(walk.points) - 1
+    found = _detect(problem, walk.points[k - 1], walk.points[k], tol, k - 1, locate, ("fold",))
+    found += _detect(problem, walk.points[walk.fresh_index], walk.points[k], tol, walk.fresh_index, locate,
+                     ("period-doubling", "neimark-sacker"))
+    found = sorted(found, key=lambda q: (q.index, SPECIAL_KINDS.index(q.kind)))
+    found = [_as_hopf(problem, q, size0) if size0 is not None and walk.points[-1].stick_phases == 0 else q
+             for q in found]
+    if any(q.kind == "hopf" for q in found):
+        return found, "hopf (the cycle shrinks onto the equilibrium)"
+    if any(q.kind in stop_on for q in found):
+        return found, "stop_on " + ",".join(sorted({q.kind for q in found if q.kind in stop_on}))
+    return found, None
 
 
 def _start_digest(start, params: Parameters, model: str) -> str:
