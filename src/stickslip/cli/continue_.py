@@ -128,5 +128,7 @@ def continue_command(
     for p in branch.special:
         table.add_row(p.label, f"{param} = {p.value:.6g}" + ("" if p.located else " (not located to tolerance)"))
     table.add_row("wall time", f"{summary['total_s']:.2f} s ({summary['simulations']} simulations)")
+    if summary["points_resumed"]:
+        table.add_row("resumed", f"{summary['points_resumed']} orbits read back from {out} or its journal")
     table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
     console.print(table)
