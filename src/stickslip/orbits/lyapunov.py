@@ -319,6 +319,9 @@ def lyapunov_spectrum(
     rtol: float = 1e-10,
     atol: float | None = None,
     slip_band: float = DEFAULT_SLIP_BAND,
+    method: str = "variational",
+    chunk: float = 1.0,
+    d0: float = DEFAULT_D0,
 ) -> LyapunovSpectrum:
     """All Lyapunov exponents of the attractor reached from ``ic`` (Benettin–Shimada–Nagashima).
 
@@ -347,6 +350,16 @@ def lyapunov_spectrum(
         Tolerances of the ``event`` run (``atol`` default 1e-3 · rtol).
     slip_band : float
         Low-speed band [m/s].
+    method : {"variational", "finite-difference"}
+        ``variational``: the variational equations with saltation matrices (above).
+        ``finite-difference``: 2 n_free perturbed trajectories at distance ``d0`` around the
+        reference, advanced by the ``event`` integrator chunk by chunk (τ = ``chunk``) and
+        re-orthonormalised by QR after each chunk (the saltation is then inside the
+        differences; needs no variational re-integration, so it also works where that one
+        refuses, e.g. velocity reversals and in-band returns to v_r ≈ 0; directions collapsed
+        by stick come out at ln(integration noise / d0) per chunk instead of −∞).
+    chunk, d0 : float
+        Chunk length [s] and scaled separation [-] of ``finite-difference``.
 
     Returns
     -------
@@ -384,6 +397,11 @@ def lyapunov_spectrum(
     half = tr.t >= 0.5 * t_transient
     sigma = _scales(np.ptp(tr.states[half], axis=0), free)
     s_ref, _ = flow(params, model, s, t_transient, **opts)
+    if method == "finite-difference":
+        return _fd_spectrum(params, model, system, free, sigma, s_ref, t_transient, t_average, chunk, d0, opts,
+                            perturbation, t_start)
+    if method != "variational":
+        raise OrbitError(f"unknown method {method!r}; use 'variational' or 'finite-difference'")
     end, transitions = flow(params, model, s_ref, t_average, **opts)
 
     k = free.size
@@ -413,5 +431,52 @@ def lyapunov_spectrum(
         exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
         scale=sigma, stick_phases=int(np.sum(transitions.kind == 1)), wall_time=_time.perf_counter() - t_start,
         params=params, model=model, options=dict(opts, perturbation=perturbation, record=record,
-                                                 qr_interval=QR_INTERVAL),
+                                                 qr_interval=QR_INTERVAL, method="variational"),
+    )
+
+
+def _fd_spectrum(params, model, system, free, sigma, s_ref, t_transient, t_average, chunk, d0, opts,
+                 perturbation, t_start) -> LyapunovSpectrum:
+    """Benettin with 2 n_free perturbed trajectories and QR after every chunk (see
+    :func:`lyapunov_spectrum`, ``method="finite-difference"``)."""
+    n_chunks = int(round(t_average / chunk))
+    if n_chunks < 1:
+        raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
+    k = free.size
+    Q = np.eye(k)
+    log_sum = np.zeros(k)
+    sums = np.empty((n_chunks, k))
+    sticks = 0
+
+    def perturbed(s0, direction):
+        sp = s0.copy()
+        sp[free] += d0 * direction * sigma
+        vx, vy = K.relative_velocity(s0, system.p)
+        if np.hypot(vx, vy) <= STICK_SPEED_TOL:  # the reference sticks: so does the perturbed state
+            y = np.zeros(14)
+            y[:12] = sp
+            K.project_velocity(y, system.minv, system.p)
+            sp = y[:12].copy()
+        return sp
+
+    for i in range(n_chunks):
+        starts = [perturbed(s_ref, Q[:, j]) for j in range(k)]
+        s_new, tr = flow(params, model, s_ref, chunk, **opts)
+        sticks += int(np.sum(tr.kind == 1))
+        # columns Φ P Q_j: the chunk's flow after the projection onto v_r = 0 that a stuck
+        # reference implies (part of the physical map: stick collapses those directions)
+        A = np.column_stack([(flow(params, model, sp, chunk, **opts)[0][free] - s_new[free]) / sigma
+                             for sp in starts]) / d0
+        Q, R = np.linalg.qr(A)
+        sign = np.where(np.diag(R) < 0, -1.0, 1.0)
+        Q = Q * sign[None, :]
+        log_sum += np.log(np.maximum(np.abs(np.diag(R)), np.finfo(float).tiny))
+        sums[i] = log_sum
+        s_ref = s_new
+    time = chunk * np.arange(1, n_chunks + 1)
+    estimate = sums / time[:, None]
+    return LyapunovSpectrum(
+        exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
+        scale=sigma, stick_phases=sticks, wall_time=_time.perf_counter() - t_start, params=params, model=model,
+        options=dict(opts, perturbation=perturbation, method="finite-difference", chunk=chunk, d0=d0),
     )
