@@ -27,7 +27,6 @@ import numpy as np
 
 from .. import __version__
 from ..integrate.driver import SimulationError, initial_state, simulate
-from ..integrate.result import Trajectory
 from ..integrate.events import STICK_SPEED_TOL
 from ..model import kernels as K
 from ..model.kernels import DEFAULT_SLIP_BAND
