@@ -856,18 +856,8 @@ def continue_orbit(
         :class:`~stickslip.orbits.OrbitError`, like ContinuationError).
     """
     t_start = time.perf_counter()
-    if direction not in (1, -1):
-        raise ContinuationError(f"direction must be +1 or -1, got {direction}")
-    if not (0.0 < min_step <= step <= max_step):
-        raise ContinuationError(f"need 0 < min_step <= step <= max_step, got {min_step}, {step}, {max_step}")
-    if max_points < 1:
-        raise ContinuationError(f"max_points must be >= 1, got {max_points}")
-    if int(jacobian_every) < 1:
-        raise ContinuationError(f"jacobian_every must be >= 1, got {jacobian_every}")
+    _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
     jacobian_every = int(jacobian_every)
-    unknown = sorted(set(stop_on) - set(SPECIAL_KINDS))
-    if unknown:
-        raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
     if isinstance(start, (PeriodicOrbit, Trajectory)) and params is None:
         params = start.params
     params = Parameters() if params is None else params
@@ -909,13 +899,7 @@ def continue_orbit(
     walk = _walk_from_records(records)
     resumed = 0 if walk is None else len(walk.points)
     if walk is None:
-        v0 = problem.pack(begin.state, begin.period, float(getattr(begin.params, param)))
-        try:
-            R, end, tr = _residual(problem, v0)
-            p0 = _make_point(problem, v0, R, end, tr, 0, None, float(direction))
-        except (OrbitError, SimulationError) as exc:
-            raise ContinuationError(f"the Jacobian at the start orbit failed: {exc}") from exc
-        walk = _Walk(points=[p0], arclength=[0.0], amplitudes=[measure(p0)], special=[], h=float(step))
+        walk = _first_walk(problem, begin, direction, step, measure)
         _journal_point(journal, walk, problem, [], 0.0, t_start)
     else:
         problem.counter["simulations"] = walk.simulations
@@ -986,6 +970,32 @@ def continue_orbit(
         branch.to_netcdf(out)
         journal.remove()
     return branch
+
+
+def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on) -> None:
+    """Refuse bad numerical options of :func:`continue_orbit` before computing (ContinuationError)."""
+    if direction not in (1, -1):
+        raise ContinuationError(f"direction must be +1 or -1, got {direction}")
+    if not (0.0 < min_step <= step <= max_step):
+        raise ContinuationError(f"need 0 < min_step <= step <= max_step, got {min_step}, {step}, {max_step}")
+    if max_points < 1:
+        raise ContinuationError(f"max_points must be >= 1, got {max_points}")
+    if int(jacobian_every) < 1:
+        raise ContinuationError(f"jacobian_every must be >= 1, got {jacobian_every}")
+    unknown = sorted(set(stop_on) - set(SPECIAL_KINDS))
+    if unknown:
+        raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
+
+
+def _first_walk(problem: _Problem, begin: _Start, direction: int, step: float, measure) -> "_Walk":
+    """The walk at its first point: the start orbit with its Jacobian, tangent and amplitude."""
+    v0 = problem.pack(begin.state, begin.period, float(getattr(begin.params, problem.param)))
+    try:
+        R, end, tr = _residual(problem, v0)
+        p0 = _make_point(problem, v0, R, end, tr, 0, None, float(direction))
+    except (OrbitError, SimulationError) as exc:
+        raise ContinuationError(f"the Jacobian at the start orbit failed: {exc}") from exc
+    return _Walk(points=[p0], arclength=[0.0], amplitudes=[measure(p0)], special=[], h=float(step))
 
 
 @dataclasses.dataclass(eq=False)
