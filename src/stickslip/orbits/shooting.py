@@ -223,8 +223,8 @@ def _newton_columns(params, model, s0, T, free, cols, h, sigma, method, opts):
     if method == "saltation":
         try:
             return _var.flow_jacobian(params, model, s0, T, scale=sigma, **opts).matrix[np.ix_(free, cols)]
-        except OrbitError:
-            pass
+        except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError):
+            pass  # e.g. an iterate whose event sequence the re-integration does not reproduce
     return _monodromy(params, model, s0, T, free, cols, h, **opts)
 
 
@@ -383,7 +383,7 @@ def periodic_orbit(
     if method == "saltation":
         try:
             M = _var.flow_jacobian(params, model, s0, T, scale=sigma, **opts).matrix[np.ix_(free, free)]
-        except OrbitError as exc:
+        except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError) as exc:
             warnings.warn(f"saltation monodromy failed ({exc}); using finite differences", RuntimeWarning,
                           stacklevel=2)
             method = "finite-difference"

@@ -572,7 +572,11 @@ def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray) -> np.nda
     grad_h = e @ Dv
     # the rest of the approach, τ = |v_r| / (−e · dv_r/dt), with the regular part of the slip
     # Jacobian (direction frozen at e; its 1/|v_r| part is the impulse above): first order in τ
-    tau = speed / -float(grad_h @ f_minus)
+    approach = -float(grad_h @ f_minus)  # −e · dv_r/dt [m/s²], > 0 on an approach
+    if not approach > 0.0:
+        raise OrbitError("the slip velocity does not head into zero at the stick arrival (grazing); "
+                         "no saltation matrix")
+    tau = speed / approach
     Fx, Fy = K.slip_force(speed, e[0], e[1], system.p)
     J = np.empty((12, 12))
     fixed_force_jacobian(np.ascontiguousarray(s_c[:12], dtype=float), Fx, Fy, system.minv, system.damp,
