@@ -1146,9 +1146,10 @@ def _branch_settings(params, param, start, model, section, rtol, atol, slip_band
 
 
 def _read_branch(path) -> tuple:
-    """(attrs, Branch) of a branch file, for :func:`.branch_store.open_output`."""
+    """(attrs, Branch) of a branch file, for :func:`.branch_store.open_output` (files of earlier
+    versions have no digest: they are refused by it, not read)."""
     ds = load_branch(path)
-    return ds.attrs, Branch.from_xarray(ds)
+    return ds.attrs, (Branch.from_xarray(ds) if ds.attrs.get("digest") else None)
 
 
 def _distance_from_equilibrium(problem: _Problem, state: np.ndarray, lam: float) -> float:
