@@ -14,6 +14,7 @@ from scipy.optimize import linear_sum_assignment
 
 from stickslip import Parameters
 from stickslip.model import kernels as K
+from stickslip.model.kernels import DEFAULT_SLIP_BAND as P_BAND
 from stickslip.model.system import assemble
 from stickslip.orbits import OrbitError, periodic_orbit
 from stickslip.orbits.variational import (Monodromy, field, flow_jacobian, monodromy, saltation_matrix,
@@ -216,3 +217,24 @@ def test_newton_with_the_saltation_jacobian_converges_to_the_same_orbit(orbit50)
     assert np.allclose(o.state, orbit50.state, rtol=0, atol=1e-8 * np.abs(orbit50.state).max())
     ds = flow_jacobian(o.params, o.model, o.state, o.period, scale=o.scale).to_xarray()
     assert ds["flow_jacobian"].shape == (12, 12) and ds.attrs["duration"] == o.period
+
+
+@pytest.mark.parametrize("law", ["coulomb", "exponential"])
+def test_velocity_reversals_against_finite_differences(law):
+    """Belt oscillator started at φ = 0.3 rad (10× the stick limit μs N r / k): v_r passes
+    through zero where the stick force is inadmissible (the integrator projects and slips on,
+    recording no transition). The reversal jump (saltation with f⁺ the departing slip field,
+    no projection) against central differences of the flow map over 1 s (4 reversals)."""
+    from stickslip.orbits.variational import fd_monodromy
+
+    P = Parameters(Omega=0.5, friction_law=law)
+    s0 = np.zeros(12)
+    s0[4] = 0.3
+    sigma = np.array([0.6, 8.0])   # φ and φ̇ ranges of the motion [rad, rad/s]
+    fj = flow_jacobian(P, "phi", s0, 1.0, scale=sigma)
+    assert [k for _, k in fj.events].count("reversal") == 4
+    M = fj.matrix[np.ix_([4, 10], [4, 10])]
+    Mfd = fd_monodromy(P, "phi", s0, 1.0, np.array([4, 10]), 1e-6 * sigma, rtol=1e-10, atol=1e-13,
+                       slip_band=P_BAND)
+    # measured 5e-8 (Coulomb) and 7e-8 (exponential) relative; the same with FD step 1e-5 σ
+    assert np.max(np.abs(M - Mfd)) < 1e-5 * np.max(np.abs(Mfd))

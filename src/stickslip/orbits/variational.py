@@ -539,7 +539,7 @@ def stick_projection(system: System, s: np.ndarray) -> np.ndarray:
     return np.eye(12) - _force_input(system, s) @ Ainv @ _velocity_gradient(system, s)
 
 
-def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray) -> np.ndarray:
+def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray, departure=None) -> np.ndarray:
     """Jump matrix (12 × 12) of the variations at slip → stick (docs/orbits.md).
 
     Parameters
@@ -555,6 +555,11 @@ def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray) -> np.nda
     the direction dynamics (rate μN uᵀAu/|v_r| → ∞) deliver before arrival; (2) the saltation
     matrix of h = e·v_r with f⁻ the slip and f⁺ the stick field; (3) the linearised projection
     onto v_r = 0 (removes the residual O(|v_r|) of the first two).
+
+    With ``departure`` = e_b (unit 2-vector) the stick is inadmissible (|F_stick| > μs N at
+    v_r = 0: a velocity reversal, after which the integrator's slip departs along e_b): f⁺ is
+    then that departing slip field and there is no projection (the perturbed motion leaves
+    v_r = 0 at its own instant, δv_r⁺ = v̇_r⁺ δt).
     """
     vx, vy = K.relative_velocity(np.ascontiguousarray(s_c[:12], dtype=float), system.p)
     speed = math.hypot(vx, vy)
@@ -568,7 +573,7 @@ def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray) -> np.nda
     if auu > K.RANK_TOL * np.trace(A):  # rank 1 (Model 4, belt): friction cannot act along u
         kill -= np.outer(B @ u, u @ Dv) / auu
     f_minus = field(system, s_c, K.MODE_SLIP_EXACT)
-    f_plus = field(system, s_c, K.MODE_STICK)
+    f_plus = field(system, s_c, K.MODE_STICK) if departure is None else _band_field(system, s_c, departure)
     grad_h = e @ Dv
     # the rest of the approach, τ = |v_r| / (−e · dv_r/dt), with the regular part of the slip
     # Jacobian (direction frozen at e; its 1/|v_r| part is the impulse above): first order in τ
@@ -583,6 +588,8 @@ def arrival_jump(system: System, s_c: np.ndarray, s_stick: np.ndarray) -> np.nda
                          system.stiff, system.p, J)
     J += B @ (-system.p[K.P_N] * friction_slope(speed, system.p) * np.outer(e, grad_h))
     S = saltation_matrix(f_minus, f_plus, grad_h)
+    if departure is not None:
+        return S @ (np.eye(12) + tau * J) @ kill
     return stick_projection(system, s_stick) @ S @ (np.eye(12) + tau * J) @ kill
 
 
@@ -916,29 +923,49 @@ def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=N
                 t = t1
             Phi = after(t, Phi)
         else:
-            if t_cap < t_next or k >= n_tr:
-                t1 = min(t_cap, t_next)
-                sol, y, Phi = run(y, Phi, t, t1, mode, e, [_speed_event(system, ARRIVAL_SPEED, -1)])
-                if sol.status == 1:
-                    raise OrbitError(f"the re-integration reaches v_r = 0 at {sol.t[-1]:.9f} s; the event integrator does not")
-                t = t1
-                Phi = after(t, Phi)
-                continue
-            sol, s_c, Phi = run(y, Phi, t, t_next + 1.0, mode, e, [_speed_event(system, ARRIVAL_SPEED, -1)])
-            if sol.status != 1 or abs(sol.t_events[0][0] - t_next) > MATCH_TIME_TOL:
-                raise OrbitError(f"arrival at stick of the re-integration at {sol.t[-1]:.9f} s, "
+            expect_stick = k < n_tr and t_cap >= t_next
+            t1 = t_next + 1.0 if expect_stick else min(t_cap, t_next)
+            sol, s_c, Phi_c = run(y, Phi, t, t1, mode, e, [_speed_event(system, ARRIVAL_SPEED, -1)])
+            t_ev = float(sol.t[-1])
+            if sol.status == 1 and expect_stick and abs(t_ev - t_next) <= MATCH_TIME_TOL:
+                s_s = tr.state[k]
+                # positions only (extrapolated over the rest of the approach to the integrator's
+                # instant): the velocities differ by that O(τ) rest and by the integrator's
+                # projection of its arrival residual (≤ STICK_SPEED_TOL)
+                s_x = s_c + (t_next - t_ev) * field(system, s_c, K.MODE_SLIP_EXACT)
+                check(s_x, s_s, system.variant.free_indices)
+                Phi = after(t_next, arrival_jump(system, s_c, s_s) @ Phi_c)
+                events.append((t_next, "stick"))
+                y, t, mode, e, k = s_s.copy(), t_next, K.MODE_STICK, (0.0, 0.0), k + 1
+            elif sol.status == 1 and t_ev < t_next - MATCH_TIME_TOL:
+                # v_r reaches 0 before the next recorded transition: the stick force must be
+                # inadmissible there (a velocity reversal, which the integrator does not record)
+                s_r = _projected(system, s_c)
+                Fx, Fy, _ = K.stick_force(s_r, system.minv, system.damp, system.stiff, system.p)
+                norm = math.hypot(Fx, Fy)
+                if norm <= K.static_limit(system.p):
+                    raise OrbitError(f"the re-integration reaches an admissible stick at {t_ev:.9f} s, the event "
+                                     f"integrator does not (next transition {t_next:.9f} s): the event "
+                                     "sequences differ (e.g. a return to v_r ≈ 0 inside the low-speed band)")
+                e_b = (-Fx / norm, -Fy / norm)
+                Phi = after(t_ev, arrival_jump(system, s_c, s_r, departure=e_b) @ Phi_c)
+                events.append((t_ev, "reversal"))
+                y, t, mode, e = s_r, t_ev, K.MODE_SLIP, e_b
+            elif sol.status == 0 and not expect_stick:
+                y, t, Phi = s_c, t1, after(t1, Phi_c)
+            else:
+                raise OrbitError(f"arrival at stick of the re-integration at {t_ev:.9f} s, "
                                  f"event integrator {t_next:.9f} s")
-            s_s = tr.state[k]
-            # positions only (extrapolated over the rest of the approach to the integrator's
-            # instant): the velocities differ by that O(τ) rest and by the integrator's
-            # projection of its arrival residual (≤ STICK_SPEED_TOL)
-            s_x = s_c + (t_next - float(sol.t[-1])) * field(system, s_c, K.MODE_SLIP_EXACT)
-            check(s_x, s_s, system.variant.free_indices)
-            Phi = after(t_next, arrival_jump(system, s_c, s_s) @ Phi)
-            events.append((t_next, "stick"))
-            y, t, mode, e, k = s_s.copy(), t_next, K.MODE_STICK, (0.0, 0.0), k + 1
     check(y, end)
     return Phi, events, mismatch
+
+
+def _projected(system: System, s: np.ndarray) -> np.ndarray:
+    """The state with q̇ projected onto v_r = 0 (:func:`kernels.project_velocity`), (12,)."""
+    yy = np.zeros(14)
+    yy[:12] = s[:12]
+    K.project_velocity(yy, system.minv, system.p)
+    return yy[:12].copy()
 
 
 def _pad(P: np.ndarray) -> np.ndarray:
