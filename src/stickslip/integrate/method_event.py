@@ -302,9 +302,10 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             else:
                 ex, ey = K.quasi_static_direction(y, ex, ey, minv, damp, stiff, p)
             if mode == K.MODE_SLIP_QUASI_STATIC:
-                if speed > p[K.P_SLIP_BAND]:
-                    # departed: the exact direction from the next step on (the force law
-                    # changes between steps, never inside one)
+                if speed > p[K.P_SLIP_BAND] or v1x * a1x + v1y * a1y < 0.0:
+                    # departed, or |v_r| falls again inside the band (an approach, which may end
+                    # in stick or a reversal: watched in exact mode): the exact direction from
+                    # the next step on (the force law changes between steps, never inside one)
                     mode = K.MODE_SLIP_EXACT
                     K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
                     stats[2] += 1
