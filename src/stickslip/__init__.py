@@ -15,6 +15,7 @@
 ``regions``                 bistability regions I/II/III (Fig. 8) and stick-slip domains (Fig. 9)
 ``periodic_orbit``          periodic orbit by shooting on a Poincaré section, Floquet multipliers
 ``monodromy``               monodromy matrix of an orbit (variational equations + saltation, or FD)
+``flow_jacobian``           linearised flow ∂Φ(s0, t)/∂s0 across stick↔slip transitions
 ``lyapunov_exponent``       largest Lyapunov exponent (Benettin, across events)
 ``lyapunov_spectrum``       all Lyapunov exponents (variational equations + saltation + QR)
 ``continue_orbit``          pseudo-arclength continuation of periodic orbits in one parameter
@@ -44,7 +45,8 @@ _LAZY = {
     **dict.fromkeys(["RegionMap", "SweepError", "SweepResult", "load_region_map", "load_sweep", "regions", "sweep"],
                     ".sweep"),
     **dict.fromkeys(["LyapunovResult", "LyapunovSpectrum", "OrbitError", "PeriodicOrbit", "Monodromy",
-                     "lyapunov_exponent", "lyapunov_spectrum", "monodromy", "periodic_orbit"], ".orbits"),
+                     "FlowJacobian", "flow_jacobian", "lyapunov_exponent", "lyapunov_spectrum", "monodromy",
+                     "periodic_orbit"], ".orbits"),
     **dict.fromkeys(["Branch", "ContinuationError", "FoldCurve", "SpecialPoint", "continue_orbit", "fold_curve",
                      "load_branch", "unstable_cycle"], ".orbits.continuation"),
 }
@@ -71,7 +73,7 @@ __all__ = [
     "stability", "StabilityResult", "stability_map", "StabilityMap", "load_stability_map",
     "classify", "Classification", "find_peaks", "intensity",
     "sweep", "SweepResult", "SweepError", "load_sweep", "regions", "RegionMap", "load_region_map",
-    "periodic_orbit", "PeriodicOrbit", "monodromy", "Monodromy", "OrbitError",
+    "periodic_orbit", "PeriodicOrbit", "monodromy", "Monodromy", "flow_jacobian", "FlowJacobian", "OrbitError",
     "lyapunov_exponent", "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum",
     "continue_orbit", "Branch", "SpecialPoint", "fold_curve", "FoldCurve", "unstable_cycle", "load_branch",
     "ContinuationError",

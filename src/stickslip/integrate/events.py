@@ -49,6 +49,10 @@ STICK_SPEED_TOL = 1e-6
 #: EVENT_TIME_TOL.
 MAX_BISECTIONS = 200
 
+#: Cap on the Illinois iterations refining one root (each at least halves the bracket every
+#: few steps; ~40 are needed from a step of 0.1 s down to EVENT_TIME_TOL).
+MAX_REFINEMENTS = 200
+
 #: Sub-intervals of a step on which the event function is sampled for a sign change.
 EVENT_CHECKS = 4
 
@@ -113,26 +117,39 @@ def first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work):
         return -1.0
     tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
     side = 0
-    for _ in range(200):
+    for _ in range(MAX_REFINEMENTS):
         if gb == 0.0 or (b - a) <= tol:
             break
-        c = b - gb * (b - a) / (gb - ga)
-        # keep c strictly inside the bracket
-        if not (a < c < b):
-            c = 0.5 * (a + b)
+        c = regula_falsi_point(a, ga, b, gb)
         dense_state(y0, Q, h, c, work)
         gc = event_value(kind, work, e0x, e0y, minv, damp, stiff, p)
-        if gc > 0.0:
-            a, ga = c, gc
-            if side == 1:  # Illinois: the same end moved twice, halve the other end's value
-                gb *= 0.5
-            side = 1
-        else:
-            b, gb = c, gc
-            if side == -1:
-                ga *= 0.5
-            side = -1
+        a, ga, b, gb, side = illinois_update(a, ga, b, gb, c, gc, gc > 0.0, side)
     return b
+
+
+@kernel
+def regula_falsi_point(a, ga, b, gb):
+    """Secant point of the bracket [a, b] with values ga, gb of opposite sides, kept strictly inside."""
+    c = b - gb * (b - a) / (gb - ga)
+    if not (a < c < b):
+        c = 0.5 * (a + b)
+    return c
+
+
+@kernel
+def illinois_update(a, ga, b, gb, c, gc, before, side):
+    """One Illinois regula-falsi update: c (value gc) replaces a if ``before`` (c lies before the
+    root), else b; when the same end moves twice the other end's value is halved.
+
+    ``side`` is the end moved last (+1 a, −1 b, 0 none). Returns (a, ga, b, gb, side).
+    """
+    if before:
+        if side == 1:
+            gb *= 0.5
+        return c, gc, b, gb, 1
+    if side == -1:
+        ga *= 0.5
+    return a, ga, c, gc, -1
 
 
 @kernel

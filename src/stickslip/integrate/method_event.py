@@ -22,6 +22,7 @@ import numpy as np
 
 from ..model import kernels as K
 from ..model.jit import kernel, loop
+from . import dormand_prince as DP
 from . import events as E
 
 N_STATE = 14  # 12 states + work of friction + work of damping
@@ -30,24 +31,6 @@ STATUS_OK = 0
 STATUS_STEP_UNDERFLOW = 1
 STATUS_NOT_FINITE = 2
 STATUS_MAX_STEPS = 3
-
-# Dormand–Prince 5(4) tableau and 4th-order dense output (Dormand & Prince 1980; Shampine 1986),
-# the coefficients used by scipy.integrate.RK45, as scalar constants so that the compiled stage
-# loops below are fully unrolled (A_ij: stage i from stage j; B: 5th-order weights; E: error
-# weights, 5th minus 4th order; P_jc: dense output, stage j, power θ^(c+1)).
-A21 = 1 / 5
-A31, A32 = 3 / 40, 9 / 40
-A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
-A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
-A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
-B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
-E1, E3, E4, E5, E6, E7 = -71 / 57600, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40
-P10, P11, P12, P13 = 1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432
-P31, P32, P33 = 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799
-P41, P42, P43 = -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072
-P51, P52, P53 = 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632
-P61, P62, P63 = -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844
-P71, P72, P73 = 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423
 
 SAFETY = 0.9        # standard step-size safety factor
 MIN_FACTOR = 0.2    # largest step reduction after a rejection
@@ -60,30 +43,12 @@ MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.
 @kernel
 def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
     """One Dormand–Prince step from y with k1 = f(y); fills the stages Kst[0:7] and ynew."""
-    n = y.shape[0]
-    k2 = Kst[1]
-    k3 = Kst[2]
-    k4 = Kst[3]
-    k5 = Kst[4]
-    k6 = Kst[5]
-    for i in range(n):
+    for i in range(y.shape[0]):
         Kst[0, i] = k1[i]
-        ytmp[i] = y[i] + h * A21 * k1[i]
-    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k2)
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k3)
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k4)
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k5)
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-    K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, k6)
-    for i in range(n):
-        ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+    for stage in range(1, 6):
+        DP.stage_state(y, Kst, h, stage, ytmp)
+        K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, Kst[stage])
+    DP.stage_state(y, Kst, h, 6, ynew)
     K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
 
 
@@ -96,30 +61,12 @@ def _error_norm(y, ynew, Kst, h, minv, rtol, atol):
         if minv[d] == 0.0:
             continue
         for i in (d, d + 6):
-            err = h * (E1 * Kst[0, i] + E3 * Kst[2, i] + E4 * Kst[3, i] + E5 * Kst[4, i]
-                       + E6 * Kst[5, i] + E7 * Kst[6, i])
             scale = atol + rtol * max(abs(y[i]), abs(ynew[i]))
-            total += (err / scale) ** 2
+            total += (DP.local_error(Kst, h, i) / scale) ** 2
             count += 1
     if count == 0:
         return 0.0
     return math.sqrt(total / count)
-
-
-@kernel
-def _dense_coefficients(Kst, Q):
-    """Q = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ."""
-    for i in range(Q.shape[0]):
-        k1 = Kst[0, i]
-        k3 = Kst[2, i]
-        k4 = Kst[3, i]
-        k5 = Kst[4, i]
-        k6 = Kst[5, i]
-        k7 = Kst[6, i]
-        Q[i, 0] = P10 * k1
-        Q[i, 1] = P11 * k1 + P31 * k3 + P41 * k4 + P51 * k5 + P61 * k6 + P71 * k7
-        Q[i, 2] = P12 * k1 + P32 * k3 + P42 * k4 + P52 * k5 + P62 * k6 + P72 * k7
-        Q[i, 3] = P13 * k1 + P33 * k3 + P43 * k4 + P53 * k5 + P63 * k6 + P73 * k7
 
 
 @kernel
@@ -274,7 +221,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 e0y = v0y / speed0
                 if E.slip_event_possible(speed0, h * (a0x * e0x + a0y * e0y), v1x * e0x + v1y * e0y,
                                          h * (a1x * e0x + a1y * e0y)):
-                    _dense_coefficients(Kst, Q)
+                    DP.dense_coefficients(Kst, Q)
                     q_ready = True
                     theta = E.first_crossing(E.EVENT_SLIP, y, Q, h, e0x, e0y, minv, damp, stiff, p, work)
             if theta > 0.0 and (1.0 - theta) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
@@ -287,7 +234,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 continue
             if idx < n_samples and sample_times[idx] <= t + h:
                 if not q_ready:
-                    _dense_coefficients(Kst, Q)
+                    DP.dense_coefficients(Kst, Q)
                 idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
                                      sample_times, out_s, out_mode, out_F, work)
             t += h
@@ -352,7 +299,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             if mode != K.MODE_SLIP_EXACT:
                 tau_start = math.inf
         else:
-            _dense_coefficients(Kst, Q)
+            DP.dense_coefficients(Kst, Q)
             theta = E.first_crossing(E.EVENT_STICK, y, Q, h, 0.0, 0.0, minv, damp, stiff, p, work)
             if theta > 0.0:
                 # breakaway inside the step: the stick flow is smooth, so cut the step at the root

@@ -43,6 +43,8 @@ from numba import njit
 from scipy.integrate import solve_ivp
 
 from .. import __version__
+from ..integrate import dormand_prince as DP
+from ..integrate import events as E
 from ..integrate.events import STICK_SPEED_TOL
 from ..model import kernels as K
 from ..model.kernels import DEFAULT_SLIP_BAND
@@ -310,30 +312,6 @@ def variational_rhs(y, mode, ex, ey, minv, damp, stiff, p, steps, dy, J):
             dy[12 + 12 * i + k] = acc
 
 
-# Dormand–Prince 5(4) with the 4th-order dense output (Dormand & Prince 1980; Shampine 1986):
-# the tableau of scipy's RK45 and of the event integrator (integrate/method_event.py), copied
-# here so the variational integrator does not depend on that module's private names.
-_DP_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
-_DP_A = np.array([
-    [0.0, 0.0, 0.0, 0.0, 0.0],
-    [1 / 5, 0.0, 0.0, 0.0, 0.0],
-    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
-    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
-    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
-    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
-])
-_DP_B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
-_DP_E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
-_DP_P = np.array([
-    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
-    [0.0, 0.0, 0.0, 0.0],
-    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
-    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
-    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
-    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
-    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
-])
-
 EV_NONE = 0
 EV_SPEED = 1      # |v_r| − level
 EV_BREAKAWAY = 2  # μs N − |F_stick|
@@ -355,16 +333,6 @@ def _ev_value(kind, y, level, minv, damp, stiff, p):
         Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
         return K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy)
     return 0.0
-
-
-@njit(cache=True)
-def _dense(y0, Q, h, theta, out):
-    n = y0.shape[0]
-    for i in range(n):
-        acc = Q[i, 3]
-        for j in range(2, -1, -1):
-            acc = Q[i, j] + theta * acc
-        out[i] = y0[i] + h * theta * acc
 
 
 @njit(cache=True)
@@ -399,37 +367,22 @@ def integrate_variational(y0, t0, t1, mode, ex, ey, minv, damp, stiff, p, steps,
         h = min(h, t1 - t)
         if h <= 1e-15 * max(1.0, abs(t)):
             return 2, t, y
-        for s in range(1, 7):
-            for i in range(n):
-                acc = 0.0
-                for j in range(s if s < 6 else 6):
-                    acc += (_DP_A[s, j] if s < 6 else _DP_B[j]) * Kst[j, i]
-                ytmp[i] = y[i] + h * acc
-            if s < 6:
-                variational_rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, steps, Kst[s], J)
-            else:
-                for i in range(n):
-                    ynew[i] = ytmp[i]
-                variational_rhs(ynew, mode, ex, ey, minv, damp, stiff, p, steps, Kst[6], J)
+        for stage in range(1, 6):
+            DP.stage_state(y, Kst, h, stage, ytmp)
+            variational_rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, steps, Kst[stage], J)
+        DP.stage_state(y, Kst, h, 6, ynew)
+        variational_rhs(ynew, mode, ex, ey, minv, damp, stiff, p, steps, Kst[6], J)
         total = 0.0
         for i in range(n):
-            err = 0.0
-            for j in range(7):
-                err += _DP_E[j] * Kst[j, i]
             sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
-            total += (h * err / sc) ** 2
+            total += (DP.local_error(Kst, h, i) / sc) ** 2
         err_norm = math.sqrt(total / n)
         if not math.isfinite(err_norm) or err_norm > 1.0:
             fac = 0.2 if not math.isfinite(err_norm) else max(0.2, 0.9 * err_norm ** -0.2)
             h *= fac
             continue
         if ev_kind != EV_NONE:
-            for i in range(n):
-                for c in range(4):
-                    acc = 0.0
-                    for j in range(7):
-                        acc += Kst[j, i] * _DP_P[j, c]
-                    Q[i, c] = acc
+            DP.dense_coefficients(Kst, Q)
             a = 0.0
             ga = g0
             b = -1.0
@@ -439,7 +392,7 @@ def integrate_variational(y0, t0, t1, mode, ex, ey, minv, damp, stiff, p, steps,
                 if k == EV_CHECKS:
                     g = _ev_value(ev_kind, ynew, ev_level, minv, damp, stiff, p)
                 else:
-                    _dense(y, Q, h, th, work)
+                    E.dense_state(y, Q, h, th, work)
                     g = _ev_value(ev_kind, work, ev_level, minv, damp, stiff, p)
                 if ev_dir * ga < 0.0 and ev_dir * g >= 0.0:
                     b = th
@@ -450,25 +403,14 @@ def integrate_variational(y0, t0, t1, mode, ex, ey, minv, damp, stiff, p, steps,
             if b > 0.0:
                 tol = EV_TIME_TOL / h
                 side = 0
-                for _ in range(200):
+                for _ in range(E.MAX_REFINEMENTS):
                     if gb == 0.0 or (b - a) <= tol:
                         break
-                    c = b - gb * (b - a) / (gb - ga)
-                    if not (a < c < b):
-                        c = 0.5 * (a + b)
-                    _dense(y, Q, h, c, work)
+                    c = E.regula_falsi_point(a, ga, b, gb)
+                    E.dense_state(y, Q, h, c, work)
                     gc = _ev_value(ev_kind, work, ev_level, minv, damp, stiff, p)
-                    if ev_dir * gc < 0.0:
-                        a, ga = c, gc
-                        if side == 1:
-                            gb *= 0.5
-                        side = 1
-                    else:
-                        b, gb = c, gc
-                        if side == -1:
-                            ga *= 0.5
-                        side = -1
-                _dense(y, Q, h, b, work)
+                    a, ga, b, gb, side = E.illinois_update(a, ga, b, gb, c, gc, ev_dir * gc < 0.0, side)
+                E.dense_state(y, Q, h, b, work)
                 return 1, t + b * h, work.copy()
             g0 = _ev_value(ev_kind, ynew, ev_level, minv, damp, stiff, p)
         t += h
