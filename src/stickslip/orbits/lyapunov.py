@@ -113,6 +113,41 @@ class LyapunovResult:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, slip_band):
+    """The common start of the Lyapunov computations: resolve the start, run the transient.
+
+    ``ic`` may be a :class:`PeriodicOrbit` (its parameters and model are then the defaults).
+    Returns (params, model name, system, free state indices, scales σ of the free states (peak-to-
+    peak over the transient's second half), the exact state at the end of the transient, the
+    integration options).
+    """
+    if isinstance(ic, PeriodicOrbit):
+        params = ic.params if params is None else params
+        model = ic.model
+        ic = ic.state
+    params = Parameters() if params is None else params
+    atol = 1e-3 * rtol if atol is None else float(atol)
+    if t_transient <= 0.0:
+        raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
+    system = assemble(params, model, slip_band)
+    free = free_states(system)
+    if perturbation is None and isinstance(ic, str) and ic == "equilibrium":
+        perturbation = 1e-3
+    try:
+        s = initial_state(system, ic, perturbation)
+    except SimulationError as exc:
+        raise OrbitError(f"bad initial condition: {exc}") from exc
+    opts = dict(rtol=rtol, atol=atol, slip_band=slip_band)
+    model = system.variant.name
+    tr = simulate(params, t_transient, model=model, ic=s, sample_rate=max(200.0, 1.0 / t_transient), **opts)
+    if tr.status != "success":
+        raise OrbitError(f"the transient run failed: {tr.status}")
+    half = tr.t >= 0.5 * t_transient
+    sigma = _scales(np.ptp(tr.states[half], axis=0), free)
+    s_ref, _ = flow(params, model, s, t_transient, **opts)  # exact end of the transient
+    return params, model, system, free, sigma, s_ref, opts
+
+
 def lyapunov_exponent(
     params: Parameters | None = None,
     ic="equilibrium",
@@ -165,34 +200,11 @@ def lyapunov_exponent(
     OrbitError
         If a run fails or the transient does not move (no scales).
     """
-    if isinstance(ic, PeriodicOrbit):
-        params = ic.params if params is None else params
-        model = ic.model
-        ic = ic.state
-    params = Parameters() if params is None else params
-    atol = 1e-3 * rtol if atol is None else float(atol)
-    if t_transient <= 0.0:
-        raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
-    system = assemble(params, model, slip_band)
-    model = system.variant.name
-    free_dofs = system.variant.free_indices
-    free = np.concatenate([free_dofs, free_dofs + 6])
-    if perturbation is None and isinstance(ic, str) and ic == "equilibrium":
-        perturbation = 1e-3
-    try:
-        s = initial_state(system, ic, perturbation)
-    except SimulationError as exc:
-        raise OrbitError(f"bad initial condition: {exc}") from exc
-    opts = dict(rtol=rtol, atol=atol, slip_band=slip_band)
-    tr = simulate(params, t_transient, model=model, ic=s, sample_rate=max(200.0, 1.0 / t_transient), **opts)
-    if tr.status != "success":
-        raise OrbitError(f"the transient run failed: {tr.status}")
-    half = tr.t >= 0.5 * t_transient
-    sigma = _scales(np.ptp(tr.states[half], axis=0), free)
-    s_ref, _ = flow(params, model, s, t_transient, **opts)  # exact end of the transient
+    params, model, system, free, sigma, s_ref, opts = _after_transient(
+        params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
 
     def perturbed(direction):
         # s_ref + d0 σ·direction; if s_ref sticks, the separation is projected onto v_r = 0
@@ -370,32 +382,10 @@ def lyapunov_spectrum(
         If a run fails or the variational re-integration does not reproduce the event sequence.
     """
     t_start = _time.perf_counter()
-    if isinstance(ic, PeriodicOrbit):
-        params = ic.params if params is None else params
-        model = ic.model
-        ic = ic.state
-    params = Parameters() if params is None else params
-    atol = 1e-3 * rtol if atol is None else float(atol)
-    if t_transient <= 0.0:
-        raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
     if t_average <= 0.0:
         raise OrbitError(f"t_average = {t_average} s must be > 0")
-    system = assemble(params, model, slip_band)
-    model = system.variant.name
-    free = free_states(system)
-    if perturbation is None and isinstance(ic, str) and ic == "equilibrium":
-        perturbation = 1e-3
-    try:
-        s = initial_state(system, ic, perturbation)
-    except SimulationError as exc:
-        raise OrbitError(f"bad initial condition: {exc}") from exc
-    opts = dict(rtol=rtol, atol=atol, slip_band=slip_band)
-    tr = simulate(params, t_transient, model=model, ic=s, sample_rate=max(200.0, 1.0 / t_transient), **opts)
-    if tr.status != "success":
-        raise OrbitError(f"the transient run failed: {tr.status}")
-    half = tr.t >= 0.5 * t_transient
-    sigma = _scales(np.ptp(tr.states[half], axis=0), free)
-    s_ref, _ = flow(params, model, s, t_transient, **opts)
+    params, model, system, free, sigma, s_ref, opts = _after_transient(
+        params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
     if method == "finite-difference":
         return _fd_spectrum(params, model, system, free, sigma, s_ref, t_transient, t_average, chunk, d0, opts,
                             perturbation, t_start)
