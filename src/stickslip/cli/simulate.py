@@ -81,7 +81,7 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
     rows = [
         ("status", traj.status),
         ("steady window", f"{s.t_from:g} – {s.t_to:g} s"),
-        ("response", kind + (f", {s.period_multiplicity} crossing(s) per period" if s.periodic else "")),
+        ("response", kind + (f", {s.period_multiplicity} peak(s) of φ per period" if s.periodic else "")),
         ("fundamental frequency of φ", "–" if freq is None else f"{freq:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         ("transitions in window", str(s.n_transitions)),

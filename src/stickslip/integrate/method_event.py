@@ -258,7 +258,11 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     stats[2] += 1
             else:
                 v_arrive = E.arrival_speed(y, rtol, atol)
-                near = theta > 0.0 or retakes > 0 or homing > 0 or speed <= v_arrive
+                # arrived: a located root, homing, or |v_r| at the error control's resolution
+                # and falling (right after a departure |v_r| may still be below that
+                # resolution at loose tolerances, but it grows)
+                near = (theta > 0.0 or retakes > 0 or homing > 0
+                        or (speed <= v_arrive and v1x * a1x + v1y * a1y < 0.0))
                 tau = E.time_to_zero_of(v1x, v1y, a1x, a1y)
                 if tau_start < math.inf and tau < math.inf:
                     # approach to stick: the local error of the stiff direction dynamics is a

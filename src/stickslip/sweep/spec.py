@@ -313,8 +313,12 @@ def evaluate_batch(spec: SweepSpec, indices) -> tuple[np.ndarray, np.ndarray]:
 
 
 def warm_up(spec: SweepSpec | None = None) -> float:
-    """Compile or load the numba kernels in this process (a 10 ms run); returns the seconds taken."""
+    """Prepare a worker process: compile or load the numba kernels (a 10 ms run) and import the
+    analysis that :func:`evaluate` uses (~0.5 s of imports that would otherwise land on the
+    first point of every worker). Returns the seconds taken."""
+    from ..analysis import classify, intensity  # noqa: F401
     from ..integrate.driver import simulate
+    from ..stability import equilibrium  # noqa: F401  (imported by the intensity of each point)
 
     start = time.perf_counter()
     simulate(None, 0.01, sample_rate=1000.0)
