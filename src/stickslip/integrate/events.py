@@ -153,16 +153,6 @@ def illinois_update(a, ga, b, gb, c, gc, before, side):
 
 
 @kernel
-def time_to_zero(y, dy, p):
-    """Time [s] to the closest approach of v_r to zero, extrapolating dv_r/dt linearly.
-
-    State ``y`` with derivative ``dy``; see :func:`time_to_zero_of`.
-    """
-    vx, vy, ax, ay = K.relative_velocity_acceleration(y, dy, p)
-    return time_to_zero_of(vx, vy, ax, ay)
-
-
-@kernel
 def time_to_zero_of(vx, vy, ax, ay):
     """Time [s] to the closest approach of v_r = (vx, vy) to zero under constant dv_r/dt = (ax, ay).
 

@@ -291,12 +291,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                                                       ytmp, k2, k3, k4, stats)
             idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, False, 0.0, 0.0, minv, damp,
                                 stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
-            speed = math.sqrt(vx * vx + vy * vy)
-            if speed > p[K.P_SLIP_BAND]:
-                ex = vx / speed
-                ey = vy / speed
-            else:
-                ex, ey = K.quasi_static_direction(ynew, ex, ey, minv, damp, stiff, p)
+            ex, ey = K.slip_direction(ynew, vx, vy, ex, ey, minv, damp, stiff, p)
             if crossed:
                 stick, ex, ey = after_slip_root(ynew, ex, ey, minv, damp, stiff, p)
                 if stick:

@@ -243,11 +243,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 k1[i] = Kst[6, i]
             stats[0] += 1
             speed = math.sqrt(v1x * v1x + v1y * v1y)
-            if speed > p[K.P_SLIP_BAND]:
-                ex = v1x / speed
-                ey = v1y / speed
-            else:
-                ex, ey = K.quasi_static_direction(y, ex, ey, minv, damp, stiff, p)
+            ex, ey = K.slip_direction(y, v1x, v1y, ex, ey, minv, damp, stiff, p)
             if mode == K.MODE_SLIP_QUASI_STATIC:
                 if speed > p[K.P_SLIP_BAND] or v1x * a1x + v1y * a1y < 0.0:
                     # departed, or |v_r| falls again inside the band (an approach, which may end

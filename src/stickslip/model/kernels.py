@@ -106,13 +106,6 @@ def relative_velocity_acceleration(s, ds, p):
 
 
 @kernel
-def relative_acceleration(s, ds, p):
-    """dv_r/dt [m/s²] along the state derivative ``ds`` (time derivative of Eq. 9)."""
-    _, _, ax, ay = relative_velocity_acceleration(s, ds, p)
-    return ax, ay
-
-
-@kernel
 def friction_coefficient(speed, p):
     """Kinetic friction coefficient μ(|v_r|) [-]: Eq. (4), or μk for the Coulomb law."""
     if p[P_LAW] == LAW_COULOMB:
@@ -327,9 +320,9 @@ def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
 
 
 @kernel
-def slip_direction(s, ex, ey, minv, damp, stiff, p):
-    """Unit slip direction: v_r/|v_r| above the low-speed band, the quasi-static one inside."""
-    vx, vy = relative_velocity(s, p)
+def slip_direction(s, vx, vy, ex, ey, minv, damp, stiff, p):
+    """Unit slip direction at state ``s`` with v_r = (vx, vy) [m/s]: v_r/|v_r| above the low-speed
+    band, inside it the quasi-static one found from the last direction (ex, ey)."""
     speed = math.sqrt(vx * vx + vy * vy)
     if speed > p[P_SLIP_BAND]:
         return vx / speed, vy / speed
