@@ -97,9 +97,11 @@ def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
         new_t = np.empty(cap)
         new_kind = np.empty(cap, dtype=np.int8)
         new_s = np.empty((cap, tr_s.shape[1]))
-        new_t[:n] = tr_t[:n]
-        new_kind[:n] = tr_kind[:n]
-        new_s[:n] = tr_s[:n]
+        for j in range(n):  # element loops: a slice copy would compile numba's shape-mismatch
+            new_t[j] = tr_t[j]  # error formatting (~6 s of cold compile for nothing)
+            new_kind[j] = tr_kind[j]
+            for i in range(tr_s.shape[1]):
+                new_s[j, i] = tr_s[j, i]
         tr_t, tr_kind, tr_s = new_t, new_kind, new_s
     tr_t[n] = t
     tr_kind[n] = kind

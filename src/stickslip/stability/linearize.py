@@ -351,7 +351,10 @@ def equilibrium_jacobian(free, minv, damp, stiff, p, max_iter, tol, J):
     if not (rel <= tol) or speed <= p[P_SLIP_BAND]:
         J[:, :] = np.nan
         return False
-    J[:, :] = reduced_jacobian(q, free, minv, damp, stiff, p)
+    Jq = reduced_jacobian(q, free, minv, damp, stiff, p)
+    for i in range(J.shape[0]):  # element loop: a slice copy compiles numba's shape-error formatting
+        for j in range(J.shape[1]):
+            J[i, j] = Jq[i, j]
     return True
 
 
