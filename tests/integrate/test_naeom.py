@@ -45,7 +45,7 @@ def test_iteration_cap_raises_clear_error(monkeypatch):
     # the runner turns STATUS_SOLVE_FAILED into a SimulationError naming the fix
     def failing(*args):
         status = N.STATUS_SOLVE_FAILED
-        return status, 1.234, np.zeros(14), np.zeros(0), np.zeros(0, np.int8), np.zeros((0, 14)), np.zeros(8, np.int64)
+        return status, 1.234, np.zeros(14), 0, np.zeros(8, np.int64)  # no transitions
     monkeypatch.setattr(F, "integrate_fixed_step", failing)
     monkeypatch.setattr(F, "warm_up", lambda *a: 0.0)
     with pytest.raises(SimulationError, match=r"stick-force solve did not reach \|v_r\| ≤ 1e-12 m/s in 50 Newton iterations at t = 1.234 s"):

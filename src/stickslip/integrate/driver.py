@@ -104,7 +104,8 @@ def _warm_up(kernel, y, t0, system, out_s, out_mode, out_F) -> float:
         return 0.0
     start = time.perf_counter()
     kernel(y, t0, t0 + 1e-6, system.minv, system.damp, system.stiff, system.p, 1e-6, 1e-8, 1e-7, 1e-6,
-           10, np.array([t0]), out_s[:1].copy(), out_mode[:1].copy(), out_F[:1].copy())
+           10, np.array([t0]), out_s[:1].copy(), out_mode[:1].copy(), out_F[:1].copy(),
+           np.empty(1), np.empty(1, dtype=np.int8), np.empty((1, y.size)))
     return time.perf_counter() - start
 
 
@@ -119,9 +120,15 @@ def _run_event(system: System, y0: np.ndarray, t0: float, t_end: float, sample_t
     y = np.zeros(method_event.N_STATE)
     y[:12] = y0
     compile_time = _warm_up(method_event.integrate_event, y, t0, system, out_s, out_mode, out_F)
-    res = method_event.integrate_event(y, t0, t_end, system.minv, system.damp, system.stiff, system.p,
-                                       rtol, atol, h_init, h_max, max_steps, sample_times, out_s, out_mode, out_F)
-    status, t_reached, _, _, _, _, tr_t, tr_kind, tr_s, st = res
+
+    def run(tr_t, tr_kind, tr_s):
+        res = method_event.integrate_event(y, t0, t_end, system.minv, system.damp, system.stiff, system.p,
+                                           rtol, atol, h_init, h_max, max_steps, sample_times, out_s, out_mode,
+                                           out_F, tr_t, tr_kind, tr_s)
+        return res, res[6]
+
+    res, tr_t, tr_kind, tr_s = method_event.with_transition_room(run, t_end - t0)
+    status, t_reached, st = res[0], res[1], res[7]
     stats = dict(accepted_steps=int(st[0]), rejected_steps=int(st[1]), rhs_calls=int(st[2]),
                  retaken_steps=int(st[3]), slip_to_stick=int(st[4]), stick_to_slip=int(st[5]),
                  compile_time_s=compile_time)

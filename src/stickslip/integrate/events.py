@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 
 from ..model import kernels as K
 from ..model.jit import kernel
@@ -116,7 +117,7 @@ def first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work):
     if b < 0.0:
         return -1.0
     tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
-    side = 0
+    side = np.int64(0)  # not a literal: one compiled version of illinois_update
     for _ in range(MAX_REFINEMENTS):
         if gb == 0.0 or (b - a) <= tol:
             break

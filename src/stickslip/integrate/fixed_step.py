@@ -32,7 +32,8 @@ from ..model import kernels as K
 from ..model.jit import kernel, loop
 from . import events as E
 from .method_aeom import aeom_stick_branch, dependent_states
-from .method_event import N_STATE, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_OK, STATUS_STEP_UNDERFLOW, _record
+from .method_event import (N_STATE, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_OK, STATUS_STEP_UNDERFLOW,
+                           record_transition, with_transition_room)
 from .method_naeom import MAX_NEWTON, STATUS_SOLVE_FAILED, VR_TOL, naeom_stick_branch
 
 __all__ = ["integrate_fixed_step", "run_aeom", "run_naeom", "check_step", "step_band", "kernel_parameters",
@@ -55,6 +56,10 @@ STABILITY_LIMIT = 2.0
 #: (Ω r = 1 m/s in Sect. 4.2.1) and change the model rather than the numerics; measured at
 #: Δt = 1e-4 s, a band of 1e-2 m/s still changes φ's amplitude by only 9e-5 relative.
 MAX_STEP_BAND = 1e-2
+
+#: Samples within this fraction of a step from its end are written as the step end itself
+#: (the interpolant there equals y1 up to round-off; θ from sample times is exact to ~1e-16/Δt).
+END_SAMPLE_TOL = 1e-9
 
 # --------------------------------------------------------------------------- shared RK4 pieces
 @kernel
@@ -95,22 +100,29 @@ def hermite_coefficients(y0, f0, y1, f1, h, Q):
 
 
 @kernel
-def write_samples(idx, t, h, y0, f0, y1, f1, mode, ex, ey, fixed_force, Fx, Fy, minv, damp, stiff, p,
+def write_samples(idx, t, h, y0, f0, y1, f1, F1x, F1y, mode, ex, ey, fixed_force, minv, damp, stiff, p,
                   sample_times, out_s, out_mode, out_F, Q, work):
     """Write the samples with t < ts ≤ t + h from the Hermite interpolant of the step.
 
-    The friction force written is (Fx, Fy) if ``fixed_force`` (NAEOM's per-step force in stick),
-    else ``kernels.contact_force`` at the sample. Returns the next sample index.
+    ``(F1x, F1y)`` is the friction force at the step end y1 [N]. A sample at the step end
+    (θ = 1 to :data:`END_SAMPLE_TOL`; every sample when the sample period is a multiple of Δt)
+    is y1 with that force, and needs neither the interpolant nor a force evaluation. Inside
+    the step the force written is (F1x, F1y) if ``fixed_force`` (NAEOM's per-step force in
+    stick), else ``kernels.contact_force`` at the sample. Returns the next sample index.
     """
     n_samples = sample_times.shape[0]
     t_to = t + h
-    if idx >= n_samples or sample_times[idx] > t_to:
-        return idx
-    hermite_coefficients(y0, f0, y1, f1, h, Q)
+    q_ready = False
     while idx < n_samples and sample_times[idx] <= t_to:
         theta = (sample_times[idx] - t) / h
-        E.dense_state(y0, Q, h, theta, work)
-        _store(idx, work, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
+        if theta >= 1.0 - END_SAMPLE_TOL:
+            E.store_sample(idx, y1, mode, F1x, F1y, out_s, out_mode, out_F)
+        else:
+            if not q_ready:
+                hermite_coefficients(y0, f0, y1, f1, h, Q)
+                q_ready = True
+            E.dense_state(y0, Q, h, theta, work)
+            _store(idx, work, mode, ex, ey, F1x, F1y, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
     return idx
 
@@ -127,7 +139,7 @@ def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_
 def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p,
                           sample_times, out_s, out_mode, out_F):
     """Samples at t ≤ t0 (the initial state). Returns the next sample index."""
-    idx = 0
+    idx = np.int64(0)  # not a literal: one compiled version of _store
     while idx < sample_times.shape[0] and sample_times[idx] <= t0:
         _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
         idx += 1
@@ -143,22 +155,22 @@ def slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, f
     trial re-taking the RK4 step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step is then the one that ends on the ≤ 0 side of the root.
 
-    ``(vx, vy)`` is v_r at ``y`` [m/s]. Returns (h_taken, crossed, v1x, v1y): the step length
-    actually taken [s], whether it ends at a zero of the slip velocity, and v_r at the step end.
+    ``(vx, vy)`` is v_r at ``y`` [m/s]. Returns (h_taken, crossed, v1x, v1y, F1x, F1y): the step
+    length actually taken [s], whether it ends at a zero of the slip velocity, and v_r [m/s] and
+    the friction force [N] at the step end.
     ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is updated (rhs calls at index 2,
     re-taken steps at 3).
     """
     speed = math.sqrt(vx * vx + vy * vy)
     stats[2] += rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    F1x, F1y, v1x, v1y = K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    v1x, v1y = K.relative_velocity(ynew, p)
     if speed <= K.SPEED_FLOOR:  # just after breakaway (v_r = 0) there is nothing to detect
-        return h, False, v1x, v1y
+        return h, False, v1x, v1y, F1x, F1y
     e0x = vx / speed
     e0y = vy / speed
     if v1x * e0x + v1y * e0y > 0.0:  # the slip event (events.EVENT_SLIP) stays positive
-        return h, False, v1x, v1y
+        return h, False, v1x, v1y, F1x, F1y
     a = 0.0
     b = 1.0
     for _ in range(E.MAX_BISECTIONS):
@@ -174,10 +186,9 @@ def slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, f
     if b < 1.0:
         stats[2] += rk4_slip_step(y, k1, b * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
         stats[3] += 1
-    K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    F1x, F1y, v1x, v1y = K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    v1x, v1y = K.relative_velocity(ynew, p)
-    return b * h, True, v1x, v1y
+    return b * h, True, v1x, v1y, F1x, F1y
 
 
 @kernel
@@ -225,10 +236,11 @@ def next_step(t, t0, dt, k_grid, t_end):
 
 @loop
 def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_steps, sample_times, out_s, out_mode,
-                         out_F):
+                         out_F, tr_t, tr_kind, tr_s):
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end] with the fixed step ``dt`` [s].
 
-    ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step).
+    ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step). Samples and
+    transitions are written as by ``method_event.integrate_event``.
 
     Returns
     -------
@@ -238,8 +250,8 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
         Time reached [s].
     y : ndarray (N_STATE,)
         Final state.
-    tr_t, tr_kind, tr_s :
-        Transition instants [s], kinds (+1 to stick, −1 to slip) and states.
+    n_transitions : int
+        Transitions found (in the buffers up to their room).
     stats : ndarray (8,) int64
         steps, 0 (no rejections), rhs calls (each RK4 stage counts one), re-taken (bisection)
         steps, slip → stick, stick → slip, NAEOM's total Newton iterations and most iterations
@@ -258,11 +270,10 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
     s1 = np.empty(n)
     Q = np.empty((n, 3))
     hist = np.zeros(7)  # NAEOM: force history of the stick phase (method_naeom.naeom_stick_branch)
-    tr_t = np.empty(16)
-    tr_kind = np.empty(16, dtype=np.int8)
-    tr_s = np.empty((16, n))
     n_tr = np.int64(0)  # not a literal: one compiled version of the callees
     stats = np.zeros(8, dtype=np.int64)
+    force_given = np.bool_(True)  # write_samples' fixed_force; not literals: one compiled version
+    force_from_state = np.bool_(False)
 
     mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
     if method == METHOD_AEOM and mode == K.MODE_STICK:
@@ -270,10 +281,10 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
     K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
     stats[2] += 1
     vx, vy = K.relative_velocity(y, p)
-    idx = write_initial_samples(y, t0, mode, ex, ey, 0.0, 0.0, False, minv, damp, stiff, p,
+    idx = write_initial_samples(y, t0, mode, ex, ey, 0.0, 0.0, force_from_state, minv, damp, stiff, p,
                                 sample_times, out_s, out_mode, out_F)
     t = t0
-    k_grid = 1
+    k_grid = np.int64(1)  # not a literal: one compiled version of next_step
     status = STATUS_OK
     n_steps = 0
     while t < t_end:
@@ -287,9 +298,9 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             break
         transition = 0
         if mode == K.MODE_SLIP:
-            h, crossed, vx, vy = slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, fnew,
-                                                      ytmp, k2, k3, k4, stats)
-            idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, False, 0.0, 0.0, minv, damp,
+            h, crossed, vx, vy, Fx, Fy = slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p,
+                                                              ynew, fnew, ytmp, k2, k3, k4, stats)
+            idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv, damp,
                                 stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
             ex, ey = K.slip_direction(ynew, vx, vy, ex, ey, minv, damp, stiff, p)
             if crossed:
@@ -299,10 +310,10 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                     hist[0] = 0.0
         else:
             if method == METHOD_AEOM:
-                h, transition = aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4,
-                                                  stats)
-                idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, False, 0.0, 0.0, minv, damp,
-                                    stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
+                h, transition, Fx, Fy = aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3,
+                                                          k4, stats)
+                idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
+                                    damp, stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
             else:
                 h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp,
                                                                    s1, k2, k3, k4, stats)
@@ -314,7 +325,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                     K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
                     K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, fnew)
                     stats[2] += 2
-                    idx = write_samples(idx, t, h, y, k1, ynew, fnew, mode, ex, ey, True, Fx, Fy, minv, damp,
+                    idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_given, minv, damp,
                                         stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
             if transition == E.TRANSITION_TO_SLIP:
                 Fx, Fy, _ = K.stick_force(ynew, minv, damp, stiff, p)
@@ -327,7 +338,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
         if transition != 0:
             mode = K.MODE_STICK if transition == E.TRANSITION_TO_STICK else K.MODE_SLIP
             stats[4 if transition == E.TRANSITION_TO_STICK else 5] += 1
-            tr_t, tr_kind, tr_s = _record(n_tr, t, transition, y, tr_t, tr_kind, tr_s)
+            record_transition(n_tr, t, transition, y, tr_t, tr_kind, tr_s)
             n_tr += 1
             K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)  # projected state / new mode
             stats[2] += 1
@@ -337,7 +348,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                 status = STATUS_NOT_FINITE
         if status != STATUS_OK:
             break
-    return status, t, y, tr_t[:n_tr].copy(), tr_kind[:n_tr].copy(), tr_s[:n_tr].copy(), stats
+    return status, t, y, n_tr, stats
 
 
 # --------------------------------------------------------------------------- Python runners
@@ -421,7 +432,8 @@ def warm_up(system, t0, dt, method) -> float:
     start = time.perf_counter()
     y = np.zeros(N_STATE)
     integrate_fixed_step(method, y, t0, t0 + dt, dt, system.minv, system.damp, system.stiff, system.p, 10,
-                         np.array([t0]), np.zeros((1, N_STATE)), np.zeros(1, dtype=np.int8), np.zeros((1, 2)))
+                         np.array([t0]), np.zeros((1, N_STATE)), np.zeros(1, dtype=np.int8), np.zeros((1, 2)),
+                         np.empty(1), np.empty(1, dtype=np.int8), np.empty((1, N_STATE)))
     return time.perf_counter() - start
 
 
@@ -449,9 +461,14 @@ def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float,
     out_F = np.empty((n, 2))
     y = np.zeros(N_STATE)
     y[:12] = y0
-    status, t_reached, _, tr_t, tr_kind, tr_s, st = integrate_fixed_step(
-        code, y, t0, t_end, dt, system.minv, system.damp, system.stiff, kernel_parameters(system, dt), max_steps,
-        sample_times, out_s, out_mode, out_F)
+    p = kernel_parameters(system, dt)
+
+    def run(tr_t, tr_kind, tr_s):
+        res = integrate_fixed_step(code, y, t0, t_end, dt, system.minv, system.damp, system.stiff, p, max_steps,
+                                   sample_times, out_s, out_mode, out_F, tr_t, tr_kind, tr_s)
+        return res, res[3]
+
+    (status, t_reached, _, _, st), tr_t, tr_kind, tr_s = with_transition_room(run, t_end - t0)
     if status == STATUS_SOLVE_FAILED:
         raise SimulationError(
             f"naeom: the stick-force solve did not reach |v_r| ≤ {VR_TOL:g} m/s in {MAX_NEWTON} Newton "

@@ -146,15 +146,16 @@ def aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, 
     re-taking the stick step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step then ends on the slip side of the root.
 
-    Returns (h_taken, transition): the step length taken [s] and 0 or
-    ``events.TRANSITION_TO_SLIP``. ``ynew`` and ``fnew`` = f(ynew) (stick) hold the step end;
-    ``stats`` counts rhs calls (index 2) and re-taken steps (index 3).
+    Returns (h_taken, transition, Fx, Fy): the step length taken [s], 0 or
+    ``events.TRANSITION_TO_SLIP``, and the stick force at the step end [N]. ``ynew`` and
+    ``fnew`` = f(ynew) (stick) hold the step end; ``stats`` counts rhs calls (index 2) and
+    re-taken steps (index 3).
     """
     stats[2] += aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    Fx, Fy = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
+    Fx, Fy, _, _ = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
     stats[2] += 1
     if K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
-        return h, 0
+        return h, 0, Fx, Fy
     a = 0.0
     b = 1.0
     for _ in range(E.MAX_BISECTIONS):
@@ -170,6 +171,6 @@ def aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, 
     if b < 1.0:
         stats[2] += aeom_stick_step(y, k1, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
         stats[3] += 1
-    K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
+    Fx, Fy, _, _ = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    return b * h, E.TRANSITION_TO_SLIP
+    return b * h, E.TRANSITION_TO_SLIP, Fx, Fy

@@ -48,7 +48,7 @@ def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
     for stage in range(1, 6):
         DP.stage_state(y, Kst, h, stage, ytmp)
         K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, Kst[stage])
-    DP.stage_state(y, Kst, h, 6, ynew)
+    DP.stage_state(y, Kst, h, np.int64(6), ynew)  # not a literal: one compiled version
     K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
 
 
@@ -89,31 +89,52 @@ def _store_sample(idx, y, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, o
     E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
 
 
-@loop
-def _record(n, t, kind, y, tr_t, tr_kind, tr_s):
-    """Append a transition, growing the buffers when full; returns the (possibly new) buffers."""
-    if n == tr_t.shape[0]:
-        cap = 2 * n + 16
-        new_t = np.empty(cap)
-        new_kind = np.empty(cap, dtype=np.int8)
-        new_s = np.empty((cap, tr_s.shape[1]))
-        for j in range(n):  # element loops: a slice copy would compile numba's shape-mismatch
-            new_t[j] = tr_t[j]  # error formatting (~6 s of cold compile for nothing)
-            new_kind[j] = tr_kind[j]
-            for i in range(tr_s.shape[1]):
-                new_s[j, i] = tr_s[j, i]
-        tr_t, tr_kind, tr_s = new_t, new_kind, new_s
-    tr_t[n] = t
-    tr_kind[n] = kind
-    for i in range(tr_s.shape[1]):
-        tr_s[n, i] = y[i]
-    return tr_t, tr_kind, tr_s
+@kernel
+def record_transition(n, t, kind, y, tr_t, tr_kind, tr_s):
+    """Write transition ``n`` (time [s], kind, state) into the buffers if they have room.
+
+    The loops count on past the capacity and :func:`with_transition_room` runs again with room
+    for all: buffers that grew inside the loop would be loop-carried arrays, which numba
+    reference-counts on every iteration (measured ~8 % of a fixed-step run).
+    """
+    if n < tr_t.shape[0]:
+        tr_t[n] = t
+        tr_kind[n] = kind
+        for i in range(tr_s.shape[1]):
+            tr_s[n, i] = y[i]
+
+
+#: Initial room for transitions per simulated second (the paper's stick-slip cycles have 2 per
+#: period of ≥ 0.36 s); a run with more is run again with room for all (deterministic, same result).
+TRANSITIONS_PER_SECOND = 64
+MIN_TRANSITION_ROOM = 1024
+
+
+def with_transition_room(run, duration: float, n_state: int = N_STATE):
+    """Call ``run(tr_t, tr_kind, tr_s)`` with transition buffers for a run of ``duration`` [s],
+    again with bigger ones if the transitions it found exceeded their room.
+
+    ``run`` returns ``(result, n_transitions)``. Returns ``(result, tr_t, tr_kind, tr_s)`` trimmed
+    to the transitions recorded.
+    """
+    capacity = MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * duration)
+    while True:
+        tr_t = np.empty(capacity)
+        tr_kind = np.empty(capacity, dtype=np.int8)
+        tr_s = np.empty((capacity, n_state))
+        result, n_tr = run(tr_t, tr_kind, tr_s)
+        if n_tr <= capacity:
+            return result, tr_t[:n_tr], tr_kind[:n_tr], tr_s[:n_tr]
+        capacity = n_tr
 
 
 @loop
 def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_max, max_steps,
-                    sample_times, out_s, out_mode, out_F):
+                    sample_times, out_s, out_mode, out_F, tr_t, tr_kind, tr_s):
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end]; see the module docstring.
+
+    Samples go to ``out_s``, ``out_mode``, ``out_F`` at ``sample_times``; transitions to
+    ``tr_t``, ``tr_kind``, ``tr_s`` as far as they have room (:func:`record_transition`).
 
     Returns
     -------
@@ -124,8 +145,9 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
         Final state.
     mode, ex, ey :
         Final mode and stored slip direction.
-    tr_t, tr_kind, tr_s :
-        Transition instants [s], kinds (+1 to stick, −1 to slip) and states (trimmed).
+    n_transitions : int
+        Transitions found (instants [s], kinds +1 to stick, −1 to slip, and states are in the
+        buffers up to their room).
     stats : ndarray (6,) int64
         accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
         slip → stick transitions, stick → slip transitions.
@@ -138,9 +160,6 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     Kst = np.empty((7, n))
     Q = np.empty((n, 4))
     k1 = np.empty(n)
-    tr_t = np.empty(16)
-    tr_kind = np.empty(16, dtype=np.int8)
-    tr_s = np.empty((16, n))
     n_tr = np.int64(0)  # not a literal: one compiled version of the callees
     stats = np.zeros(6, dtype=np.int64)
 
@@ -283,7 +302,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     if stick:
                         mode = K.MODE_STICK
                         stats[4] += 1
-                        tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_STICK, y, tr_t, tr_kind, tr_s)
+                        record_transition(n_tr, t, E.TRANSITION_TO_STICK, y, tr_t, tr_kind, tr_s)
                         n_tr += 1
                     elif nex != 0.0 or ney != 0.0:
                         # v_r reached zero but stick cannot hold: slip departs again (reversal)
@@ -317,7 +336,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 ex, ey = E.breakaway_direction(Fx, Fy)
                 mode = K.MODE_SLIP_QUASI_STATIC
                 stats[5] += 1
-                tr_t, tr_kind, tr_s = _record(n_tr, t, E.TRANSITION_TO_SLIP, y, tr_t, tr_kind, tr_s)
+                record_transition(n_tr, t, E.TRANSITION_TO_SLIP, y, tr_t, tr_kind, tr_s)
                 n_tr += 1
             else:
                 idx = _write_samples(idx, t + h, y, Q, h, t, mode, ex, ey, minv, damp, stiff, p,
@@ -339,5 +358,4 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             h_override = -1.0
         else:
             h *= factor
-    return (status, t, y, mode, ex, ey, tr_t[:n_tr].copy(), tr_kind[:n_tr].copy(),
-            tr_s[:n_tr].copy(), stats)
+    return status, t, y, mode, ex, ey, n_tr, stats

@@ -331,22 +331,24 @@ def slip_direction(s, vx, vy, ex, ey, minv, damp, stiff, p):
 
 @kernel
 def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
-    """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N].
+    """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N] and the
+    relative velocity (vx, vy) at ``s`` [m/s], Eq. (9).
 
-    Stick and slip above the low-speed band use one evaluation of the contact kinematics
-    (this function is the integrators' inner loop); the band goes through :func:`contact_force`.
+    One evaluation of the contact kinematics for all of it in stick and in slip above the
+    low-speed band (this function is the integrators' inner loop, and v_r at a step's end is
+    what the event tests need); the band goes through :func:`contact_force`.
     """
     sphi, cphi, X, Y = contact_kinematics(s, p)
+    dX, dY = contact_rates(s, p, sphi, cphi)
+    w = p[P_OMEGA] + s[11]
+    vx = dX + w * Y
+    vy = dY - w * X
     Fx = Fy = 0.0
     done = False
     if mode == MODE_STICK:
         Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
         done = True
     else:
-        dX, dY = contact_rates(s, p, sphi, cphi)
-        w = p[P_OMEGA] + s[11]
-        vx = dX + w * Y
-        vy = dY - w * X
         speed = math.sqrt(vx * vx + vy * vy)
         if exact_direction(mode, speed, p):
             Fx, Fy = slip_force(speed, vx / speed, vy / speed, p)
@@ -354,7 +356,7 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     if not done:
         Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
     dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
-    return Fx, Fy
+    return Fx, Fy, vx, vy
 
 
 @kernel

@@ -370,7 +370,7 @@ def integrate_variational(y0, t0, t1, mode, ex, ey, minv, damp, stiff, p, steps,
         for stage in range(1, 6):
             DP.stage_state(y, Kst, h, stage, ytmp)
             variational_rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, steps, Kst[stage], J)
-        DP.stage_state(y, Kst, h, 6, ynew)
+        DP.stage_state(y, Kst, h, np.int64(6), ynew)  # not a literal: one compiled version
         variational_rhs(ynew, mode, ex, ey, minv, damp, stiff, p, steps, Kst[6], J)
         total = 0.0
         for i in range(n):
@@ -402,7 +402,7 @@ def integrate_variational(y0, t0, t1, mode, ex, ey, minv, damp, stiff, p, steps,
                 ga = g
             if b > 0.0:
                 tol = EV_TIME_TOL / h
-                side = 0
+                side = np.int64(0)
                 for _ in range(E.MAX_REFINEMENTS):
                     if gb == 0.0 or (b - a) <= tol:
                         break
