@@ -77,7 +77,8 @@ def _write_samples(idx, t_to, y0, Q, h, t_step, mode, ex, ey, minv, damp, stiff,
     while idx < n_samples and sample_times[idx] <= t_to:
         theta = (sample_times[idx] - t_step) / h if h > 0.0 else 0.0
         E.dense_state(y0, Q, h, theta, work)
-        _store_sample(idx, work, mode, ex, ey, minv, damp, stiff, p, out_s, out_mode, out_F)
+        Fx, Fy = K.contact_force(work, mode, ex, ey, minv, damp, stiff, p)  # as _store_sample, one call less
+        E.store_sample(idx, work, mode, Fx, Fy, out_s, out_mode, out_F)
         idx += 1
     return idx
 
@@ -189,6 +190,10 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
     h_free = -1.0       # step size before a homing episode, if > 0
     tau_start = math.inf  # extrapolated time to v_r = 0 at the start of the step (approach)
     rejected = False    # whether the last attempt was rejected
+    # v_r and dv_r/dt at the step start: those of the last accepted step's end, while y and k1
+    # are still that end (invalidated by any projection or change of mode)
+    v0_ready = False
+    v0x = v0y = a0x = a0y = 0.0
     n_steps = 0
     while t < t_end:
         if n_steps >= max_steps:
@@ -236,7 +241,9 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     stats[3] += 1
                     continue
             if mode == K.MODE_SLIP_EXACT:  # while departing from v_r = 0 there is nothing to detect
-                v0x, v0y, a0x, a0y = K.relative_velocity_acceleration(y, k1, p)
+                if not v0_ready:
+                    v0x, v0y, a0x, a0y = K.relative_velocity_acceleration(y, k1, p)
+                    v0_ready = True
                 speed0 = math.sqrt(v0x * v0x + v0y * v0y)
                 e0x = v0x / speed0
                 e0y = v0y / speed0
@@ -263,6 +270,8 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                 y[i] = ynew[i]
                 k1[i] = Kst[6, i]
             stats[0] += 1
+            v0x, v0y, a0x, a0y = v1x, v1y, a1x, a1y
+            v0_ready = True
             speed = math.sqrt(v1x * v1x + v1y * v1y)
             ex, ey = K.slip_direction(y, v1x, v1y, ex, ey, minv, damp, stiff, p)
             if mode == K.MODE_SLIP_QUASI_STATIC:
@@ -273,6 +282,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     mode = K.MODE_SLIP_EXACT
                     K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
                     stats[2] += 1
+                    v0_ready = False
             else:
                 v_arrive = E.arrival_speed(y, rtol, atol)
                 # arrived: a located root, homing, or |v_r| at the error control's resolution
@@ -298,6 +308,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
                     homing += 1
                 elif near:
                     homing = 0
+                    v0_ready = False  # y may be projected, k1 recomputed
                     stick, nex, ney = E.try_stick(y, minv, damp, stiff, p, v_arrive)
                     if stick:
                         mode = K.MODE_STICK
@@ -348,6 +359,7 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             stats[0] += 1
             K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
             stats[2] += 1
+            v0_ready = False
         for i in range(n):
             if not math.isfinite(y[i]):
                 status = STATUS_NOT_FINITE
