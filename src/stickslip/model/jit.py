@@ -13,6 +13,7 @@ from __future__ import annotations
 from numba import njit
 
 kernel = njit(cache=True, _nrt=False)
+inlined_kernel = njit(cache=True, _nrt=False, inline="always")
 loop = njit(cache=True)
 
-__all__ = ["kernel", "loop"]
+__all__ = ["kernel", "inlined_kernel", "loop"]

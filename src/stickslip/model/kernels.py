@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from .jit import kernel
+from .jit import inlined_kernel, kernel
 
 # Indices into the packed contact/friction array ``p``.
 P_R, P_N, P_OMEGA, P_MU_K, P_DELTA_MU, P_ALPHA, P_LAW, P_SLIP_BAND = range(8)
@@ -221,7 +221,7 @@ def dynamics(s, Fx, Fy, minv, damp, stiff, p, ds):
     dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
 
 
-@kernel
+@inlined_kernel
 def dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds):
     """:func:`dynamics` with the contact kinematics (sin φ, cos φ, X, Y) already computed."""
     r = p[P_R]
