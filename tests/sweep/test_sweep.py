@@ -60,6 +60,21 @@ def test_dask_local_cluster_matches_serial(serial, tmp_path):
     _assert_same(serial.dataset, res.dataset)
 
 
+def test_local_cluster_workers_start_without_malloc_trim_threshold():
+    # dask's nanny sets MALLOC_TRIM_THRESHOLD_, which makes glibc map and unmap every sample
+    # buffer per point (20 % slower points); our LocalCluster's workers start without it
+    pytest.importorskip("distributed")
+    from distributed import Client
+
+    from stickslip.sweep.executors import local_cluster
+
+    with local_cluster(1) as cluster, Client(cluster) as client:
+        env = client.run(lambda: {k: os.environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")})
+    (worker_env,) = env.values()
+    assert worker_env["MALLOC_TRIM_THRESHOLD_"] is None
+    assert worker_env["OMP_NUM_THREADS"] == "1"  # the rest of the nanny's environment is kept
+
+
 _CHILD = textwrap.dedent("""
     import sys
     from stickslip.sweep import sweep
