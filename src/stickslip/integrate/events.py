@@ -74,6 +74,16 @@ def dense_state(y0, Q, h, theta, out):
 
 
 @kernel
+def all_finite(y):
+    """Whether every entry of ``y`` is finite: one branch on Σ y_i·0, which is NaN exactly when
+    some y_i is ±inf or NaN (and never overflows), instead of one per entry (checked every step)."""
+    acc = 0.0
+    for i in range(y.shape[0]):
+        acc += y[i] * 0.0
+    return acc == 0.0
+
+
+@kernel
 def store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F):
     """Write the state, the mode flag (1 = stick, 0 = slip) and the friction force of sample ``idx``."""
     for i in range(y.shape[0]):

@@ -343,9 +343,8 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)  # projected state / new mode
             stats[2] += 1
             vx, vy = K.relative_velocity(y, p)
-        for i in range(n):
-            if not math.isfinite(y[i]):
-                status = STATUS_NOT_FINITE
+        if not E.all_finite(y):
+            status = STATUS_NOT_FINITE
         if status != STATUS_OK:
             break
     return status, t, y, n_tr, stats

@@ -360,9 +360,8 @@ def integrate_event(y0, t0, t_end, minv, damp, stiff, p, rtol, atol, h_init, h_m
             K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
             stats[2] += 1
             v0_ready = False
-        for i in range(n):
-            if not math.isfinite(y[i]):
-                status = STATUS_NOT_FINITE
+        if not E.all_finite(y):
+            status = STATUS_NOT_FINITE
         if status != STATUS_OK:
             break
         if h_override > 0.0:

@@ -351,7 +351,8 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     else:
         speed = math.sqrt(vx * vx + vy * vy)
         if exact_direction(mode, speed, p):
-            Fx, Fy = slip_force(speed, vx / speed, vy / speed, p)
+            inv_speed = 1.0 / speed
+            Fx, Fy = slip_force(speed, vx * inv_speed, vy * inv_speed, p)
             done = True
     if not done:
         Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
