@@ -87,6 +87,21 @@ def test_rank_one_solution_is_minimal_norm():
     assert np.allclose([x1, x2], np.linalg.pinv(A) @ b)
 
 
+@pytest.mark.parametrize("ratio", [1.0, 1e-3, 1e-9, 1.01e-10, 0.99e-10, 1e-14])
+def test_rank_decision_follows_eigenvalue_ratio(ratio):
+    # eigenvalues (1, ratio) in a rotated frame: full rank exactly when λ2 > RANK_TOL λ1, whether
+    # the cheap determinant test or the eigenvalue path decides it; full rank is the inverse
+    c, s_ = math.cos(0.3), math.sin(0.3)
+    R = np.array([[c, -s_], [s_, c]])
+    A = R @ np.diag([1.0, ratio]) @ R.T
+    b = A @ np.array([0.7, -0.2])
+    x1, x2, rank = kernels.solve_psd_2x2(A[0, 0], A[0, 1], A[1, 1], b[0], b[1])
+    assert rank == (2 if ratio > kernels.RANK_TOL else 1)
+    if ratio >= 1e-3:
+        assert np.allclose([x1, x2], np.linalg.solve(A, b), rtol=1e-12)
+    assert np.allclose(A @ [x1, x2], b, atol=1e-12)
+
+
 def test_projection_is_minimal_kinetic_energy_change():
     P = Parameters()
     sys_ = assemble(P)

@@ -137,11 +137,13 @@ def solve_psd_2x2(a11, a12, a22, b1, b2):
     tr = a11 + a22
     if tr <= 0.0:
         return 0.0, 0.0, 0
+    det = a11 * a22 - a12 * a12
+    if det > RANK_TOL * tr * tr:  # λ1 λ2 > RANK_TOL tr² ≥ RANK_TOL λ1²: full rank without the eigenvalues
+        return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det, 2
     half_gap = math.sqrt(0.25 * (a11 - a22) ** 2 + a12 * a12)
     lam1 = 0.5 * tr + half_gap
     lam2 = 0.5 * tr - half_gap
     if lam2 > RANK_TOL * lam1:
-        det = a11 * a22 - a12 * a12
         return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det, 2
     # eigenvector of lam1: choose the better conditioned of the two row forms
     u1, u2 = a12, lam1 - a11
@@ -268,10 +270,10 @@ def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
     muN = friction_coefficient(math.sqrt(vx * vx + vy * vy), p) * p[P_N]
     theta = math.atan2(ey, ex)
     for _ in range(8):
-        c2 = math.cos(2.0 * theta)
-        s2 = math.sin(2.0 * theta)
         c = math.cos(theta)
         sn = math.sin(theta)
+        c2 = c * c - sn * sn  # cos 2θ, sin 2θ from the double-angle formulas: two trig calls less
+        s2 = 2.0 * c * sn
         g = muN * (a12 * c2 + 0.5 * (a22 - a11) * s2) + (c * wy - sn * wx)
         dg = muN * (-2.0 * a12 * s2 + (a22 - a11) * c2) - (c * wx + sn * wy)
         if dg <= 0.0:  # not near a stable root: keep the previous direction
