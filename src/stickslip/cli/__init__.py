@@ -11,5 +11,6 @@ from . import study  # noqa: E402,F401  (registers `stickslip study timestep`)
 from . import reproduce  # noqa: E402,F401  (registers `stickslip reproduce`)
 from . import sweep  # noqa: E402,F401  (registers `stickslip sweep`, `bifurcation`, `regions`)
 from . import continue_  # noqa: E402,F401  (registers `stickslip continue`)
+from . import orbit  # noqa: E402,F401  (registers `stickslip orbit`, `lyapunov`)
 
 __all__ = ["app"]

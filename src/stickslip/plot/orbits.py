@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-__all__ = ["plot_lyapunov_convergence", "plot_lyapunov_spectrum"]
+from .trajectory import _shade_stick, stick_intervals
+
+__all__ = ["plot_lyapunov_convergence", "plot_lyapunov_spectrum", "plot_orbit", "plot_multipliers",
+           "save_orbit_figure", "save_lyapunov_spectrum_figure"]
 
 
 def plot_lyapunov_convergence(results, labels=None, ax=None):
@@ -82,3 +87,132 @@ def plot_lyapunov_spectrum(spectrum, reference=None, n_show=None, ax=None):
     ax.legend(fontsize=6, ncol=2)
     ax.grid(alpha=0.3)
     return fig
+
+
+def plot_orbit(orbit, traj, ax=None):
+    """φ over one period of a periodic orbit, stick phases shaded.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+    traj : Trajectory
+        The orbit simulated over one period from its section state (``orbit.trajectory(1.0)``).
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.4, 3.6), constrained_layout=True)
+    else:
+        fig = ax.figure
+    _shade_stick(ax, stick_intervals(traj.t, traj.mode), traj.t[0], traj.t[-1])
+    ax.plot(traj.t, traj.states[:, 4], color="tab:blue", lw=1.2, label="φ")
+    ax.set_xlim(0.0, orbit.period)
+    ax.set_xlabel("time from the section [s]")
+    ax.set_ylabel("φ [rad]")
+    ax.set_title(f"T = {orbit.period:.6g} s ({orbit.frequency:.6g} Hz), {orbit.stick_phases} stick phase(s)",
+                 fontsize=9)
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def plot_multipliers(orbit, ax=None):
+    """Floquet multipliers of a periodic orbit in the complex plane with the unit circle.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The trivial multiplier (closest to 1) is drawn as an open circle, the others as crosses.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(4.0, 4.0), constrained_layout=True)
+    else:
+        fig = ax.figure
+    angle = np.linspace(0.0, 2.0 * np.pi, 361)
+    ax.plot(np.cos(angle), np.sin(angle), color="k", lw=0.6)
+    mu = np.asarray(orbit.nontrivial_multipliers)
+    triv = orbit.trivial_multiplier
+    ax.plot(mu.real, mu.imag, "x", color="tab:red" if not orbit.stable else "tab:blue", ms=7,
+            label=f"μ (max |μ| = {np.max(np.abs(mu)):.6g})" if mu.size else "μ")
+    ax.plot([triv.real], [triv.imag], "o", mfc="none", color="0.3", ms=8, label=f"trivial μ = {triv.real:.6g}")
+    reach = max(1.1, 1.05 * float(np.max(np.abs(orbit.multipliers))))
+    ax.set_xlim(-reach, reach)
+    ax.set_ylim(-reach, reach)
+    ax.set_aspect("equal")
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    ax.axvline(0.0, color="0.7", lw=0.5)
+    ax.set_xlabel("Re μ")
+    ax.set_ylabel("Im μ")
+    ax.set_title(f"Floquet multipliers ({orbit.options.get('monodromy', 'finite-difference')}): "
+                 f"{'stable' if orbit.stable else 'unstable'}", fontsize=9)
+    ax.legend(fontsize=7, loc="lower left")
+    return fig
+
+
+def save_orbit_figure(orbit, traj, path, *, dpi: int = 110) -> Path:
+    """:func:`plot_orbit` and :func:`plot_multipliers` side by side into a PNG file (Agg backend).
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+    traj : Trajectory
+        One period of the orbit (``orbit.trajectory(1.0)``).
+    path : str or Path
+    dpi : int
+
+    Returns
+    -------
+    Path
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained", width_ratios=(1.6, 1.0))
+    plot_orbit(orbit, traj, axes[0])
+    plot_multipliers(orbit, axes[1])
+    p = orbit.params
+    fig.suptitle(f"Periodic orbit, model {orbit.model}: N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
+                 f"section {orbit.section.name}", fontsize=10)
+    path = Path(path)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
+def save_lyapunov_spectrum_figure(spectrum, path, *, dpi: int = 110) -> Path:
+    """:func:`plot_lyapunov_spectrum` (the running estimate of every exponent) into a PNG file.
+
+    Parameters
+    ----------
+    spectrum : LyapunovSpectrum
+    path : str or Path
+    dpi : int
+
+    Returns
+    -------
+    Path
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plot_lyapunov_spectrum(spectrum)
+    path = Path(path)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

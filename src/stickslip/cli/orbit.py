@@ -1,0 +1,214 @@
+"""``stickslip orbit`` and ``stickslip lyapunov``: a periodic orbit with its Floquet multipliers,
+and the Lyapunov spectrum of the attractor reached from a start.
+
+Parse → library call (:func:`stickslip.orbits.periodic_orbit`,
+:func:`stickslip.orbits.lyapunov_spectrum`) → write NetCDF and a figure; no physics here.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import List, Optional
+
+import numpy as np
+import typer
+from rich.table import Table
+
+from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+
+#: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``).
+_ICS = ("far", "near", "zero", "equilibrium")
+
+#: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
+_METHODS = ("saltation", "finite-difference")
+_LYAPUNOV_METHODS = ("variational", "finite-difference")
+
+_N_HELP = "Normal preload N \\[N] (default 50)."
+_OMEGA_HELP = "Angular velocity Ω of the lower plate \\[rad/s] (default 5)."
+_MODEL_HELP = "full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi."
+_IC_HELP = "Start run: far | near | zero | equilibrium (docs/sweeps.md)."
+_BAND_HELP = "Low-speed band of the slip direction \\[m/s] (default: that of stickslip.simulate)."
+
+
+def _check_common(out: Path, ic: str, model: str, positive: dict) -> None:
+    """Checks shared by both commands (one-line ValueError naming the fix), before any computing.
+
+    Parameters
+    ----------
+    out : Path
+        NetCDF output; must end in ``.nc``.
+    ic : str
+        One of :data:`_ICS`.
+    model : str
+        A model variant name (resolved here so that a typo fails before the start run).
+    positive : dict
+        ``{flag: value}`` of options that must be finite and > 0 (times [s], tolerances [-],
+        bands [m/s]); ``None`` values (not given) are skipped.
+    """
+    from ..model.variants import resolve_variant
+
+    if out.suffix != ".nc":
+        raise ValueError(f"--out {out}: give a path ending in .nc")
+    if ic not in _ICS:
+        raise ValueError(f"--ic {ic}: choose one of {', '.join(_ICS)}")
+    for flag, value in positive.items():
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+    try:
+        resolve_variant(model)
+    except ValueError as exc:
+        raise ValueError(f"--model {model}: {exc}") from None
+
+
+def _finite_or_none(x: float):
+    """A float for JSON, ``None`` where it is not finite (JSON has no ±inf or NaN)."""
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+@app.command("orbit")
+def orbit_command(
+    N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
+    omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
+    model: str = typer.Option("full", "--model", help=_MODEL_HELP),
+    ic: str = typer.Option("far", "--ic", help=_IC_HELP),
+    search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run \\[s]; the guess is "
+                                      "taken from its last section crossings."),
+    period_multiplicity: int = typer.Option(1, "--period-multiplicity", help="Section crossings (maxima of φ) per period."),
+    monodromy: str = typer.Option("saltation", "--monodromy", help="Monodromy matrix: saltation | finite-difference."),
+    rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map (atol = 1e-3 rtol)."),
+    tol: float = typer.Option(1e-8, "--tol", help="Newton tolerance (scaled shooting residual)."),
+    slip_band: Optional[float] = typer.Option(None, "--slip-band", help=_BAND_HELP),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
+    out: Path = typer.Option(Path("orbit.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+) -> None:
+    """Find a periodic orbit by Newton shooting on the φ-maximum section, with its Floquet multipliers.
+
+    A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
+    """
+    from ..analysis.steady import stick_time
+    from ..orbits import periodic_orbit
+    from ..orbits.continuation import start_run
+
+    with user_errors():
+        _check_common(out, ic, model, {"--search-time": search_time, "--rtol": rtol, "--tol": tol,
+                                       "--slip-band": slip_band})
+        if monodromy not in _METHODS:
+            raise ValueError(f"--monodromy {monodromy}: choose one of {', '.join(_METHODS)}")
+        if period_multiplicity < 1:
+            raise ValueError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
+        band = {} if slip_band is None else {"slip_band": slip_band}
+        params = build_parameters(config, set_, N=N, Omega=omega)
+        t0 = time.perf_counter()
+        run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
+        orbit = periodic_orbit(params, run, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
+                               monodromy=monodromy, **band)
+        wall = time.perf_counter() - t0
+        one_period = orbit.trajectory(1.0)
+        stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
+                           one_period.transitions.kind)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        orbit.to_xarray().to_netcdf(out, engine="h5netcdf")
+        figure = None
+        if not no_plot:
+            from ..plot.orbits import save_orbit_figure
+
+            figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
+    others = np.abs(orbit.nontrivial_multipliers)
+    summary = {
+        "out": str(out), "figure": None if figure is None else str(figure), "model": orbit.model,
+        "period_s": float(orbit.period), "frequency_hz": float(orbit.frequency),
+        "stick_phases": int(orbit.stick_phases), "stick_fraction": float(stick / orbit.period),
+        "max_nontrivial_multiplier_abs": float(others.max()) if others.size else None,
+        "trivial_multiplier_error": float(abs(orbit.trivial_multiplier - 1.0)),
+        "stable": bool(orbit.stable), "monodromy": orbit.options.get("monodromy", monodromy),
+        "iterations": int(orbit.iterations), "residual": float(orbit.residual), "wall_time_s": wall,
+    }
+    if as_json:
+        print(json.dumps(summary))
+        return
+    p = orbit.params
+    table = Table(title=f"stickslip orbit ({orbit.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s)", show_header=False)
+    table.add_row("period", f"{summary['period_s']:.10g} s ({summary['frequency_hz']:.8g} Hz)")
+    table.add_row("stick", f"{summary['stick_phases']} phase(s), {summary['stick_fraction']:.4f} of the period")
+    if summary["max_nontrivial_multiplier_abs"] is not None:
+        table.add_row("largest |μ| (non-trivial)", f"{summary['max_nontrivial_multiplier_abs']:.8g}")
+    table.add_row("|μ_trivial − 1|", f"{summary['trivial_multiplier_error']:.2e} ({summary['monodromy']})")
+    table.add_row("stability", "[green]stable[/]" if orbit.stable else "[bold red]unstable[/]")
+    table.add_row("Newton", f"{summary['iterations']} iterations, residual {summary['residual']:.2e}")
+    table.add_row("wall time", f"{wall:.2f} s (start run + shooting + multipliers)")
+    table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
+    console.print(table)
+
+
+@app.command("lyapunov")
+def lyapunov_command(
+    N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
+    omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
+    model: str = typer.Option("full", "--model", help=_MODEL_HELP),
+    ic: str = typer.Option("far", "--ic", help=_IC_HELP),
+    t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first \\[s]."),
+    t_average: float = typer.Option(200.0, "--t-average", help="Averaging time \\[s]."),
+    method: str = typer.Option("variational", "--method", help="variational (saltation matrices) | "
+                               "finite-difference (perturbed trajectories; works where the variational one refuses)."),
+    rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of the runs (atol = 1e-3 rtol)."),
+    slip_band: Optional[float] = typer.Option(None, "--slip-band", help=_BAND_HELP),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
+    out: Path = typer.Option(Path("lyapunov.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary (exponents largest first)."),
+) -> None:
+    """Lyapunov spectrum (Benettin–Shimada–Nagashima) of the attractor reached from --ic.
+
+    Runs --t-transient seconds from --ic, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
+    """
+    from ..orbits import lyapunov_spectrum
+    from ..sweep.spec import initial_condition
+
+    with user_errors():
+        _check_common(out, ic, model, {"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol,
+                                       "--slip-band": slip_band})
+        if method not in _LYAPUNOV_METHODS:
+            raise ValueError(f"--method {method}: choose one of {', '.join(_LYAPUNOV_METHODS)}")
+        band = {} if slip_band is None else {"slip_band": slip_band}
+        params = build_parameters(config, set_, N=N, Omega=omega)
+        start, perturbation = initial_condition(ic, params, model)
+        spectrum = lyapunov_spectrum(params, start, model=model, t_transient=t_transient, t_average=t_average,
+                                     perturbation=perturbation, rtol=rtol, method=method, **band)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        spectrum.to_xarray().to_netcdf(out, engine="h5netcdf")
+        figure = None
+        if not no_plot:
+            from ..plot.orbits import save_lyapunov_spectrum_figure
+
+            figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
+    ordered = np.sort(spectrum.exponents)[::-1]  # λ1 ≥ … ≥ λk (the file keeps the library's column order)
+    summary = {
+        "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,
+        "method": method, "t_transient_s": float(t_transient), "t_average_s": float(t_average),
+        "exponents": [_finite_or_none(x) for x in ordered], "largest": _finite_or_none(ordered[0]),
+        "stick_phases": int(spectrum.stick_phases), "wall_time_s": float(spectrum.wall_time),
+    }
+    if as_json:
+        print(json.dumps(summary))
+        return
+    p = spectrum.params
+    console.print(f"stickslip lyapunov: {spectrum.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, {method}",
+                  highlight=False, soft_wrap=True)
+    table = Table()
+    table.add_column("#", justify="right")
+    table.add_column("λ \\[1/s]", justify="right")
+    for i, lam in enumerate(ordered, start=1):
+        table.add_row(str(i), f"{lam:+.6g}", style="bold red" if lam > 0 else None)
+    console.print(table)
+    console.print(f"averaged over {t_average:g} s after a {t_transient:g} s transient from --ic {ic}; "
+                  f"{spectrum.stick_phases} stick phases; wall time {spectrum.wall_time:.2f} s", highlight=False,
+                  soft_wrap=True)
+    console.print(f"wrote {out}" + ("" if figure is None else f", {figure}"), highlight=False, soft_wrap=True)

@@ -1,0 +1,137 @@
+"""`stickslip orbit` and `stickslip lyapunov`: the files hold what the library computes with the
+same options, the figures are drawn, --json parses, and bad input is one line with exit 2."""
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+from typer.testing import CliRunner
+
+from stickslip import Parameters
+from stickslip.cli import app
+from stickslip.orbits import lyapunov_spectrum, periodic_orbit
+from stickslip.orbits.continuation import start_run
+from stickslip.sweep.spec import initial_condition
+
+runner = CliRunner()
+
+#: The default case (N = 50 N, Ω = 5 rad/s, Model 1): from --ic far a 10 s start run is on the
+#: stick-slip orbit (T ≈ 0.37 s) closely enough for Newton (5 iterations, ~0.3 s).
+SEARCH = 10.0
+
+ORBIT_KEYS = {"out", "figure", "model", "period_s", "frequency_hz", "stick_phases", "stick_fraction",
+              "max_nontrivial_multiplier_abs", "trivial_multiplier_error", "stable", "monodromy", "iterations",
+              "residual", "wall_time_s"}
+LYAPUNOV_KEYS = {"out", "figure", "model", "method", "t_transient_s", "t_average_s", "exponents", "largest",
+                 "stick_phases", "wall_time_s"}
+
+
+def _one_error_line(res, message):
+    assert res.exit_code == 2, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:") and message in lines[0], res.output
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--ic", "hot"], "--ic hot: choose one of far, near, zero, equilibrium"),
+    (["--search-time", "0"], "--search-time must be a finite number > 0"),
+    (["--search-time", "nan"], "--search-time must be a finite number > 0"),
+    (["--rtol", "-1e-10"], "--rtol must be a finite number > 0"),
+    (["--tol", "inf"], "--tol must be a finite number > 0"),
+    (["--slip-band", "0"], "--slip-band must be a finite number > 0"),
+    (["--monodromy", "exact"], "--monodromy exact: choose one of saltation, finite-difference"),
+    (["--period-multiplicity", "0"], "--period-multiplicity must be >= 1"),
+    (["--out", "o.txt"], "--out o.txt: give a path ending in .nc"),
+    (["--model", "xyz"], "--model xyz"),
+    (["--set", "k_px"], "--set expects NAME=VALUE"),
+    (["--N", "-5"], "N"),
+])
+def test_orbit_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
+    res = runner.invoke(app, ["orbit", *args] + ([] if "--out" in args else ["--out", str(tmp_path / "o.nc")]))
+    _one_error_line(res, message)
+    assert not (tmp_path / "o.nc").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--ic", "hot"], "--ic hot: choose one of far, near, zero, equilibrium"),
+    (["--t-transient", "0"], "--t-transient must be a finite number > 0"),
+    (["--t-average", "-10"], "--t-average must be a finite number > 0"),
+    (["--t-average", "inf"], "--t-average must be a finite number > 0"),
+    (["--rtol", "nan"], "--rtol must be a finite number > 0"),
+    (["--method", "qr"], "--method qr: choose one of variational, finite-difference"),
+    (["--out", "l.csv"], "--out l.csv: give a path ending in .nc"),
+    (["--model", "xyz"], "--model xyz"),
+    (["--config", "missing.toml"], "missing.toml"),
+])
+def test_lyapunov_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
+    res = runner.invoke(app, ["lyapunov", *args] + ([] if "--out" in args else ["--out", str(tmp_path / "l.nc")]))
+    _one_error_line(res, message)
+    assert not (tmp_path / "l.nc").exists()
+
+
+def test_library_error_is_one_line(tmp_path):
+    """A start run too short for two section crossings: the library's OrbitError, as one line."""
+    res = runner.invoke(app, ["orbit", "--search-time", "0.05", "--out", str(tmp_path / "o.nc")])
+    _one_error_line(res, "the guess run crosses section phi_max 0 times")
+    assert not (tmp_path / "o.nc").exists()
+
+
+def test_orbit_writes_the_library_orbit_and_a_figure(tmp_path):
+    out = tmp_path / "orbit.nc"
+    res = runner.invoke(app, ["orbit", "--N", "50", "--omega", "5", "--search-time", str(SEARCH), "--out", str(out),
+                              "--json"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.stdout.strip().splitlines()[-1])
+    assert set(summary) == ORBIT_KEYS
+    assert out.with_suffix(".png").stat().st_size > 10_000  # a drawn figure, not an empty canvas
+
+    p = Parameters(N=50.0, Omega=5.0)
+    orbit = periodic_orbit(p, start_run(p, "far", model="full", t_end=SEARCH), monodromy="saltation")
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.attrs["period"] == orbit.period
+        assert ds.attrs["iterations"] == orbit.iterations and ds.attrs["model"] == "full"
+        assert np.array_equal(ds["state_on_section"].values, orbit.state)
+        assert np.array_equal(ds["multiplier_abs"].values, np.abs(orbit.multipliers))
+    assert summary["period_s"] == orbit.period and summary["frequency_hz"] == orbit.frequency
+    assert summary["stable"] == orbit.stable and summary["stick_phases"] == orbit.stick_phases
+    assert summary["max_nontrivial_multiplier_abs"] == np.abs(orbit.nontrivial_multipliers).max()
+    assert 0.0 < summary["stick_fraction"] < 1.0 and summary["monodromy"] == "saltation"
+
+
+def test_orbit_human_summary(tmp_path):
+    res = runner.invoke(app, ["orbit", "--search-time", str(SEARCH), "--monodromy", "finite-difference",
+                              "--no-plot", "--out", str(tmp_path / "o.nc")])
+    assert res.exit_code == 0, res.output
+    assert "period" in res.output and "finite-difference" in res.output and "stable" in res.output
+    assert (tmp_path / "o.nc").exists() and not (tmp_path / "o.png").exists()
+
+
+@pytest.mark.parametrize("method", ["variational", "finite-difference"])
+def test_lyapunov_writes_the_library_spectrum_and_a_figure(method, tmp_path):
+    out = tmp_path / "lyapunov.nc"
+    cfg = tmp_path / "p.toml"
+    cfg.write_text("[parameters]\nN = 50\n")
+    res = runner.invoke(app, ["lyapunov", "--config", str(cfg), "--omega", "5", "--t-transient", "5",
+                              "--t-average", "10", "--method", method, "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.stdout.strip().splitlines()[-1])
+    assert set(summary) == LYAPUNOV_KEYS and summary["method"] == method
+    assert out.with_suffix(".png").stat().st_size > 10_000
+
+    p = Parameters(N=50.0, Omega=5.0)
+    state, pert = initial_condition("far", p, "full")
+    S = lyapunov_spectrum(p, state, model="full", t_transient=5.0, t_average=10.0, perturbation=pert, method=method)
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert np.array_equal(ds["exponent"].values, S.exponents)
+        assert np.array_equal(ds["estimate"].values, S.estimate)
+    assert summary["exponents"] == sorted(S.exponents.tolist(), reverse=True)
+    assert summary["largest"] == S.exponents.max()
+
+
+def test_lyapunov_human_summary(tmp_path):
+    res = runner.invoke(app, ["lyapunov", "--ic", "near", "--t-transient", "2", "--t-average", "3", "--no-plot",
+                              "--out", str(tmp_path / "l.nc")])
+    assert res.exit_code == 0, res.output
+    assert "λ [1/s]" in res.output and "wall time" in res.output
+    assert (tmp_path / "l.nc").exists() and not (tmp_path / "l.png").exists()
