@@ -189,7 +189,7 @@ def lyapunov_command(
             from ..plot.orbits import save_lyapunov_spectrum_figure
 
             figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
-    ordered = np.sort(spectrum.exponents)[::-1]  # λ1 ≥ … ≥ λk (the file keeps the library's column order)
+    ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,
         "method": method, "t_transient_s": float(t_transient), "t_average_s": float(t_average),

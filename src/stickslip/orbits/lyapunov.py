@@ -258,7 +258,7 @@ class LyapunovSpectrum:
     time : ndarray (n,)
         Averaging time at each record [s].
     estimate : ndarray (n, k)
-        Running estimates of the exponents [1/s].
+        Running estimates of the exponents [1/s], columns in the order of ``exponents``.
     t_transient : float
         Discarded transient [s].
     scale : ndarray (k,)
@@ -310,6 +310,15 @@ class LyapunovSpectrum:
         coords = {"time": ("time", self.time, {"units": "s", "long_name": "averaging time"}),
                   "index": np.arange(1, self.exponents.size + 1)}
         return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _largest_first(estimate: np.ndarray) -> np.ndarray:
+    """Running estimates (n, k) with the columns ordered by their final value, largest first.
+
+    QR keeps the columns in the order they grew (Benettin), which over a finite averaging
+    time need not be the order of the exponents; the spectrum is reported sorted.
+    """
+    return estimate[:, np.argsort(-estimate[-1], kind="stable")]
 
 
 #: Longest smooth piece between QR re-orthonormalisations [s]: growth rates of the paper's
@@ -415,7 +424,7 @@ def lyapunov_spectrum(
     propagate(system, s_ref, t_average, transitions, end, D.copy(), scale=sigma, after=reorthonormalise,
               max_interval=QR_INTERVAL)
     time = np.array(times[1:])
-    estimate = np.array(sums[1:]) / time[:, None]
+    estimate = _largest_first(np.array(sums[1:]) / time[:, None])
     return LyapunovSpectrum(
         exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
         scale=sigma, stick_phases=int(np.sum(transitions.kind == 1)), wall_time=_time.perf_counter() - t_start,
@@ -463,7 +472,7 @@ def _fd_spectrum(params, model, system, free, sigma, s_ref, t_transient, t_avera
         sums[i] = log_sum
         s_ref = s_new
     time = chunk * np.arange(1, n_chunks + 1)
-    estimate = sums / time[:, None]
+    estimate = _largest_first(sums / time[:, None])
     return LyapunovSpectrum(
         exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
         scale=sigma, stick_phases=sticks, wall_time=_time.perf_counter() - t_start, params=params, model=model,
