@@ -185,7 +185,8 @@ def _guess_from_samples(params, model, system, section, t, states, mode, multipl
     if times.size < multiplicity + 1:
         raise OrbitError(
             f"the guess run crosses section {section.name} {times.size} times; need ≥ {multiplicity + 1} "
-            f"for period_multiplicity = {multiplicity}. Give a longer guess run or another section"
+            f"for period_multiplicity = {multiplicity}. Give a longer guess run (search_time; `--search-time` "
+            "on the command line) or another section"
         )
     c = times.size - 1 - multiplicity
     i = max(int(idx[c]) - 1, 0)  # start one sample early, so the landing time is ≥ one interval
