@@ -57,8 +57,9 @@ STABILITY_LIMIT = 2.0
 #: Δt = 1e-4 s, a band of 1e-2 m/s still changes φ's amplitude by only 9e-5 relative.
 MAX_STEP_BAND = 1e-2
 
-#: Samples within this fraction of a step from its end are written as the step end itself
-#: (the interpolant there equals y1 up to round-off; θ from sample times is exact to ~1e-16/Δt).
+#: Samples within this fraction of a step from its end (either side) are written as the step end
+#: itself (the interpolant there equals y1 up to round-off; sample times and step ends agree to
+#: ~1e-16 t, i.e. ~1e-11 of a step of 1e-3 s at t = 100 s).
 END_SAMPLE_TOL = 1e-9
 
 # --------------------------------------------------------------------------- shared RK4 pieces
@@ -105,15 +106,19 @@ def write_samples(idx, t, h, y0, f0, y1, f1, F1x, F1y, mode, ex, ey, fixed_force
     """Write the samples with t < ts ≤ t + h from the Hermite interpolant of the step.
 
     ``(F1x, F1y)`` is the friction force at the step end y1 [N]. A sample at the step end
-    (θ = 1 to :data:`END_SAMPLE_TOL`; every sample when the sample period is a multiple of Δt)
-    is y1 with that force, and needs neither the interpolant nor a force evaluation. Inside
-    the step the force written is (F1x, F1y) if ``fixed_force`` (NAEOM's per-step force in
-    stick), else ``kernels.contact_force`` at the sample. Returns the next sample index.
+    (θ = 1 to :data:`END_SAMPLE_TOL` on either side; every sample when the sample period is a
+    multiple of Δt) is y1 with that force, and needs neither the interpolant nor a force
+    evaluation. The tolerance also covers the far side: sample times and grid points are
+    rounded separately, and a sample one ulp after the step end would otherwise be interpolated
+    at θ ≈ 0 of the next step, at the full cost of an interpolated sample.
+    Inside the step the force written is (F1x, F1y) if ``fixed_force`` (NAEOM's per-step force
+    in stick), else ``kernels.contact_force`` at the sample. Returns the next sample index.
     """
     n_samples = sample_times.shape[0]
     t_to = t + h
+    t_last = t_to + END_SAMPLE_TOL * h
     q_ready = False
-    while idx < n_samples and sample_times[idx] <= t_to:
+    while idx < n_samples and sample_times[idx] <= t_last:
         theta = (sample_times[idx] - t) / h
         if theta >= 1.0 - END_SAMPLE_TOL:
             E.store_sample(idx, y1, mode, F1x, F1y, out_s, out_mode, out_F)
@@ -320,7 +325,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                 if not solved:
                     status = STATUS_SOLVE_FAILED
                     break
-                if idx < sample_times.shape[0] and sample_times[idx] <= t + h:
+                if idx < sample_times.shape[0] and sample_times[idx] <= t + h + END_SAMPLE_TOL * h:
                     # derivatives at both step ends under the solved force, for the Hermite samples
                     K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
                     K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, fnew)
