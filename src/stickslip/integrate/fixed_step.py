@@ -103,7 +103,8 @@ def hermite_coefficients(y0, f0, y1, f1, h, Q):
 @kernel
 def write_samples(idx, t, h, y0, f0, y1, f1, F1x, F1y, mode, ex, ey, fixed_force, minv, damp, stiff, p,
                   sample_times, out_s, out_mode, out_F, Q, work):
-    """Write the samples with t < ts ≤ t + h from the Hermite interpolant of the step.
+    """Write the samples with t < ts ≤ t + h (to END_SAMPLE_TOL) from the Hermite interpolant of
+    the step.
 
     ``(F1x, F1y)`` is the friction force at the step end y1 [N]. A sample at the step end
     (θ = 1 to :data:`END_SAMPLE_TOL` on either side; every sample when the sample period is a
