@@ -141,3 +141,16 @@ def test_step_band_formula():
     # Δt μs N tr(G M⁻¹ Gᵀ) at R = r: 1e-4 * 15 * (1 + 1 + 0.1 + 0.1 + 0.04/0.5 + 0.04/5)
     assert step_band(system, 1e-4) == pytest.approx(1e-4 * 15 * 2.288)
     assert kernel_parameters(system, 1e-6)[K.P_SLIP_BAND] == system.p[K.P_SLIP_BAND]
+
+
+@pytest.mark.parametrize("method", ["aeom", "naeom"])
+def test_samples_on_the_step_grid_are_the_step_ends(method):
+    # with the sample period a multiple of Δt every sample is a step end, written directly
+    # (fixed_step.end_sample_only) rather than interpolated: it must be the integrator's state
+    # there, which is the final state of a run that stops at that instant
+    dt = 1e-3
+    long = stickslip.simulate(t_end=2.0, method=method, dt=dt)
+    assert long.mode.min() == 0 and long.mode.max() == 1  # the window holds stick and slip
+    for k in (137, 700, 1401, 1999):
+        short = stickslip.simulate(t_end=k * dt, method=method, dt=dt)
+        np.testing.assert_array_equal(long.states[k], short.final_state)

@@ -134,6 +134,26 @@ def write_samples(idx, t, h, y0, f0, y1, f1, F1x, F1y, mode, ex, ey, fixed_force
 
 
 @kernel
+def end_sample_only(idx, t, h, sample_times, y1, mode, Fx, Fy, out_s, out_mode, out_F):
+    """The samples of a step that has none or only one, at its end (the usual cases when the
+    sample period is a multiple of Δt), without the call to :func:`write_samples`.
+
+    Writes that one sample (y1 with the force (Fx, Fy) at y1 [N]) and returns (next index, True);
+    returns (idx, False) and writes nothing when the step needs :func:`write_samples`.
+    """
+    n_samples = sample_times.shape[0]
+    t_last = t + h + END_SAMPLE_TOL * h
+    if idx >= n_samples or sample_times[idx] > t_last:
+        return idx, True  # no sample in this step
+    if (sample_times[idx] - t) / h < 1.0 - END_SAMPLE_TOL:
+        return idx, False  # a sample inside the step: interpolate
+    if idx + 1 < n_samples and sample_times[idx + 1] <= t_last:
+        return idx, False
+    E.store_sample(idx, y1, mode, Fx, Fy, out_s, out_mode, out_F)
+    return idx + 1, True
+
+
+@kernel
 def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F):
     """Write sample ``idx``: the given force if ``fixed_force``, else the contact force of ``mode``."""
     if not fixed_force:
@@ -306,8 +326,10 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
         if mode == K.MODE_SLIP:
             h, crossed, vx, vy, Fx, Fy = slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p,
                                                               ynew, fnew, ytmp, k2, k3, k4, stats)
-            idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv, damp,
-                                stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
+            idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
+            if not done:
+                idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
+                                    damp, stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
             ex, ey = K.slip_direction(ynew, vx, vy, ex, ey, minv, damp, stiff, p)
             if crossed:
                 stick, ex, ey = after_slip_root(ynew, ex, ey, minv, damp, stiff, p)
@@ -318,15 +340,18 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             if method == METHOD_AEOM:
                 h, transition, Fx, Fy = aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3,
                                                           k4, stats)
-                idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
-                                    damp, stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
+                idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
+                if not done:
+                    idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
+                                        damp, stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
             else:
                 h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp,
                                                                    s1, k2, k3, k4, stats)
                 if not solved:
                     status = STATUS_SOLVE_FAILED
                     break
-                if idx < sample_times.shape[0] and sample_times[idx] <= t + h + END_SAMPLE_TOL * h:
+                idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
+                if not done:
                     # derivatives at both step ends under the solved force, for the Hermite samples
                     K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
                     K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, fnew)
