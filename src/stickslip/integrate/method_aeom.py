@@ -69,15 +69,16 @@ def dependent_states(s, tau, u0, w0, a0, b0, minv, p):
     u0, w0, a0, b0 : float
         (x2 − x1), (y2 − y1) [m] at t_{n−1} and their rates from Eq. (11) [m/s].
 
-    Only free DOFs among x2, y2 are set (see the module docstring for the variants).
+    Only free DOFs among x2, y2 are set (see the module docstring for the variants). Returns
+    (sin φ, cos φ) of ``s[4]``, which the stage's stick accelerations need too.
     """
     fx = minv[2] != 0.0
     fy = minv[3] != 0.0
-    if not (fx or fy):
-        return
-    r = p[K.P_R]
     sphi = math.sin(s[4])
     cphi = math.cos(s[4])
+    if not (fx or fy):
+        return sphi, cphi
+    r = p[K.P_R]
     dphi = s[10]
     wt = p[K.P_OMEGA] + s[11]
     half = 0.5 * tau
@@ -103,6 +104,7 @@ def dependent_states(s, tau, u0, w0, a0, b0, minv, p):
         s[8] = s[6] - r * dphi * sphi + wt * (s[1] - s[3] + r * sphi)
     if fy:
         s[9] = s[7] + r * dphi * cphi - wt * (s[0] - s[2] + r * cphi)
+    return sphi, cphi
 
 
 @kernel
@@ -111,31 +113,32 @@ def aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
 
     ``k1`` = f(y) in stick. At every stage the dependent x2, y2, ẋ2, ẏ2 are recomputed with
     :func:`dependent_states` for the stage time, then the stick accelerations are evaluated
-    (``kernels.rhs`` in stick mode ≡ Eq. 13). The RK4 update of the dependent entries is
-    discarded and replaced by Eq. (12) at the step end. Returns the rhs calls made (3).
+    (``kernels.stick_rhs_at`` ≡ Eq. 13, with the sin φ, cos φ that :func:`dependent_states`
+    computed). The RK4 update of the dependent entries is discarded and replaced by Eq. (12) at
+    the step end. Returns the rhs calls made (3) and sin φ, cos φ at the step end.
     """
     n = y.shape[0]
     u0, w0, a0, b0 = _trapezoid_base(y, p)
     half = 0.5 * h
     for i in range(n):
         ytmp[i] = y[i] + half * k1[i]
-    dependent_states(ytmp, half, u0, w0, a0, b0, minv, p)
-    K.rhs(ytmp, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, k2)
+    sphi, cphi = dependent_states(ytmp, half, u0, w0, a0, b0, minv, p)
+    K.stick_rhs_at(ytmp, sphi, cphi, minv, damp, stiff, p, k2)
     for i in range(n):
         ytmp[i] = y[i] + half * k2[i]
-    dependent_states(ytmp, half, u0, w0, a0, b0, minv, p)
-    K.rhs(ytmp, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, k3)
+    sphi, cphi = dependent_states(ytmp, half, u0, w0, a0, b0, minv, p)
+    K.stick_rhs_at(ytmp, sphi, cphi, minv, damp, stiff, p, k3)
     for i in range(n):
         ytmp[i] = y[i] + h * k3[i]
-    dependent_states(ytmp, h, u0, w0, a0, b0, minv, p)
-    K.rhs(ytmp, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, k4)
+    sphi, cphi = dependent_states(ytmp, h, u0, w0, a0, b0, minv, p)
+    K.stick_rhs_at(ytmp, sphi, cphi, minv, damp, stiff, p, k4)
     sixth = h / 6.0
     for i in range(n):
         ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-    dependent_states(ynew, h, u0, w0, a0, b0, minv, p)
+    sphi, cphi = dependent_states(ynew, h, u0, w0, a0, b0, minv, p)
     if minv[2] == 0.0 or minv[3] == 0.0:
-        K.project_velocity(ynew, minv, p)  # the component(s) of v_r = 0 not built in
-    return 3
+        K.project_velocity(ynew, minv, p)  # the component(s) of v_r = 0 not built in (φ unchanged)
+    return 3, sphi, cphi
 
 
 @kernel
@@ -151,9 +154,9 @@ def aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, 
     ``fnew`` = f(ynew) (stick) hold the step end; ``stats`` counts rhs calls (index 2) and
     re-taken steps (index 3).
     """
-    stats[2] += aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    Fx, Fy, _, _ = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
-    stats[2] += 1
+    calls, sphi, cphi = aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+    Fx, Fy = K.stick_rhs_at(ynew, sphi, cphi, minv, damp, stiff, p, fnew)
+    stats[2] += calls + 1
     if K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
         return h, 0, Fx, Fy
     a = 0.0
@@ -162,14 +165,16 @@ def aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, 
         if (b - a) * h <= E.EVENT_TIME_TOL:
             break
         c = 0.5 * (a + b)
-        stats[2] += aeom_stick_step(y, k1, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        calls, _, _ = aeom_stick_step(y, k1, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[2] += calls
         stats[3] += 1
         if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
             a = c
         else:
             b = c
     if b < 1.0:
-        stats[2] += aeom_stick_step(y, k1, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        calls, _, _ = aeom_stick_step(y, k1, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[2] += calls
         stats[3] += 1
     Fx, Fy, _, _ = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
     stats[2] += 1

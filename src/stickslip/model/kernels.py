@@ -59,10 +59,17 @@ RANK_TOL = 1e-10
 @kernel
 def contact_kinematics(s, p):
     """(sin φ, cos φ, X, Y): the contact point relative to O2 [m] (paper Eqs. 2, 8)."""
-    r = p[P_R]
     sphi = math.sin(s[4])
     cphi = math.cos(s[4])
-    return sphi, cphi, s[0] - s[2] + r * cphi, s[1] - s[3] + r * sphi
+    X, Y = contact_position_at(s, sphi, cphi, p)
+    return sphi, cphi, X, Y
+
+
+@kernel
+def contact_position_at(s, sphi, cphi, p):
+    """(X, Y) [m] with sin φ, cos φ of ``s[4]`` given."""
+    r = p[P_R]
+    return s[0] - s[2] + r * cphi, s[1] - s[3] + r * sphi
 
 
 @kernel
@@ -329,6 +336,16 @@ def slip_direction(s, vx, vy, ex, ey, minv, damp, stiff, p):
     if speed > p[P_SLIP_BAND]:
         return vx / speed, vy / speed
     return quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
+
+
+@kernel
+def stick_rhs_at(s, sphi, cphi, minv, damp, stiff, p, ds):
+    """:func:`rhs` in stick with sin φ, cos φ of ``s[4]`` given (AEOM's stages have them from the
+    trapezoidal update of x2, y2); returns the stick force (Fx, Fy) [N]."""
+    X, Y = contact_position_at(s, sphi, cphi, p)
+    Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
+    dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
+    return Fx, Fy
 
 
 @kernel
