@@ -187,16 +187,17 @@ def slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, f
     ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is updated (rhs calls at index 2,
     re-taken steps at 3).
     """
-    speed = math.sqrt(vx * vx + vy * vy)
     stats[2] += rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
     F1x, F1y, v1x, v1y = K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    if speed <= K.SPEED_FLOOR:  # just after breakaway (v_r = 0) there is nothing to detect
+    speed2 = vx * vx + vy * vy
+    if speed2 <= K.SPEED_FLOOR * K.SPEED_FLOOR:  # just after breakaway (v_r = 0) nothing to detect
         return h, False, v1x, v1y, F1x, F1y
+    if v1x * vx + v1y * vy > 0.0:  # the slip event v_r·e0 (events.EVENT_SLIP) stays positive
+        return h, False, v1x, v1y, F1x, F1y
+    speed = math.sqrt(speed2)
     e0x = vx / speed
     e0y = vy / speed
-    if v1x * e0x + v1y * e0y > 0.0:  # the slip event (events.EVENT_SLIP) stays positive
-        return h, False, v1x, v1y, F1x, F1y
     a = 0.0
     b = 1.0
     for _ in range(E.MAX_BISECTIONS):
