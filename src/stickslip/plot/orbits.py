@@ -12,6 +12,15 @@ __all__ = ["plot_lyapunov_convergence", "plot_lyapunov_spectrum", "plot_orbit", 
            "save_orbit_figure", "save_lyapunov_spectrum_figure"]
 
 
+def _figure_axes(ax, figsize):
+    """(figure, axes): those of ``ax``, or a new constrained-layout figure of ``figsize`` [in]."""
+    if ax is not None:
+        return ax.figure, ax
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(figsize=figsize, constrained_layout=True)
+
+
 def plot_lyapunov_convergence(results, labels=None, ax=None):
     """Running estimate of λ_max against averaging time, one curve per result.
 
@@ -25,15 +34,10 @@ def plot_lyapunov_convergence(results, labels=None, ax=None):
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
-
     if not isinstance(results, (list, tuple)):
         results = [results]
     labels = labels or [f"{r.model}, N = {r.params.N:g} N, Ω = {r.params.Omega:g} rad/s" for r in results]
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.4, 3.6), constrained_layout=True)
-    else:
-        fig = ax.figure
+    fig, ax = _figure_axes(ax, (6.4, 3.6))
     for r, lab in zip(results, labels):
         ax.plot(r.time, r.estimate, label=f"{lab}: λ = {r.exponent:.4f} ± {r.standard_error:.4f} 1/s")
     ax.axhline(0.0, color="k", lw=0.6)
@@ -61,12 +65,7 @@ def plot_lyapunov_spectrum(spectrum, reference=None, n_show=None, ax=None):
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.4, 3.8), constrained_layout=True)
-    else:
-        fig = ax.figure
+    fig, ax = _figure_axes(ax, (6.4, 3.8))
     order = np.argsort(-spectrum.exponents)
     if n_show is None:
         order = [i for i in order if spectrum.exponents[i] > -10.0]
@@ -103,12 +102,7 @@ def plot_orbit(orbit, traj, ax=None):
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.4, 3.6), constrained_layout=True)
-    else:
-        fig = ax.figure
+    fig, ax = _figure_axes(ax, (6.4, 3.6))
     _shade_stick(ax, stick_intervals(traj.t, traj.mode), traj.t[0], traj.t[-1])
     ax.plot(traj.t, traj.states[:, 4], color="tab:blue", lw=1.2, label="φ")
     ax.set_xlim(0.0, orbit.period)
@@ -134,12 +128,7 @@ def plot_multipliers(orbit, ax=None):
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(4.0, 4.0), constrained_layout=True)
-    else:
-        fig = ax.figure
+    fig, ax = _figure_axes(ax, (4.0, 4.0))
     angle = np.linspace(0.0, 2.0 * np.pi, 361)
     ax.plot(np.cos(angle), np.sin(angle), color="k", lw=0.6)
     mu = np.asarray(orbit.nontrivial_multipliers)
