@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from contextlib import contextmanager
 
@@ -49,6 +50,25 @@ def parse_assignments(items: list[str] | None) -> dict:
         except ValueError:
             values[name] = text
     return values
+
+
+def check_nc_path(out) -> None:
+    """A NetCDF output path must end in ``.nc`` (ValueError naming the fix)."""
+    if out.suffix != ".nc":
+        raise ValueError(f"--out {out}: give a path ending in .nc")
+
+
+def check_choice(flag: str, value, choices) -> None:
+    """``value`` of option ``flag`` must be one of ``choices``."""
+    if value not in choices:
+        raise ValueError(f"{flag} {value}: choose one of {', '.join(choices)}")
+
+
+def check_positive(flags: dict) -> None:
+    """Every ``{flag: value}`` must be a finite number > 0 (``None``: not given, skipped)."""
+    for flag, value in flags.items():
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
 
 
 def build_parameters(config, assignments, **named):

@@ -14,7 +14,8 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, console, err_console, user_errors
+from ._app import (CONFIG_HELP, app, build_parameters, check_choice, check_nc_path, check_positive, console,
+                   err_console, user_errors)
 
 _ICS = ("far", "near", "zero", "equilibrium")
 
@@ -33,16 +34,12 @@ def _check(param: str, start: float, stop: float, out: Path, ic: str, max_points
             raise ValueError(f"{flag} must be a finite number, got {value}")
     if start == stop:
         raise ValueError(f"--from and --to are both {start:g}; give the end of the range to continue to")
-    if out.suffix != ".nc":
-        raise ValueError(f"--out {out}: give a path ending in .nc")
-    if ic not in _ICS:
-        raise ValueError(f"--ic {ic}: choose one of {', '.join(_ICS)}")
+    check_nc_path(out)
+    check_choice("--ic", ic, _ICS)
     if max_points < 2:
         raise ValueError(f"--max-points must be >= 2, got {max_points}")
-    for flag, value in (("--step", step), ("--max-step", max_step), ("--search-time", search_time),
-                        ("--rtol", rtol), ("--tol", tol)):
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+    check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--rtol": rtol,
+                    "--tol": tol})
     if step > max_step:
         raise ValueError(f"--step {step:g} is larger than --max-step {max_step:g}")
     bad = [k for k in stop_on if k not in SPECIAL_KINDS]
@@ -91,8 +88,7 @@ def continue_command(
     with user_errors():
         stop_on = list(stop_on or [])
         _check(param, start, stop, out, ic, max_points, step, max_step, search_time, rtol, tol, stop_on)
-        if slip_band is not None and not (math.isfinite(slip_band) and slip_band > 0):
-            raise ValueError(f"--slip-band must be a finite number > 0, got {slip_band}")
+        check_positive({"--slip-band": slip_band})
         band = {} if slip_band is None else {"slip_band": slip_band}
         params = build_parameters(config, set_, N=N, Omega=omega).replace(**{param: start})
         progress = None if (no_progress or as_json) else (

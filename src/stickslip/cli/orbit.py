@@ -17,7 +17,8 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+from ._app import (CONFIG_HELP, app, build_parameters, check_choice, check_nc_path, check_positive, console,
+                   user_errors)
 
 #: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``).
 _ICS = ("far", "near", "zero", "equilibrium")
@@ -50,13 +51,9 @@ def _check_common(out: Path, ic: str, model: str, positive: dict) -> None:
     """
     from ..model.variants import resolve_variant
 
-    if out.suffix != ".nc":
-        raise ValueError(f"--out {out}: give a path ending in .nc")
-    if ic not in _ICS:
-        raise ValueError(f"--ic {ic}: choose one of {', '.join(_ICS)}")
-    for flag, value in positive.items():
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+    check_nc_path(out)
+    check_choice("--ic", ic, _ICS)
+    check_positive(positive)
     try:
         resolve_variant(model)
     except ValueError as exc:
@@ -99,8 +96,7 @@ def orbit_command(
     with user_errors():
         _check_common(out, ic, model, {"--search-time": search_time, "--rtol": rtol, "--tol": tol,
                                        "--slip-band": slip_band})
-        if monodromy not in _METHODS:
-            raise ValueError(f"--monodromy {monodromy}: choose one of {', '.join(_METHODS)}")
+        check_choice("--monodromy", monodromy, _METHODS)
         if period_multiplicity < 1:
             raise ValueError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
         band = {} if slip_band is None else {"slip_band": slip_band}
@@ -175,8 +171,7 @@ def lyapunov_command(
     with user_errors():
         _check_common(out, ic, model, {"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol,
                                        "--slip-band": slip_band})
-        if method not in _LYAPUNOV_METHODS:
-            raise ValueError(f"--method {method}: choose one of {', '.join(_LYAPUNOV_METHODS)}")
+        check_choice("--method", method, _LYAPUNOV_METHODS)
         band = {} if slip_band is None else {"slip_band": slip_band}
         params = build_parameters(config, set_, N=N, Omega=omega)
         start, perturbation = initial_condition(ic, params, model)

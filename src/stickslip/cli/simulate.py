@@ -10,7 +10,7 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, check_nc_path, console, user_errors
 
 
 def _parse_ic(text: str):
@@ -51,8 +51,7 @@ def simulate(
 
     with user_errors():
         params = build_parameters(config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-        if out.suffix != ".nc":
-            raise ValueError(f"--out {out}: give a path ending in .nc")
+        check_nc_path(out)
         traj = run_simulation(params, t_end, model=model, method=method, ic=_parse_ic(ic), perturbation=perturb,
                               rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate, steady_from=steady_from)
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -13,7 +13,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, check_nc_path, console, user_errors
 
 _N_HELP = "Normal preload N [N] (default 50)."
 _OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
@@ -94,8 +94,7 @@ def stability_map(
 
     with user_errors():
         params = build_parameters(config, set_, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-        if out.suffix != ".nc":
-            raise ValueError(f"--out {out}: give a path ending in .nc")
+        check_nc_path(out)
         N = _axis("N", n_min, n_max, n_points)
         W = _axis("omega", omega_min, omega_max, omega_points)
         smap = run_map(params, N, W, model=model, family=parse_family(family), boundary=not no_boundary)

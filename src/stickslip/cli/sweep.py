@@ -16,7 +16,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, console, user_errors
+from ._app import CONFIG_HELP, app, build_parameters, check_nc_path, check_positive, console, user_errors
 
 _CATEGORICAL = ("model", "ic")
 
@@ -100,17 +100,10 @@ def _executor(executor: str | None, scheduler: str | None) -> str:
     return executor
 
 
-def _check_out(out: Path) -> None:
-    if out.suffix != ".nc":
-        raise ValueError(f"--out {out}: give a path ending in .nc")
-
-
 def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
     if workers is not None and workers < 1:
         raise ValueError(f"--workers must be >= 1, got {workers}")
-    for flag, value in (("--t-end", t_end), ("--sample-rate", sample_rate), ("--rtol", rtol), ("--atol", atol)):
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+    check_positive({"--t-end": t_end, "--sample-rate": sample_rate, "--rtol": rtol, "--atol": atol})
     if t_from is not None and not math.isfinite(t_from):
         raise ValueError(f"--t-from must be a finite number, got {t_from}")
     return dict(executor=_executor(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
@@ -187,7 +180,7 @@ def sweep_command(
     with user_errors():
         params = build_parameters(config, set_)
         values = parse_grid(grid)
-        _check_out(out)
+        check_nc_path(out)
         if plot_var not in COLUMNS or plot_var == "peaks":
             raise ValueError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
         options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
@@ -246,7 +239,7 @@ def bifurcation(
         values = parse_values(param, range_, option="--range")
         models = parse_values("model", model, option="--model") if "," in model else [model]
         grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
-        _check_out(out)
+        check_nc_path(out)
         if n_peaks < 1:
             raise ValueError(f"--peaks must be >= 1, got {n_peaks}")
         options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
@@ -324,7 +317,7 @@ def regions_command(
         n_values = parse_values("N", N, option="--N")
         w_values = parse_values("Omega", omega, option="--omega")
         models = parse_values("model", model, option="--model")
-        _check_out(out)
+        check_nc_path(out)
         if t_from is None and math.isfinite(t_end):
             t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
         options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
