@@ -122,3 +122,47 @@ def test_variants():
     assert resolve_variant(["phi"]).name == "custom:phi"
     with pytest.raises(ValueError, match="unknown model"):
         resolve_variant("z")
+
+
+@pytest.mark.parametrize("angle", [0.0, 1e-9, -3e-4, 0.05, -0.1, 0.1000001, -0.7, 2.5, -40.0])
+def test_rotated_is_the_angle_sum(angle):
+    """(cos, sin) turned by an angle, Taylor series or library: the angle-sum formulas to round-off."""
+    for theta in (0.0, 0.3, -2.0, 3.1):
+        c, s_ = kernels.rotated(math.cos(theta), math.sin(theta), angle)
+        assert abs(c - math.cos(theta + angle)) < 5e-16 * (1 + abs(theta + angle))
+        assert abs(s_ - math.sin(theta + angle)) < 5e-16 * (1 + abs(theta + angle))
+
+
+def _direction_function(s, sys_, theta):
+    """g(θ) = e × A (μ N e + F_s) with e = (cos θ, sin θ), A = G M⁻¹ Gᵀ (docstring of
+    kernels.quasi_static_direction), from the matrices written out here."""
+    P_r = sys_.p[kernels.P_R]
+    X, Y = kernels.contact_position(s, sys_.p)
+    G = np.array([[1, 0, -1, 0, -P_r * math.sin(s[4]), Y], [0, 1, 0, -1, P_r * math.cos(s[4]), -X]])
+    A = G @ np.diag(sys_.minv) @ G.T
+    Fs = np.array(kernels.stick_force(s, sys_.minv, sys_.damp, sys_.stiff, sys_.p)[:2])
+    speed = math.hypot(*kernels.relative_velocity(s, sys_.p))
+    muN = kernels.friction_coefficient(speed, sys_.p) * sys_.p[kernels.P_N]
+    e = np.array([np.cos(theta), np.sin(theta)])
+    w = A @ (muN * e + Fs[:, None])
+    return e[0] * w[1] - e[1] * w[0]
+
+
+@pytest.mark.parametrize("trial", range(4))
+def test_quasi_static_direction_is_the_nearest_stable_root(trial):
+    """Against a scan of g(θ): the stable root (g rising through 0) nearest the start direction."""
+    sys_ = assemble(Parameters())
+    s = random_state()
+    kernels.project_velocity(s, sys_.minv, sys_.p)
+    s[6] += 1e-5  # a small slip velocity, inside the low-speed band
+    grid = np.linspace(-math.pi, math.pi, 20001)
+    g = _direction_function(s, sys_, grid)
+    rising = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0))
+    roots = grid[rising] - g[rising] * (grid[1] - grid[0]) / (g[rising + 1] - g[rising])
+    start = roots[trial % roots.size] + 0.05  # near one of them
+    ex, ey = kernels.quasi_static_direction(s, math.cos(start), math.sin(start), sys_.minv, sys_.damp,
+                                            sys_.stiff, sys_.p)
+    assert abs(math.hypot(ex, ey) - 1.0) < 1e-14
+    nearest = roots[np.argmin(np.abs(np.angle(np.exp(1j * (roots - start)))))]
+    assert abs(np.angle(np.exp(1j * (math.atan2(ey, ex) - nearest)))) < 1e-6
+    assert abs(_direction_function(s, sys_, np.array([math.atan2(ey, ex)]))[0]) < 1e-9 * np.abs(g).max()

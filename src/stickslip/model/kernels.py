@@ -55,6 +55,10 @@ DEFAULT_SLIP_BAND = 5e-4
 #: DESIGN.md §1.2). In Model 4 it is exactly 0 up to round-off (~1e-16 relative).
 RANK_TOL = 1e-10
 
+#: Largest angle [rad] that :func:`rotated` turns by with its Taylor series (sin a to a⁹, cos a
+#: to a¹⁰: truncation ≤ a¹¹/11! ≈ 2.5e-19 relative at 0.1); larger angles call sin and cos.
+SMALL_ANGLE = 0.1
+
 
 @kernel
 def contact_kinematics(s, p):
@@ -261,6 +265,25 @@ def dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds):
 
 
 @kernel
+def rotated(c, s, angle):
+    """(cos(θ + a), sin(θ + a)) from (c, s) = (cos θ, sin θ) and the angle a [rad].
+
+    Small angles (|a| ≤ :data:`SMALL_ANGLE`, e.g. a Newton step or the change of φ over an
+    RK4 stage) take the Taylor series of sin a and cos a to round-off (truncation below 1e-18
+    relative), a few multiply-adds instead of a call to ``sincos``; larger ones take the library
+    sin and cos.
+    """
+    if abs(angle) <= SMALL_ANGLE:
+        a2 = angle * angle
+        sin_a = angle * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0))))
+        cos_a = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0 * (1.0 - a2 / 90.0))))
+    else:
+        sin_a = math.sin(angle)
+        cos_a = math.cos(angle)
+    return c * cos_a - s * sin_a, s * cos_a + c * sin_a
+
+
+@kernel
 def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
     """Slip direction e on the slow manifold of the direction dynamics at |v_r| → 0.
 
@@ -269,27 +292,44 @@ def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
     sits at a stable root g = 0 (g' > 0), where v_r grows or shrinks along e itself. At breakaway
     e = −F_s/|F_s| is such a root. Newton from the previous direction (ex, ey).
     """
-    a11, a12, a22 = constraint_metric(s, minv, p)
-    Fx, Fy, _ = stick_force(s, minv, damp, stiff, p)
+    sphi, cphi, X, Y = contact_kinematics(s, p)
+    dX, dY = contact_rates(s, p, sphi, cphi)
+    w = p[P_OMEGA] + s[11]
+    return quasi_static_direction_at(s, sphi, cphi, X, Y, dX + w * Y, dY - w * X, ex, ey, minv, damp, stiff, p)
+
+
+@kernel
+def quasi_static_direction_at(s, sphi, cphi, X, Y, vx, vy, ex, ey, minv, damp, stiff, p):
+    """:func:`quasi_static_direction` with the contact kinematics and v_r = (vx, vy) [m/s] at ``s``
+    already computed.
+
+    Newton on g(θ) works on the unit vector (cos θ, sin θ) and turns it by each step with
+    :func:`rotated`: no atan2, and no sin/cos for steps below :data:`SMALL_ANGLE`.
+    """
+    a11, a12, a22 = constraint_metric_at(sphi, cphi, X, Y, minv, p)
+    Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
     wx = a11 * Fx + a12 * Fy
     wy = a12 * Fx + a22 * Fy
-    vx, vy = relative_velocity(s, p)
     muN = friction_coefficient(math.sqrt(vx * vx + vy * vy), p) * p[P_N]
-    theta = math.atan2(ey, ex)
+    norm = math.sqrt(ex * ex + ey * ey)
+    if norm > 0.0:
+        c = ex / norm
+        sn = ey / norm
+    else:
+        c = 1.0
+        sn = 0.0
     for _ in range(8):
-        c = math.cos(theta)
-        sn = math.sin(theta)
-        c2 = c * c - sn * sn  # cos 2θ, sin 2θ from the double-angle formulas: two trig calls less
+        c2 = c * c - sn * sn  # cos 2θ, sin 2θ
         s2 = 2.0 * c * sn
         g = muN * (a12 * c2 + 0.5 * (a22 - a11) * s2) + (c * wy - sn * wx)
         dg = muN * (-2.0 * a12 * s2 + (a22 - a11) * c2) - (c * wx + sn * wy)
         if dg <= 0.0:  # not near a stable root: keep the previous direction
             break
         step = g / dg
-        theta -= step
+        c, sn = rotated(c, sn, -step)
         if abs(step) < 1e-14:  # converged to round-off of an angle
             break
-    return math.cos(theta), math.sin(theta)
+    return c, sn
 
 
 @kernel
@@ -317,14 +357,24 @@ def exact_direction(mode, speed, p):
 def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
     """Friction force in the given mode [N]: the stick multiplier, or Eq. (3) in slip with the
     direction of :func:`exact_direction` (``(ex, ey)``: the last known direction)."""
+    sphi, cphi, X, Y = contact_kinematics(s, p)
     if mode == MODE_STICK:
-        Fx, Fy, _ = stick_force(s, minv, damp, stiff, p)
+        Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
         return Fx, Fy
-    vx, vy = relative_velocity(s, p)
+    dX, dY = contact_rates(s, p, sphi, cphi)
+    w = p[P_OMEGA] + s[11]
+    return slip_force_at(s, sphi, cphi, X, Y, dX + w * Y, dY - w * X, mode, ex, ey, minv, damp, stiff, p)
+
+
+@kernel
+def slip_force_at(s, sphi, cphi, X, Y, vx, vy, mode, ex, ey, minv, damp, stiff, p):
+    """Slip force of ``mode`` [N], Eq. (3), with the contact kinematics and v_r = (vx, vy) [m/s]
+    at ``s`` already computed; the direction as in :func:`contact_force`."""
     speed = math.sqrt(vx * vx + vy * vy)
     if exact_direction(mode, speed, p):
-        return slip_force(speed, vx / speed, vy / speed, p)
-    dx, dy = quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
+        inv_speed = 1.0 / speed
+        return slip_force(speed, vx * inv_speed, vy * inv_speed, p)
+    dx, dy = quasi_static_direction_at(s, sphi, cphi, X, Y, vx, vy, ex, ey, minv, damp, stiff, p)
     return slip_force(speed, dx, dy, p)
 
 
@@ -335,7 +385,8 @@ def slip_direction(s, vx, vy, ex, ey, minv, damp, stiff, p):
     speed = math.sqrt(vx * vx + vy * vy)
     if speed > p[P_SLIP_BAND]:
         return vx / speed, vy / speed
-    return quasi_static_direction(s, ex, ey, minv, damp, stiff, p)
+    sphi, cphi, X, Y = contact_kinematics(s, p)
+    return quasi_static_direction_at(s, sphi, cphi, X, Y, vx, vy, ex, ey, minv, damp, stiff, p)
 
 
 @kernel
@@ -353,28 +404,19 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N] and the
     relative velocity (vx, vy) at ``s`` [m/s], Eq. (9).
 
-    One evaluation of the contact kinematics for all of it in stick and in slip above the
-    low-speed band (this function is the integrators' inner loop, and v_r at a step's end is
-    what the event tests need); the band goes through :func:`contact_force`.
+    One evaluation of the contact kinematics (one sin/cos of φ) for all of it, in stick, in slip
+    and in the low-speed band (this function is the integrators' inner loop, and v_r at a step's
+    end is what the event tests need).
     """
     sphi, cphi, X, Y = contact_kinematics(s, p)
     dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
     vx = dX + w * Y
     vy = dY - w * X
-    Fx = Fy = 0.0
-    done = False
     if mode == MODE_STICK:
         Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
-        done = True
     else:
-        speed = math.sqrt(vx * vx + vy * vy)
-        if exact_direction(mode, speed, p):
-            inv_speed = 1.0 / speed
-            Fx, Fy = slip_force(speed, vx * inv_speed, vy * inv_speed, p)
-            done = True
-    if not done:
-        Fx, Fy = contact_force(s, mode, ex, ey, minv, damp, stiff, p)
+        Fx, Fy = slip_force_at(s, sphi, cphi, X, Y, vx, vy, mode, ex, ey, minv, damp, stiff, p)
     dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
     return Fx, Fy, vx, vy
 
