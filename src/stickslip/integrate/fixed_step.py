@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 from ..model import kernels as K
-from ..model.jit import kernel, loop
+from ..model.jit import inlined_kernel, kernel, loop
 from . import events as E
 from .method_aeom import aeom_stick_branch, dependent_states
 from .method_event import (N_STATE, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_OK, STATUS_STEP_UNDERFLOW,
@@ -64,26 +64,40 @@ END_SAMPLE_TOL = 1e-9
 
 # --------------------------------------------------------------------------- shared RK4 pieces
 @kernel
-def rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
+def rk4_slip_step(y, k1, sphi, cphi, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
     """One classic RK4 step of length ``h`` [s] in slip (Eq. 1 with Eq. 3), k1 = f(y) given.
 
-    Writes ``ynew``; ``ytmp``, ``k2``…``k4`` are work arrays. Returns the rhs calls made (3).
+    ``sphi``, ``cphi``: sin φ, cos φ at ``y``; each stage turns them by its change of φ
+    (:func:`stage_rhs`). Writes ``ynew``; ``ytmp``, ``k2``…``k4`` are work arrays. Returns the
+    rhs calls made (3).
     """
     n = y.shape[0]
     half = 0.5 * h
     for i in range(n):
         ytmp[i] = y[i] + half * k1[i]
-    K.rhs(ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k2)
+    stage_rhs(y, sphi, cphi, ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k2)
     for i in range(n):
         ytmp[i] = y[i] + half * k2[i]
-    K.rhs(ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k3)
+    stage_rhs(y, sphi, cphi, ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k3)
     for i in range(n):
         ytmp[i] = y[i] + h * k3[i]
-    K.rhs(ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k4)
+    stage_rhs(y, sphi, cphi, ytmp, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k4)
     sixth = h / 6.0
     for i in range(n):
         ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     return 3
+
+
+@inlined_kernel
+def stage_rhs(y, sphi, cphi, ytmp, mode, ex, ey, minv, damp, stiff, p, ds):
+    """``kernels.rhs`` at the stage state ``ytmp`` of a step from ``y`` whose sin φ, cos φ are given.
+
+    The stage's sin φ, cos φ are those at ``y`` turned by the change of φ, ytmp[4] − y[4]
+    (``kernels.rotated``: a few multiply-adds for the small angle of a stage instead of a call
+    to sin and cos, equal to round-off). Returns what ``kernels.rhs`` returns.
+    """
+    c, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
+    return K.rhs_at(ytmp, sn, c, mode, ex, ey, minv, damp, stiff, p, ds)
 
 
 @kernel
@@ -173,7 +187,7 @@ def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, 
 
 
 @kernel
-def slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
+def slip_step_with_event(y, k1, sphi, cphi, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
     """A slip step with the slip → stick event located by bisection on re-stepping.
 
     The event function is the projection of v_r on its direction at the step start
@@ -181,41 +195,49 @@ def slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p, ynew, f
     trial re-taking the RK4 step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step is then the one that ends on the ≤ 0 side of the root.
 
-    ``(vx, vy)`` is v_r at ``y`` [m/s]. Returns (h_taken, crossed, v1x, v1y, F1x, F1y): the step
-    length actually taken [s], whether it ends at a zero of the slip velocity, and v_r [m/s] and
-    the friction force [N] at the step end.
+    ``(vx, vy)`` is v_r at ``y`` [m/s], ``sphi``, ``cphi`` sin φ, cos φ there. Returns
+    (h_taken, crossed, v1x, v1y, F1x, F1y, sphi1, cphi1): the step length actually taken [s],
+    whether it ends at a zero of the slip velocity, and v_r [m/s], the friction force [N] and
+    sin φ, cos φ at the step end.
     ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is updated (rhs calls at index 2,
     re-taken steps at 3).
     """
-    stats[2] += rk4_slip_step(y, k1, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    F1x, F1y, v1x, v1y = K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    stats[2] += rk4_slip_step(y, k1, sphi, cphi, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+    sphi1 = math.sin(ynew[4])
+    cphi1 = math.cos(ynew[4])
+    F1x, F1y, v1x, v1y = K.rhs_at(ynew, sphi1, cphi1, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
     stats[2] += 1
     speed2 = vx * vx + vy * vy
     if speed2 <= K.SPEED_FLOOR * K.SPEED_FLOOR:  # just after breakaway (v_r = 0) nothing to detect
-        return h, False, v1x, v1y, F1x, F1y
+        return h, False, v1x, v1y, F1x, F1y, sphi1, cphi1
     if v1x * vx + v1y * vy > 0.0:  # the slip event v_r·e0 (events.EVENT_SLIP) stays positive
-        return h, False, v1x, v1y, F1x, F1y
+        return h, False, v1x, v1y, F1x, F1y, sphi1, cphi1
     speed = math.sqrt(speed2)
     e0x = vx / speed
     e0y = vy / speed
     a = 0.0
     b = 1.0
+    at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
     for _ in range(E.MAX_BISECTIONS):
         if (b - a) * h <= E.EVENT_TIME_TOL:
             break
         c = 0.5 * (a + b)
-        stats[2] += rk4_slip_step(y, k1, c * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[2] += rk4_slip_step(y, k1, sphi, cphi, c * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
         stats[3] += 1
         if E.event_value(E.EVENT_SLIP, ynew, e0x, e0y, minv, damp, stiff, p) > 0.0:
             a = c
+            at_b = False
         else:
             b = c
-    if b < 1.0:
-        stats[2] += rk4_slip_step(y, k1, b * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+            at_b = True
+    if not at_b:
+        stats[2] += rk4_slip_step(y, k1, sphi, cphi, b * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
         stats[3] += 1
-    F1x, F1y, v1x, v1y = K.rhs(ynew, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    sphi1 = math.sin(ynew[4])
+    cphi1 = math.cos(ynew[4])
+    F1x, F1y, v1x, v1y = K.rhs_at(ynew, sphi1, cphi1, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    return b * h, True, v1x, v1y, F1x, F1y
+    return b * h, True, v1x, v1y, F1x, F1y, sphi1, cphi1
 
 
 @kernel
@@ -303,11 +325,12 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
     force_from_state = np.bool_(False)
 
     mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
+    sphi = math.sin(y[4])  # sin φ, cos φ of the current state, carried from step to step (φ
+    cphi = math.cos(y[4])  # changes only in steps; every step returns them at its end)
     if method == METHOD_AEOM and mode == K.MODE_STICK:
-        dependent_states(y, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, minv, p)
-    K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)
+        dependent_states(y, sphi, cphi, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, minv, p)
+    _, _, vx, vy = K.rhs_at(y, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, k1)
     stats[2] += 1
-    vx, vy = K.relative_velocity(y, p)
     idx = write_initial_samples(y, t0, mode, ex, ey, 0.0, 0.0, force_from_state, minv, damp, stiff, p,
                                 sample_times, out_s, out_mode, out_F)
     t = t0
@@ -325,8 +348,9 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             break
         transition = 0
         if mode == K.MODE_SLIP:
-            h, crossed, vx, vy, Fx, Fy = slip_step_with_event(y, k1, h, vx, vy, ex, ey, minv, damp, stiff, p,
-                                                              ynew, fnew, ytmp, k2, k3, k4, stats)
+            h, crossed, vx, vy, Fx, Fy, sphi, cphi = slip_step_with_event(y, k1, sphi, cphi, h, vx, vy, ex, ey, minv,
+                                                                          damp, stiff, p, ynew, fnew, ytmp, k2, k3,
+                                                                          k4, stats)
             idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
             if not done:
                 idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
@@ -339,8 +363,8 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                     hist[0] = 0.0
         else:
             if method == METHOD_AEOM:
-                h, transition, Fx, Fy = aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3,
-                                                          k4, stats)
+                h, transition, Fx, Fy, sphi, cphi = aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p,
+                                                                      ynew, fnew, ytmp, k2, k3, k4, stats)
                 idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
                 if not done:
                     idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
@@ -351,6 +375,8 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
                 if not solved:
                     status = STATUS_SOLVE_FAILED
                     break
+                sphi = math.sin(ynew[4])
+                cphi = math.cos(ynew[4])
                 idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
                 if not done:
                     # derivatives at both step ends under the solved force, for the Hermite samples
@@ -372,9 +398,8 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             stats[4 if transition == E.TRANSITION_TO_STICK else 5] += 1
             record_transition(n_tr, t, transition, y, tr_t, tr_kind, tr_s)
             n_tr += 1
-            K.rhs(y, mode, ex, ey, minv, damp, stiff, p, k1)  # projected state / new mode
+            _, _, vx, vy = K.rhs_at(y, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, k1)  # projected / new mode
             stats[2] += 1
-            vx, vy = K.relative_velocity(y, p)
         if not E.all_finite(y):
             status = STATUS_NOT_FINITE
         if status != STATUS_OK:

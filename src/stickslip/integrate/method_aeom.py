@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 
 from ..model import kernels as K
-from ..model.jit import kernel
+from ..model.jit import inlined_kernel, kernel
 from . import events as E
 
 __all__ = ["aeom_stick_branch", "aeom_stick_step", "dependent_states"]
@@ -45,11 +45,10 @@ __all__ = ["aeom_stick_branch", "aeom_stick_step", "dependent_states"]
 
 # --------------------------------------------------------------------------- AEOM stick step
 @kernel
-def _trapezoid_base(y, p):
-    """u = x2 − x1, w = y2 − y1 and their rates from v_r = 0 (Eq. 11) at the step start."""
+def _trapezoid_base(y, sphi, cphi, p):
+    """u = x2 − x1, w = y2 − y1 and their rates from v_r = 0 (Eq. 11) at the step start (sin φ,
+    cos φ of ``y[4]`` given)."""
     r = p[K.P_R]
-    sphi = math.sin(y[4])
-    cphi = math.cos(y[4])
     wt = p[K.P_OMEGA] + y[11]
     a0 = -r * y[10] * sphi + wt * (y[1] - y[3] + r * sphi)
     b0 = r * y[10] * cphi - wt * (y[0] - y[2] + r * cphi)
@@ -57,27 +56,26 @@ def _trapezoid_base(y, p):
 
 
 @kernel
-def dependent_states(s, tau, u0, w0, a0, b0, minv, p):
+def dependent_states(s, sphi, cphi, tau, u0, w0, a0, b0, minv, p):
     """Set x2, y2 by the trapezoidal rule (Eqs. 11–12) and ẋ2, ẏ2 from v_r = 0 (Eq. 11), in place.
 
     Parameters
     ----------
     s : ndarray (≥ 12,)
         State at t_{n−1} + τ whose x1, y1, φ, ψ and rates are given.
+    sphi, cphi : float
+        sin φ, cos φ of ``s[4]``.
     tau : float
         Time since the step start t_{n−1} [s] (Δt of Eq. 12).
     u0, w0, a0, b0 : float
         (x2 − x1), (y2 − y1) [m] at t_{n−1} and their rates from Eq. (11) [m/s].
 
-    Only free DOFs among x2, y2 are set (see the module docstring for the variants). Returns
-    (sin φ, cos φ) of ``s[4]``, which the stage's stick accelerations need too.
+    Only free DOFs among x2, y2 are set (see the module docstring for the variants).
     """
     fx = minv[2] != 0.0
     fy = minv[3] != 0.0
-    sphi = math.sin(s[4])
-    cphi = math.cos(s[4])
     if not (fx or fy):
-        return sphi, cphi
+        return
     r = p[K.P_R]
     dphi = s[10]
     wt = p[K.P_OMEGA] + s[11]
@@ -104,78 +102,93 @@ def dependent_states(s, tau, u0, w0, a0, b0, minv, p):
         s[8] = s[6] - r * dphi * sphi + wt * (s[1] - s[3] + r * sphi)
     if fy:
         s[9] = s[7] + r * dphi * cphi - wt * (s[0] - s[2] + r * cphi)
-    return sphi, cphi
 
 
 @kernel
-def aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
+def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
     """One AEOM stick step of length ``h`` [s]: RK4 on x1, y1, φ, ψ (Eq. 13), x2, y2 by Eq. (12).
 
-    ``k1`` = f(y) in stick. At every stage the dependent x2, y2, ẋ2, ẏ2 are recomputed with
-    :func:`dependent_states` for the stage time, then the stick accelerations are evaluated
-    (``kernels.stick_rhs_at`` ≡ Eq. 13, with the sin φ, cos φ that :func:`dependent_states`
-    computed). The RK4 update of the dependent entries is discarded and replaced by Eq. (12) at
-    the step end. Returns the rhs calls made (3) and sin φ, cos φ at the step end.
+    ``k1`` = f(y) in stick; ``sphi``, ``cphi``: sin φ, cos φ at ``y``. At every stage the
+    dependent x2, y2, ẋ2, ẏ2 are recomputed with :func:`dependent_states` for the stage time,
+    then the stick accelerations are evaluated (``kernels.rhs_at`` in stick ≡ Eq. 13; the
+    stage's sin φ, cos φ are those at ``y`` turned by its change of φ, ``kernels.rotated``). The
+    RK4 update of the dependent entries is discarded and replaced by Eq. (12) at the step end.
+    Returns the rhs calls made (3) and sin φ, cos φ at the step end.
     """
     n = y.shape[0]
-    u0, w0, a0, b0 = _trapezoid_base(y, p)
+    u0, w0, a0, b0 = _trapezoid_base(y, sphi, cphi, p)
     half = 0.5 * h
     for i in range(n):
         ytmp[i] = y[i] + half * k1[i]
-    sphi, cphi = dependent_states(ytmp, half, u0, w0, a0, b0, minv, p)
-    K.stick_rhs_at(ytmp, sphi, cphi, minv, damp, stiff, p, k2)
+    _stick_stage(y, sphi, cphi, ytmp, half, u0, w0, a0, b0, minv, damp, stiff, p, k2)
     for i in range(n):
         ytmp[i] = y[i] + half * k2[i]
-    sphi, cphi = dependent_states(ytmp, half, u0, w0, a0, b0, minv, p)
-    K.stick_rhs_at(ytmp, sphi, cphi, minv, damp, stiff, p, k3)
+    _stick_stage(y, sphi, cphi, ytmp, half, u0, w0, a0, b0, minv, damp, stiff, p, k3)
     for i in range(n):
         ytmp[i] = y[i] + h * k3[i]
-    sphi, cphi = dependent_states(ytmp, h, u0, w0, a0, b0, minv, p)
-    K.stick_rhs_at(ytmp, sphi, cphi, minv, damp, stiff, p, k4)
+    _stick_stage(y, sphi, cphi, ytmp, h, u0, w0, a0, b0, minv, damp, stiff, p, k4)
     sixth = h / 6.0
     for i in range(n):
         ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-    sphi, cphi = dependent_states(ynew, h, u0, w0, a0, b0, minv, p)
+    sphi1 = math.sin(ynew[4])
+    cphi1 = math.cos(ynew[4])
+    dependent_states(ynew, sphi1, cphi1, h, u0, w0, a0, b0, minv, p)
     if minv[2] == 0.0 or minv[3] == 0.0:
         K.project_velocity(ynew, minv, p)  # the component(s) of v_r = 0 not built in (φ unchanged)
-    return 3, sphi, cphi
+    return 3, sphi1, cphi1
+
+
+@inlined_kernel
+def _stick_stage(y, sphi, cphi, ytmp, tau, u0, w0, a0, b0, minv, damp, stiff, p, ds):
+    """A stage of :func:`aeom_stick_step` at time τ [s] into the step: dependent states, then
+    the stick derivative into ``ds``."""
+    c, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
+    dependent_states(ytmp, sn, c, tau, u0, w0, a0, b0, minv, p)
+    K.rhs_at(ytmp, sn, c, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, ds)
 
 
 @kernel
-def aeom_stick_branch(y, k1, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
+def aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
     """An AEOM stick step of length ``h`` [s] with breakaway located by bisection on re-stepping.
 
     If the stick force at the step end violates Eq. (10), θ ∈ (0, 1] is bisected, each trial
     re-taking the stick step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step then ends on the slip side of the root.
 
-    Returns (h_taken, transition, Fx, Fy): the step length taken [s], 0 or
-    ``events.TRANSITION_TO_SLIP``, and the stick force at the step end [N]. ``ynew`` and
-    ``fnew`` = f(ynew) (stick) hold the step end; ``stats`` counts rhs calls (index 2) and
-    re-taken steps (index 3).
+    ``sphi``, ``cphi``: sin φ, cos φ at ``y``. Returns (h_taken, transition, Fx, Fy, sphi1,
+    cphi1): the step length taken [s], 0 or ``events.TRANSITION_TO_SLIP``, the stick force at
+    the step end [N] and sin φ, cos φ there. ``ynew`` and ``fnew`` = f(ynew) (stick) hold the
+    step end; ``stats`` counts rhs calls (index 2) and re-taken steps (index 3).
     """
-    calls, sphi, cphi = aeom_stick_step(y, k1, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    Fx, Fy = K.stick_rhs_at(ynew, sphi, cphi, minv, damp, stiff, p, fnew)
+    calls, sphi1, cphi1 = aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+    Fx, Fy, _, _ = K.rhs_at(ynew, sphi1, cphi1, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
     stats[2] += calls + 1
     if K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
-        return h, 0, Fx, Fy
+        return h, 0, Fx, Fy, sphi1, cphi1
     a = 0.0
     b = 1.0
+    at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
     for _ in range(E.MAX_BISECTIONS):
         if (b - a) * h <= E.EVENT_TIME_TOL:
             break
         c = 0.5 * (a + b)
-        calls, _, _ = aeom_stick_step(y, k1, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        calls, sphi_c, cphi_c = aeom_stick_step(y, k1, sphi, cphi, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3,
+                                                k4)
         stats[2] += calls
         stats[3] += 1
         if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
             a = c
+            at_b = False
         else:
             b = c
-    if b < 1.0:
-        calls, _, _ = aeom_stick_step(y, k1, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+            at_b = True
+            sphi1 = sphi_c
+            cphi1 = cphi_c
+    if not at_b:
+        calls, sphi1, cphi1 = aeom_stick_step(y, k1, sphi, cphi, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3,
+                                              k4)
         stats[2] += calls
         stats[3] += 1
-    Fx, Fy, _, _ = K.rhs(ynew, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
+    Fx, Fy, _, _ = K.rhs_at(ynew, sphi1, cphi1, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
     stats[2] += 1
-    return b * h, E.TRANSITION_TO_SLIP, Fx, Fy
+    return b * h, E.TRANSITION_TO_SLIP, Fx, Fy, sphi1, cphi1

@@ -58,6 +58,8 @@ RANK_TOL = 1e-10
 #: Largest angle [rad] that :func:`rotated` turns by with its Taylor series (sin a to a⁹, cos a
 #: to a¹⁰: truncation ≤ a¹¹/11! ≈ 2.5e-19 relative at 0.1); larger angles call sin and cos.
 SMALL_ANGLE = 0.1
+_S3, _S5, _S7, _S9 = -1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362880.0
+_C2, _C4, _C6, _C8, _C10 = -0.5, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0, -1.0 / 3628800.0
 
 
 @kernel
@@ -264,7 +266,7 @@ def dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds):
                    + damp[3] * s[9] * s[9] + damp[4] * s[10] * s[10] + damp[5] * s[11] * s[11])
 
 
-@kernel
+@inlined_kernel
 def rotated(c, s, angle):
     """(cos(θ + a), sin(θ + a)) from (c, s) = (cos θ, sin θ) and the angle a [rad].
 
@@ -274,9 +276,9 @@ def rotated(c, s, angle):
     sin and cos.
     """
     if abs(angle) <= SMALL_ANGLE:
-        a2 = angle * angle
-        sin_a = angle * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0))))
-        cos_a = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0 * (1.0 - a2 / 90.0))))
+        a2 = angle * angle  # Horner in a² with the reciprocal factorials: multiplies only, no divisions
+        sin_a = angle + angle * a2 * (_S3 + a2 * (_S5 + a2 * (_S7 + a2 * _S9)))
+        cos_a = 1.0 + a2 * (_C2 + a2 * (_C4 + a2 * (_C6 + a2 * (_C8 + a2 * _C10))))
     else:
         sin_a = math.sin(angle)
         cos_a = math.cos(angle)
@@ -366,7 +368,7 @@ def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
     return slip_force_at(s, sphi, cphi, X, Y, dX + w * Y, dY - w * X, mode, ex, ey, minv, damp, stiff, p)
 
 
-@kernel
+@inlined_kernel
 def slip_force_at(s, sphi, cphi, X, Y, vx, vy, mode, ex, ey, minv, damp, stiff, p):
     """Slip force of ``mode`` [N], Eq. (3), with the contact kinematics and v_r = (vx, vy) [m/s]
     at ``s`` already computed; the direction as in :func:`contact_force`."""
@@ -390,16 +392,6 @@ def slip_direction(s, vx, vy, ex, ey, minv, damp, stiff, p):
 
 
 @kernel
-def stick_rhs_at(s, sphi, cphi, minv, damp, stiff, p, ds):
-    """:func:`rhs` in stick with sin φ, cos φ of ``s[4]`` given (AEOM's stages have them from the
-    trapezoidal update of x2, y2); returns the stick force (Fx, Fy) [N]."""
-    X, Y = contact_position_at(s, sphi, cphi, p)
-    Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
-    dynamics_at(s, Fx, Fy, sphi, cphi, X, Y, minv, damp, stiff, p, ds)
-    return Fx, Fy
-
-
-@kernel
 def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     """State derivative in slip or stick; returns the friction force (Fx, Fy) used [N] and the
     relative velocity (vx, vy) at ``s`` [m/s], Eq. (9).
@@ -408,7 +400,20 @@ def rhs(s, mode, ex, ey, minv, damp, stiff, p, ds):
     and in the low-speed band (this function is the integrators' inner loop, and v_r at a step's
     end is what the event tests need).
     """
-    sphi, cphi, X, Y = contact_kinematics(s, p)
+    return _rhs_body(s, math.sin(s[4]), math.cos(s[4]), mode, ex, ey, minv, damp, stiff, p, ds)
+
+
+@kernel
+def rhs_at(s, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, ds):
+    """:func:`rhs` with sin φ, cos φ of ``s[4]`` given: an RK4 stage turns them from the step start
+    by the stage's change of φ (:func:`rotated`) instead of calling sin and cos."""
+    return _rhs_body(s, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, ds)
+
+
+@inlined_kernel
+def _rhs_body(s, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, ds):
+    """The body of :func:`rhs` and :func:`rhs_at`, inlined into both (no call in between)."""
+    X, Y = contact_position_at(s, sphi, cphi, p)
     dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
     vx = dX + w * Y
