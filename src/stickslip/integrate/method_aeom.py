@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 
 from ..model import kernels as K
-from ..model.jit import inlined_kernel, kernel
+from ..model.jit import kernel
 from . import events as E
 
 __all__ = ["aeom_stick_branch", "aeom_stick_step", "dependent_states"]
@@ -110,7 +110,7 @@ def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, 
 
     ``k1`` = f(y) in stick; ``sphi``, ``cphi``: sin φ, cos φ at ``y``. At every stage the
     dependent x2, y2, ẋ2, ẏ2 are recomputed with :func:`dependent_states` for the stage time,
-    then the stick accelerations are evaluated (``kernels.rhs_at`` in stick ≡ Eq. 13; the
+    then the stick accelerations are evaluated (``kernels.rhs`` in stick ≡ Eq. 13; the
     stage's sin φ, cos φ are those at ``y`` turned by its change of φ, ``kernels.rotated``). The
     RK4 update of the dependent entries is discarded and replaced by Eq. (12) at the step end.
     Returns the rhs calls made (3) and sin φ, cos φ at the step end.
@@ -118,15 +118,23 @@ def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, 
     n = y.shape[0]
     u0, w0, a0, b0 = _trapezoid_base(y, sphi, cphi, p)
     half = 0.5 * h
-    for i in range(n):
-        ytmp[i] = y[i] + half * k1[i]
-    _stick_stage(y, sphi, cphi, ytmp, half, u0, w0, a0, b0, minv, damp, stiff, p, k2)
-    for i in range(n):
-        ytmp[i] = y[i] + half * k2[i]
-    _stick_stage(y, sphi, cphi, ytmp, half, u0, w0, a0, b0, minv, damp, stiff, p, k3)
-    for i in range(n):
-        ytmp[i] = y[i] + h * k3[i]
-    _stick_stage(y, sphi, cphi, ytmp, h, u0, w0, a0, b0, minv, damp, stiff, p, k4)
+    k_in = k1
+    for stage in range(3):  # one inlined right-hand side for the three stages, as fixed_step.rk4_slip_step
+        if stage == 0:
+            tau = half
+            k_out = k2
+        elif stage == 1:
+            tau = half
+            k_out = k3
+        else:
+            tau = h
+            k_out = k4
+        for i in range(n):
+            ytmp[i] = y[i] + tau * k_in[i]
+        cs, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
+        dependent_states(ytmp, sn, cs, tau, u0, w0, a0, b0, minv, p)
+        K._rhs_body(ytmp, sn, cs, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, k_out)
+        k_in = k_out
     sixth = h / 6.0
     for i in range(n):
         ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -136,15 +144,6 @@ def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, 
     if minv[2] == 0.0 or minv[3] == 0.0:
         K.project_velocity(ynew, minv, p)  # the component(s) of v_r = 0 not built in (φ unchanged)
     return 3, sphi1, cphi1
-
-
-@inlined_kernel
-def _stick_stage(y, sphi, cphi, ytmp, tau, u0, w0, a0, b0, minv, damp, stiff, p, ds):
-    """A stage of :func:`aeom_stick_step` at time τ [s] into the step: dependent states, then
-    the stick derivative into ``ds``."""
-    c, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
-    dependent_states(ytmp, sn, c, tau, u0, w0, a0, b0, minv, p)
-    K.rhs_at(ytmp, sn, c, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, ds)
 
 
 @kernel
