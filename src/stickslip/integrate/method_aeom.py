@@ -147,7 +147,7 @@ def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, 
 
 
 @kernel
-def aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
+def aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, Q, work, stats):
     """An AEOM stick step of length ``h`` [s] with breakaway located by bisection on re-stepping.
 
     If the stick force at the step end violates Eq. (10), θ ∈ (0, 1] is bisected, each trial
@@ -164,13 +164,14 @@ def aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, fnew, yt
     stats[2] += calls + 1
     if K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
         return h, 0, Fx, Fy, sphi1, cphi1
+    estimate = E.interpolated_crossing(E.EVENT_STICK, y, k1, ynew, fnew, h, 0.0, 0.0, minv, damp, stiff, p, Q, work)
     a = 0.0
     b = 1.0
     at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
     for _ in range(E.MAX_BISECTIONS):
-        if (b - a) * h <= E.EVENT_TIME_TOL:
+        c = E.bisection_point(a, b, estimate, h)
+        if c < 0.0:
             break
-        c = 0.5 * (a + b)
         calls, sphi_c, cphi_c = aeom_stick_step(y, k1, sphi, cphi, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3,
                                                 k4)
         stats[2] += calls

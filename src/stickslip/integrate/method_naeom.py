@@ -154,7 +154,7 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
 
 
 @kernel
-def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4, stats):
+def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4, Q, stats):
     """A NAEOM stick step from ``y`` at time ``t`` [s] of length ``h`` [s], breakaway bisected.
 
     ``hist`` (7,) is the force history of the current stick phase, updated here: the number of
@@ -164,7 +164,9 @@ def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, 
 
     Returns (h_taken, transition, Fx, Fy, solved): the step length taken [s], 0 or
     ``events.TRANSITION_TO_SLIP``, the solved force [N], and False if a solve failed
-    (:data:`MAX_NEWTON`). ``ynew`` holds the step end.
+    (:data:`MAX_NEWTON`). ``ynew`` holds the step end. Breakaway is bisected on re-solved steps,
+    the first trials around the root on the step's interpolant (``events.bisection_point``);
+    ``Q`` (n, 3) is a work array.
     """
     n_hist = hist[0]
     tm = t + 0.5 * h
@@ -181,12 +183,18 @@ def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, 
         return h, 0, Fx, Fy, False
     transition = 0
     if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) <= 0.0:
+        # the step's Hermite interpolant under the solved force gives the first trials
+        K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
+        K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, k2)
+        estimate = E.interpolated_crossing(E.EVENT_STICK, y, k1, ynew, k2, h, 0.0, 0.0, minv, damp, stiff, p, Q,
+                                           ytmp)
         a = 0.0
         b = 1.0
+        at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
         for _ in range(E.MAX_BISECTIONS):
-            if (b - a) * h <= E.EVENT_TIME_TOL:
+            c = E.bisection_point(a, b, estimate, h)
+            if c < 0.0:
                 break
-            c = 0.5 * (a + b)
             Fx, Fy, it = solve_stick_step(y, c * h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4,
                                           stats)
             stats[3] += 1
@@ -194,9 +202,11 @@ def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, 
                 return h, 0, Fx, Fy, False
             if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
                 a = c
+                at_b = False
             else:
                 b = c
-        if b < 1.0:
+                at_b = True
+        if not at_b:
             Fx, Fy, it = solve_stick_step(y, b * h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4,
                                           stats)
             stats[3] += 1
