@@ -186,7 +186,7 @@ def test_compiled_segments_agree_with_scipy_dop853(orbit50, monkeypatch):
 def test_flow_jacobian_of_a_transient_against_finite_differences(model, N, duration):
     """Not an orbit: the linearised flow over a stretch of a transient with several stick
     phases (Model 2: 3 stick + 3 breakaway, Model 1 at N = 120 N: 3 + 2) against central
-    differences of the flow map (step 1e-6 σ)."""
+    differences of the flow map (step 1e-5 σ)."""
     from stickslip import simulate
     from stickslip.orbits.variational import fd_monodromy, free_states
 
@@ -200,9 +200,12 @@ def test_flow_jacobian_of_a_transient_against_finite_differences(model, N, durat
     fj = flow_jacobian(P, model, tr.final_state, duration, scale=sigma)
     assert sum(k == "stick" for _, k in fj.events) == 3
     M = fj.matrix[np.ix_(free, free)]
-    Mfd = fd_monodromy(P, model, tr.final_state, duration, free, 1e-6 * sigma, rtol=1e-10, atol=1e-13,
+    # Step 1e-5 σ: the adaptive flow map carries round-off-level noise (rtol 1e-10) that central
+    # differences divide by the step. Measured for Model 1 against the variational matrix: step
+    # 1e-7 σ 1.2e-4, 1e-6 σ 1.1e-5 to 1.5e-5 (it depends on the start state's last bits), 1e-5 σ
+    # 1.1e-6, where the variational matrices of two code versions agree to 1e-8.
+    Mfd = fd_monodromy(P, model, tr.final_state, duration, free, 1e-5 * sigma, rtol=1e-10, atol=1e-13,
                        slip_band=1e-4)
-    # measured 7.9e-7 (Model 2) and 2.1e-6 (Model 1) relative to the largest entry
     assert np.max(np.abs(M - Mfd)) < 1e-5 * np.max(np.abs(Mfd))
 
 

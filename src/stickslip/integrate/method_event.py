@@ -42,12 +42,20 @@ MAX_HOMING_STEP = 1e-3  # [s] longest extrapolated step onto v_r = 0; ≪ the 0.
 
 @kernel
 def _dp_step(y, k1, h, mode, ex, ey, minv, damp, stiff, p, Kst, ynew, ytmp):
-    """One Dormand–Prince step from y with k1 = f(y); fills the stages Kst[0:7] and ynew."""
+    """One Dormand–Prince step from y with k1 = f(y); fills the stages Kst[0:7] and ynew.
+
+    The five inner stages are one loop around one inlined right-hand side
+    (``kernels._rhs_body``), their sin φ, cos φ those of ``y`` turned by the stage's change of
+    φ (``kernels.rotated``, round-off equal to sin and cos) — as the fixed-step RK4 stages.
+    """
     for i in range(y.shape[0]):
         Kst[0, i] = k1[i]
+    sphi = math.sin(y[4])
+    cphi = math.cos(y[4])
     for stage in range(1, 6):
         DP.stage_state(y, Kst, h, stage, ytmp)
-        K.rhs(ytmp, mode, ex, ey, minv, damp, stiff, p, Kst[stage])
+        cs, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
+        K._rhs_body(ytmp, sn, cs, mode, ex, ey, minv, damp, stiff, p, Kst[stage])
     DP.stage_state(y, Kst, h, np.int64(6), ynew)  # not a literal: one compiled version
     K.rhs(ynew, mode, ex, ey, minv, damp, stiff, p, Kst[6])
 
