@@ -182,9 +182,10 @@ def slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv, damp, stiff
     trial re-taking the RK4 step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step is then the one that ends on the ≤ 0 side of the root.
     Plain halving from the whole step: unlike breakaway (``events.bisection_point``), the root
-    on the step's interpolant is no guide here (measured off by 1e-4 to 0.2 of the step at
+    on the step's interpolant is a poor guide here (measured off by 1e-4 to 0.2 of the step at
     Δt = 1e-3 s: near v_r = 0 the slip direction relaxes faster than the step resolves, and the
-    re-taken RK4 steps of different lengths do not follow one smooth path).
+    re-taken RK4 steps of different lengths do not follow one smooth path). Starting from it
+    saved 2 % of the re-steps at Δt = 1e-3 s and 26 % at 1e-4 s (0.2 % of that run): not kept.
 
     ``(rx, ry)``: unit reference direction, (0, 0) for none (right after breakaway, v_r = 0);
     ``sphi``, ``cphi``: sin φ, cos φ at ``y``. Returns
