@@ -124,7 +124,7 @@ def test_variants():
         resolve_variant("z")
 
 
-@pytest.mark.parametrize("angle", [0.0, 1e-9, -3e-4, 0.05, -0.1, 0.1000001, -0.7, 2.5, -40.0])
+@pytest.mark.parametrize("angle", [0.0, 1e-9, -3e-4, 2.0**-9, -0.0019532, 0.05, -0.1, 0.1000001, -0.7, 2.5, -40.0])
 def test_rotated_is_the_angle_sum(angle):
     """(cos, sin) turned by an angle, Taylor series or library: the angle-sum formulas to round-off."""
     for theta in (0.0, 0.3, -2.0, 3.1):
