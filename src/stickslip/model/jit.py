@@ -14,9 +14,9 @@ kernels on the innermost path (``kernels.dynamics_at``, ``slip_force_at``, ``rot
 the right-hand side's body ``kernels._rhs_body`` at exactly one call site per integrator step,
 inside the loop over its stages (a call passes each array as 7 words, ~40 per rhs; inlined:
 −1.5…6 % per fixed-step run). Each inlined copy of the rhs costs ~2.3 s of cold compile: three
-copies (one per RK4 stage) took it +5…9 s for about the speed of one copy in a loop. Inlining larger step functions (``fixed_step.rk4_slip_step``)
-into the loop made runs 1.5× *slower*, and inlining every kernel took the cold compile from
-15 s to 295 s.
+copies (one per RK4 stage) took it +5…9 s for about the speed of one copy in a loop. Inlining
+larger step functions (``fixed_step.rk4_slip_step``) into the loop made runs 1.5× *slower*, and
+inlining every kernel took the cold compile from 15 s to 295 s.
 
 ``error_model="numpy"`` everywhere: a float division by zero gives inf/nan as in numpy instead
 of raising ZeroDivisionError, so divisions carry no zero test and branch to an exception
