@@ -39,6 +39,7 @@ import math
 from ..model import kernels as K
 from ..model.jit import kernel
 from . import events as E
+from . import rk4
 
 __all__ = ["aeom_stick_branch", "aeom_stick_step", "dependent_states"]
 
@@ -115,29 +116,14 @@ def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, 
     RK4 update of the dependent entries is discarded and replaced by Eq. (12) at the step end.
     Returns the rhs calls made (3) and sin φ, cos φ at the step end.
     """
-    n = y.shape[0]
     u0, w0, a0, b0 = _trapezoid_base(y, sphi, cphi, p)
-    half = 0.5 * h
-    k_in = k1
-    for stage in range(3):  # one inlined right-hand side for the three stages, as fixed_step.rk4_slip_step
-        if stage == 0:
-            tau = half
-            k_out = k2
-        elif stage == 1:
-            tau = half
-            k_out = k3
-        else:
-            tau = h
-            k_out = k4
-        for i in range(n):
-            ytmp[i] = y[i] + tau * k_in[i]
+    for stage in range(3):  # one inlined right-hand side for the three stages (integrate/rk4.py)
+        tau, k_in, k_out = rk4.stage_arrays(stage, h, k1, k2, k3, k4)
+        rk4.stage_state(y, k_in, tau, ytmp)
         cs, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
         dependent_states(ytmp, sn, cs, tau, u0, w0, a0, b0, minv, p)
         K._rhs_body(ytmp, sn, cs, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, k_out)
-        k_in = k_out
-    sixth = h / 6.0
-    for i in range(n):
-        ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    rk4.combine(y, h, k1, k2, k3, k4, ynew)
     sphi1 = math.sin(ynew[4])
     cphi1 = math.cos(ynew[4])
     dependent_states(ynew, sphi1, cphi1, h, u0, w0, a0, b0, minv, p)

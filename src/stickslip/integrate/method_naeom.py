@@ -33,6 +33,7 @@ import math
 from ..model import kernels as K
 from ..model.jit import kernel
 from . import events as E
+from . import rk4
 
 __all__ = ["naeom_stick_branch", "solve_stick_step", "rk4_force_step", "VR_TOL", "MAX_NEWTON", "STATUS_SOLVE_FAILED"]
 
@@ -62,21 +63,12 @@ STATUS_SOLVE_FAILED = 4
 @kernel
 def rk4_force_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4):
     """RK4 step of Eq. (1) with the friction force (Fx, Fy) [N] held constant; writes ``ynew``."""
-    n = y.shape[0]
-    half = 0.5 * h
     K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
-    for i in range(n):
-        ytmp[i] = y[i] + half * k1[i]
-    K.dynamics(ytmp, Fx, Fy, minv, damp, stiff, p, k2)
-    for i in range(n):
-        ytmp[i] = y[i] + half * k2[i]
-    K.dynamics(ytmp, Fx, Fy, minv, damp, stiff, p, k3)
-    for i in range(n):
-        ytmp[i] = y[i] + h * k3[i]
-    K.dynamics(ytmp, Fx, Fy, minv, damp, stiff, p, k4)
-    sixth = h / 6.0
-    for i in range(n):
-        ynew[i] = y[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    for stage in range(3):
+        c, k_in, k_out = rk4.stage_arrays(stage, h, k1, k2, k3, k4)
+        rk4.stage_state(y, k_in, c, ytmp)
+        K.dynamics(ytmp, Fx, Fy, minv, damp, stiff, p, k_out)
+    rk4.combine(y, h, k1, k2, k3, k4, ynew)
 
 
 @kernel
