@@ -164,9 +164,9 @@ def slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv, damp, stiff
 
     The event function is the projection of v_r on the reference direction (rx, ry)
     (``events.EVENT_SLIP``; :func:`event_direction`). If it has turned ≤ 0 at the step end,
-    θ ∈ (0, 1] is bisected, each
-    trial re-taking the RK4 step with θ h from ``y``, until the bracket is shorter than
-    ``events.EVENT_TIME_TOL``; the step is then the one that ends on the ≤ 0 side of the root.
+    θ ∈ (0, 1] is bisected, each trial re-taking the RK4 step with θ h from ``y``, until the
+    bracket is shorter than ``events.EVENT_TIME_TOL``; the step is then the one that ends on the
+    ≤ 0 side of the root.
     Plain halving from the whole step: unlike breakaway (``events.bisection_point``), the root
     on the step's interpolant is a poor guide here (measured off by 1e-4 to 0.2 of the step at
     Δt = 1e-3 s: near v_r = 0 the slip direction relaxes faster than the step resolves, and the
@@ -348,48 +348,45 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             status = STATUS_STEP_UNDERFLOW
             break
         transition = 0
+        crossed = False
         if mode == K.MODE_SLIP:
             rx, ry = event_direction(vx, vy, rx, ry, p)
             h, crossed, vx, vy, Fx, Fy, sphi, cphi = slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv,
                                                                           damp, stiff, p, ynew, fnew, ytmp, k2, k3,
                                                                           k4, stats)
-            idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
-            if not done:
-                idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
-                                    damp, stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
+        elif method == METHOD_AEOM:
+            h, transition, Fx, Fy, sphi, cphi = aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew,
+                                                                  fnew, ytmp, k2, k3, k4, Q, work, stats)
+        else:
+            h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, s1,
+                                                               k2, k3, k4, Q, stats)
+            if not solved:
+                status = STATUS_SOLVE_FAILED
+                break
+            sphi = math.sin(ynew[4])
+            cphi = math.cos(ynew[4])
+        # samples of the step (Fx, Fy: the friction force at its end), before a transition changes ex, ey
+        idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
+        if not done:
+            fixed_force = force_from_state
+            if mode == K.MODE_STICK and method == METHOD_NAEOM:
+                # NAEOM's constant force: derivatives at both step ends under it, for the Hermite samples
+                K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
+                K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, fnew)
+                stats[2] += 2
+                fixed_force = force_given
+            idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, fixed_force, minv, damp, stiff,
+                                p, sample_times, out_s, out_mode, out_F, Q, work)
+        if mode == K.MODE_SLIP:
             ex, ey = K.slip_direction(ynew, vx, vy, ex, ey, minv, damp, stiff, p)
             if crossed:
                 stick, ex, ey = after_slip_root(ynew, ex, ey, minv, damp, stiff, p)
                 if stick:
                     transition = E.TRANSITION_TO_STICK
                     hist[0] = 0.0
-        else:
-            if method == METHOD_AEOM:
-                h, transition, Fx, Fy, sphi, cphi = aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p,
-                                                                      ynew, fnew, ytmp, k2, k3, k4, Q, work, stats)
-                idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
-                if not done:
-                    idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_from_state, minv,
-                                        damp, stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
-            else:
-                h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp,
-                                                                   s1, k2, k3, k4, Q, stats)
-                if not solved:
-                    status = STATUS_SOLVE_FAILED
-                    break
-                sphi = math.sin(ynew[4])
-                cphi = math.cos(ynew[4])
-                idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
-                if not done:
-                    # derivatives at both step ends under the solved force, for the Hermite samples
-                    K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
-                    K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, fnew)
-                    stats[2] += 2
-                    idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, force_given, minv, damp,
-                                        stiff, p, sample_times, out_s, out_mode, out_F, Q, work)
-            if transition == E.TRANSITION_TO_SLIP:
-                Fx, Fy, _ = K.stick_force(ynew, minv, damp, stiff, p)
-                ex, ey = E.breakaway_direction(Fx, Fy)
+        elif transition == E.TRANSITION_TO_SLIP:
+            Fx, Fy, _ = K.stick_force(ynew, minv, damp, stiff, p)
+            ex, ey = E.breakaway_direction(Fx, Fy)
         t += h
         stats[0] += 1
         for i in range(n):

@@ -99,6 +99,12 @@ def contact_position(s, p):
 def relative_velocity(s, p):
     """Relative velocity v_r of the upper plate against the lower one at the contact, Eq. (9) [m/s]."""
     sphi, cphi, X, Y = contact_kinematics(s, p)
+    return relative_velocity_at(s, sphi, cphi, X, Y, p)
+
+
+@inlined_kernel
+def relative_velocity_at(s, sphi, cphi, X, Y, p):
+    """:func:`relative_velocity` with the contact kinematics (sin φ, cos φ, X, Y) already computed."""
     dX, dY = contact_rates(s, p, sphi, cphi)
     w = p[P_OMEGA] + s[11]
     return dX + w * Y, dY - w * X
@@ -302,9 +308,8 @@ def quasi_static_direction(s, ex, ey, minv, damp, stiff, p):
     e = −F_s/|F_s| is such a root. Newton from the previous direction (ex, ey).
     """
     sphi, cphi, X, Y = contact_kinematics(s, p)
-    dX, dY = contact_rates(s, p, sphi, cphi)
-    w = p[P_OMEGA] + s[11]
-    return quasi_static_direction_at(s, sphi, cphi, X, Y, dX + w * Y, dY - w * X, ex, ey, minv, damp, stiff, p)
+    vx, vy = relative_velocity_at(s, sphi, cphi, X, Y, p)
+    return quasi_static_direction_at(s, sphi, cphi, X, Y, vx, vy, ex, ey, minv, damp, stiff, p)
 
 
 @kernel
@@ -370,9 +375,8 @@ def contact_force(s, mode, ex, ey, minv, damp, stiff, p):
     if mode == MODE_STICK:
         Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
         return Fx, Fy
-    dX, dY = contact_rates(s, p, sphi, cphi)
-    w = p[P_OMEGA] + s[11]
-    return slip_force_at(s, sphi, cphi, X, Y, dX + w * Y, dY - w * X, mode, ex, ey, minv, damp, stiff, p)
+    vx, vy = relative_velocity_at(s, sphi, cphi, X, Y, p)
+    return slip_force_at(s, sphi, cphi, X, Y, vx, vy, mode, ex, ey, minv, damp, stiff, p)
 
 
 @inlined_kernel
@@ -421,10 +425,7 @@ def rhs_at(s, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, ds):
 def _rhs_body(s, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, ds):
     """The body of :func:`rhs` and :func:`rhs_at`, inlined into both (no call in between)."""
     X, Y = contact_position_at(s, sphi, cphi, p)
-    dX, dY = contact_rates(s, p, sphi, cphi)
-    w = p[P_OMEGA] + s[11]
-    vx = dX + w * Y
-    vy = dY - w * X
+    vx, vy = relative_velocity_at(s, sphi, cphi, X, Y, p)
     if mode == MODE_STICK:
         Fx, Fy, _ = stick_force_at(s, sphi, cphi, X, Y, minv, damp, stiff, p)
     else:
