@@ -165,21 +165,14 @@ def save_orbit_figure(orbit, traj, path, *, dpi: int = 110) -> Path:
     -------
     Path
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = _pyplot_agg()
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained", width_ratios=(1.6, 1.0))
     plot_orbit(orbit, traj, axes[0])
     plot_multipliers(orbit, axes[1])
     p = orbit.params
     fig.suptitle(f"Periodic orbit, model {orbit.model}: N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
                  f"section {orbit.section.name}", fontsize=10)
-    path = Path(path)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return _save(fig, path, dpi)
 
 
 def save_lyapunov_spectrum_figure(spectrum, path, *, dpi: int = 110) -> Path:
@@ -195,12 +188,24 @@ def save_lyapunov_spectrum_figure(spectrum, path, *, dpi: int = 110) -> Path:
     -------
     Path
     """
+    _pyplot_agg()
+    return _save(plot_lyapunov_spectrum(spectrum), path, dpi)
+
+
+def _pyplot_agg():
+    """pyplot on the Agg backend (files only, no display)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = plot_lyapunov_spectrum(spectrum)
+    return plt
+
+
+def _save(fig, path, dpi: int) -> Path:
+    """Write ``fig`` to ``path`` and close it; returns the path."""
+    import matplotlib.pyplot as plt
+
     path = Path(path)
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
