@@ -32,6 +32,7 @@ import importlib
 __version__ = "0.1.0"
 
 from .analysis import Classification, classify, find_peaks, intensity
+from .errors import StickSlipError
 from .integrate.driver import SimulationError, simulate
 from .integrate.result import FileFormatError, Trajectory, load_trajectory
 from .model.parameters import ParameterError, Parameters
@@ -65,7 +66,7 @@ def __dir__():
 
 
 __all__ = [
-    "__version__",
+    "__version__", "StickSlipError",
     "Parameters", "ParameterError",
     "simulate", "SimulationError",
     "Trajectory", "load_trajectory", "FileFormatError",

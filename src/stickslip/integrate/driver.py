@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import math
 import time
 from pathlib import Path
@@ -23,7 +25,7 @@ __all__ = ["simulate", "initial_state", "SimulationError", "METHODS"]
 MAX_SAMPLES = 20_000_000
 
 
-class SimulationError(ValueError):
+class SimulationError(StickSlipError, ValueError):
     """Invalid simulation options, or a run that could not finish."""
 
 

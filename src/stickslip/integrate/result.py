@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import dataclasses
 import json
 from functools import cached_property
@@ -29,7 +31,7 @@ _STATE_LONG_NAMES = (
 ) + tuple(f"velocity of {n}" for n in STATE_NAMES[:6])
 
 
-class FileFormatError(ValueError):
+class FileFormatError(StickSlipError, ValueError):
     """A file that is not a stickslip result."""
 
 

@@ -6,6 +6,8 @@ N = 50 N, Ω = 5 rad/s, μk = 0.2, Δμ = 0.1, α = 5 s/m used throughout Sect. 
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import dataclasses
 import math
 import sys
@@ -77,7 +79,7 @@ def parameter_attrs(values: Mapping[str, Any]) -> dict[str, Any]:
     return attrs
 
 
-class ParameterError(ValueError):
+class ParameterError(StickSlipError, ValueError):
     """A parameter value or file that cannot describe the physical model."""
 
 

@@ -7,6 +7,8 @@ the upper plate rotating against a rigidly driven lower plate, the 1-DOF belt os
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import dataclasses
 from typing import Iterable
 
@@ -28,7 +30,7 @@ MODELS: dict[str, tuple[str, ...]] = {
 }
 
 
-class VariantError(ValueError):
+class VariantError(StickSlipError, ValueError):
     """An unknown model name or DOF."""
 
 

@@ -13,6 +13,8 @@ not a dense-output sample before it.
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import dataclasses
 
 import numpy as np
@@ -26,7 +28,7 @@ from ..model.variants import STATE_NAMES
 __all__ = ["Section", "resolve_section", "OrbitError", "flow", "vector_field", "section_crossings"]
 
 
-class OrbitError(RuntimeError):
+class OrbitError(StickSlipError, RuntimeError):
     """A periodic orbit or Lyapunov exponent could not be computed (the message says why)."""
 
 

@@ -8,6 +8,8 @@ simulator's own kernel (:func:`equilibrium_residual`).
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import math
 
 import numpy as np
@@ -29,7 +31,7 @@ RESIDUAL_TOL = 1e-10
 MAX_ITER = 60
 
 
-class EquilibriumError(RuntimeError):
+class EquilibriumError(StickSlipError, RuntimeError):
     """No steady-sliding equilibrium could be found."""
 
 

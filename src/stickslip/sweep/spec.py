@@ -7,6 +7,8 @@ the trajectory outlives the point and memory stays flat as the grid grows.
 
 from __future__ import annotations
 
+from ..errors import StickSlipError
+
 import dataclasses
 import hashlib
 import json
@@ -39,7 +41,7 @@ NAMED_ICS = {
 _SPECIAL_DIMS = ("model", "ic")
 
 
-class SweepError(ValueError):
+class SweepError(StickSlipError, ValueError):
     """An invalid sweep definition, or an output that belongs to another sweep."""
 
 
