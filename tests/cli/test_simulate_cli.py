@@ -67,7 +67,7 @@ def test_config_file_and_continuation(tmp_path):
         (["--set", "N"], "NAME=VALUE"),
         (["--model", "z"], "unknown model"),
         (["--method", "euler"], "unknown method"),
-        (["--t-end", "-1"], "t_end"),
+        (["--t-end", "-1"], "--t-end"),
         (["--rtol", "0"], "rtol"),
         (["--rtol", "1e-20"], "rtol"),
         (["--dt", "-0.1"], "dt"),
@@ -103,3 +103,142 @@ def test_locked_dof_in_initial_state_is_refused(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     res = run("--t-end", "1", "--no-plot", "--model", "rotation", "--ic", ",".join(["0.001"] + ["0"] * 11))
     assert res.exit_code != 0 and "locked" in res.output
+
+
+# ----------------------------------------------------------------------------- continuing a run
+def lines_of(res) -> list:
+    return [ln for ln in res.output.splitlines() if ln.strip()]
+
+
+@pytest.fixture(scope="module")
+def saved_run(tmp_path_factory):
+    """A rotation-model run with non-default parameters and settings, 0–2 s."""
+    path = tmp_path_factory.mktemp("saved") / "first.nc"
+    res = run("--model", "rotation", "--N", "30", "--omega", "0.5", "--set", "k_pphi=150", "--t-end", "2",
+              "--sample-rate", "500", "--rtol", "1e-9", "--no-plot", "--out", str(path))
+    assert res.exit_code == 0, res.output
+    return path
+
+
+def test_continuing_a_run_takes_its_model_parameters_settings_and_time(saved_run, tmp_path):
+    first = load_trajectory(saved_run)
+    out = tmp_path / "second.nc"
+    res = run("--ic", str(saved_run), "--t-end", "1", "--no-plot", "--out", str(out))
+    assert res.exit_code == 0, res.output
+    assert f"continuing {saved_run} from t = 2 s" in res.output and "overridden" not in res.output
+    second = load_trajectory(out)
+    assert second.model == "rotation" and second.params == first.params
+    assert (second.options["sample_rate"], second.options["rtol"]) == (500.0, 1e-9)
+    assert second.t[0] == first.t[-1] == 2.0 and second.t[-1] == 3.0  # --t-end is the time added
+    assert np.array_equal(second.states[0], first.states[-1])
+
+
+def test_options_given_when_continuing_override_the_saved_ones_and_are_named(saved_run, tmp_path):
+    out = tmp_path / "second.nc"
+    res = run("--ic", str(saved_run), "--t-end", "1", "--N", "40", "--set", "alpha=3", "--rtol", "1e-8",
+              "--no-plot", "--out", str(out))
+    assert res.exit_code == 0, res.output
+    assert "overridden: --set alpha, --N, --rtol" in res.output
+    second, first = load_trajectory(out), load_trajectory(saved_run)
+    assert (second.params.N, second.params.alpha, second.params.k_pphi) == (40.0, 3.0, first.params.k_pphi)
+    assert (second.options["rtol"], second.options["sample_rate"]) == (1e-8, 500.0)
+
+
+@pytest.mark.parametrize("extra", [[], ["--overwrite"]])
+def test_the_input_run_is_never_overwritten(tmp_path, monkeypatch, extra):
+    monkeypatch.chdir(tmp_path)
+    assert run("--t-end", "1", "--no-plot").exit_code == 0
+    before = (tmp_path / "run.nc").read_bytes()
+    res = run("--ic", "run.nc", "--t-end", "1", "--no-plot", *extra)
+    assert res.exit_code == 2 and len(lines_of(res)) == 1, res.output
+    assert "--out run.nc is the file given to --ic" in res.output
+    assert (tmp_path / "run.nc").read_bytes() == before
+
+
+# ----------------------------------------------------------------------------- outputs
+@pytest.mark.parametrize("existing", ["x.nc", "x.png"])
+def test_an_existing_output_is_refused_without_overwrite(tmp_path, existing):
+    (tmp_path / existing).write_text("the user's file")
+    res = run("--t-end", "1", "--out", str(tmp_path / "x.nc"))
+    assert res.exit_code == 2 and len(lines_of(res)) == 1, res.output
+    assert f"{tmp_path / existing} exists; pass --overwrite" in res.output
+    assert (tmp_path / existing).read_text() == "the user's file"
+    assert run("--t-end", "1", "--out", str(tmp_path / "x.nc"), "--overwrite").exit_code == 0
+    assert load_trajectory(tmp_path / "x.nc").t[-1] == 1.0
+
+
+def test_json_alone_writes_nothing(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = run("--t-end", "1", "--json")
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout.strip().splitlines()[-1])["steps"] > 0
+    assert not list(tmp_path.iterdir())
+
+
+# ----------------------------------------------------------------------------- option checks
+@pytest.mark.parametrize("args, words", [
+    (["--t-end", "1e9", "--sample-rate", "1e6"], "lower --sample-rate to at most"),
+    (["--t-end", "1e300", "--sample-rate", "1e300"], "lower --sample-rate to at most"),
+    (["--N", "30", "--set", "N=40"], "--set N=40 and --N 30 both set N"),
+    (["--set", "N=30", "--set", "N=40"], "--set N is given twice"),
+    (["--steady-from", "-1"], "--steady-from -1 s is outside the run, which goes from 0 to 1 s"),
+    (["--steady-from", "5"], "--steady-from 5 s is outside the run"),
+    (["--steady-from", "nan"], "--steady-from must be a finite number"),
+    (["--perturb", "inf"], "--perturb must be a finite number"),
+    (["--sample-rate", "0"], "--sample-rate must be a finite number > 0"),
+])
+def test_refused_options_say_why_in_one_line(args, words, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = run("--t-end", "1", *args)
+    assert res.exit_code == 2 and len(lines_of(res)) == 1 and words in res.output, res.output
+    assert not list(tmp_path.iterdir())
+
+
+def test_the_steady_window_of_a_continuation_is_in_the_runs_time(saved_run, tmp_path):
+    res = run("--ic", str(saved_run), "--t-end", "1", "--steady-from", "1", "--json")
+    assert res.exit_code == 2 and "outside the run, which goes from 2 to 3 s" in res.output, res.output
+    res = run("--ic", str(saved_run), "--t-end", "1", "--steady-from", "2.5", "--json")
+    assert res.exit_code == 0, res.output
+
+
+def test_a_sample_rate_that_aliases_the_modes_is_warned_about(tmp_path):
+    res = run("--t-end", "20", "--sample-rate", "2", "--json")
+    assert res.exit_code == 0, res.output
+    warnings = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    # Table 1: the fastest linear mode is sqrt(k_px/m_p)/(2π) = 2.757 Hz, Nyquist 5.51 Hz
+    assert len(warnings) == 1 and "2.757 Hz" in warnings[0] and "--sample-rate 6 or more" in warnings[0], warnings
+    quiet = run("--t-end", "1", "--json")
+    assert quiet.exit_code == 0 and not quiet.stderr.strip(), quiet.stderr
+
+
+def test_a_run_that_stops_at_its_start_is_said_in_one_line(tmp_path):
+    out = tmp_path / "x.nc"
+    res = run("--t-end", "1", "--N", "1e300", "--no-plot", "--out", str(out))
+    assert res.exit_code == 1, res.output
+    assert lines_of(res) == ["error: the run stopped early: state became non-finite at t = 0 s; "
+                             "it kept too few samples to write"]
+    assert not out.exists()
+
+
+def test_a_run_that_stops_early_is_kept_and_said_in_one_line(tmp_path, monkeypatch):
+    import dataclasses
+
+    import stickslip.integrate.driver as driver
+
+    library = driver.simulate
+
+    def stops_at_half_time(*args, **kwargs):
+        traj = library(*args, **kwargs)
+        keep = traj.t <= 0.5
+        return dataclasses.replace(traj, t=traj.t[keep], states=traj.states[keep], mode=traj.mode[keep],
+                                   friction=traj.friction[keep], work=traj.work[keep], steady_from=0.25,
+                                   status="max_steps reached at t = 0.5 s")
+
+    monkeypatch.setattr(driver, "simulate", stops_at_half_time)
+    out = tmp_path / "x.nc"
+    res = run("--t-end", "1", "--out", str(out), "--json")
+    assert res.exit_code == 1, res.output
+    assert lines_of(res) == [f"error: the run stopped early: max_steps reached at t = 0.5 s; what it computed is in {out}"]
+    kept = load_trajectory(out)
+    assert kept.t[-1] == 0.5 and kept.status == "max_steps reached at t = 0.5 s"
+    assert out.with_suffix(".png").is_file()

@@ -160,7 +160,7 @@ def test_regions_of_known_cases_and_direct_run(tmp_path):
     (["sweep", "--grid", "N=30", "--t-end", "10", "--t-from", "20"], "t_from"),
     (["sweep", "--grid", "N=30", "--plot", "colour"], "--plot"),
     (["sweep", "--grid", "N=30", "--config", "missing.toml"], "does not exist"),
-    (["bifurcation", "--param", "N", "--N", "30"], "conflicts"),
+    (["bifurcation", "--param", "N", "--N", "30"], "--param N and --N 30 both set N"),
     (["bifurcation", "--param", "model"], "numeric"),
     (["bifurcation", "--param", "bogus", "--range", "1,2"], "cannot sweep"),
     (["bifurcation", "--range", "1:2"], "start:stop:count"),

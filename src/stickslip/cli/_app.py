@@ -1,49 +1,179 @@
-"""The typer application and helpers shared by the commands."""
+"""The typer application, its one error path, and helpers shared by the commands.
+
+Every command runs inside :class:`_Application`, which turns what the user can fix into one line
+on stderr and exit code 2: option values the parser refuses, any
+:class:`~stickslip.errors.StickSlipError` (the library's and this package's :class:`CLIError`),
+and operating-system errors with a path (read-only, missing or wrong kind of file or folder, full
+disk). Ctrl-C prints one line saying what was kept and exits with 130. Anything else is a bug
+and keeps its traceback. Text is printed as written: the consoles read no rich markup or emoji
+codes, and help texts are escaped from markup once, here.
+"""
 
 from __future__ import annotations
 
+import errno
 import math
+import os
 import sys
-from contextlib import contextmanager
+from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
+from rich.text import Text
+from typer.core import TyperGroup
+
+from ..errors import StickSlipError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised only on Python 3.10
+    import tomli as tomllib
+
+console = Console(markup=False, emoji=False, highlight=False)
+err_console = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
+
+#: Help text of every --config option.
+CONFIG_HELP = "TOML file with a [parameters] table (names not given keep their defaults; --set and named options win)."
+
+#: Help text of every --overwrite option of a command whose outputs are not resumable.
+OVERWRITE_HELP = "Replace existing output files instead of refusing."
+
+#: Help text of the --overwrite option of a command that writes into a folder.
+OVERWRITE_FOLDER_HELP = "Write into a folder that is not empty, replacing files of the same names."
+
+#: Help text of the --overwrite option of a resumable command.
+RESTART_HELP = ("Start over: replace the output, its journal and its figure (of this or another run) instead of "
+                "resuming or refusing.")
+
+#: Peak memory of `stickslip simulate` per kept sample [bytes]: the run's arrays, the steady-state
+#: analysis, the NetCDF dataset and the figure (measured: about 290 B, from 1e5 to 5e6 samples).
+SAMPLE_BYTES = 300
+
+#: The click base class of usage errors (typer re-exports only its subclass BadParameter; recent
+#: typer versions carry their own copy of click).
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+
+#: errno values of operating-system errors about a path the user gave or can fix.
+_PATH_ERRNOS = {errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOENT, errno.EISDIR, errno.ENOTDIR, errno.EEXIST,
+                errno.ENOSPC, errno.EDQUOT, errno.ENAMETOOLONG, errno.ELOOP, errno.EFBIG}
+
+
+class CLIError(StickSlipError, ValueError):
+    """An option value the command line refuses: out of range, conflicting, or an output that
+    must not be replaced. The message names the option and the fix."""
+
+
+def error_line(message: str) -> None:
+    """Print ``error: message`` as one line on stderr, exactly as written."""
+    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(str(message).split())))
+
+
+def warning_line(message: str) -> None:
+    """Print ``warning: message`` as one line on stderr (stdout stays clean for --json)."""
+    err_console.print(Text.assemble(("warning:", "yellow"), " ", " ".join(str(message).split())))
+
+
+def note_line(message: str) -> None:
+    """Print one informative line on stderr."""
+    err_console.print(Text(" ".join(str(message).split()), style="dim"))
+
+
+#: What a Ctrl-C leaves behind, as set by the running command (:func:`on_interrupt`).
+_interrupt_note = {"text": "nothing was written"}
+
+
+def on_interrupt(text: str) -> None:
+    """Say what an interruption from now on keeps (printed after ``interrupted:``)."""
+    _interrupt_note["text"] = text
+
+
+def _path_error_message(exc: OSError) -> str:
+    where = exc.filename or ""
+    what = exc.strerror or str(exc)
+    return (f"cannot write or read {where}: {what}" if where else str(exc)) + \
+        "; check the path and its permissions, or choose another path"
+
+
+def _escape_help(command) -> None:
+    """Escape the help texts of a command tree from rich markup, so that they print as written
+    (units such as [s] and [rad/s] included)."""
+    if getattr(command, "help", None):
+        command.help = escape(command.help)
+    for param in getattr(command, "params", []):
+        if getattr(param, "help", None):
+            param.help = escape(param.help)
+    for sub in getattr(command, "commands", {}).values():
+        _escape_help(sub)
+
+
+class _Application(TyperGroup):
+    """The ``stickslip`` group: the one place where errors become a line and an exit code."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        _escape_help(self)
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        try:
+            code = super().main(args=args, prog_name=prog_name, complete_var=complete_var, standalone_mode=False,
+                                **extra)
+        except _ClickException as exc:  # the parser's: unknown, missing or mistyped options
+            code = exc.exit_code
+            if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help
+                ctx = getattr(exc, "ctx", None)
+                error_line(exc.format_message() + (f" (see '{ctx.command_path} --help')" if ctx else ""))
+        except typer.Abort:
+            error_line("aborted")
+            code = 1
+        code = code if isinstance(code, int) else 0
+        if not standalone_mode:
+            return code
+        sys.exit(code)
+
+    def invoke(self, ctx):
+        on_interrupt("nothing was written")
+        try:
+            return super().invoke(ctx)
+        except StickSlipError as exc:
+            error_line(str(exc))
+        except OSError as exc:
+            if exc.errno not in _PATH_ERRNOS:
+                raise
+            error_line(_path_error_message(exc))
+        except KeyboardInterrupt:
+            err_console.print(Text(f"interrupted: {_interrupt_note['text']}"))
+            raise typer.Exit(130) from None
+        raise typer.Exit(2)
+
 
 app = typer.Typer(
     name="stickslip",
+    cls=_Application,
     help="Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-console = Console()
-err_console = Console(stderr=True)
-
-#: Help text of every --config option (the backslash keeps rich from reading [parameters] as markup).
-CONFIG_HELP = "TOML file with a \\[parameters] table (names not given keep their defaults)."
-
-#: Errors that are the user's to fix: printed as one line, exit code 2.
-USER_ERRORS: tuple[type[BaseException], ...] = (ValueError, FileNotFoundError, RuntimeError)
 
 
-@contextmanager
-def user_errors():
-    """Turn library errors into a one-line message and exit code 2."""
-    try:
-        yield
-    except USER_ERRORS as exc:
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
-        sys.exit(2)
-
-
+# ----------------------------------------------------------------------------- option parsing
 def parse_assignments(items: list[str] | None) -> dict:
-    """``["N=50", "friction_law=coulomb"]`` → ``{"N": 50.0, "friction_law": "coulomb"}``."""
+    """``["N=50", "friction_law=coulomb"]`` → ``{"N": 50.0, "friction_law": "coulomb"}``.
+
+    Raises
+    ------
+    CLIError
+        For an item without ``=`` or a name given twice.
+    """
     values: dict = {}
     for item in items or []:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise ValueError(f"--set expects NAME=VALUE, got {item!r}; e.g. --set k_px=400")
+            raise CLIError(f"--set expects NAME=VALUE, got {item!r}; e.g. --set k_px=400")
+        if name in values:
+            raise CLIError(f"--set {name} is given twice; give each parameter once")
         text = text.strip()
         try:
             values[name] = float(text)
@@ -52,33 +182,230 @@ def parse_assignments(items: list[str] | None) -> dict:
     return values
 
 
-def check_nc_path(out) -> None:
-    """A NetCDF output path must end in ``.nc`` (ValueError naming the fix)."""
-    if out.suffix != ".nc":
-        raise ValueError(f"--out {out}: give a path ending in .nc")
+#: The option of each parameter that has one of its own.
+PARAMETER_FLAGS = {"N": "--N", "Omega": "--omega", "mu_k": "--mu-k", "delta_mu": "--delta-mu", "alpha": "--alpha"}
+
+
+def config_values(config) -> dict:
+    """``{name: value}`` of the parameters a --config TOML file sets (validated; names it does
+    not set are left out)."""
+    from ..model.parameters import Parameters
+
+    loaded = Parameters.load_toml(config)
+    data = tomllib.loads(Path(config).read_text())
+    return {name: getattr(loaded, name) for name in data.get("parameters", data)}
+
+
+def build_parameters(config, assignments, base=None, swept: dict | None = None, **named):
+    """Parameters from ``base`` (default Table 1), then a TOML file, then ``--set``, then the
+    named options that were given (not None).
+
+    Parameters
+    ----------
+    config : path or None
+        ``--config``.
+    assignments : list of str or None
+        ``--set`` items.
+    base : Parameters, optional
+        What the file and options change (default Table 1).
+    swept : dict of parameter name → option, optional
+        Parameters the command varies itself (``{"N": "--grid N"}``); ``--set`` or a named option
+        for one of them is refused.
+    **named
+        Named options by parameter name (``N=``, ``Omega=``, ...; None: not given).
+
+    Returns
+    -------
+    params : Parameters
+    given : list of str
+        The options that set a parameter (``--config``, ``--set NAME``, ``--N``, ...), in order.
+
+    Raises
+    ------
+    CLIError
+        When two options set the same parameter (a named option and ``--set``, or either and
+        the option that sweeps it).
+    """
+    from ..model.parameters import Parameters
+
+    params = Parameters() if base is None else base
+    given = []
+    if config is not None:
+        params = params.replace(**config_values(config))
+        given.append("--config")
+    changes = parse_assignments(assignments)
+    named = {k: v for k, v in named.items() if v is not None}
+    setters = {item.partition("=")[0].strip(): [f"--set {item.strip()}"] for item in assignments or []}
+    for name, value in named.items():
+        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {value:g}")
+    for name, sweeper in (swept or {}).items():
+        setters.setdefault(name, []).insert(0, sweeper)
+    for name, options in setters.items():
+        if len(options) > 1:
+            raise CLIError(f"{' and '.join(options)} both set {name}; give one of them")
+    given += [f"--set {k}" for k in changes] + [PARAMETER_FLAGS.get(k, f"--{k}") for k in named]
+    changes.update(named)
+    return (params.replace(**changes) if changes else params), given
+
+
+def check_nc_path(out, flag: str = "--out") -> None:
+    """A NetCDF output path must end in ``.nc``."""
+    if Path(out).suffix != ".nc":
+        raise CLIError(f"{flag} {out}: give a path ending in .nc")
 
 
 def check_choice(flag: str, value, choices) -> None:
     """``value`` of option ``flag`` must be one of ``choices``."""
     if value not in choices:
-        raise ValueError(f"{flag} {value}: choose one of {', '.join(choices)}")
+        raise CLIError(f"{flag} {value}: choose one of {', '.join(choices)}")
 
 
 def check_positive(flags: dict) -> None:
     """Every ``{flag: value}`` must be a finite number > 0 (``None``: not given, skipped)."""
     for flag, value in flags.items():
         if value is not None and not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{flag} must be a finite number > 0, got {value}")
+            raise CLIError(f"{flag} must be a finite number > 0, got {value}")
 
 
-def build_parameters(config, assignments, **named):
-    """Parameters from an optional TOML file, then ``--set`` pairs, then the named options (not None)."""
-    from ..model.parameters import Parameters
+def check_finite(flags: dict) -> None:
+    """Every ``{flag: value}`` must be a finite number (``None``: not given, skipped)."""
+    for flag, value in flags.items():
+        if value is not None and not math.isfinite(value):
+            raise CLIError(f"{flag} must be a finite number, got {value}")
 
-    params = Parameters.load_toml(config) if config is not None else Parameters()
-    changes = parse_assignments(assignments)
-    changes.update({k: v for k, v in named.items() if v is not None})
-    return params.replace(**changes) if changes else params
+
+# ----------------------------------------------------------------------------- memory
+def available_memory() -> float | None:
+    """Memory the system can give this process now [bytes] (``MemAvailable``), else the
+    physical memory, else None when neither can be read."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    try:
+        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_samples(duration: float, sample_rate: float, *, time_flag: str = "--t-end",
+                  rate_flag: str | None = "--sample-rate") -> None:
+    """Refuse a run whose samples would not fit: more than the library keeps per run
+    (``MAX_SAMPLES``) or more memory than is available (:data:`SAMPLE_BYTES` each).
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time [s] (finite, > 0).
+    sample_rate : float
+        Samples per second [Hz] (finite, > 0).
+    time_flag, rate_flag : str
+        The options that set them, named in the message (``rate_flag`` None: not an option).
+    """
+    from ..integrate.driver import MAX_SAMPLES
+
+    n = duration * sample_rate + 1.0
+    limit, what = float(MAX_SAMPLES), f"the {MAX_SAMPLES} samples a run may keep"
+    memory = available_memory()
+    if memory is not None and memory / SAMPLE_BYTES < limit:
+        limit, what = memory / SAMPLE_BYTES, f"the {memory / 1e9:.3g} GB of memory available"
+    if n <= limit:
+        return
+    fix = f"shorten {time_flag}"
+    if rate_flag is not None:
+        fix = f"lower {rate_flag} to at most {(limit - 1.0) / duration:.3g} Hz or " + fix
+    raise CLIError(f"{time_flag} {duration:g} s at {sample_rate:g} Hz keeps {n:.3g} samples "
+                   f"(≈ {n * SAMPLE_BYTES / 1e9:.3g} GB), more than {what}; {fix}")
+
+
+# ----------------------------------------------------------------------------- outputs
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
+
+
+def _check_folder(path: Path, flag: str) -> None:
+    """The folder of ``path`` exists and is writable, or can be created."""
+    folder = path.parent if str(path.parent) else Path(".")
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise CLIError(f"{flag} {path}: {existing} is a file, not a folder; choose another {flag}")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise CLIError(f"{flag} {path}: the folder {existing} is not writable; choose another {flag}")
+
+
+def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: dict | None = None) -> None:
+    """Refuse, before anything is computed, an output file that must not or cannot be written.
+
+    Parameters
+    ----------
+    path : Path
+        A file the command will write.
+    overwrite : bool
+        The command's ``--overwrite``: replace an existing file.
+    flag : str
+        The option that names it.
+    inputs : dict of option → Path, optional
+        Files the command reads; never overwritten, not even with ``--overwrite``.
+    """
+    for in_flag, in_path in (inputs or {}).items():
+        if in_path is not None and _same_file(path, Path(in_path)):
+            raise CLIError(f"{flag} {path} is the file given to {in_flag}; an input is never overwritten, "
+                           f"give another {flag}")
+    if path.is_dir():
+        raise CLIError(f"{flag} {path} is a directory; give a file name")
+    if (path.exists() or path.is_symlink()) and not overwrite:
+        raise CLIError(f"{path} exists; pass --overwrite to replace it, or give another {flag}")
+    _check_folder(path, flag)
+
+
+def check_outputs(out: Path, figure: bool, overwrite: bool, **kwargs) -> None:
+    """:func:`check_output` for a NetCDF output and, with ``figure``, the .png beside it."""
+    check_nc_path(out, kwargs.get("flag", "--out"))
+    check_output(out, overwrite, **kwargs)
+    if figure:
+        check_output(out.with_suffix(".png"), overwrite, **kwargs)
+
+
+def journal_of(out: Path) -> Path:
+    """The journal a resumable command keeps beside its output (``OUT.nc.journal``)."""
+    return out.with_name(out.name + ".journal")
+
+
+def check_resumable_output(out: Path, figure: bool, overwrite: bool) -> None:
+    """Outputs of a resumable command: the NetCDF file and its journal are the command's own
+    (the library resumes them or refuses another run's); a figure is refused only when a
+    fresh run would replace a file that is not the command's."""
+    check_nc_path(out)
+    if out.is_dir():
+        raise CLIError(f"--out {out} is a directory; give a file name")
+    _check_folder(out, "--out")
+    fresh = not out.exists() and not journal_of(out).exists()
+    if figure and fresh:
+        check_output(out.with_suffix(".png"), overwrite)
+    on_interrupt(f"finished work is kept in {journal_of(out)}; run the same command again to resume")
+
+
+def check_output_folder(out: Path, overwrite: bool) -> None:
+    """An output folder must not hold files already, unless ``overwrite``."""
+    if out.exists() and not out.is_dir():
+        raise CLIError(f"--out {out} is a file; give a folder")
+    if out.is_dir() and any(out.iterdir()) and not overwrite:
+        raise CLIError(f"--out {out} is not empty; pass --overwrite to replace its files, or give another --out")
+    _check_folder(out / "x", "--out")
+
+
+def given(ctx: typer.Context, name: str) -> bool:
+    """Whether option ``name`` (its parameter name) was given, not left at its default."""
+    source = ctx.get_parameter_source(name)
+    return source is not None and source.name not in ("DEFAULT", "DEFAULT_MAP")
 
 
 def _version(value: bool) -> None:

@@ -7,61 +7,57 @@ figure; no physics here.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import List, Optional
 
 import typer
 from rich.table import Table
 
-from ._app import (CONFIG_HELP, app, build_parameters, check_choice, check_nc_path, check_positive, console,
-                   err_console, user_errors)
+from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_choice, check_finite, check_positive,
+                   check_resumable_output, check_samples, console, note_line)
 
 _ICS = ("far", "near", "zero", "equilibrium")
 
 
-def _check(param: str, start: float, stop: float, out: Path, ic: str, max_points: int, step: float,
+def _check(param: str, start: float, stop: float, ic: str, max_points: int, step: float,
            max_step: float, search_time: float, rtol: float, tol: float, stop_on: list[str]) -> None:
-    """Validate the options before anything is computed (one-line ValueError naming the fix)."""
+    """Validate the options before anything is computed (one-line CLIError naming the fix)."""
     from ..model.parameters import Parameters
     from ..orbits.continuation import SPECIAL_KINDS
 
     numeric = [n for n in Parameters.names() if n != "friction_law"]
     if param not in numeric:
-        raise ValueError(f"--param {param}: not a numeric parameter; choose one of {', '.join(numeric)}")
-    for flag, value in (("--from", start), ("--to", stop)):
-        if not math.isfinite(value):
-            raise ValueError(f"{flag} must be a finite number, got {value}")
+        raise CLIError(f"--param {param}: not a numeric parameter; choose one of {', '.join(numeric)}")
+    check_finite({"--from": start, "--to": stop})
     if start == stop:
-        raise ValueError(f"--from and --to are both {start:g}; give the end of the range to continue to")
-    check_nc_path(out)
+        raise CLIError(f"--from and --to are both {start:g}; give the end of the range to continue to")
     check_choice("--ic", ic, _ICS)
     if max_points < 2:
-        raise ValueError(f"--max-points must be >= 2, got {max_points}")
+        raise CLIError(f"--max-points must be >= 2, got {max_points}")
     check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--rtol": rtol,
                     "--tol": tol})
     if step > max_step:
-        raise ValueError(f"--step {step:g} is larger than --max-step {max_step:g}")
+        raise CLIError(f"--step {step:g} is larger than --max-step {max_step:g}")
     bad = [k for k in stop_on if k not in SPECIAL_KINDS]
     if bad:
-        raise ValueError(f"--stop-on {', '.join(bad)}: choose from {', '.join(SPECIAL_KINDS)}")
+        raise CLIError(f"--stop-on {', '.join(bad)}: choose from {', '.join(SPECIAL_KINDS)}")
 
 
 def _note_resume(k: int) -> None:
     """One line on stderr (stdout stays clean for --json) when a run picks up earlier work."""
-    err_console.print(f"resuming from {k} points", highlight=False)
+    note_line(f"resuming from {k} points")
 
 
 @app.command("continue")
 def continue_command(
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: N, Omega, delta_mu, alpha, mu_k, k_px, ..."),
-    start: float = typer.Option(..., "--from", help="Start value of the parameter (where the first orbit is found)."),
-    stop: float = typer.Option(..., "--to", help="End of the range; the branch goes from --from towards it."),
-    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N \\[N] when not continued (default 50)."),
-    omega: Optional[float] = typer.Option(None, "--omega", help="Ω \\[rad/s] when not continued (default 5)."),
+    start: float = typer.Option(..., "--from", help="Start value of the parameter [its unit: N for N, rad/s for Omega, ...] (where the first orbit is found)."),
+    stop: float = typer.Option(..., "--to", help="End of the range [the unit of --param]; the branch goes from --from towards it."),
+    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
+    omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4)."),
     ic: str = typer.Option("far", "--ic", help="Start run: far | near | zero | equilibrium (docs/sweeps.md)."),
-    search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run \\[s]."),
+    search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run [s]."),
     max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
     step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
     max_step: float = typer.Option(0.2, "--max-step", help="Largest step in scaled arclength."),
@@ -69,12 +65,13 @@ def continue_command(
                                                 "fold, period-doubling, neimark-sacker, stick-phases."),
     rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map."),
     tol: float = typer.Option(1e-8, "--tol", help="Corrector tolerance (scaled shooting residual)."),
-    slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction \\[m/s] "
+    slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction [m/s] "
                                               "(default: that of stickslip.simulate)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output, journaled as it goes (OUT.nc.journal): "
                              "the same command again resumes; the figure goes beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
@@ -83,28 +80,30 @@ def continue_command(
 
     The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused).
     """
-    from ..orbits.continuation import continue_orbit, start_run
+    from ..orbits.continuation import START_RATE, continue_orbit, start_run
 
-    with user_errors():
-        stop_on = list(stop_on or [])
-        _check(param, start, stop, out, ic, max_points, step, max_step, search_time, rtol, tol, stop_on)
-        check_positive({"--slip-band": slip_band})
-        band = {} if slip_band is None else {"slip_band": slip_band}
-        params = build_parameters(config, set_, N=N, Omega=omega).replace(**{param: start})
-        progress = None if (no_progress or as_json) else (
-            lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
-                                              f"{'stable' if st else 'unstable'}", highlight=False))
-        run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        branch = continue_orbit(params, param, start=run, direction=1 if stop > start else -1, step=step,
-                                max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
-                                stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress, out=out,
-                                on_resume=_note_resume, **band)
-        figure = None
-        if not no_plot:
-            from ..plot.continuation import save_branch_figure
+    stop_on = list(stop_on or [])
+    _check(param, start, stop, ic, max_points, step, max_step, search_time, rtol, tol, stop_on)
+    check_positive({"--slip-band": slip_band})
+    check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
+    band = {} if slip_band is None else {"slip_band": slip_band}
+    params, _ = build_parameters(config, set_, swept={param: f"--param {param}"}, N=N, Omega=omega)
+    params = params.replace(**{param: start})
+    check_resumable_output(out, not no_plot, overwrite)
+    progress = None if (no_progress or as_json) else (
+        lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
+                                          f"{'stable' if st else 'unstable'}"))
+    run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    branch = continue_orbit(params, param, start=run, direction=1 if stop > start else -1, step=step,
+                            max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
+                            stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress, out=out,
+                            on_resume=_note_resume, resume=not overwrite, **band)
+    figure = None
+    if not no_plot:
+        from ..plot.continuation import save_branch_figure
 
-            figure = save_branch_figure(branch, out.with_suffix(".png"))
+        figure = save_branch_figure(branch, out.with_suffix(".png"))
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "param": param,
         "points": len(branch), "from": float(branch.values[0]), "to": float(branch.values[-1]),

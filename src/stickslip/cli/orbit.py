@@ -16,9 +16,11 @@ from typing import List, Optional
 import numpy as np
 import typer
 from rich.table import Table
+from rich.text import Text
 
-from ._app import (CONFIG_HELP, app, build_parameters, check_choice, check_nc_path, check_positive, console,
-                   user_errors)
+from ..errors import StickSlipError
+from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_choice, check_outputs,
+                   check_positive, check_samples, console)
 
 #: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``).
 _ICS = ("far", "near", "zero", "equilibrium")
@@ -27,20 +29,18 @@ _ICS = ("far", "near", "zero", "equilibrium")
 _METHODS = ("saltation", "finite-difference")
 _LYAPUNOV_METHODS = ("variational", "finite-difference")
 
-_N_HELP = "Normal preload N \\[N] (default 50)."
-_OMEGA_HELP = "Angular velocity Ω of the lower plate \\[rad/s] (default 5)."
+_N_HELP = "Normal preload N [N] (default 50)."
+_OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
 _MODEL_HELP = "full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi."
 _IC_HELP = "Start run: far | near | zero | equilibrium (docs/sweeps.md)."
-_BAND_HELP = "Low-speed band of the slip direction \\[m/s] (default: that of stickslip.simulate)."
+_BAND_HELP = "Low-speed band of the slip direction [m/s] (default: that of stickslip.simulate)."
 
 
-def _check_common(out: Path, ic: str, model: str, positive: dict) -> None:
-    """Checks shared by both commands (one-line ValueError naming the fix), before any computing.
+def _check_common(ic: str, model: str, positive: dict) -> None:
+    """Checks shared by both commands (one-line CLIError naming the fix), before any computing.
 
     Parameters
     ----------
-    out : Path
-        NetCDF output; must end in ``.nc``.
     ic : str
         One of :data:`_ICS`.
     model : str
@@ -51,13 +51,12 @@ def _check_common(out: Path, ic: str, model: str, positive: dict) -> None:
     """
     from ..model.variants import resolve_variant
 
-    check_nc_path(out)
     check_choice("--ic", ic, _ICS)
     check_positive(positive)
     try:
         resolve_variant(model)
-    except ValueError as exc:
-        raise ValueError(f"--model {model}: {exc}") from None
+    except StickSlipError as exc:
+        raise CLIError(f"--model {model}: {exc}") from None
 
 
 def _finite_or_none(x: float):
@@ -72,7 +71,7 @@ def orbit_command(
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
     model: str = typer.Option("full", "--model", help=_MODEL_HELP),
     ic: str = typer.Option("far", "--ic", help=_IC_HELP),
-    search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run \\[s]; the guess is "
+    search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run [s]; the guess is "
                                       "taken from its last section crossings."),
     period_multiplicity: int = typer.Option(1, "--period-multiplicity", help="Section crossings (maxima of φ) per period."),
     monodromy: str = typer.Option("saltation", "--monodromy", help="Monodromy matrix: saltation | finite-difference."),
@@ -82,6 +81,7 @@ def orbit_command(
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("orbit.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
 ) -> None:
@@ -91,31 +91,31 @@ def orbit_command(
     """
     from ..analysis.steady import stick_time
     from ..orbits import periodic_orbit
-    from ..orbits.continuation import start_run
+    from ..orbits.continuation import START_RATE, start_run
 
-    with user_errors():
-        _check_common(out, ic, model, {"--search-time": search_time, "--rtol": rtol, "--tol": tol,
-                                       "--slip-band": slip_band})
-        check_choice("--monodromy", monodromy, _METHODS)
-        if period_multiplicity < 1:
-            raise ValueError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
-        band = {} if slip_band is None else {"slip_band": slip_band}
-        params = build_parameters(config, set_, N=N, Omega=omega)
-        t0 = time.perf_counter()
-        run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
-        orbit = periodic_orbit(params, run, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
-                               monodromy=monodromy, **band)
-        wall = time.perf_counter() - t0
-        one_period = orbit.trajectory(1.0)
-        stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
-                           one_period.transitions.kind)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        orbit.to_xarray().to_netcdf(out, engine="h5netcdf")
-        figure = None
-        if not no_plot:
-            from ..plot.orbits import save_orbit_figure
+    _check_common(ic, model, {"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
+    check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
+    check_choice("--monodromy", monodromy, _METHODS)
+    if period_multiplicity < 1:
+        raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
+    band = {} if slip_band is None else {"slip_band": slip_band}
+    params, _ = build_parameters(config, set_, N=N, Omega=omega)
+    check_outputs(out, not no_plot, overwrite)
+    t0 = time.perf_counter()
+    run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
+    orbit = periodic_orbit(params, run, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
+                           monodromy=monodromy, **band)
+    wall = time.perf_counter() - t0
+    one_period = orbit.trajectory(1.0)
+    stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
+                       one_period.transitions.kind)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    orbit.to_xarray().to_netcdf(out, engine="h5netcdf")
+    figure = None
+    if not no_plot:
+        from ..plot.orbits import save_orbit_figure
 
-            figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
+        figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
     others = np.abs(orbit.nontrivial_multipliers)
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": orbit.model,
@@ -136,7 +136,7 @@ def orbit_command(
     if summary["max_nontrivial_multiplier_abs"] is not None:
         table.add_row("largest |μ| (non-trivial)", f"{summary['max_nontrivial_multiplier_abs']:.8g}")
     table.add_row("|μ_trivial − 1|", f"{summary['trivial_multiplier_error']:.2e} ({summary['monodromy']})")
-    table.add_row("stability", "[green]stable[/]" if orbit.stable else "[bold red]unstable[/]")
+    table.add_row("stability", Text("stable", style="green") if orbit.stable else Text("unstable", style="bold red"))
     table.add_row("Newton", f"{summary['iterations']} iterations, residual {summary['residual']:.2e}")
     table.add_row("wall time", f"{wall:.2f} s (start run + shooting + multipliers)")
     table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
@@ -149,8 +149,8 @@ def lyapunov_command(
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
     model: str = typer.Option("full", "--model", help=_MODEL_HELP),
     ic: str = typer.Option("far", "--ic", help=_IC_HELP),
-    t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first \\[s]."),
-    t_average: float = typer.Option(200.0, "--t-average", help="Averaging time \\[s]."),
+    t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first [s]."),
+    t_average: float = typer.Option(200.0, "--t-average", help="Averaging time [s]."),
     method: str = typer.Option("variational", "--method", help="variational (saltation matrices) | "
                                "finite-difference (perturbed trajectories; works where the variational one refuses)."),
     rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of the runs (atol = 1e-3 rtol)."),
@@ -158,6 +158,7 @@ def lyapunov_command(
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("lyapunov.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary (exponents largest first)."),
 ) -> None:
@@ -168,22 +169,22 @@ def lyapunov_command(
     from ..orbits import lyapunov_spectrum
     from ..sweep.spec import initial_condition
 
-    with user_errors():
-        _check_common(out, ic, model, {"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol,
-                                       "--slip-band": slip_band})
-        check_choice("--method", method, _LYAPUNOV_METHODS)
-        band = {} if slip_band is None else {"slip_band": slip_band}
-        params = build_parameters(config, set_, N=N, Omega=omega)
-        start, perturbation = initial_condition(ic, params, model)
-        spectrum = lyapunov_spectrum(params, start, model=model, t_transient=t_transient, t_average=t_average,
-                                     perturbation=perturbation, rtol=rtol, method=method, **band)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        spectrum.to_xarray().to_netcdf(out, engine="h5netcdf")
-        figure = None
-        if not no_plot:
-            from ..plot.orbits import save_lyapunov_spectrum_figure
+    _check_common(ic, model, {"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol,
+                              "--slip-band": slip_band})
+    check_choice("--method", method, _LYAPUNOV_METHODS)
+    band = {} if slip_band is None else {"slip_band": slip_band}
+    params, _ = build_parameters(config, set_, N=N, Omega=omega)
+    check_outputs(out, not no_plot, overwrite)
+    start, perturbation = initial_condition(ic, params, model)
+    spectrum = lyapunov_spectrum(params, start, model=model, t_transient=t_transient, t_average=t_average,
+                                 perturbation=perturbation, rtol=rtol, method=method, **band)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    spectrum.to_xarray().to_netcdf(out, engine="h5netcdf")
+    figure = None
+    if not no_plot:
+        from ..plot.orbits import save_lyapunov_spectrum_figure
 
-            figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
+        figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,
@@ -196,14 +197,13 @@ def lyapunov_command(
         return
     p = spectrum.params
     console.print(f"stickslip lyapunov: {spectrum.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, {method}",
-                  highlight=False, soft_wrap=True)
+                  soft_wrap=True)
     table = Table()
     table.add_column("#", justify="right")
-    table.add_column("λ \\[1/s]", justify="right")
+    table.add_column("λ [1/s]", justify="right")
     for i, lam in enumerate(ordered, start=1):
         table.add_row(str(i), f"{lam:+.6g}", style="bold red" if lam > 0 else None)
     console.print(table)
     console.print(f"averaged over {t_average:g} s after a {t_transient:g} s transient from --ic {ic}; "
-                  f"{spectrum.stick_phases} stick phases; wall time {spectrum.wall_time:.2f} s", highlight=False,
-                  soft_wrap=True)
-    console.print(f"wrote {out}" + ("" if figure is None else f", {figure}"), highlight=False, soft_wrap=True)
+                  f"{spectrum.stick_phases} stick phases; wall time {spectrum.wall_time:.2f} s", soft_wrap=True)
+    console.print(f"wrote {out}" + ("" if figure is None else f", {figure}"), soft_wrap=True)

@@ -7,28 +7,29 @@ from pathlib import Path
 
 import typer
 
-from ._app import app, console, err_console, user_errors
+from ._app import OVERWRITE_FOLDER_HELP, CLIError, app, check_output_folder, console, note_line, on_interrupt
 
 
 @app.command("reproduce")
 def reproduce(
-    out: Path = typer.Option(Path("paper"), "--out", help="Output directory: report.md, PNGs, results.json."),
+    out: Path = typer.Option(Path("paper"), "--out", help="Output folder: report.md, PNGs, results.json."),
     quick: bool = typer.Option(False, "--quick", help="Coarse grids (3-7 minutes on 2 cores)."),
     only: list[str] = typer.Option(None, "--only", help="Run only these figures (repeatable): "
                                    "fig3, fig4, table2, fig7, fig8, fig9, fig10, fig11, fig12a, "
                                    "fig12b, fig13, fig14, fig15, fig16."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_FOLDER_HELP),
 ) -> None:
     """Paper Sects. 4.1–4.2: Figs. 3–16 and Table 2 beside the paper's statements, with a table
     "paper says / we measure / agrees?" (OUT/report.md)."""
     from ..studies.reproduce import recipe_names
     from ..studies.reproduce import reproduce as run_reproduce
 
-    with user_errors():
-        if only:
-            unknown = [n for n in only if n not in recipe_names()]
-            if unknown:
-                raise ValueError(f"unknown figure {', '.join(map(repr, unknown))} for --only; "
-                                 f"choose from {', '.join(recipe_names())}")
-        report = run_reproduce(out, "quick" if quick else "full", only=only or None,
-                               progress=lambda msg: err_console.print(f"[dim]{msg}[/]", highlight=False))
-    console.print(f"wrote {report}", highlight=False, markup=False)
+    if only:
+        unknown = [n for n in only if n not in recipe_names()]
+        if unknown:
+            raise CLIError(f"unknown figure {', '.join(map(repr, unknown))} for --only; "
+                           f"choose from {', '.join(recipe_names())}")
+    check_output_folder(out, overwrite)
+    on_interrupt(f"the figures finished so far are listed in {out / 'report.md'}")
+    report = run_reproduce(out, "quick" if quick else "full", only=only or None, progress=note_line)
+    console.print(f"wrote {report}")

@@ -1,4 +1,8 @@
-"""``stickslip simulate``: one run, written to NetCDF with a figure and a summary."""
+"""``stickslip simulate``: one run, written to NetCDF with a figure and a summary.
+
+Parse → library call (:func:`stickslip.simulate`) → write; no physics here. ``--ic RUN.nc``
+continues a saved run: its model, parameters and settings, from its last sample on.
+"""
 
 from __future__ import annotations
 
@@ -7,10 +11,17 @@ import math
 from pathlib import Path
 from typing import List, Optional
 
+import numpy as np
 import typer
 from rich.table import Table
+from rich.text import Text
 
-from ._app import CONFIG_HELP, app, build_parameters, check_nc_path, console, user_errors
+from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_finite, check_outputs,
+                   check_positive, check_samples, console, error_line, given, note_line, warning_line)
+
+#: Settings of a run that ``--ic RUN.nc`` takes from the saved run unless given: option → parameter name.
+_SETTINGS = {"--model": "model", "--method": "method", "--rtol": "rtol", "--atol": "atol", "--dt": "dt",
+             "--sample-rate": "sample_rate"}
 
 
 def _parse_ic(text: str):
@@ -19,66 +30,145 @@ def _parse_ic(text: str):
         try:
             return [float(v) for v in text.split(",")]
         except ValueError:
-            raise ValueError(f"--ic {text!r}: give 12 comma-separated numbers") from None
+            raise CLIError(f"--ic {text}: give 12 comma-separated numbers") from None
     return text
+
+
+def _continuation(ctx: typer.Context, ic: str, settings: dict):
+    """The saved run ``ic`` (a .nc path) and the settings it gives: those not on the command line.
+
+    Returns
+    -------
+    params : Parameters
+        The saved run's.
+    t0 : float
+        Time of its last sample [s], where the continuation starts.
+    settings : dict
+        ``settings`` with every option not given replaced by the saved run's, plus its slip band.
+    overridden : list of str
+        The options of :data:`_SETTINGS` given on the command line.
+    """
+    from ..integrate.result import load_trajectory
+
+    saved = load_trajectory(ic)
+    stored = dict(saved.options, model=saved.model, method=saved.method)
+    overridden = [flag for flag, name in _SETTINGS.items() if given(ctx, name)]
+    settings = {name: (value if given(ctx, name) or name not in stored else stored[name])
+                for name, value in settings.items()}
+    if stored.get("slip_band") is not None:
+        settings["slip_band"] = stored["slip_band"]
+    return saved.params, float(saved.t[-1]), settings, overridden
+
+
+def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rate: float) -> None:
+    """The steady-state window must start inside the run and hold at least two samples."""
+    if steady_from is None:
+        return
+    last = t_end - 1.0 / sample_rate
+    if not t0 <= steady_from <= last:
+        raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
+                       f"give a time from {t0:g} to {last:g} s (one sample before the end)")
+
+
+def _warn_aliasing(params, model: str, sample_rate: float) -> None:
+    """One warning line when the samples cannot resolve the model's fastest linear mode."""
+    from ..model.modes import natural_frequencies
+
+    highest = float(natural_frequencies(params, model).max(initial=0.0))
+    if sample_rate < 2.0 * highest:
+        warning_line(f"--sample-rate {sample_rate:g} Hz is below twice the highest linear mode frequency of model "
+                     f"{model} ({highest:.4g} Hz): the spectrum and the frequency of φ alias; give --sample-rate "
+                     f"{math.ceil(2.0 * highest)} or more")
 
 
 @app.command()
 def simulate(
+    ctx: typer.Context,
     N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] (default 50)."),
     omega: Optional[float] = typer.Option(None, "--omega", help="Angular velocity Ω of the lower plate [rad/s] (default 5)."),
     mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
-    t_end: float = typer.Option(100.0, "--t-end", help="Simulated time [s]."),
-    method: str = typer.Option("event", "--method", help="Integration method."),
+    t_end: float = typer.Option(100.0, "--t-end", help="Simulated time [s]; with --ic RUN.nc, the time added after "
+                                                     "the end of that run."),
+    method: str = typer.Option("event", "--method", help="Integration method: event | aeom | naeom."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance (event)."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance (event)."),
-    ic: str = typer.Option("zero", "--ic", help="zero | equilibrium | RUN.nc (its final state) | 12 comma-separated numbers."),
+    ic: str = typer.Option("zero", "--ic", help="zero | equilibrium | 12 comma-separated numbers | RUN.nc: continue "
+                           "that run from its end, with its model, parameters and settings unless given here."),
     perturb: Optional[float] = typer.Option(None, "--perturb", help="Added to φ of the initial state [rad]."),
     sample_rate: float = typer.Option(1000.0, "--sample-rate", help="Output samples per second [Hz]."),
-    steady_from: Optional[float] = typer.Option(None, "--steady-from", help="Start of the steady-state window [s] (default: last half)."),
+    steady_from: Optional[float] = typer.Option(None, "--steady-from", help="Start of the steady-state window, in the "
+                                                "run's time [s] (default: the last half of the run)."),
     set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    out: Path = typer.Option(Path("run.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    out: Optional[Path] = typer.Option(None, "--out", help="NetCDF output (default run.nc; with --json, nothing is "
+                                       "written unless --out is given); the figure goes beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     as_json: bool = typer.Option(False, "--json", help="Print the steady-state summary as one JSON object."),
 ) -> None:
     """Simulate the two-plate model (defaults: Table 1, N = 50 N, Ω = 5 rad/s, 100 s)."""
     from ..integrate.driver import simulate as run_simulation
 
-    with user_errors():
-        params = build_parameters(config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-        check_nc_path(out)
-        traj = run_simulation(params, t_end, model=model, method=method, ic=_parse_ic(ic), perturbation=perturb,
-                              rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate, steady_from=steady_from)
+    start = _parse_ic(ic)
+    settings = dict(model=model, method=method, rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate)
+    run_file = Path(start) if isinstance(start, str) and start.endswith(".nc") else None
+    base, t0, overridden = None, 0.0, []
+    if run_file is not None:
+        base, t0, settings, overridden = _continuation(ctx, start, settings)
+    params, set_by = build_parameters(config, set_, base=base, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu,
+                                      alpha=alpha)
+    check_positive({"--t-end": t_end, "--sample-rate": settings["sample_rate"]})
+    check_finite({"--perturb": perturb, "--steady-from": steady_from})
+    _check_window(steady_from, t0, t0 + t_end, settings["sample_rate"])
+    check_samples(t_end, settings["sample_rate"])
+    write = out is not None or not as_json
+    out = Path("run.nc") if out is None else out
+    if write:
+        check_outputs(out, not no_plot, overwrite, inputs={"--ic": run_file, "--config": config})
+    if run_file is not None:
+        overridden = set_by + overridden
+        note_line(f"continuing {run_file} from t = {t0:g} s with its model, parameters and settings"
+                  + (f"; overridden: {', '.join(overridden)}" if overridden else ""))
+    _warn_aliasing(params, settings["model"], settings["sample_rate"])
+
+    traj = run_simulation(params, t0 + t_end, t0=t0, ic=start, perturbation=perturb, steady_from=steady_from,
+                          **settings)
+    # a run that stopped early can be too short for its steady-state window, which the file needs
+    keep = write and int(np.count_nonzero(traj.t >= traj.steady_from)) >= 2
+    figure = None
+    if keep:
         out.parent.mkdir(parents=True, exist_ok=True)
         traj.to_netcdf(out)
-        figure = None
         if not no_plot:
             from ..plot.trajectory import save_trajectory_figure
 
             figure = save_trajectory_figure(traj, out.with_suffix(".png"))
+    if traj.status != "success":
+        kept = f"; what it computed is in {out}" if keep else ("; it kept too few samples to write" if write else "")
+        error_line(f"the run stopped early: {traj.status}{kept}")
+        raise typer.Exit(1)
     summary = traj.summary()
     if as_json:
         print(json.dumps(summary))
     else:
-        _print_summary(traj, summary, out, figure)
-    if traj.status != "success":
-        raise typer.Exit(1)
+        _print_summary(traj, summary, out if write else None, figure)
 
 
-def _print_summary(traj, summary: dict, out: Path, figure) -> None:
+def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     s = traj.steady
     p = traj.params
     table = Table(title=f"stickslip: model {traj.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
                         f"μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}", show_header=False)
     freq = summary["fundamental_frequency_hz"]
     kind = "at rest" if freq is None else ("periodic" if s.periodic else "not periodic")
+    wrote = "nothing" if out is None else str(out) + ("" if figure is None else f", {figure}")
     rows = [
         ("status", traj.status),
+        ("time", f"{traj.t[0]:g} – {traj.t[-1]:g} s"),
         ("steady window", f"{s.t_from:g} – {s.t_to:g} s"),
         ("response", kind + (f", {s.period_multiplicity} peak(s) of φ per period" if s.periodic else "")),
         ("fundamental frequency of φ", "–" if freq is None else f"{freq:.6g} Hz"),
@@ -87,14 +177,14 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
         ("φ min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g} rad"),
         ("steps (accepted + rejected)", f"{traj.stats.steps} ({traj.method})"),
         ("wall time", f"{traj.stats.wall_time_s:.3f} s"),
-        ("wrote", str(out) + ("" if figure is None else f", {figure}")),
+        ("wrote", wrote),
     ]
     for key, value in rows:
-        table.add_row(key, value)
+        table.add_row(key, Text(value))
     console.print(table)
     if not math.isnan(s.fundamental_frequency_hz) and not s.periodic:
-        console.print("[dim]not periodic within the window: the frequency is the highest peak of "
-                      "the φ spectrum[/]")
+        console.print("not periodic within the window: the frequency is the highest peak of the φ spectrum",
+                      style="dim")
     if traj.stats.compile_time_s > 0:
-        console.print(f"[dim]first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
-                      "(not included in the wall time)[/]")
+        console.print(f"first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
+                      "(not included in the wall time)", style="dim")

@@ -16,7 +16,8 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import CONFIG_HELP, app, build_parameters, check_nc_path, check_positive, console, user_errors
+from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_finite, check_positive,
+                   check_resumable_output, check_samples, config_values, console, parse_assignments)
 
 _CATEGORICAL = ("model", "ic")
 
@@ -26,7 +27,6 @@ _SCHEDULER_HELP = "dask.distributed scheduler address, e.g. tcp://head-node:8786
 _TEND_HELP = "Simulated time of every grid point [s]."
 _TFROM_HELP = "Start of the steady-state window [s] (default t_end/2)."
 _SET_HELP = "Any base parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."
-_OVERWRITE_HELP = "Replace an output (or journal) that belongs to a different sweep instead of refusing."
 
 
 def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
@@ -37,42 +37,42 @@ def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
 
     Raises
     ------
-    ValueError
+    CLIError
         With a one-line message naming the fix.
     """
     text = text.strip()
-    example = f"{option} {name}=10:130:13 or {option} {name}=30,50,70"
+    given = f"{option} {name}={text}" if option == "--grid" else f"{option} {text}"
+    prefix = f"{option} {name}=" if option == "--grid" else f"{option} "
+    example = f"{prefix}10:130:13 or {prefix}30,50,70"
     if not text:
-        raise ValueError(f"{option} {name}= has no values; e.g. {example}")
+        raise CLIError(f"{given} has no values; e.g. {example}")
     if name in _CATEGORICAL:
         values = [v.strip() for v in text.split(",")]
         if not all(values):
-            raise ValueError(f"{option} {name}={text}: empty name in the list; e.g. {option} {name}=full,rotation")
+            raise CLIError(f"{given}: empty name in the list; e.g. {prefix}full,rotation")
         return values
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3:
-            raise ValueError(f"{option} {name}={text}: a range is start:stop:count; e.g. {example}")
+            raise CLIError(f"{given}: a range is start:stop:count; e.g. {example}")
         try:
             start, stop = float(parts[0]), float(parts[1])
             count = int(parts[2])
         except ValueError:
-            raise ValueError(f"{option} {name}={text}: start and stop must be numbers and count an integer; "
-                             f"e.g. {example}") from None
+            raise CLIError(f"{given}: start and stop must be numbers and count an integer; e.g. {example}") from None
         if not (math.isfinite(start) and math.isfinite(stop)):
-            raise ValueError(f"{option} {name}={text}: start and stop must be finite numbers")
+            raise CLIError(f"{given}: start and stop must be finite numbers")
         if count < 2:
-            raise ValueError(f"{option} {name}={text}: count must be >= 2 (for one value write {option} {name}={parts[0]})")
+            raise CLIError(f"{given}: count must be >= 2 (for one value write {prefix}{parts[0]})")
         if start == stop:
-            raise ValueError(f"{option} {name}={text}: start equals stop; give different ends or a single value")
+            raise CLIError(f"{given}: start equals stop; give different ends or a single value")
         return np.linspace(start, stop, count).tolist()
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
-        raise ValueError(f"{option} {name}={text}: give numbers separated by commas or start:stop:count; "
-                         f"e.g. {example}") from None
+        raise CLIError(f"{given}: give numbers separated by commas or start:stop:count; e.g. {example}") from None
     if not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{option} {name}={text}: values must be finite numbers")
+        raise CLIError(f"{given}: values must be finite numbers")
     return values
 
 
@@ -83,12 +83,12 @@ def parse_grid(items: list[str] | None) -> dict:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise ValueError(f"--grid expects NAME=VALUES, got {item!r}; e.g. --grid N=10:130:13 --grid Omega=0.5,5,8.5")
+            raise CLIError(f"--grid expects NAME=VALUES, got {item!r}; e.g. --grid N=10:130:13 --grid Omega=0.5,5,8.5")
         if name in grid:
-            raise ValueError(f"--grid {name} given twice; give each dimension once")
+            raise CLIError(f"--grid {name} given twice; give each dimension once")
         grid[name] = parse_values(name, text)
     if not grid:
-        raise ValueError("give at least one --grid NAME=VALUES, e.g. --grid N=10:130:13")
+        raise CLIError("give at least one --grid NAME=VALUES, e.g. --grid N=10:130:13")
     return grid
 
 
@@ -96,16 +96,16 @@ def _executor(executor: str | None, scheduler: str | None) -> str:
     if executor is None:
         return "dask" if scheduler else "processes"
     if scheduler and executor != "dask":
-        raise ValueError(f"--scheduler needs --executor dask (got --executor {executor})")
+        raise CLIError(f"--scheduler needs --executor dask (got --executor {executor})")
     return executor
 
 
 def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
     if workers is not None and workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {workers}")
+        raise CLIError(f"--workers must be >= 1, got {workers}")
     check_positive({"--t-end": t_end, "--sample-rate": sample_rate, "--rtol": rtol, "--atol": atol})
-    if t_from is not None and not math.isfinite(t_from):
-        raise ValueError(f"--t-from must be a finite number, got {t_from}")
+    check_finite({"--t-from": t_from})
+    check_samples(t_end, sample_rate)
     return dict(executor=_executor(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
                 overwrite=overwrite, t_end=t_end, t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
 
@@ -164,7 +164,7 @@ def sweep_command(
                                                            "the figure goes beside it as .png."),
     plot_var: str = typer.Option("frequency", "--plot", help="Reduction drawn in the figure: frequency, amplitude, "
                                                             "stick_fraction, kind, intensity_r_phi, ..."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=_OVERWRITE_HELP),
+    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
@@ -177,19 +177,20 @@ def sweep_command(
     from ..sweep import sweep as run_sweep
     from ..sweep.spec import COLUMNS
 
-    with user_errors():
-        params = build_parameters(config, set_)
-        values = parse_grid(grid)
-        check_nc_path(out)
-        if plot_var not in COLUMNS or plot_var == "peaks":
-            raise ValueError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
-        options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-        result = run_sweep(values, params, out=out, model=model, ic=ic, **options)
-        figure = None
-        if not no_plot:
-            from ..plot.sweep import save_sweep_figure
+    from ..model.parameters import Parameters
 
-            figure = save_sweep_figure(result, out.with_suffix(".png"), var=plot_var)
+    values = parse_grid(grid)
+    params, _ = build_parameters(config, set_, swept={k: f"--grid {k}" for k in values if k in Parameters.names()})
+    if plot_var not in COLUMNS or plot_var == "peaks":
+        raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
+    options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+    check_resumable_output(out, not no_plot, overwrite)
+    result = run_sweep(values, params, out=out, model=model, ic=ic, **options)
+    figure = None
+    if not no_plot:
+        from ..plot.sweep import save_sweep_figure
+
+        figure = save_sweep_figure(result, out.with_suffix(".png"), var=plot_var)
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
             result.dataset, as_json)
 
@@ -219,7 +220,7 @@ def bifurcation(
     workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
     out: Path = typer.Option(Path("bifurcation.nc"), "--out", help="NetCDF output (resumable); figure beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=_OVERWRITE_HELP),
+    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
@@ -227,28 +228,24 @@ def bifurcation(
     """Bifurcation diagram of φ: steady-state peak values against one parameter (Figs. 12–14)."""
     from ..sweep import sweep as run_sweep
 
-    with user_errors():
-        if param in _CATEGORICAL:
-            raise ValueError(f"--param {param}: the control parameter must be numeric; use --model full,x,y,rotation "
-                             "for one panel per model")
-        named = dict(N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-        flags = dict(N="--N", Omega="--omega", mu_k="--mu-k", delta_mu="--delta-mu", alpha="--alpha")
-        if named.get(param) is not None:
-            raise ValueError(f"{flags[param]} conflicts with --param {param}; drop {flags[param]} (the range sets it)")
-        params = _bifurcation_parameters(config, set_, named, param)
-        values = parse_values(param, range_, option="--range")
-        models = parse_values("model", model, option="--model") if "," in model else [model]
-        grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
-        check_nc_path(out)
-        if n_peaks < 1:
-            raise ValueError(f"--peaks must be >= 1, got {n_peaks}")
-        options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-        result = run_sweep(grid, params, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
-        figure = None
-        if not no_plot:
-            from ..plot.sweep import save_bifurcation_figure
+    if param in _CATEGORICAL:
+        raise CLIError(f"--param {param}: the control parameter must be numeric; use --model full,x,y,rotation "
+                       "for one panel per model")
+    named = dict(N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    params = _bifurcation_parameters(config, set_, named, param)
+    values = parse_values(param, range_, option="--range")
+    models = parse_values("model", model, option="--model") if "," in model else [model]
+    grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
+    if n_peaks < 1:
+        raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
+    options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+    check_resumable_output(out, not no_plot, overwrite)
+    result = run_sweep(grid, params, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
+    figure = None
+    if not no_plot:
+        from ..plot.sweep import save_bifurcation_figure
 
-            figure = save_bifurcation_figure(result, out.with_suffix(".png"))
+        figure = save_bifurcation_figure(result, out.with_suffix(".png"))
     _report(f"bifurcation diagram of φ against {param}", out, figure, result.timings, result.dataset, as_json)
 
 
@@ -259,15 +256,12 @@ BIFURCATION_BASE = {"N": 50.0, "Omega": 0.5}
 
 def _bifurcation_parameters(config, assignments, named: dict, param: str):
     """Base parameters: :data:`BIFURCATION_BASE` for N and Ω unless the config file, ``--set`` or
-    the named options give them, then everything as in :func:`build_parameters`."""
-    import tomllib
-
-    params = build_parameters(config, assignments, **named)
-    given = {k for k, v in named.items() if v is not None}
-    given |= {item.partition("=")[0].strip() for item in assignments or []}
+    the named options give them, then everything as in :func:`build_parameters` (which refuses
+    an option that sets the control parameter ``param``)."""
+    params, _ = build_parameters(config, assignments, swept={param: f"--param {param}"}, **named)
+    given = {k for k, v in named.items() if v is not None} | set(parse_assignments(assignments))
     if config is not None:
-        data = tomllib.loads(Path(config).read_text())
-        given |= set(data.get("parameters", data))
+        given |= set(config_values(config))
     changes = {k: v for k, v in BIFURCATION_BASE.items() if k != param and k not in given}
     return params.replace(**changes) if changes else params
 
@@ -301,7 +295,7 @@ def regions_command(
     workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
     out: Path = typer.Option(Path("regions.nc"), "--out", help="NetCDF output (resumable); figure beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=_OVERWRITE_HELP),
+    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
@@ -312,21 +306,21 @@ def regions_command(
     """
     from ..sweep import regions as run_regions
 
-    with user_errors():
-        params = build_parameters(config, set_, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-        n_values = parse_values("N", N, option="--N")
-        w_values = parse_values("Omega", omega, option="--omega")
-        models = parse_values("model", model, option="--model")
-        check_nc_path(out)
-        if t_from is None and math.isfinite(t_end):
-            t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
-        options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-        rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
-        figure = None
-        if not no_plot:
-            from ..plot.regions import save_regions_figure
+    params, _ = build_parameters(config, set_, swept={"N": "--N", "Omega": "--omega"}, mu_k=mu_k, delta_mu=delta_mu,
+                                 alpha=alpha)
+    n_values = parse_values("N", N, option="--N")
+    w_values = parse_values("Omega", omega, option="--omega")
+    models = parse_values("model", model, option="--model")
+    if t_from is None and math.isfinite(t_end):
+        t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
+    options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+    check_resumable_output(out, not no_plot, overwrite)
+    rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
+    figure = None
+    if not no_plot:
+        from ..plot.regions import save_regions_figure
 
-            figure = save_regions_figure(rmap, out.with_suffix(".png"))
+        figure = save_regions_figure(rmap, out.with_suffix(".png"))
     from ..sweep.bistability import REGION_NAMES
 
     region = rmap.region

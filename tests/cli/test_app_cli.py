@@ -1,0 +1,191 @@
+"""The application around every command: one error line (exit 2) for what the user can fix,
+exit 130 and one line on Ctrl-C, text that is printed as written (no rich markup), and units in
+every --help."""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import inspect
+import json
+import typing
+
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from stickslip.cli import app
+
+runner = CliRunner()
+
+
+def invoke(*args, **kwargs):
+    return runner.invoke(app, list(args), **kwargs)
+
+
+def one_error_line(res, code=2, prefix="error:") -> str:
+    """The single line of a refused command (exit ``code``, no traceback)."""
+    assert res.exit_code == code, res.output
+    assert res.exception is None or isinstance(res.exception, SystemExit), res.exception
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith(prefix), res.output
+    return lines[0]
+
+
+def commands(typer_app=app, path=()):
+    """(command path, callback) of every command."""
+    for info in typer_app.registered_commands:
+        yield [*path, info.name or info.callback.__name__.replace("_", "-")], info.callback
+    for group in typer_app.registered_groups:
+        yield from commands(group.typer_instance, (*path, group.name))
+
+
+def options(callback):
+    """(flag, type, help) of every option of a command."""
+    hints = typing.get_type_hints(callback)
+    for name, parameter in inspect.signature(callback).parameters.items():
+        info = parameter.default
+        if isinstance(info, typer.models.OptionInfo):
+            yield (info.param_decls[0] if info.param_decls else f"--{name}"), hints.get(name), info.help or ""
+
+
+# ----------------------------------------------------------------------------- usage errors
+@pytest.mark.parametrize("args, words", [
+    (["simulate", "--N", "abc"], "Invalid value for '--N'"),
+    (["simulate", "--bogus", "1"], "No such option: --bogus"),
+    (["continue", "--param", "Omega"], "Missing option '--from'"),
+    (["stability-map", "--N-points", "2.5"], "Invalid value for '--N-points'"),
+    (["no-such-command"], "No such command"),
+])
+def test_usage_errors_are_one_line(args, words):
+    line = one_error_line(invoke(*args))
+    assert words in line and "--help" in line, line
+
+
+# ----------------------------------------------------------------------------- markup
+@pytest.mark.parametrize("text", ["[red]a:b:c", "[bold]x[/]", ":smile:"])
+def test_user_input_in_an_error_is_printed_as_given(text):
+    line = one_error_line(invoke("simulate", "--model", text, "--t-end", "1", "--json"))
+    assert text in line, line
+
+
+def test_user_input_in_a_summary_is_printed_as_given(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    res = invoke("simulate", "--t-end", "1", "--no-plot", "--out", "[red]a:b:c.nc")
+    assert res.exit_code == 0, res.output
+    assert "[red]a:b:c.nc" in res.output and (tmp_path / "[red]a:b:c.nc").is_file()
+
+
+#: Options without a unit (counts, names, flags, and dimensionless numbers).
+DIMENSIONLESS = {"--mu-k", "--delta-mu", "--rtol", "--atol", "--tol", "--step", "--max-step"}
+
+
+def test_every_float_option_states_its_unit():
+    missing = []
+    for path, callback in commands():
+        for flag, kind, text in options(callback):
+            if kind in (float, typing.Optional[float]) and flag not in DIMENSIONLESS:
+                if not re.search(r"\[[^\]]+\]", text):
+                    missing.append(f"{' '.join(path)} {flag}")
+    assert not missing, missing
+
+
+@pytest.mark.parametrize("name", [" ".join(path) for path, _ in commands()])
+def test_help_shows_every_bracket_as_written(name):
+    path, callback = next((p, c) for p, c in commands() if " ".join(p) == name)
+    res = invoke(*path, "--help")
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.replace("│", " ").split())  # the words, without the panel's borders
+    for flag, _, help_text in options(callback):
+        for token in re.findall(r"\[[^\]]*\]", help_text):
+            assert token in text, f"{name} {flag}: {token} missing from --help"
+
+
+# ----------------------------------------------------------------------------- paths
+def test_a_directory_as_output_is_one_line(tmp_path):
+    (tmp_path / "d.nc").mkdir()
+    line = one_error_line(invoke("simulate", "--t-end", "1", "--out", str(tmp_path / "d.nc")))
+    assert "directory" in line and "--out" in line
+
+
+def test_an_unwritable_output_is_one_line_before_the_run(tmp_path):
+    line = one_error_line(invoke("simulate", "--t-end", "1", "--out", "/proc/stickslip-test/x.nc"))
+    assert "/proc" in line
+
+
+@pytest.mark.skipif(hasattr(os, "geteuid") and os.geteuid() == 0, reason="root writes into read-only folders")
+def test_a_read_only_folder_is_one_line(tmp_path):
+    ro = tmp_path / "ro"
+    ro.mkdir(mode=0o555)
+    line = one_error_line(invoke("simulate", "--t-end", "1", "--out", str(ro / "x.nc")))
+    assert "not writable" in line and "--out" in line
+
+
+def test_an_os_error_while_writing_is_one_line(tmp_path, monkeypatch):
+    from stickslip.integrate.result import Trajectory
+
+    def full_disk(self, path):
+        raise OSError(28, "No space left on device", str(path))
+
+    monkeypatch.setattr(Trajectory, "to_netcdf", full_disk)
+    line = one_error_line(invoke("simulate", "--t-end", "1", "--no-plot", "--out", str(tmp_path / "x.nc")))
+    assert "No space left on device" in line
+
+
+# ----------------------------------------------------------------------------- bugs stay visible
+def test_a_bug_keeps_its_traceback(tmp_path, monkeypatch):
+    import stickslip.integrate.driver as driver
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setattr(driver, "simulate", broken)
+    res = invoke("simulate", "--t-end", "1", "--out", str(tmp_path / "x.nc"))
+    assert isinstance(res.exception, ZeroDivisionError)
+
+
+# ----------------------------------------------------------------------------- Ctrl-C
+def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch):
+    import stickslip.integrate.driver as driver
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(driver, "simulate", interrupted)
+    res = invoke("simulate", "--t-end", "1", "--out", str(tmp_path / "x.nc"))
+    line = one_error_line(res, code=130, prefix="interrupted:")
+    assert "nothing was written" in line
+    assert not (tmp_path / "x.nc").exists()
+
+
+def _size(folder) -> int:
+    return sum(f.stat().st_size for f in folder.iterdir()) if folder.is_dir() else -1
+
+
+def test_ctrl_c_of_a_sweep_keeps_its_journal_and_the_same_command_resumes(tmp_path):
+    out, journal = tmp_path / "s.nc", tmp_path / "s.nc.journal"
+    cmd = [sys.executable, "-c", "from stickslip.cli import app; app()", "sweep", "--grid", "N=20:80:6000",
+           "--grid", "Omega=0.5", "--t-end", "2", "--executor", "serial", "--no-plot", "--no-progress",
+           "--out", str(out), "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while _size(journal) < 0 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)  # the journal's header is written; its first points take longer (kernels load)
+    created = _size(journal)
+    while _size(journal) <= created and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)  # until the first points are journaled
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stderr
+    lines = [ln for ln in stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("interrupted:") and "resume" in lines[0], stderr
+    assert not out.exists() and _size(journal) > created
+
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    summary = json.loads(again.stdout.strip().splitlines()[-1])
+    assert summary["points_resumed"] >= 1 and summary["points_resumed"] + summary["points_computed"] == 6000
