@@ -111,7 +111,7 @@ def test_a_directory_as_output_is_one_line(tmp_path):
     assert "directory" in line and "--out" in line
 
 
-def test_an_unwritable_output_is_one_line_before_the_run(tmp_path):
+def test_an_unwritable_output_is_one_line(tmp_path):
     line = one_error_line(invoke("simulate", "--t-end", "1", "--out", "/proc/stickslip-test/x.nc"))
     assert "/proc" in line
 

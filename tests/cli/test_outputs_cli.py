@@ -91,6 +91,11 @@ def test_an_output_folder_with_files_is_refused(args, tmp_path):
     (["bifurcation", "--param", "Omega", "--set", "Omega=3"], "--param Omega and --set Omega=3 both set Omega"),
     (["regions", "--set", "Omega=3"], "--omega and --set Omega=3 both set Omega"),
     (["sweep", "--grid", "N=30", "--t-end", "1e12"], "lower --sample-rate"),
+    (["sweep", "--grid", "N=1:2:1000000000000"], "give a smaller count in --grid"),
+    (["sweep", "--grid", "N=1:2:1000000", "--grid", "Omega=1:2:1000000"], "a grid of 1000000000000 points"),
+    (["bifurcation", "--range", "30,50", "--peaks", "1000000000000"], "or a smaller --peaks"),
+    (["orbit", "--tol", "1e300"], "--tol 1e+300: a relative tolerance must be < 1"),
+    (["continue", "--from", "5", "--to", "6", "--tol", "2"], "--tol 2: a relative tolerance must be < 1"),
 ])
 def test_refused_options_say_why_in_one_line(args, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

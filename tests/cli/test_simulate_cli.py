@@ -186,6 +186,8 @@ def test_json_alone_writes_nothing(tmp_path, monkeypatch):
     (["--steady-from", "nan"], "--steady-from must be a finite number"),
     (["--perturb", "inf"], "--perturb must be a finite number"),
     (["--sample-rate", "0"], "--sample-rate must be a finite number > 0"),
+    (["--dt", "1e-12"], "--dt 1e-12 s takes at least 1e+12 steps"),
+    (["--method", "aeom", "--dt", "1e-300"], "give --dt 2e-08 or more"),
 ])
 def test_refused_options_say_why_in_one_line(args, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
@@ -242,3 +244,20 @@ def test_a_run_that_stops_early_is_kept_and_said_in_one_line(tmp_path, monkeypat
     kept = load_trajectory(out)
     assert kept.t[-1] == 0.5 and kept.status == "max_steps reached at t = 0.5 s"
     assert out.with_suffix(".png").is_file()
+
+
+def test_a_library_warning_is_one_line(tmp_path, monkeypatch):
+    import warnings
+
+    import stickslip.integrate.driver as driver
+
+    library = driver.simulate
+
+    def warns(*args, **kwargs):
+        warnings.warn("something to know\nover two lines", RuntimeWarning)
+        return library(*args, **kwargs)
+
+    monkeypatch.setattr(driver, "simulate", warns)
+    res = run("--t-end", "1", "--json")
+    assert res.exit_code == 0, res.output
+    assert [ln for ln in res.stderr.splitlines() if ln.strip()] == ["warning: something to know over two lines"]

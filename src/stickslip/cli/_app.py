@@ -15,6 +15,7 @@ import errno
 import math
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import typer
@@ -55,8 +56,9 @@ SAMPLE_BYTES = 300
 _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
 
 #: errno values of operating-system errors about a path the user gave or can fix.
-_PATH_ERRNOS = {errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOENT, errno.EISDIR, errno.ENOTDIR, errno.EEXIST,
-                errno.ENOSPC, errno.EDQUOT, errno.ENAMETOOLONG, errno.ELOOP, errno.EFBIG}
+_PATH_ERRNOS = {getattr(errno, name) for name in ("EACCES", "EPERM", "EROFS", "ENOENT", "EISDIR", "ENOTDIR", "EEXIST",
+                                                  "ENOSPC", "EDQUOT", "ENAMETOOLONG", "ELOOP", "EFBIG")
+                if hasattr(errno, name)}
 
 
 class CLIError(StickSlipError, ValueError):
@@ -93,6 +95,11 @@ def _path_error_message(exc: OSError) -> str:
     what = exc.strerror or str(exc)
     return (f"cannot write or read {where}: {what}" if where else str(exc)) + \
         "; check the path and its permissions, or choose another path"
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings of the library, as one ``warning:`` line each."""
+    warning_line(str(message))
 
 
 def _escape_help(command) -> None:
@@ -134,7 +141,9 @@ class _Application(TyperGroup):
     def invoke(self, ctx):
         on_interrupt("nothing was written")
         try:
-            return super().invoke(ctx)
+            with warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                return super().invoke(ctx)
         except StickSlipError as exc:
             error_line(str(exc))
         except OSError as exc:
@@ -267,6 +276,13 @@ def check_positive(flags: dict) -> None:
             raise CLIError(f"{flag} must be a finite number > 0, got {value}")
 
 
+def check_below_one(flags: dict) -> None:
+    """Every ``{flag: value}`` (a relative tolerance) must be < 1: at 1 or more any guess passes."""
+    for flag, value in flags.items():
+        if value is not None and not value < 1.0:
+            raise CLIError(f"{flag} {value:g}: a relative tolerance must be < 1 (typical values 1e-6 … 1e-10)")
+
+
 def check_finite(flags: dict) -> None:
     """Every ``{flag: value}`` must be a finite number (``None``: not given, skipped)."""
     for flag, value in flags.items():
@@ -289,6 +305,24 @@ def available_memory() -> float | None:
         return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
     except (ValueError, OSError, AttributeError):
         return None
+
+
+def check_memory(need: float, what: str, fix: str) -> None:
+    """Refuse work that needs ``need`` bytes when less memory is available.
+
+    Parameters
+    ----------
+    need : float
+        Estimated peak memory [bytes] (may be inf).
+    what : str
+        What needs it, for the message (``"a 1000 × 1000 map"``).
+    fix : str
+        The options that lower it (``"lower --N-points"``).
+    """
+    memory = available_memory()
+    if memory is not None and not need <= memory:
+        raise CLIError(f"{what} needs ≈ {need / 1e9:.3g} GB, more than the {memory / 1e9:.3g} GB of memory "
+                       f"available; {fix}")
 
 
 def check_samples(duration: float, sample_rate: float, *, time_flag: str = "--t-end",

@@ -13,8 +13,8 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_choice, check_finite, check_positive,
-                   check_resumable_output, check_samples, console, note_line)
+from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_below_one, check_choice,
+                   check_finite, check_positive, check_resumable_output, check_samples, console, note_line)
 
 _ICS = ("far", "near", "zero", "equilibrium")
 
@@ -36,6 +36,7 @@ def _check(param: str, start: float, stop: float, ic: str, max_points: int, step
         raise CLIError(f"--max-points must be >= 2, got {max_points}")
     check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--rtol": rtol,
                     "--tol": tol})
+    check_below_one({"--tol": tol})
     if step > max_step:
         raise CLIError(f"--step {step:g} is larger than --max-step {max_step:g}")
     bad = [k for k in stop_on if k not in SPECIAL_KINDS]

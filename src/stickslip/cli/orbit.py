@@ -19,8 +19,8 @@ from rich.table import Table
 from rich.text import Text
 
 from ..errors import StickSlipError
-from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_choice, check_outputs,
-                   check_positive, check_samples, console)
+from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_below_one, check_choice,
+                   check_outputs, check_positive, check_samples, console)
 
 #: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``).
 _ICS = ("far", "near", "zero", "equilibrium")
@@ -94,6 +94,7 @@ def orbit_command(
     from ..orbits.continuation import START_RATE, start_run
 
     _check_common(ic, model, {"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
+    check_below_one({"--tol": tol})
     check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
     check_choice("--monodromy", monodromy, _METHODS)
     if period_multiplicity < 1:

@@ -70,6 +70,18 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
                        f"give a time from {t0:g} to {last:g} s (one sample before the end)")
 
 
+def _check_steps(t_end: float, dt: float | None) -> None:
+    """A step of ``dt`` must cover ``t_end`` within the library's cap on steps (``max_steps``)."""
+    import inspect
+
+    from ..integrate.driver import simulate as run_simulation
+
+    cap = getattr(inspect.signature(run_simulation).parameters.get("max_steps"), "default", None)
+    if cap is not None and dt is not None and math.isfinite(dt) and dt > 0 and not t_end / dt <= cap:
+        raise CLIError(f"--dt {dt:g} s takes at least {t_end / dt:.3g} steps for {t_end:g} s, more than the {cap} a "
+                       f"run may take; give --dt {t_end / cap:.3g} or more, or a shorter --t-end")
+
+
 def _warn_aliasing(params, model: str, sample_rate: float) -> None:
     """One warning line when the samples cannot resolve the model's fastest linear mode."""
     from ..model.modes import natural_frequencies
@@ -125,6 +137,7 @@ def simulate(
     check_finite({"--perturb": perturb, "--steady-from": steady_from})
     _check_window(steady_from, t0, t0 + t_end, settings["sample_rate"])
     check_samples(t_end, settings["sample_rate"])
+    _check_steps(t_end, settings["dt"])
     write = out is not None or not as_json
     out = Path("run.nc") if out is None else out
     if write:

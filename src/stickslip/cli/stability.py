@@ -12,10 +12,9 @@ from typing import List, Optional
 import numpy as np
 import typer
 from rich.table import Table
-
 from rich.text import Text
 
-from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, available_memory, build_parameters, check_finite,
+from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_finite, check_memory,
                    check_outputs, console)
 
 _N_HELP = "Normal preload N [N] (default 50)."
@@ -82,11 +81,8 @@ def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
 
 
 def _check_grid_memory(n_points: int, omega_points: int, members: int) -> None:
-    memory = available_memory()
     need = float(n_points) * omega_points * members * _MAP_POINT_BYTES + float(omega_points) * _MAP_OMEGA_BYTES
-    if memory is not None and need > memory:
-        raise CLIError(f"a {n_points} × {omega_points} map of {members} member(s) needs ≈ {need / 1e9:.3g} GB, more "
-                       f"than the {memory / 1e9:.3g} GB of memory available; lower --N-points or --omega-points")
+    check_memory(need, f"a {n_points} × {omega_points} map of {members} member(s)", "lower --N-points or --omega-points")
 
 
 @app.command("stability-map")

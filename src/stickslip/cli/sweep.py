@@ -16,10 +16,16 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_finite, check_positive,
-                   check_resumable_output, check_samples, config_values, console, parse_assignments)
+from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_finite, check_memory,
+                   check_positive, check_resumable_output, check_samples, config_values, console, parse_assignments)
 
 _CATEGORICAL = ("model", "ic")
+
+#: Memory per grid point of a sweep [bytes]: its coordinate values, done mask and pending index.
+_POINT_BYTES = 32
+
+#: Memory per value of a parsed axis [bytes]: a Python float in a list and its array copies.
+_VALUE_BYTES = 64
 
 _EXECUTOR_HELP = "serial | processes | dask (default processes; dask when --scheduler is given)."
 _WORKERS_HELP = "Worker processes (default: all cores); with dask and no --scheduler, the LocalCluster size."
@@ -66,6 +72,7 @@ def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
             raise CLIError(f"{given}: count must be >= 2 (for one value write {prefix}{parts[0]})")
         if start == stop:
             raise CLIError(f"{given}: start equals stop; give different ends or a single value")
+        check_memory(count * float(_VALUE_BYTES), f"{given} ({count} values)", f"give a smaller count in {option}")
         return np.linspace(start, stop, count).tolist()
     try:
         values = [float(v) for v in text.split(",")]
@@ -90,6 +97,13 @@ def parse_grid(items: list[str] | None) -> dict:
     if not grid:
         raise CLIError("give at least one --grid NAME=VALUES, e.g. --grid N=10:130:13")
     return grid
+
+
+def _check_grid(grid: dict, n_peaks: int = 64) -> None:
+    """Refuse a grid whose points (and their peaks) would not fit in memory."""
+    points = math.prod(len(v) for v in grid.values())
+    check_memory(points * (_POINT_BYTES + 8.0 * n_peaks), f"a grid of {points} points with {n_peaks} peaks each",
+                 "give fewer values" + (" or a smaller --peaks" if n_peaks > 64 else ""))
 
 
 def _executor(executor: str | None, scheduler: str | None) -> str:
@@ -183,6 +197,7 @@ def sweep_command(
     params, _ = build_parameters(config, set_, swept={k: f"--grid {k}" for k in values if k in Parameters.names()})
     if plot_var not in COLUMNS or plot_var == "peaks":
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
+    _check_grid(values)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     check_resumable_output(out, not no_plot, overwrite)
     result = run_sweep(values, params, out=out, model=model, ic=ic, **options)
@@ -238,6 +253,7 @@ def bifurcation(
     grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
+    _check_grid(grid, n_peaks)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     check_resumable_output(out, not no_plot, overwrite)
     result = run_sweep(grid, params, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
@@ -311,6 +327,7 @@ def regions_command(
     n_values = parse_values("N", N, option="--N")
     w_values = parse_values("Omega", omega, option="--omega")
     models = parse_values("model", model, option="--model")
+    _check_grid({"model": models, "N": n_values, "Omega": w_values, "ic": [0, 0]})
     if t_from is None and math.isfinite(t_end):
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
