@@ -12,7 +12,7 @@ from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import System, assemble
 from ..model.variants import DOF_NAMES
 from . import linearize
-from .equilibrium import solve_equilibrium
+from .equilibrium import EquilibriumError, solve_equilibrium
 
 __all__ = ["StabilityResult", "stability", "linearization"]
 
@@ -198,13 +198,17 @@ def stability(params: Parameters, model="full") -> StabilityResult:
     EquilibriumError
         No steady sliding (Ω = 0, Newton failure), or a sliding speed |Ω| R at equilibrium
         inside the simulator's low-speed band, where its slip direction is not v_r/|v_r|
-        (see :func:`stickslip.stability.equilibrium.solve_equilibrium`).
+        (see :func:`stickslip.stability.equilibrium.solve_equilibrium`), or a Jacobian that
+        overflows (values far outside physical size).
     """
     if not isinstance(params, Parameters):
         raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
     system = assemble(params, model)
     q, residual, _ = solve_equilibrium(system)
     J, K_L, C_L = linearization(system, q)
+    if not np.all(np.isfinite(J)):
+        raise EquilibriumError(f"the linearisation at steady sliding is not finite (N = {params.N:g} N, "
+                               f"Ω = {params.Omega:g} rad/s overflow); give values of physical size")
     lam, vec = np.linalg.eig(J)
     order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
     lam = lam[order]
