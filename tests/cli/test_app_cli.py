@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 
+import importlib
 import inspect
 import json
 import typing
@@ -159,6 +160,27 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch):
     line = one_error_line(res, code=130, prefix="interrupted:")
     assert "nothing was written" in line
     assert not (tmp_path / "x.nc").exists()
+
+
+@pytest.mark.parametrize("target, args, kept", [
+    ("stickslip.orbits.continuation.start_run", ["continue", "--from", "5", "--to", "6", "--out", "b.nc"],
+     "finished work is kept in b.nc.journal; run the same command again to resume"),
+    ("stickslip.sweep.sweep", ["sweep", "--grid", "N=30,50", "--out", "s.nc"],
+     "finished work is kept in s.nc.journal; run the same command again to resume"),
+    ("stickslip.studies.reproduce.reproduce", ["reproduce", "--only", "fig3", "--out", "paper"],
+     "the figures finished so far are listed in paper/report.md"),
+    ("stickslip.orbits.lyapunov_spectrum", ["lyapunov", "--out", "l.nc"], "nothing was written"),
+])
+def test_ctrl_c_says_what_each_command_keeps(target, args, kept, tmp_path, monkeypatch):
+    module, _, name = target.rpartition(".")
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(importlib.import_module(module), name, interrupted)
+    monkeypatch.chdir(tmp_path)
+    line = one_error_line(invoke(*args), code=130, prefix="interrupted:")
+    assert line == f"interrupted: {kept}"
 
 
 def _size(folder) -> int:

@@ -83,6 +83,7 @@ def test_an_output_folder_with_files_is_refused(args, tmp_path):
     (["stability-map", "--family", "delta_mu"], "--family"),
     (["stability-map", "--N-points", "1000000000", "--omega-points", "1000000000"], "lower --N-points"),
     (["stability", "--omega", "5", "--set", "Omega=3"], "--set Omega=3 and --omega 5 both set Omega"),
+    (["stability", "--omega", "-2.1199605744342958e+229"], "not finite"),  # found by the property tests
     (["orbit", "--N", "50", "--set", "N=30"], "--set N=30 and --N 50 both set N"),
     (["orbit", "--search-time", "1e12"], "--search-time 1e+12 s"),
     (["continue", "--from", "5", "--to", "6", "--omega", "3"], "--param Omega and --omega 3 both set Omega"),

@@ -135,7 +135,7 @@ def ranges(huge: float):
 
 CI = settings(max_examples=3, derandomize=True, deadline=None, database=None,
               suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-MANY = settings(max_examples=150, deadline=None, database=None,
+MANY = settings(max_examples=40, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 CI_HUGE, SLOW_HUGE = 1e7, 1.7e308
 
