@@ -52,8 +52,10 @@ def _note_resume(k: int) -> None:
 @app.command("continue")
 def continue_command(
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: N, Omega, delta_mu, alpha, mu_k, k_px, ..."),
-    start: float = typer.Option(..., "--from", help="Start value of the parameter [its unit: N for N, rad/s for Omega, ...] (where the first orbit is found)."),
-    stop: float = typer.Option(..., "--to", help="End of the range [the unit of --param]; the branch goes from --from towards it."),
+    start: float = typer.Option(..., "--from", help="Start value of the parameter [its unit: N for N, rad/s for "
+                                "Omega, ...]; the first orbit is found there."),
+    stop: float = typer.Option(..., "--to", help="End of the range [the unit of --param]; the branch goes from "
+                               "--from towards it."),
     N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
     omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4)."),
