@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import math
 import time
 from pathlib import Path
@@ -11,6 +9,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..errors import StickSlipError
 from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import Parameters
 from ..model.system import System, assemble

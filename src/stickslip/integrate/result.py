@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 import json
 from functools import cached_property
@@ -12,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from ..errors import StickSlipError
 from .. import __version__
 from ..analysis.steady import SteadyState, summarize
 from ..model import kernels

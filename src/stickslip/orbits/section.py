@@ -13,12 +13,11 @@ not a dense-output sample before it.
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 
 import numpy as np
 
+from ..errors import StickSlipError
 from ..analysis.steady import _hermite_crossings
 from ..integrate.driver import simulate
 from ..model import kernels as K

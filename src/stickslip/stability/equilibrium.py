@@ -8,12 +8,11 @@ simulator's own kernel (:func:`equilibrium_residual`).
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import math
 
 import numpy as np
 
+from ..errors import StickSlipError
 from ..model import kernels
 from ..model.parameters import Parameters
 from ..model.system import System, assemble

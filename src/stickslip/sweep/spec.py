@@ -7,8 +7,6 @@ the trajectory outlives the point and memory stays flat as the grid grows.
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 import hashlib
 import json
@@ -18,6 +16,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..errors import StickSlipError
 from ..model.parameters import Parameters
 from ..model.variants import DOF_NAMES, STATE_NAMES, resolve_variant
 
