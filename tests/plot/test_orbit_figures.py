@@ -90,7 +90,7 @@ def _timestep_study(t_end=6.0):
 
 def test_timestep_panels_name_the_static_friction_level_and_relative_errors():
     fig = plot_timestep_method(_timestep_study(), "aeom")
-    labels = set()
+    labels = {t.get_text() for legend in fig.legends for t in legend.get_texts()}
     for ax in fig.axes:
         labels |= set(legend_entries(ax))
     assert "μs N" in labels
