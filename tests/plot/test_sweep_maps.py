@@ -45,6 +45,12 @@ def test_non_uniform_grid_is_drawn_with_its_true_cell_edges():
     assert ax.get_yscale() == "linear"
 
 
+def test_few_grid_values_are_the_ticks_of_their_axis():
+    ax = _map([0.5, 5.0, 8.5], np.ones((3, 3)))
+    np.testing.assert_allclose(ax.get_yticks(), [0.5, 5.0, 8.5])
+    np.testing.assert_allclose(ax.get_xticks(), N3)
+
+
 def test_geometric_grid_is_drawn_on_a_log_axis_with_equal_cells():
     omega = [0.5, 1.0, 2.0, 4.0]
     ax = _map(omega, np.ones((3, 4)))

@@ -88,14 +88,22 @@ def cell_edges(values) -> tuple[np.ndarray, str]:
     return edges, "linear"
 
 
-def grid_axis(ax, which: str, edges: np.ndarray, scale: str) -> None:
-    """Limits and scale of the x or y axis of a cell map (``which``: ``"x"`` or ``"y"``)."""
-    if which == "x":
-        ax.set_xscale(scale)
-        ax.set_xlim(edges[0], edges[-1])
-    else:
-        ax.set_yscale(scale)
-        ax.set_ylim(edges[0], edges[-1])
+#: Axes of a cell map with at most this many grid values get one tick per value.
+MAX_VALUE_TICKS = 8
+
+
+def grid_axis(ax, which: str, edges: np.ndarray, scale: str, values=None) -> None:
+    """Limits and scale of the x or y axis of a cell map (``which``: ``"x"`` or ``"y"``); with
+    few ``values`` (≤ :data:`MAX_VALUE_TICKS`) the ticks sit at the grid values, so that a
+    non-uniform grid shows where it was computed."""
+    from matplotlib.ticker import NullLocator
+
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    (ax.set_xscale if which == "x" else ax.set_yscale)(scale)
+    (ax.set_xlim if which == "x" else ax.set_ylim)(edges[0], edges[-1])
+    if values is not None and len(values) <= MAX_VALUE_TICKS:
+        axis.set_ticks(values, [f"{v:g}" for v in values])
+        axis.set_minor_locator(NullLocator())
 
 
 def agg_figure(figsize, **kwargs):

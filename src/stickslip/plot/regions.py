@@ -85,8 +85,8 @@ def plot_regions(rmap, ax=None, *, model: str | None = None, boundary: bool = Tr
         if np.any(np.isfinite(omax)):
             ax.plot(N, omax, "k.-", lw=1.5, ms=5)
             handles.append(Line2D([], [], color="k", marker=".", lw=1.5, label="largest Ω with stick-slip"))
-    grid_axis(ax, "x", ne, ns)
-    grid_axis(ax, "y", we, ws)
+    grid_axis(ax, "x", ne, ns, N)
+    grid_axis(ax, "y", we, ws, W)
     ax.set_xlabel("normal load N [N]")
     ax.set_ylabel("Ω [rad/s]")
     ax.set_title(MODEL_LABELS.get(model, f"model {model}") if title is None else title, fontsize=10)

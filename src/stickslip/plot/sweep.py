@@ -51,6 +51,10 @@ MAX_PANELS = 12
 
 _CATEGORICAL = ("model", "ic")
 
+#: Names of reductions on axes and colour bars (others go by their variable name).
+_VAR_NAMES = {"stick_fraction": "stick fraction", "fft_frequency": "FFT frequency", "intensity_r_phi": "I(rφ)",
+              "intensity_x1": "I(x1)", "intensity_y1": "I(y1)", "intensity_translation": "I(x1, y1)"}
+
 
 def _dataset(result):
     return getattr(result, "dataset", result)
@@ -65,7 +69,7 @@ def axis_label(ds, name: str) -> str:
         attrs = {}
     units = attrs.get("units", PARAMETER_UNITS.get(name, ""))
     unit = unit_text(units)
-    symbol = SYMBOLS.get(name, name)
+    symbol = SYMBOLS.get(name, _VAR_NAMES.get(name, name))
     return f"{symbol} {unit}" if unit else symbol
 
 
@@ -172,8 +176,8 @@ def _heat_map(ax, da, kind, x, y, var, styles, label, colorbar):
         cmap = ListedColormap([_class_style(k, styles)[0] for k in keys])
         ax.pcolormesh(xe, ye, np.ma.masked_less(codes, 0), cmap=cmap, vmin=-0.5, vmax=len(keys) - 0.5)
         _class_legend(ax, keys, styles, var)
-    grid_axis(ax, "x", xe, xs)
-    grid_axis(ax, "y", ye, ys)
+    grid_axis(ax, "x", xe, xs, da[x].values)
+    grid_axis(ax, "y", ye, ys, da[y].values)
     ax.set_xlabel(axis_label(da, x))
     ax.set_ylabel(axis_label(da, y))
 
