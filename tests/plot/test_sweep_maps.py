@@ -140,3 +140,10 @@ def test_sweep_figure_title_gives_fixed_parameters_with_units(tmp_path, monkeypa
     save_sweep_figure(ds, tmp_path / "s.png", var="frequency")
     title = saved[0].get_suptitle()
     assert "α = 5 s/m" in title and "steady window 100–200 s" in title
+
+
+def test_title_names_the_value_of_a_grid_dimension_of_length_one(tmp_path, monkeypatch):
+    saved = capture_saved_figures(monkeypatch)
+    ds = make_sweep({"N": N3, "Omega": [8.5]}, kind=np.full((3, 1), 2.0), frequency=np.ones((3, 1)))
+    save_sweep_figure(ds, tmp_path / "s.png", var="frequency")
+    assert "Ω = 8.5 rad/s" in saved[0].get_suptitle()

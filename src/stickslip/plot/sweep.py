@@ -112,70 +112,59 @@ def kind_styles(ds) -> dict[int, tuple[str, str]]:
     return styles
 
 
-def _classes(values, kind, styles, var):
-    """Cells drawn in a colour of their own instead of on the colour scale.
+#: Class of a cell drawn on the colour scale, and of a cell without a value and without a kind
+#: that explains it (:data:`NO_VALUE`); other classes are kind codes.
+_ON_SCALE, _NO_VALUE = -1000, -999
 
-    Returns an array of class keys (None: on the scale): a kind code where the kind has no
-    oscillation and ``var`` describes one, or where the value is missing and the kind says why;
-    ``"none"`` where the value is missing otherwise.
-    """
+
+def _classes(values, kind, styles, var) -> np.ndarray:
+    """Class of each cell (int array): :data:`_ON_SCALE`, or the kind code where the kind has no
+    oscillation and either ``var`` describes one or the value is missing, or :data:`_NO_VALUE`
+    where the value is missing otherwise. For ``var == "kind"`` the values are the classes."""
     values = np.asarray(values, dtype=float)
+    if var == "kind":
+        return np.where(np.isfinite(values), values, _NO_VALUE).astype(int)
     kind = np.full(values.shape, np.nan) if kind is None else np.asarray(kind, dtype=float)
-    out = np.full(values.shape, None, dtype=object)
+    out = np.full(values.shape, _ON_SCALE, dtype=int)
     for code, (_, label) in styles.items():
-        is_code = kind == code
-        still = label in NOT_OSCILLATING
-        out[is_code & ((still & (var in OSCILLATION_VARS)) | (~np.isfinite(values) & still))] = code
-    out[(out == None) & ~np.isfinite(values)] = "none"  # noqa: E711 (elementwise on an object array)
+        if label in NOT_OSCILLATING:
+            out[(kind == code) & ((var in OSCILLATION_VARS) | ~np.isfinite(values))] = code
+    out[(out == _ON_SCALE) & ~np.isfinite(values)] = _NO_VALUE
     return out
 
 
-def _class_style(key, styles):
-    if key == "none":
+def _class_style(key: int, styles, var: str) -> tuple[str, str]:
+    """(colour, legend label) of a cell class; a kind without oscillation says what it lacks."""
+    if key == _NO_VALUE:
         return NO_VALUE
-    return styles.get(int(key), (_EXTRA_COLOURS[-1], f"kind {int(key)}"))
-
-
-def _class_legend(ax, keys, styles, var):
-    """Legend of the cells drawn off the scale, below the axes so it hides no cell."""
-    from matplotlib.patches import Patch
-
-    handles = []
-    for key in keys:
-        colour, label = _class_style(key, styles)
-        if var != "kind" and key != "none" and label in NOT_OSCILLATING:
-            label += f" (no {var})" if var in OSCILLATION_VARS else ""
-        handles.append(Patch(color=colour, label=label))
-    if handles:
-        ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14),
-                  ncol=min(3, len(handles)), frameon=False)
+    colour, label = styles.get(int(key), (_EXTRA_COLOURS[-1], f"kind {int(key)}"))
+    if var in OSCILLATION_VARS and label in NOT_OSCILLATING:
+        label += f" (no {var})"
+    return colour, label
 
 
 def _heat_map(ax, da, kind, x, y, var, styles, label, colorbar):
-    """Cells over the true cell edges of (x, y); off-scale classes in their own colours."""
+    """Cells over the true cell edges of (x, y); off-scale classes in their own colours, named
+    in a legend below the axes (where it hides no cell)."""
     from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
 
     z = da.transpose(y, x).values.astype(float)
-    kz = None if kind is None else kind.transpose(y, x).values.astype(float)
-    if var == "kind":
-        z = np.where(np.isfinite(z), z, np.nan)
-        cls = np.where(np.isfinite(z), z, None).astype(object)
-        cls[cls == None] = "none"  # noqa: E711
-    else:
-        cls = _classes(z, kz, styles, var)
+    cls = _classes(z, None if kind is None else kind.transpose(y, x).values, styles, var)
     (xe, xs), (ye, ys) = cell_edges(da[x].values), cell_edges(da[y].values)
-    on_scale = cls == None  # noqa: E711
+    on_scale = cls == _ON_SCALE
     if np.any(on_scale):
         mesh = ax.pcolormesh(xe, ye, np.ma.masked_where(~on_scale, z), cmap="viridis")
         if colorbar:
             ax.figure.colorbar(mesh, ax=ax, label=label)
-    keys = sorted({k for k in cls.ravel() if k is not None}, key=lambda k: (isinstance(k, str), k))
-    if keys:
-        index = {k: i for i, k in enumerate(keys)}
-        codes = np.array([[index.get(k, -1) for k in row] for row in cls], dtype=float)
-        cmap = ListedColormap([_class_style(k, styles)[0] for k in keys])
-        ax.pcolormesh(xe, ye, np.ma.masked_less(codes, 0), cmap=cmap, vmin=-0.5, vmax=len(keys) - 0.5)
-        _class_legend(ax, keys, styles, var)
+    keys = np.unique(cls[~on_scale])  # sorted: no value first, then the kind codes
+    if keys.size:
+        styled = [_class_style(k, styles, var) for k in keys]
+        index = np.searchsorted(keys, cls)
+        cmap = ListedColormap([colour for colour, _ in styled])
+        ax.pcolormesh(xe, ye, np.ma.masked_where(on_scale, index), cmap=cmap, vmin=-0.5, vmax=keys.size - 0.5)
+        ax.legend(handles=[Patch(color=c, label=t) for c, t in styled], fontsize=7, loc="upper center",
+                  bbox_to_anchor=(0.5, -0.14), ncol=min(3, keys.size), frameon=False)
     grid_axis(ax, "x", xe, xs, da[x].values)
     grid_axis(ax, "y", ye, ys, da[y].values)
     ax.set_xlabel(axis_label(da, x))
@@ -191,16 +180,16 @@ def _line_plot(ax, da, kind, x, categorical, var, styles, label):
     marked = {}
     for cat, line, kline in groups:
         ys = line.transpose(x).values.astype(float)
-        cls = _classes(ys, None if kline is None else kline.transpose(x).values, styles, var) \
-            if var != "kind" else np.full(ys.shape, None, dtype=object)
-        ys = np.where(cls == None, ys, np.nan)  # noqa: E711
-        ax.plot(xs, ys, "o-", ms=3, lw=1.2, label=None if cat is None else f"{categorical} = {cat}")
-        for key in {k for k in cls if k is not None}:
-            marked.setdefault(key, []).extend(xs[cls == key])
-    for key, where in sorted(marked.items(), key=lambda kv: (isinstance(kv[0], str), kv[0])):
-        colour, text = _class_style(key, styles)
-        ax.plot(where, np.zeros(len(where)), "|", color=colour, ms=12, mew=2, transform=ax.get_xaxis_transform(),
-                label=f"{text} (no {var})" if var in OSCILLATION_VARS and key != "none" else text)
+        cls = (np.full(ys.shape, _ON_SCALE) if var == "kind" else
+               _classes(ys, None if kline is None else kline.transpose(x).values, styles, var))
+        ax.plot(xs, np.where(cls == _ON_SCALE, ys, np.nan), "o-", ms=3, lw=1.2,
+                label=None if cat is None else f"{categorical} = {cat}")
+        for key in np.unique(cls[cls != _ON_SCALE]):
+            marked.setdefault(int(key), []).extend(xs[cls == key])
+    for key in sorted(marked):
+        colour, text = _class_style(key, styles, var)
+        ax.plot(marked[key], np.zeros(len(marked[key])), "|", color=colour, ms=12, mew=2,
+                transform=ax.get_xaxis_transform(), label=text)
     if var == "kind":
         ax.set_yticks(sorted(styles), [styles[c][1] for c in sorted(styles)])
     if categorical or marked:
@@ -304,12 +293,20 @@ def _panel_title(sel: dict) -> str:
 
 
 def _conditions(ds, skip=()) -> str:
-    """Short line of the fixed operating/friction parameters (with units) and run options."""
+    """Short line of the fixed operating/friction parameters (with units) and run options: from
+    the base parameters, or the one value of a grid dimension of length 1."""
     params = json.loads(ds.attrs.get("parameters", "{}"))
-    parts = [param_text(k, params[k]) for k in ("N", "Omega", "mu_k", "delta_mu", "alpha")
-             if k in params and k not in skip and k not in ds.dims]
-    if "model" not in ds.dims and "model" not in skip:
-        parts.insert(0, f"model {ds.attrs.get('model', '?')}")
+    single = {d: ds[d].values[0] for d in _grid_dims(ds) if ds.sizes[d] == 1 and d not in skip}
+    model = single.pop("model", None if "model" in ds.dims else ds.attrs.get("model", "?"))
+    ic = single.pop("ic", None if "ic" in ds.dims else ds.attrs.get("ic"))
+    parts = [f"{text} {value}" for dim, text, value in (("model", "model", model), ("ic", "initial condition", ic))
+             if value is not None and dim not in skip]
+    for k in ("N", "Omega", "mu_k", "delta_mu", "alpha"):
+        if k in single:
+            parts.append(param_text(k, single.pop(k)))
+        elif k in params and k not in skip and k not in ds.dims:
+            parts.append(param_text(k, params[k]))
+    parts += [param_text(k, v) for k, v in single.items()]
     parts.append(f"steady window {ds.attrs.get('t_from', float('nan')):g}–{ds.attrs.get('t_end', float('nan')):g} s")
     return ", ".join(parts)
 
