@@ -10,7 +10,7 @@ from matplotlib.collections import QuadMesh
 
 from stickslip.plot.regions import REGION_STYLE, plot_regions
 
-from .figdata import legend_entries, mesh_edges, top_cell_colours
+from .figdata import capture_saved_figures, legend_entries, mesh_edges, top_cell_colours
 
 
 def _region_map(omega):
@@ -47,3 +47,11 @@ def test_region_map_of_an_unsorted_grid_keeps_each_region_at_its_omega():
     entries = legend_entries(ax)
     np.testing.assert_allclose(cells[0, 0], entries[REGION_STYLE[1][1]].get_facecolor())  # Ω = 0.5: region I
     np.testing.assert_allclose(cells[2, 0], entries[REGION_STYLE[3][1]].get_facecolor())  # Ω = 5: region III
+
+
+def test_regions_figure_title_gives_alpha_with_its_unit(tmp_path, monkeypatch):
+    from stickslip.plot.regions import save_regions_figure
+
+    saved = capture_saved_figures(monkeypatch)
+    save_regions_figure(_region_map([0.5, 2.0, 5.0]), tmp_path / "r.png")
+    assert "α = 5 s/m" in saved[0].get_suptitle()

@@ -1,5 +1,5 @@
-"""Shared pieces of the figures: grid cell edges (uniform, non-uniform, geometric), parameter
-labels with units, and the Agg figure/save helpers. Nothing here computes physics."""
+"""Shared pieces of the figures: grid cell edges (uniform, non-uniform, geometric) and their axes,
+parameter labels with units, and a figure on the Agg canvas. Nothing here computes physics."""
 
 from __future__ import annotations
 
@@ -98,9 +98,14 @@ def grid_axis(ax, which: str, edges: np.ndarray, scale: str, values=None) -> Non
     non-uniform grid shows where it was computed."""
     from matplotlib.ticker import NullLocator
 
-    axis = ax.xaxis if which == "x" else ax.yaxis
-    (ax.set_xscale if which == "x" else ax.set_yscale)(scale)
-    (ax.set_xlim if which == "x" else ax.set_ylim)(edges[0], edges[-1])
+    if which == "x":
+        axis = ax.xaxis
+        ax.set_xscale(scale)
+        ax.set_xlim(edges[0], edges[-1])
+    else:
+        axis = ax.yaxis
+        ax.set_yscale(scale)
+        ax.set_ylim(edges[0], edges[-1])
     if values is not None and len(values) <= MAX_VALUE_TICKS:
         axis.set_ticks(values, [f"{v:g}" for v in values])
         axis.set_minor_locator(NullLocator())

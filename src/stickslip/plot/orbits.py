@@ -73,7 +73,7 @@ def plot_lyapunov_spectrum(spectrum, reference=None, n_show=None, ax=None):
     order = np.argsort(-spectrum.exponents)
     if n_show is None:
         order = [i for i in order if spectrum.exponents[i] > SHOWN_ABOVE]
-        left_out = f"{spectrum.exponents.size - len(order)} exponents below −10 1/s not shown"
+        left_out = f"{spectrum.exponents.size - len(order)} exponents below {SHOWN_ABOVE:g} 1/s not shown".replace("-", "−")
     else:
         order = order[:n_show]
         left_out = f"{spectrum.exponents.size - len(order)} smallest exponents not shown"

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import MODEL_LABELS, cell_edges, grid_axis, is_geometric
+from ._common import MODEL_LABELS, cell_edges, grid_axis, is_geometric, param_text
 from .sweep import _new_figure
 
 __all__ = ["plot_regions", "plot_stick_slip_domains", "save_regions_figure", "REGION_STYLE", "MODEL_LABELS"]
@@ -31,7 +31,7 @@ def _dataset(rmap):
 
 def _params_line(ds) -> str:
     p = json.loads(ds.attrs.get("parameters", "{}"))
-    parts = [f"μk = {p['mu_k']:g}, Δμ = {p['delta_mu']:g}, α = {p['alpha']:g}"] if p else []
+    parts = [param_text(k, p[k]) for k in ("mu_k", "delta_mu", "alpha") if k in p]
     parts.append(f"{ds.attrs.get('t_end', float('nan')):g} s runs, steady window from {ds.attrs.get('t_from', float('nan')):g} s")
     return ", ".join(parts)
 
