@@ -164,6 +164,25 @@ def _fsync_file(path: Path) -> None:
         os.fsync(fh.fileno())
 
 
+def _abandon_netcdf(path: Path) -> None:
+    """Mark every ``h5netcdf.File`` still open on ``path`` closed, so that nothing writes to it again.
+
+    After a failed HDF5 write (a full disk) the writer may be left open (xarray keeps it in its
+    file cache when closing it fails); its next ``close``, from the cache or from ``__del__``, would
+    flush the NetCDF metadata into the broken file and h5py then crashes the process. ``path``
+    is a temporary that is deleted anyway.
+    """
+    h5netcdf = sys.modules.get("h5netcdf")
+    if h5netcdf is None:
+        return
+    import gc
+
+    for obj in gc.get_objects():
+        if isinstance(obj, h5netcdf.File) and not getattr(obj, "_closed", True) \
+                and str(getattr(obj, "_filename", "")) == str(path):  # no HDF5 call: any may crash now
+            obj._closed = True  # its close() (also from __del__) must not flush again
+
+
 def atomic_write(path, write: Callable[[Path], object], *, kept: str | None = None) -> Path:
     """Replace ``path`` by the file that ``write(tmp)`` creates, all at once.
 
@@ -197,6 +216,9 @@ def atomic_write(path, write: Callable[[Path], object], *, kept: str | None = No
             write(tmp)
             _fsync_file(tmp)
             os.replace(tmp, path)
+    except BaseException:
+        _abandon_netcdf(tmp)
+        raise
     finally:
         tmp.unlink(missing_ok=True)
     fsync_dir(path.parent)
