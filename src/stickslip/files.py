@@ -245,6 +245,7 @@ class AppendLog:
     def __init__(self, path, *, kept: str | None = None):
         self.path = Path(path)
         self.kept = kept or f"the records before this one are kept in {self.path}"
+        self._fd = None
         with writing_errors(self.path, self.kept):
             self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
 
@@ -263,10 +264,6 @@ class AppendLog:
             except OSError:  # pragma: no cover - the reader drops a torn record anyway
                 pass
             raise
-
-    @property
-    def closed(self) -> bool:
-        return self._fd is None
 
     def close(self) -> None:
         if self._fd is not None:
@@ -365,6 +362,15 @@ class OutputLock:
     @property
     def held(self) -> bool:
         return self._held
+
+    @contextmanager
+    def released_on_error(self):
+        """Release the lock if the block raises (setting up what it guards failed), then re-raise."""
+        try:
+            yield self
+        except BaseException:
+            self.release()
+            raise
 
     def __enter__(self) -> "OutputLock":
         return self.acquire()

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import time
 
 import pytest
 from typer.testing import CliRunner
@@ -65,8 +66,10 @@ def test_workers_end_after_the_parent_is_killed(executor, tmp_path):
         children = _descendants_once_running(proc, workers)
         proc.send_signal(signal.SIGKILL)
         proc.wait()
+        t = time.monotonic()
         assert wait_for(lambda: not _alive(children), GRACE_S), \
             f"{len(_alive(children))} of {len(children)} workers still running {GRACE_S} s after kill -9 of the parent"
+        print(f"{executor}: {len(children)} worker processes gone {time.monotonic() - t:.2f} s after kill -9")
     finally:  # never leave processes of this test behind, whatever failed
         for pid in _alive([proc.pid] + children):
             os.kill(pid, signal.SIGKILL)

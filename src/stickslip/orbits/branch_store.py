@@ -131,11 +131,8 @@ class Journal:
         self.path = journal_path(out)
         self.kind, self.digest = kind, digest
         self.lock = (lock or OutputLock(out)).acquire()
-        try:
+        with self.lock.released_on_error():
             self._open(settings)
-        except BaseException:
-            self.lock.release()
-            raise
 
     def _open(self, settings: dict) -> None:
         kind, digest = self.kind, self.digest
@@ -219,7 +216,7 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
     """
     out, jp = Path(out), journal_path(out)
     lock = OutputLock(out).acquire()  # before anything is deleted or read: one writer at a time
-    try:
+    with lock.released_on_error():
         if not resume:
             jp.unlink(missing_ok=True)
             out.unlink(missing_ok=True)
@@ -233,6 +230,3 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
             lock.release()
             return None, result
         return Journal(out, kind, digest, settings, lock=lock), None
-    except BaseException:
-        lock.release()
-        raise

@@ -87,7 +87,9 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
     """Make this process (a pool worker) end when its parent does, even after ``kill -9``.
 
     On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``), which
-    works while the worker is inside a compiled kernel that holds the GIL. Everywhere, a daemon
+    works while the worker is inside a compiled kernel that holds the GIL. (Strictly, when the
+    thread that forked the worker ends: our pools are started and used by one thread for the
+    whole run.) Everywhere, a daemon
     thread also polls the parent pid every ``interval`` seconds and ends the process with
     ``os._exit`` once the parent is gone (reparented: ``os.getppid()`` changed).
     """

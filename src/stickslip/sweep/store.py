@@ -86,11 +86,8 @@ class Journal:
         self.spec = spec
         self.width = spec.row_width + 2
         self.lock = OutputLock(self.out).acquire()
-        try:
+        with self.lock.released_on_error():
             self._open(overwrite)
-        except BaseException:
-            self.lock.release()
-            raise
 
     def _open(self, overwrite: bool) -> None:
         manifest = self.dir / "manifest.json"
