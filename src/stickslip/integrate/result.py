@@ -12,6 +12,7 @@ from numba import njit
 
 from ..errors import StickSlipError
 from .. import __version__
+from ..files import FileFormatError, atomic_write, format_name, open_ours
 from ..analysis.steady import SteadyState, summarize
 from ..model import kernels
 from ..model.parameters import Parameters, parameter_attrs
@@ -20,7 +21,7 @@ from ..model.variants import STATE_NAMES, resolve_variant
 
 __all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError"]
 
-FORMAT = "stickslip-trajectory-1"
+FORMAT = format_name("trajectory", 1)
 
 _STATE_UNITS = ("m", "m", "m", "m", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "rad/s", "rad/s")
 _STATE_LONG_NAMES = (
@@ -28,10 +29,6 @@ _STATE_LONG_NAMES = (
     "lower plate x displacement", "lower plate y displacement",
     "upper plate rotation phi", "lower plate rotation psi (relative to Omega t)",
 ) + tuple(f"velocity of {n}" for n in STATE_NAMES[:6])
-
-
-class FileFormatError(StickSlipError, ValueError):
-    """A file that is not a stickslip result."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -241,9 +238,8 @@ class Trajectory:
 
     def to_netcdf(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` to a NetCDF-4 file (h5netcdf engine)."""
-        path = Path(path)
-        self.to_xarray().to_netcdf(path, engine="h5netcdf")
-        return path
+        ds = self.to_xarray()
+        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 
     @classmethod
     def from_xarray(cls, ds) -> "Trajectory":
@@ -281,21 +277,8 @@ def load_trajectory(path: str | Path) -> Trajectory:
     Raises
     ------
     FileFormatError
-        If the file does not exist, is not NetCDF, or was not written by stickslip.
+        If the file does not exist, is not NetCDF, is truncated, was not written by stickslip or is
+        of a newer format.
     """
-    import xarray as xr
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileFormatError(f"{path} does not exist; give the path of a run.nc written by `stickslip simulate`")
-    try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
-            ds.load()
-            return Trajectory.from_xarray(ds)
-    except FileFormatError:
-        raise
-    except Exception as exc:  # h5py/xarray raise many types for foreign files
-        raise FileFormatError(
-            f"{path} is not a stickslip NetCDF file ({type(exc).__name__}: {exc}); "
-            "give a file written by `stickslip simulate`"
-        ) from exc
+    ds = open_ours(path, "trajectory", what="a run.nc written by `stickslip simulate`")
+    return Trajectory.from_xarray(ds)

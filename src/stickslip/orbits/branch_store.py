@@ -1,20 +1,23 @@
 """Append-only journals that make long continuation runs resumable.
 
-A run that writes to ``OUT.nc`` keeps, while it works, a journal ``OUT.nc.journal`` beside it
-(as :mod:`stickslip.sweep.store` does for sweeps): a text file of JSON lines,
+A run that writes to ``OUT.nc`` holds the output's lock ``OUT.nc.lock`` (:func:`stickslip.files.lock`:
+a second run on the same output is refused with one line naming the holder) and keeps, while it
+works, a journal ``OUT.nc.journal`` beside it (as :mod:`stickslip.sweep.store` does for sweeps):
+a text file of JSON lines,
 
 * line 1, the header: ``{"format", "kind", "digest", "settings", "stickslip_version"}``,
-  written atomically (temporary file + rename) when the journal is created;
+  written atomically (:func:`stickslip.files.atomic_write`) when the journal is created;
 * then one record per finished unit of work (a branch point of
   :func:`~stickslip.orbits.continuation.continue_orbit`, one N of
   :func:`~stickslip.orbits.continuation.fold_curve`), each written with one ``write`` ending in a
-  newline and flushed to the operating system, so a killed process loses only the unit it was
-  working on.
+  newline and ``fsync``-ed (:class:`stickslip.files.AppendLog`), so a killed process or a power
+  cut loses only the unit it was working on, and a full disk loses nothing written before.
 
 On reopening, a torn last line (a kill inside a write: no final newline, or not valid JSON) is cut
 off. The digest covers everything that determines the results; a journal or an output file with
 another digest is refused (:class:`JournalMismatch`), never mixed in. When the run ends, the
-caller writes ``OUT.nc`` atomically (:func:`write_atomically`) and removes the journal.
+caller writes ``OUT.nc`` atomically (:func:`write_atomically`) and removes the journal, which
+releases the lock.
 
 Floats go through JSON as ``repr`` text, which round-trips float64 exactly (NaN as ``NaN``), so a
 resumed run restarts from bit-identical numbers.
@@ -24,12 +27,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
+from ..files import AppendLog, FileFormatError, OutputLock, atomic_write, fsync_dir
 from .section import OrbitError
 
 __all__ = ["Journal", "JournalMismatch", "journal_path", "digest_of", "array_digest", "encode_array",
@@ -81,12 +84,9 @@ def decode_array(d: dict) -> np.ndarray:
 
 
 def write_atomically(path: Path, write) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it onto ``path``."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    write(tmp)
-    os.replace(tmp, path)
-    return path
+    """Call ``write(tmp)`` on a unique temporary file beside ``path``, then replace ``path`` by it
+    (:func:`stickslip.files.atomic_write`: fsync-ed; a full disk raises WriteError, ``path`` unchanged)."""
+    return atomic_write(path, write)
 
 
 def _read_lines(path: Path) -> tuple[list, int]:
@@ -115,16 +115,27 @@ class Journal:
         :func:`digest_of` the settings that determine the results.
     settings : dict
         Stored in the header (JSON), for the record and for :meth:`header`.
+    lock : OutputLock, optional
+        The output's lock, already held by the caller (default: taken here). Held until
+        :meth:`close` or :meth:`remove`.
 
     Raises
     ------
     JournalMismatch
         If a journal with another kind or digest exists at that path.
+    stickslip.files.LockError
+        If another process is writing ``out``.
     """
 
-    def __init__(self, out, kind: str, digest: str, settings: dict):
+    def __init__(self, out, kind: str, digest: str, settings: dict, lock: OutputLock | None = None):
         self.path = journal_path(out)
         self.kind, self.digest = kind, digest
+        self.lock = (lock or OutputLock(out)).acquire()
+        with self.lock.released_on_error():
+            self._open(settings)
+
+    def _open(self, settings: dict) -> None:
+        kind, digest = self.kind, self.digest
         if self.path.exists():
             lines, good = _read_lines(self.path)
             head = lines[0] if lines else {}
@@ -143,23 +154,24 @@ class Journal:
                       "stickslip_version": __version__}
             write_atomically(self.path, lambda tmp: tmp.write_text(json.dumps(header, default=str) + "\n"))
             self.records = []
-        self._fh = open(self.path, "ab")
+        self._log = AppendLog(self.path, kept=f"the {kind} computed so far is kept in {self.path}")
 
     def append(self, record: dict) -> None:
-        """Write one record (one line, one ``write``, flushed to the operating system)."""
-        self._fh.write((json.dumps(record) + "\n").encode())
-        self._fh.flush()
+        """Write one record (one line, one ``write``, ``fsync``-ed)."""
+        self._log.append((json.dumps(record) + "\n").encode())
         self.records.append(record)
 
     def close(self) -> None:
-        """Close the file (the journal stays on disk)."""
-        if not self._fh.closed:
-            self._fh.close()
+        """Close the file (the journal stays on disk) and release the output's lock."""
+        self._log.close()
+        self.lock.release()
 
     def remove(self) -> None:
-        """Close and delete the journal (after the output is written)."""
-        self.close()
+        """Close and delete the journal (after the output is written), then release the lock."""
+        self._log.close()
         self.path.unlink(missing_ok=True)
+        fsync_dir(self.path.parent)
+        self.lock.release()
 
 
 def check_output(out, kind: str, digest: str, attrs: dict) -> None:
@@ -171,7 +183,7 @@ def check_output(out, kind: str, digest: str, attrs: dict) -> None:
         The file was written by a run with other settings (or by an older version, no digest).
     """
     if attrs.get("digest") != digest:
-            raise JournalMismatch(f"{out} holds a {kind} of different settings or start (digest {attrs.get('digest')} "
+        raise JournalMismatch(f"{out} holds a {kind} of different settings or start (digest {attrs.get('digest')} "
                               f"vs {digest}); choose another output (--out) or delete {out}")
 
 
@@ -197,18 +209,24 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
     Raises
     ------
     JournalMismatch
-        If the journal or the output file belongs to a run with other settings.
+        If the journal or the output file belongs to a run with other settings, or the output
+        is not a stickslip file of this kind.
+    stickslip.files.LockError
+        If another process is writing ``out``.
     """
     out, jp = Path(out), journal_path(out)
-    if not resume:
-        jp.unlink(missing_ok=True)
-        out.unlink(missing_ok=True)
-    if out.exists() and not jp.exists():
-        try:
-            attrs, result = read(out)
-        except Exception as exc:  # h5py/xarray raise many types for foreign files
-            raise JournalMismatch(f"{out} exists and is not a stickslip {kind} file ({type(exc).__name__}); "
-                                  f"choose another output (--out) or delete {out}") from exc
-        check_output(out, kind, digest, attrs)
-        return None, result
-    return Journal(out, kind, digest, settings), None
+    lock = OutputLock(out).acquire()  # before anything is deleted or read: one writer at a time
+    with lock.released_on_error():
+        if not resume:
+            jp.unlink(missing_ok=True)
+            out.unlink(missing_ok=True)
+        if out.exists() and not jp.exists():
+            try:
+                attrs, result = read(out)
+            except FileFormatError as exc:
+                raise JournalMismatch(f"{exc}; refusing to overwrite it: choose another output (--out) or delete "
+                                      f"{out}") from None
+            check_output(out, kind, digest, attrs)
+            lock.release()
+            return None, result
+        return Journal(out, kind, digest, settings, lock=lock), None

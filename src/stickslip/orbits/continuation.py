@@ -52,6 +52,7 @@ from typing import Sequence
 import numpy as np
 
 from .. import __version__
+from ..files import open_ours
 from ..integrate.driver import SimulationError, simulate
 from ..integrate.result import Trajectory
 from ..model.kernels import DEFAULT_SLIP_BAND
@@ -601,15 +602,10 @@ def load_branch(path):
 
     Raises
     ------
-    ValueError
-        If the file is not a stickslip branch.
+    stickslip.files.FileFormatError
+        If the file is missing, truncated, not a stickslip branch or of a newer format (a ValueError).
     """
-    import xarray as xr
-
-    ds = xr.load_dataset(path, engine="h5netcdf")
-    if ds.attrs.get("format") != "stickslip-branch-1":
-        raise ValueError(f"{path} is not a stickslip branch file (written by `stickslip continue` / Branch.to_netcdf)")
-    return ds
+    return open_ours(path, "branch", what="a .nc file written by `stickslip continue` (Branch.to_netcdf)")
 
 
 # --------------------------------------------------------------------------- location
@@ -1339,14 +1335,10 @@ def load_fold_curve(path) -> FoldCurve:
 
     Raises
     ------
-    ValueError
-        If the file is not a stickslip fold curve.
+    stickslip.files.FileFormatError
+        If the file is missing, truncated, not a stickslip fold curve or of a newer format (a ValueError).
     """
-    import xarray as xr
-
-    ds = xr.load_dataset(path, engine="h5netcdf")
-    if ds.attrs.get("format") != "stickslip-foldcurve-1":
-        raise ValueError(f"{path} is not a stickslip fold-curve file (written by FoldCurve.to_netcdf)")
+    ds = open_ours(path, "foldcurve", noun="fold-curve", what="a .nc file written by FoldCurve.to_netcdf")
     return FoldCurve(N=ds["N"].values, edge=ds["edge"].values, kind=tuple(str(k) for k in ds["kind"].values),
                      located=ds["located"].values.astype(bool), period=ds["period"].values,
                      omega_stable_max=ds["omega_stable_max"].values, points=ds["points"].values.astype(int),

@@ -12,7 +12,8 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..model.parameters import Parameters
-from .executors import default_workers, run_batches
+from ..files import FileFormatError
+from .executors import check_workers, run_batches
 from .spec import SweepError, SweepSpec, evaluate_batch
 from .store import Journal, assemble, journal_dir, load_sweep
 
@@ -108,7 +109,8 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
         had finished. Default: a temporary file (the dataset is returned loaded).
     executor : {"serial", "processes", "dask"}
     workers : int, optional
-        Worker processes (default: all cores). For ``dask`` without ``address``, the LocalCluster size.
+        Worker processes (default: all CPUs available to this process, also the most allowed). For
+        ``dask`` without ``address``, the LocalCluster size.
     address : str, optional
         ``dask.distributed`` scheduler address (``tcp://host:8786``); default a LocalCluster.
     batch_size : int or "auto"
@@ -135,13 +137,18 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     Raises
     ------
     SweepError
-        For an invalid grid or option, or an output that belongs to a different sweep.
+        For an invalid grid or option, more ``workers`` than CPUs, an unreachable scheduler, or an
+        output that belongs to a different sweep.
+    stickslip.files.LockError
+        If another process is writing the same output.
+    stickslip.files.WriteError
+        If the disk is full (the journal keeps every finished point: run again to resume).
     """
     t_start = time.perf_counter()
     spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
     if executor not in TARGET_BATCH_S:
         raise SweepError(f"unknown executor {executor!r}; choose serial, processes or dask")
-    workers = default_workers() if workers is None else int(workers)
+    workers = check_workers(workers, address=address)
     tmpdir = None
     if out is None:
         tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-sweep-")
@@ -153,7 +160,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     if out.exists() and not journal_dir(out).exists() and not overwrite:
         try:
             ds = load_sweep(out, load="auto")
-        except SweepError as exc:
+        except FileFormatError as exc:
             raise SweepError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
         if ds.attrs.get("digest") == spec.digest and int(ds.attrs.get("complete", 0)):
             return SweepResult(out, spec, ds, {"total_s": time.perf_counter() - t_start, "points_computed": 0,
