@@ -166,15 +166,16 @@ def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds):
     return total
 
 
-def summarize(t, states, mode, transition_times, transition_kinds, t_from):
-    """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`)."""
+def summarize(t, states, mode, transition_times, transition_kinds, t_from, coordinate=4, rate=10):
+    """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
+    state column ``coordinate`` (its rate in column ``rate``; default the plates' φ)."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
         raise ValueError(f"steady_from = {t_from} s leaves fewer than 2 samples; choose an earlier time")
     ts = t[sel]
-    phi = states[sel, 4]
-    dphi = states[sel, 10]
+    phi = states[sel, coordinate]
+    dphi = states[sel, rate]
     t0, t1 = float(ts[0]), float(ts[-1])
     # mode just after t0: the sample's mode unless a transition sits exactly on t0
     mode0 = int(mode[sel][0])

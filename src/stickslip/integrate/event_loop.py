@@ -444,7 +444,7 @@ def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, 
             h_override = -1.0
         else:
             h *= factor
-            if tau >= tau_stop and h_free < 0.0 and homing.sum() == 0:
+            if tau_stop <= tau < tau_end and h_free < 0.0 and homing.sum() == 0:
                 status = CHUNK_END
                 break
     return status, tau, y, h, idx, n_tr, stats, lost

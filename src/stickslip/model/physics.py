@@ -272,7 +272,6 @@ def frame_with_bias(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by num
     raise NotImplementedError
 
 
-@inlined_kernel
 def _frame_bias_complex_step(s, c, md, G2, w2, h2):
     """Float state: the frame at q + iε q̇ gives G, w (real parts, exact) and h = Im[G q̇ − w]/ε
     (exact to round-off) in one evaluation; 0 for constant kinematics."""
@@ -299,7 +298,6 @@ def _frame_bias_complex_step(s, c, md, G2, w2, h2):
     return normal.real
 
 
-@inlined_kernel
 def _frame_bias_central(s, c, md, G2, w2, h2):
     """Complex state (inside a complex-step Jacobian): the frame itself, and h as the central
     difference of G(q ± ε q̇) q̇ − w(q ± ε q̇) over 2ε, ε = BIAS_TIME_STEP / max|q̇| (~1e-10 relative)."""
@@ -328,13 +326,14 @@ def _frame_bias_central(s, c, md, G2, w2, h2):
     return contact_frame(md.kin, s, c, m, G2, w2)
 
 
-@overload(frame_with_bias, inline="always")
+@overload(frame_with_bias)
 def _frame_with_bias(s, c, md, G2, w2, h2):
     from numba.core import types
 
+    # the implementations are plain functions: numba compiles the one for the state's number type
     if isinstance(s.dtype, types.Complex):
-        return _frame_bias_central.py_func
-    return _frame_bias_complex_step.py_func
+        return _frame_bias_central
+    return _frame_bias_complex_step
 
 
 @inlined_kernel
