@@ -19,6 +19,7 @@ from ..model.system_model import FrictionModel
 from . import contacts as E
 from .event_loop import N_EXTRA, integrate_event
 from .result import Stats, Trajectory, Transitions, load_trajectory
+from .interrupt import interruptible
 from .status import CHUNK_END, Status
 
 __all__ = ["simulate", "initial_state", "SimulationError", "METHODS", "MAX_SAMPLES"]
@@ -39,6 +40,16 @@ FIRST_CHUNK = 20.0
 #: period); a chunk with more is run again from its start with room for all (same result).
 TRANSITIONS_PER_SECOND = 64
 MIN_TRANSITION_ROOM = 1024
+
+#: Transitions a run keeps: the most recent ones (earlier ones are counted in
+#: ``Transitions.dropped``), so that memory stays bounded however long the run: 10^6 transitions
+#: × (instant, kind, contact) plus the states of the last :data:`KEEP_TRANSITION_STATES`.
+KEEP_TRANSITIONS = 1_000_000
+KEEP_TRANSITION_STATES = 100_000
+
+
+#: "No cap" on the steps of a run (int64 for the compiled loop).
+NO_STEP_CAP = 2**62
 
 
 class SimulationError(StickSlipError, ValueError):
@@ -146,6 +157,33 @@ class _Buffers:
         self.tr_kind: list[np.ndarray] = []
         self.tr_contact: list[np.ndarray] = []
         self.tr_s: list[np.ndarray] = []
+        self.kept = 0
+        self.dropped = 0
+
+    def add_transitions(self, tr, n_tr: int) -> None:
+        """Keep the first ``n_tr`` transitions of a chunk's buffers, dropping the oldest beyond the caps."""
+        for store, buf in zip((self.tr_t, self.tr_kind, self.tr_contact, self.tr_s), tr):
+            store.append(buf[:n_tr].copy())
+        self.kept += n_tr
+        if self.kept > 2 * KEEP_TRANSITIONS or sum(len(s) for s in self.tr_s) > 2 * KEEP_TRANSITION_STATES:
+            drop = max(self.kept - KEEP_TRANSITIONS, 0)
+            for store in (self.tr_t, self.tr_kind, self.tr_contact):
+                joined = np.concatenate(store)[drop:]
+                store[:] = [joined]
+            states = np.concatenate(self.tr_s)
+            self.tr_s[:] = [states[max(len(states) - KEEP_TRANSITION_STATES, 0):]]
+            self.kept -= drop
+            self.dropped += drop
+
+    def transitions(self, ns: int) -> Transitions:
+        """The kept transitions; states of the earliest kept ones beyond the state cap are NaN."""
+        if not self.tr_t:
+            return Transitions(np.empty(0), np.empty(0, np.int8), np.empty((0, ns)), np.empty(0, np.int8))
+        time_, kind, contact = (np.concatenate(s) for s in (self.tr_t, self.tr_kind, self.tr_contact))
+        states = np.concatenate(self.tr_s)
+        if len(states) < len(time_):
+            states = np.concatenate([np.full((len(time_) - len(states), ns), np.nan), states])
+        return Transitions(time_, kind, states, contact, dropped=self.dropped)
 
     @staticmethod
     def transition_room(duration: float, ns: int, capacity: int | None = None):
@@ -193,14 +231,13 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
     stats = np.zeros(6, dtype=np.int64)
     t = t0
     idx = 0
-    n_tr_total = 0
     chunk = min(FIRST_CHUNK, t_end - t0)
     status = CHUNK_END
     lost = -1
     steps_left = max_steps
     interrupted = False
-    try:
-        while status == CHUNK_END:
+    with interruptible() as stop:
+        while status == CHUNK_END and not stop.requested:
             tau_end = t_end - t
             tau_stop = min(chunk, tau_end)
             start_state = (y.copy(), cst.copy(), h, idx)
@@ -217,23 +254,15 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
                 y, cst, h, idx = start_state[0].copy(), start_state[1].copy(), start_state[2], start_state[3]
             wall = time.perf_counter() - wall
             status, tau, y, h, idx, _, st, lost = res
-            buffers.tr_t.append(tr[0][:n_tr].copy())
-            buffers.tr_kind.append(tr[1][:n_tr].copy())
-            buffers.tr_contact.append(tr[2][:n_tr].copy())
-            buffers.tr_s.append(tr[3][:n_tr].copy())
-            n_tr_total += n_tr
+            buffers.add_transitions(tr, n_tr)
             stats += st
             steps_left = max_steps - int(stats[0] + stats[1])
             t = t + tau
             if tau > 0.0 and wall > 0.0:  # aim the next chunk at CHUNK_WALL seconds of wall time
                 chunk = min(max(tau * CHUNK_WALL / wall, 1e-3), 10.0 * max(tau, 1e-3))
-    except KeyboardInterrupt:
-        interrupted = True
+        interrupted = stop.requested and status == CHUNK_END
     code = Status.INTERRUPTED if interrupted else Status(status)
-    transitions = Transitions(*(np.concatenate(parts) if parts else np.empty(0) for parts in
-                                (buffers.tr_t, buffers.tr_kind, buffers.tr_s, buffers.tr_contact)))
-    if transitions.state.ndim == 1:
-        transitions = Transitions(np.empty(0), np.empty(0, np.int8), np.empty((0, ns)), np.empty(0, np.int8))
+    transitions = buffers.transitions(ns)
     stats_out = dict(accepted_steps=int(stats[0]), rejected_steps=int(stats[1]), rhs_calls=int(stats[2]),
                      retaken_steps=int(stats[3]), slip_to_stick=int(stats[4]), stick_to_slip=int(stats[5]),
                      compile_time_s=compile_time)
@@ -282,7 +311,7 @@ def simulate(
     sample_rate: float = 1000.0,
     t0: float = 0.0,
     steady_from: float | None = None,
-    max_steps: int = 50_000_000,
+    max_steps: int | None = None,
     slip_band: float | None = None,
 ) -> Trajectory:
     """Simulate a friction-contact model with exact stick and slip.
@@ -313,8 +342,9 @@ def simulate(
         Initial time [s].
     steady_from : float, optional
         Start of the steady-state window [s]; default the last half of the run.
-    max_steps : int
-        Safety cap on integration steps.
+    max_steps : int, optional
+        Cap on integration steps (default none: a run is stopped with Ctrl-C, which returns the
+        part done).
     slip_band : float, optional
         Low-speed band [m/s] of the 2-D slip direction; default the model's (results converge as
         it → 0).
@@ -356,7 +386,7 @@ def simulate(
     start = time.perf_counter()
     runner = _run_event if method == "event" else (lambda *a: _run_fixed_step(method, *a))
     code, t_reached, lost, n_kept, buffers, transitions, stats = runner(
-        system, y0, t0, t_end, sample_times, rtol, atol, dt, int(max_steps))
+        system, y0, t0, t_end, sample_times, rtol, atol, dt, NO_STEP_CAP if max_steps is None else int(max_steps))
     wall = time.perf_counter() - start - stats.get("compile_time_s", 0.0)  # integration only
     if n_kept == 0:
         raise SimulationError(f"the run ended before its first sample ({code.message(t_reached, lost)})")
@@ -376,7 +406,8 @@ def simulate(
         mode=buffers.out_mode[:n_kept],
         friction=buffers.out_F[:n_kept],
         work=buffers.out_s[:n_kept, n2:n2 + 2],
-        transitions=Transitions(transitions.time, transitions.kind, transitions.state[:, :n2], transitions.contact),
+        transitions=Transitions(transitions.time, transitions.kind, transitions.state[:, :n2], transitions.contact,
+                                transitions.dropped),
         stats=Stats(**stats, wall_time_s=wall),
         status=code.message(t_reached, lost),
         system=system,

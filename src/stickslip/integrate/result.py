@@ -64,12 +64,16 @@ class Transitions:
         States at the transitions (after projection when entering stick).
     contact : ndarray (k,) int8
         The contact that changed (0 for a one-contact model).
+    dropped : int
+        Earlier transitions of the run that were not kept (very long runs keep the most recent
+        10^6, and the states of the most recent 10^5; older states are NaN).
     """
 
     time: np.ndarray
     kind: np.ndarray
     state: np.ndarray
     contact: np.ndarray | None = None
+    dropped: int = 0
 
     def __post_init__(self) -> None:
         if self.contact is None:
@@ -295,6 +299,7 @@ class Trajectory:
             "options": json.dumps(self.options),
             "stats": json.dumps(dataclasses.asdict(self.stats)),
             "parameters": json.dumps(dict(system.parameters)),
+            "transitions_dropped": int(self.transitions.dropped),
         }
         if self.is_plates:
             attrs.update(parameter_attrs(self.params.to_dict()))
@@ -329,7 +334,8 @@ class Trajectory:
             work=np.stack([ds["work_friction"].values, ds["work_damping"].values], axis=1),
             transitions=Transitions(ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),
                                     ds["transition_state"].values.reshape(-1, 2 * system.n),
-                                    ds["transition_contact"].values.astype(np.int8)),
+                                    ds["transition_contact"].values.astype(np.int8),
+                                    int(ds.attrs.get("transitions_dropped", 0))),
             stats=Stats(**json.loads(ds.attrs["stats"])), status=ds.attrs["status"], system=system,
             method=ds.attrs["method"], options=json.loads(ds.attrs["options"]),
             steady_from=float(ds.attrs["steady_from"]), status_code=code,
