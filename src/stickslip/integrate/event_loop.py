@@ -144,13 +144,39 @@ def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
 @loop
 def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps,
                     sample_times, idx0, out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0):
-    """Integrate from ``y0`` at local time 0 (absolute ``t_base``) towards ``tau_end``; see the
-    module docstring.
+    """Integrate from ``y0`` at local time 0 (absolute ``t_base``) towards ``tau_end``: allocates the
+    work arrays and runs :func:`event_loop` (see there for arguments and results)."""
+    n, nc, diagonal = model_sizes(md.kin, md.m)
+    ns = y0.shape[0]
+    y = y0.copy()
+    work = np.empty((5, ns))
+    Kst = np.empty((7, ns))
+    Q = np.empty((ns, 4))
+    F = np.empty(2 * nc)
+    N = np.empty(nc)
+    vv = np.empty(2 * nc)
+    va = np.empty((2, 4 * nc))
+    homing = np.zeros(nc, dtype=np.int64)
+    stats = np.zeros(6, dtype=np.int64)
+    status, tau, h, idx, n_tr, lost = event_loop(
+        y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps, sample_times, idx0, out_s,
+        out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0, work, Kst, Q, F, N, vv, va, homing, stats)
+    return status, tau, y, h, idx, n_tr, stats, lost
 
-    ``cst`` (CST nc,) is the contacts' integration state, updated in place (pass the one returned
-    by the previous chunk). Samples from index ``idx0`` go to ``out_s``, ``out_mode``, ``out_F``
-    at the absolute ``sample_times``; transitions from number ``n_tr0`` to the ``tr_*`` buffers as
-    far as they have room.
+
+@kernel
+def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps, sample_times, idx0,
+               out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0, work5, Kst, Q, F, N, vv, va2, homing,
+               stats):
+    """The loop of :func:`integrate_event` (module docstring), free of reference counting.
+
+    ``y`` (2n + 2,) is advanced in place from local time 0 (absolute ``t_base``) towards
+    ``tau_end``; ``cst`` (CST nc,) is the contacts' integration state, updated in place (pass the
+    one returned by the previous chunk). Samples from index ``idx0`` go to ``out_s``, ``out_mode``,
+    ``out_F`` at the absolute ``sample_times``; transitions from number ``n_tr0`` to the ``tr_*``
+    buffers as far as they have room. ``work5`` … ``homing`` are work arrays; ``stats`` (6,)
+    receives accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
+    slip → stick and stick → slip transitions.
 
     Returns
     -------
@@ -158,38 +184,25 @@ def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, 
         :mod:`stickslip.integrate.status` code; CHUNK_END when stopped at ``tau_stop``.
     tau : float
         Local time reached [s].
-    y : ndarray (2n + 2,)
-        State reached.
     h : float
         Step size to continue with [s].
     idx : int
         Next sample index.
     n_tr : int
         Transitions found so far (counted past the buffers' room).
-    stats : ndarray (6,) int64
-        accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
-        slip → stick transitions, stick → slip transitions (this call).
     lost : int
         Contact whose normal force reached 0 (status CONTACT_LOST), else −1.
     """
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
-    ns = y0.shape[0]
-    y = y0.copy()
-    ynew = np.empty(ns)
-    ytmp = np.empty(ns)
-    work = np.empty(ns)
-    Kst = np.empty((7, ns))
-    Q = np.empty((ns, 4))
-    k1 = np.empty(ns)
-    F = np.empty(2 * nc)
-    N = np.empty(nc)
-    vv = np.empty(2 * nc)
-    va = np.empty(4 * nc)       # v0x, v0y, a0x, a0y per contact at the step start
-    va1 = np.empty(4 * nc)      # the same at the step end
-    homing = np.zeros(nc, dtype=np.int64)
+    ns = y.shape[0]
+    ynew = work5[0]
+    ytmp = work5[1]
+    work = work5[2]
+    k1 = work5[3]
+    va = va2[0]       # v0x, v0y, a0x, a0y per contact at the step start
+    va1 = va2[1]      # the same at the step end
     n_tr = n_tr0
-    stats = np.zeros(6, dtype=np.int64)
     band = m[H_BAND]
 
     P.rhs(y, cst, md, k1)
@@ -447,4 +460,4 @@ def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, 
             if tau_stop <= tau < tau_end and h_free < 0.0 and homing.sum() == 0:
                 status = CHUNK_END
                 break
-    return status, tau, y, h, idx, n_tr, stats, lost
+    return status, tau, h, idx, n_tr, lost

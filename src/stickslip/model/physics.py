@@ -581,6 +581,36 @@ def general_rhs(s, cst, md, ds):
 
 
 @inlined_kernel
+def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+    """The common case on the caller's (stack) arrays: every contact sliding outside the low-speed
+    band. Fills G, w, v, N, F and f = f0 − C q̇ − K q + Σ G_cᵀ F_c and returns True; returns False
+    (arrays incomplete) as soon as a contact sticks or is inside the band."""
+    m = md.m
+    for c in range(nc):
+        if is_stick(cst, c):
+            return False
+    band = m[H_BAND]
+    base_force(s, m, n, diagonal, f)
+    for c in range(nc):
+        G2 = G[2 * c:2 * c + 2]
+        normal = contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
+        N[c] = normal
+        dim = contact_dim(md.kin, m, n, c)
+        v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
+        v[2 * c] = v0
+        v[2 * c + 1] = v1
+        speed = csm.sqrt(v0 * v0 + v1 * v1)
+        if not exact_direction(np.int64(cst[CST * c]), speed.real, band):
+            return False
+        inv = 1.0 / speed
+        F0, F1 = slip_force(m, n, c, dim, speed, v0 * inv, v1 * inv, normal)
+        F[2 * c] = F0
+        F[2 * c + 1] = F1
+        add_contact_force(G2, dim, n, F0, F1, f)
+    return True
+
+
+@inlined_kernel
 def rhs_body(s, cst, md, ds):
     """Body of :func:`rhs`, inlined into the integrators' stage loops.
 
@@ -589,38 +619,16 @@ def rhs_body(s, cst, md, ds):
     """
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
-    fast = True
-    for c in range(nc):
-        if is_stick(cst, c):
-            fast = False
-    if fast:
-        band = m[H_BAND]
-        G = work_matrix(md.kin, ROWS, DOFS, s)
-        vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-        w = vec[0]
-        v = vec[1]
-        F = vec[2]
-        f = vec[3]
-        base_force(s, m, n, diagonal, f)
-        for c in range(nc):
-            G2 = G[2 * c:2 * c + 2]
-            normal = contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
-            dim = contact_dim(md.kin, m, n, c)
-            v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
-            v[2 * c] = v0
-            v[2 * c + 1] = v1
-            speed = csm.sqrt(v0 * v0 + v1 * v1)
-            if not exact_direction(np.int64(cst[CST * c]), speed.real, band):
-                fast = False
-                break
-            inv = 1.0 / speed
-            F0, F1 = slip_force(m, n, c, dim, speed, v0 * inv, v1 * inv, normal)
-            F[2 * c] = F0
-            F[2 * c + 1] = F1
-            add_contact_force(G2, dim, n, F0, F1, f)
-        if fast:
-            write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
-    if not fast:
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    w = vec[0]
+    v = vec[1]
+    N = vec[2]
+    F = vec[3]
+    f = vec[4]
+    if sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+        write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
+    else:
         general_rhs(s, cst, md, ds)
 
 
@@ -648,7 +656,8 @@ def contact_forces(s, cst, md, F_out, N_out, v_out):
     h = vec[3]
     F = vec[4]
     f = vec[5]
-    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    if not sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+        general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     for c in range(nc):
         N_out[c] = N[c]
         for i in range(2):
