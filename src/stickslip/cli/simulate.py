@@ -31,7 +31,9 @@ def simulate(
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
-    t_end: float = typer.Option(100.0, "--t-end", help="Simulated time [s]."),
+    t_end: str = typer.Option("100", "--t-end", help="Simulated time [s], or 'auto': extend the run until it "
+                              "has settled, up to --cap (the steady window is then the last 100 s)."),
+    cap: float = typer.Option(2000.0, "--cap", help="With --t-end auto: the longest run [s]."),
     method: str = typer.Option("event", "--method", help="Integration method."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance (event)."),
@@ -52,8 +54,21 @@ def simulate(
     with user_errors():
         params = build_parameters(config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
         check_nc_path(out)
-        traj = run_simulation(params, t_end, model=model, method=method, ic=_parse_ic(ic), perturbation=perturb,
-                              rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate, steady_from=steady_from)
+        options = dict(model=model, method=method, ic=_parse_ic(ic), perturbation=perturb, rtol=rtol, atol=atol,
+                       dt=dt, sample_rate=sample_rate)
+        if t_end.strip().lower() == "auto":
+            from ..analysis.settle import simulate_until_settled
+
+            if steady_from is not None:
+                raise ValueError("--steady-from cannot be combined with --t-end auto (the window is the last 100 s); "
+                                 "drop one of them")
+            traj = simulate_until_settled(params, cap=cap, **options)
+        else:
+            try:
+                t_end_s = float(t_end)
+            except ValueError:
+                raise ValueError(f"--t-end {t_end}: give a time in seconds or auto") from None
+            traj = run_simulation(params, t_end_s, steady_from=steady_from, **options)
         out.parent.mkdir(parents=True, exist_ok=True)
         traj.to_netcdf(out)
         figure = None
