@@ -184,7 +184,7 @@ def _evidence(p: np.ndarray, tau: np.ndarray, k: int, amplitude: float, separati
         r = ratio ** (-1.0 / steps) if math.isfinite(ratio) else 0.0
         # a geometric sequence of complex ratio λ (|λ| = r) still moves by d |λ| / |1 − λ|;
         # its net share |Σ dp| / Σ |dp| over the window is (1 − r) / |1 − λ|, measured per branch
-        net = max(abs(float(np.sum(dp[j::k]))) / float(np.sum(np.abs(dp[j::k]))) for j in range(k))
+        net = max(abs(float(np.sum(dp[j::k]))) / max(float(np.sum(np.abs(dp[j::k]))), 1e-300) for j in range(k))
         tail = float(np.median(_thirds(np.abs(dp))[1])) / amplitude * r / (1.0 - r) * net
     settled = (spread <= SETTLE_RTOL and (drift <= spread or drift <= DRIFT_FLOOR) and tail <= SETTLE_RTOL
                and separation >= SEPARATION_FACTOR * max(spread, DRIFT_FLOOR))
