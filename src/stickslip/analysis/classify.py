@@ -86,7 +86,7 @@ class Classification:
         ``equilibrium`` (at rest), ``periodic``, ``decaying``, ``stationary`` or ``unsettled``
         (module docstring).
     evidence : dict
-        What was measured: ``multiplicity``, ``period_s``, ``spread``, ``drift``, ``tail``,
+        What was measured: ``multiplicity``, ``period_s``, ``spread``, ``drift``,
         ``separation`` of the settled or best return map
         (:class:`~stickslip.analysis.period.ReturnMap`); when not periodic also
         ``amplitude_ratio`` (last quarter's peak-to-peak over the first's) and, when not

@@ -32,8 +32,8 @@ __all__ = ["ORBIT_PERIODS", "PERIOD_RTOL", "LAMBDA_ZERO", "QUASI_WINDOW_S", "LYA
            "confirm_period", "confirm_stationary"]
 
 #: Periods of the run from the shot orbit on which its own multiplicity is measured (the period
-#: rule needs nine).
-ORBIT_PERIODS = 12
+#: rule needs nine; thirty average the noise of its drift test).
+ORBIT_PERIODS = 30
 
 #: Agreement of the shot orbit's period with the run's [-]; the run's period has settled to
 #: 1e-5 (:data:`~.period.SETTLE_RTOL`).

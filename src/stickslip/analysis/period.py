@@ -7,27 +7,20 @@ give the sequence of peak values p_i at times τ_i over the window.
 A matching return map is not enough: a slowly converging transient repeats to any fixed
 tolerance after a while, and a transient whose slowest Floquet multipliers lie near −1 repeats
 better every second crossing than every crossing (it passes for period 2). So for each
-candidate multiplicity k (crossings per period) three things are measured, relative to the
+candidate multiplicity k (crossings per period) these are measured, relative to the
 peak-to-peak amplitude A of x in the window (values) and to the period T (times):
 
 * **spread**: max_i |p_{i+k} − p_i| and max_i |(τ_{i+k} − τ_i) − T|, T the mean of τ_{i+k} − τ_i;
 * **drift**: the trend across the window: for each of the k branches (p_j, p_{j+k}, ...), the
   mean of its last third minus the mean of its first third (and the same for τ_{i+k} − τ_i);
   a settled orbit drifts by no more than its noise, a converging one by many return steps;
-* **tail**: when the return differences |p_{i+k} − p_i| decay across the window (the median of
-  the first third over that of the last third is above :data:`DECAY_FACTOR`), the geometric
-  rate r per period fitted to them predicts how far the branches will still move: a sequence
-  with ratio λ, |λ| = r, moves by d |λ| / |1 − λ| = d r / (1 − r) · (1 − r) / |1 − λ| after a
-  step d (the last third's median), and (1 − r) / |1 − λ| is the net share of its steps,
-  |Σ (p_{i+k} − p_i)| / Σ |p_{i+k} − p_i| over the window (1 for a monotone approach, small
-  for an oscillating one).
+* **separation** (k ≥ 2): the smallest spread of the multiplicities below k.
 
 The response is **periodic and settled** with multiplicity k for the smallest k ≤
 :data:`MAX_MULTIPLICITY` with at least :data:`MIN_PERIODS` periods in the window, spread ≤
-:data:`SETTLE_RTOL`, drift ≤ spread (or ≤ :data:`DRIFT_FLOOR`), tail ≤ :data:`SETTLE_RTOL`,
-and, for k ≥ 2, branches that are distinct: every smaller multiplicity's spread at least
-:data:`SEPARATION_FACTOR` times the spread at k. Below :data:`~stickslip.analysis.steady.REST_AMPLITUDE` the response is
-at rest and not periodic.
+:data:`SETTLE_RTOL`, drift ≤ spread (or ≤ :data:`DRIFT_FLOOR`) and separation ≥
+:data:`SEPARATION_FACTOR` × spread: a period of k ≥ 2 crossings needs distinct branches. Below
+:data:`~stickslip.analysis.steady.REST_AMPLITUDE` the response is at rest and not periodic.
 
 This is the rule of the signal alone; :mod:`stickslip.analysis.settle` adds what the dynamics
 must confirm (a period-k claim with k ≥ 2 by shooting, chaos by a Lyapunov exponent). Every
@@ -44,22 +37,26 @@ import numpy as np
 from .peaks import Peaks, find_peaks
 from .steady import REST_AMPLITUDE
 
-__all__ = ["SETTLE_RTOL", "DRIFT_FLOOR", "DECAY_FACTOR", "SEPARATION_FACTOR", "MAX_MULTIPLICITY", "MIN_PERIODS", "REST_AMPLITUDE",
-           "ReturnMap", "Periodicity", "return_map", "detect_period"]
+__all__ = ["SETTLE_RTOL", "DRIFT_FLOOR", "DECAY_FACTOR", "SEPARATION_FACTOR", "MAX_MULTIPLICITY", "MIN_PERIODS",
+           "REST_AMPLITUDE", "ReturnMap", "Periodicity", "return_map", "decay_ratio", "detect_period"]
 
-#: Spread and tail allowed for a settled period, relative to the amplitude A (values) and to
+#: Spread allowed for a settled period, relative to the amplitude A (values) and to
 #: the period T (times). The integration and peak-location noise of a settled orbit is
 #: 1e-9 … 1e-8 A in values and 2e-7 T in times at rtol = 1e-8 and 200 samples per second
-#: (Model 1, N = 50 N, Ω = 0.5 and 5 rad/s, measured in 100 s windows of a 1500 s run); 1e-5
-#: leaves a factor ≥ 50 over it and is 100 times finer than a bifurcation diagram resolves.
+#: (Model 1, N = 50 N, Ω = 0.5 and 5 rad/s, measured in 100 s windows of a 1500 s run; 4e-7 T
+#: at N = 70 N); 1e-5 leaves a factor ≥ 25 over it and is 100 times finer than a bifurcation
+#: diagram resolves.
 SETTLE_RTOL = 1e-5
 
-#: Drift across the window accepted whatever the spread (relative, like SETTLE_RTOL): a trend
-#: of 1e-7 A is below anything reported.
-DRIFT_FLOOR = 1e-2 * SETTLE_RTOL
+#: Drift across the window accepted whatever the spread (relative, like SETTLE_RTOL): above the
+#: noise of the means of a third of the returns (timing noise 2e-7 T at 200 samples per second:
+#: on a settled orbit the drift is ~1e-7, as large as the spread) and 10 times below the
+#: settle tolerance.
+DRIFT_FLOOR = 0.1 * SETTLE_RTOL
 
 #: Ratio of the median return difference of the window's first third to its last third above
-#: which the differences count as decaying (a converging transient), not as noise.
+#: which the differences count as decaying (a converging transient, not a stationary response:
+#: :mod:`~stickslip.analysis.classify`).
 DECAY_FACTOR = 3.0
 
 #: A period of k ≥ 2 crossings needs its branches distinct: every multiplicity below k must
@@ -94,9 +91,6 @@ class ReturnMap:
         max of the value and time spreads [-].
     drift : float
         max of the branch-value and period drifts across the window [-].
-    tail : float
-        Predicted remaining motion of a geometric decay of the return differences [-]
-        (0 when they do not decay).
     separation : float
         Smallest spread of the multiplicities below k [-] (inf for k = 1): how distinct the
         k branches are.
@@ -108,7 +102,6 @@ class ReturnMap:
     period_s: float
     spread: float
     drift: float
-    tail: float
     separation: float
     settled: bool
 
@@ -176,19 +169,9 @@ def _evidence(p: np.ndarray, tau: np.ndarray, k: int, amplitude: float, separati
         drift = max(drift, abs(float(np.mean(last) - np.mean(first))) / amplitude)
     first, last = _thirds(dtau)
     drift = max(drift, abs(float(np.mean(last) - np.mean(first))) / period)
-    tail = 0.0
-    ratio = decay_ratio(dp)
-    if ratio > DECAY_FACTOR:
-        # medians of the thirds sit ~2/3 of the returns apart; k returns make one period
-        steps = max((2 * dp.size) // (3 * k), 1)
-        r = ratio ** (-1.0 / steps) if math.isfinite(ratio) else 0.0
-        # a geometric sequence of complex ratio λ (|λ| = r) still moves by d |λ| / |1 − λ|;
-        # its net share |Σ dp| / Σ |dp| over the window is (1 − r) / |1 − λ|, measured per branch
-        net = max(abs(float(np.sum(dp[j::k]))) / max(float(np.sum(np.abs(dp[j::k]))), 1e-300) for j in range(k))
-        tail = float(np.median(_thirds(np.abs(dp))[1])) / amplitude * r / (1.0 - r) * net
-    settled = (spread <= SETTLE_RTOL and (drift <= spread or drift <= DRIFT_FLOOR) and tail <= SETTLE_RTOL
+    settled = (spread <= SETTLE_RTOL and (drift <= spread or drift <= DRIFT_FLOOR)
                and separation >= SEPARATION_FACTOR * max(spread, DRIFT_FLOOR))
-    return ReturnMap(k, period, spread, drift, tail, separation, bool(settled))
+    return ReturnMap(k, period, spread, drift, separation, bool(settled))
 
 
 def return_map(peaks: Peaks, amplitude: float) -> tuple[ReturnMap | None, ReturnMap]:
@@ -220,7 +203,7 @@ def return_map(peaks: Peaks, amplitude: float) -> tuple[ReturnMap | None, Return
         seen.append(ev)
         separation = min(separation, ev.spread)
     if not seen:
-        return None, ReturnMap(0, math.nan, math.inf, math.inf, math.inf, math.inf, False)
+        return None, ReturnMap(0, math.nan, math.inf, math.inf, math.inf, False)
     return None, next(ev for ev in seen if ev.spread <= BEST_FACTOR * separation)
 
 
@@ -244,7 +227,7 @@ def detect_period(t, x, dx) -> Periodicity:
     amp = float(np.max(x) - np.min(x)) if x.size else 0.0
     pk = find_peaks(t, x, dx)
     if amp < REST_AMPLITUDE:
-        return Periodicity(False, 0, math.nan, amp, pk, ReturnMap(0, math.nan, 0.0, 0.0, 0.0, math.inf, False))
+        return Periodicity(False, 0, math.nan, amp, pk, ReturnMap(0, math.nan, 0.0, 0.0, math.inf, False))
     settled, best = return_map(pk, amp)
     if settled is None:
         return Periodicity(False, 0, math.nan, amp, pk, best)

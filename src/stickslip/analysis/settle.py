@@ -35,7 +35,7 @@ from ..errors import StickSlipError
 from .classify import Classification, classify
 from .confirm import QUASI_WINDOW_S, confirm_period, confirm_stationary
 
-__all__ = ["ATTRACTORS", "Attractor", "attractor", "simulate_until_settled", "attractor_code",
+__all__ = ["ATTRACTORS", "Attractor", "attractor", "simulate_until_settled", "attractor_code", "jsonable",
            "DEFAULT_CAP_S", "DEFAULT_WINDOW_S", "DEFAULT_STEP_S", "DEFAULT_T_MIN_S"]
 
 #: Verdicts; their index is the integer code stored in sweeps (−1: the run failed).
@@ -73,7 +73,8 @@ class Attractor:
     fundamental_frequency_hz : float or None
         1 / period of a settled periodic orbit [Hz]; None otherwise.
     dominant_frequency_hz : float or None
-        Highest peak of the coordinate's spectrum in the window [Hz]; None at rest.
+        Highest peak of the coordinate's spectrum in the window [Hz]; None at rest (peak-to-peak
+        below :data:`~stickslip.analysis.steady.REST_AMPLITUDE`).
     settle_time_s : float or None
         Simulated time by which the run was seen settled: the end of the window judged [s];
         None when unsettled.
@@ -113,14 +114,17 @@ class Attractor:
         return {"settled": self.settled, "attractor": self.attractor, "period_count": self.period_count,
                 "fundamental_frequency_hz": self.fundamental_frequency_hz,
                 "dominant_frequency_hz": self.dominant_frequency_hz, "settle_time_s": self.settle_time_s,
-                "evidence": _jsonable(self.evidence)}
+                "evidence": jsonable(self.evidence)}
 
 
-def _jsonable(x):
+def jsonable(x):
+    """``x`` with numpy scalars as Python ones and non-finite floats as None (for JSON)."""
     if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
+        return {str(k): jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [jsonable(v) for v in x]
     if isinstance(x, (np.floating, float)):
-        return float(x) if math.isfinite(x) else None
+        return float(x) if math.isfinite(float(x)) else None
     if isinstance(x, (np.integer, np.bool_)):
         return x.item()
     return x
@@ -163,7 +167,7 @@ def attractor(traj, t_from: float | None = None, *, dof: str = "phi", confirm: b
                          None, {"reason": f"the run stopped early: {traj.status}"})
     c = classify(traj, t_from, dof)
     evidence = dict(c.evidence)
-    dominant = None if c.amplitude <= 0.0 else _finite(c.fft_frequency_hz)
+    dominant = _finite(c.fft_frequency_hz)
 
     def verdict(name, k=None, period=math.nan, **more):
         evidence.update(more)

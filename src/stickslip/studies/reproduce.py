@@ -928,20 +928,6 @@ def render_report(entries: list, res: Resolution, pending: list, elapsed: float)
     return "\n".join(lines)
 
 
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return float(x) if math.isfinite(float(x)) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
-
-
 def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str] | None = None,
               progress: Callable[[str], None] | None = None) -> Path:
     """Run the recipes and write ``out_dir/report.md`` (+ PNGs, ``results.json``).
@@ -962,6 +948,8 @@ def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str
     """
     import matplotlib
 
+    from ..analysis.settle import jsonable
+
     matplotlib.use("Agg")
     if isinstance(resolution, str) and resolution not in RESOLUTIONS:
         raise ValueError(f"unknown resolution {resolution!r}; choose one of {', '.join(RESOLUTIONS)}")
@@ -981,7 +969,7 @@ def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str
 
     def write(pending):
         report.write_text(render_report(entries, res, pending, time.perf_counter() - t_start), encoding="utf-8")
-        (out / "results.json").write_text(json.dumps(_jsonable({"resolution": dataclasses.asdict(res),
+        (out / "results.json").write_text(json.dumps(jsonable({"resolution": dataclasses.asdict(res),
                                                                 "recipes": entries}), indent=1), encoding="utf-8")
 
     for i, recipe in enumerate(selected):
