@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import List, Optional
 
@@ -90,13 +89,16 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
     p = traj.params
     table = Table(title=f"stickslip: model {traj.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
                         f"μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}", show_header=False)
-    freq = summary["fundamental_frequency_hz"]
-    kind = "at rest" if freq is None else ("periodic" if s.periodic else "not periodic")
+    freq, dominant = summary["fundamental_frequency_hz"], summary["dominant_frequency_hz"]
+    kind = summary["attractor"] + (f", {summary['period_count']} peak(s) of φ per period" if summary["period_count"] else "")
+    kind += (f" (settled by {summary['settle_time_s']:g} s)" if summary["settled"]
+             else f" ({summary['evidence'].get('reason', 'no verdict')})")
     rows = [
         ("status", traj.status),
         ("steady window", f"{s.t_from:g} – {s.t_to:g} s"),
-        ("response", kind + (f", {s.period_multiplicity} peak(s) of φ per period" if s.periodic else "")),
+        ("response", kind),
         ("fundamental frequency of φ", "–" if freq is None else f"{freq:.6g} Hz"),
+        ("dominant frequency of φ", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         ("transitions in window", str(s.n_transitions)),
         ("φ min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g} rad"),
@@ -107,9 +109,9 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
     for key, value in rows:
         table.add_row(key, value)
     console.print(table)
-    if not math.isnan(s.fundamental_frequency_hz) and not s.periodic:
-        console.print("[dim]not periodic within the window: the frequency is the highest peak of "
-                      "the φ spectrum[/]")
+    if not summary["settled"]:
+        console.print("[dim]not settled in the window: no period is claimed (the dominant frequency is the "
+                      "highest peak of the φ spectrum); run longer or use --t-end auto[/]")
     if traj.stats.compile_time_s > 0:
         console.print(f"[dim]first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
                       "(not included in the wall time)[/]")
