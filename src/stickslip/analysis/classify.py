@@ -17,7 +17,8 @@ The decision uses the window t ≥ t_from (the transient before it is discarded)
    with the linear stability of the equilibrium. A slip-only response that grows in any
    response is not an equilibrium.
 4. Otherwise ``non-periodic``: **stationary** when the return differences of the best
-   multiplicity seen neither decay (:func:`~stickslip.analysis.period.decay_ratio` at most
+   multiplicity seen are far from a match (spread ≥ :data:`STATIONARY_MIN_SPREAD`), neither
+   decay (:func:`~stickslip.analysis.period.decay_ratio` at most
    :data:`~stickslip.analysis.period.DECAY_FACTOR`) nor trend (their drift is no larger than
    their spread): no sign of a transient, a candidate for chaos or a torus that only the
    dynamics can confirm (:mod:`stickslip.analysis.settle`); else **unsettled**. The range of
@@ -50,6 +51,16 @@ KINDS = ("equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic")
 #: periodic before this test). The slowest free decay of Table 1 (time constant 2 m_d / c_dx =
 #: 200 s) gives e^(−0.75 W / 200) < 0.99 for any window W > 2.7 s.
 DECAY_RATIO = 0.99
+
+#: Smallest return spread (relative to A) of a stationary non-periodic window: a window that
+#: nearly repeats (spread 1e-5 … 1e-3) is a slow approach to a periodic orbit until shown
+#: otherwise (Model 3, N = 50 N, Ω = 0.677 rad/s: spread 1.1e-5 at 100–200 s, period 1 by 400 s).
+STATIONARY_MIN_SPREAD = 1e-3
+
+#: Agreement of the peak ranges of two windows of a stationary response, relative to A (the
+#: range change of a torus's windows; :func:`range_change`).
+STATIONARY_RTOL = 1e-2
+
 
 def kind_code(kind: str) -> int:
     """Integer code of a kind (index in :data:`KINDS`); −1 for ``failed``."""
@@ -142,11 +153,11 @@ def _decaying(q):
     return q[-1] < REST_AMPLITUDE or q[-1] < DECAY_RATIO * q[0]
 
 
-def _range_change(pk, mid, amp):
-    a, b = pk.value[pk.time < mid], pk.value[pk.time >= mid]
+def range_change(a: np.ndarray, b: np.ndarray, amplitude: float) -> float:
+    """Largest change of the extreme peak values between two sets of peaks, relative to A."""
     if a.size < 2 or b.size < 2:
         return math.inf
-    return max(abs(a.min() - b.min()), abs(a.max() - b.max())) / amp
+    return max(abs(a.min() - b.min()), abs(a.max() - b.max())) / amplitude
 
 
 def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | None = None,
@@ -197,12 +208,13 @@ def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | 
     if stick_fraction == 0.0 and all(_decaying(q) for q in quarters):
         return Classification("equilibrium", 0, math.nan, float(rate), fft_f, settled=False, attractor="decaying",
                               evidence=evidence, **base)
-    change = _range_change(pk, 0.5 * (t0 + t1), amp)
-    evidence["range_change"] = change
+    mid = 0.5 * (t0 + t1)
+    evidence["range_change"] = range_change(pk.value[pk.time < mid], pk.value[pk.time >= mid], amp)
     k = max(per.evidence.multiplicity, 1)
     evidence["return_decay"] = decay_ratio(pk.value[k:] - pk.value[:-k])
     best = per.evidence
-    stationary = evidence["return_decay"] <= DECAY_FACTOR and not best.drift > best.spread
+    stationary = (best.spread >= STATIONARY_MIN_SPREAD and evidence["return_decay"] <= DECAY_FACTOR
+                  and not best.drift > best.spread)
     return Classification("non-periodic", 0, math.nan, float(rate), fft_f, settled=False,
                           attractor="stationary" if stationary else "unsettled", evidence=evidence, **base)
 

@@ -11,12 +11,12 @@ the orbit shows, by the same period rule as the signal (:func:`~.period.detect_p
 same k and the same period to :data:`PERIOD_RTOL`: a transient near a period-1 orbit shot with
 multiplicity 2 converges onto that orbit, whose own run then shows k = 1.
 
-Non-periodic but stationary (:func:`confirm_stationary`): the largest Lyapunov exponent λ
-(:func:`stickslip.lyapunov_exponent`, Benettin, started from the run's final state) decides:
-``chaotic`` when λ > :data:`LAMBDA_ZERO` and λ > 3 standard errors; ``quasiperiodic`` when
-|λ| ≤ :data:`LAMBDA_ZERO` and the stationary window was long enough that any contraction at a
-rate above :data:`LAMBDA_ZERO` would have shown as decaying returns
-(:data:`QUASI_WINDOW_S`); otherwise no claim.
+Non-periodic but stationary: the largest Lyapunov exponent λ (:func:`lyapunov_sign`,
+Benettin from the run's final state, once for each initial separation of :data:`SEPARATIONS`)
+decides. ``chaotic`` when every estimate is > :data:`LAMBDA_ZERO` and > 3 standard errors;
+``quasiperiodic`` when every |λ| is within :data:`LAMBDA_ZERO` + 3 standard errors of 0 (a
+torus's exponent converges like 1/t) **and** the crossings have not changed
+over :data:`QUASI_SPAN_S` (:func:`span_change`); otherwise no claim.
 """
 
 from __future__ import annotations
@@ -26,10 +26,10 @@ import math
 import numpy as np
 
 from ..errors import StickSlipError
-from .period import DECAY_FACTOR, detect_period
+from .period import detect_period
 
-__all__ = ["ORBIT_PERIODS", "PERIOD_RTOL", "LAMBDA_ZERO", "QUASI_WINDOW_S", "LYAPUNOV_TIME_S",
-           "confirm_period", "confirm_stationary"]
+__all__ = ["ORBIT_PERIODS", "PERIOD_RTOL", "LAMBDA_ZERO", "SEPARATIONS", "QUASI_SPAN_S", "QUASI_RATE",
+           "LYAPUNOV_TIME_S", "confirm_period", "lyapunov_sign", "span_change"]
 
 #: Periods of the run from the shot orbit on which its own multiplicity is measured (the period
 #: rule needs nine; thirty average the noise of its drift test).
@@ -39,14 +39,22 @@ ORBIT_PERIODS = 30
 #: 1e-5 (:data:`~.period.SETTLE_RTOL`).
 PERIOD_RTOL = 1e-4
 
-#: Largest Lyapunov exponents within ±LAMBDA_ZERO of 0 count as zero [1/s]. The slowest
-#: contraction of the paper's stick-slip orbits is ln 0.994 / 0.65 s = −0.009 1/s; Benettin
-#: estimates of periodic orbits are within ±0.002 1/s of their limit after 500–1500 s.
+#: A positive largest Lyapunov exponent must exceed this [1/s] (and 3 standard errors). Benettin
+#: estimates of periodic orbits are within ±0.002 1/s of their limit (0) after 500–1500 s.
 LAMBDA_ZERO = 5e-3
 
-#: Shortest stationary window for a torus claim [s]: over it a contraction at LAMBDA_ZERO
-#: shrinks the return differences by DECAY_FACTOR between the window's first and last thirds.
-QUASI_WINDOW_S = 1.5 * math.log(DECAY_FACTOR) / LAMBDA_ZERO
+#: Initial separations of the two Benettin runs [-]: a chaotic exponent does not depend on d0
+#: (docs/orbits.md: 1e-8 … 1e-6 agree), a spurious one does (Model 3, N = 50 N, Ω = 0.677 rad/s
+#: after 200 s: 0.345 ± 0.029 1/s at 1e-7, −0.001 at 1e-6; the run is period 1 by 400 s).
+SEPARATIONS = (1e-7, 1e-6)
+
+#: A torus claim needs the crossings unchanged over this span [s]: the spreads of its first and
+#: last windows may differ by a contraction rate of at most QUASI_RATE [1/s], and their peak
+#: ranges by :data:`~.classify.STATIONARY_RTOL` of A. A λ ≈ 0 alone does not tell a torus from
+#: a periodic orbit approached slowly (Model 1, N = 50 N, Ω = 0.5, Δμ = 0.0661: λ = −0.0004 1/s,
+#: no visible decay in 330 s, but the spreads fall ×2.7 per 500 s, 0.5 → 5e-4 over 4000 s).
+QUASI_SPAN_S = 1000.0
+QUASI_RATE = 1e-4
 
 #: Averaging time of the Lyapunov exponent [s] (after a 20 s start that sets the norm's scales).
 LYAPUNOV_TIME_S = 500.0
@@ -142,38 +150,77 @@ def _dof_index(dof: str) -> int:
     return DOF_NAMES.index(dof)
 
 
-def confirm_stationary(traj, window_s: float, *, averaging: float = LYAPUNOV_TIME_S) -> dict:
-    """Largest Lyapunov exponent from the run's final state, and the verdict it supports.
+def lyapunov_sign(traj, *, averaging: float = LYAPUNOV_TIME_S) -> dict:
+    """Largest Lyapunov exponent from the run's final state, once per separation of
+    :data:`SEPARATIONS`, and whether they agree on its sign.
 
     Parameters
     ----------
     traj : Trajectory
         The run; its window showed a stationary, non-periodic response.
-    window_s : float
-        Length of the stationary window [s] (a torus claim needs :data:`QUASI_WINDOW_S`).
     averaging : float
-        Averaging time of the exponent [s].
+        Averaging time of each exponent [s].
 
     Returns
     -------
     dict
-        ``attractor`` (``chaotic``, ``quasiperiodic`` or None: no claim), ``lyapunov_exponent``
-        [1/s], ``standard_error`` [1/s], ``averaging_s``; ``reason`` when no claim is made.
+        ``sign`` (``positive``: every estimate > :data:`LAMBDA_ZERO` and > 3 standard errors;
+        ``zero``: every |λ| ≤ :data:`LAMBDA_ZERO` + 3 standard errors, i.e. consistent with 0;
+        None otherwise: the estimates disagree), ``exponents`` [1/s],
+        ``standard_errors`` [1/s], ``separations``, ``averaging_s``; ``reason`` when None.
     """
     from ..orbits import lyapunov_exponent
 
-    try:
-        res = lyapunov_exponent(traj.params, traj.final_state, model=traj.model, t_transient=20.0,
-                                t_average=averaging)
-    except (StickSlipError, ArithmeticError) as exc:
-        return {"attractor": None, "reason": f"Lyapunov exponent failed: {exc}"}
-    lam, se = float(res.exponent), float(res.standard_error)
-    out = {"lyapunov_exponent": lam, "standard_error": se, "averaging_s": float(averaging)}
-    if lam > LAMBDA_ZERO and lam > 3.0 * se:
-        return {"attractor": "chaotic", **out}
-    if abs(lam) <= LAMBDA_ZERO and window_s >= QUASI_WINDOW_S:
-        return {"attractor": "quasiperiodic", **out}
-    reason = (f"λ = {lam:.3g} ± {se:.2g} 1/s is neither > {LAMBDA_ZERO:g} (and > 3 standard errors) nor "
-              f"within ±{LAMBDA_ZERO:g} of 0 over a stationary window ≥ {QUASI_WINDOW_S:.0f} s "
-              f"(window {window_s:.0f} s)")
-    return {"attractor": None, "reason": reason, **out}
+    lams, ses = [], []
+    for d0 in SEPARATIONS:
+        try:
+            res = lyapunov_exponent(traj.params, traj.final_state, model=traj.model, t_transient=20.0,
+                                    t_average=averaging, d0=d0)
+        except (StickSlipError, ArithmeticError) as exc:
+            return {"sign": None, "reason": f"Lyapunov exponent failed: {exc}"}
+        lams.append(float(res.exponent))
+        ses.append(float(res.standard_error))
+    out = {"exponents": lams, "standard_errors": ses, "separations": list(SEPARATIONS), "averaging_s": float(averaging)}
+    if all(lam > LAMBDA_ZERO and lam > 3.0 * se for lam, se in zip(lams, ses)):
+        return {"sign": "positive", **out}
+    if all(abs(lam) <= LAMBDA_ZERO + 3.0 * se for lam, se in zip(lams, ses)):
+        return {"sign": "zero", **out}
+    text = ", ".join(f"{lam:.3g} ± {se:.2g}" for lam, se in zip(lams, ses))
+    return {"sign": None, "reason": f"largest Lyapunov exponents {text} 1/s (d0 = {', '.join(map(str, SEPARATIONS))}) "
+                                    f"are neither all > {LAMBDA_ZERO:g} (and > 3 standard errors) nor all consistent "
+                                    "with 0", **out}
+
+
+def span_change(traj, window: float, *, dof: str = "phi", span: float = QUASI_SPAN_S) -> dict | None:
+    """How the crossings changed between the first and the last ``window`` seconds of the run's
+    last ``span`` seconds; None when the run is shorter than ``span``.
+
+    Returns
+    -------
+    dict or None
+        ``span_s``, ``multiplicity`` (the last window's best), ``rate`` (|ln| of the ratio of the
+        two windows' spreads at that multiplicity over the time between them [1/s]) and
+        ``range_change`` (:func:`~.classify.range_change`).
+    """
+    from .classify import range_change
+    from .peaks import find_peaks
+    from .period import evidence_at, return_map
+
+    end = float(traj.t[-1])
+    if end - float(traj.t[0]) < span - 1e-9:
+        return None
+    j = _dof_index(dof)
+    windows = []
+    for a in (end - span, end - window):
+        sel = (traj.t >= a) & (traj.t <= a + window)
+        x = traj.states[sel, j]
+        windows.append((find_peaks(traj.t[sel], x, traj.states[sel, 6 + j]), float(np.ptp(x))))
+    (early, amp_e), (late, amp_l) = windows
+    k = max(return_map(late, amp_l)[1].multiplicity, 1)
+    if min(len(early), len(late)) <= k:
+        return None
+    s_e = evidence_at(early.value, early.time, k, amp_e).spread
+    s_l = evidence_at(late.value, late.time, k, amp_l).spread
+    rate = abs(math.log(s_e / s_l)) / (span - window) if s_e > 0 and s_l > 0 else math.inf
+    return {"span_s": float(span), "multiplicity": int(k), "rate": float(rate),
+            "range_change": float(range_change(early.value, late.value, amp_l))}

@@ -38,7 +38,7 @@ from .peaks import Peaks, find_peaks
 from .steady import REST_AMPLITUDE
 
 __all__ = ["SETTLE_RTOL", "DRIFT_FLOOR", "DECAY_FACTOR", "SEPARATION_FACTOR", "MAX_MULTIPLICITY", "MIN_PERIODS",
-           "REST_AMPLITUDE", "ReturnMap", "Periodicity", "return_map", "decay_ratio", "detect_period"]
+           "REST_AMPLITUDE", "ReturnMap", "Periodicity", "return_map", "evidence_at", "decay_ratio", "detect_period"]
 
 #: Spread allowed for a settled period, relative to the amplitude A (values) and to
 #: the period T (times). The integration and peak-location noise of a settled orbit is
@@ -158,7 +158,20 @@ def decay_ratio(d: np.ndarray) -> float:
     return float(np.median(first)) / lo if lo > 0.0 else math.inf
 
 
-def _evidence(p: np.ndarray, tau: np.ndarray, k: int, amplitude: float, separation: float) -> ReturnMap:
+def evidence_at(p: np.ndarray, tau: np.ndarray, k: int, amplitude: float, separation: float = math.inf) -> ReturnMap:
+    """The measurements of the return map at multiplicity ``k`` (module docstring).
+
+    Parameters
+    ----------
+    p, tau : ndarray (n,)
+        Crossing values [unit of x] and times [s], n > k.
+    k : int
+        Multiplicity.
+    amplitude : float
+        Peak-to-peak amplitude A of the response.
+    separation : float
+        Smallest spread of the multiplicities below k [-] (inf for k = 1).
+    """
     dp = p[k:] - p[:-k]
     dtau = tau[k:] - tau[:-k]
     period = float(np.mean(dtau))
@@ -197,7 +210,7 @@ def return_map(peaks: Peaks, amplitude: float) -> tuple[ReturnMap | None, Return
     for k in range(1, MAX_MULTIPLICITY + 1):
         if p.size < MIN_PERIODS * k + 1:
             break
-        ev = _evidence(p, tau, k, amplitude, separation)
+        ev = evidence_at(p, tau, k, amplitude, separation)
         if ev.settled:
             return ev, ev
         seen.append(ev)

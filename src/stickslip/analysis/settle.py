@@ -9,8 +9,10 @@
 ``periodic``       the maxima of the coordinate repeat with k crossings per period and the
                    window shows no drift (:mod:`.period`); for k ≥ 2 only when the shot
                    k-periodic orbit confirms it (:func:`.confirm.confirm_period`)
-``chaotic``        stationary, not periodic, largest Lyapunov exponent positive
-``quasiperiodic``  stationary over a long window, not periodic, largest exponent zero
+``chaotic``        stationary, not periodic, largest Lyapunov exponent positive for two
+                   initial separations (:func:`.confirm.lyapunov_sign`)
+``quasiperiodic``  stationary, not periodic, largest exponent zero for both, and the
+                   crossings unchanged over 1000 s (:func:`.confirm.span_change`)
 ``unbounded``      the state became non-finite
 ``unsettled``      anything else: a transient, an unconfirmed claim, a failed run
 =================  ======================================================================
@@ -32,8 +34,8 @@ import math
 import numpy as np
 
 from ..errors import StickSlipError
-from .classify import Classification, classify
-from .confirm import QUASI_WINDOW_S, confirm_period, confirm_stationary
+from .classify import STATIONARY_RTOL, Classification, classify
+from .confirm import QUASI_RATE, QUASI_SPAN_S, confirm_period, lyapunov_sign, span_change
 
 __all__ = ["ATTRACTORS", "Attractor", "attractor", "simulate_until_settled", "attractor_code", "jsonable",
            "DEFAULT_CAP_S", "DEFAULT_WINDOW_S", "DEFAULT_STEP_S", "DEFAULT_T_MIN_S"]
@@ -200,17 +202,22 @@ def attractor(traj, t_from: float | None = None, *, dof: str = "phi", confirm: b
     if c.attractor == "stationary":
         if not lyapunov:
             return verdict("unsettled", reason="stationary but not periodic; no Lyapunov exponent computed")
-        window = end - max(t_from, float(traj.t[0]))
-        if window < QUASI_WINDOW_S and end - float(traj.t[0]) >= QUASI_WINDOW_S:
-            long = classify(traj, end - QUASI_WINDOW_S, dof)
-            window = QUASI_WINDOW_S if long.attractor == "stationary" else window
-        key = ("lyapunov", window >= QUASI_WINDOW_S)
-        if key not in cache:
-            cache[key] = confirm_stationary(traj, window)
-        lyap = cache[key]
-        if lyap["attractor"] is not None:
-            return verdict(lyap["attractor"], lyapunov=lyap)
-        return verdict("unsettled", lyapunov=lyap, reason=lyap["reason"])
+        if "lyapunov" not in cache:
+            cache["lyapunov"] = lyapunov_sign(traj)
+        lyap = cache["lyapunov"]
+        if lyap["sign"] == "positive":
+            return verdict("chaotic", lyapunov=lyap)
+        if lyap["sign"] is None:
+            return verdict("unsettled", lyapunov=lyap, reason=lyap["reason"])
+        span = span_change(traj, end - max(t_from, float(traj.t[0])), dof=dof)
+        if span is not None and span["rate"] <= QUASI_RATE and span["range_change"] <= STATIONARY_RTOL:
+            return verdict("quasiperiodic", lyapunov=lyap, span=span)
+        why = (f"the run is shorter than {QUASI_SPAN_S:g} s" if span is None else
+               f"its crossings changed over {QUASI_SPAN_S:g} s (rate {span['rate']:.2g} 1/s, range "
+               f"{span['range_change']:.2g} A)")
+        return verdict("unsettled", lyapunov=lyap, span=span,
+                       reason=f"largest Lyapunov exponent ≈ 0, but a torus is claimed only when the crossings stay "
+                              f"unchanged over {QUASI_SPAN_S:g} s and {why}")
     return verdict("unsettled", reason="the window still drifts")
 
 
@@ -273,7 +280,7 @@ def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: fl
     dof : str
         Coordinate whose maxima form the section.
     keep : {"all", "window"}
-        Keep every sample of the run, or only the last max(window, QUASI_WINDOW_S) seconds
+        Keep every sample of the run, or only the last max(window, QUASI_SPAN_S) seconds
         (memory stays flat however long the run; for sweeps).
     confirm, lyapunov : bool
         See :func:`attractor`.
@@ -320,7 +327,7 @@ def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: fl
                         **simulate_options)
         traj = _join(traj, more)
         if keep == "window":
-            traj = _tail(traj, float(traj.t[-1]) - max(window, QUASI_WINDOW_S))
+            traj = _tail(traj, float(traj.t[-1]) - max(window, QUASI_SPAN_S))
         extensions += 1
     settle = {"cap_s": float(cap), "window_s": float(window), "step_s": float(step), "t_min_s": float(t_min),
               "settled": verdict.settled, "attractor": verdict.attractor,
