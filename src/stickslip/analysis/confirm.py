@@ -51,14 +51,14 @@ SEPARATIONS = (1e-7, 1e-6)
 #: A torus claim needs the crossings unchanged over this span [s]: the spreads of its first and
 #: last windows may differ by a contraction rate of at most QUASI_RATE [1/s], and their peak
 #: ranges by :data:`~.classify.STATIONARY_RTOL` of A. A λ ≈ 0 alone does not tell a torus from
-#: a periodic orbit approached slowly (Model 1, N = 50 N, Ω = 0.5, Δμ = 0.0661: λ = −0.0004 1/s,
-#: no visible decay in 330 s, but the spreads fall ×2.7 per 500 s, 0.5 → 5e-4 over 4000 s).
+#: a periodic orbit approached slowly (Model 1, N = 50 N, Ω = 0.5, Δμ = 0.0661: λ = −0.0004 …
+#: 0.005 1/s, no visible decay in 330 s, but the spreads fall ×2.7 per 500 s, 0.5 → 5e-4 over
+#: 4000 s).
 QUASI_SPAN_S = 1000.0
 QUASI_RATE = 1e-4
 
 #: Averaging time of the Lyapunov exponent [s] (after a 20 s start that sets the norm's scales).
 LYAPUNOV_TIME_S = 500.0
-
 
 #: Levels of the coordinate, as fractions of its range in the window, whose up- and
 #: down-crossings are tried as sections after its maxima and minima.
@@ -69,11 +69,12 @@ def _sections_in_slip(traj, dof: str, t_from: float, period: float):
     """Sections crossed only in slip in the window, with their crossings per period: on ``dof``
     first, then on the model's other free coordinates; on each, its maxima, its minima, then
     up- and down-crossings of :data:`LEVELS` of its range in the window."""
+    from ..model.kernels import DEFAULT_SLIP_BAND
     from ..model.system import assemble
     from ..model.variants import DOF_NAMES
     from ..orbits.section import Section, section_crossings
 
-    system = assemble(traj.params, traj.model, traj.options.get("slip_band", 1e-3))
+    system = assemble(traj.params, traj.model, traj.options.get("slip_band", DEFAULT_SLIP_BAND))
     sel = traj.t >= t_from
     t, states, mode = traj.t[sel], traj.states[sel], traj.mode[sel]
     span = float(t[-1] - t[0])
