@@ -11,8 +11,9 @@ from stickslip.cli import app
 
 runner = CliRunner()
 
-JSON_KEYS = {"fundamental_frequency_hz", "stick_fraction", "n_transitions", "phi_min", "phi_max",
-             "steps", "wall_time_s", "method"}
+JSON_KEYS = {"settled", "attractor", "period_count", "fundamental_frequency_hz", "dominant_frequency_hz",
+             "settle_time_s", "evidence", "status", "model", "parameters", "t_end_s", "steady_from_s",
+             "stick_fraction", "n_transitions", "phi_min", "phi_max", "steps", "wall_time_s", "method"}
 
 
 def run(*args):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import List, Optional
 
@@ -31,7 +30,9 @@ def simulate(
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
-    t_end: float = typer.Option(100.0, "--t-end", help="Simulated time [s]."),
+    t_end: str = typer.Option("100", "--t-end", help="Simulated time [s], or 'auto': extend the run until it "
+                              "has settled, up to --cap (the steady window is then the last 100 s)."),
+    cap: float = typer.Option(2000.0, "--cap", help="With --t-end auto: the longest run [s]."),
     method: str = typer.Option("event", "--method", help="Integration method."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance (event)."),
@@ -52,8 +53,21 @@ def simulate(
     with user_errors():
         params = build_parameters(config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
         check_nc_path(out)
-        traj = run_simulation(params, t_end, model=model, method=method, ic=_parse_ic(ic), perturbation=perturb,
-                              rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate, steady_from=steady_from)
+        options = dict(model=model, method=method, ic=_parse_ic(ic), perturbation=perturb, rtol=rtol, atol=atol,
+                       dt=dt, sample_rate=sample_rate)
+        if t_end.strip().lower() == "auto":
+            from ..analysis.settle import simulate_until_settled
+
+            if steady_from is not None:
+                raise ValueError("--steady-from cannot be combined with --t-end auto (the window is the last 100 s); "
+                                 "drop one of them")
+            traj = simulate_until_settled(params, cap=cap, **options)
+        else:
+            try:
+                t_end_s = float(t_end)
+            except ValueError:
+                raise ValueError(f"--t-end {t_end}: give a time in seconds or auto") from None
+            traj = run_simulation(params, t_end_s, steady_from=steady_from, **options)
         out.parent.mkdir(parents=True, exist_ok=True)
         traj.to_netcdf(out)
         figure = None
@@ -75,13 +89,16 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
     p = traj.params
     table = Table(title=f"stickslip: model {traj.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
                         f"μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}", show_header=False)
-    freq = summary["fundamental_frequency_hz"]
-    kind = "at rest" if freq is None else ("periodic" if s.periodic else "not periodic")
+    freq, dominant = summary["fundamental_frequency_hz"], summary["dominant_frequency_hz"]
+    kind = summary["attractor"] + (f", {summary['period_count']} peak(s) of φ per period" if summary["period_count"] else "")
+    kind += (f" (settled by {summary['settle_time_s']:g} s)" if summary["settled"]
+             else f" ({summary['evidence'].get('reason', 'no verdict')})")
     rows = [
         ("status", traj.status),
         ("steady window", f"{s.t_from:g} – {s.t_to:g} s"),
-        ("response", kind + (f", {s.period_multiplicity} peak(s) of φ per period" if s.periodic else "")),
+        ("response", kind),
         ("fundamental frequency of φ", "–" if freq is None else f"{freq:.6g} Hz"),
+        ("dominant frequency of φ", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         ("transitions in window", str(s.n_transitions)),
         ("φ min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g} rad"),
@@ -92,9 +109,9 @@ def _print_summary(traj, summary: dict, out: Path, figure) -> None:
     for key, value in rows:
         table.add_row(key, value)
     console.print(table)
-    if not math.isnan(s.fundamental_frequency_hz) and not s.periodic:
-        console.print("[dim]not periodic within the window: the frequency is the highest peak of "
-                      "the φ spectrum[/]")
+    if not summary["settled"]:
+        console.print("[dim]not settled in the window: no period is claimed (the dominant frequency is the "
+                      "highest peak of the φ spectrum); run longer or use --t-end auto[/]")
     if traj.stats.compile_time_s > 0:
         console.print(f"[dim]first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
                       "(not included in the wall time)[/]")

@@ -230,19 +230,36 @@ class Trajectory:
         return summarize(self.t, self.states, self.mode, self.transitions.time, self.transitions.kind, t_from,
                          coordinate=i, rate=i + self.system.n)
 
+    @cached_property
+    def attractor(self):
+        """What the steady window settles to, with its evidence
+        (:func:`stickslip.analysis.settle.attractor`: may shoot an orbit or compute a Lyapunov
+        exponent to confirm a claim)."""
+        from ..analysis.settle import attractor
+
+        return attractor(self)
+
     def summary(self) -> dict:
-        """The steady-state summary with the run's cost, as a flat JSON-ready dict."""
+        """The verdict on the steady window, the steady-state summary and the run's cost, as a
+        JSON-ready dict.
+
+        Keys: ``settled``, ``attractor``, ``period_count``, ``fundamental_frequency_hz`` (None
+        unless settled and periodic), ``dominant_frequency_hz`` (spectral peak), ``settle_time_s``,
+        ``evidence`` (:class:`stickslip.analysis.settle.Attractor`); ``status``, ``model``,
+        ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction``, ``n_transitions``,
+        ``phi_min``, ``phi_max`` [rad] of the window; ``steps``, ``wall_time_s``, ``method``;
+        ``settle`` (the cap and steps of :func:`stickslip.analysis.settle.simulate_until_settled`)
+        when the run was extended until settled.
+        """
         s = self.steady
-        return {
-            "fundamental_frequency_hz": None if np.isnan(s.fundamental_frequency_hz) else s.fundamental_frequency_hz,
-            "stick_fraction": s.stick_fraction,
-            "n_transitions": s.n_transitions,
-            "phi_min": s.phi_min,
-            "phi_max": s.phi_max,
-            "steps": self.stats.steps,
-            "wall_time_s": self.stats.wall_time_s,
-            "method": self.method,
-        }
+        out = {**self.attractor.to_dict(), "status": self.status, "model": self.model,
+               "parameters": dict(self.system.parameters), "t_end_s": float(self.t[-1]), "steady_from_s": s.t_from,
+               "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "phi_min": s.phi_min,
+               "phi_max": s.phi_max, "steps": self.stats.steps, "wall_time_s": self.stats.wall_time_s,
+               "method": self.method}
+        if "settle" in self.options:
+            out["settle"] = self.options["settle"]
+        return out
 
     def plot(self, **kwargs):
         """Overview figure; see :func:`stickslip.plot.plot_trajectory`."""

@@ -79,6 +79,16 @@ def _auto_batch(t_point: float, remaining: int, workers: int, executor: str) -> 
     return size
 
 
+def _settle_attrs(spec: SweepSpec) -> dict:
+    """File attributes saying how each point's run length was chosen."""
+    attrs = {"settle": int(spec.settle), "confirm": int(spec.confirm)}
+    if spec.settle:
+        attrs.update(cap=spec.cap, cap_units="s",
+                     settle_comment="each run extended from its final state in steps of t_end - t_from until "
+                                    "settled or cap; settle_time per point, window t_end - t_from at its end")
+    return attrs
+
+
 def _progress_bar():
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskProgressColumn, TextColumn,
                                TimeElapsedColumn, TimeRemainingColumn)
@@ -128,7 +138,9 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
         Run length and start of the steady window of every point [s] (default t_end/2).
     **options
         ``model``, ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
-        ``n_peaks``, ``method``: see :class:`~stickslip.sweep.spec.SweepSpec`.
+        ``n_peaks``, ``method``, ``settle`` (extend every run until it has settled; then
+        ``t_end`` is the first run's length), ``cap`` [s] (longest run when settling),
+        ``confirm``: see :class:`~stickslip.sweep.spec.SweepSpec`.
 
     Returns
     -------
@@ -191,7 +203,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
                 rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
                 bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
             if time.perf_counter() - last_snapshot > snapshot_interval:
-                assemble(journal, out)
+                assemble(journal, out, extra_attrs=_settle_attrs(spec))
                 last_snapshot = time.perf_counter()
 
         if todo.size:
@@ -211,7 +223,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
         info["compute_s"] = time.perf_counter() - compute_start
         if bar is not None:
             bar.stop()
-        assemble(journal, out, extra_attrs={"executor": executor})
+        assemble(journal, out, extra_attrs={"executor": executor, **_settle_attrs(spec)})
         if not keep_journal:
             journal.remove()
         else:
