@@ -58,7 +58,7 @@ class Branch:
         Parameter value of each orbit [unit of the parameter].
     periods : ndarray (n,)
         Periods [s].
-    states : ndarray (n, 12)
+    states : ndarray (n, N_STATES)
         States on the Poincaré section [m, rad, m/s, rad/s].
     multipliers : ndarray (n, 2 n_free) complex
         Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus
@@ -221,7 +221,7 @@ def continue_orbit(
     param : str
         The parameter to vary: any numeric :class:`~stickslip.Parameters` field (``N`` [N],
         ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...).
-    start : PeriodicOrbit, Trajectory, array-like (12,) or "equilibrium"
+    start : PeriodicOrbit, Trajectory, array-like (N_STATES,) or "equilibrium"
         The first orbit; or a run that settled on it (shot by
         :func:`~stickslip.orbits.start.start_orbit_from_run`, one
         stick onset per period); or a state handed to :func:`~stickslip.orbits.periodic_orbit`.

@@ -29,14 +29,17 @@ import sys
 import types
 
 from . import arclength, region_edge
-from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_STEPS_PER_SECOND, ContinuationError, _jacobian,
-                        _residual)
-from .branch import AMPLITUDE_SAMPLES, Branch, continue_orbit, load_branch
+from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_CORRECTOR, MAX_STEPS_PER_SECOND, MIN_TANGENT_COS,
+                        ContinuationError, _jacobian, _residual)
+from .branch import (AMPLITUDE_SAMPLES, EASY_ITERATIONS, GROW, HARD_ITERATIONS, SHRINK, Branch, continue_orbit,
+                     load_branch)
 from .problem import nontrivial, unstable_count
-from .region_edge import (FOLD_JACOBIAN_EVERY, FOLD_RTOL, FOLD_TOL, START_FALLBACK, FoldCurve, _edge_at, branch_edge,
-                          fold_curve, load_fold_curve, unstable_cycle)
+from .region_edge import (EDGE_BISECTIONS, EDGE_PROBE, EDGE_SEPARATION, EDGE_WINDOW, FOLD_JACOBIAN_EVERY, FOLD_RTOL,
+                          FOLD_TOL, START_FALLBACK, FoldCurve, _edge_at, branch_edge, fold_curve, load_fold_curve,
+                          unstable_cycle)
 from .section import OrbitError
-from .special_points import HOPF_RATIO, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint
+from .special_points import (HOPF_RATIO, LOCATE_RTOL, MAX_LOCATE, MIN_STICK_FRACTION, SPECIAL_KINDS, VANISH_FIT_POINTS,
+                             VANISH_FIT_RTOL, SpecialPoint)
 from .start import START_RATE, START_RUN, crossings_per_stick, start_orbit_from_run, start_run
 
 __all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run",

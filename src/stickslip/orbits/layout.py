@@ -16,7 +16,7 @@ from ..model import kernels as K
 from ..model.variants import DOF_NAMES, STATE_NAMES
 
 __all__ = ["N_DOFS", "N_STATES", "PHI", "PHI_DOT", "STATE_UNITS", "STATE_NAMES", "free_states",
-           "velocity_of", "equilibrium_state", "stick_projected", "kernel_state"]
+           "velocity_of", "equilibrium_state", "stick_projected", "kernel_state", "KERNEL_STATE"]
 
 #: Generalised coordinates q (x1, y1, x2, y2, φ, ψ) and states s = [q, q̇].
 N_DOFS = len(DOF_NAMES)
@@ -30,7 +30,7 @@ PHI_DOT = STATE_NAMES.index("dphi")
 STATE_UNITS = ("m", "m", "m", "m", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "rad/s", "rad/s")
 
 #: Length of the integrator kernels' work vector: the states and two stick-multiplier slots.
-_KERNEL_STATE = N_STATES + 2
+KERNEL_STATE = N_STATES + 2
 
 
 def velocity_of(index: int) -> int:
@@ -55,7 +55,7 @@ def equilibrium_state(params, model) -> np.ndarray:
 
 def kernel_state(s: np.ndarray) -> np.ndarray:
     """The kernels' work vector (N_STATES + 2,) holding state ``s``."""
-    y = np.zeros(_KERNEL_STATE)
+    y = np.zeros(KERNEL_STATE)
     y[:N_STATES] = s[:N_STATES]
     return y
 

@@ -169,7 +169,7 @@ def lyapunov_exponent(
     ----------
     params : Parameters, optional
         Default: the orbit's or Table 1.
-    ic : "equilibrium", "zero", array-like (12,), Trajectory or PeriodicOrbit
+    ic : "equilibrium", "zero", array-like (N_STATES,), Trajectory or PeriodicOrbit
         Start of the transient run (a PeriodicOrbit: its section state, and its params/model).
     model : str
         Model variant.
@@ -344,7 +344,7 @@ def lyapunov_spectrum(
     ----------
     params : Parameters, optional
         Default: the orbit's or Table 1.
-    ic : "equilibrium", "zero", array-like (12,), Trajectory or PeriodicOrbit
+    ic : "equilibrium", "zero", array-like (N_STATES,), Trajectory or PeriodicOrbit
         Start of the transient run (a PeriodicOrbit: its section state, params and model).
     model : str
         Model variant.

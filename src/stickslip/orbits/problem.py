@@ -22,6 +22,7 @@ matrix. A PeriodicOrbit's monodromy and Floquet multipliers (:class:`Monodromy`)
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import time as _time
 from typing import NamedTuple
@@ -227,7 +228,7 @@ class ShootingProblem:
         """The integration options of every flow map: rtol, atol, slip_band."""
         return dict(rtol=self.rtol, atol=self.atol, slip_band=self.slip_band)
 
-    @property
+    @functools.cached_property
     def unknown(self) -> np.ndarray:
         """Positions in :attr:`free` of the unknown states: all but the one the section fixes."""
         return np.array([k for k, j in enumerate(self.free) if j != self.section.index])

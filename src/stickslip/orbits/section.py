@@ -22,7 +22,7 @@ from ..analysis.steady import _hermite_crossings
 from ..integrate.driver import simulate
 from ..model import kernels as K
 from ..model.system import System
-from .layout import N_DOFS, N_STATES, PHI_DOT, STATE_NAMES, kernel_state, velocity_of
+from .layout import KERNEL_STATE, N_DOFS, N_STATES, PHI_DOT, STATE_NAMES, velocity_of
 
 __all__ = ["Section", "resolve_section", "OrbitError", "flow", "vector_field", "section_crossings"]
 
@@ -75,8 +75,9 @@ def resolve_section(section) -> Section:
 
 def vector_field(system: System, s: np.ndarray, mode: int = K.MODE_SLIP_EXACT) -> np.ndarray:
     """ds/dt (N_STATES,) at state ``s`` in ``mode`` (slip with the exact direction v_r/|v_r| by default)."""
-    y = kernel_state(s)
-    ds = np.zeros_like(y)
+    y = np.zeros(KERNEL_STATE)  # inline, not kernel_state(): called once per sample by section_crossings
+    y[:N_STATES] = s
+    ds = np.zeros(KERNEL_STATE)
     vx, vy = K.relative_velocity(y, system.p)
     speed = float(np.hypot(vx, vy))
     ex, ey = (vx / speed, vy / speed) if speed > 0.0 else (1.0, 0.0)

@@ -30,8 +30,8 @@ from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import assemble
 from .layout import STATE_NAMES, STATE_UNITS, free_states
-from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, Multipliers, ShootingProblem, check_method, check_section,
-                      multiplier_variables, scales, sorted_eigenvalues, stick_count)
+from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
+                      check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
 from .section import OrbitError, Section, land_on_section, resolve_section, section_crossings
 
 __all__ = ["PeriodicOrbit", "periodic_orbit", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
@@ -48,7 +48,7 @@ class PeriodicOrbit(Multipliers):
 
     Attributes
     ----------
-    state : ndarray (12,)
+    state : ndarray (N_STATES,)
         State on the section, s = [q, q̇] [m, rad, m/s, rad/s].
     period : float
         Period T [s] (of ``multiplicity`` section returns).
@@ -185,7 +185,7 @@ def periodic_orbit(
     ----------
     params : Parameters, optional
         Physical parameters (default: those of ``guess`` if it is a Trajectory, else Table 1).
-    guess : Trajectory, array-like (12,), or "equilibrium"/"zero"
+    guess : Trajectory, array-like (N_STATES,), or "equilibrium"/"zero"
         A Trajectory near the orbit (its last ``period_multiplicity + 1`` section crossings give
         the starting state and period), or an initial state from which a ``search_time`` run
         is made to find them.

@@ -80,7 +80,7 @@ class SpecialPoint:
         Parameter value at the special point [unit of the parameter].
     period : float
         Period there [s].
-    state : ndarray (12,)
+    state : ndarray (N_STATES,)
         State on the section there.
     multipliers : ndarray complex
         Floquet multipliers there (at the nearest evaluated point for discrete tests) [-].
