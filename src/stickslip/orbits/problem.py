@@ -348,7 +348,8 @@ class ShootingProblem:
     # ------------------------------------------------------------------ perturbations
     def perturbed(self, s: np.ndarray, direction: np.ndarray, d: float) -> np.ndarray:
         """``s`` moved by ``d`` along the σ-scaled ``direction`` (2 n_free,); projected onto v_r = 0
-        if ``s`` sticks (a perturbed stuck state sticks too: the dynamics' own first instant)."""
+        if ``s`` sticks (a perturbed stuck state sticks too, so this is the dynamics' own first
+        instant, and the integrator need not resolve a 1e-9 m/s slip against the constraint)."""
         sp = s.copy()
         sp[self.free] += d * direction * self.sigma
         vx, vy = K.relative_velocity(s, self.system.p)

@@ -1,12 +1,15 @@
-"""Periodic orbits by shooting on a Poincaré section, with finite-difference Floquet multipliers.
+"""Periodic orbits by shooting on a Poincaré section, with their Floquet multipliers.
 
 Unknowns: the free states on the section except the one the section fixes (so the phase along
 the flow is fixed by the section), and the return time T. Equations: Φ(s0, T) − s0 = 0 on the
 free states, Φ the exact flow map of the ``event`` integrator (:func:`.section.flow`). This is
-a square system (2 n_free equations, 2 n_free − 1 + 1 unknowns), solved by Newton with a
-central finite-difference Jacobian of Φ (perturbed shooting: each column is two simulations,
-so the jumps of the variational equations at stick↔slip transitions — the saltation matrices —
-are contained in it implicitly) and the exact column ∂Φ/∂T = f(Φ) from the vector field.
+a square system (2 n_free equations, 2 n_free − 1 + 1 unknowns): the shooting problem of
+:class:`.problem.ShootingProblem`, solved by its Newton iteration with ∂Φ/∂s0 from the
+variational equations with saltation matrices (default) or from central differences of Φ
+(perturbed shooting: each column is two simulations, so the jumps of the variational equations
+at stick↔slip transitions are contained in it implicitly), and the exact column ∂Φ/∂T = f(Φ)
+from the vector field. The guess — the section state, the period and the scales σ — comes from
+the last section crossings of a run.
 
 At the converged orbit the full-state monodromy matrix ∂Φ/∂s0 (2 n_free × 2 n_free) is
 computed from the variational equations with saltation matrices (:mod:`.variational`; default)
@@ -14,7 +17,6 @@ or differenced once more (``monodromy="finite-difference"``); its eigenvalues ar
 multipliers. One of them is 1 (a shift along the orbit); stick phases collapse the directions
 that violate v_r = 0, which gives multipliers 0.
 """
-
 from __future__ import annotations
 
 import dataclasses
@@ -34,7 +36,7 @@ from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, M
                       check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
 from .section import OrbitError, Section, land_on_section, resolve_section, section_crossings
 
-__all__ = ["PeriodicOrbit", "periodic_orbit", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
+__all__ = ["PeriodicOrbit", "periodic_orbit", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_HALVINGS", "SCALE_FLOOR"]
 
 #: Samples per second of the search run that finds the first section crossings (≥ 100 per
 #: period of the fastest free mode of Table 1, 0.36 s), and its length [s] when none is given.

@@ -7,8 +7,8 @@ transition (docs/orbits.md, "Saltation monodromy", has the derivation):
 * **smooth segments**: δṡ = J(s) δs, J the Jacobian of the right-hand side of the segment's
   mode (slip: paper Eq. 1 with Eq. 3 and the direction v_r/|v_r| of Eq. 9; stick: Eq. 1 with
   the stick multiplier of docs/numerics.md; the low-speed band after breakaway: the
-  quasi-static direction of :func:`stickslip.model.kernels.quasi_static_direction`). The slip Jacobian is
-  analytic in the friction force (its 1/|v_r| direction term grows without bound on the
+  quasi-static direction of :func:`stickslip.model.kernels.quasi_static_direction`). The slip
+  Jacobian is analytic in the friction force (its 1/|v_r| direction term grows without bound on the
   approach to stick, but times the time left, |v_r|/|dv_r/dt|, it stays O(1), so an explicit
   adaptive method takes geometrically shrinking steps, ~15 per decade of |v_r|); the smooth
   parts (the stick multiplier, the residual of the quasi-static direction) are differenced
@@ -815,10 +815,7 @@ def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=N
     Fx, Fy, _ = K.stick_force(y, system.minv, system.damp, system.stiff, system.p)
     if math.hypot(vx, vy) <= STICK_SPEED_TOL and math.hypot(Fx, Fy) <= K.static_limit(system.p):
         mode, e = K.MODE_STICK, (0.0, 0.0)
-        yy = np.zeros(14)
-        yy[:12] = y
-        K.project_velocity(yy, system.minv, system.p)
-        y = yy[:12].copy()
+        y = stick_projected(system, y)
         Phi = stick_projection(system, y) @ Phi
     elif math.hypot(vx, vy) > STICK_SPEED_TOL:
         mode, e = K.MODE_SLIP_EXACT, (vx, vy)
