@@ -14,13 +14,14 @@ import pytest
 
 from reliability.helpers import wait_for  # the fault suite's helpers (tests/reliability; needs psutil)
 from reliability.test_worker_processes import GRACE_S, _alive, _descendants_once_running
+from stickslip.orbits import arclength, region_edge
 from stickslip.orbits import continuation as C
 from stickslip.sweep.executors import WorkersError, default_workers
 
 
 def test_more_workers_than_cpus_is_refused_before_anything_runs(monkeypatch, tmp_path):
     calls = []
-    monkeypatch.setattr(C, "_edge_at", lambda *a: calls.append(a[0]))
+    monkeypatch.setattr(region_edge, "_edge_at", lambda *a: calls.append(a[0]))
     too_many = default_workers() + 1
     with pytest.raises(WorkersError, match=f"more than the {default_workers()} CPUs"):
         C.fold_curve([10.0, 20.0, 30.0], workers=too_many, out=tmp_path / "fc.nc")
@@ -32,11 +33,12 @@ def test_more_workers_than_cpus_is_refused_before_anything_runs(monkeypatch, tmp
 _SLOW_CHILD = textwrap.dedent("""
     import time
     from stickslip.orbits import continuation as C
+    from stickslip.orbits import region_edge
 
     def slow_edge(N, *args):  # one N that takes long: the parent is killed while the workers run
         time.sleep(300)
 
-    C._edge_at = slow_edge
+    region_edge._edge_at = slow_edge
     C.fold_curve([10.0, 20.0, 30.0, 40.0], workers=2)
 """)
 

@@ -25,10 +25,7 @@ with a known fold, a stand-in for one N): setting them here sets them in the mod
 
 from __future__ import annotations
 
-import sys
-import types
 
-from . import arclength, region_edge
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_CORRECTOR, MAX_STEPS_PER_SECOND, MIN_TANGENT_COS,
                         ContinuationError, _jacobian, _residual)
 from .branch import (AMPLITUDE_SAMPLES, EASY_ITERATIONS, GROW, HARD_ITERATIONS, SHRINK, Branch, continue_orbit,
@@ -45,20 +42,3 @@ from .start import START_RATE, START_RUN, crossings_per_stick, start_orbit_from_
 __all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run",
            "crossings_per_stick", "start_orbit_from_run", "unstable_cycle", "load_branch", "load_fold_curve",
            "ContinuationError", "SPECIAL_KINDS"]
-
-#: The steps that can be replaced through this module, and the module that calls them: the
-#: shooting residual and Jacobian of the corrector, and one N of :func:`fold_curve`.
-_REPLACEABLE = {"_residual": arclength, "_jacobian": arclength, "_edge_at": region_edge}
-
-
-class _Reexports(types.ModuleType):
-    """This module: setting a replaceable step here sets it where it is called too."""
-
-    def __setattr__(self, name, value):
-        home = _REPLACEABLE.get(name)
-        if home is not None:
-            setattr(home, name, value)
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Reexports
