@@ -183,31 +183,69 @@ def test_ctrl_c_says_what_each_command_keeps(target, args, kept, tmp_path, monke
     assert line == f"interrupted: {kept}"
 
 
-def _size(folder) -> int:
-    return sum(f.stat().st_size for f in folder.iterdir()) if folder.is_dir() else -1
+def _size(path) -> int:
+    """Bytes in a journal (a file, or a folder of files); -1 when there is none."""
+    if path.is_dir():
+        return sum(f.stat().st_size for f in path.iterdir())
+    return path.stat().st_size if path.exists() else -1
 
 
-def test_ctrl_c_of_a_sweep_keeps_its_journal_and_the_same_command_resumes(tmp_path):
-    out, journal = tmp_path / "s.nc", tmp_path / "s.nc.journal"
-    cmd = [sys.executable, "-c", "from stickslip.cli import app; app()", "sweep", "--grid", "N=20:80:6000",
-           "--grid", "Omega=0.5", "--t-end", "2", "--executor", "serial", "--no-plot", "--no-progress",
-           "--out", str(out), "--json"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
-    while _size(journal) < 0 and time.monotonic() < deadline:
+def _stickslip(*args) -> list:
+    return [sys.executable, "-c", "from stickslip.cli import app; app()", *args]
+
+
+def _interrupt_when(proc, ready, deadline_s=120.0) -> tuple:
+    """Send SIGINT to ``proc`` once ``ready()`` is true; its (returncode, stdout, stderr lines)."""
+    deadline = time.monotonic() + deadline_s
+    while not ready() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
-    time.sleep(0.5)  # the journal's header is written; its first points take longer (kernels load)
-    created = _size(journal)
-    while _size(journal) <= created and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.05)  # until the first points are journaled
     proc.send_signal(signal.SIGINT)
-    stdout, stderr = proc.communicate(timeout=60)
-    assert proc.returncode == 130, stderr
-    lines = [ln for ln in stderr.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("interrupted:") and "resume" in lines[0], stderr
-    assert not out.exists() and _size(journal) > created
+    try:
+        stdout, stderr = proc.communicate(timeout=60)
+    finally:
+        proc.kill()  # if Ctrl-C did not end it
+    return proc.returncode, stdout, [ln for ln in stderr.splitlines() if ln.strip()]
 
+
+@pytest.mark.parametrize("command", [
+    ["sweep", "--grid", "N=20:80:8", "--grid", "Omega=0.5", "--t-end", "2", "--executor", "serial", "--no-progress"],
+    ["continue", "--from", "5", "--to", "30", "--max-points", "100000", "--step", "1e-4", "--max-step", "2e-4",
+     "--search-time", "20", "--no-progress"],
+])
+def test_ctrl_c_stops_resumable_work_keeps_its_journal_and_the_same_command_resumes(command, tmp_path):
+    out, journal = tmp_path / "r.nc", tmp_path / "r.nc.journal"
+    cmd = _stickslip(*command, "--no-plot", "--out", str(out), "--json")
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    sizes = []
+
+    def first_work_journaled() -> bool:  # the journal has grown since its header was written
+        sizes.append(_size(journal))
+        return len(sizes) > 10 and sizes[-11] >= 0 and sizes[-1] > sizes[-11]
+
+    code, _, lines = _interrupt_when(proc, first_work_journaled)
+    assert code == 130, lines
+    assert len(lines) == 1 and lines[0].startswith("interrupted:") and "resume" in lines[0], lines
+    assert not out.exists() and _size(journal) > 0
+    if command[0] == "continue":
+        again = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        code, _, lines = _interrupt_when(again, lambda: False, deadline_s=10.0)
+        assert code == 130 and lines[0].startswith("resuming from "), lines
+        return
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
     summary = json.loads(again.stdout.strip().splitlines()[-1])
-    assert summary["points_resumed"] >= 1 and summary["points_resumed"] + summary["points_computed"] == 6000
+    assert summary["points_resumed"] >= 1 and summary["points_resumed"] + summary["points_computed"] == 8
+
+
+def test_ctrl_c_keeps_the_part_of_a_run_done(tmp_path):
+    from stickslip import load_trajectory
+
+    out = tmp_path / "x.nc"
+    proc = subprocess.Popen(_stickslip("simulate", "--t-end", "100000", "--sample-rate", "10", "--no-plot",
+                                       "--out", str(out)), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    started = time.monotonic()
+    code, _, lines = _interrupt_when(proc, lambda: time.monotonic() - started > 8)
+    assert code == 130, lines
+    assert len(lines) == 1 and lines[0].startswith("interrupted: interrupted at t = ") and str(out) in lines[0], lines
+    kept = load_trajectory(out)
+    assert 0 < kept.t[-1] < 100000 and kept.status.startswith("interrupted at t = ")

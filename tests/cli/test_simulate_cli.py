@@ -11,8 +11,9 @@ from stickslip.cli import app
 
 runner = CliRunner()
 
-JSON_KEYS = {"fundamental_frequency_hz", "stick_fraction", "n_transitions", "phi_min", "phi_max",
-             "steps", "wall_time_s", "method"}
+JSON_KEYS = {"settled", "attractor", "period_count", "fundamental_frequency_hz", "dominant_frequency_hz",
+             "settle_time_s", "evidence", "status", "model", "parameters", "t_end_s", "steady_from_s",
+             "stick_fraction", "n_transitions", "phi_min", "phi_max", "steps", "wall_time_s", "method"}
 
 
 def run(*args):
@@ -182,12 +183,14 @@ def test_json_alone_writes_nothing(tmp_path, monkeypatch):
     (["--N", "30", "--set", "N=40"], "--set N=40 and --N 30 both set N"),
     (["--set", "N=30", "--set", "N=40"], "--set N is given twice"),
     (["--steady-from", "-1"], "--steady-from -1 s is outside the run, which goes from 0 to 1 s"),
+    (["--steady-from", "0.999"], "the steady window 0.999 – 1 s holds 2 samples at 1000 Hz and its summary needs 8"),
+    (["--sample-rate", "10"], "the steady window 0.5 – 1 s holds 6 samples at 10 Hz"),
     (["--steady-from", "5"], "--steady-from 5 s is outside the run"),
     (["--steady-from", "nan"], "--steady-from must be a finite number"),
     (["--perturb", "inf"], "--perturb must be a finite number"),
     (["--sample-rate", "0"], "--sample-rate must be a finite number > 0"),
-    (["--dt", "1e-12"], "--dt 1e-12 s takes at least 1e+12 steps"),
-    (["--method", "aeom", "--dt", "1e-300"], "give --dt 2e-08 or more"),
+    (["--dt", "1e-12"], "--dt 1e-12 s takes at least 1e+12 steps for --t-end 1 s"),
+    (["--method", "aeom", "--dt", "1e-300"], "give --dt 1e-10 or more"),
 ])
 def test_refused_options_say_why_in_one_line(args, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

@@ -17,6 +17,7 @@ import pytest
 
 from stickslip import Parameters, simulate
 from stickslip.orbits import PeriodicOrbit, periodic_orbit, resolve_section
+from stickslip.orbits import arclength, region_edge
 from stickslip.orbits import continuation as C
 from stickslip.orbits.continuation import ContinuationError, continue_orbit, load_branch, start_run
 
@@ -59,8 +60,8 @@ def constructed(monkeypatch):
         J = np.array([[2 * v[0], 0, 0, 0, 1.0], [0, 1.0, 0, 0, -0.1], [0, 0, 1.0, 0, 0], [0, 0, 0, 1.0, 0]])
         return J, _monodromy(v)
 
-    monkeypatch.setattr(C, "_residual", residual)
-    monkeypatch.setattr(C, "_jacobian", jacobian)
+    monkeypatch.setattr(arclength, "_residual", residual)
+    monkeypatch.setattr(arclength, "_jacobian", jacobian)
     return _constructed_orbit()
 
 
@@ -461,11 +462,11 @@ def test_fold_curve_writes_each_N_and_skips_them_on_restart(monkeypatch, tmp_pat
     keeps the others, and the restart computes only the missing N (the result is that of one
     uninterrupted run); a finished file is read back, and more N are added to it."""
     calls = []
-    monkeypatch.setattr(C, "_edge_at", lambda *a: calls.append(a[0]) or _fake_edge(*a))
+    monkeypatch.setattr(region_edge, "_edge_at", lambda *a: calls.append(a[0]) or _fake_edge(*a))
     Ns = [10.0, 20.0, 30.0, 40.0]
     full = C.fold_curve(Ns)
     out = tmp_path / "fc.nc"
-    monkeypatch.setattr(C, "_edge_at", _fake_edge)  # forked workers need a picklable function
+    monkeypatch.setattr(region_edge, "_edge_at", _fake_edge)  # forked workers need a picklable function
     monkeypatch.setattr(sys.modules[__name__], "_FAIL_AT", {30.0})
     with pytest.raises(_Interrupt):
         C.fold_curve(Ns, out=out, workers=workers)
@@ -474,7 +475,7 @@ def test_fold_curve_writes_each_N_and_skips_them_on_restart(monkeypatch, tmp_pat
     assert written == (2 if workers == 1 else 3) and not out.exists()  # processes: every other N is kept
     monkeypatch.setattr(sys.modules[__name__], "_FAIL_AT", set())
     calls.clear()
-    monkeypatch.setattr(C, "_edge_at", lambda *a: calls.append(a[0]) or _fake_edge(*a))
+    monkeypatch.setattr(region_edge, "_edge_at", lambda *a: calls.append(a[0]) or _fake_edge(*a))
     fc = C.fold_curve(Ns, out=out)
     assert 30.0 in calls and len(calls) == 4 - written and fc.timings["n_resumed"] == written
     for name in ("N", "edge", "located", "period", "omega_stable_max", "points", "seconds"):

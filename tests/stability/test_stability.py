@@ -121,4 +121,4 @@ def test_errors():
     with pytest.raises(EquilibriumError, match="low-speed band"):
         stability(Parameters(Omega=1e-7))
     with pytest.raises(TypeError):
-        stability(None)
+        stability(object())  # neither Parameters nor a model (None means the default plates)

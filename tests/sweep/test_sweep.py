@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stickslip.files import FileFormatError
 from stickslip.sweep import SweepError, load_sweep, regions, sweep
 from stickslip.sweep.spec import TIMING_COLUMNS
 
@@ -127,7 +128,7 @@ def test_torn_journal_record_is_recomputed(serial, tmp_path):
 def test_foreign_and_mismatched_files_are_refused(serial, tmp_path):
     foreign = tmp_path / "foreign.nc"
     foreign.write_text("not a netcdf file")
-    with pytest.raises(SweepError, match="not a NetCDF file written by stickslip"):
+    with pytest.raises(FileFormatError, match="not a stickslip NetCDF file"):
         load_sweep(foreign)
     with pytest.raises(SweepError, match="refusing to overwrite"):
         sweep(GRID, out=foreign, executor="serial", **OPTS)
@@ -137,7 +138,7 @@ def test_foreign_and_mismatched_files_are_refused(serial, tmp_path):
     import stickslip
 
     stickslip.simulate(None, 0.1).to_netcdf(traj_file)
-    with pytest.raises(SweepError, match="not a stickslip sweep"):
+    with pytest.raises(FileFormatError, match="is a stickslip trajectory file, not a stickslip sweep"):
         load_sweep(traj_file)
 
 

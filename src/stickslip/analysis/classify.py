@@ -1,26 +1,32 @@
-"""Classification of the steady state: equilibrium, periodic slip, periodic stick-slip, non-periodic.
+"""Classification of a response window from the signal alone: at rest, periodic, decaying,
+stationary or still drifting.
 
 The decision uses the window t ≥ t_from (the transient before it is discarded):
 
-1. **At rest** – peak-to-peak φ below :data:`~stickslip.analysis.steady.REST_AMPLITUDE`:
-   ``equilibrium``.
-2. **Return map of the peaks** – :func:`~stickslip.analysis.period.detect_period`, the one
-   period detection shared with the steady-state summary (``Trajectory.steady``): the peaks of φ
-   (events φ̇ = 0, φ̈ < 0) form the sequence p_i at times τ_i; the response is periodic with
-   multiplicity k (peaks per period) for the smallest k ≤ :data:`MAX_MULTIPLICITY` with
-   |p_{i+k} − p_i| ≤ :data:`PEAK_RTOL` · A and |(τ_{i+k} − τ_i) − T| ≤ :data:`PEAK_RTOL` · T for
-   all i, A the peak-to-peak amplitude of φ and T the period; at least :data:`MIN_REPEATS`
-   periods must fit. Periodic: ``periodic-stick-slip`` if any stick occurs in the window, else
-   ``periodic-slip``.
-3. **Decay** – not periodic, no stick, and the peak-to-peak amplitude in the last quarter of the
-   window below :data:`DECAY_RATIO` times that of the first quarter, in φ and in every other free
-   DOF: ``equilibrium`` (converging to steady sliding, Eq. 14). A slip-only response that grows
-   in any DOF is not an equilibrium.
-4. Otherwise ``non-periodic``.
+1. **At rest** – peak-to-peak x below :data:`~stickslip.analysis.steady.REST_AMPLITUDE`:
+   ``equilibrium``, settled.
+2. **Settled period** – :func:`~stickslip.analysis.period.detect_period` (the one period rule,
+   shared with ``Trajectory.steady``): the peaks repeat with multiplicity k and the window shows
+   no drift and no decaying return differences. ``periodic-stick-slip`` if any stick occurs in
+   the window, else ``periodic-slip``.
+3. **Decay** – no settled period, no stick, and the peak-to-peak amplitude in the last quarter
+   of the window below :data:`DECAY_RATIO` times that of the first quarter, in x and in every
+   other given response: ``equilibrium`` (converging to steady sliding). The signal cannot
+   tell a decay onto the equilibrium from one onto a small slip limit cycle or a mode growing
+   unseen below it, so this is not settled here: :mod:`stickslip.analysis.settle` confirms it
+   with the linear stability of the equilibrium. A slip-only response that grows in any
+   response is not an equilibrium.
+4. Otherwise ``non-periodic``: **stationary** when the return differences of the best
+   multiplicity seen are far from a match (spread ≥ :data:`STATIONARY_MIN_SPREAD`), neither
+   decay (:func:`~stickslip.analysis.period.decay_ratio` at most
+   :data:`~stickslip.analysis.period.DECAY_FACTOR`) nor trend (their drift is no larger than
+   their spread): no sign of a transient, a candidate for chaos or a torus that only the
+   dynamics can confirm (:mod:`stickslip.analysis.settle`); else **unsettled**. The range of
+   the peaks is not required to repeat between the window halves: a chaotic attractor's
+   100-s windows differ in range by 3–25 % (docs/settling.md).
 
-``settled`` says whether the attractor has stopped drifting: periodic and equilibrium
-classifications are settled by construction; for a non-periodic response the range of the
-peaks in the two halves of the window must agree to :data:`SETTLE_RTOL` · A.
+``settled`` is True only for cases 1 and 2. ``attractor`` names what the signal shows:
+``equilibrium`` (at rest), ``periodic``, ``decaying``, ``stationary`` or ``unsettled``.
 """
 
 from __future__ import annotations
@@ -31,11 +37,11 @@ import math
 import numpy as np
 
 from .peaks import Peaks
-from .period import MAX_MULTIPLICITY, MIN_REPEATS, PEAK_RTOL, detect_period
+from .period import DECAY_FACTOR, MAX_MULTIPLICITY, MIN_PERIODS, SETTLE_RTOL, decay_ratio, detect_period
 from .steady import REST_AMPLITUDE, _spectral_peak, stick_time
 
 __all__ = ["KINDS", "Classification", "classify_response", "classify", "kind_code",
-           "PEAK_RTOL", "MAX_MULTIPLICITY", "MIN_REPEATS"]
+           "SETTLE_RTOL", "MAX_MULTIPLICITY", "MIN_PERIODS"]
 
 #: Steady-state kinds; their index is the integer code stored in sweeps (−1: the run failed).
 KINDS = ("equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic")
@@ -46,9 +52,14 @@ KINDS = ("equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic")
 #: 200 s) gives e^(−0.75 W / 200) < 0.99 for any window W > 2.7 s.
 DECAY_RATIO = 0.99
 
-#: Relative agreement of the peak ranges of the two window halves for a settled non-periodic
-#: response (1 % of A: chaotic peak sets fill their range to that level within ~50 peaks).
-SETTLE_RTOL = 1e-2
+#: Smallest return spread (relative to A) of a stationary non-periodic window: a window that
+#: nearly repeats (spread 1e-5 … 1e-3) is a slow approach to a periodic orbit until shown
+#: otherwise (Model 3, N = 50 N, Ω = 0.677 rad/s: spread 1.1e-5 at 100–200 s, period 1 by 400 s).
+STATIONARY_MIN_SPREAD = 1e-3
+
+#: Agreement of the peak ranges of two windows of a stationary response, relative to A (the
+#: range change of a torus's windows; :func:`range_change`).
+STATIONARY_RTOL = 1e-2
 
 
 def kind_code(kind: str) -> int:
@@ -58,30 +69,41 @@ def kind_code(kind: str) -> int:
 
 @dataclasses.dataclass(frozen=True)
 class Classification:
-    """Steady-state classification of φ over [t_from, t_to].
+    """Classification of a response over [t_from, t_to] from the signal alone.
 
     Attributes
     ----------
     kind : str
         One of :data:`KINDS`.
     multiplicity : int
-        Peaks per period of a periodic response (the period multiplicity); 0 otherwise.
+        Peaks per period of a settled periodic response; 0 otherwise.
     period_s : float
         Period from the return map [s]; NaN unless periodic.
     frequency_hz : float
         1/period when periodic; otherwise the mean rate of peaks [Hz]; NaN without peaks.
     fft_frequency_hz : float
-        Highest peak of the Hann-windowed amplitude spectrum of φ [Hz]; NaN at rest.
+        Highest peak of the Hann-windowed amplitude spectrum of x [Hz]; NaN at rest.
     stick_fraction : float
         Fraction of the window in stick [-].
     settled : bool
-        Whether the attractor has stopped drifting (see module docstring).
+        Whether the window shows the attractor itself, not a transient (module docstring).
     amplitude : float
-        Peak-to-peak φ in the window [rad].
+        Peak-to-peak x in the window [unit of x].
     peaks : Peaks
-        Event-located peaks of φ in the window.
+        Event-located peaks of x in the window.
     t_from, t_to : float
         The window [s].
+    attractor : str
+        ``equilibrium`` (at rest), ``periodic``, ``decaying``, ``stationary`` or ``unsettled``
+        (module docstring).
+    evidence : dict
+        What was measured: ``multiplicity``, ``period_s``, ``spread``, ``drift``,
+        ``separation`` of the settled or best return map
+        (:class:`~stickslip.analysis.period.ReturnMap`); when not periodic also
+        ``amplitude_ratio`` (last quarter's peak-to-peak over the first's) and, when not
+        decaying, ``range_change`` (of the peak ranges between the window halves, relative to
+        A) and ``return_decay`` (:func:`~stickslip.analysis.period.decay_ratio` of the return
+        differences).
     """
 
     kind: str
@@ -95,6 +117,8 @@ class Classification:
     peaks: Peaks
     t_from: float
     t_to: float
+    attractor: str = "unsettled"
+    evidence: dict = dataclasses.field(default_factory=dict)
 
     @property
     def code(self) -> int:
@@ -118,74 +142,95 @@ def _ptp(x):
     return float(np.max(x) - np.min(x)) if x.size else 0.0
 
 
-def _decaying(t, x, t0, t1):
-    """Whether the peak-to-peak of x in the last quarter is below DECAY_RATIO × the first's."""
-    q = (t1 - t0) / 4.0
-    first, last = _ptp(x[t <= t0 + q]), _ptp(x[t >= t1 - q])
-    return last < REST_AMPLITUDE or last < DECAY_RATIO * first
+def _quarters(t, x, t0, t1):
+    """Peak-to-peak of x in the four quarters of [t0, t1]."""
+    edges = np.linspace(t0, t1, 5)
+    return np.array([_ptp(x[(t >= a) & (t <= b)]) for a, b in zip(edges[:-1], edges[1:])])
 
 
-def classify_response(t, phi, dphi, *, stick_fraction: float = 0.0, t_from: float | None = None,
+def _decaying(q):
+    """Whether the last quarter's amplitude is below DECAY_RATIO × the first's (or at rest)."""
+    return q[-1] < REST_AMPLITUDE or q[-1] < DECAY_RATIO * q[0]
+
+
+def range_change(a: np.ndarray, b: np.ndarray, amplitude: float) -> float:
+    """Largest change of the extreme peak values between two sets of peaks, relative to A."""
+    if a.size < 2 or b.size < 2:
+        return math.inf
+    return max(abs(a.min() - b.min()), abs(a.max() - b.max())) / amplitude
+
+
+def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | None = None,
                       others=None) -> Classification:
-    """Classify a sampled response φ(t) (see the module docstring for the rules).
+    """Classify a sampled response x(t) (see the module docstring for the rules).
 
     Parameters
     ----------
     t : ndarray (n,)
         Uniform sample times [s].
-    phi, dphi : ndarray (n,)
-        φ [rad] and φ̇ [rad/s] (any response and its rate will do).
+    x, dx : ndarray (n,)
+        The response (e.g. φ [rad]) and its rate (e.g. φ̇ [rad/s]); any coordinate will do.
     stick_fraction : float
         Fraction of the window spent in stick [-] (0 for a slip-only or constructed signal).
     t_from : float, optional
         Start of the window [s]; default the first sample.
-    others : ndarray (n, k), optional
-        Other responses (e.g. the free translations) that must decay too before a slip-only
-        response counts as converging to the equilibrium: an unstable mode may grow in them
-        while φ still decays.
+    others : ndarray (n, m), optional
+        Other responses (e.g. the other free coordinates) that must decay too before a
+        slip-only response counts as converging to the equilibrium: an unstable mode may grow
+        in them while x still decays.
     """
     t = np.asarray(t, dtype=float)
-    phi = np.asarray(phi, dtype=float)
-    dphi = np.asarray(dphi, dtype=float)
+    x = np.asarray(x, dtype=float)
+    dx = np.asarray(dx, dtype=float)
     others = None if others is None else np.asarray(others, dtype=float).reshape(t.size, -1)
     if t_from is not None:
         sel = t >= t_from
-        t, phi, dphi = t[sel], phi[sel], dphi[sel]
+        t, x, dx = t[sel], x[sel], dx[sel]
         others = None if others is None else others[sel]
     if t.size < 8:
         raise ValueError("classification needs at least 8 samples in the window; choose an earlier t_from")
     t0, t1 = float(t[0]), float(t[-1])
-    per = detect_period(t, phi, dphi)
+    per = detect_period(t, x, dx)
     amp, pk = per.amplitude, per.peaks
     base = dict(stick_fraction=float(stick_fraction), amplitude=amp, peaks=pk, t_from=t0, t_to=t1)
+    evidence = per.evidence.to_dict()
     if amp < REST_AMPLITUDE:
-        return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, **base)
-    fft_f = _spectral_peak(t, phi)
-    k, period = per.multiplicity, per.period_s
-    if k:
+        return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, attractor="equilibrium",
+                              evidence=evidence, **base)
+    fft_f = _spectral_peak(t, x)
+    if per.periodic:
         kind = "periodic-stick-slip" if stick_fraction > 0.0 else "periodic-slip"
-        return Classification(kind, k, period, 1.0 / period, fft_f, settled=True, **base)
-    decaying = _decaying(t, phi, t0, t1) and (others is None or all(_decaying(t, x, t0, t1) for x in others.T))
-    if stick_fraction == 0.0 and decaying:
-        rate = (len(pk) - 1) / (pk.time[-1] - pk.time[0]) if len(pk) >= 2 else math.nan
-        return Classification("equilibrium", 0, math.nan, float(rate), fft_f, settled=True, **base)
+        return Classification(kind, per.multiplicity, per.period_s, 1.0 / per.period_s, fft_f, settled=True,
+                              attractor="periodic", evidence=evidence, **base)
     rate = (len(pk) - 1) / (pk.time[-1] - pk.time[0]) if len(pk) >= 2 else math.nan
+    quarters = [_quarters(t, x, t0, t1)] + ([] if others is None else [_quarters(t, y, t0, t1) for y in others.T])
+    evidence["amplitude_ratio"] = float(quarters[0][-1] / quarters[0][0]) if quarters[0][0] > 0 else math.nan
+    if stick_fraction == 0.0 and all(_decaying(q) for q in quarters):
+        return Classification("equilibrium", 0, math.nan, float(rate), fft_f, settled=False, attractor="decaying",
+                              evidence=evidence, **base)
     mid = 0.5 * (t0 + t1)
-    a, b = pk.value[pk.time < mid], pk.value[pk.time >= mid]
-    settled = bool(a.size >= 2 and b.size >= 2
-                   and abs(a.min() - b.min()) <= SETTLE_RTOL * amp and abs(a.max() - b.max()) <= SETTLE_RTOL * amp)
-    return Classification("non-periodic", 0, math.nan, float(rate), fft_f, settled=settled, **base)
+    evidence["range_change"] = range_change(pk.value[pk.time < mid], pk.value[pk.time >= mid], amp)
+    k = max(per.evidence.multiplicity, 1)
+    evidence["return_decay"] = decay_ratio(pk.value[k:] - pk.value[:-k])
+    best = per.evidence
+    stationary = (best.spread >= STATIONARY_MIN_SPREAD and evidence["return_decay"] <= DECAY_FACTOR
+                  and not best.drift > best.spread)
+    return Classification("non-periodic", 0, math.nan, float(rate), fft_f, settled=False,
+                          attractor="stationary" if stationary else "unsettled", evidence=evidence, **base)
 
 
-def classify(traj, t_from: float | None = None, dof: str = "phi") -> Classification:
-    """Classify the steady state of a :class:`~stickslip.Trajectory` over t ≥ ``t_from`` [s].
+def classify(traj, t_from: float | None = None, dof: str | None = None) -> Classification:
+    """Classify the steady state of a :class:`~stickslip.Trajectory` over t ≥ ``t_from`` [s]
+    from the signal of one DOF (the other free DOFs enter the decay test).
 
     The stick fraction comes from the exact transition instants. ``t_from`` defaults to the
-    trajectory's ``steady_from`` (the last half of the run unless set).
+    trajectory's ``steady_from`` (the last half of the run unless set). This is the signal's
+    verdict; :func:`stickslip.analysis.settle.attractor` adds the dynamical confirmations.
+    ``dof`` defaults to the model's observed coordinate (the plates' φ).
     """
-    from ..model.variants import DOF_NAMES, resolve_variant
-
-    j = DOF_NAMES.index(dof)
+    system = traj.system
+    j = dof_index(traj, dof)
+    n = system.n
     t_from = traj.steady_from if t_from is None else float(t_from)
     sel = traj.t >= t_from
     ts = traj.t[sel]
@@ -193,6 +238,16 @@ def classify(traj, t_from: float | None = None, dof: str = "phi") -> Classificat
         raise ValueError(f"t_from = {t_from} s leaves fewer than 8 samples; choose an earlier time")
     stick = stick_time(float(ts[0]), float(ts[-1]), int(traj.mode[sel][0]), traj.transitions.time, traj.transitions.kind)
     frac = stick / float(ts[-1] - ts[0])
-    free = [i for i, name in enumerate(DOF_NAMES) if name in resolve_variant(traj.model).free and i != j]
-    return classify_response(ts, traj.states[sel, j], traj.states[sel, 6 + j], stick_fraction=frac,
+    free = [int(i) for i in np.flatnonzero(system.free) if i != j]
+    return classify_response(ts, traj.states[sel, j], traj.states[sel, n + j], stick_fraction=frac,
                              others=traj.states[sel][:, free] if free else None)
+
+
+def dof_index(traj, dof: str | None = None) -> int:
+    """Index in q of the coordinate ``dof`` of the trajectory's model (default its observed one)."""
+    system = traj.system
+    if dof is None:
+        return system.observed_index
+    if dof not in system.dofs:
+        raise ValueError(f"unknown coordinate {dof!r} of model {system.name!r}; choose one of {', '.join(system.dofs)}")
+    return system.dofs.index(dof)

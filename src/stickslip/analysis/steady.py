@@ -24,12 +24,14 @@ class SteadyState:
     t_from, t_to : float
         Window analysed [s].
     fundamental_frequency_hz : float
-        1 / (smallest period) of φ [Hz] when periodic (return map on the peak section,
-        :func:`stickslip.analysis.period.detect_period`); otherwise the highest peak of the
-        spectrum (dominant frequency); NaN at rest.
+        1 / (smallest period) of φ [Hz] when periodic and settled (return map on the peak
+        section, :func:`stickslip.analysis.period.detect_period`); otherwise the highest peak
+        of the spectrum (dominant frequency); NaN at rest. ``Trajectory.summary()`` keeps the
+        two apart and confirms periods of more than one peak.
     periodic : bool
-        Whether φ repeats on the section (within :data:`stickslip.analysis.period.PEAK_RTOL`);
-        the same decision as :func:`stickslip.analysis.classify.classify`.
+        Whether φ repeats on the section and has settled (the signal rule of
+        :mod:`stickslip.analysis.period`); the same decision as
+        :func:`stickslip.analysis.classify.classify`.
     period_multiplicity : int
         Section crossings (peaks of φ) per period (0 when not periodic).
     stick_fraction : float
@@ -117,8 +119,8 @@ def fundamental_frequency(t, phi, dphi):
     """Fundamental frequency of φ(t) [Hz], whether it is periodic, and its multiplicity.
 
     Periodicity, multiplicity (peaks per period) and period come from
-    :func:`stickslip.analysis.period.detect_period` (peak section, tolerance
-    :data:`~stickslip.analysis.period.PEAK_RTOL`), the rule :func:`~stickslip.analysis.classify.classify`
+    :func:`stickslip.analysis.period.detect_period` (peak section, settled to
+    :data:`~stickslip.analysis.period.SETTLE_RTOL`), the rule :func:`~stickslip.analysis.classify.classify`
     uses. Non-periodic responses get the highest peak of the Hann spectrum, refined by parabolic
     interpolation; at rest (peak-to-peak below :data:`REST_AMPLITUDE`) NaN.
 
@@ -166,15 +168,16 @@ def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds):
     return total
 
 
-def summarize(t, states, mode, transition_times, transition_kinds, t_from):
-    """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`)."""
+def summarize(t, states, mode, transition_times, transition_kinds, t_from, coordinate=4, rate=10):
+    """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
+    state column ``coordinate`` (its rate in column ``rate``; default the plates' φ)."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
         raise ValueError(f"steady_from = {t_from} s leaves fewer than 2 samples; choose an earlier time")
     ts = t[sel]
-    phi = states[sel, 4]
-    dphi = states[sel, 10]
+    phi = states[sel, coordinate]
+    dphi = states[sel, rate]
     t0, t1 = float(ts[0]), float(ts[-1])
     # mode just after t0: the sample's mode unless a transition sits exactly on t0
     mode0 = int(mode[sel][0])

@@ -139,9 +139,13 @@ class _Application(TyperGroup):
         sys.exit(code)
 
     def invoke(self, ctx):
+        from ..integrate.interrupt import on_ctrl_c
+
         on_interrupt("nothing was written")
         try:
-            with warnings.catch_warnings():
+            # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
+            # `simulate` keeps its one interrupted run instead
+            with warnings.catch_warnings(), on_ctrl_c(partial=False):
                 warnings.showwarning = _show_warning
                 return super().invoke(ctx)
         except StickSlipError as exc:

@@ -16,8 +16,18 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..integrate.interrupt import on_ctrl_c
+from ..integrate.status import Status
 from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_finite, check_outputs,
-                   check_positive, check_samples, console, error_line, given, note_line, warning_line)
+                   check_positive, check_samples, console, err_console, error_line, given, note_line, warning_line)
+
+#: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
+#: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
+#: needs more is refused rather than left to run for days.
+MAX_RUN_STEPS = 10**10
+
+#: Samples the steady-state summary needs in its window (the classification of the response).
+WINDOW_SAMPLES = 8
 
 #: Settings of a run that ``--ic RUN.nc`` takes from the saved run unless given: option → parameter name.
 _SETTINGS = {"--model": "model", "--method": "method", "--rtol": "rtol", "--atol": "atol", "--dt": "dt",
@@ -61,25 +71,42 @@ def _continuation(ctx: typer.Context, ic: str, settings: dict):
 
 
 def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rate: float) -> None:
-    """The steady-state window must start inside the run and hold at least two samples."""
-    if steady_from is None:
-        return
-    last = t_end - 1.0 / sample_rate
-    if not t0 <= steady_from <= last:
+    """The steady-state window (default: the last half) must lie in the run and hold
+    :data:`WINDOW_SAMPLES` samples."""
+    if steady_from is not None and not t0 <= steady_from < t_end:
         raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
-                       f"give a time from {t0:g} to {last:g} s (one sample before the end)")
+                       f"give a time in that range")
+    start = t0 + 0.5 * (t_end - t0) if steady_from is None else steady_from
+    first = math.ceil((start - t0) * sample_rate - 1e-9)
+    n = math.floor((t_end - t0) * sample_rate + 1e-9) - first + 1
+    if n < WINDOW_SAMPLES:
+        raise CLIError(f"the steady window {start:g} – {t_end:g} s holds {n} samples at {sample_rate:g} Hz and its "
+                       f"summary needs {WINDOW_SAMPLES}; give a longer --t-end, a higher --sample-rate"
+                       + ("" if steady_from is None else " or an earlier --steady-from"))
 
 
-def _check_steps(t_end: float, dt: float | None) -> None:
-    """A step of ``dt`` must cover ``t_end`` within the library's cap on steps (``max_steps``)."""
-    import inspect
+def _parse_t_end(text: str, cap: float, steady_from: float | None) -> float | None:
+    """The run length [s] from ``--t-end``, or None for ``auto`` (run until settled, up to ``cap``)."""
+    if text.strip().lower() == "auto":
+        if steady_from is not None:
+            raise CLIError("--steady-from and --t-end auto both set the steady window (auto: the last 100 s); "
+                           "give one of them")
+        check_positive({"--cap": cap})
+        return None
+    try:
+        duration = float(text)
+    except ValueError:
+        raise CLIError(f"--t-end {text}: give a time in seconds or auto") from None
+    check_positive({"--t-end": duration})
+    return duration
 
-    from ..integrate.driver import simulate as run_simulation
 
-    cap = getattr(inspect.signature(run_simulation).parameters.get("max_steps"), "default", None)
-    if cap is not None and dt is not None and math.isfinite(dt) and dt > 0 and not t_end / dt <= cap:
-        raise CLIError(f"--dt {dt:g} s takes at least {t_end / dt:.3g} steps for {t_end:g} s, more than the {cap} a "
-                       f"run may take; give --dt {t_end / cap:.3g} or more, or a shorter --t-end")
+def _check_steps(duration: float, dt: float | None, time_flag: str = "--t-end") -> None:
+    """A step of ``dt`` must cover ``duration`` within :data:`MAX_RUN_STEPS` steps."""
+    if dt is not None and math.isfinite(dt) and dt > 0 and not duration / dt <= MAX_RUN_STEPS:
+        raise CLIError(f"--dt {dt:g} s takes at least {duration / dt:.3g} steps for {time_flag} {duration:g} s, more "
+                       f"than the {MAX_RUN_STEPS:.0e} (hours of computing) a run may take from the command line; give "
+                       f"--dt {duration / MAX_RUN_STEPS:.3g} or more, or a shorter {time_flag}")
 
 
 def _warn_aliasing(params, model: str, sample_rate: float) -> None:
@@ -102,8 +129,10 @@ def simulate(
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
     model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
-    t_end: float = typer.Option(100.0, "--t-end", help="Simulated time [s]; with --ic RUN.nc, the time added after "
-                                                     "the end of that run."),
+    t_end: str = typer.Option("100", "--t-end", help="Simulated time [s], or 'auto': extend the run until it has "
+                              "settled, up to --cap (the steady window is then the last 100 s). With --ic RUN.nc, "
+                              "the time added after the end of that run."),
+    cap: float = typer.Option(2000.0, "--cap", help="With --t-end auto: the longest run [s]."),
     method: str = typer.Option("event", "--method", help="Integration method: event | aeom | naeom."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance (event)."),
@@ -133,11 +162,14 @@ def simulate(
         base, t0, settings, overridden = _continuation(ctx, start, settings)
     params, set_by = build_parameters(config, set_, base=base, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu,
                                       alpha=alpha)
-    check_positive({"--t-end": t_end, "--sample-rate": settings["sample_rate"]})
+    duration = _parse_t_end(t_end, cap, steady_from)
+    check_positive({"--sample-rate": settings["sample_rate"]})
     check_finite({"--perturb": perturb, "--steady-from": steady_from})
-    _check_window(steady_from, t0, t0 + t_end, settings["sample_rate"])
-    check_samples(t_end, settings["sample_rate"])
-    _check_steps(t_end, settings["dt"])
+    _check_window(steady_from, t0, t0 + duration, settings["sample_rate"])
+    time_flag = "--cap" if duration is None else "--t-end"
+    longest = cap if duration is None else duration
+    check_samples(longest, settings["sample_rate"], time_flag=time_flag)
+    _check_steps(longest, settings["dt"], time_flag)
     write = out is not None or not as_json
     out = Path("run.nc") if out is None else out
     if write:
@@ -148,8 +180,14 @@ def simulate(
                   + (f"; overridden: {', '.join(overridden)}" if overridden else ""))
     _warn_aliasing(params, settings["model"], settings["sample_rate"])
 
-    traj = run_simulation(params, t0 + t_end, t0=t0, ic=start, perturbation=perturb, steady_from=steady_from,
-                          **settings)
+    with on_ctrl_c(partial=True):  # Ctrl-C ends the run with the part done, which is written below
+        if duration is None:
+            from ..analysis.settle import simulate_until_settled
+
+            traj = simulate_until_settled(params, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
+        else:
+            traj = run_simulation(params, t0 + duration, t0=t0, ic=start, perturbation=perturb,
+                                  steady_from=steady_from, **settings)
     # a run that stopped early can be too short for its steady-state window, which the file needs
     keep = write and int(np.count_nonzero(traj.t >= traj.steady_from)) >= 2
     figure = None
@@ -160,9 +198,13 @@ def simulate(
             from ..plot.trajectory import save_trajectory_figure
 
             figure = save_trajectory_figure(traj, out.with_suffix(".png"))
+    kept = f"what it computed is in {out}" if keep else ("it kept too few samples to write" if write else
+                                                         "nothing was written (--json without --out)")
+    if traj.status_code == Status.INTERRUPTED:
+        err_console.print(Text(f"interrupted: {traj.status}; {kept}"))
+        raise typer.Exit(130)
     if traj.status != "success":
-        kept = f"; what it computed is in {out}" if keep else ("; it kept too few samples to write" if write else "")
-        error_line(f"the run stopped early: {traj.status}{kept}")
+        error_line(f"the run stopped early: {traj.status}; {kept}")
         raise typer.Exit(1)
     summary = traj.summary()
     if as_json:
@@ -176,15 +218,18 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     p = traj.params
     table = Table(title=f"stickslip: model {traj.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
                         f"μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}", show_header=False)
-    freq = summary["fundamental_frequency_hz"]
-    kind = "at rest" if freq is None else ("periodic" if s.periodic else "not periodic")
+    freq, dominant = summary["fundamental_frequency_hz"], summary["dominant_frequency_hz"]
+    kind = summary["attractor"] + (f", {summary['period_count']} peak(s) of φ per period" if summary["period_count"] else "")
+    kind += (f" (settled by {summary['settle_time_s']:g} s)" if summary["settled"]
+             else f" ({summary['evidence'].get('reason', 'no verdict')})")
     wrote = "nothing" if out is None else str(out) + ("" if figure is None else f", {figure}")
     rows = [
         ("status", traj.status),
         ("time", f"{traj.t[0]:g} – {traj.t[-1]:g} s"),
         ("steady window", f"{s.t_from:g} – {s.t_to:g} s"),
-        ("response", kind + (f", {s.period_multiplicity} peak(s) of φ per period" if s.periodic else "")),
+        ("response", kind),
         ("fundamental frequency of φ", "–" if freq is None else f"{freq:.6g} Hz"),
+        ("dominant frequency of φ", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         ("transitions in window", str(s.n_transitions)),
         ("φ min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g} rad"),
@@ -195,9 +240,9 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     for key, value in rows:
         table.add_row(key, Text(value))
     console.print(table)
-    if not math.isnan(s.fundamental_frequency_hz) and not s.periodic:
-        console.print("not periodic within the window: the frequency is the highest peak of the φ spectrum",
-                      style="dim")
+    if not summary["settled"]:
+        console.print("not settled in the window: no period is claimed (the dominant frequency is the highest "
+                      "peak of the φ spectrum); run longer or use --t-end auto", style="dim")
     if traj.stats.compile_time_s > 0:
         console.print(f"first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
                       "(not included in the wall time)", style="dim")

@@ -1,28 +1,55 @@
-"""The ``simulate()`` driver: validate options, build the initial state, run a method, wrap results."""
+"""The ``simulate()`` driver: resolve the model, validate options, build the initial state, run a
+method in chunks, wrap the result."""
 
 from __future__ import annotations
-
-from ..errors import StickSlipError
 
 import math
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Mapping
 
 import numpy as np
 
-from ..model.kernels import DEFAULT_SLIP_BAND
+from ..errors import StickSlipError
+from ..model.bundle import contact_state
+from ..model.library import resolve_system
+from ..model.library.two_plates import NAME as TWO_PLATES
 from ..model.parameters import Parameters
-from ..model.system import System, assemble
-from ..model.variants import STATE_NAMES
-from . import method_event
-from .fixed_step import run_aeom, run_naeom
+from ..model.system_model import FrictionModel
+from . import contacts as E
+from .event_loop import N_EXTRA, integrate_event
 from .result import Stats, Trajectory, Transitions, load_trajectory
+from .interrupt import interruptible, partial_on_ctrl_c
+from .status import CHUNK_END, Status
 
-__all__ = ["simulate", "initial_state", "SimulationError", "METHODS"]
+__all__ = ["simulate", "initial_state", "SimulationError", "METHODS", "MAX_SAMPLES"]
 
-#: Largest number of uniform samples a run may keep (12 states + extras ≈ 150 B each).
+#: Largest number of uniform samples a run may keep (each ~ (2n + 2 + 2 nc) float64 and a flag byte).
 MAX_SAMPLES = 20_000_000
+
+#: Integration methods by name; ``aeom`` and ``naeom`` are the paper's fixed-step methods for the
+#: two plates only.
+METHODS = ("event", "aeom", "naeom")
+
+#: Wall-clock length [s] a chunk of the compiled loop aims at: Ctrl-C is answered between chunks.
+CHUNK_WALL = 0.25
+#: Simulated time [s] of the first chunk, before its speed is known.
+FIRST_CHUNK = 20.0
+
+#: Initial room for transitions per simulated second of a chunk (stick-slip cycles have 2 per
+#: period); a chunk with more is run again from its start with room for all (same result).
+TRANSITIONS_PER_SECOND = 64
+MIN_TRANSITION_ROOM = 1024
+
+#: Transitions a run keeps: the most recent ones (earlier ones are counted in
+#: ``Transitions.dropped``), so that memory stays bounded however long the run: 10^6 transitions
+#: × (instant, kind, contact) plus the states of the last :data:`KEEP_TRANSITION_STATES`.
+KEEP_TRANSITIONS = 1_000_000
+KEEP_TRANSITION_STATES = 100_000
+
+
+#: "No cap" on the steps of a run (int64 for the compiled loop).
+NO_STEP_CAP = 2**62
 
 
 class SimulationError(StickSlipError, ValueError):
@@ -39,33 +66,48 @@ def _check_positive(name: str, value, hint: str) -> float:
     return value
 
 
-def initial_state(system: System, ic="zero", perturbation=None) -> np.ndarray:
-    """The 12-state initial condition.
+def initial_state(system: FrictionModel, ic="zero", perturbation=None) -> np.ndarray:
+    """The 2n-state initial condition of ``system``.
 
     Parameters
     ----------
-    system : System
-    ic : {"zero", "equilibrium"}, array-like (12,), path to a run's ``.nc`` file, or Trajectory
-        ``zero``: plates at rest, springs undeformed. ``equilibrium``: steady sliding (Eq. 14).
-        A file or Trajectory: its final state (a continuation of that run).
-    perturbation : float or array-like (12,), optional
-        Added to the state: a float perturbs φ [rad], a 12-vector every state.
+    system : FrictionModel
+    ic : {"zero", "equilibrium"}, array-like (2n,), mapping, path of a run's ``.nc`` file, or Trajectory
+        ``zero``: at rest, springs undeformed. ``equilibrium``: steady sliding. A mapping
+        ``{state name: value}`` sets those states (the others 0). A file or Trajectory: its final
+        state (a continuation of that run).
+    perturbation : float or array-like (2n,), optional
+        Added to the state: a float perturbs the observed coordinate (the plates' φ), a vector
+        every state.
 
     Raises
     ------
     SimulationError
-        For an unknown string, a wrong shape, a non-finite value, or a non-zero state of a
-        locked DOF.
+        For an unknown string or state name, a wrong shape, a non-finite value, or a non-zero state
+        of a locked DOF.
     """
+    if not isinstance(system, FrictionModel):  # the plates' assembled arrays (orbit tools)
+        from ..model.library import two_plates
+
+        system = two_plates(system.params, system.variant)
+    n2 = 2 * system.n
+    names = system.state_names
     if isinstance(ic, Trajectory):
         s = ic.final_state
+    elif isinstance(ic, Mapping):
+        s = np.zeros(n2)
+        for name, value in ic.items():
+            if name not in names:
+                raise SimulationError(f"initial state: unknown state {name!r} of model {system.name!r}; "
+                                      f"states are {', '.join(names)}")
+            s[names.index(name)] = float(value)
     elif isinstance(ic, (str, Path)) and str(ic) in ("zero", "equilibrium"):
-        s = np.zeros(12)
+        s = np.zeros(n2)
         if str(ic) == "equilibrium":
-            from ..stability.equilibrium import EquilibriumError, equilibrium
+            from ..stability.equilibrium import EquilibriumError, steady_sliding
 
             try:
-                s[:6] = equilibrium(system.params, system.variant)
+                s[:system.n] = steady_sliding(system)
             except EquilibriumError as exc:
                 raise SimulationError(f"ic='equilibrium': {exc}") from exc
     elif isinstance(ic, Path) or (isinstance(ic, str) and ic.endswith(".nc")):
@@ -73,86 +115,195 @@ def initial_state(system: System, ic="zero", perturbation=None) -> np.ndarray:
     elif isinstance(ic, str):
         raise SimulationError(
             f"unknown initial condition {ic!r}; use 'zero', 'equilibrium', a path to a run .nc file, "
-            "or 12 comma-separated numbers"
+            f"name=value pairs of states ({', '.join(names)}) or {n2} numbers"
         )
     else:
         s = np.asarray(ic, dtype=float).copy()
-        if s.shape != (12,):
-            raise SimulationError(f"initial state must have 12 entries ({', '.join(STATE_NAMES)}), got shape {s.shape}")
+        if s.shape != (n2,):
+            raise SimulationError(f"initial state must have {n2} entries ({', '.join(names)}), got shape {s.shape}")
+    if s.shape != (n2,):
+        raise SimulationError(f"initial state from {ic!r} has {s.size} entries, model {system.name!r} has {n2} states")
     if perturbation is not None:
         delta = np.asarray(perturbation, dtype=float)
         if delta.ndim == 0:
-            s[4] += float(delta)
-        elif delta.shape == (12,):
+            s[system.observed_index] += float(delta)
+        elif delta.shape == (n2,):
             s = s + delta
         else:
-            raise SimulationError(f"perturbation must be a number (added to phi) or 12 numbers, got shape {delta.shape}")
+            raise SimulationError(f"perturbation must be a number (added to {system.dofs[system.observed_index]}) "
+                                  f"or {n2} numbers, got shape {delta.shape}")
     if not np.all(np.isfinite(s)):
         raise SimulationError("initial state has a non-finite entry; give finite numbers")
-    locked = ~np.concatenate([system.variant.mask, system.variant.mask])
-    bad = [STATE_NAMES[i] for i in np.flatnonzero(locked & (s != 0.0))]
+    locked = ~np.concatenate([system.free, system.free])
+    bad = [names[i] for i in np.flatnonzero(locked & (s != 0.0))]
     if bad:
         raise SimulationError(
-            f"initial state sets {', '.join(bad)} but those DOFs are locked in model {system.variant.name!r}; "
+            f"initial state sets {', '.join(bad)} but those DOFs are locked in this model; "
             "set them to 0 or choose a model that frees them"
         )
     return s
 
 
-def _warm_up(kernel, y, t0, system, out_s, out_mode, out_F) -> float:
-    """Compile (or load from cache) ``integrate_event`` on a 1 µs run, so that the timed run
-    measures integration only; returns the seconds spent, 0 if already compiled."""
-    if kernel.signatures:
-        return 0.0
+class _Buffers:
+    """Output arrays of a run: samples (allocated once) and per-chunk transition buffers."""
+
+    def __init__(self, system: FrictionModel, sample_times: np.ndarray):
+        n = sample_times.size
+        ns = 2 * system.n + N_EXTRA
+        self.out_s = np.empty((n, ns))
+        self.out_mode = np.empty(n, dtype=np.int8)
+        self.out_F = np.empty((n, 2 * system.n_contacts))
+        self.tr_t: list[np.ndarray] = []
+        self.tr_kind: list[np.ndarray] = []
+        self.tr_contact: list[np.ndarray] = []
+        self.tr_s: list[np.ndarray] = []
+        self.kept = 0
+        self.dropped = 0
+
+    def add_transitions(self, tr, n_tr: int) -> None:
+        """Keep the first ``n_tr`` transitions of a chunk's buffers, dropping the oldest beyond the caps."""
+        for store, buf in zip((self.tr_t, self.tr_kind, self.tr_contact, self.tr_s), tr):
+            store.append(buf[:n_tr].copy())
+        self.kept += n_tr
+        if self.kept > 2 * KEEP_TRANSITIONS or sum(len(s) for s in self.tr_s) > 2 * KEEP_TRANSITION_STATES:
+            drop = max(self.kept - KEEP_TRANSITIONS, 0)
+            for store in (self.tr_t, self.tr_kind, self.tr_contact):
+                joined = np.concatenate(store)[drop:]
+                store[:] = [joined]
+            states = np.concatenate(self.tr_s)
+            self.tr_s[:] = [states[max(len(states) - KEEP_TRANSITION_STATES, 0):]]
+            self.kept -= drop
+            self.dropped += drop
+
+    def transitions(self, ns: int) -> Transitions:
+        """The kept transitions; states of the earliest kept ones beyond the state cap are NaN."""
+        if not self.tr_t:
+            return Transitions(np.empty(0), np.empty(0, np.int8), np.empty((0, ns)), np.empty(0, np.int8))
+        time_, kind, contact = (np.concatenate(s) for s in (self.tr_t, self.tr_kind, self.tr_contact))
+        states = np.concatenate(self.tr_s)
+        if len(states) < len(time_):
+            states = np.concatenate([np.full((len(time_) - len(states), ns), np.nan), states])
+        return Transitions(time_, kind, states, contact, dropped=self.dropped)
+
+    @staticmethod
+    def transition_room(duration: float, ns: int, capacity: int | None = None):
+        cap = capacity or MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * max(duration, 0.0))
+        return np.empty(cap), np.empty(cap, dtype=np.int8), np.empty(cap, dtype=np.int8), np.empty((cap, ns))
+
+
+def _warm_up(system: FrictionModel, y: np.ndarray, rtol, atol) -> float:
+    """Compile (or load from cache) the event loop for this kinematics class on a 1 µs run;
+    returns the seconds spent (0 if it was ready)."""
     start = time.perf_counter()
-    kernel(y, t0, t0 + 1e-6, system.minv, system.damp, system.stiff, system.p, 1e-6, 1e-8, 1e-7, 1e-6,
-           10, np.array([t0]), out_s[:1].copy(), out_mode[:1].copy(), out_F[:1].copy(),
-           np.empty(1), np.empty(1, dtype=np.int8), np.empty((1, y.size)))
-    return time.perf_counter() - start
+    ns = y.size
+    cst = contact_state(system.data.m)
+    st = np.array([0.0])
+    tr = _Buffers.transition_room(0.0, ns, 1)
+    integrate_event(y.copy(), cst, 0.0, 1e-6, 1e-6, system.data, rtol, atol, 1e-7, 1e-6, 10, st, 0,
+                    np.empty((1, ns)), np.empty(1, dtype=np.int8), np.empty((1, 2 * system.n_contacts)),
+                    tr[0], tr[1], tr[2], tr[3], 0)
+    spent = time.perf_counter() - start
+    return spent if spent > 0.05 else 0.0  # a cached or compiled loop answers in microseconds
 
 
-def _run_event(system: System, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
+def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
                rtol: float, atol: float, dt: float | None, max_steps: int):
+    """The ``event`` method, in chunks of about :data:`CHUNK_WALL` seconds of wall time.
+
+    Each chunk integrates in its own local time from the previous chunk's end (absolute time
+    never enters a step or an event tolerance, so runs of any length keep their resolution) and
+    ends at the first accepted step past its planned end that is not inside an approach to stick,
+    so the chunks take the same steps as one long call. A KeyboardInterrupt between chunks ends
+    the run with what is done (status INTERRUPTED).
+    """
+    md = system.data
+    ns = 2 * system.n + N_EXTRA
+    y = np.zeros(ns)
+    y[:2 * system.n] = y0
+    F = np.empty(2 * system.n_contacts)
+    N = np.empty(system.n_contacts)
+    cst = contact_state(md.m)
+    compile_time = _warm_up(system, y, rtol, atol)
+    E.initial_modes(y, cst, md, rtol, atol, F, N)
     h_max = dt if dt is not None else (t_end - t0)
-    h_init = min(1e-3, h_max)  # ~1/100 of the fastest natural period of Table 1 (0.36 s)
-    n = sample_times.size
-    out_s = np.empty((n, method_event.N_STATE))  # every kept sample is written
-    out_mode = np.empty(n, dtype=np.int8)
-    out_F = np.empty((n, 2))
-    y = np.zeros(method_event.N_STATE)
-    y[:12] = y0
-    compile_time = _warm_up(method_event.integrate_event, y, t0, system, out_s, out_mode, out_F)
+    h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
+    buffers = _Buffers(system, sample_times)
+    stats = np.zeros(6, dtype=np.int64)
+    t = t0
+    idx = 0
+    chunk = min(FIRST_CHUNK, t_end - t0)
+    status = CHUNK_END
+    lost = -1
+    steps_left = max_steps
+    interrupted = False
+    with interruptible() as stop:
+        while status == CHUNK_END and not stop.requested:
+            tau_end = t_end - t
+            tau_stop = min(chunk, tau_end)
+            start_state = (y.copy(), cst.copy(), h, idx)
+            capacity = None
+            wall = time.perf_counter()
+            while True:
+                tr = _Buffers.transition_room(tau_stop, ns, capacity)
+                res = integrate_event(y, cst, t, tau_stop, tau_end, md, rtol, atol, h, h_max, steps_left, sample_times,
+                                      idx, buffers.out_s, buffers.out_mode, buffers.out_F, tr[0], tr[1], tr[2], tr[3], 0)
+                n_tr = res[5]
+                if n_tr <= tr[0].size:
+                    break
+                capacity = n_tr  # rerun this chunk from its start with room for all its transitions
+                y, cst, h, idx = start_state[0].copy(), start_state[1].copy(), start_state[2], start_state[3]
+            wall = time.perf_counter() - wall
+            status, tau, y, h, idx, _, st, lost = res
+            buffers.add_transitions(tr, n_tr)
+            stats += st
+            steps_left = max_steps - int(stats[0] + stats[1])
+            t = t + tau
+            if tau > 0.0 and wall > 0.0:  # aim the next chunk at CHUNK_WALL seconds of wall time
+                chunk = min(max(tau * CHUNK_WALL / wall, 1e-3), 10.0 * max(tau, 1e-3))
+        interrupted = stop.requested and status == CHUNK_END
+    if stop.requested and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
+        raise KeyboardInterrupt
+    code = Status.INTERRUPTED if interrupted else Status(status)
+    transitions = buffers.transitions(ns)
+    stats_out = dict(accepted_steps=int(stats[0]), rejected_steps=int(stats[1]), rhs_calls=int(stats[2]),
+                     retaken_steps=int(stats[3]), slip_to_stick=int(stats[4]), stick_to_slip=int(stats[5]),
+                     compile_time_s=compile_time)
+    return code, t, lost, idx, buffers, transitions, stats_out
 
-    def run(tr_t, tr_kind, tr_s):
-        res = method_event.integrate_event(y, t0, t_end, system.minv, system.damp, system.stiff, system.p,
-                                           rtol, atol, h_init, h_max, max_steps, sample_times, out_s, out_mode,
-                                           out_F, tr_t, tr_kind, tr_s)
-        return res, res[6]
 
-    res, tr_t, tr_kind, tr_s = method_event.with_transition_room(run, t_end - t0)
-    status, t_reached, st = res[0], res[1], res[7]
-    stats = dict(accepted_steps=int(st[0]), rejected_steps=int(st[1]), rhs_calls=int(st[2]),
-                 retaken_steps=int(st[3]), slip_to_stick=int(st[4]), stick_to_slip=int(st[5]),
-                 compile_time_s=compile_time)
-    messages = {
-        method_event.STATUS_OK: "success",
-        method_event.STATUS_STEP_UNDERFLOW: f"step size underflow at t = {t_reached:.6g} s",
-        method_event.STATUS_NOT_FINITE: f"state became non-finite at t = {t_reached:.6g} s",
-        method_event.STATUS_MAX_STEPS: f"max_steps reached at t = {t_reached:.6g} s",
-    }
-    keep = sample_times <= t_reached
-    return (messages[status], keep, out_s, out_mode, out_F, Transitions(tr_t, tr_kind, tr_s[:, :12]), stats)
+def _run_fixed_step(method: str, system: FrictionModel, y0: np.ndarray, t0: float, t_end: float,
+                    sample_times: np.ndarray, rtol: float, atol: float, dt: float | None, max_steps: int):
+    """The paper's fixed-step methods (two plates only)."""
+    from ..model.system import assemble
+    from .fixed_step import run_aeom, run_naeom
 
-
-#: Integration methods by name: callables with the signature of ``_run_event``.
-METHODS: dict[str, Callable] = {"event": _run_event, "aeom": run_aeom, "naeom": run_naeom}
+    if system.name != TWO_PLATES:
+        raise SimulationError(f"method {method!r} is the paper's fixed-step method for the two plates; "
+                              f"model {system.name!r} runs with method='event' (CLI: --method event)")
+    values = dict(system.parameters)
+    variant = values.pop("variant")
+    plates = assemble(Parameters.from_dict(values), variant, system.slip_band)
+    runner = run_aeom if method == "aeom" else run_naeom
+    message, keep, out_s, out_mode, out_F, transitions, stats = runner(plates, y0, t0, t_end, sample_times, rtol,
+                                                                       atol, dt, max_steps)
+    buffers = _Buffers.__new__(_Buffers)
+    buffers.out_s, buffers.out_mode, buffers.out_F = out_s, out_mode, out_F
+    code = Status.SUCCESS if message == "success" else next(
+        s for s in Status if s is not Status.SUCCESS and s.message(0.0).split(" at ")[0] == message.split(" at ")[0])
+    n_kept = int(np.count_nonzero(keep))
+    t_reached = float(sample_times[n_kept - 1]) if code is not Status.SUCCESS and n_kept else t_end
+    ns = out_s.shape[1]
+    transitions = Transitions(transitions.time, transitions.kind,
+                              np.concatenate([transitions.state, np.zeros((len(transitions), ns - 12))], axis=1)[:, :ns],
+                              np.zeros(len(transitions), dtype=np.int8))
+    return code, t_reached, -1, n_kept, buffers, transitions, stats
 
 
 def simulate(
-    params: Parameters | None = None,
+    system=None,
     t_end: float = 100.0,
     *,
-    model="full",
+    model=None,
     method: str = "event",
     ic="zero",
     perturbation=None,
@@ -162,24 +313,27 @@ def simulate(
     sample_rate: float = 1000.0,
     t0: float = 0.0,
     steady_from: float | None = None,
-    max_steps: int = 50_000_000,
-    slip_band: float = DEFAULT_SLIP_BAND,
+    max_steps: int | None = None,
+    slip_band: float | None = None,
 ) -> Trajectory:
-    """Simulate the two-plate friction system with exact stick and slip.
+    """Simulate a friction-contact model with exact stick and slip.
 
     Parameters
     ----------
-    params : Parameters, optional
-        Physical parameters; default Table 1 with N = 50 N, Ω = 5 rad/s, μk = 0.2, Δμ = 0.1, α = 5.
+    system : FrictionModel, Parameters, str, optional
+        The model: a :class:`FrictionModel`, a library name (``belt``, ...) or model file path, or
+        the two plates' :class:`Parameters`; default the plates with Table 1 at N = 50 N, Ω = 5 rad/s.
     t_end : float
         Final time [s].
-    model : str or iterable of DOF names
-        ``full`` (Model 1), ``x`` (2), ``y`` (3), ``rotation`` (4), or the DOFs to free.
+    model : str, iterable of DOF names, or FrictionModel, optional
+        The plates' variant: ``full`` (Model 1, default), ``x`` (2), ``y`` (3), ``rotation`` (4), or
+        the DOFs to free; a library name or model file here is the same as ``system``.
     method : str
-        ``event`` (adaptive, exact transitions; default).
+        ``event`` (adaptive, exact transitions; default); ``aeom`` or ``naeom`` (the paper's fixed-step
+        methods, two plates only).
     ic : see :func:`initial_state`
-    perturbation : float or (12,), optional
-        Added to the initial state (a float perturbs φ [rad]).
+    perturbation : float or (2n,), optional
+        Added to the initial state (a float perturbs the observed coordinate, the plates' φ).
     rtol, atol : float
         Local error tolerances of the adaptive method.
     dt : float, optional
@@ -190,26 +344,28 @@ def simulate(
         Initial time [s].
     steady_from : float, optional
         Start of the steady-state window [s]; default the last half of the run.
-    max_steps : int
-        Safety cap on integration steps.
-    slip_band : float
-        Low-speed band [m/s] inside which the slip direction is the quasi-static one
-        (``stickslip.model.kernels.quasi_static_direction``); results converge as it → 0.
+    max_steps : int, optional
+        Cap on integration steps (default none: a run is stopped with Ctrl-C, which returns the
+        part done).
+    slip_band : float, optional
+        Low-speed band [m/s] of the 2-D slip direction; default the model's (results converge as
+        it → 0).
 
     Returns
     -------
     Trajectory
+        Its ``status`` says how the run ended; an interrupted run (Ctrl-C) returns what was done.
 
     Raises
     ------
     SimulationError
         For invalid options (each message names the fix).
     """
-    params = Parameters() if params is None else params
-    if not isinstance(params, Parameters):
-        raise SimulationError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
     if method not in METHODS:
         raise SimulationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    if slip_band is not None:
+        slip_band = _check_positive("slip_band", slip_band, "give a speed in m/s, e.g. 1e-6")
+    system = resolve_system(system, model, slip_band)
     t0 = float(t0)
     if not math.isfinite(t0):
         raise SimulationError("t0 must be finite")
@@ -226,36 +382,39 @@ def simulate(
         raise SimulationError(
             f"{n_samples} samples requested (t_end × sample_rate); lower sample_rate to keep ≤ {MAX_SAMPLES}"
         )
-    slip_band = _check_positive("slip_band", slip_band, "give a speed in m/s, e.g. 1e-6")
-    system = assemble(params, model, slip_band)
     y0 = initial_state(system, ic, perturbation)
     sample_times = t0 + np.arange(n_samples) / sample_rate
 
     start = time.perf_counter()
-    status, keep, out_s, out_mode, out_F, transitions, stats = METHODS[method](
-        system, y0, t0, t_end, sample_times, rtol, atol, dt, int(max_steps))
+    runner = _run_event if method == "event" else (lambda *a: _run_fixed_step(method, *a))
+    code, t_reached, lost, n_kept, buffers, transitions, stats = runner(
+        system, y0, t0, t_end, sample_times, rtol, atol, dt, NO_STEP_CAP if max_steps is None else int(max_steps))
     wall = time.perf_counter() - start - stats.get("compile_time_s", 0.0)  # integration only
+    if n_kept == 0:
+        raise SimulationError(f"the run ended before its first sample ({code.message(t_reached, lost)})")
 
-    ic_text = ic if isinstance(ic, str) else ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path) else "explicit")
+    ic_text = ic if isinstance(ic, str) else ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path)
+                                              else "states" if isinstance(ic, Mapping) else "explicit")
     options = {"rtol": rtol, "atol": atol, "dt": dt, "sample_rate": sample_rate, "ic": ic_text,
                "perturbation": None if perturbation is None else np.asarray(perturbation, dtype=float).tolist(),
-               "t0": t0, "t_end": t_end, "slip_band": slip_band}
-    n_kept = int(np.count_nonzero(keep))  # the samples up to the time reached: a prefix, so views
-    t_samples = sample_times[:n_kept]
+               "t0": t0, "t_end": t_end, "slip_band": system.slip_band}
+    t_samples = sample_times[:n_kept]  # the samples up to the time reached: a prefix, so views
     if steady_from is None:
         steady_from = t0 + 0.5 * (t_samples[-1] - t0)
+    n2 = 2 * system.n
     return Trajectory(
         t=t_samples,
-        states=out_s[:n_kept, :12],
-        mode=out_mode[:n_kept],
-        friction=out_F[:n_kept],
-        work=out_s[:n_kept, 12:14],
-        transitions=transitions,
+        states=buffers.out_s[:n_kept, :n2],
+        mode=buffers.out_mode[:n_kept],
+        friction=buffers.out_F[:n_kept],
+        work=buffers.out_s[:n_kept, n2:n2 + 2],
+        transitions=Transitions(transitions.time, transitions.kind, transitions.state[:, :n2], transitions.contact,
+                                transitions.dropped),
         stats=Stats(**stats, wall_time_s=wall),
-        status=status,
-        params=params,
-        model=system.variant.name,
+        status=code.message(t_reached, lost),
+        system=system,
         method=method,
         options=options,
         steady_from=float(steady_from),
+        status_code=code,
     )

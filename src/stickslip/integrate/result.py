@@ -1,8 +1,6 @@
-"""Typed, self-describing simulation results with NetCDF round trip."""
+"""Typed, self-describing simulation results with NetCDF round trip, for any friction model."""
 
 from __future__ import annotations
-
-from ..errors import StickSlipError
 
 import dataclasses
 import json
@@ -14,25 +12,19 @@ from numba import njit
 
 from .. import __version__
 from ..analysis.steady import SteadyState, summarize
-from ..model import kernels
+from ..files import FileFormatError, atomic_write, format_name, open_ours
+from ..model import physics
+from ..model.library import describe_system, system_from_description, two_plates
+from ..model.library.two_plates import NAME as TWO_PLATES
 from ..model.parameters import Parameters, parameter_attrs
-from ..model.system import assemble
-from ..model.variants import STATE_NAMES, resolve_variant
+from ..model.system_model import FrictionModel
+from .status import Status
 
 __all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError"]
 
-FORMAT = "stickslip-trajectory-1"
-
-_STATE_UNITS = ("m", "m", "m", "m", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "rad/s", "rad/s")
-_STATE_LONG_NAMES = (
-    "upper plate x displacement", "upper plate y displacement",
-    "lower plate x displacement", "lower plate y displacement",
-    "upper plate rotation phi", "lower plate rotation psi (relative to Omega t)",
-) + tuple(f"velocity of {n}" for n in STATE_NAMES[:6])
-
-
-class FileFormatError(StickSlipError, ValueError):
-    """A file that is not a stickslip result."""
+FORMAT = format_name("trajectory", 2)
+#: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
+READ_VERSIONS = (1, 2)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,30 +60,40 @@ class Transitions:
         Instants [s].
     kind : ndarray (k,) int8
         +1 slip → stick, −1 stick → slip.
-    state : ndarray (k, 12)
+    state : ndarray (k, 2n)
         States at the transitions (after projection when entering stick).
+    contact : ndarray (k,) int8
+        The contact that changed (0 for a one-contact model).
+    dropped : int
+        Earlier transitions of the run that were not kept (very long runs keep the most recent
+        10^6, and the states of the most recent 10^5; older states are NaN).
     """
 
     time: np.ndarray
     kind: np.ndarray
     state: np.ndarray
+    contact: np.ndarray | None = None
+    dropped: int = 0
+
+    def __post_init__(self) -> None:
+        if self.contact is None:
+            object.__setattr__(self, "contact", np.zeros(self.time.size, dtype=np.int8))
 
     def __len__(self) -> int:
         return int(self.time.size)
 
 
 @njit(cache=True)
-def _series(states, p):
-    """v_r (n, 2) and the sliding angle (n,) at each sample."""
-    n = states.shape[0]
-    vr = np.empty((n, 2))
-    ang = np.empty(n)
-    for i in range(n):
-        vx, vy = kernels.relative_velocity(states[i], p)
-        vr[i, 0] = vx
-        vr[i, 1] = vy
-        ang[i] = kernels.sliding_angle(states[i], p)
-    return vr, ang
+def _slip_velocities(states, md, nc):
+    """Slip velocity of every contact (k, 2 nc) at each sample [m/s]."""
+    k = states.shape[0]
+    out = np.empty((k, 2 * nc))
+    for i in range(k):
+        for c in range(nc):
+            v0, v1 = physics.slip_velocity(states[i], c, md)
+            out[i, 2 * c] = v0
+            out[i, 2 * c + 1] = v1
+    return out
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -100,27 +102,29 @@ class Trajectory:
 
     Attributes
     ----------
-    t : ndarray (n,)
+    t : ndarray (k,)
         Uniform sample times [s].
-    states : ndarray (n, 12)
-        s = [x1, y1, x2, y2, φ, ψ, and their rates] [m, rad, m/s, rad/s].
-    mode : ndarray (n,) int8
-        1 in stick, 0 in slip.
-    friction : ndarray (n, 2)
-        Friction force on the upper plate (Fx, Fy) [N].
-    work : ndarray (n, 2)
-        Work done since t0 by friction on the plates and by the dampers [J].
+    states : ndarray (k, 2n)
+        s = [q, q̇] in the order of ``system.state_names``.
+    mode : ndarray (k,) int8
+        Bit c set when contact c sticks (a one-contact model: 1 in stick, 0 in slip).
+    friction : ndarray (k, 2 nc)
+        Friction force of contact c at columns 2c, 2c+1 [N] (for the plates: (Fx, Fy) on the
+        upper plate; for a 1-D contact the second column is 0).
+    work : ndarray (k, 2)
+        Work done since t0 by friction and by the dampers [J].
     transitions : Transitions
     stats : Stats
     status : str
-        ``"success"`` or the reason the run stopped early.
-    params : Parameters
-    model : str
+        ``"success"`` or the reason the run stopped early (:attr:`status_code` as an enum).
+    system : FrictionModel
+        The model simulated, with its parameters.
     method : str
     options : dict
-        rtol, atol, dt, sample_rate, ic.
+        rtol, atol, dt, sample_rate, ic, t0, t_end, slip_band.
     steady_from : float
         Start of the steady-state window used by :attr:`steady` [s].
+    status_code : Status
     """
 
     t: np.ndarray
@@ -131,43 +135,88 @@ class Trajectory:
     transitions: Transitions
     stats: Stats
     status: str
-    params: Parameters
-    model: str
+    system: FrictionModel
     method: str
     options: dict
     steady_from: float
+    status_code: Status = Status.SUCCESS
+
+    # ------------------------------------------------------------- the model
+    @property
+    def is_plates(self) -> bool:
+        """Whether the model is the paper's two plates."""
+        return self.system.name == TWO_PLATES
+
+    @property
+    def params(self) -> Parameters | None:
+        """The plates' :class:`Parameters` (None for other models: see ``system.parameters``)."""
+        if not self.is_plates:
+            return None
+        values = dict(self.system.parameters)
+        values.pop("variant", None)
+        return Parameters.from_dict(values)
+
+    @property
+    def model(self) -> str:
+        """The plates' variant (``full``, ``rotation``, ...) or the model's name."""
+        if self.is_plates:
+            return str(self.system.parameters["variant"])
+        return self.system.name
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return self.system.state_names
+
+    @property
+    def observed(self) -> int:
+        """Index of the coordinate the summaries follow (the plates' φ, else the first dof)."""
+        return self.system.observed_index
 
     # ------------------------------------------------------------- derived series
     @cached_property
-    def _vr_angle(self):
-        return _series(np.ascontiguousarray(self.states), assemble(self.params, self.model).p)
+    def slip_velocity(self) -> np.ndarray:
+        """Slip velocity of each contact (k, 2 nc) [m/s]; for the plates v_r of Eq. (9)."""
+        return _slip_velocities(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
 
     @property
     def relative_velocity(self) -> np.ndarray:
-        """v_r (n, 2), Eq. (9) [m/s]."""
-        return self._vr_angle[0]
+        """The plates' v_r (k, 2), Eq. (9) [m/s] (the first contact's slip velocity)."""
+        return self.slip_velocity[:, :2]
 
     @property
     def sliding_angle_deg(self) -> np.ndarray:
-        """Angle of v_r against the circumferential direction −e_n2 [deg], NaN in stick."""
-        return np.degrees(self._vr_angle[1])
+        """The plates: angle of v_r against the circumferential direction −e_n2 [deg], NaN in stick.
+
+        e_n2 = (−Y, X)/R is the direction of motion of the lower plate's surface at the contact
+        (Eq. 8); in steady sliding v_r = −Ω R e_n2, so the angle is 0 there (Fig. 11).
+        """
+        if not self.is_plates:
+            raise AttributeError("sliding_angle_deg is defined for the two plates only")
+        r = self.system.kinematics.r
+        s = self.states
+        X = s[:, 0] - s[:, 2] + r * np.cos(s[:, 4])
+        Y = s[:, 1] - s[:, 3] + r * np.sin(s[:, 4])
+        vx, vy = self.relative_velocity.T
+        with np.errstate(invalid="ignore"):
+            angle = np.degrees(np.arctan2(Y * vy + X * vx, vx * Y - vy * X))
+        return np.where((vx == 0.0) & (vy == 0.0), np.nan, angle)
 
     @property
     def friction_magnitude(self) -> np.ndarray:
-        """|F| (n,) [N]."""
+        """|F| of the first contact (k,) [N]."""
         return np.hypot(self.friction[:, 0], self.friction[:, 1])
 
     @property
     def mechanical_energy(self) -> np.ndarray:
-        """½ q̇ᵀ M q̇ + ½ qᵀ K q of the free DOFs (n,) [J]."""
-        system = assemble(self.params, self.model)
-        mass = np.where(system.variant.mask, system.mass, 0.0)  # locked DOFs: q̇ = 0, no energy
-        q, dq = self.states[:, :6], self.states[:, 6:]
-        return 0.5 * (dq**2 @ mass) + 0.5 * (q**2 @ system.stiff)
+        """½ q̇ᵀ M q̇ + ½ qᵀ K_s q (k,) [J], K_s the symmetric part of K (locked DOFs never move)."""
+        n = self.system.n
+        q, dq = self.states[:, :n], self.states[:, n:2 * n]
+        Ks = 0.5 * (self.system.stiffness + self.system.stiffness.T)
+        return 0.5 * np.einsum("ki,ij,kj->k", dq, self.system.mass, dq) + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q)
 
     @property
     def final_state(self) -> np.ndarray:
-        """State at the last sample (12,)."""
+        """State at the last sample (2n,)."""
         return self.states[-1].copy()
 
     @cached_property
@@ -177,21 +226,40 @@ class Trajectory:
 
     def steady_state(self, t_from: float) -> SteadyState:
         """Steady-state summary over t ≥ ``t_from`` [s]."""
-        return summarize(self.t, self.states, self.mode, self.transitions.time, self.transitions.kind, t_from)
+        i = self.observed
+        return summarize(self.t, self.states, self.mode, self.transitions.time, self.transitions.kind, t_from,
+                         coordinate=i, rate=i + self.system.n)
+
+    @cached_property
+    def attractor(self):
+        """What the steady window settles to, with its evidence
+        (:func:`stickslip.analysis.settle.attractor`: may shoot an orbit or compute a Lyapunov
+        exponent to confirm a claim)."""
+        from ..analysis.settle import attractor
+
+        return attractor(self)
 
     def summary(self) -> dict:
-        """The steady-state summary with the run's cost, as a flat JSON-ready dict."""
+        """The verdict on the steady window, the steady-state summary and the run's cost, as a
+        JSON-ready dict.
+
+        Keys: ``settled``, ``attractor``, ``period_count``, ``fundamental_frequency_hz`` (None
+        unless settled and periodic), ``dominant_frequency_hz`` (spectral peak), ``settle_time_s``,
+        ``evidence`` (:class:`stickslip.analysis.settle.Attractor`); ``status``, ``model``,
+        ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction``, ``n_transitions``,
+        ``phi_min``, ``phi_max`` [rad] of the window; ``steps``, ``wall_time_s``, ``method``;
+        ``settle`` (the cap and steps of :func:`stickslip.analysis.settle.simulate_until_settled`)
+        when the run was extended until settled.
+        """
         s = self.steady
-        return {
-            "fundamental_frequency_hz": None if np.isnan(s.fundamental_frequency_hz) else s.fundamental_frequency_hz,
-            "stick_fraction": s.stick_fraction,
-            "n_transitions": s.n_transitions,
-            "phi_min": s.phi_min,
-            "phi_max": s.phi_max,
-            "steps": self.stats.steps,
-            "wall_time_s": self.stats.wall_time_s,
-            "method": self.method,
-        }
+        out = {**self.attractor.to_dict(), "status": self.status, "model": self.model,
+               "parameters": dict(self.system.parameters), "t_end_s": float(self.t[-1]), "steady_from_s": s.t_from,
+               "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "phi_min": s.phi_min,
+               "phi_max": s.phi_max, "steps": self.stats.steps, "wall_time_s": self.stats.wall_time_s,
+               "method": self.method}
+        if "settle" in self.options:
+            out["settle"] = self.options["settle"]
+        return out
 
     def plot(self, **kwargs):
         """Overview figure; see :func:`stickslip.plot.plot_trajectory`."""
@@ -201,102 +269,125 @@ class Trajectory:
 
     # ------------------------------------------------------------- xarray / NetCDF
     def to_xarray(self):
-        """``xarray.Dataset`` with units, long names, the full parameter set and run options."""
+        """``xarray.Dataset`` with units, long names, the model and its parameters, and the run options."""
         import xarray as xr
 
-        coords = {"time": ("time", self.t, {"units": "s", "long_name": "time"})}
+        system = self.system
+        coords = {"time": ("time", self.t, {"units": "s", "long_name": "time"}),
+                  "state": ("state", list(system.state_names)),
+                  "contact": ("contact", [c.name or f"contact{i}" for i, c in enumerate(system.contacts)]),
+                  "component": ("component", ["t1", "t2"])}
         data = {}
-        for j, name in enumerate(STATE_NAMES):
-            data[name] = ("time", self.states[:, j], {"units": _STATE_UNITS[j], "long_name": _STATE_LONG_NAMES[j]})
-        data["mode"] = ("time", self.mode.astype(np.int8), {"long_name": "contact mode", "flag_values": "0 1", "flag_meanings": "slip stick"})
-        data["Fx"] = ("time", self.friction[:, 0], {"units": "N", "long_name": "friction force on the upper plate, x"})
-        data["Fy"] = ("time", self.friction[:, 1], {"units": "N", "long_name": "friction force on the upper plate, y"})
-        data["F_abs"] = ("time", self.friction_magnitude, {"units": "N", "long_name": "friction force magnitude |F|"})
-        vr = self.relative_velocity
-        data["vr_x"] = ("time", vr[:, 0], {"units": "m/s", "long_name": "relative velocity x, Eq. (9)"})
-        data["vr_y"] = ("time", vr[:, 1], {"units": "m/s", "long_name": "relative velocity y, Eq. (9)"})
-        data["sliding_angle"] = ("time", self.sliding_angle_deg, {"units": "degree", "long_name": "angle of v_r against the circumferential direction"})
-        data["work_friction"] = ("time", self.work[:, 0], {"units": "J", "long_name": "work of friction on the plates since t0"})
+        for j, name in enumerate(system.state_names):
+            dof = system.dofs[j % system.n]
+            unit = system.units.get(dof, "")
+            unit = unit if j < system.n else (f"{unit}/s" if unit and unit != "-" else unit)
+            data[name] = ("time", self.states[:, j], {"units": unit, "long_name": ("" if j < system.n else "rate of ") + dof})
+        nc = system.n_contacts
+        data["mode"] = ("time", self.mode.astype(np.int8), {
+            "long_name": "sticking contacts (bit c set: contact c sticks)",
+            **({"flag_values": "0 1", "flag_meanings": "slip stick"} if nc == 1 else {"flag_masks": " ".join(str(1 << c) for c in range(nc))})})
+        data["friction"] = (("time", "contact", "component"), self.friction.reshape(-1, nc, 2),
+                            {"units": "N", "long_name": "friction force of each contact along its tangent rows"})
+        data["slip_velocity"] = (("time", "contact", "component"), self.slip_velocity.reshape(-1, nc, 2),
+                                 {"units": "m/s", "long_name": "slip velocity v = G q̇ − w of each contact"})
+        if self.is_plates:
+            data["sliding_angle"] = ("time", self.sliding_angle_deg,
+                                     {"units": "degree", "long_name": "angle of v_r against the circumferential direction"})
+        data["work_friction"] = ("time", self.work[:, 0], {"units": "J", "long_name": "work of friction since t0"})
         data["work_damping"] = ("time", self.work[:, 1], {"units": "J", "long_name": "work of the dampers since t0"})
         data["transition_time"] = ("transition", self.transitions.time, {"units": "s"})
-        data["transition_kind"] = ("transition", self.transitions.kind.astype(np.int8), {"flag_values": "-1 1", "flag_meanings": "stick_to_slip slip_to_stick"})
+        data["transition_kind"] = ("transition", self.transitions.kind.astype(np.int8),
+                                   {"flag_values": "-1 1", "flag_meanings": "stick_to_slip slip_to_stick"})
+        data["transition_contact"] = ("transition", self.transitions.contact.astype(np.int8))
         data["transition_state"] = (("transition", "state"), self.transitions.state)
         attrs = {
             "format": FORMAT,
             "stickslip_version": __version__,
-            "title": "stickslip trajectory of the two-plate friction model",
+            "title": f"stickslip trajectory of model {system.name}",
             "model": self.model,
+            "model_name": system.name,
+            "model_source": system.source,
+            "system": json.dumps(describe_system(system)),
             "method": self.method,
             "status": self.status,
+            "status_code": int(self.status_code),
             "steady_from": self.steady_from,
             "options": json.dumps(self.options),
             "stats": json.dumps(dataclasses.asdict(self.stats)),
-            "parameters": json.dumps(self.params.to_dict()),
+            "parameters": json.dumps(dict(system.parameters)),
+            "transitions_dropped": int(self.transitions.dropped),
         }
-        attrs.update(parameter_attrs(self.params.to_dict()))
+        if self.is_plates:
+            attrs.update(parameter_attrs(self.params.to_dict()))
         for key, value in self.steady.to_dict().items():
             attrs[f"steady_{key}"] = int(value) if isinstance(value, bool) else value
-        ds = xr.Dataset(data, coords=coords, attrs=attrs)
-        ds = ds.assign_coords(state=("state", list(STATE_NAMES)))
-        return ds
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def to_netcdf(self, path: str | Path) -> Path:
-        """Write :meth:`to_xarray` to a NetCDF-4 file (h5netcdf engine)."""
-        path = Path(path)
-        self.to_xarray().to_netcdf(path, engine="h5netcdf")
-        return path
+        """Write :meth:`to_xarray` to a NetCDF-4 file (h5netcdf engine), atomically."""
+        ds = self.to_xarray()
+        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 
     @classmethod
-    def from_xarray(cls, ds) -> "Trajectory":
-        """Rebuild a trajectory from :meth:`to_xarray` output."""
+    def from_xarray(cls, ds, system: FrictionModel | None = None) -> "Trajectory":
+        """Rebuild a trajectory from :meth:`to_xarray` output (or a format-1 plates file).
+
+        ``system`` overrides the model written in the file (needed for models defined in Python
+        without a rule to rebuild them).
+        """
+        if ds.attrs.get("format") == format_name("trajectory", 1):
+            return cls._from_plates_v1(ds)
         if ds.attrs.get("format") != FORMAT:
-            raise FileFormatError(
-                f"dataset is not a stickslip trajectory (format attribute {ds.attrs.get('format')!r}, "
-                f"expected {FORMAT!r}); give a file written by `stickslip simulate`"
-            )
-        params = Parameters.from_dict(json.loads(ds.attrs["parameters"]))
-        states = np.stack([ds[name].values for name in STATE_NAMES], axis=1)
+            raise FileFormatError(f"dataset is not a stickslip trajectory (format attribute {ds.attrs.get('format')!r}, "
+                                  f"expected {FORMAT!r}); give a file written by `stickslip simulate`")
+        system = system or system_from_description(json.loads(ds.attrs["system"]))
+        states = np.stack([ds[name].values for name in system.state_names], axis=1)
+        nc = system.n_contacts
+        code = Status(int(ds.attrs.get("status_code", 0)))
         return cls(
-            t=ds["time"].values,
-            states=states,
-            mode=ds["mode"].values.astype(np.int8),
+            t=ds["time"].values, states=states, mode=ds["mode"].values.astype(np.int8),
+            friction=ds["friction"].values.reshape(-1, 2 * nc),
+            work=np.stack([ds["work_friction"].values, ds["work_damping"].values], axis=1),
+            transitions=Transitions(ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),
+                                    ds["transition_state"].values.reshape(-1, 2 * system.n),
+                                    ds["transition_contact"].values.astype(np.int8),
+                                    int(ds.attrs.get("transitions_dropped", 0))),
+            stats=Stats(**json.loads(ds.attrs["stats"])), status=ds.attrs["status"], system=system,
+            method=ds.attrs["method"], options=json.loads(ds.attrs["options"]),
+            steady_from=float(ds.attrs["steady_from"]), status_code=code,
+        )
+
+    @classmethod
+    def _from_plates_v1(cls, ds) -> "Trajectory":
+        """A run of the two plates written before models were data (format 1)."""
+        params = Parameters.from_dict(json.loads(ds.attrs["parameters"]))
+        system = two_plates(params, ds.attrs["model"])
+        states = np.stack([ds[name].values for name in system.state_names], axis=1)
+        return cls(
+            t=ds["time"].values, states=states, mode=ds["mode"].values.astype(np.int8),
             friction=np.stack([ds["Fx"].values, ds["Fy"].values], axis=1),
             work=np.stack([ds["work_friction"].values, ds["work_damping"].values], axis=1),
-            transitions=Transitions(
-                ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),
-                ds["transition_state"].values.reshape(-1, 12),
-            ),
-            stats=Stats(**json.loads(ds.attrs["stats"])),
-            status=ds.attrs["status"],
-            params=params,
-            model=resolve_variant(ds.attrs["model"]).name,
-            method=ds.attrs["method"],
-            options=json.loads(ds.attrs["options"]),
+            transitions=Transitions(ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),
+                                    ds["transition_state"].values.reshape(-1, 12)),
+            stats=Stats(**json.loads(ds.attrs["stats"])), status=ds.attrs["status"], system=system,
+            method=ds.attrs["method"], options=json.loads(ds.attrs["options"]),
             steady_from=float(ds.attrs["steady_from"]),
+            status_code=Status.SUCCESS if ds.attrs["status"] == "success" else Status.STEP_UNDERFLOW,
         )
 
 
-def load_trajectory(path: str | Path) -> Trajectory:
+def load_trajectory(path: str | Path, system: FrictionModel | None = None) -> Trajectory:
     """Read a trajectory written by :meth:`Trajectory.to_netcdf`.
+
+    ``system``: the model, for runs of a model defined in Python (files and library models are
+    rebuilt from the file itself).
 
     Raises
     ------
     FileFormatError
-        If the file does not exist, is not NetCDF, or was not written by stickslip.
+        If the file does not exist, is not NetCDF, is truncated, was not written by stickslip or is
+        of a newer format.
     """
-    import xarray as xr
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileFormatError(f"{path} does not exist; give the path of a run.nc written by `stickslip simulate`")
-    try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
-            ds.load()
-            return Trajectory.from_xarray(ds)
-    except FileFormatError:
-        raise
-    except Exception as exc:  # h5py/xarray raise many types for foreign files
-        raise FileFormatError(
-            f"{path} is not a stickslip NetCDF file ({type(exc).__name__}: {exc}); "
-            "give a file written by `stickslip simulate`"
-        ) from exc
+    ds = open_ours(path, "trajectory", what="a run.nc written by `stickslip simulate`", versions=READ_VERSIONS)
+    return Trajectory.from_xarray(ds, system)

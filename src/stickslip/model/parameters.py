@@ -6,13 +6,13 @@ N = 50 N, Ω = 5 rad/s, μk = 0.2, Δμ = 0.1, α = 5 s/m used throughout Sect. 
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 import math
 import sys
 from pathlib import Path
 from typing import Any, Mapping
+
+from ..errors import StickSlipError
 
 if sys.version_info >= (3, 11):
     import tomllib

@@ -7,12 +7,12 @@ the upper plate rotating against a rigidly driven lower plate, the 1-DOF belt os
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 from typing import Iterable
 
 import numpy as np
+
+from ..errors import StickSlipError
 
 __all__ = ["DOF_NAMES", "STATE_NAMES", "Variant", "MODELS", "resolve_variant"]
 

@@ -14,8 +14,9 @@
 
 from .lyapunov import LyapunovResult, LyapunovSpectrum, lyapunov_exponent, lyapunov_spectrum
 from .section import OrbitError, Section, resolve_section
+from .problem import Monodromy, monodromy
 from .shooting import PeriodicOrbit, periodic_orbit
-from .variational import FlowJacobian, Monodromy, flow_jacobian, monodromy
+from .variational import FlowJacobian, flow_jacobian
 
 __all__ = ["periodic_orbit", "PeriodicOrbit", "Section", "resolve_section", "lyapunov_exponent",
            "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum", "monodromy", "Monodromy",

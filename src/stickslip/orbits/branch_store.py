@@ -1,39 +1,61 @@
-"""Append-only journals that make long continuation runs resumable.
+"""Persistence of branches and fold curves: resumable journals, JSON records, NetCDF datasets.
 
-A run that writes to ``OUT.nc`` keeps, while it works, a journal ``OUT.nc.journal`` beside it
-(as :mod:`stickslip.sweep.store` does for sweeps): a text file of JSON lines,
+Journals
+--------
+Append-only journals make long continuation runs resumable.
+
+A run that writes to ``OUT.nc`` holds the output's lock ``OUT.nc.lock`` (:func:`stickslip.files.lock`:
+a second run on the same output is refused with one line naming the holder) and keeps, while it
+works, a journal ``OUT.nc.journal`` beside it (as :mod:`stickslip.sweep.store` does for sweeps):
+a text file of JSON lines,
 
 * line 1, the header: ``{"format", "kind", "digest", "settings", "stickslip_version"}``,
-  written atomically (temporary file + rename) when the journal is created;
+  written atomically (:func:`stickslip.files.atomic_write`) when the journal is created;
 * then one record per finished unit of work (a branch point of
-  :func:`~stickslip.orbits.continuation.continue_orbit`, one N of
-  :func:`~stickslip.orbits.continuation.fold_curve`), each written with one ``write`` ending in a
-  newline and flushed to the operating system, so a killed process loses only the unit it was
-  working on.
+  :func:`~stickslip.orbits.branch.continue_orbit`, one N of
+  :func:`~stickslip.orbits.region_edge.fold_curve`), each written with one ``write`` ending in a
+  newline and ``fsync``-ed (:class:`stickslip.files.AppendLog`), so a killed process or a power
+  cut loses only the unit it was working on, and a full disk loses nothing written before.
 
 On reopening, a torn last line (a kill inside a write: no final newline, or not valid JSON) is cut
 off. The digest covers everything that determines the results; a journal or an output file with
 another digest is refused (:class:`JournalMismatch`), never mixed in. When the run ends, the
-caller writes ``OUT.nc`` atomically (:func:`write_atomically`) and removes the journal.
+caller writes ``OUT.nc`` atomically (:func:`write_atomically`) and removes the journal, which
+releases the lock.
 
 Floats go through JSON as ``repr`` text, which round-trips float64 exactly (NaN as ``NaN``), so a
 resumed run restarts from bit-identical numbers.
+
+Records and datasets
+--------------------
+The journal records of a branch point, its start orbit and its settings' digest, and the NetCDF
+datasets of a :class:`~stickslip.orbits.branch.Branch` and a
+:class:`~stickslip.orbits.region_edge.FoldCurve` (format ``stickslip-branch-1`` and
+``stickslip-foldcurve-1``) are written and read here; the result types call these functions and
+build themselves from the fields read back.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
-from .section import OrbitError
+from ..files import AppendLog, FileFormatError, OutputLock, atomic_write, fsync_dir
+from ..integrate.result import Trajectory
+from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
+from .layout import N_STATES, STATE_NAMES, STATE_UNITS
+from .section import OrbitError, Section
+from .shooting import PeriodicOrbit
 
 __all__ = ["Journal", "JournalMismatch", "journal_path", "digest_of", "array_digest", "encode_array",
-           "decode_array", "write_atomically", "check_output", "open_output", "JOURNAL_FORMAT"]
+           "decode_array", "write_atomically", "check_output", "open_output", "JOURNAL_FORMAT", "section_spec",
+           "section_of", "point_record", "point_fields", "start_record", "start_fields", "start_digest",
+           "branch_settings", "branch_dataset", "branch_fields", "fold_curve_dataset", "fold_curve_fields",
+           "plain_row", "write_dataset"]
 
 JOURNAL_FORMAT = "stickslip-continuation-journal-1"
 
@@ -81,12 +103,9 @@ def decode_array(d: dict) -> np.ndarray:
 
 
 def write_atomically(path: Path, write) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it onto ``path``."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    write(tmp)
-    os.replace(tmp, path)
-    return path
+    """Call ``write(tmp)`` on a unique temporary file beside ``path``, then replace ``path`` by it
+    (:func:`stickslip.files.atomic_write`: fsync-ed; a full disk raises WriteError, ``path`` unchanged)."""
+    return atomic_write(path, write)
 
 
 def _read_lines(path: Path) -> tuple[list, int]:
@@ -115,16 +134,27 @@ class Journal:
         :func:`digest_of` the settings that determine the results.
     settings : dict
         Stored in the header (JSON), for the record and for :meth:`header`.
+    lock : OutputLock, optional
+        The output's lock, already held by the caller (default: taken here). Held until
+        :meth:`close` or :meth:`remove`.
 
     Raises
     ------
     JournalMismatch
         If a journal with another kind or digest exists at that path.
+    stickslip.files.LockError
+        If another process is writing ``out``.
     """
 
-    def __init__(self, out, kind: str, digest: str, settings: dict):
+    def __init__(self, out, kind: str, digest: str, settings: dict, lock: OutputLock | None = None):
         self.path = journal_path(out)
         self.kind, self.digest = kind, digest
+        self.lock = (lock or OutputLock(out)).acquire()
+        with self.lock.released_on_error():
+            self._open(settings)
+
+    def _open(self, settings: dict) -> None:
+        kind, digest = self.kind, self.digest
         if self.path.exists():
             lines, good = _read_lines(self.path)
             head = lines[0] if lines else {}
@@ -143,23 +173,24 @@ class Journal:
                       "stickslip_version": __version__}
             write_atomically(self.path, lambda tmp: tmp.write_text(json.dumps(header, default=str) + "\n"))
             self.records = []
-        self._fh = open(self.path, "ab")
+        self._log = AppendLog(self.path, kept=f"the {kind} computed so far is kept in {self.path}")
 
     def append(self, record: dict) -> None:
-        """Write one record (one line, one ``write``, flushed to the operating system)."""
-        self._fh.write((json.dumps(record) + "\n").encode())
-        self._fh.flush()
+        """Write one record (one line, one ``write``, ``fsync``-ed)."""
+        self._log.append((json.dumps(record) + "\n").encode())
         self.records.append(record)
 
     def close(self) -> None:
-        """Close the file (the journal stays on disk)."""
-        if not self._fh.closed:
-            self._fh.close()
+        """Close the file (the journal stays on disk) and release the output's lock."""
+        self._log.close()
+        self.lock.release()
 
     def remove(self) -> None:
-        """Close and delete the journal (after the output is written)."""
-        self.close()
+        """Close and delete the journal (after the output is written), then release the lock."""
+        self._log.close()
         self.path.unlink(missing_ok=True)
+        fsync_dir(self.path.parent)
+        self.lock.release()
 
 
 def check_output(out, kind: str, digest: str, attrs: dict) -> None:
@@ -171,7 +202,7 @@ def check_output(out, kind: str, digest: str, attrs: dict) -> None:
         The file was written by a run with other settings (or by an older version, no digest).
     """
     if attrs.get("digest") != digest:
-            raise JournalMismatch(f"{out} holds a {kind} of different settings or start (digest {attrs.get('digest')} "
+        raise JournalMismatch(f"{out} holds a {kind} of different settings or start (digest {attrs.get('digest')} "
                               f"vs {digest}); choose another output (--out) or delete {out}")
 
 
@@ -197,18 +228,220 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
     Raises
     ------
     JournalMismatch
-        If the journal or the output file belongs to a run with other settings.
+        If the journal or the output file belongs to a run with other settings, or the output
+        is not a stickslip file of this kind.
+    stickslip.files.LockError
+        If another process is writing ``out``.
     """
     out, jp = Path(out), journal_path(out)
-    if not resume:
-        jp.unlink(missing_ok=True)
-        out.unlink(missing_ok=True)
-    if out.exists() and not jp.exists():
-        try:
-            attrs, result = read(out)
-        except Exception as exc:  # h5py/xarray raise many types for foreign files
-            raise JournalMismatch(f"{out} exists and is not a stickslip {kind} file ({type(exc).__name__}); "
-                                  f"choose another output (--out) or delete {out}") from exc
-        check_output(out, kind, digest, attrs)
-        return None, result
-    return Journal(out, kind, digest, settings), None
+    lock = OutputLock(out).acquire()  # before anything is deleted or read: one writer at a time
+    with lock.released_on_error():
+        if not resume:
+            jp.unlink(missing_ok=True)
+            out.unlink(missing_ok=True)
+        if out.exists() and not jp.exists():
+            try:
+                attrs, result = read(out)
+            except FileFormatError as exc:
+                raise JournalMismatch(f"{exc}; refusing to overwrite it: choose another output (--out) or delete "
+                                      f"{out}") from None
+            check_output(out, kind, digest, attrs)
+            lock.release()
+            return None, result
+        return Journal(out, kind, digest, settings, lock=lock), None
+
+
+# ----------------------------------------------------------------------- records of a branch
+def section_spec(section: Section) -> list:
+    """A section as JSON-ready ``[index, value, direction, name]``."""
+    return [section.index, section.value, section.direction, section.name]
+
+
+def section_of(spec) -> Section:
+    """Inverse of :func:`section_spec`."""
+    index, value, direction, name = spec
+    return Section(index=int(index), value=float(value), direction=int(direction), name=name)
+
+
+def point_record(point) -> dict:
+    """A branch point as a JSON-ready dict (exact floats: a resumed run restarts bit for bit)."""
+    enc = encode_array
+    return {"v": enc(point.v), "J": enc(point.J), "M": enc(point.M), "tangent": enc(point.tangent),
+            "multipliers": enc(point.multipliers), "stick_phases": int(point.stick_phases),
+            "stick_time": float(point.stick_time), "residual": float(point.residual),
+            "iterations": int(point.iterations)}
+
+
+def point_fields(rec: dict) -> dict:
+    """The fields of the branch point of a :func:`point_record`."""
+    dec = decode_array
+    return dict(v=dec(rec["v"]), J=dec(rec["J"]), M=dec(rec["M"]), tangent=dec(rec["tangent"]),
+                multipliers=dec(rec["multipliers"]).astype(complex), stick_phases=int(rec["stick_phases"]),
+                stick_time=float(rec["stick_time"]), residual=float(rec["residual"]), iterations=int(rec["iterations"]))
+
+
+def start_record(start) -> dict:
+    """What a branch keeps of its start orbit (state, period, stick phases, scale, params, model,
+    section, options) as a JSON-ready dict (exact floats)."""
+    return {"state": start.state.tolist(), "period": start.period, "stick_phases": start.stick_phases,
+            "scale": start.scale.tolist(), "params": start.params.to_dict(), "model": start.model,
+            "section": section_spec(start.section), "options": start.options}
+
+
+def start_fields(rec: dict) -> dict:
+    """Inverse of :func:`start_record`: the fields of the start."""
+    return dict(state=np.array(rec["state"], dtype=float), period=float(rec["period"]),
+                stick_phases=int(rec["stick_phases"]), scale=np.array(rec["scale"], dtype=float),
+                params=Parameters.from_dict(rec["params"]), model=rec["model"], section=section_of(rec["section"]),
+                options=dict(rec["options"]))
+
+
+def start_digest(start, params: Parameters, model: str) -> str:
+    """Digest of the ``start`` argument of ``continue_orbit`` (an orbit, a run or a state)."""
+    if isinstance(start, PeriodicOrbit):
+        return digest_of({"orbit": array_digest(start.state, np.array([start.period]), start.scale),
+                          "params": start.params.to_dict(), "model": start.model,
+                          "section": section_spec(start.section),
+                          "options": {k: start.options.get(k) for k in ("rtol", "atol", "slip_band")}})
+    if isinstance(start, Trajectory):
+        return digest_of({"run": array_digest(start.t, start.states, start.mode),
+                          "params": start.params.to_dict(), "model": start.model})
+    if start is None or isinstance(start, str):
+        return digest_of({"start": repr(start), "params": params.to_dict(), "model": model})
+    return digest_of({"state": array_digest(np.asarray(start, dtype=float)), "params": params.to_dict(),
+                      "model": model})
+
+
+def branch_settings(params, param, start, model, section, rtol, atol, slip_band, numerics: dict) -> dict:
+    """Everything that determines a branch (its digest; the journal header)."""
+    return {"start": start_digest(start, params, model), "params": params.to_dict(), "param": param,
+            "model": model, "section": section_spec(section), "rtol": rtol, "atol": atol, "slip_band": slip_band,
+            **numerics}
+
+
+# ----------------------------------------------------------------------- NetCDF
+def write_dataset(ds, path) -> Path:
+    """Write ``ds`` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
+    return write_atomically(Path(path), lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+
+def branch_dataset(branch):
+    """``xarray.Dataset`` of a branch with dims ``point``, ``state``, ``multiplier`` and ``special``."""
+    import xarray as xr
+
+    unit = PARAMETER_UNITS.get(branch.param, "")
+    sp = branch.special
+    data = {
+        "value": ("point", branch.values, {"long_name": f"continuation parameter {branch.param}", "units": unit}),
+        "period": ("point", branch.periods, {"long_name": "period", "units": "s"}),
+        "state_on_section": (("point", "state"), branch.states, {"long_name": "state on the Poincaré section",
+                                                                 "units": " ".join(STATE_UNITS)}),
+        "multiplier_real": (("point", "multiplier"), branch.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
+        "multiplier_imag": (("point", "multiplier"), branch.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
+        "stable": ("point", branch.stable.astype(np.int8), {"long_name": "1 if every non-trivial multiplier is inside the unit circle"}),
+        "n_unstable": ("point", branch.n_unstable.astype(np.int16), {"long_name": "non-trivial multipliers outside the unit circle"}),
+        "stick_phases": ("point", branch.stick_phases.astype(np.int16), {"long_name": "stick phases per period"}),
+        "stick_time": ("point", branch.stick_time, {"long_name": "time in stick per period", "units": "s"}),
+        "amplitude": ("point", branch.amplitude, {"long_name": "peak-to-peak range of phi over one period", "units": "rad"}),
+        "arclength": ("point", branch.arclength, {"long_name": "scaled pseudo-arclength", "units": "1"}),
+        "residual": ("point", branch.residuals, {"long_name": "scaled shooting residual", "units": "1"}),
+        "iterations": ("point", branch.iterations.astype(np.int16), {"long_name": "corrector iterations"}),
+        "special_kind": ("special", np.array([p.kind for p in sp], dtype=str), {"long_name": "kind of special point"}),
+        "special_index": ("special", np.array([p.index for p in sp], dtype=np.int32),
+                          {"long_name": "lies between branch points index and index + 1"}),
+        "special_value": ("special", np.array([p.value for p in sp], dtype=float), {"long_name": f"{branch.param} at the special point", "units": unit}),
+        "special_period": ("special", np.array([p.period for p in sp], dtype=float), {"long_name": "period at the special point", "units": "s"}),
+        "special_before": ("special", np.array([p.before for p in sp], dtype=float), {"long_name": "test function before"}),
+        "special_after": ("special", np.array([p.after for p in sp], dtype=float), {"long_name": "test function after"}),
+        "special_bracket": ("special", np.array([p.bracket for p in sp], dtype=float), {"long_name": "final bracket width", "units": unit}),
+        "special_located": ("special", np.array([p.located for p in sp], dtype=np.int8), {"long_name": "1 if located to tolerance"}),
+        "special_state": (("special", "state"), np.array([p.state for p in sp], dtype=float).reshape(len(sp), N_STATES),
+                          {"long_name": "state on the section at the special point"}),
+        "special_multiplier_real": (("special", "multiplier"), np.array([np.real(p.multipliers) for p in sp], dtype=float)
+                                    .reshape(len(sp), branch.multipliers.shape[1]),
+                                    {"long_name": "Floquet multiplier at the special point, real part", "units": "1"}),
+        "special_multiplier_imag": (("special", "multiplier"), np.array([np.imag(p.multipliers) for p in sp], dtype=float)
+                                    .reshape(len(sp), branch.multipliers.shape[1]),
+                                    {"long_name": "Floquet multiplier at the special point, imaginary part", "units": "1"}),
+    }
+    coords = {"point": np.arange(len(branch)), "state": list(STATE_NAMES),
+              "multiplier": np.arange(branch.multipliers.shape[1]), "special": np.arange(len(sp))}
+    attrs = {
+        "title": f"stickslip branch of periodic orbits in {branch.param} (pseudo-arclength continuation)",
+        "format": "stickslip-branch-1",
+        "stickslip_version": __version__,
+        "param": branch.param, "param_units": unit,
+        "model": branch.model, "section": branch.section.name,
+        "section_spec": json.dumps(section_spec(branch.section)),
+        "digest": branch.digest,
+        "stop_reason": branch.stop_reason,
+        "options": json.dumps(branch.options),
+        "timings": json.dumps(branch.timings),
+        "parameters": json.dumps(branch.params.to_dict()),
+    }
+    attrs.update(parameter_attrs(branch.params.to_dict()))
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def branch_fields(ds) -> dict:
+    """The fields of the branch of a dataset written by :func:`branch_dataset` (files of this
+    version: with ``section_spec`` and the special points' multipliers); ``special`` is a list of
+    the fields of each special point."""
+    mult = ds["multiplier_real"].values + 1j * ds["multiplier_imag"].values
+    smult = ds["special_multiplier_real"].values + 1j * ds["special_multiplier_imag"].values
+    special = [dict(kind=str(ds["special_kind"].values[k]), index=int(ds["special_index"].values[k]),
+                    value=float(ds["special_value"].values[k]), period=float(ds["special_period"].values[k]),
+                    state=ds["special_state"].values[k], multipliers=smult[k],
+                    before=float(ds["special_before"].values[k]), after=float(ds["special_after"].values[k]),
+                    bracket=float(ds["special_bracket"].values[k]), located=bool(ds["special_located"].values[k]))
+               for k in range(ds.sizes.get("special", 0))]
+    return dict(param=ds.attrs["param"], values=ds["value"].values, periods=ds["period"].values,
+                states=ds["state_on_section"].values, multipliers=mult, stable=ds["stable"].values.astype(bool),
+                n_unstable=ds["n_unstable"].values.astype(int), stick_phases=ds["stick_phases"].values.astype(int),
+                stick_time=ds["stick_time"].values, amplitude=ds["amplitude"].values,
+                arclength=ds["arclength"].values, residuals=ds["residual"].values,
+                iterations=ds["iterations"].values.astype(int), special=special, stop_reason=ds.attrs["stop_reason"],
+                params=Parameters.from_dict(json.loads(ds.attrs["parameters"])), model=ds.attrs["model"],
+                section=section_of(json.loads(ds.attrs["section_spec"])), options=json.loads(ds.attrs["options"]),
+                timings=json.loads(ds.attrs["timings"]), digest=str(ds.attrs.get("digest", "")))
+
+
+def fold_curve_dataset(fc):
+    """``xarray.Dataset`` of a fold curve over ``N``."""
+    import xarray as xr
+
+    data = {
+        "edge": ("N", fc.edge, {"long_name": "Omega where the stick-slip branch ends", "units": "rad/s"}),
+        "kind": ("N", np.array(fc.kind, dtype=str), {"long_name": "fold | stick-vanishing | bounds | failed"}),
+        "located": ("N", fc.located.astype(np.int8), {"long_name": "1 if located to tolerance"}),
+        "period": ("N", fc.period, {"long_name": "period at the edge", "units": "s"}),
+        "omega_stable_max": ("N", fc.omega_stable_max, {"long_name": "largest Omega of a stable orbit", "units": "rad/s"}),
+        "points": ("N", fc.points.astype(np.int32), {"long_name": "branch points"}),
+        "seconds": ("N", fc.seconds, {"long_name": "wall time", "units": "s"}),
+        "message": ("N", np.array(fc.message, dtype=str), {"long_name": "stop reason or error"}),
+    }
+    attrs = {"title": "stickslip: end of the stick-slip branch over N (upper edge of Region II, Fig. 8)",
+             "format": "stickslip-foldcurve-1", "stickslip_version": __version__, "model": fc.model,
+             "omega_start": fc.omega_start, "timings": json.dumps(fc.timings),
+             "parameters": json.dumps(fc.params.to_dict()), "digest": fc.digest}
+    attrs.update(parameter_attrs(fc.params.to_dict()))
+    return xr.Dataset(data, coords={"N": ("N", fc.N, {"units": "N", "long_name": "normal load"})}, attrs=attrs)
+
+
+def fold_curve_fields(ds) -> dict:
+    """The fields of the fold curve of a dataset written by :func:`fold_curve_dataset`."""
+    return dict(N=ds["N"].values, edge=ds["edge"].values, kind=tuple(str(k) for k in ds["kind"].values),
+                located=ds["located"].values.astype(bool), period=ds["period"].values,
+                omega_stable_max=ds["omega_stable_max"].values, points=ds["points"].values.astype(int),
+                seconds=ds["seconds"].values, message=tuple(str(m) for m in ds["message"].values),
+                omega_start=float(ds.attrs["omega_start"]),
+                params=Parameters.from_dict(json.loads(ds.attrs["parameters"])), model=ds.attrs["model"],
+                timings=json.loads(ds.attrs["timings"]), digest=str(ds.attrs.get("digest", "")))
+
+
+def plain_row(row) -> list:
+    """A row of ``fold_curve`` (see ``FoldCurve.rows``) as JSON-ready Python values."""
+    edge, kind, located, period, stable_max, points, seconds, message = row
+    return [float(edge), str(kind), bool(located), float(period), float(stable_max), int(points), float(seconds),
+            str(message)]
+

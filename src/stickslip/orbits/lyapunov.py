@@ -27,14 +27,14 @@ import numpy as np
 
 from .. import __version__
 from ..integrate.driver import SimulationError, initial_state, simulate
-from ..integrate.events import STICK_SPEED_TOL
-from ..model import kernels as K
 from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import Parameters
 from ..model.system import assemble
-from .section import OrbitError, flow
-from .shooting import PeriodicOrbit, _scales
-from .variational import free_states, propagate
+from .layout import N_STATES, free_states
+from .problem import ShootingProblem, scales, stick_count
+from .section import OrbitError
+from .shooting import PeriodicOrbit
+from .variational import propagate
 
 __all__ = ["LyapunovResult", "lyapunov_exponent", "LyapunovSpectrum", "lyapunov_spectrum"]
 
@@ -117,9 +117,9 @@ def _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, s
     """The common start of the Lyapunov computations: resolve the start, run the transient.
 
     ``ic`` may be a :class:`PeriodicOrbit` (its parameters and model are then the defaults).
-    Returns (params, model name, system, free state indices, scales σ of the free states (peak-to-
-    peak over the transient's second half), the exact state at the end of the transient, the
-    integration options).
+    Returns the flow map as a :class:`.problem.ShootingProblem` without a section (σ: the
+    peak-to-peak ranges over the transient's second half) and the exact state at the end of the
+    transient.
     """
     if isinstance(ic, PeriodicOrbit):
         params = ic.params if params is None else params
@@ -130,22 +130,22 @@ def _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, s
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
     system = assemble(params, model, slip_band)
-    free = free_states(system)
     if perturbation is None and isinstance(ic, str) and ic == "equilibrium":
         perturbation = 1e-3
     try:
         s = initial_state(system, ic, perturbation)
     except SimulationError as exc:
         raise OrbitError(f"bad initial condition: {exc}") from exc
-    opts = dict(rtol=rtol, atol=atol, slip_band=slip_band)
     model = system.variant.name
-    tr = simulate(params, t_transient, model=model, ic=s, sample_rate=max(200.0, 1.0 / t_transient), **opts)
+    tr = simulate(params, t_transient, model=model, ic=s, sample_rate=max(200.0, 1.0 / t_transient), rtol=rtol,
+                  atol=atol, slip_band=slip_band)
     if tr.status != "success":
         raise OrbitError(f"the transient run failed: {tr.status}")
     half = tr.t >= 0.5 * t_transient
-    sigma = _scales(np.ptp(tr.states[half], axis=0), free)
-    s_ref, _ = flow(params, model, s, t_transient, **opts)  # exact end of the transient
-    return params, model, system, free, sigma, s_ref, opts
+    problem = ShootingProblem.build(params, model, sigma=scales(np.ptp(tr.states[half], axis=0), free_states(system)),
+                                    system=system, rtol=rtol, atol=atol, slip_band=slip_band)
+    s_ref, _ = problem.flow(s, t_transient)  # exact end of the transient
+    return problem, s_ref
 
 
 def lyapunov_exponent(
@@ -169,7 +169,7 @@ def lyapunov_exponent(
     ----------
     params : Parameters, optional
         Default: the orbit's or Table 1.
-    ic : "equilibrium", "zero", array-like (12,), Trajectory or PeriodicOrbit
+    ic : "equilibrium", "zero", array-like (N_STATES,), Trajectory or PeriodicOrbit
         Start of the transient run (a PeriodicOrbit: its section state, and its params/model).
     model : str
         Model variant.
@@ -203,21 +203,11 @@ def lyapunov_exponent(
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
-    params, model, system, free, sigma, s_ref, opts = _after_transient(
-        params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    problem, s_ref = _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    free, sigma = problem.free, problem.sigma
 
     def perturbed(direction):
-        # s_ref + d0 σ·direction; if s_ref sticks, the separation is projected onto v_r = 0
-        # (a perturbed stuck state sticks too, so this is the dynamics' own first instant, and
-        # the integrator need not resolve a 1e-9 m/s slip against the constraint)
-        sp = s_ref.copy()
-        sp[free] += d0 * direction * sigma
-        vx, vy = K.relative_velocity(s_ref, system.p)
-        if np.hypot(vx, vy) <= STICK_SPEED_TOL:
-            y = np.zeros(14)
-            y[:12] = sp
-            K.project_velocity(y, system.minv, system.p)
-            sp = y[:12].copy()
+        sp = problem.perturbed(s_ref, direction, d0)
         d_start = float(np.linalg.norm((sp[free] - s_ref[free]) / sigma))
         if not d_start > 0.0:
             raise OrbitError("the separation vanished on projection onto the stick constraint; change seed")
@@ -228,8 +218,8 @@ def lyapunov_exponent(
     s_pert, d_start = perturbed(u / np.linalg.norm(u))
     growth = np.empty(n_chunks)
     for i in range(n_chunks):
-        s_ref, _ = flow(params, model, s_ref, chunk, **opts)
-        s_pert, _ = flow(params, model, s_pert, chunk, **opts)
+        s_ref, _ = problem.flow(s_ref, chunk)
+        s_pert, _ = problem.flow(s_pert, chunk)
         delta = (s_pert[free] - s_ref[free]) / sigma
         d = float(np.linalg.norm(delta))
         if not np.isfinite(d) or d == 0.0:
@@ -240,8 +230,8 @@ def lyapunov_exponent(
     estimate = np.cumsum(growth) / time
     return LyapunovResult(
         exponent=float(estimate[-1]), time=time, estimate=estimate, log_growth=growth, chunk=float(chunk),
-        d0=float(d0), t_transient=float(t_transient), scale=sigma, params=params, model=model,
-        options=dict(opts, seed=seed, perturbation=perturbation),
+        d0=float(d0), t_transient=float(t_transient), scale=sigma, params=problem.params, model=problem.model,
+        options=dict(problem.options, seed=seed, perturbation=perturbation),
     )
 
 
@@ -354,7 +344,7 @@ def lyapunov_spectrum(
     ----------
     params : Parameters, optional
         Default: the orbit's or Table 1.
-    ic : "equilibrium", "zero", array-like (12,), Trajectory or PeriodicOrbit
+    ic : "equilibrium", "zero", array-like (N_STATES,), Trajectory or PeriodicOrbit
         Start of the transient run (a PeriodicOrbit: its section state, params and model).
     model : str
         Model variant.
@@ -393,88 +383,77 @@ def lyapunov_spectrum(
     t_start = _time.perf_counter()
     if t_average <= 0.0:
         raise OrbitError(f"t_average = {t_average} s must be > 0")
-    params, model, system, free, sigma, s_ref, opts = _after_transient(
-        params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    problem, s_ref = _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
     if method == "finite-difference":
-        return _fd_spectrum(params, model, system, free, sigma, s_ref, t_transient, t_average, chunk, d0, opts,
-                            perturbation, t_start)
+        return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
     if method != "variational":
         raise OrbitError(f"unknown method {method!r}; use 'variational' or 'finite-difference'")
-    end, transitions = flow(params, model, s_ref, t_average, **opts)
+    end, transitions = problem.flow(s_ref, t_average)
+    free, sigma = problem.free, problem.sigma
 
     k = free.size
-    D = np.zeros((12, k))
+    D = np.zeros((N_STATES, k))
     D[free, np.arange(k)] = sigma          # columns: σ-scaled unit vectors
     log_sum = np.zeros(k)
     times, sums = [0.0], [np.zeros(k)]
 
     def reorthonormalise(t, P):
-        A = P[free] / sigma[:, None]
-        Q, R = np.linalg.qr(A)
-        d = np.abs(np.diag(R))
-        sign = np.where(np.diag(R) < 0, -1.0, 1.0)
-        log_sum[:] += np.log(np.maximum(d, np.finfo(float).tiny))
-        out = np.zeros((12, k))
-        out[free] = (Q * sign[None, :]) * sigma[:, None]
+        Q, log_r = _qr(P[free] / sigma[:, None])
+        log_sum[:] += log_r
+        out = np.zeros((N_STATES, k))
+        out[free] = Q * sigma[:, None]
         if t - times[-1] >= record or t >= t_average:
             times.append(t)
             sums.append(log_sum.copy())
         return out
 
-    propagate(system, s_ref, t_average, transitions, end, D.copy(), scale=sigma, after=reorthonormalise,
+    propagate(problem.system, s_ref, t_average, transitions, end, D.copy(), scale=sigma, after=reorthonormalise,
               max_interval=QR_INTERVAL)
     time = np.array(times[1:])
-    estimate = _largest_first(np.array(sums[1:]) / time[:, None])
+    return _spectrum(problem, np.array(sums[1:]) / time[:, None], time, t_transient, stick_count(transitions), t_start,
+                     dict(perturbation=perturbation, record=record, qr_interval=QR_INTERVAL, method="variational"))
+
+
+def _qr(A: np.ndarray):
+    """A = Q R with diag(R) ≥ 0: Q and ln |R_ii| (floored at the smallest float)."""
+    Q, R = np.linalg.qr(A)
+    sign = np.where(np.diag(R) < 0, -1.0, 1.0)
+    return Q * sign[None, :], np.log(np.maximum(np.abs(np.diag(R)), np.finfo(float).tiny))
+
+
+def _spectrum(problem, estimate, time, t_transient, stick_phases, t_start, options) -> LyapunovSpectrum:
+    """The :class:`LyapunovSpectrum` of running estimates (n, k) at ``time`` (n,)."""
+    estimate = _largest_first(estimate)
     return LyapunovSpectrum(
         exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
-        scale=sigma, stick_phases=int(np.sum(transitions.kind == 1)), wall_time=_time.perf_counter() - t_start,
-        params=params, model=model, options=dict(opts, perturbation=perturbation, record=record,
-                                                 qr_interval=QR_INTERVAL, method="variational"),
+        scale=problem.sigma, stick_phases=stick_phases, wall_time=_time.perf_counter() - t_start,
+        params=problem.params, model=problem.model, options=dict(problem.options, **options),
     )
 
 
-def _fd_spectrum(params, model, system, free, sigma, s_ref, t_transient, t_average, chunk, d0, opts,
-                 perturbation, t_start) -> LyapunovSpectrum:
+def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start) -> LyapunovSpectrum:
     """Benettin with 2 n_free perturbed trajectories and QR after every chunk (see
     :func:`lyapunov_spectrum`, ``method="finite-difference"``)."""
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
+    free, sigma = problem.free, problem.sigma
     k = free.size
     Q = np.eye(k)
     log_sum = np.zeros(k)
     sums = np.empty((n_chunks, k))
     sticks = 0
-
-    def perturbed(s0, direction):
-        sp = s0.copy()
-        sp[free] += d0 * direction * sigma
-        vx, vy = K.relative_velocity(s0, system.p)
-        if np.hypot(vx, vy) <= STICK_SPEED_TOL:  # the reference sticks: so does the perturbed state
-            y = np.zeros(14)
-            y[:12] = sp
-            K.project_velocity(y, system.minv, system.p)
-            sp = y[:12].copy()
-        return sp
-
     for i in range(n_chunks):
-        starts = [perturbed(s_ref, Q[:, j]) for j in range(k)]
-        s_new, tr = flow(params, model, s_ref, chunk, **opts)
-        sticks += int(np.sum(tr.kind == 1))
+        starts = [problem.perturbed(s_ref, Q[:, j], d0) for j in range(k)]
+        s_new, tr = problem.flow(s_ref, chunk)
+        sticks += stick_count(tr)
         # columns Φ P Q_j: the chunk's flow after the projection onto v_r = 0 that a stuck
         # reference implies (part of the physical map: stick collapses those directions)
-        A = np.column_stack([(flow(params, model, sp, chunk, **opts)[0][free] - s_new[free]) / sigma
-                             for sp in starts]) / d0
-        Q, R = np.linalg.qr(A)
-        sign = np.where(np.diag(R) < 0, -1.0, 1.0)
-        Q = Q * sign[None, :]
-        log_sum += np.log(np.maximum(np.abs(np.diag(R)), np.finfo(float).tiny))
+        A = np.column_stack([(problem.flow(sp, chunk)[0][free] - s_new[free]) / sigma for sp in starts]) / d0
+        Q, log_r = _qr(A)
+        log_sum += log_r
         sums[i] = log_sum
         s_ref = s_new
     time = chunk * np.arange(1, n_chunks + 1)
-    estimate = _largest_first(sums / time[:, None])
-    return LyapunovSpectrum(
-        exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
-        scale=sigma, stick_phases=sticks, wall_time=_time.perf_counter() - t_start, params=params, model=model,
-        options=dict(opts, perturbation=perturbation, method="finite-difference", chunk=chunk, d0=d0),
-    )
+    return _spectrum(problem, sums / time[:, None], time, t_transient, sticks, t_start,
+                     dict(perturbation=perturbation, method="finite-difference", chunk=chunk, d0=d0))

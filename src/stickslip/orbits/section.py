@@ -13,17 +13,16 @@ not a dense-output sample before it.
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 
 import numpy as np
 
+from ..errors import StickSlipError
 from ..analysis.steady import _hermite_crossings
 from ..integrate.driver import simulate
 from ..model import kernels as K
 from ..model.system import System
-from ..model.variants import STATE_NAMES
+from .layout import KERNEL_STATE, N_DOFS, N_STATES, PHI_DOT, STATE_NAMES, velocity_of
 
 __all__ = ["Section", "resolve_section", "OrbitError", "flow", "vector_field", "section_crossings"]
 
@@ -39,7 +38,7 @@ class Section:
     Attributes
     ----------
     index : int
-        State index (0–11, :data:`stickslip.STATE_NAMES` order) fixed on the section.
+        State index (:data:`stickslip.STATE_NAMES` order) fixed on the section.
     value : float
         Its value on the section [m, rad, m/s or rad/s].
     direction : int
@@ -54,7 +53,7 @@ class Section:
     name: str
 
     def g(self, s: np.ndarray) -> float:
-        """Section function of one state (12,); zero on the section, increasing through it."""
+        """Section function of one state (N_STATES,); zero on the section, increasing through it."""
         return self.direction * (float(s[self.index]) - self.value)
 
 
@@ -63,8 +62,8 @@ def resolve_section(section) -> Section:
     if isinstance(section, Section):
         return section
     if isinstance(section, str) and section == "phi_max":
-        return Section(index=10, value=0.0, direction=-1, name="phi_max")
-    if isinstance(section, tuple) and len(section) == 2 and section[0] in STATE_NAMES[:6]:
+        return Section(index=PHI_DOT, value=0.0, direction=-1, name="phi_max")
+    if isinstance(section, tuple) and len(section) == 2 and section[0] in STATE_NAMES[:N_DOFS]:
         j = STATE_NAMES.index(section[0])
         level = float(section[1])
         return Section(index=j, value=level, direction=1, name=f"{section[0]}={level:g} up")
@@ -75,23 +74,27 @@ def resolve_section(section) -> Section:
 
 
 def vector_field(system: System, s: np.ndarray, mode: int = K.MODE_SLIP_EXACT) -> np.ndarray:
-    """ds/dt (12,) at state ``s`` in ``mode`` (slip with the exact direction v_r/|v_r| by default)."""
-    y = np.zeros(14)
-    y[:12] = s
-    ds = np.zeros(14)
+    """ds/dt (N_STATES,) at state ``s`` in ``mode`` (slip with the exact direction v_r/|v_r| by default)."""
+    y = np.zeros(KERNEL_STATE)  # inline, not kernel_state(): called once per sample by section_crossings
+    y[:N_STATES] = s
+    ds = np.zeros(KERNEL_STATE)
     vx, vy = K.relative_velocity(y, system.p)
     speed = float(np.hypot(vx, vy))
     ex, ey = (vx / speed, vy / speed) if speed > 0.0 else (1.0, 0.0)
     K.rhs(y, int(mode), ex, ey, system.minv, system.damp, system.stiff, system.p, ds)
-    return ds[:12].copy()
+    return ds[:N_STATES].copy()
 
 
-def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, slip_band: float):
+def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, slip_band: float,
+         max_steps: int | None = None):
     """Φ(s0, T): the state after exactly T seconds, and the run's transitions.
+
+    ``max_steps`` caps the integrator's steps (None: the driver's default): a stalled integration
+    then fails fast instead of running for minutes.
 
     Returns
     -------
-    state : ndarray (12,)
+    state : ndarray (N_STATES,)
     transitions : stickslip.integrate.result.Transitions
 
     Raises
@@ -103,8 +106,9 @@ def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, s
         raise OrbitError(f"return time T = {T} s is not positive; the Newton iteration left the orbit")
     rate = 1.0 / T
     T_exact = 1.0 / rate  # the last sample time the driver will compute, so it lands on t_end
+    cap = {} if max_steps is None else {"max_steps": int(max_steps)}
     traj = simulate(params, T_exact, model=model, ic=s0, rtol=rtol, atol=atol, sample_rate=rate,
-                    slip_band=slip_band)
+                    slip_band=slip_band, **cap)
     if traj.status != "success" or traj.t[-1] != T_exact:
         raise OrbitError(f"the flow map over T = {T} s failed: {traj.status}")
     return traj.final_state, traj.transitions
@@ -112,8 +116,8 @@ def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, s
 
 def _state_rates(system: System, states: np.ndarray, mode: np.ndarray, index: int) -> np.ndarray:
     """d s[index]/dt at each sample (n,): a state for positions, the vector field for velocities."""
-    if index < 6:
-        return states[:, index + 6].copy()
+    if index < N_DOFS:
+        return states[:, velocity_of(index)].copy()
     out = np.empty(states.shape[0])
     for i in range(states.shape[0]):
         m = K.MODE_STICK if mode[i] == 1 else K.MODE_SLIP_EXACT
@@ -130,7 +134,7 @@ def section_crossings(system: System, section: Section, t, states, mode):
     section : Section
     t : ndarray (n,)
         Sample times [s].
-    states : ndarray (n, 12)
+    states : ndarray (n, N_STATES)
     mode : ndarray (n,) int8
         1 in stick.
 
@@ -156,7 +160,7 @@ def land_on_section(params, model, system: System, section: Section, s_before: n
     """Integrate from ``s_before`` exactly onto the section, starting from the guess ``dt`` [s].
 
     Newton on the crossing time with dg/dt from the vector field; each iterate re-simulates from
-    ``s_before``. Returns (state on the section (12,), time from ``s_before`` [s], |g| before
+    ``s_before``. Returns (state on the section (N_STATES,), time from ``s_before`` [s], |g| before
     the coordinate is set to the section value [unit of the coordinate]).
     """
     s = s_before

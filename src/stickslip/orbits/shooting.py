@@ -1,12 +1,15 @@
-"""Periodic orbits by shooting on a Poincaré section, with finite-difference Floquet multipliers.
+"""Periodic orbits by shooting on a Poincaré section, with their Floquet multipliers.
 
 Unknowns: the free states on the section except the one the section fixes (so the phase along
 the flow is fixed by the section), and the return time T. Equations: Φ(s0, T) − s0 = 0 on the
 free states, Φ the exact flow map of the ``event`` integrator (:func:`.section.flow`). This is
-a square system (2 n_free equations, 2 n_free − 1 + 1 unknowns), solved by Newton with a
-central finite-difference Jacobian of Φ (perturbed shooting: each column is two simulations,
-so the jumps of the variational equations at stick↔slip transitions — the saltation matrices —
-are contained in it implicitly) and the exact column ∂Φ/∂T = f(Φ) from the vector field.
+a square system (2 n_free equations, 2 n_free − 1 + 1 unknowns): the shooting problem of
+:class:`.problem.ShootingProblem`, solved by its Newton iteration with ∂Φ/∂s0 from the
+variational equations with saltation matrices (default) or from central differences of Φ
+(perturbed shooting: each column is two simulations, so the jumps of the variational equations
+at stick↔slip transitions are contained in it implicitly), and the exact column ∂Φ/∂T = f(Φ)
+from the vector field. The guess — the section state, the period and the scales σ — comes from
+the last section crossings of a run.
 
 At the converged orbit the full-state monodromy matrix ∂Φ/∂s0 (2 n_free × 2 n_free) is
 computed from the variational equations with saltation matrices (:mod:`.variational`; default)
@@ -14,7 +17,6 @@ or differenced once more (``monodromy="finite-difference"``); its eigenvalues ar
 multipliers. One of them is 1 (a shift along the orbit); stick phases collapse the directions
 that violate v_r = 0, which gives multipliers 0.
 """
-
 from __future__ import annotations
 
 import dataclasses
@@ -29,32 +31,12 @@ from ..integrate.result import Trajectory
 from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import assemble
-from ..model.variants import STATE_NAMES
-from . import variational as _var
-from .section import OrbitError, Section, flow, land_on_section, resolve_section, section_crossings, vector_field
+from .layout import STATE_NAMES, STATE_UNITS, free_states
+from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
+                      check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
+from .section import OrbitError, Section, land_on_section, resolve_section, section_crossings
 
-__all__ = ["PeriodicOrbit", "periodic_orbit"]
-
-_STATE_UNITS = ("m", "m", "m", "m", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "rad/s", "rad/s")
-
-#: Default convergence tolerance of Newton: max over free states of |Φ(s0, T) − s0| / σ, σ the
-#: peak-to-peak range of each state over the guessed period. With rtol = 1e-10 the flow map
-#: repeats to ~1e-10 σ (measured residuals at convergence 1e-11 … 1e-9), so 1e-8 is reachable
-#: and still 1e-5 below the return-map resolution of :mod:`stickslip.analysis.classify`.
-DEFAULT_TOL = 1e-8
-
-#: Default relative finite-difference step (of σ). Central differences: truncation error
-#: ~ step² (1e-10) and round-off/integration noise ~ rtol / step (1e-5 at rtol 1e-10), so the
-#: Jacobian entries are good to ~1e-5, enough for Newton and for multipliers to ~1e-5 (docs/orbits.md).
-DEFAULT_FD_STEP = 1e-5
-
-#: Floor of the state scales σ, relative to the largest σ of the same kind (positions or
-#: velocities): keeps a DOF that barely moves on the orbit from getting a perturbation below
-#: the integration noise.
-SCALE_FLOOR = 1e-4
-
-#: Halvings of a Newton step that increases the residual, before giving up.
-MAX_HALVINGS = 6
+__all__ = ["PeriodicOrbit", "periodic_orbit", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_HALVINGS", "SCALE_FLOOR"]
 
 #: Samples per second of the search run that finds the first section crossings (≥ 100 per
 #: period of the fastest free mode of Table 1, 0.36 s), and its length [s] when none is given.
@@ -63,12 +45,12 @@ SEARCH_TIME = 30.0
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class PeriodicOrbit:
+class PeriodicOrbit(Multipliers):
     """A periodic orbit found by :func:`periodic_orbit`.
 
     Attributes
     ----------
-    state : ndarray (12,)
+    state : ndarray (N_STATES,)
         State on the section, s = [q, q̇] [m, rad, m/s, rad/s].
     period : float
         Period T [s] (of ``multiplicity`` section returns).
@@ -119,22 +101,6 @@ class PeriodicOrbit:
         """Fundamental frequency 1/T [Hz]."""
         return 1.0 / self.period
 
-    @property
-    def trivial_multiplier(self) -> complex:
-        """The multiplier closest to 1 (the shift along the orbit) [-]."""
-        return complex(self.multipliers[np.argmin(np.abs(self.multipliers - 1.0))])
-
-    @property
-    def nontrivial_multipliers(self) -> np.ndarray:
-        """All multipliers except :attr:`trivial_multiplier`, by decreasing modulus [-]."""
-        k = int(np.argmin(np.abs(self.multipliers - 1.0)))
-        return np.delete(self.multipliers, k)
-
-    @property
-    def stable(self) -> bool:
-        """True if every non-trivial multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.nontrivial_multipliers) < 1.0))
-
     def trajectory(self, periods: float = 1.0, sample_rate: float = 1000.0) -> Trajectory:
         """Simulate the orbit from its section state over ``periods`` periods (for plots)."""
         opt = self.options
@@ -147,10 +113,8 @@ class PeriodicOrbit:
 
         data = {
             "state_on_section": ("state", self.state, {"long_name": "state on the Poincaré section",
-                                                       "units": " ".join(_STATE_UNITS)}),
-            "multiplier_real": ("multiplier", self.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
-            "multiplier_imag": ("multiplier", self.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
-            "multiplier_abs": ("multiplier", np.abs(self.multipliers), {"long_name": "Floquet multiplier modulus", "units": "1"}),
+                                                       "units": " ".join(STATE_UNITS)}),
+            **multiplier_variables(self.multipliers, "multiplier"),
             "monodromy": (("free_state", "free_state_0"), self.monodromy,
                           {"long_name": f"monodromy matrix d s(T) / d s(0) on the free states ({self.options.get('monodromy', 'finite-difference')})",
                            "units": "SI"}),
@@ -200,35 +164,6 @@ def _guess_from_samples(params, model, system, section, t, states, mode, multipl
     return s0, T0, ptp, miss
 
 
-def _scales(ptp: np.ndarray, free: np.ndarray) -> np.ndarray:
-    """σ of the free states from their peak-to-peak range, floored per kind (see SCALE_FLOOR)."""
-    sigma = ptp[free].astype(float).copy()
-    n = free.size // 2
-    for part in (slice(0, n), slice(n, 2 * n)):
-        top = sigma[part].max()
-        if top <= 0.0:
-            raise OrbitError("the guess does not move: no oscillation to shoot from (is it the equilibrium?)")
-        sigma[part] = np.maximum(sigma[part], SCALE_FLOOR * top)
-    return sigma
-
-
-def _monodromy(params, model, s0, T, free, cols, h, *, rtol, atol, slip_band):
-    """Central-difference columns ∂Φ(s0, T)/∂s0[j] for j in ``cols`` (free-state rows)."""
-    return _var.fd_monodromy(params, model, s0, T, free, h[free], rtol=rtol, atol=atol,
-                             slip_band=slip_band, cols=cols)
-
-
-def _newton_columns(params, model, s0, T, free, cols, h, sigma, method, opts):
-    """∂Φ(s0, T)/∂s0 on the free rows and the ``cols`` columns, by ``method`` (saltation with a
-    finite-difference fallback)."""
-    if method == "saltation":
-        try:
-            return _var.flow_jacobian(params, model, s0, T, scale=sigma, **opts).matrix[np.ix_(free, cols)]
-        except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError):
-            pass  # e.g. an iterate whose event sequence the re-integration does not reproduce
-    return _monodromy(params, model, s0, T, free, cols, h, **opts)
-
-
 def periodic_orbit(
     params: Parameters | None = None,
     guess=None,
@@ -252,7 +187,7 @@ def periodic_orbit(
     ----------
     params : Parameters, optional
         Physical parameters (default: those of ``guess`` if it is a Trajectory, else Table 1).
-    guess : Trajectory, array-like (12,), or "equilibrium"/"zero"
+    guess : Trajectory, array-like (N_STATES,), or "equilibrium"/"zero"
         A Trajectory near the orbit (its last ``period_multiplicity + 1`` section crossings give
         the starting state and period), or an initial state from which a ``search_time`` run
         is made to find them.
@@ -306,18 +241,13 @@ def periodic_orbit(
     k = int(period_multiplicity)
     if k < 1:
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")
-    if monodromy not in _var.METHODS:
-        raise OrbitError(f"unknown monodromy method {monodromy!r}; use one of {_var.METHODS}")
-    if newton_jacobian not in _var.METHODS:
-        raise OrbitError(f"unknown newton_jacobian {newton_jacobian!r}; use one of {_var.METHODS}")
+    check_method(monodromy)
+    check_method(newton_jacobian, "newton_jacobian")
     atol = 1e-3 * rtol if atol is None else float(atol)
     sec = resolve_section(section)
     system = assemble(params, model, slip_band)
     model = system.variant.name
-    free_dofs = system.variant.free_indices
-    free = np.concatenate([free_dofs, free_dofs + 6])
-    if sec.index not in free:
-        raise OrbitError(f"section {sec.name} fixes {STATE_NAMES[sec.index]}, which is locked in model {model!r}")
+    check_section(sec, system)
     opts = dict(rtol=rtol, atol=atol, slip_band=slip_band)
 
     if guess is None:
@@ -331,71 +261,24 @@ def periodic_orbit(
         if guess.status != "success":
             raise OrbitError(f"the search run failed: {guess.status}")
     s0, T, ptp, _ = _guess_from_samples(params, model, system, sec, guess.t, guess.states, guess.mode, k, **opts)
-    sigma = _scales(ptp, free)
-    h = np.zeros(12)
-    h[free] = fd_step * sigma
-    cols = [j for j in free if j != sec.index]
-
-    def residual(s, T):
-        end, tr = flow(params, model, s, T, **opts)
-        return (end[free] - s[free]) / sigma, end, tr
-
-    R, end, tr = residual(s0, T)
-    history = [float(np.max(np.abs(R)))]
-    it = 0
-    while history[-1] > tol:
-        if it >= max_iter:
-            raise OrbitError(
-                f"Newton did not converge in {max_iter} iterations (scaled residuals "
-                f"{', '.join(f'{r:.2e}' for r in history)}; tol {tol:.1e}). The orbit may be "
-                "non-periodic, or the guess too far: give a guess closer to the orbit or raise max_iter"
-            )
-        A = np.empty((free.size, free.size))
-        A[:, :-1] = _newton_columns(params, model, s0, T, free, cols, h, sigma, newton_jacobian, opts)
-        A[:, :-1] -= np.eye(free.size)[:, [list(free).index(j) for j in cols]]
-        A[:, :-1] *= sigma[[list(free).index(j) for j in cols]][None, :]  # unknowns in σ units
-        A[:, :-1] /= sigma[:, None]
-        A[:, -1] = vector_field(system, end)[free] / sigma
-        step = np.linalg.lstsq(A, -R, rcond=None)[0]
-        lam = 1.0
-        for _ in range(MAX_HALVINGS + 1):
-            s_new = s0.copy()
-            for c_i, j in enumerate(cols):
-                s_new[j] += lam * step[c_i] * sigma[list(free).index(j)]
-            T_new = T + lam * step[-1]
-            try:
-                R_new, end_new, tr_new = residual(s_new, T_new)
-            except (OrbitError, SimulationError):
-                lam *= 0.5
-                continue
-            if np.max(np.abs(R_new)) < history[-1]:
-                break
-            lam *= 0.5
-        else:
-            raise OrbitError(
-                f"Newton step {it + 1} does not reduce the residual (history "
-                f"{', '.join(f'{r:.2e}' for r in history)}); the guess is too far or the orbit is not isolated"
-            )
-        s0, T, R, end, tr = s_new, T_new, R_new, end_new, tr_new
-        history.append(float(np.max(np.abs(R))))
-        it += 1
-
+    problem = ShootingProblem.build(params, model, sigma=scales(ptp, free_states(system)), section=sec, system=system,
+                                    fd_step=fd_step, **opts)
+    orbit = problem.newton(s0, T, tol=tol, max_iter=max_iter, method=newton_jacobian)
     method = monodromy
     if method == "saltation":
         try:
-            M = _var.flow_jacobian(params, model, s0, T, scale=sigma, **opts).matrix[np.ix_(free, free)]
+            M, _ = problem.monodromy(orbit.state, orbit.period, method)
         except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError) as exc:
             warnings.warn(f"saltation monodromy failed ({exc}); using finite differences", RuntimeWarning,
                           stacklevel=2)
             method = "finite-difference"
     if method == "finite-difference":
-        M = _monodromy(params, model, s0, T, free, list(free), h, **opts)
-    mult = _var.sorted_eigenvalues(M)
-    sticks = int(np.sum(tr.kind == 1))
+        M, _ = problem.monodromy(orbit.state, orbit.period, method)
     return PeriodicOrbit(
-        state=s0, period=float(T), multiplicity=k, stick_phases=sticks, residual=history[-1],
-        iterations=it, residual_history=np.array(history), multipliers=mult, monodromy=M,
-        free_states=tuple(STATE_NAMES[j] for j in free), scale=sigma, params=params, model=model,
-        section=sec, options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method,
-                                  newton_jacobian=newton_jacobian),
+        state=orbit.state, period=orbit.period, multiplicity=k, stick_phases=stick_count(orbit.transitions),
+        residual=orbit.history[-1], iterations=orbit.iterations, residual_history=np.array(orbit.history),
+        multipliers=sorted_eigenvalues(M), monodromy=M, free_states=tuple(STATE_NAMES[j] for j in problem.free),
+        scale=problem.sigma, params=params, model=model, section=sec,
+        options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method,
+                     newton_jacobian=newton_jacobian),
     )

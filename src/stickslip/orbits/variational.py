@@ -1,4 +1,4 @@
-"""Monodromy matrices from the variational equations with saltation matrices (issue 6).
+"""The linearised flow map across stick↔slip transitions: variational equations with saltation matrices.
 
 The linearised flow ∂Φ(s0, t)/∂s0 of the non-smooth stick-slip system is the product of the
 linearised flows of the smooth segments between transitions and of one jump matrix per
@@ -6,9 +6,9 @@ transition (docs/orbits.md, "Saltation monodromy", has the derivation):
 
 * **smooth segments**: δṡ = J(s) δs, J the Jacobian of the right-hand side of the segment's
   mode (slip: paper Eq. 1 with Eq. 3 and the direction v_r/|v_r| of Eq. 9; stick: Eq. 1 with
-  the stick multiplier, DESIGN.md §1; the low-speed band after breakaway: the quasi-static
-  direction of :func:`stickslip.model.kernels.quasi_static_direction`). The slip Jacobian is
-  analytic in the friction force (its 1/|v_r| direction term grows without bound on the
+  the stick multiplier of docs/numerics.md; the low-speed band after breakaway: the
+  quasi-static direction of :func:`stickslip.model.kernels.quasi_static_direction`). The slip
+  Jacobian is analytic in the friction force (its 1/|v_r| direction term grows without bound on the
   approach to stick, but times the time left, |v_r|/|dv_r/dt|, it stays O(1), so an explicit
   adaptive method takes geometrically shrinking steps, ~15 per decade of |v_r|); the smooth
   parts (the stick multiplier, the residual of the quasi-static direction) are differenced
@@ -48,12 +48,13 @@ from ..integrate import events as E
 from ..integrate.events import STICK_SPEED_TOL
 from ..model import kernels as K
 from ..model.kernels import DEFAULT_SLIP_BAND
-from ..model.parameters import Parameters, parameter_attrs
+from ..model.parameters import Parameters
 from ..model.system import System, assemble
 from ..model.variants import STATE_NAMES
+from .layout import free_states, stick_projected
 from .section import OrbitError, flow
 
-__all__ = ["FlowJacobian", "Monodromy", "flow_jacobian", "monodromy", "state_jacobian",
+__all__ = ["FlowJacobian", "flow_jacobian", "free_states", "propagate", "state_jacobian",
            "saltation_matrix"]
 
 #: |v_r| [m/s] at which the integration of an approach to stick stops and the arrival jump is
@@ -693,7 +694,7 @@ class FlowJacobian:
 
 def _default_steps(system: System, scale) -> np.ndarray:
     """Difference steps (12,) of the smooth Jacobian parts: FD_REL_STEP × a state scale."""
-    free = np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
+    free = free_states(system)
     steps = np.zeros(12)
     if scale is None:
         # characteristic magnitudes of the paper's cases: 1e-3 m / 1e-2 rad, 1e-2 m/s / 0.1 rad/s
@@ -750,11 +751,6 @@ def flow_jacobian(params: Parameters, model, s0, duration: float, *, rtol: float
     M[np.ix_(free, free)] = Phi[np.ix_(free, free)]
     return FlowJacobian(matrix=M, state0=s0, state=np.asarray(end).copy(), duration=float(duration),
                         events=tuple(events), mismatch=mismatch, wall_time=_time.perf_counter() - t_start)
-
-
-def free_states(system: System) -> np.ndarray:
-    """Indices (2 n_free,) of the free states of the system's variant (positions, velocities)."""
-    return np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
 
 
 def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, after=None,
@@ -819,10 +815,7 @@ def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=N
     Fx, Fy, _ = K.stick_force(y, system.minv, system.damp, system.stiff, system.p)
     if math.hypot(vx, vy) <= STICK_SPEED_TOL and math.hypot(Fx, Fy) <= K.static_limit(system.p):
         mode, e = K.MODE_STICK, (0.0, 0.0)
-        yy = np.zeros(14)
-        yy[:12] = y
-        K.project_velocity(yy, system.minv, system.p)
-        y = yy[:12].copy()
+        y = stick_projected(system, y)
         Phi = stick_projection(system, y) @ Phi
     elif math.hypot(vx, vy) > STICK_SPEED_TOL:
         mode, e = K.MODE_SLIP_EXACT, (vx, vy)
@@ -882,7 +875,7 @@ def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=N
             elif sol.status == 1 and t_ev < t_next - MATCH_TIME_TOL:
                 # v_r reaches 0 before the next recorded transition: the stick force must be
                 # inadmissible there (a velocity reversal, which the integrator does not record)
-                s_r = _projected(system, s_c)
+                s_r = stick_projected(system, s_c)
                 Fx, Fy, _ = K.stick_force(s_r, system.minv, system.damp, system.stiff, system.p)
                 norm = math.hypot(Fx, Fy)
                 if norm <= K.static_limit(system.p):
@@ -902,156 +895,20 @@ def propagate(system: System, s0, T: float, tr, end, Phi: np.ndarray, *, scale=N
     return Phi, events, mismatch
 
 
-def _projected(system: System, s: np.ndarray) -> np.ndarray:
-    """The state with q̇ projected onto v_r = 0 (:func:`kernels.project_velocity`), (12,)."""
-    yy = np.zeros(14)
-    yy[:12] = s[:12]
-    K.project_velocity(yy, system.minv, system.p)
-    return yy[:12].copy()
-
-
 def _pad(P: np.ndarray) -> np.ndarray:
     out = np.zeros((12, 12))
     out[:, :P.shape[1]] = P
     return out
 
 
-# --------------------------------------------------------------------------------------------
-# Monodromy of a periodic orbit
-# --------------------------------------------------------------------------------------------
-
-METHODS = ("saltation", "finite-difference")
+#: Names that moved to :mod:`.problem` (the shooting problem and an orbit's monodromy), still
+#: importable from here.
+_MOVED = ("METHODS", "Monodromy", "monodromy", "fd_monodromy", "sorted_eigenvalues")
 
 
-@dataclasses.dataclass(frozen=True, eq=False)
-class Monodromy:
-    """Monodromy matrix and Floquet multipliers of a periodic orbit.
+def __getattr__(name):
+    if name in _MOVED:
+        from . import problem
 
-    Attributes
-    ----------
-    matrix : ndarray (2 n_free, 2 n_free)
-        ∂Φ(s0, T)/∂s0 on the free states [SI units].
-    multipliers : ndarray (2 n_free,) complex
-        Its eigenvalues by decreasing modulus [-].
-    method : str
-        ``"saltation"`` (variational equations with jump matrices) or ``"finite-difference"``.
-    period : float
-        T [s].
-    free_states : tuple of str
-    events : tuple of (float, str)
-        Jumps applied (saltation only): (instant [s], "stick" | "breakaway" | "band").
-    wall_time : float
-        Seconds taken.
-    params : Parameters
-    model : str
-    """
-
-    matrix: np.ndarray
-    multipliers: np.ndarray
-    method: str
-    period: float
-    free_states: tuple
-    events: tuple
-    wall_time: float
-    params: Parameters
-    model: str
-
-    @property
-    def trivial_multiplier(self) -> complex:
-        """The multiplier closest to 1 (the shift along the orbit) [-]."""
-        return complex(self.multipliers[np.argmin(np.abs(self.multipliers - 1.0))])
-
-    @property
-    def nontrivial_multipliers(self) -> np.ndarray:
-        """All multipliers but the trivial one, by decreasing modulus [-]."""
-        return np.delete(self.multipliers, int(np.argmin(np.abs(self.multipliers - 1.0))))
-
-    @property
-    def stable(self) -> bool:
-        """True if every non-trivial multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.nontrivial_multipliers) < 1.0))
-
-    def to_xarray(self):
-        """``xarray.Dataset``: matrix and multipliers, method and period as attributes."""
-        import xarray as xr
-
-        data = {
-            "monodromy": (("free_state", "free_state_0"), self.matrix,
-                          {"long_name": f"monodromy matrix d s(T) / d s(0) ({self.method})", "units": "SI"}),
-            "multiplier_real": ("multiplier", self.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
-            "multiplier_imag": ("multiplier", self.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
-            "multiplier_abs": ("multiplier", np.abs(self.multipliers), {"long_name": "Floquet multiplier modulus", "units": "1"}),
-        }
-        attrs = {"title": "stickslip monodromy matrix", "stickslip_version": __version__, "model": self.model,
-                 "method": self.method, "period": self.period, "period_units": "s",
-                 "wall_time_s": self.wall_time, "events": json.dumps(self.events),
-                 "parameters": json.dumps(self.params.to_dict())}
-        attrs.update(parameter_attrs(self.params.to_dict()))
-        coords = {"free_state": list(self.free_states), "free_state_0": list(self.free_states)}
-        return xr.Dataset(data, coords=coords, attrs=attrs)
-
-
-def sorted_eigenvalues(M: np.ndarray) -> np.ndarray:
-    """Eigenvalues of M by decreasing modulus (stable order for equal moduli)."""
-    mult = np.linalg.eigvals(M)
-    return mult[np.argsort(-np.abs(mult), kind="stable")]
-
-
-def monodromy(orbit, method: str = "saltation", *, fd_step: float | None = None) -> Monodromy:
-    """Monodromy matrix of a periodic orbit on its free states.
-
-    Parameters
-    ----------
-    orbit : PeriodicOrbit
-        From :func:`stickslip.orbits.periodic_orbit` (state, period, params, model, scale,
-        options rtol/atol/slip_band/fd_step are used).
-    method : {"saltation", "finite-difference"}
-        ``saltation``: variational equations along the orbit with jump matrices at every
-        stick↔slip transition (:func:`flow_jacobian`). ``finite-difference``: central
-        differences of the flow map, two ``event`` runs per column (perturbed shooting).
-    fd_step : float, optional
-        Relative step of the finite differences (default: the orbit's).
-
-    Returns
-    -------
-    Monodromy
-    """
-    if method not in METHODS:
-        raise OrbitError(f"unknown monodromy method {method!r}; use one of {METHODS}")
-    t0 = _time.perf_counter()
-    opt = orbit.options
-    system = assemble(orbit.params, orbit.model, opt["slip_band"])
-    free = np.concatenate([system.variant.free_indices, system.variant.free_indices + 6])
-    events: tuple = ()
-    if method == "saltation":
-        fj = flow_jacobian(orbit.params, orbit.model, orbit.state, orbit.period, rtol=opt["rtol"],
-                           atol=opt["atol"], slip_band=opt["slip_band"], scale=orbit.scale)
-        M = fj.matrix[np.ix_(free, free)]
-        events = fj.events
-    else:
-        step = opt.get("fd_step", 1e-5) if fd_step is None else fd_step
-        M = fd_monodromy(orbit.params, orbit.model, orbit.state, orbit.period, free,
-                         step * np.asarray(orbit.scale), rtol=opt["rtol"], atol=opt["atol"],
-                         slip_band=opt["slip_band"])
-    return Monodromy(matrix=M, multipliers=sorted_eigenvalues(M), method=method, period=float(orbit.period),
-                     free_states=tuple(STATE_NAMES[j] for j in free), events=events,
-                     wall_time=_time.perf_counter() - t0, params=orbit.params, model=orbit.model)
-
-
-def fd_monodromy(params, model, s0, T, free, h_free, *, rtol, atol, slip_band, cols=None) -> np.ndarray:
-    """Central-difference columns ∂Φ(s0, T)/∂s0[j] (free-state rows) for the state indices
-    ``cols`` (default: all free states), steps ``h_free`` (2 n_free,) on the free states [SI]."""
-    free = np.asarray(free)
-    cols = list(free) if cols is None else list(cols)
-    h = np.zeros(12)
-    h[free] = h_free
-    out = np.empty((free.size, len(cols)))
-    for k, j in enumerate(cols):
-        sp = np.asarray(s0, dtype=float).copy()
-        sm = sp.copy()
-        sp[j] += h[j]
-        sm[j] -= h[j]
-        fp, _ = flow(params, model, sp, T, rtol=rtol, atol=atol, slip_band=slip_band)
-        fm, _ = flow(params, model, sm, T, rtol=rtol, atol=atol, slip_band=slip_band)
-        out[:, k] = (fp[free] - fm[free]) / (2.0 * h[j])
-    return out
+        return getattr(problem, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ._common import SYMBOLS, param_label, param_text
+
 __all__ = ["plot_branch", "save_branch_figure", "plot_region_edge", "SPECIAL_MARKERS"]
 
 #: Marker and colour of each kind of special point.
@@ -34,14 +36,15 @@ def _branch_data(branch) -> dict:
         return {"param": branch.param, "value": branch.values, "period": branch.periods,
                 "amplitude": branch.amplitude, "stick_time": branch.stick_time, "stable": branch.stable.astype(bool),
                 "special": [(p.kind, p.index, p.value) for p in sp], "model": branch.model,
-                "N": branch.params.N, "Omega": branch.params.Omega}
+                "N": branch.params.N, "Omega": branch.params.Omega, "stop_reason": branch.stop_reason}
     ds = branch
     return {"param": ds.attrs["param"], "value": ds["value"].values, "period": ds["period"].values,
             "amplitude": ds["amplitude"].values, "stick_time": ds["stick_time"].values,
             "stable": ds["stable"].values.astype(bool),
             "special": [(str(k), int(i), float(v)) for k, i, v in zip(ds["special_kind"].values, ds["special_index"].values,
                                                                        ds["special_value"].values)],
-            "model": ds.attrs["model"], "N": ds.attrs.get("param_N"), "Omega": ds.attrs.get("param_Omega")}
+            "model": ds.attrs["model"], "N": ds.attrs.get("param_N"), "Omega": ds.attrs.get("param_Omega"),
+            "stop_reason": ds.attrs.get("stop_reason")}
 
 
 def _stability_segments(x, y, stable):
@@ -92,7 +95,7 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True, colo
         ax.plot(xs, ys, "-" if st else "--", color=color, lw=1.4)
     prefix = "" if label is None else f"{label}: "
     handles = [Line2D([], [], color=color, ls=ls, label=prefix + name)
-               for ls, name, on in (("-", "stable", stable.any()), ("--", "unstable", (~stable).any())) if on or label is None]
+               for ls, name, on in (("-", "stable", stable.any()), ("--", "unstable", (~stable).any())) if on]
     seen = set()
     for kind, i, value in d["special"]:
         marker, colour = SPECIAL_MARKERS.get(kind, ("x", "k"))
@@ -102,10 +105,7 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True, colo
         if kind not in seen:
             handles.append(Line2D([], [], marker=marker, color=colour, ls="", mfc="none", mew=1.8, label=kind))
             seen.add(kind)
-    from ..model.parameters import PARAMETER_UNITS
-
-    unit = PARAMETER_UNITS.get(d["param"], "")
-    ax.set_xlabel(f"{d['param']} [{unit}]" if unit else d["param"])
+    ax.set_xlabel(param_label(d["param"]))
     ax.set_ylabel(_YLABELS[y])
     ax.grid(alpha=0.3)
     if legend:
@@ -122,9 +122,11 @@ def save_branch_figure(branch, path, *, dpi: int = 110) -> Path:
     plot_branch(branch, axes[0], y="period")
     plot_branch(branch, axes[1], y="amplitude", legend=False)
     plot_branch(branch, axes[2], y="stick_time", legend=False)
-    fixed = ", ".join(f"{k} = {v:g}" for k, v in (("N", d["N"]), ("Omega", d["Omega"]))
+    fixed = ", ".join(param_text(k, v) for k, v in (("N", d["N"]), ("Omega", d["Omega"]))
                       if k != d["param"] and v is not None)
-    fig.suptitle(f"Branch of periodic orbits in {d['param']} (model {d['model']}; {fixed})", fontsize=10)
+    ends = f"; stopped: {d['stop_reason']}" if d.get("stop_reason") else ""
+    fig.suptitle(f"Branch of periodic orbits in {SYMBOLS.get(d['param'], d['param'])} (model {d['model']}; {fixed}"
+                 f"{ends})", fontsize=10)
     path = Path(path)
     fig.savefig(path, dpi=dpi)
     plt.close(fig)

@@ -8,6 +8,10 @@ import numpy as np
 
 from .trajectory import _shade_stick, stick_intervals
 
+#: Exponents at or below this [1/s] are left out of :func:`plot_lyapunov_spectrum` by default:
+#: the directions a stick phase collapses, −∞ in exact arithmetic.
+SHOWN_ABOVE = -10.0
+
 __all__ = ["plot_lyapunov_convergence", "plot_lyapunov_spectrum", "plot_orbit", "plot_multipliers",
            "save_orbit_figure", "save_lyapunov_spectrum_figure"]
 
@@ -68,19 +72,25 @@ def plot_lyapunov_spectrum(spectrum, reference=None, n_show=None, ax=None):
     fig, ax = _figure_axes(ax, (6.4, 3.8))
     order = np.argsort(-spectrum.exponents)
     if n_show is None:
-        order = [i for i in order if spectrum.exponents[i] > -10.0]
+        order = [i for i in order if spectrum.exponents[i] > SHOWN_ABOVE]
+        left_out = f"{spectrum.exponents.size - len(order)} exponents below {SHOWN_ABOVE:g} 1/s not shown".replace("-", "−")
     else:
         order = order[:n_show]
+        left_out = f"{spectrum.exponents.size - len(order)} smallest exponents not shown"
     for rank, i in enumerate(order, start=1):
         ax.plot(spectrum.time, spectrum.estimate[:, i], lw=1.0,
                 label=f"λ{rank} = {spectrum.exponents[i]:+.4f} 1/s")
     if reference is not None:
         for v in np.asarray(reference, dtype=float):
-            if v > -10.0:
+            if v > SHOWN_ABOVE:
                 ax.axhline(v, color="0.4", lw=0.6, ls="--")
     ax.axhline(0.0, color="k", lw=0.6)
     p = spectrum.params
-    ax.set_title(f"{spectrum.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s", fontsize=9)
+    title = (f"model {spectrum.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s: averaged over "
+             f"{spectrum.time[-1]:g} s after a {spectrum.t_transient:g} s transient")
+    if len(order) < spectrum.exponents.size:
+        title += f"\n({left_out})"
+    ax.set_title(title, fontsize=9)
     ax.set_xlabel("averaging time [s]")
     ax.set_ylabel("Lyapunov exponent estimate [1/s]")
     ax.legend(fontsize=6, ncol=2)

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .sweep import _edges, _new_figure
+from ._common import MODEL_LABELS, cell_edges, grid_axis, is_geometric, param_text
+from .sweep import _new_figure
 
 __all__ = ["plot_regions", "plot_stick_slip_domains", "save_regions_figure", "REGION_STYLE", "MODEL_LABELS"]
 
@@ -23,10 +24,6 @@ REGION_STYLE = {
     3: ("#4c9be8", "III: equilibrium only"),
 }
 
-#: The paper's names of the model variants (Sect. 4.2.3).
-MODEL_LABELS = {"full": "Model 1 (full)", "x": "Model 2 (x translation)", "y": "Model 3 (y translation)",
-                "rotation": "Model 4 (rotation only)"}
-
 
 def _dataset(rmap):
     return getattr(rmap, "dataset", rmap)
@@ -34,7 +31,7 @@ def _dataset(rmap):
 
 def _params_line(ds) -> str:
     p = json.loads(ds.attrs.get("parameters", "{}"))
-    parts = [f"μk = {p['mu_k']:g}, Δμ = {p['delta_mu']:g}, α = {p['alpha']:g}"] if p else []
+    parts = [param_text(k, p[k]) for k in ("mu_k", "delta_mu", "alpha") if k in p]
     parts.append(f"{ds.attrs.get('t_end', float('nan')):g} s runs, steady window from {ds.attrs.get('t_from', float('nan')):g} s")
     return ", ".join(parts)
 
@@ -74,11 +71,13 @@ def plot_regions(rmap, ax=None, *, model: str | None = None, boundary: bool = Tr
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+    ds = ds.sortby("N").sortby("Omega")
     N, W = ds["N"].values.astype(float), ds["Omega"].values.astype(float)
     region = ds["region"].sel(model=model).transpose("N", "Omega").values
     cmap = ListedColormap([REGION_STYLE[c][0] for c in sorted(REGION_STYLE)])
     norm = BoundaryNorm(np.arange(-0.5, 4.5), cmap.N)
-    ax.pcolormesh(_edges(N), _edges(W), region.T, cmap=cmap, norm=norm, edgecolors="white", linewidth=0.3)
+    (ne, ns), (we, ws) = cell_edges(N), cell_edges(W)
+    ax.pcolormesh(ne, we, region.T, cmap=cmap, norm=norm, edgecolors="white", linewidth=0.3)
     handles = [Patch(color=REGION_STYLE[c][0], label=REGION_STYLE[c][1]) for c in sorted(REGION_STYLE)
                if np.any(region == c)]
     if boundary:
@@ -86,8 +85,8 @@ def plot_regions(rmap, ax=None, *, model: str | None = None, boundary: bool = Tr
         if np.any(np.isfinite(omax)):
             ax.plot(N, omax, "k.-", lw=1.5, ms=5)
             handles.append(Line2D([], [], color="k", marker=".", lw=1.5, label="largest Ω with stick-slip"))
-    ax.set_xlim(_edges(N)[0], _edges(N)[-1])
-    ax.set_ylim(_edges(W)[0], _edges(W)[-1])
+    grid_axis(ax, "x", ne, ns, N)
+    grid_axis(ax, "y", we, ws, W)
     ax.set_xlabel("normal load N [N]")
     ax.set_ylabel("Ω [rad/s]")
     ax.set_title(MODEL_LABELS.get(model, f"model {model}") if title is None else title, fontsize=10)
@@ -112,6 +111,7 @@ def plot_stick_slip_domains(rmap, ax=None, *, legend: bool = True):
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+    ds = ds.sortby("N").sortby("Omega")
     N, W = ds["N"].values.astype(float), ds["Omega"].values.astype(float)
     styles = ["o-", "s--", "^-.", "v:"]
     found = False
@@ -122,8 +122,13 @@ def plot_stick_slip_domains(rmap, ax=None, *, legend: bool = True):
     if not found:
         ax.text(0.5, 0.5, "no stick-slip on this grid", transform=ax.transAxes, ha="center", va="center", color="0.4")
     ax.axhline(W[-1], color="0.6", lw=0.8, ls=":", label="top of the Ω grid")
-    ax.set_xlim(_edges(N)[0], _edges(N)[-1])
-    ax.set_ylim(0.0, W[-1] + 0.06 * (W[-1] - W[0] if W.size > 1 else 1.0))
+    ne, ns = cell_edges(N)
+    grid_axis(ax, "x", ne, ns)
+    if is_geometric(W):
+        ax.set_yscale("log")
+        ax.set_ylim(W[0] / 1.2, W[-1] * 1.2)
+    else:
+        ax.set_ylim(min(0.0, W[0]), W[-1] + 0.06 * (W[-1] - W[0] if W.size > 1 else 1.0))
     ax.set_xlabel("normal load N [N]")
     ax.set_ylabel("largest Ω with stick-slip [rad/s]")
     ax.set_title("stick-slip domains (below each curve)", fontsize=10)

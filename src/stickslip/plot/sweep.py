@@ -14,11 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ..model.parameters import PARAMETER_UNITS
+from ._common import MODEL_LABELS, SYMBOLS, agg_figure, cell_edges, grid_axis, is_geometric, param_text, unit_text
+
 __all__ = ["plot_reduction", "save_sweep_figure", "plot_bifurcation", "save_bifurcation_figure", "KIND_STYLE",
-           "axis_label"]
+           "kind_styles", "axis_label"]
 
 #: Colour and label of each steady-state kind code (:data:`stickslip.analysis.classify.KINDS`,
-#: −1 = the run failed).
+#: −1 = the run failed). A sweep file names its codes in the ``flag_values`` / ``flag_meanings``
+#: attributes of ``kind``; :func:`kind_styles` reads them and keeps these colours for known kinds.
 KIND_STYLE = {
     -1: ("#d62728", "failed"),
     0: ("#7f7f7f", "equilibrium"),
@@ -27,12 +31,29 @@ KIND_STYLE = {
     3: ("#ff7f0e", "non-periodic"),
 }
 
+#: Colours of kinds that :data:`KIND_STYLE` does not know, in order of their codes.
+_EXTRA_COLOURS = ("#9467bd", "#2ca02c", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
+
+#: Kinds without an oscillation: their cells carry their own colour in maps of :data:`OSCILLATION_VARS`.
+NOT_OSCILLATING = ("failed", "equilibrium", "unbounded")
+
+#: Reductions that describe an oscillation and mean nothing at rest (at an equilibrium the
+#: sweep stores the decay frequency and the peak-to-peak range of the dying transient).
+OSCILLATION_VARS = ("frequency", "fft_frequency", "fundamental_frequency", "dominant_frequency", "period",
+                    "multiplicity", "period_count", "amplitude", "n_peaks")
+
+#: Colour and label of a cell without a value whose run did not say why (not computed, or NaN).
+NO_VALUE = ("#e0e0e0", "no value")
+
 #: Most panels drawn by :func:`save_sweep_figure`; further combinations of the panel dimensions
 #: are left out (named in the title) so a figure stays readable.
 MAX_PANELS = 12
 
-_SYMBOLS = {"N": "N", "Omega": "Ω", "mu_k": "μk", "delta_mu": "Δμ", "alpha": "α"}
 _CATEGORICAL = ("model", "ic")
+
+#: Names of reductions on axes and colour bars (others go by their variable name).
+_VAR_NAMES = {"stick_fraction": "stick fraction", "fft_frequency": "FFT frequency", "intensity_r_phi": "I(rφ)",
+              "intensity_x1": "I(x1)", "intensity_y1": "I(y1)", "intensity_translation": "I(x1, y1)"}
 
 
 def _dataset(result):
@@ -40,12 +61,16 @@ def _dataset(result):
 
 
 def axis_label(ds, name: str) -> str:
-    """``"Ω [rad/s]"``-style label of a coordinate or variable from its attributes."""
-    attrs = ds[name].attrs if name in ds.variables else {}
-    symbol = _SYMBOLS.get(name, name)
-    text = symbol
-    units = attrs.get("units", "")
-    return f"{text} [{units}]" if units and units != "1" else text
+    """``"Ω [rad/s]"``-style label of a coordinate or variable from its attributes (``[-]`` when
+    dimensionless)."""
+    try:
+        attrs = ds[name].attrs  # a variable or coordinate of a Dataset, a coordinate of a DataArray
+    except KeyError:
+        attrs = {}
+    units = attrs.get("units", PARAMETER_UNITS.get(name, ""))
+    unit = unit_text(units)
+    symbol = SYMBOLS.get(name, _VAR_NAMES.get(name, name))
+    return f"{symbol} {unit}" if unit else symbol
 
 
 def _grid_dims(ds) -> list[str]:
@@ -65,25 +90,113 @@ def _split_dims(ds, var: str):
     return plotted, panels
 
 
-def _fmt(value) -> str:
-    return f"{value:g}" if isinstance(value, (float, np.floating)) else str(value)
+def _norm_name(name: str) -> str:
+    return name.replace("-", "").replace("_", "").replace(" ", "").lower()
 
 
-def _edges(v: np.ndarray) -> np.ndarray:
-    """Cell edges around grid values (midpoints; half a spacing beyond the ends)."""
-    v = np.asarray(v, dtype=float)
-    if v.size == 1:
-        return np.array([v[0] - 0.5, v[0] + 0.5])
-    mid = 0.5 * (v[1:] + v[:-1])
-    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+def kind_styles(ds) -> dict[int, tuple[str, str]]:
+    """{code: (colour, label)} of the steady-state kinds of a sweep, from the ``flag_values`` and
+    ``flag_meanings`` of its ``kind`` variable (:data:`KIND_STYLE` when it has none); kinds that
+    :data:`KIND_STYLE` does not know get colours of their own."""
+    attrs = ds["kind"].attrs if "kind" in ds.variables else {}
+    values, meanings = attrs.get("flag_values"), attrs.get("flag_meanings")
+    if values is None or meanings is None:
+        return dict(KIND_STYLE)
+    codes = [int(v) for v in (values.split() if isinstance(values, str) else np.atleast_1d(values))]
+    known = {_norm_name(label): (colour, label) for colour, label in KIND_STYLE.values()}
+    extra = iter(_EXTRA_COLOURS)
+    styles = {}
+    for code, name in zip(codes, str(meanings).split()):
+        colour, label = known.get(_norm_name(name), (None, name.replace("-", " ")))
+        styles[code] = (colour if colour is not None else next(extra, "#000080"), label)
+    return styles
 
 
-def _kind_cmap():
-    from matplotlib.colors import BoundaryNorm, ListedColormap
+#: Class of a cell drawn on the colour scale, and of a cell without a value and without a kind
+#: that explains it (:data:`NO_VALUE`); other classes are kind codes.
+_ON_SCALE, _NO_VALUE = -1000, -999
 
-    codes = sorted(KIND_STYLE)
-    cmap = ListedColormap([KIND_STYLE[c][0] for c in codes])
-    return cmap, BoundaryNorm(np.arange(codes[0] - 0.5, codes[-1] + 1.5), cmap.N)
+
+def _classes(values, kind, styles, var) -> np.ndarray:
+    """Class of each cell (int array): :data:`_ON_SCALE`, or the kind code where the kind has no
+    oscillation and either ``var`` describes one or the value is missing, or :data:`_NO_VALUE`
+    where the value is missing otherwise. For ``var == "kind"`` the values are the classes."""
+    values = np.asarray(values, dtype=float)
+    if var == "kind":
+        return np.where(np.isfinite(values), values, _NO_VALUE).astype(int)
+    kind = np.full(values.shape, np.nan) if kind is None else np.asarray(kind, dtype=float)
+    out = np.full(values.shape, _ON_SCALE, dtype=int)
+    for code, (_, label) in styles.items():
+        if label in NOT_OSCILLATING:
+            out[(kind == code) & ((var in OSCILLATION_VARS) | ~np.isfinite(values))] = code
+    out[(out == _ON_SCALE) & ~np.isfinite(values)] = _NO_VALUE
+    return out
+
+
+def _class_style(key: int, styles, var: str) -> tuple[str, str]:
+    """(colour, legend label) of a cell class; a kind without oscillation says what it lacks."""
+    if key == _NO_VALUE:
+        return NO_VALUE
+    colour, label = styles.get(int(key), (_EXTRA_COLOURS[-1], f"kind {int(key)}"))
+    if var in OSCILLATION_VARS and label in NOT_OSCILLATING:
+        label += f" (no {var})"
+    return colour, label
+
+
+def _heat_map(ax, da, kind, x, y, var, styles, label, colorbar):
+    """Cells over the true cell edges of (x, y); off-scale classes in their own colours, named
+    in a legend below the axes (where it hides no cell)."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    z = da.transpose(y, x).values.astype(float)
+    cls = _classes(z, None if kind is None else kind.transpose(y, x).values, styles, var)
+    (xe, xs), (ye, ys) = cell_edges(da[x].values), cell_edges(da[y].values)
+    on_scale = cls == _ON_SCALE
+    if np.any(on_scale):
+        mesh = ax.pcolormesh(xe, ye, np.ma.masked_where(~on_scale, z), cmap="viridis")
+        if colorbar:
+            ax.figure.colorbar(mesh, ax=ax, label=label)
+    keys = np.unique(cls[~on_scale])  # sorted: no value first, then the kind codes
+    if keys.size:
+        styled = [_class_style(k, styles, var) for k in keys]
+        index = np.searchsorted(keys, cls)
+        cmap = ListedColormap([colour for colour, _ in styled])
+        ax.pcolormesh(xe, ye, np.ma.masked_where(on_scale, index), cmap=cmap, vmin=-0.5, vmax=keys.size - 0.5)
+        ax.legend(handles=[Patch(color=c, label=t) for c, t in styled], fontsize=7, loc="upper center",
+                  bbox_to_anchor=(0.5, -0.14), ncol=min(3, keys.size), frameon=False)
+    grid_axis(ax, "x", xe, xs, da[x].values)
+    grid_axis(ax, "y", ye, ys, da[y].values)
+    ax.set_xlabel(axis_label(da, x))
+    ax.set_ylabel(axis_label(da, y))
+
+
+def _line_plot(ax, da, kind, x, categorical, var, styles, label):
+    """Values against one parameter; off-scale points as ticks on the lower edge, in their colours."""
+    groups = [(None, da, kind)] if not categorical else [
+        (c, da.sel({categorical: c}), None if kind is None else kind.sel({categorical: c}))
+        for c in da[categorical].values]
+    xs = da[x].values.astype(float)
+    marked = {}
+    for cat, line, kline in groups:
+        ys = line.transpose(x).values.astype(float)
+        cls = (np.full(ys.shape, _ON_SCALE) if var == "kind" else
+               _classes(ys, None if kline is None else kline.transpose(x).values, styles, var))
+        ax.plot(xs, np.where(cls == _ON_SCALE, ys, np.nan), "o-", ms=3, lw=1.2,
+                label=None if cat is None else f"{categorical} = {cat}")
+        for key in np.unique(cls[cls != _ON_SCALE]):
+            marked.setdefault(int(key), []).extend(xs[cls == key])
+    for key in sorted(marked):
+        colour, text = _class_style(key, styles, var)
+        ax.plot(marked[key], np.zeros(len(marked[key])), "|", color=colour, ms=12, mew=2,
+                transform=ax.get_xaxis_transform(), label=text)
+    if var == "kind":
+        ax.set_yticks(sorted(styles), [styles[c][1] for c in sorted(styles)])
+    if categorical or marked:
+        ax.legend(fontsize=8)
+    ax.set_xlabel(axis_label(da, x))
+    ax.set_ylabel(label)
+    ax.grid(alpha=0.3)
 
 
 def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | None = None, colorbar: bool = True):
@@ -93,15 +206,20 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
     length 1, the variable must have at most two dimensions:
 
     * one numeric dimension: a line with markers against it;
-    * two numeric dimensions: a heat map (cells centred on the grid values, colour bar with the
-      variable's units; ``kind`` drawn with one colour per steady-state kind);
+    * two numeric dimensions: a heat map whose cells span their true edges (midpoints between
+      grid values; geometric grids on a log axis, see :func:`~stickslip.plot._common.cell_edges`),
+      with a colour bar in the variable's units; ``kind`` drawn with one colour per kind;
     * one numeric and one categorical (``model``, ``ic``) dimension: one line per category.
+
+    Points whose kind has no oscillation (equilibrium, failed run) are never drawn on the scale
+    of a quantity of an oscillation (:data:`OSCILLATION_VARS`): they get their kind's colour and
+    a legend entry, as do cells without a value.
 
     Parameters
     ----------
     result : SweepResult or xarray.Dataset
     var : str
-        A variable of the sweep (``frequency`` [Hz], ``amplitude`` [rad], ``stick_fraction``,
+        A variable of the sweep (``frequency`` [Hz], ``amplitude`` [rad], ``stick_fraction`` [-],
         ``kind``, ``intensity_r_phi`` [m s^-1/2], ...).
     ax : matplotlib.axes.Axes, optional
     select : dict, optional
@@ -122,49 +240,28 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
 
         _, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
     da = ds[var]
+    kind = ds["kind"] if "kind" in ds.data_vars and var != "kind" else None
     for dim, value in (select or {}).items():
-        da = da.sel({dim: value}, method=None if not _is_numeric(ds, dim) else "nearest")
+        method = None if not _is_numeric(ds, dim) else "nearest"
+        da = da.sel({dim: value}, method=method)
+        kind = None if kind is None else kind.sel({dim: value}, method=method)
     da = da.squeeze(drop=False)
+    kind = None if kind is None else kind.squeeze(drop=False)
     dims = [d for d in da.dims if da.sizes[d] > 1]
     numeric = [d for d in dims if _is_numeric(ds, d)]
     categorical = [d for d in dims if d not in numeric]
-    is_kind = var == "kind"
+    for d in numeric:  # a grid given out of order is drawn in order
+        da = da.sortby(d)
+        kind = None if kind is None else kind.sortby(d)
+    styles = kind_styles(ds)
     label = axis_label(ds, var)
     if len(dims) > 2 or len(categorical) > 1 or (len(dims) == 2 and not numeric):
         raise ValueError(f"{var} has dimensions {tuple(dims)} after selection; select values of all but two "
                          "(at most one of them model or ic)")
     if len(numeric) == 2:
-        x, y = numeric[0], numeric[1]  # first swept dimension across, as N in Figs. 8–9
-        z = da.transpose(y, x).values.astype(float)
-        xe, ye = _edges(ds[x].values), _edges(ds[y].values)
-        if is_kind:
-            cmap, norm = _kind_cmap()
-            mesh = ax.pcolormesh(xe, ye, np.where(np.isfinite(z), z, -1), cmap=cmap, norm=norm)
-            _kind_legend(ax, np.unique(np.where(np.isfinite(z), z, -1)))
-        else:
-            mesh = ax.pcolormesh(xe, ye, np.ma.masked_invalid(z), cmap="viridis")
-            if colorbar:
-                ax.figure.colorbar(mesh, ax=ax, label=label)
-            if np.any(~np.isfinite(z)):
-                ax.set_facecolor("0.85")  # NaN cells (e.g. no frequency at an equilibrium) stay light grey
-        ax.set_xlim(xe[0], xe[-1])
-        ax.set_ylim(ye[0], ye[-1])
-        ax.set_xlabel(axis_label(ds, x))
-        ax.set_ylabel(axis_label(ds, y))
+        _heat_map(ax, da, kind, numeric[0], numeric[1], var, styles, label, colorbar)  # first swept dim across
     elif len(numeric) == 1:
-        x = numeric[0]
-        xs = ds[x].values
-        groups = [(None, da)] if not categorical else [(c, da.sel({categorical[0]: c})) for c in da[categorical[0]].values]
-        for cat, line in groups:
-            ys = line.transpose(x).values.astype(float)
-            ax.plot(xs, ys, "o-", ms=3, lw=1.2, label=None if cat is None else f"{categorical[0]} = {cat}")
-        if is_kind:
-            ax.set_yticks(sorted(KIND_STYLE), [KIND_STYLE[c][1] for c in sorted(KIND_STYLE)])
-        if categorical:
-            ax.legend(fontsize=8)
-        ax.set_xlabel(axis_label(ds, x))
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3)
+        _line_plot(ax, da, kind, numeric[0], categorical[0] if categorical else None, var, styles, label)
     else:  # only categories (or a single point)
         cats = [str(c) for c in da[dims[0]].values] if dims else ["point"]
         ax.bar(cats, np.atleast_1d(da.values.astype(float)), color="0.4")
@@ -174,34 +271,44 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
     return ax
 
 
-def _kind_legend(ax, codes, loc="best"):
-    from matplotlib.patches import Patch
-
-    handles = [Patch(color=KIND_STYLE[int(c)][0], label=KIND_STYLE[int(c)][1]) for c in codes if int(c) in KIND_STYLE]
-    ax.legend(handles=handles, fontsize=8, loc=loc)
-
-
 def _new_figure(n_panels: int, width: float = 5.2, height: float = 4.0):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
     cols = min(n_panels, 3)
     rows = -(-n_panels // cols)
-    fig = Figure(figsize=(width * cols, height * rows), layout="constrained")  # Agg canvas: no display
-    FigureCanvasAgg(fig)
+    fig = agg_figure((width * cols, height * rows))
     axes = [fig.add_subplot(rows, cols, i + 1) for i in range(n_panels)]
     return fig, axes
 
 
+def _panel_title(sel: dict) -> str:
+    """``"Model 2 (x translation), Δμ = 0.2"``: the values that make a panel, with units."""
+    parts = []
+    for k, v in sel.items():
+        if k == "model":
+            parts.append(MODEL_LABELS.get(str(v), f"model {v}"))
+        elif k in _CATEGORICAL:
+            parts.append(f"{k} {v}")
+        else:
+            parts.append(param_text(k, v))
+    return ", ".join(parts)
+
+
 def _conditions(ds, skip=()) -> str:
-    """Short line of the fixed operating/friction parameters and run options."""
+    """Short line of the fixed operating/friction parameters (with units) and run options: from
+    the base parameters, or the one value of a grid dimension of length 1."""
     params = json.loads(ds.attrs.get("parameters", "{}"))
-    parts = [f"{_SYMBOLS[k]} = {params[k]:g}" for k in ("N", "Omega", "mu_k", "delta_mu", "alpha")
-             if k in params and k not in skip and k not in ds.dims]
-    if "model" not in ds.dims and "model" not in skip:
-        parts.insert(0, f"model {ds.attrs.get('model', '?')}")
+    single = {d: ds[d].values[0] for d in _grid_dims(ds) if ds.sizes[d] == 1 and d not in skip}
+    model = single.pop("model", None if "model" in ds.dims else ds.attrs.get("model", "?"))
+    ic = single.pop("ic", None if "ic" in ds.dims else ds.attrs.get("ic"))
+    parts = [f"{text} {value}" for dim, text, value in (("model", "model", model), ("ic", "initial condition", ic))
+             if value is not None and dim not in skip]
+    for k in ("N", "Omega", "mu_k", "delta_mu", "alpha"):
+        if k in single:
+            parts.append(param_text(k, single.pop(k)))
+        elif k in params and k not in skip and k not in ds.dims:
+            parts.append(param_text(k, params[k]))
+    parts += [param_text(k, v) for k, v in single.items()]
     parts.append(f"steady window {ds.attrs.get('t_from', float('nan')):g}–{ds.attrs.get('t_end', float('nan')):g} s")
-    return ", ".join(parts).replace("Omega", "Ω")
+    return ", ".join(parts)
 
 
 def save_sweep_figure(result, path, var: str = "frequency", *, dpi: int = 110) -> Path:
@@ -222,7 +329,7 @@ def save_sweep_figure(result, path, var: str = "frequency", *, dpi: int = 110) -
         sel = dict(zip(panel_dims, combo))
         plot_reduction(ds, var, ax, select=sel)
         if sel:
-            ax.set_title(", ".join(f"{_SYMBOLS.get(k, k)} = {_fmt(v)}" for k, v in sel.items()), fontsize=9)
+            ax.set_title(_panel_title(sel), fontsize=9)
     title = f"{var}: {ds[var].attrs.get('long_name', var)}\n{_conditions(ds)}"
     if len(combos) > len(shown):
         title += f" (first {len(shown)} of {len(combos)} panels)"
@@ -245,10 +352,10 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
     """Bifurcation diagram: the steady-state peak values of φ (events φ̇ = 0) against the control
     parameter, as dots (paper Figs. 12–14).
 
-    Dots are coloured by the steady-state kind of the point (periodic stick-slip black,
-    non-periodic orange, periodic slip blue). Equilibria have no peaks and are drawn as grey
-    crosses at the resting φ (the time mean in the window); failed runs as red ticks on the
-    lower edge.
+    Dots are coloured by the steady-state kind of the point (:func:`kind_styles`: periodic
+    stick-slip black, non-periodic orange, periodic slip blue, ...). Equilibria have no peaks and
+    are drawn as grey crosses at the resting φ (the time mean in the window); failed runs as red
+    ticks on the lower edge. A geometric control grid is drawn on a log axis.
 
     Parameters
     ----------
@@ -265,6 +372,8 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
     -------
     matplotlib.axes.Axes
     """
+    from matplotlib.lines import Line2D
+
     ds = _dataset(result)
     for dim, value in (select or {}).items():
         ds = ds.sel({dim: value})
@@ -273,37 +382,47 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
         raise ValueError(f"select one value of {', '.join(extra)} (e.g. select={{'{extra[0]}': ...}})")
     ds = ds.squeeze(drop=True) if any(ds.sizes[d] == 1 for d in _grid_dims(ds) if not _is_numeric(ds, d)) else ds
     x = _control_dim(ds)
+    ds = ds.sortby(x)
     if ax is None:
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+    styles = kind_styles(ds)
     xs = ds[x].values.astype(float)
     peaks = ds["peaks"].transpose(x, "peak").values
-    kind = np.where(np.isfinite(ds["kind"].values), ds["kind"].values, -1).astype(int)
-    present = []
-    for code in (2, 3, 1):
+    pending = ~np.isfinite(ds["kind"].values)  # not computed (yet)
+    kind = np.where(pending, -99, ds["kind"].values).astype(int)
+    handles = []
+    for code, (colour, label) in styles.items():
         rows = kind == code
+        if label in NOT_OSCILLATING or not np.any(rows):
+            continue
         xx = np.repeat(xs[rows], peaks.shape[1])
         yy = peaks[rows].ravel()
         ok = np.isfinite(yy)
         if np.any(ok):
-            ax.scatter(xx[ok], yy[ok], s=marker_size, color=KIND_STYLE[code][0], linewidths=0, rasterized=True,
-                       label=KIND_STYLE[code][1])
-            present.append(code)
-    eq = kind == 0
+            ax.scatter(xx[ok], yy[ok], s=marker_size, color=colour, linewidths=0, rasterized=True)
+            handles.append(Line2D([], [], ls="", marker="o", ms=5, color=colour, label=label))
+    codes = {label: code for code, (_, label) in styles.items()}
+    eq = kind == codes.get("equilibrium", 0)
     if np.any(eq):
-        ax.plot(xs[eq], ds["phi_mean"].values[eq], "x", color=KIND_STYLE[0][0], ms=4, label="equilibrium (φ at rest)")
-    failed = kind == -1
-    if np.any(failed):
-        ax.plot(xs[failed], np.zeros(failed.sum()), "|", color=KIND_STYLE[-1][0], ms=10,
-                transform=ax.get_xaxis_transform(), label="run failed")
+        colour = styles.get(codes.get("equilibrium", 0), KIND_STYLE[0])[0]
+        ax.plot(xs[eq], ds["phi_mean"].values[eq], "x", color=colour, ms=5)
+        handles.append(Line2D([], [], ls="", marker="x", ms=5, color=colour, label="equilibrium (φ at rest)"))
+    for where, colour, label in ((kind == codes.get("failed", -1), KIND_STYLE[-1][0], "run failed"),
+                                 (pending, "#b0b0b0", "not computed")):
+        if np.any(where):  # ticks on the lower edge: these points have no φ to show
+            ax.plot(xs[where], np.zeros(where.sum()), "|", color=colour, ms=10, transform=ax.get_xaxis_transform())
+            handles.append(Line2D([], [], ls="", marker="|", ms=5, mew=1.5, color=colour, label=label))
     ax.set_xlabel(axis_label(ds, x))
     ax.set_ylabel("peak values of φ [rad]")
-    if xs.size > 1:
+    if is_geometric(xs):
+        ax.set_xscale("log")
+    elif xs.size > 1:
         ax.set_xlim(xs.min() - 0.02 * np.ptp(xs), xs.max() + 0.02 * np.ptp(xs))
     ax.grid(alpha=0.3)
-    if legend and (present or np.any(eq) or np.any(failed)):
-        ax.legend(fontsize=8, markerscale=4, loc="best")
+    if legend and handles:
+        ax.legend(handles=handles, fontsize=8, loc="best")
     return ax
 
 
@@ -318,8 +437,9 @@ def save_bifurcation_figure(result, path, *, dpi: int = 130) -> Path:
         sel = dict(zip(panel_dims, combo))
         plot_bifurcation(ds, ax, select=sel)
         if sel:
-            ax.set_title(", ".join(f"{k} {_fmt(v)}" for k, v in sel.items()), fontsize=9)
-    fig.suptitle(f"Bifurcation diagram of φ against {_SYMBOLS.get(x, x)}\n{_conditions(ds, skip=(x,))}", fontsize=10)
+            ax.set_title(_panel_title(sel), fontsize=9)
+    fig.suptitle(f"Bifurcation diagram: peak values of φ against {axis_label(ds, x)}\n{_conditions(ds, skip=(x,))}",
+                 fontsize=10)
     path = Path(path)
     fig.savefig(path, dpi=dpi)
     return path

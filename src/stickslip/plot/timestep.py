@@ -23,7 +23,8 @@ def plot_timestep_method(study, method: str, fig=None):
     runs = study.fixed(method)
     ref = study.reference
     if fig is None:
-        fig, axes = plt.subplots(len(runs), 2, figsize=(10, 1.9 * len(runs) + 0.8), sharex=True, squeeze=False)
+        fig, axes = plt.subplots(len(runs), 2, figsize=(10, 1.9 * len(runs) + 1.2), sharex=True, squeeze=False,
+                                 layout="constrained")
     else:
         axes = np.array(fig.subplots(len(runs), 2, sharex=True, squeeze=False))
     level = 0.5 * (ref.phi_min + ref.phi_max)
@@ -40,21 +41,20 @@ def plot_timestep_method(study, method: str, fig=None):
         tt = aligned(run)
         for ax, y_run, y_ref, unit in ((row[0], run.window_phi, ref.window_phi, "φ [rad]"),
                                        (row[1], run.window_F, ref.window_F, "|F| [N]")):
-            ax.plot(tr, y_ref, "k--", lw=0.9, label="event (converged)")
-            ax.plot(tt, y_run, color="tab:blue", lw=1.1, label=f"{method.upper()}, Δt = {run.dt:g} s")
+            ax.plot(tr, y_ref, "k--", lw=0.9, label=f"event, rtol {ref.rtol:g} (reference)")
+            ax.plot(tt, y_run, color="tab:blue", lw=1.1, label=f"{method.upper()} (Δt of the row)")
             ax.set_ylabel(unit)
             ax.grid(alpha=0.3)
         row[1].axhline(static, color="tab:red", lw=0.7, ls=":", label="μs N")
         err = run.errors
-        row[0].set_title(f"Δt = {run.dt:g} s: f error {err['freq_error']:.1e}, φ p-p error {err['phi_pp_error']:.1e}, "
-                         f"{run.stick_phases} stick phases", fontsize=9, loc="left")
-        row[0].legend(fontsize=7, loc="upper right")
+        row[0].set_title(f"Δt = {run.dt:g} s: relative errors of f {err['freq_error']:.1e}, of φ peak-to-peak "
+                         f"{err['phi_pp_error']:.1e}; {run.stick_phases} stick phases", fontsize=9, loc="left")
+    fig.legend(handles=axes[0, 1].get_lines(), loc="outside lower center", ncol=3, fontsize=9, frameon=False)
     for ax in axes[-1]:
         ax.set_xlim(0.0, min(tr[-1], 1.5))
         ax.set_xlabel("time since an up-crossing of the mid level of φ [s]")
     fig.suptitle(f"{_PAPER_FIG.get(method, '')}: steady-state φ and |F| by {method.upper()} for various Δt "
                  f"(Ω = {study.params.Omega:g} rad/s, N = {study.params.N:g} N)", fontsize=10)
-    fig.tight_layout()
     return fig
 
 
@@ -80,7 +80,7 @@ def plot_timestep_errors(study, fig=None):
             for w, e, r in zip(wall, err, runs):
                 ax.annotate(f"{r.dt:g}" if r.dt is not None else f"{r.rtol:g}", (w, e), fontsize=7,
                             textcoords="offset points", xytext=(4, 3))
-            ax.set_xlabel("wall time for 0–100 s [s]")
+            ax.set_xlabel(f"wall time for 0–{study.t_end:g} s [s]")
             ax.set_title(title, fontsize=10)
             ax.grid(alpha=0.3, which="both")
     axes[0].legend()

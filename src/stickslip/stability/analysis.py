@@ -22,21 +22,22 @@ class StabilityResult:
 
     Attributes
     ----------
-    params : Parameters
+    params : Parameters or None
+        The plates' parameters (None for other models: see ``system.parameters``).
     model : str
-        Variant name (``full``, ``x``, ``y``, ``rotation`` or ``custom:...``).
+        The plates' variant (``full``, ``x``, ``y``, ``rotation`` or ``custom:...``) or the model's name.
     dofs : tuple of str
         The free DOFs, in q order; the reduced state is [dofs, d(dofs)/dt].
-    equilibrium : ndarray (6,)
-        q_e = [x1, y1, x2, y2, φ, ψ] [m, rad]; locked DOFs are 0.
+    equilibrium : ndarray (n,)
+        q_e of every dof (for the plates [x1, y1, x2, y2, φ, ψ] [m, rad]); locked DOFs are 0.
     residual : float
         Relative residual of Eq. (14) at ``equilibrium`` (simulator kernel).
     jacobian : ndarray (2k, 2k)
         ∂(ds/dt)/∂s of the slip equations at (q_e, q̇ = 0), reduced to the k free DOFs [1/s, 1/s²].
     stiffness, damping : ndarray (k, k)
         K_L and C_L of Eq. (15) on the free DOFs (M_L is diagonal: ``mass``).
-    mass : ndarray (k,)
-        Diagonal of M_L on the free DOFs [kg, kg m²].
+    mass : ndarray (k,) or (k, k)
+        M_L on the free DOFs: its diagonal when M is diagonal (the plates) [kg, kg m²], else the matrix.
     eigenvalues : ndarray (2k,) complex
         Sorted by real part, descending (conjugate pairs: positive imaginary part first) [1/s].
     mode_shapes : ndarray (2k, k) complex
@@ -54,6 +55,8 @@ class StabilityResult:
     mass: np.ndarray
     eigenvalues: np.ndarray
     mode_shapes: np.ndarray
+    system: object = None
+    all_dofs: tuple[str, ...] = DOF_NAMES
 
     # ------------------------------------------------------------------ derived
     @property
@@ -78,8 +81,8 @@ class StabilityResult:
 
     @property
     def equilibrium_dict(self) -> dict[str, float]:
-        """``{dof name: value}`` of the equilibrium, all six DOFs."""
-        return {name: float(v) for name, v in zip(DOF_NAMES, self.equilibrium)}
+        """``{dof name: value}`` of the equilibrium, every dof."""
+        return {name: float(v) for name, v in zip(self.all_dofs, self.equilibrium)}
 
     def modes(self, *, one_per_pair: bool = True) -> list[dict]:
         """One dict per mode: eigenvalue, growth rate [1/s], frequency [Hz], dominant DOF, shape.
@@ -131,13 +134,13 @@ class StabilityResult:
             "jacobian": (("state", "state_col"), self.jacobian, {"long_name": "Jacobian of the slip equations at q_e"}),
             "stiffness_L": (("dof", "dof_col"), self.stiffness, {"long_name": "K_L of Eq. (15)"}),
             "damping_L": (("dof", "dof_col"), self.damping, {"long_name": "C_L of Eq. (15)"}),
-            "mass_L": ("dof", self.mass, {"long_name": "diagonal of M_L of Eq. (15)"}),
+            "mass_L": (("dof",) if self.mass.ndim == 1 else ("dof", "dof_col"), self.mass, {"long_name": "M_L of Eq. (15)"}),
         }
         coords = {
             "mode": ("mode", np.arange(2 * k)),
             "dof": ("dof", list(self.dofs)),
             "dof_col": ("dof_col", list(self.dofs)),
-            "dof_all": ("dof_all", list(DOF_NAMES)),
+            "dof_all": ("dof_all", list(self.all_dofs)),
             "state": ("state", states),
             "state_col": ("state_col", states),
         }
@@ -149,9 +152,10 @@ class StabilityResult:
             "max_real_part_units": "1/s",
             "stable": int(self.stable),
             "equilibrium_residual": self.residual,
-            "parameters": json.dumps(self.params.to_dict()),
+            "parameters": json.dumps(self.params.to_dict() if self.params is not None else dict(self.system.parameters)),
         }
-        attrs.update(parameter_attrs(self.params.to_dict()))
+        if self.params is not None:
+            attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -175,19 +179,22 @@ def linearization(system: System, q: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return J, -dQ[free, :k], -dQ[free, k:]
 
 
-def stability(params: Parameters, model="full") -> StabilityResult:
-    """Linear stability of steady sliding (paper Sect. 4.1).
+def stability(params=None, model="full") -> StabilityResult:
+    """Linear stability of steady sliding (paper Sect. 4.1) of any friction model.
 
-    Finds the equilibrium of Eq. (14), linearises the slip equations about it (Eq. 15) with the
-    exact Jacobian of the simulator's right-hand side (complex-step differentiation, see
-    :mod:`stickslip.stability.linearize`), and takes the eigenvalues.
+    Finds the steady-sliding equilibrium (Eq. 14 for the plates), linearises the slip equations
+    about it (Eq. 15) with the exact Jacobian of the simulator's right-hand side (complex-step
+    differentiation), and takes the eigenvalues.
 
     Parameters
     ----------
-    params : Parameters
+    params : Parameters, FrictionModel or str, optional
+        The plates' parameters (default Table 1), or any model (a FrictionModel, a library name
+        or a model file path).
     model : str, iterable of DOF names or Variant
-        ``full`` (Model 1), ``x`` (2), ``y`` (3), ``rotation`` (4), or the DOFs to free. The
-        Jacobian is reduced to the free DOFs.
+        The plates' variant: ``full`` (Model 1), ``x`` (2), ``y`` (3), ``rotation`` (4), or the DOFs
+        to free (or a library name / model file, as ``params``). The Jacobian is reduced to the
+        free DOFs.
 
     Returns
     -------
@@ -196,13 +203,65 @@ def stability(params: Parameters, model="full") -> StabilityResult:
     Raises
     ------
     EquilibriumError
-        No steady sliding (Ω = 0, Newton failure), or a sliding speed |Ω| R at equilibrium
-        inside the simulator's low-speed band, where its slip direction is not v_r/|v_r|
-        (see :func:`stickslip.stability.equilibrium.solve_equilibrium`), or a Jacobian that
+        No steady sliding (Ω = 0, Newton failure), a sliding speed at equilibrium inside the
+        simulator's low-speed band, where its slip direction is not v/|v|, or a Jacobian that
         overflows (values far outside physical size).
     """
-    if not isinstance(params, Parameters):
-        raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
+    from ..model.library import resolve_system
+    from ..model.library.two_plates import NAME as TWO_PLATES
+
+    if params is not None and not isinstance(params, (Parameters, str)) and not hasattr(params, "data"):
+        raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
+    system = resolve_system(params, model)
+    if system.name == TWO_PLATES:
+        values = dict(system.parameters)
+        return _plates_stability(Parameters.from_dict({k: v for k, v in values.items() if k != "variant"}),
+                                 values["variant"], system)
+    return model_stability(system)
+
+
+def model_stability(system) -> StabilityResult:
+    """:func:`stability` of a :class:`~stickslip.model.FrictionModel` (the generic path)."""
+    from ..model.bundle import CST, contact_state
+    from ..model.derivatives import state_jacobian
+    from ..model.physics import MODE_SLIP_EXACT
+    from .equilibrium import steady_sliding, steady_residual
+
+    q = steady_sliding(system)
+    n = system.n
+    s = np.zeros(2 * n)
+    s[:n] = q
+    cst = contact_state(system.data.m)
+    cst[0::CST] = MODE_SLIP_EXACT
+    J_full = np.empty((2 * n, 2 * n))
+    state_jacobian(s, cst, system.data, J_full, np.zeros(2 * n, dtype=complex), np.zeros(2 * n, dtype=complex))
+    free = np.flatnonzero(system.free)
+    k = free.size
+    idx = np.concatenate([free, n + free])
+    J = J_full[np.ix_(idx, idx)]
+    M = system.mass[np.ix_(free, free)]
+    K_L = -M @ J[k:, :k]
+    C_L = -M @ J[k:, k:]
+    lam, vec = np.linalg.eig(J)
+    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
+    lam = lam[order]
+    vec = vec[:, order]
+    shapes = vec[:k, :].T.copy()
+    for j in range(shapes.shape[0]):
+        m = int(np.argmax(np.abs(shapes[j])))
+        if shapes[j, m] != 0:
+            shapes[j] /= shapes[j, m]
+    diagonal = np.count_nonzero(M - np.diag(np.diag(M))) == 0
+    return StabilityResult(
+        params=None, model=system.name, dofs=tuple(system.dofs[i] for i in free), equilibrium=q,
+        residual=steady_residual(system, q), jacobian=J, stiffness=K_L, damping=C_L,
+        mass=np.diag(M).copy() if diagonal else M, eigenvalues=lam, mode_shapes=shapes, system=system,
+        all_dofs=tuple(system.dofs),
+    )
+
+
+def _plates_stability(params: Parameters, model, system_model) -> StabilityResult:
+    """The plates' stability through their assembled arrays."""
     system = assemble(params, model)
     q, residual, _ = solve_equilibrium(system)
     J, K_L, C_L = linearization(system, q)
@@ -232,4 +291,5 @@ def stability(params: Parameters, model="full") -> StabilityResult:
         mass=system.mass[free],
         eigenvalues=lam,
         mode_shapes=shapes,
+        system=system_model,
     )

@@ -15,6 +15,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy import optimize
 
+from ..files import atomic_write, format_name, open_ours
 from ..model import kernels
 from ..model.parameters import PARAMETER_UNITS, ParameterError, Parameters, parameter_attrs
 from ..model.system import System, assemble
@@ -246,6 +247,7 @@ class StabilityMap:
         }
         attrs = {
             "title": "stickslip stability map of steady sliding (paper Sect. 4.1)",
+            "format": format_name("stabilitymap", 1),
             "stickslip_version": __version__,
             "model": self.model,
             "family_name": self.family_name,
@@ -259,9 +261,8 @@ class StabilityMap:
 
     def to_netcdf(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` to NetCDF-4 (h5netcdf engine)."""
-        path = Path(path)
-        self.to_xarray().to_netcdf(path, engine="h5netcdf")
-        return path
+        ds = self.to_xarray()
+        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 
     def plot(self, **kwargs):
         """Figure of the map; see :func:`stickslip.plot.stability.plot_stability_map`."""
@@ -272,10 +273,7 @@ class StabilityMap:
 
 def load_stability_map(path: str | Path) -> StabilityMap:
     """Read a map written by :meth:`StabilityMap.to_netcdf`."""
-    import xarray as xr
-
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        ds = ds.load()
+    ds = open_ours(path, "stabilitymap", noun="stability map", what="a .nc file written by `stickslip stability-map`")
     name = ds.attrs["family_name"]
     fam = [str(v) for v in ds["family"].values] if name in ("model", "") else [float(v) for v in ds["family"].values]
     return StabilityMap(

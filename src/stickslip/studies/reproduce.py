@@ -13,6 +13,11 @@ printed in the report beside it:
 after each one, so an interrupted run keeps what it has done. A recipe that raises is reported
 as failed (with the error) and the next one runs.
 
+Figs. 10–15 judge what each run settles to (:mod:`stickslip.analysis.settle`): every run is
+extended from its final state until it has settled or reaches ``settle_cap``; "periodic" is a
+settled, confirmed period, "non-periodic" a settled chaotic or quasi-periodic attractor, and a
+run still drifting at the cap is "unsettled" and counted as neither.
+
 Resolutions (:data:`RESOLUTIONS`): ``full`` is the paper's (stability maps 100 × 100, 100 s
 time-step study down to Δt = 1e-5 s, 121-point bifurcation diagrams over N and 100-point ones
 over Ω, Δμ, α, 100 × 100 region maps of 300 s runs from two ICs for four models), ``quick`` uses
@@ -64,6 +69,9 @@ class Resolution:
     fig14_N: int = 121                  # Fig. 14: points over N and over Ω (Model 3 is slow: ≤ 60 s a run)
     bif_t_end: float = 200.0
     fig15_t_end: float = 200.0
+    # Figs. 10–15: every run is extended from its final state until it has settled, up to this
+    # many seconds (stickslip.analysis.settle; the run lengths above are the first runs)
+    settle_cap: float = 2000.0
 
 
 RESOLUTIONS = {
@@ -74,7 +82,8 @@ RESOLUTIONS = {
                         regions_N=7, regions_Omega=8, bif_points=15, fig14_N=11),
     "micro": Resolution("micro", 8, 10, (0.1, 0.01), 4.0, (1e-4,), 4.0, 4.0, (30, 120), 3, 3.0,
                         workers=1, executor="serial", regions_N=2, regions_Omega=2, regions_t_end=4.0,
-                        regions_t_from=2.0, bif_points=3, fig14_N=3, bif_t_end=3.0, fig15_t_end=4.0),
+                        regions_t_from=2.0, bif_points=3, fig14_N=3, bif_t_end=3.0, fig15_t_end=4.0,
+                        settle_cap=6.0),
 }
 
 
@@ -311,12 +320,31 @@ PAPER_FIG10 = {30: (1.46, "periodic"), 50: (0.99, "periodic"), 70: (0.78, "perio
 PAPER_FIG11 = {30: (5.0, 15.0), 120: (0.0, 20.0)}
 
 
+def _settled_run(params, res: Resolution, t_min: float, **options):
+    """A run extended until it has settled (or reaches ``res.settle_cap``), window ≤ 100 s."""
+    from ..analysis.settle import simulate_until_settled
+
+    window = min(100.0, 0.5 * t_min)
+    return simulate_until_settled(params, cap=res.settle_cap, t_min=t_min, window=window, step=window,
+                                  sample_rate=200.0, **options)
+
+
+def _verdict_text(tr) -> str:
+    """What a settled run shows, in words, with its frequency."""
+    a = tr.attractor
+    if a.attractor == "periodic":
+        return (f"periodic, {a.period_count} peak(s) per period, fundamental {_fmt(a.fundamental_frequency_hz, 4)} Hz "
+                f"(settled by {a.settle_time_s:g} s)")
+    if a.settled:
+        return f"{a.attractor}, dominant {_fmt(a.dominant_frequency_hz)} Hz (settled by {a.settle_time_s:g} s)"
+    return f"unsettled at {tr.t[-1]:g} s, dominant {_fmt(a.dominant_frequency_hz)} Hz"
+
+
 def _fig10_runs(res: Resolution, cache: dict):
-    from ..integrate.driver import simulate
     from ..model.parameters import Parameters
 
     if "fig10_runs" not in cache:
-        cache["fig10_runs"] = {int(n): simulate(Parameters(N=float(n), Omega=0.5), res.fig10_t_end, sample_rate=200.0)
+        cache["fig10_runs"] = {int(n): _settled_run(Parameters(N=float(n), Omega=0.5), res, res.fig10_t_end)
                                for n in res.fig10_N}
     return cache["fig10_runs"]
 
@@ -324,46 +352,50 @@ def _fig10_runs(res: Resolution, cache: dict):
 def _recipe_fig10(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     import matplotlib.pyplot as plt
 
-    from ..analysis.classify import classify
     from ..analysis.steady import spectrum
 
     runs = _fig10_runs(res, cache)
     fig, axes = plt.subplots(len(runs), 3, figsize=(12, 2.2 * len(runs)), constrained_layout=True, squeeze=False)
     rows, measured = [], {}
     for k, (n, tr) in enumerate(runs.items()):
-        t_from = tr.steady_from
-        c = classify(tr, t_from=t_from)
-        sel = tr.t >= t_from
+        a = tr.attractor
+        sel = tr.t >= tr.steady_from
         t, phi, dphi = tr.t[sel], tr.states[sel, 4], tr.states[sel, 10]
-        f, a = spectrum(t, phi)
+        f, amp = spectrum(t, phi)
         axes[k, 0].plot(t, phi, lw=0.6)
         axes[k, 0].set_ylabel(f"N = {n} N\nφ [rad]")
         axes[k, 1].plot(phi, dphi, lw=0.4)
         axes[k, 1].set_ylabel("dφ/dt [rad/s]")
-        axes[k, 2].plot(f, a, lw=0.6)
+        axes[k, 2].plot(f, amp, lw=0.6)
         axes[k, 2].set_xlim(0, 8)
         axes[k, 2].set_ylabel("|Φ| [rad]")
-        axes[k, 0].set_title(f"{c.kind} ({c.multiplicity} peaks/period), f_FFT = {c.fft_frequency_hz:.3g} Hz", fontsize=8)
-        measured[n] = {"kind": c.kind, "fft_frequency_hz": c.fft_frequency_hz, "multiplicity": c.multiplicity,
-                       "stick_fraction": c.stick_fraction}
+        axes[k, 0].set_title(_verdict_text(tr), fontsize=8)
+        freq = a.fundamental_frequency_hz if a.fundamental_frequency_hz is not None else a.dominant_frequency_hz
+        measured[n] = {"attractor": a.attractor, "settled": a.settled, "period_count": a.period_count,
+                       "fundamental_frequency_hz": a.fundamental_frequency_hz,
+                       "dominant_frequency_hz": a.dominant_frequency_hz, "frequency_hz": freq,
+                       "settle_time_s": a.settle_time_s, "t_end_s": float(tr.t[-1]),
+                       "stick_fraction": a.classification.stick_fraction if a.classification else None}
         pf, pk = PAPER_FIG10.get(n, (None, None))
         if pf is not None:
-            rel = abs(c.fft_frequency_hz - pf) / pf
-            rows.append(Row(f"Fig. 10, N = {n} N", f"{pk}, fundamental {pf:g} Hz",
-                            f"{c.kind}, dominant (FFT) {c.fft_frequency_hz:.3g} Hz ({c.fft_frequency_hz / pf:.2f}× paper)",
-                            _yes(rel <= 0.1), "dominant frequency within 10 % of the paper's"))
+            ok = a.attractor == "periodic" and abs(a.fundamental_frequency_hz - pf) / pf <= 0.1
+            ratio = f" ({freq / pf:.2f}× paper)" if freq else ""
+            rows.append(Row(f"Fig. 10, N = {n} N", f"{pk}, fundamental {pf:g} Hz", _verdict_text(tr) + ratio,
+                            _yes(ok), "settled periodic, fundamental frequency within 10 % of the paper's"))
         elif pk is not None:
-            rows.append(Row(f"Fig. 10, N = {n} N", pk, c.kind, _yes(c.kind == pk), "same kind (classify)"))
+            rows.append(Row(f"Fig. 10, N = {n} N", pk, _verdict_text(tr),
+                            _yes(a.attractor in ("chaotic", "quasiperiodic")),
+                            "settled non-periodic (chaotic or quasi-periodic, by the largest Lyapunov exponent)"))
     axes[-1, 0].set_xlabel("t [s]")
     axes[-1, 1].set_xlabel("φ [rad]")
     axes[-1, 2].set_xlabel("f [Hz]")
     fig.savefig(out / "fig10.png", dpi=100)
     plt.close(fig)
-    fr = [(n, m["fft_frequency_hz"]) for n, m in measured.items()]
-    falling = len(fr) >= 2 and all(b[1] < a[1] for a, b in zip(fr, fr[1:]))
+    fr = [(n, m["frequency_hz"]) for n, m in measured.items()]
+    falling = len(fr) >= 2 and all(a[1] is not None and b[1] is not None and b[1] < a[1] for a, b in zip(fr, fr[1:]))
     rows.append(Row("Fig. 10, trend", "frequency falls as N rises (1.46 → 0.43 Hz over 30–110 N)",
                     ", ".join(f"{n}: {_fmt(f)} Hz" for n, f in fr), _yes(falling),
-                    "dominant frequency strictly decreasing in N"))
+                    "frequency (fundamental where settled periodic, else dominant) strictly decreasing in N"))
     return RecipeResult(["fig10.png"], rows, {str(k): v for k, v in measured.items()})
 
 
@@ -399,16 +431,11 @@ def _recipe_fig11(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 # ----------------------------------------------------------------------------- Fig. 12(a)
 def _recipe_fig12a(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     from ..model.parameters import Parameters
-    from ..plot.sweep import save_bifurcation_figure
-    from ..sweep import sweep
 
     N = np.linspace(10.0, 130.0, res.fig12_N)
-    r = sweep({"N": N}, Parameters(Omega=0.5), out=out / "fig12a.nc", t_end=res.fig12_t_end,
-              executor=res.executor, workers=res.workers, overwrite=True)
-    save_bifurcation_figure(r, out / "fig12a.png")
-    ds = r.to_xarray()
-    f = ds["fft_frequency"].values
-    kinds = r.kinds()
+    ds = _bifurcation_sweep(out, res, "fig12a", {"N": N}, Parameters(Omega=0.5), t_end=res.fig12_t_end)
+    f = ds["dominant_frequency"].values
+    labels = _attractor_names(ds)
     ok = np.isfinite(f)
     rho = float(np.corrcoef(np.argsort(np.argsort(N[ok])), np.argsort(np.argsort(f[ok])))[0, 1]) if ok.sum() > 2 else math.nan
     stick = ds["stick_fraction"].values
@@ -418,13 +445,13 @@ def _recipe_fig12a(out: Path, res: Resolution, cache: dict) -> RecipeResult:
             f"Spearman ρ(N, f) = {_fmt(rho)}; stick at all N: {_yes(bool(np.all(stick > 0)))}",
             _yes(rho < -0.9), "Spearman rank correlation of the dominant frequency with N below −0.9"),
         Row("Fig. 12(a), kind", "monotonous: periodic at low N → non-periodic at high N",
-            "kinds along N: " + ", ".join(f"{n:g}: {k}" for n, k in zip(N, np.ravel(kinds))),
-            _yes(np.ravel(kinds)[-1] == "non-periodic" and "non-periodic" not in
-                 [k for k in np.ravel(kinds)[: len(N) // 2]]),
-            "non-periodic at the largest N and none in the lower half of the N range"),
+            "regimes along N: " + _regimes_text(_regimes(N, labels)) + "; " + _settle_text(ds),
+            _yes(labels[-1] in NON_PERIODIC and not any(lab in NON_PERIODIC for lab in labels[: len(N) // 2])),
+            "settled non-periodic at the largest N and none in the lower half of the N range"),
     ]
-    return RecipeResult(["fig12a.png"], rows, {"N": N.tolist(), "fft_frequency": f.tolist(),
-                                               "kinds": [str(k) for k in np.ravel(kinds)]})
+    return RecipeResult(["fig12a.png"], rows, {"N": N.tolist(), "dominant_frequency": f.tolist(),
+                                               "attractors": [str(k) for k in labels],
+                                               "settle_time": ds["settle_time"].values.tolist()})
 
 
 # ----------------------------------------------------------------------------- helpers of Figs. 8–16
@@ -469,14 +496,30 @@ def _spearman(x, y) -> float:
     return float(np.corrcoef(rx, ry)[0, 1])
 
 
-def _regimes(values, kinds) -> list:
-    """Runs of periodic (``P``) and non-periodic (``NP``) responses along a control parameter.
+#: Verdicts that count as the paper's "non-periodic": settled, and not periodic.
+NON_PERIODIC = ("chaotic", "quasiperiodic")
 
-    Equilibrium and failed points are skipped. Returns a list of (label, first value, last value).
+
+def _attractor_names(ds) -> np.ndarray:
+    """Verdict names of a sweep dataset (:data:`~stickslip.analysis.settle.ATTRACTORS`; ``failed``
+    for −1 / missing)."""
+    from ..analysis.settle import ATTRACTORS
+
+    code = ds["attractor"].values
+    names = np.array(ATTRACTORS + ("failed",), dtype=object)
+    return names[np.where(np.isfinite(code), code, -1).astype(int)]
+
+
+def _regimes(values, labels) -> list:
+    """Runs of periodic (``P``), settled non-periodic (``NP``: chaotic or quasi-periodic) and
+    unsettled (``U``) responses along a control parameter.
+
+    Equilibrium, unbounded and failed points are skipped. Returns a list of (label, first value,
+    last value).
     """
     runs: list = []
-    for v, k in zip(values, kinds):
-        label = "P" if str(k).startswith("periodic") else "NP" if k == "non-periodic" else None
+    for v, k in zip(values, labels):
+        label = {"periodic": "P", "chaotic": "NP", "quasiperiodic": "NP", "unsettled": "U"}.get(str(k))
         if label is None:
             continue
         if runs and runs[-1][0] == label:
@@ -490,13 +533,28 @@ def _regimes_text(runs) -> str:
     return " → ".join(f"{lab} [{a:.3g}–{b:.3g}]" for lab, a, b in runs) or "no oscillation"
 
 
-def _bifurcation_sweep(out: Path, res: Resolution, name: str, grid: dict, params, ic: str = "zero"):
-    """Run one bifurcation sweep with the library, save ``name``.nc/.png; return the dataset."""
+def _settle_text(ds) -> str:
+    """Settle times of a sweep in words: how many settled, by when, and the cap."""
+    st = ds["settle_time"].values
+    done = np.isfinite(st)
+    cap = ds.attrs.get("cap", math.nan)
+    text = f"settled {int(done.sum())} of {st.size}"
+    if done.any():
+        text += f" (by {np.nanmin(st):g}–{np.nanmax(st):g} s)"
+    return text + f", cap {cap:g} s"
+
+
+def _bifurcation_sweep(out: Path, res: Resolution, name: str, grid: dict, params, ic: str = "zero",
+                       t_end: float | None = None):
+    """Run one bifurcation sweep with the library, every point extended until settled (up to
+    ``res.settle_cap``); save ``name``.nc/.png; return the dataset."""
     from ..plot.sweep import save_bifurcation_figure
     from ..sweep import sweep
 
-    r = sweep(grid, params, out=out / f"{name}.nc", t_end=res.bif_t_end, ic=ic, executor=res.executor,
-              workers=res.workers, overwrite=True)
+    t_end = res.bif_t_end if t_end is None else t_end
+    r = sweep(grid, params, out=out / f"{name}.nc", t_end=t_end, t_from=max(0.5 * t_end, t_end - 100.0), ic=ic,
+              executor=res.executor, workers=res.workers, overwrite=True, settle=True,
+              cap=max(res.settle_cap, t_end))
     save_bifurcation_figure(r, out / f"{name}.png")
     return r.to_xarray()
 
@@ -632,9 +690,9 @@ def _recipe_fig12b(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
     Om = np.linspace(*FIG12B_OMEGA_RANGE, res.bif_points)
     ds = _bifurcation_sweep(out, res, "fig12b", {"Omega": Om}, Parameters(N=50.0), ic="far")
-    kinds = _kind_names(ds)
+    labels = _attractor_names(ds)
     ss = _stick_slip(ds)
-    f = ds["fft_frequency"].values
+    f = ds["dominant_frequency"].values
     rho = _spearman(Om[ss], f[ss])
     top = float(Om[ss].max()) if ss.any() else math.nan
     upper = ss & (Om > 0.5 * (Om[0] + top))
@@ -645,12 +703,13 @@ def _recipe_fig12b(out: Path, res: Resolution, cache: dict) -> RecipeResult:
             f"{_fmt(f[ss][-1] if ss.any() else math.nan)} Hz at {_fmt(top)} rad/s; Spearman ρ(Ω, f) = {_fmt(rho)}",
             _yes(rho > 0.9), "Spearman rank correlation of the dominant frequency with Ω above 0.9 over the stick-slip points"),
         Row("Fig. 12(b), kind", "“changes from periodic stick-slip … to non-periodic stick-slip … with the decrease of Ω”",
-            "regimes along Ω: " + _regimes_text(_regimes(Om, kinds)),
-            _yes(kinds[0] == "non-periodic" and not np.any(kinds[upper] == "non-periodic")),
-            "non-periodic at the smallest Ω and none in the upper half of the stick-slip Ω range"),
+            "regimes along Ω: " + _regimes_text(_regimes(Om, labels)) + "; " + _settle_text(ds),
+            _yes(labels[0] in NON_PERIODIC and not np.any(np.isin(labels[upper], NON_PERIODIC))),
+            "settled non-periodic at the smallest Ω and none in the upper half of the stick-slip Ω range"),
     ]
-    return RecipeResult(["fig12b.png"], rows, {"Omega": Om.tolist(), "fft_frequency": f.tolist(),
-                                               "kinds": [str(k) for k in kinds]})
+    return RecipeResult(["fig12b.png"], rows, {"Omega": Om.tolist(), "dominant_frequency": f.tolist(),
+                                               "attractors": [str(k) for k in labels],
+                                               "settle_time": ds["settle_time"].values.tolist()})
 
 
 def _recipe_fig13(out: Path, res: Resolution, cache: dict) -> RecipeResult:
@@ -661,37 +720,42 @@ def _recipe_fig13(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     alpha = np.linspace(*FIG13_ALPHA_RANGE, res.bif_points)
     ds_a = _bifurcation_sweep(out, res, "fig13a", {"delta_mu": dmu}, base)
     ds_b = _bifurcation_sweep(out, res, "fig13b", {"alpha": alpha}, base)
-    runs_a, runs_b = _regimes(dmu, _kind_names(ds_a)), _regimes(alpha, _kind_names(ds_b))
+    runs_a, runs_b = _regimes(dmu, _attractor_names(ds_a)), _regimes(alpha, _attractor_names(ds_b))
     pat_a, pat_b = [r[0] for r in runs_a], [r[0] for r in runs_b]
     rows = [
         Row("Fig. 13(a)", "“By increasing Δμ, the response of ϕ changes from periodic oscillation to non-periodic "
             "oscillation and eventually back to periodic oscillation” (α = 5)",
-            "regimes along Δμ: " + _regimes_text(runs_a), _yes(pat_a == ["P", "NP", "P"]),
-            "the sequence of periodic (P) / non-periodic (NP) runs along Δμ (equilibria skipped) is exactly P → NP → P"),
+            "regimes along Δμ: " + _regimes_text(runs_a) + "; " + _settle_text(ds_a), _yes(pat_a == ["P", "NP", "P"]),
+            "the sequence of periodic (P) / settled non-periodic (NP) / unsettled (U) runs along Δμ (equilibria "
+            "skipped) is exactly P → NP → P"),
         Row("Fig. 13(b)", "“By increasing α, the response of ϕ changes from periodic oscillation to non-periodic "
             "oscillation, and then back to periodic oscillation and non-periodic oscillation in turn, and eventually "
             "back to periodic oscillation” (Δμ = 0.1)",
-            "regimes along α: " + _regimes_text(runs_b), _yes(pat_b == ["P", "NP", "P", "NP", "P"]),
-            "the sequence of P / NP runs along α is exactly P → NP → P → NP → P"),
+            "regimes along α: " + _regimes_text(runs_b) + "; " + _settle_text(ds_b),
+            _yes(pat_b == ["P", "NP", "P", "NP", "P"]), "the sequence of P / NP / U runs along α is exactly "
+            "P → NP → P → NP → P"),
     ]
     return RecipeResult(["fig13a.png", "fig13b.png"], rows,
-                        {"delta_mu_regimes": runs_a, "alpha_regimes": runs_b})
+                        {"delta_mu_regimes": runs_a, "alpha_regimes": runs_b,
+                         "delta_mu_settle_time": ds_a["settle_time"].values.tolist(),
+                         "alpha_settle_time": ds_b["settle_time"].values.tolist()})
 
 
 # ----------------------------------------------------------------------------- Figs. 14, 15
 def _period_summary(ds, model: str) -> dict:
-    """Stick-slip points of one model of a Fig. 14 sweep: count, kinds, multiplicities, period range."""
+    """Stick-slip points of one model of a Fig. 14 sweep: count, verdicts, peaks per period, period range."""
     d = ds.sel(model=model)
     ss = _stick_slip(d)
-    kinds = _kind_names(d)[ss]
+    labels = _attractor_names(d)
     period = d["period"].values[ss]
-    mult = d["multiplicity"].values[ss]
+    count = d["period_count"].values[ss]
     fin = np.isfinite(period)
     spread = float(period[fin].max() / period[fin].min() - 1.0) if fin.any() else math.nan
-    return {"n": int(ss.sum()), "of": int(ss.size), "all_periodic": bool(ss.any() and np.all(kinds == "periodic-stick-slip")),
-            "multiplicities": sorted({int(m) for m in mult[np.isfinite(mult)]}), "period_spread": spread,
+    return {"n": int(ss.sum()), "of": int(ss.size), "all_periodic": bool(ss.any() and np.all(labels[ss] == "periodic")),
+            "multiplicities": sorted({int(m) for m in count[np.isfinite(count) & (count > 0)]}), "period_spread": spread,
             "period_range": [float(period[fin].min()), float(period[fin].max())] if fin.any() else None,
-            "kinds": {str(k): int(np.sum(_kind_names(d) == k)) for k in np.unique(_kind_names(d))}}
+            "attractors": {str(k): int(np.sum(labels == k)) for k in np.unique(labels)},
+            "settled": int(np.sum(np.isfinite(d["settle_time"].values)))}
 
 
 def _recipe_fig14(out: Path, res: Resolution, cache: dict) -> RecipeResult:
@@ -708,16 +772,16 @@ def _recipe_fig14(out: Path, res: Resolution, cache: dict) -> RecipeResult:
         s_n, s_o = _period_summary(ds_n, m), _period_summary(ds_o, m)
         measured[m] = {"N": s_n, "Omega": s_o}
         text = "; ".join(
-            f"over {lab}: stick-slip at {s['n']}/{s['of']}, all periodic stick-slip: {_yes(s['all_periodic'])}, "
+            f"over {lab}: stick-slip at {s['n']}/{s['of']}, all settled periodic: {_yes(s['all_periodic'])}, "
             f"peaks per period {s['multiplicities'] or '–'}, period spread {_fmt(100 * s['period_spread'], 2)} %, "
-            f"kinds {s['kinds']}" for lab, s in (("N", s_n), ("Ω", s_o)))
+            f"verdicts {s['attractors']}" for lab, s in (("N", s_n), ("Ω", s_o)))
         label = MODEL_LABELS[m].split(" (")[0]
         if m == "rotation":
             ok = all(s["all_periodic"] and s["multiplicities"] == [1] and s["period_spread"] <= UNCHANGED_PERIOD_RTOL
                      for s in (s_n, s_o))
             rows.append(Row(f"Fig. 14(e)(f), {label}", "“no bifurcation appears, i.e, ϕ has periodic stick-slip "
                             "oscillation with unchanged period (or frequency) with the variation of N or Ω”", text,
-                            _yes(ok), f"over N and over Ω every stick-slip point is periodic stick-slip with one peak "
+                            _yes(ok), f"over N and over Ω every stick-slip point settles periodic with one peak "
                             f"per period and the period varies by at most {100 * UNCHANGED_PERIOD_RTOL:g} %"))
         else:
             ok = all(s["all_periodic"] and (s["period_spread"] > DIFFERENT_PERIOD_RTOL or len(s["multiplicities"]) > 1)
@@ -725,27 +789,25 @@ def _recipe_fig14(out: Path, res: Resolution, cache: dict) -> RecipeResult:
             panel = "(a)(b)" if m == "x" else "(c)(d)"
             rows.append(Row(f"Fig. 14{panel}, {label}", "“periodic stick-slip oscillations with different periods "
                             "(or frequencies) appear as N or Ω varies”", text, _yes(ok),
-                            f"over N and over Ω every stick-slip point is periodic stick-slip, and the period varies "
+                            f"over N and over Ω every stick-slip point settles periodic, and the period varies "
                             f"by more than {100 * DIFFERENT_PERIOD_RTOL:g} % or the peaks per period change"))
     return RecipeResult(["fig14_N.png", "fig14_Omega.png"], rows, measured)
 
 
 def _recipe_fig15(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..analysis.classify import classify
-    from ..integrate.driver import simulate
     from ..model.parameters import Parameters
     from ..plot.trajectory import save_trajectory_figure
 
-    tr = simulate(Parameters(N=50.0, Omega=0.5), res.fig15_t_end, model="rotation", sample_rate=200.0)
-    c = classify(tr)
+    tr = _settled_run(Parameters(N=50.0, Omega=0.5), res, res.fig15_t_end, model="rotation")
+    a = tr.attractor
     save_trajectory_figure(tr, out / "fig15.png")
     rows = [Row("Fig. 15", "Model 4 (rotation only): periodic stick-slip of φ with one period (Sect. 4.2.3, with Fig. 14(e)(f))",
-                f"N = 50 N, Ω = 0.5 rad/s: {c.kind}, {c.multiplicity} peak(s) per period, period {_fmt(c.period_s, 4)} s, "
-                f"stick fraction {_fmt(c.stick_fraction)}",
-                _yes(c.kind == "periodic-stick-slip" and c.multiplicity == 1),
-                "classified periodic stick-slip with one peak per period (the paper does not print N, Ω of Fig. 15; "
+                f"N = 50 N, Ω = 0.5 rad/s: {_verdict_text(tr)}, period {_fmt(a.period_s, 4)} s, stick fraction "
+                f"{_fmt(a.classification.stick_fraction if a.classification else math.nan)}",
+                _yes(a.kind == "periodic-stick-slip" and a.period_count == 1),
+                "settled periodic stick-slip with one peak per period (the paper does not print N, Ω of Fig. 15; "
                 "ours are those of Figs. 12(a)/14 at N = 50 N)")]
-    return RecipeResult(["fig15.png"], rows, c.to_dict())
+    return RecipeResult(["fig15.png"], rows, a.to_dict())
 
 
 RECIPES = [
@@ -866,20 +928,6 @@ def render_report(entries: list, res: Resolution, pending: list, elapsed: float)
     return "\n".join(lines)
 
 
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return float(x) if math.isfinite(float(x)) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
-
-
 def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str] | None = None,
               progress: Callable[[str], None] | None = None) -> Path:
     """Run the recipes and write ``out_dir/report.md`` (+ PNGs, ``results.json``).
@@ -900,6 +948,8 @@ def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str
     """
     import matplotlib
 
+    from ..analysis.settle import jsonable
+
     matplotlib.use("Agg")
     if isinstance(resolution, str) and resolution not in RESOLUTIONS:
         raise ValueError(f"unknown resolution {resolution!r}; choose one of {', '.join(RESOLUTIONS)}")
@@ -919,7 +969,7 @@ def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str
 
     def write(pending):
         report.write_text(render_report(entries, res, pending, time.perf_counter() - t_start), encoding="utf-8")
-        (out / "results.json").write_text(json.dumps(_jsonable({"resolution": dataclasses.asdict(res),
+        (out / "results.json").write_text(json.dumps(jsonable({"resolution": dataclasses.asdict(res),
                                                                 "recipes": entries}), indent=1), encoding="utf-8")
 
     for i, recipe in enumerate(selected):

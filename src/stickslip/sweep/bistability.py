@@ -26,17 +26,24 @@ the largest grid Ω at which stick-slip occurs.
 from __future__ import annotations
 
 import dataclasses
+import shutil
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
+from ..files import atomic_write, lock
 from ..model.parameters import Parameters
 from .engine import SweepResult, sweep
-from .spec import SweepError
+from .executors import check_workers
+from .spec import SweepError, SweepSpec
 from .store import load_sweep
 
 __all__ = ["RegionMap", "regions", "load_region_map", "REGION_NAMES", "classify_regions"]
+
+#: Keywords of :func:`~stickslip.sweep.sweep` that say how to run, not what to compute.
+_RUN_OPTIONS = ("executor", "workers", "address", "batch_size", "progress", "overwrite", "snapshot_interval",
+                "keep_journal")
 
 REGION_NAMES = {0: "other", 1: "I: stick-slip only", 2: "II: coexistence", 3: "III: equilibrium only"}
 
@@ -125,21 +132,35 @@ def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | Non
         Run length and start of the steady window [s].
     **sweep_options
         Passed to :func:`~stickslip.sweep.sweep` (executor, workers, progress, sample_rate, ...).
+
+    Raises
+    ------
+    stickslip.files.LockError
+        If another process is writing ``out``.
     """
     if "ic" in sweep_options:
         raise SweepError("regions() uses the two initial conditions 'far' and 'near'; do not pass ic")
     grid = {"model": list(models), "N": list(N), "Omega": list(Omega), "ic": ["far", "near"]}
-    res: SweepResult = sweep(grid, params, out=out, t_end=t_end, t_from=t_from, **sweep_options)
-    ds = _with_regions(res.dataset)
-    path = None
-    if out is not None:
-        path = Path(out)
-        if "region" not in res.dataset:
-            extra = ds[["region", "stick_slip_omega_max"]].load()
-            res.dataset.close()  # a large sweep is open lazily from this very file
-            extra.to_netcdf(path, engine="h5netcdf", mode="a")
-            ds = load_sweep(path, load="auto")
-    return RegionMap(ds, path, res.timings)
+    run = {k: sweep_options.pop(k) for k in _RUN_OPTIONS if k in sweep_options}
+    spec = SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **sweep_options)  # bad input: before the lock
+    check_workers(run.get("workers"), address=run.get("address"))
+    if out is None:
+        res: SweepResult = sweep(spec, **run)
+        return RegionMap(_with_regions(res.dataset), None, res.timings)
+    path = Path(out)
+    with lock(path):  # held across the sweep (which takes it again) and the region variables
+        res = sweep(spec, out=path, **run)
+        if "region" in res.dataset:
+            return RegionMap(res.dataset, path, res.timings)
+        extra = _with_regions(res.dataset)[["region", "stick_slip_omega_max"]].load()
+        res.dataset.close()  # a large sweep is open lazily from this very file
+
+        def add_regions(tmp):  # a copy of the sweep plus two variables: bounded memory, replaced atomically
+            shutil.copyfile(path, tmp)
+            extra.to_netcdf(tmp, engine="h5netcdf", mode="a")
+
+        atomic_write(path, add_regions)
+    return RegionMap(load_sweep(path, load="auto"), path, res.timings)
 
 
 def load_region_map(path) -> RegionMap:

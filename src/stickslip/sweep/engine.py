@@ -12,7 +12,8 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..model.parameters import Parameters
-from .executors import default_workers, run_batches
+from ..files import FileFormatError
+from .executors import check_workers, run_batches
 from .spec import SweepError, SweepSpec, evaluate_batch
 from .store import Journal, assemble, journal_dir, load_sweep
 
@@ -78,6 +79,16 @@ def _auto_batch(t_point: float, remaining: int, workers: int, executor: str) -> 
     return size
 
 
+def _settle_attrs(spec: SweepSpec) -> dict:
+    """File attributes saying how each point's run length was chosen."""
+    attrs = {"settle": int(spec.settle), "confirm": int(spec.confirm)}
+    if spec.settle:
+        attrs.update(cap=spec.cap, cap_units="s",
+                     settle_comment="each run extended from its final state in steps of t_end - t_from until "
+                                    "settled or cap; settle_time per point, window t_end - t_from at its end")
+    return attrs
+
+
 def _progress_bar():
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskProgressColumn, TextColumn,
                                TimeElapsedColumn, TimeRemainingColumn)
@@ -108,7 +119,8 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
         had finished. Default: a temporary file (the dataset is returned loaded).
     executor : {"serial", "processes", "dask"}
     workers : int, optional
-        Worker processes (default: all cores). For ``dask`` without ``address``, the LocalCluster size.
+        Worker processes (default: all CPUs available to this process, also the most allowed). For
+        ``dask`` without ``address``, the LocalCluster size.
     address : str, optional
         ``dask.distributed`` scheduler address (``tcp://host:8786``); default a LocalCluster.
     batch_size : int or "auto"
@@ -126,7 +138,9 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
         Run length and start of the steady window of every point [s] (default t_end/2).
     **options
         ``model``, ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
-        ``n_peaks``, ``method``: see :class:`~stickslip.sweep.spec.SweepSpec`.
+        ``n_peaks``, ``method``, ``settle`` (extend every run until it has settled; then
+        ``t_end`` is the first run's length), ``cap`` [s] (longest run when settling),
+        ``confirm``: see :class:`~stickslip.sweep.spec.SweepSpec`.
 
     Returns
     -------
@@ -135,13 +149,18 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     Raises
     ------
     SweepError
-        For an invalid grid or option, or an output that belongs to a different sweep.
+        For an invalid grid or option, more ``workers`` than CPUs, an unreachable scheduler, or an
+        output that belongs to a different sweep.
+    stickslip.files.LockError
+        If another process is writing the same output.
+    stickslip.files.WriteError
+        If the disk is full (the journal keeps every finished point: run again to resume).
     """
     t_start = time.perf_counter()
     spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
     if executor not in TARGET_BATCH_S:
         raise SweepError(f"unknown executor {executor!r}; choose serial, processes or dask")
-    workers = default_workers() if workers is None else int(workers)
+    workers = check_workers(workers, address=address)
     tmpdir = None
     if out is None:
         tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-sweep-")
@@ -153,7 +172,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     if out.exists() and not journal_dir(out).exists() and not overwrite:
         try:
             ds = load_sweep(out, load="auto")
-        except SweepError as exc:
+        except FileFormatError as exc:
             raise SweepError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
         if ds.attrs.get("digest") == spec.digest and int(ds.attrs.get("complete", 0)):
             return SweepResult(out, spec, ds, {"total_s": time.perf_counter() - t_start, "points_computed": 0,
@@ -184,7 +203,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
                 rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
                 bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
             if time.perf_counter() - last_snapshot > snapshot_interval:
-                assemble(journal, out)
+                assemble(journal, out, extra_attrs=_settle_attrs(spec))
                 last_snapshot = time.perf_counter()
 
         if todo.size:
@@ -204,7 +223,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
         info["compute_s"] = time.perf_counter() - compute_start
         if bar is not None:
             bar.stop()
-        assemble(journal, out, extra_attrs={"executor": executor})
+        assemble(journal, out, extra_attrs={"executor": executor, **_settle_attrs(spec)})
         if not keep_journal:
             journal.remove()
         else:

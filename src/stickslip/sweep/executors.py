@@ -11,13 +11,20 @@
                dask's nanny sets by default (:func:`local_cluster`).
 
 At most ``2 × workers`` batches are in flight, so the pending work held in memory does not grow
-with the grid.
+with the grid. ``workers`` may not exceed the CPUs this process may run on
+(:func:`check_workers`): more would only time-share the cores and multiply memory. Pool workers
+end within a second of their parent, also when it is killed with ``kill -9``
+(:func:`watch_parent`); dask's LocalCluster workers already do (each watches a pipe to the
+process that started it).
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import sys
+import threading
 import time
 from typing import Iterator, Sequence
 
@@ -25,17 +32,108 @@ import numpy as np
 
 from .spec import SweepError, SweepSpec, evaluate_batch, warm_up
 
-__all__ = ["EXECUTORS", "default_workers", "local_cluster", "run_batches"]
+__all__ = ["EXECUTORS", "default_workers", "check_workers", "watch_parent", "worker_pool", "connect", "local_cluster",
+           "run_batches", "WorkersError", "SchedulerError"]
 
 EXECUTORS = ("serial", "processes", "dask")
 
 
 def default_workers() -> int:
-    """Cores available to this process."""
+    """CPUs this process may run on (its affinity mask where the platform has one, else all)."""
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - macOS/Windows
         return os.cpu_count() or 1
+
+
+class WorkersError(SweepError):
+    """More worker processes than CPUs, or fewer than one."""
+
+
+def check_workers(workers: int | None, *, address: str | None = None, option: str = "workers") -> int:
+    """``workers`` (default :func:`default_workers`), checked to be between 1 and the available CPUs.
+
+    Parameters
+    ----------
+    workers : int or None
+    address : str, optional
+        A dask scheduler address: its workers run elsewhere, so only ``workers >= 1`` is checked.
+    option : str
+        How the messages name the setting (``--workers`` on the command line).
+
+    Raises
+    ------
+    WorkersError
+        One line naming the limit.
+    """
+    limit = default_workers()
+    if workers is None:
+        return limit
+    workers = int(workers)
+    if workers < 1:
+        raise WorkersError(f"{option} must be >= 1, got {workers}")
+    if workers > limit and not address:
+        raise WorkersError(f"{option} {workers} is more than the {limit} CPUs available to this process; give at "
+                           f"most {limit} (more workers than CPUs only share the same cores), or use a dask "
+                           "cluster (--scheduler) for more")
+    return workers
+
+
+#: How often a pool worker checks that its parent is alive [s] (where the platform cannot tell it).
+PARENT_POLL_S = 0.5
+
+
+def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> None:
+    """Make this process (a pool worker) end when its parent does, even after ``kill -9``.
+
+    On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``), which
+    works while the worker is inside a compiled kernel that holds the GIL. (Strictly, when the
+    thread that forked the worker ends: our pools are started and used by one thread for the
+    whole run.) Everywhere, a daemon
+    thread also polls the parent pid every ``interval`` seconds and ends the process with
+    ``os._exit`` once the parent is gone (reparented: ``os.getppid()`` changed).
+    """
+    parent = os.getppid() if parent is None else parent
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            PR_SET_PDEATHSIG = 1
+            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no libc prctl: the thread below suffices
+            pass
+    if os.getppid() != parent:  # the parent died before the watch began
+        os._exit(1)
+
+    def poll():
+        while True:
+            time.sleep(interval)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=poll, name="stickslip-watch-parent", daemon=True).start()
+
+
+def _init_worker(parent: int, warm: bool) -> None:
+    watch_parent(parent)
+    if warm:
+        warm_up()
+
+
+def worker_pool(workers: int):
+    """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes that end with this one.
+
+    Forked where the platform can (the workers inherit the kernels this process has already
+    compiled), else spawned and warmed up (:func:`~stickslip.sweep.spec.warm_up`) as they start.
+    Each worker runs :func:`watch_parent`.
+    """
+    from concurrent.futures import ProcessPoolExecutor
+
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                               initargs=(os.getpid(), ctx.get_start_method() != "fork"))
 
 
 def _serial(spec, batches, info) -> Iterator:
@@ -44,14 +142,10 @@ def _serial(spec, batches, info) -> Iterator:
 
 
 def _processes(spec, batches, workers, info) -> Iterator:
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures import FIRST_COMPLETED, wait
 
-    methods = multiprocessing.get_all_start_methods()
-    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     start = time.perf_counter()
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        if ctx.get_start_method() != "fork":
-            list(pool.map(warm_up, [None] * workers))
+    with worker_pool(workers) as pool:
         info["pool_start_s"] = time.perf_counter() - start
         it = iter(batches)
         pending = set()
@@ -100,6 +194,30 @@ def local_cluster(workers: int):
                             dashboard_address=None, silence_logs=40)
 
 
+class SchedulerError(SweepError):
+    """The dask scheduler address is malformed or cannot be reached."""
+
+
+def connect(address: str):
+    """A ``distributed.Client`` of the scheduler at ``address``.
+
+    Waits up to dask's connect timeout (``distributed.comm.timeouts.connect``, 30 s by default).
+
+    Raises
+    ------
+    SchedulerError
+        One line, if the address is malformed or nothing answers there.
+    """
+    from distributed import Client
+
+    try:
+        return Client(address)
+    except (OSError, ValueError, TypeError) as exc:
+        raise SchedulerError(f"cannot connect to the dask scheduler at {address!r} ({exc}); check the address "
+                             "(tcp://HOST:PORT, as `dask scheduler` prints it) and that the scheduler runs and is "
+                             "reachable from here, or leave out --scheduler to use this machine's cores") from None
+
+
 def _dask(spec, batches, workers, address, info) -> Iterator:
     try:
         from distributed import Client, as_completed
@@ -108,7 +226,7 @@ def _dask(spec, batches, workers, address, info) -> Iterator:
     start = time.perf_counter()
     cluster = None
     if address:
-        client = Client(address)
+        client = connect(address)
     else:
         cluster = local_cluster(workers)
         client = Client(cluster)
@@ -141,9 +259,7 @@ def run_batches(spec: SweepSpec, batches: Sequence[np.ndarray], *, executor: str
     ``info`` receives start-up timings (``pool_start_s``, ``cluster_start_s``, ``worker_warm_s``).
     """
     info = {} if info is None else info
-    workers = default_workers() if workers is None else int(workers)
-    if workers < 1:
-        raise SweepError(f"workers must be >= 1, got {workers}")
+    workers = check_workers(workers, address=address)
     if executor == "serial":
         return _serial(spec, batches, info)
     if executor == "processes":

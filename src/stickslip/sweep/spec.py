@@ -7,8 +7,6 @@ the trajectory outlives the point and memory stays flat as the grid grows.
 
 from __future__ import annotations
 
-from ..errors import StickSlipError
-
 import dataclasses
 import hashlib
 import json
@@ -18,6 +16,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..analysis.settle import ATTRACTORS, DEFAULT_CAP_S
+from ..errors import StickSlipError
 from ..model.parameters import Parameters
 from ..model.variants import DOF_NAMES, STATE_NAMES, resolve_variant
 
@@ -70,12 +70,19 @@ def _columns(n_peaks: int):
     """(name, width, attrs) of each reduced quantity, in row order."""
     cols = [
         ("kind", 1, {"long_name": "steady-state kind", "flag_values": "-1 0 1 2 3",
-                     "flag_meanings": "failed equilibrium periodic-slip periodic-stick-slip non-periodic"}),
-        ("multiplicity", 1, {"long_name": "peaks of phi per period (period multiplicity), 0 if not periodic"}),
-        ("settled", 1, {"long_name": "attractor settled in the steady window (1) or still drifting (0)"}),
-        ("period", 1, {"units": "s", "long_name": "period from the return map of the peaks of phi"}),
-        ("frequency", 1, {"units": "Hz", "long_name": "1/period, or mean rate of peaks when not periodic"}),
-        ("fft_frequency", 1, {"units": "Hz", "long_name": "highest peak of the amplitude spectrum of phi"}),
+                     "flag_meanings": "failed equilibrium periodic-slip periodic-stick-slip non-periodic",
+                     "comment": "periodic only when settled (and confirmed by shooting for more than one "
+                                "peak per period); non-periodic includes unsettled runs"}),
+        ("attractor", 1, {"long_name": "what the run settles to", "flag_values": "-1 0 1 2 3 4 5",
+                          "flag_meanings": "failed " + " ".join(ATTRACTORS)}),
+        ("settled", 1, {"long_name": "the window shows the attractor (1) or a transient (0)"}),
+        ("period_count", 1, {"long_name": "peaks of phi per period of a settled periodic orbit, 0 otherwise"}),
+        ("period", 1, {"units": "s", "long_name": "period of a settled periodic orbit (return map of the peaks of phi)"}),
+        ("fundamental_frequency", 1, {"units": "Hz",
+                                      "long_name": "fundamental frequency 1/period of a settled periodic orbit"}),
+        ("frequency", 1, {"units": "Hz", "long_name": "1/period when the peaks of phi repeat, else their mean rate"}),
+        ("dominant_frequency", 1, {"units": "Hz", "long_name": "highest peak of the amplitude spectrum of phi"}),
+        ("settle_time", 1, {"units": "s", "long_name": "simulated time by which the run was seen settled"}),
         ("stick_fraction", 1, {"units": "1", "long_name": "fraction of the steady window in stick"}),
         ("n_transitions", 1, {"long_name": "stick-slip transitions in the steady window"}),
         ("amplitude", 1, {"units": "rad", "long_name": "peak-to-peak phi in the steady window"}),
@@ -90,7 +97,8 @@ def _columns(n_peaks: int):
                                       "long_name": "intensity index I of the translation (x1, y1), Eq. (16)"}),
         ("angle_min", 1, {"units": "degree", "long_name": "minimum angle of v_r against the circumferential direction (Fig. 11)"}),
         ("angle_max", 1, {"units": "degree", "long_name": "maximum angle of v_r against the circumferential direction (Fig. 11)"}),
-        ("t_reached", 1, {"units": "s", "long_name": "time the run reached (t_end unless it failed)"}),
+        ("t_reached", 1, {"units": "s", "long_name": "time the run reached (t_end, or the settle time or cap "
+                                                     "when settling, unless it failed)"}),
         ("steps", 1, {"long_name": "integration steps (accepted + rejected)"}),
         ("wall_time", 1, {"units": "s", "long_name": "wall time of the point (simulation and reduction)"}),
         ("peaks", n_peaks, {"units": "rad", "long_name": "last peak values of phi in the steady window (events dphi = 0)"}),
@@ -120,7 +128,17 @@ class SweepSpec:
     model, ic : str
         Defaults when not swept.
     t_end, t_from : float
-        Run length and start of the steady window [s].
+        Run length and start of the steady window [s]. When settling: the first run's length
+        and the start of its window; the window length t_end − t_from is also the step.
+    settle : bool
+        Extend each run from its final state until it has settled or reaches ``cap``
+        (:func:`stickslip.analysis.settle.simulate_until_settled`).
+    cap : float
+        Longest run when settling [s].
+    confirm : bool
+        Confirm a period of more than one peak by shooting and chaos or a torus by the largest
+        Lyapunov exponent (:func:`stickslip.analysis.settle.attractor`); without it no such
+        claim is made.
     sample_rate : float
         Output samples per second of each run [Hz].
     rtol, atol : float
@@ -139,6 +157,9 @@ class SweepSpec:
     ic: str = "zero"
     t_end: float = 200.0
     t_from: float = 100.0
+    settle: bool = False
+    cap: float = DEFAULT_CAP_S
+    confirm: bool = True
     sample_rate: float = 200.0
     rtol: float = 1e-8
     atol: float = 1e-10
@@ -200,6 +221,8 @@ class SweepSpec:
             raise SweepError("n_peaks must be >= 1")
         if spec.sample_rate * (t_end - t_from) < 8:
             raise SweepError("the steady window holds fewer than 8 samples; raise sample_rate or t_end")
+        if not (math.isfinite(spec.cap) and spec.cap >= t_end):
+            raise SweepError(f"cap = {spec.cap} s must be a finite number ≥ t_end = {t_end} s")
         return spec
 
     # ---------------------------------------------------------------- geometry of the grid
@@ -248,9 +271,11 @@ class SweepSpec:
 # ----------------------------------------------------------------------------- one point
 def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     """Simulate one grid point and reduce it to a row of :attr:`SweepSpec.row_width` numbers."""
-    from ..analysis.classify import classify, kind_code
+    from ..analysis.classify import kind_code
     from ..analysis.intensity import angle_range, trajectory_intensities
+    from ..analysis.settle import attractor, simulate_until_settled
     from ..integrate.driver import SimulationError, simulate
+    from ..integrate.status import Status
 
     start = time.perf_counter()
     values = spec.point(flat_index)
@@ -268,32 +293,45 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         pert = vec
     out = {name: math.nan for name, _, _ in spec.columns}
     peaks = np.full(spec.n_peaks, math.nan)
+    run = dict(model=model, method=spec.method, ic=ic, perturbation=pert, rtol=spec.rtol, atol=spec.atol,
+               sample_rate=spec.sample_rate, max_steps=spec.max_steps)
     try:
-        traj = simulate(params, spec.t_end, model=model, method=spec.method, ic=ic, perturbation=pert,
-                        rtol=spec.rtol, atol=spec.atol, sample_rate=spec.sample_rate, steady_from=spec.t_from,
-                        max_steps=spec.max_steps)
+        if spec.settle:
+            window = spec.t_end - spec.t_from
+            traj = simulate_until_settled(params, cap=spec.cap, t_min=spec.t_end, window=window, step=window,
+                                          keep="window", confirm=spec.confirm, lyapunov=spec.confirm, **run)
+        else:
+            traj = simulate(params, spec.t_end, steady_from=spec.t_from, **run)
     except SimulationError:
         traj = None
+    if traj is not None and traj.status_code == Status.INTERRUPTED:
+        raise KeyboardInterrupt  # Ctrl-C: the point is not done (the journal keeps the others; resume redoes it)
     if traj is not None:
         out["t_reached"] = float(traj.t[-1])
         out["steps"] = float(traj.stats.steps)
     if traj is None or traj.status != "success":
         out["kind"] = -1.0
+        unbounded = traj is not None and traj.attractor.attractor == "unbounded"
+        out["attractor"] = float(traj.attractor.code) if unbounded else -1.0
     else:
-        c = classify(traj, spec.t_from)
-        sel = traj.t >= spec.t_from
+        verdict = traj.attractor if spec.settle else attractor(traj, confirm=spec.confirm, lyapunov=spec.confirm)
+        c = verdict.classification
+        t_from = traj.steady_from
+        sel = traj.t >= t_from
         phi = traj.states[sel, 4]
-        out.update(kind=float(kind_code(c.kind)), multiplicity=float(c.multiplicity), settled=float(c.settled),
-                   period=c.period_s, frequency=c.frequency_hz, fft_frequency=c.fft_frequency_hz,
-                   stick_fraction=c.stick_fraction, amplitude=c.amplitude,
+        out.update(kind=float(kind_code(verdict.kind)), attractor=float(verdict.code), settled=float(verdict.settled),
+                   period_count=float(verdict.period_count or 0), period=verdict.period_s,
+                   fundamental_frequency=_nan(verdict.fundamental_frequency_hz), frequency=c.frequency_hz,
+                   dominant_frequency=_nan(verdict.dominant_frequency_hz),
+                   settle_time=_nan(verdict.settle_time_s), stick_fraction=c.stick_fraction, amplitude=c.amplitude,
                    phi_min=float(phi.min()), phi_max=float(phi.max()),
                    phi_mean=float(np.sum(0.5 * (phi[1:] + phi[:-1]) * np.diff(traj.t[sel])) / (traj.t[sel][-1] - traj.t[sel][0])),
                    n_peaks=float(len(c.peaks)))
         tt = traj.transitions.time
-        out["n_transitions"] = float(np.sum((tt > spec.t_from) & (tt <= traj.t[-1])))
-        for key, val in trajectory_intensities(traj, spec.t_from).items():
+        out["n_transitions"] = float(np.sum((tt > t_from) & (tt <= traj.t[-1])))
+        for key, val in trajectory_intensities(traj, t_from).items():
             out[f"intensity_{key}"] = val
-        out["angle_min"], out["angle_max"] = angle_range(traj, spec.t_from)
+        out["angle_min"], out["angle_max"] = angle_range(traj, t_from)
         last = c.peaks.value[-spec.n_peaks:]
         peaks[: last.size] = last
     out["wall_time"] = time.perf_counter() - start
@@ -303,6 +341,10 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         row[j : j + width] = peaks if name == "peaks" else out[name]
         j += width
     return row
+
+
+def _nan(x) -> float:
+    return math.nan if x is None else float(x)
 
 
 def evaluate_batch(spec: SweepSpec, indices) -> tuple[np.ndarray, np.ndarray]:

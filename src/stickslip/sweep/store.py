@@ -2,17 +2,22 @@
 
 Layout beside the NetCDF output ``OUT.nc``:
 
+``OUT.nc.lock``
+    Held by the one process writing ``OUT.nc`` and its journal (:func:`stickslip.files.lock`):
+    a second sweep on the same output is refused with one line naming the holder.
 ``OUT.nc.journal/manifest.json``
     The :class:`~stickslip.sweep.spec.SweepSpec` (as JSON, with its digest) and the row layout.
 ``OUT.nc.journal/rows.f64``
     Append-only float64 records ``[flat index, row..., SENTINEL]``, one per finished point,
-    appended by the driver as each batch arrives (one ``write`` per batch, flushed to the OS, so
-    a killed process loses nothing it had received). On reopening, a torn last record (a kill
-    inside a write) and any record without the sentinel are dropped and recomputed.
+    appended by the driver as each batch arrives (one ``write`` per batch, ``fsync``-ed before
+    the next batch is taken, so neither a killed process nor a power cut loses a batch it had
+    received). On reopening, a torn last record (a kill inside a write) and any record without
+    the sentinel are dropped and recomputed.
 
 ``OUT.nc`` is assembled from the journal into a temporary file that replaces the output
-atomically, at intervals while the sweep runs and at the end; the journal is then removed. A
-killed sweep therefore always leaves either a complete earlier snapshot or none.
+atomically (:func:`stickslip.files.atomic_write`), at intervals while the sweep runs and at the
+end; the journal is then removed. A killed sweep therefore always leaves either a complete
+earlier snapshot or none, and a full disk leaves the journal and the previous ``OUT.nc``.
 
 Memory of the assembly does not grow with the grid (beyond one byte per point for the ``done``
 mask): the journal is read in blocks of :data:`READ_ROWS` records (plain reads, no memory map,
@@ -25,19 +30,19 @@ hyperslabs (:func:`flat_hyperslabs`).
 from __future__ import annotations
 
 import json
-import os
 import shutil
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
+from ..files import AppendLog, OutputLock, atomic_write, format_name, fsync_dir, open_ours
 from ..model.parameters import PARAMETER_UNITS, parameter_attrs
 from .spec import NAMED_ICS, SweepError, SweepSpec
 
 __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir", "flat_hyperslabs", "LOAD_LIMIT_POINTS"]
 
-FORMAT = "stickslip-sweep-1"
+FORMAT = format_name("sweep", 1)
 JOURNAL_FORMAT = "stickslip-sweep-journal-1"
 #: Last value of every journal record: a record without it was torn by a kill mid-write.
 SENTINEL = 8.0e300
@@ -62,32 +67,48 @@ def journal_dir(out: Path) -> Path:
 
 
 class Journal:
-    """The append-only record of finished points of one sweep."""
+    """The append-only record of finished points of one sweep, and the lock of its output.
+
+    Opening it takes the output's lock (:class:`~stickslip.files.OutputLock`) and keeps it until
+    :meth:`close` or :meth:`remove`.
+
+    Raises
+    ------
+    stickslip.files.LockError
+        If another process is writing the same output.
+    SweepError
+        If the journal beside ``out`` belongs to a different sweep (and not ``overwrite``).
+    """
 
     def __init__(self, out: Path, spec: SweepSpec, *, overwrite: bool = False):
         self.out = Path(out)
         self.dir = journal_dir(self.out)
         self.spec = spec
         self.width = spec.row_width + 2
+        self.lock = OutputLock(self.out).acquire()
+        with self.lock.released_on_error():
+            self._open(overwrite)
+
+    def _open(self, overwrite: bool) -> None:
         manifest = self.dir / "manifest.json"
         if overwrite and self.dir.exists():
             shutil.rmtree(self.dir)
         if manifest.exists():
             old = json.loads(manifest.read_text())
-            if old.get("format") != JOURNAL_FORMAT or old.get("digest") != spec.digest:
+            if old.get("format") != JOURNAL_FORMAT or old.get("digest") != self.spec.digest:
                 raise SweepError(
                     f"{self.dir} holds the journal of a different sweep (grid or options differ); "
                     "resume with the same arguments, pass overwrite=True (--overwrite), or choose another output"
                 )
         else:
             self.dir.mkdir(parents=True, exist_ok=True)
-            tmp = manifest.with_suffix(".tmp")
-            tmp.write_text(json.dumps({"format": JOURNAL_FORMAT, "digest": spec.digest, "spec": spec.to_json(),
-                                       "row_width": spec.row_width, "stickslip_version": __version__}))
-            os.replace(tmp, manifest)
+            fsync_dir(self.dir.parent)
+            text = json.dumps({"format": JOURNAL_FORMAT, "digest": self.spec.digest, "spec": self.spec.to_json(),
+                               "row_width": self.spec.row_width, "stickslip_version": __version__})
+            atomic_write(manifest, lambda tmp: tmp.write_text(text))
         self.path = self.dir / "rows.f64"
         self._repair()
-        self._fh = open(self.path, "ab")
+        self._log = AppendLog(self.path, kept=f"finished points are kept in {self.dir}")
 
     def _repair(self) -> None:
         """Drop a torn tail and records without the sentinel (streamed: bounded memory)."""
@@ -101,11 +122,13 @@ class Journal:
                 fh.truncate(size - size % rec)
         if all(np.all(block[:, -1] == SENTINEL) for block in self.blocks()):
             return
-        tmp = self.path.with_suffix(".tmp")
-        with open(tmp, "wb") as fh:
-            for block in self.blocks():
-                fh.write(block[block[:, -1] == SENTINEL].tobytes())
-        os.replace(tmp, self.path)
+
+        def keep_complete(tmp):
+            with open(tmp, "wb") as fh:
+                for block in self.blocks():
+                    fh.write(block[block[:, -1] == SENTINEL].tobytes())
+
+        atomic_write(self.path, keep_complete)
 
     def n_records(self) -> int:
         """Complete records in the journal file."""
@@ -127,20 +150,24 @@ class Journal:
         return mask
 
     def append(self, indices: np.ndarray, rows: np.ndarray) -> None:
-        """Record finished points (one write, flushed to the operating system)."""
+        """Record finished points (one write, ``fsync``-ed before returning)."""
         rec = np.empty((len(indices), self.width))
         rec[:, 0] = indices
         rec[:, 1:-1] = rows
         rec[:, -1] = SENTINEL
-        self._fh.write(rec.tobytes())
-        self._fh.flush()
+        self._log.append(rec.tobytes())
 
     def close(self) -> None:
-        self._fh.close()
+        """Close the journal (it stays on disk) and release the output's lock."""
+        self._log.close()
+        self.lock.release()
 
     def remove(self) -> None:
-        self.close()
+        """Delete the journal (after the output is written) and release the output's lock."""
+        self._log.close()
         shutil.rmtree(self.dir, ignore_errors=True)
+        fsync_dir(self.dir.parent)
+        self.lock.release()
 
     def write_ordered(self, path: Path) -> None:
         """Scatter the journal rows into ``path`` as (size, row width) float64 in grid order.
@@ -217,12 +244,16 @@ def _coords(spec: SweepSpec):
 
 
 def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -> Path:
-    """Write the journal as a NetCDF-4 dataset (dims = swept names, plus ``peak``) atomically."""
+    """Write the journal as a NetCDF-4 dataset (dims = swept names, plus ``peak``) atomically.
+
+    Raises
+    ------
+    stickslip.files.WriteError
+        If the disk is full; ``path`` is left as it was and the journal keeps every point.
+    """
     import xarray as xr
 
     spec = journal.spec
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
     done = journal.done_mask()
     attrs = {
         "format": FORMAT,
@@ -239,19 +270,20 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
     }
     attrs.update(parameter_attrs(spec.params))
     attrs.update(extra_attrs or {})
-    coords = _coords(spec)
     base = xr.Dataset({"done": (spec.names, done.reshape(spec.shape).astype(np.int8),
                                 {"long_name": "point computed (1) or pending (0)"})},
-                      coords=coords, attrs=attrs)
-    base.to_netcdf(tmp, engine="h5netcdf", mode="w")
+                      coords=_coords(spec), attrs=attrs)
     ordered = journal.dir / "ordered.f64"
-    journal.write_ordered(ordered)
-    try:
-        _write_columns(tmp, ordered, spec, done)
-    finally:
-        ordered.unlink(missing_ok=True)
-    os.replace(tmp, path)
-    return path
+
+    def write(tmp):
+        base.to_netcdf(tmp, engine="h5netcdf", mode="w")
+        try:
+            journal.write_ordered(ordered)
+            _write_columns(tmp, ordered, spec, done)
+        finally:
+            ordered.unlink(missing_ok=True)
+
+    return atomic_write(path, write, kept=f"{path} is left as it was and finished points are kept in {journal.dir}")
 
 
 def _write_columns(nc_path: Path, ordered: Path, spec: SweepSpec, done: np.ndarray) -> None:
@@ -294,25 +326,10 @@ def load_sweep(path, *, load: bool | str = True):
 
     Raises
     ------
-    SweepError
-        If the file is missing, unreadable, or not a stickslip sweep.
+    stickslip.files.FileFormatError
+        If the file is missing, unreadable, truncated, not a stickslip sweep or of a newer format.
     """
-    import xarray as xr
-
-    path = Path(path)
-    if not path.is_file():
-        raise SweepError(f"{path} does not exist; give a .nc file written by `stickslip sweep`")
-    try:
-        ds = xr.open_dataset(path, engine="h5netcdf")
-        if load is True or (load == "auto" and ("done" not in ds or ds["done"].size <= LOAD_LIMIT_POINTS)):
-            ds.load()
-            ds.close()
-    except Exception as exc:  # h5py/xarray raise many types for foreign files
-        raise SweepError(f"{path} is not a NetCDF file written by stickslip ({type(exc).__name__}: {exc})") from exc
-    if ds.attrs.get("format") != FORMAT:
-        ds.close()
-        raise SweepError(
-            f"{path} is not a stickslip sweep (format attribute {ds.attrs.get('format')!r}, expected {FORMAT!r}); "
-            "give a file written by `stickslip sweep`, `bifurcation` or `regions`"
-        )
-    return ds
+    if load == "auto":
+        load = lambda ds: "done" not in ds or ds["done"].size <= LOAD_LIMIT_POINTS  # noqa: E731
+    return open_ours(path, "sweep", load=load,
+                     what="a .nc file written by `stickslip sweep`, `bifurcation` or `regions`")

@@ -1,0 +1,341 @@
+"""Transition logic of the contacts, shared by the integrators: events, stick entry, active set.
+
+Event functions are evaluated on a state vector; roots are located on any "dense output" of the
+form ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1] (every Runge–Kutta interpolant used here).
+
+* slip → stick of contact c: ``EVENT_SLIP`` is the projection of v_c on its direction at the
+  start of the step. A sign change means the slip velocity passed (near) zero; at the located
+  root, if |v_c| is below the arrival speed and the stick force is admissible (|F_c| ≤ μs N_c,
+  paper Eq. 10) the contact sticks; if not, v_c is set to zero and slip departs as at breakaway.
+* stick → slip of contact c: ``EVENT_STICK`` = μs N_c − |F_c|; its root is breakaway. Slip
+  starts with v_c = 0 in the direction e = −F_c/|F_c|, so F is continuous.
+* several contacts: the multipliers of all sticking contacts are solved together; after any
+  transition the sticking set is re-checked and a contact whose force exceeds its limit is
+  released (:func:`release_most_overloaded`), the active-set view of Pfeiffer and Glocker.
+* a normal force that reaches zero ends the run (contact lost).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model import physics as P
+from ..model.bundle import CST
+from ..model.jit import kernel
+from ..model.kinematics import model_sizes
+
+__all__ = ["EVENT_SLIP", "EVENT_STICK", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP", "EVENT_TIME_TOL",
+           "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
+           "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
+           "time_to_zero_of", "slip_event_possible", "contact_lost", "mode_flags"]
+
+EVENT_SLIP = 0   # slip → stick candidate: v_c · e0
+EVENT_STICK = 1  # stick → slip: μs N_c − |F_c|
+
+TRANSITION_TO_STICK = 1
+TRANSITION_TO_SLIP = -1
+
+#: Time resolution [s] to which transition instants are located on the dense output.
+EVENT_TIME_TOL = 1e-12
+
+#: Extrapolated time [s] to v_c = 0 below which slip counts as arrived; homing steps shorter than
+#: this are dominated by the direction singularity of v/|v| at zero and get rejected.
+ARRIVAL_TIME_TOL = 1e-10
+
+#: |v_c| [m/s] at or below which slip is close enough to v_c = 0 to finish the approach. When v
+#: heads for zero (within 60° of head-on) the last steps are homed onto it until the
+#: extrapolated time left is below ARRIVAL_TIME_TOL; when it spirals in (anisotropic
+#: G M⁻¹ Gᵀ: the stiff direction dynamics turn v faster than it shrinks, and explicit steps at
+#: their stability limit can hover, seen at |v_r| ~ 2e-8 m/s for the plates at N = 80 N,
+#: Ω = 1 rad/s) the residual ≤ 1e-6 m/s is removed by the projection at once: an impulse of at
+#: most 1e-6 m/s × mass and an instant error of ≤ 1e-6 / |dv/dt| (~1e-7 s).
+STICK_SPEED_TOL = 1e-6
+
+#: Cap on the Illinois iterations refining one root (each at least halves the bracket every
+#: few steps; ~40 are needed from a step of 0.1 s down to EVENT_TIME_TOL).
+MAX_REFINEMENTS = 200
+
+#: Sub-intervals of a step on which the event function is sampled for a sign change.
+EVENT_CHECKS = 4
+
+#: Largest number of contacts released in one settling of the sticking set (each pass releases
+#: one contact, so nc passes always suffice).
+MAX_SETTLE = 64
+
+
+@kernel
+def dense_state(y0, Q, h, theta, out):
+    """Evaluate ``out = y0 + h Σ_j Q[:, j] θ^(j+1)`` (Horner)."""
+    n, m = Q.shape
+    if m == 4:  # Dormand–Prince dense output: unrolled (the samples' inner loop)
+        for i in range(n):
+            out[i] = y0[i] + h * theta * (Q[i, 0] + theta * (Q[i, 1] + theta * (Q[i, 2] + theta * Q[i, 3])))
+        return
+    for i in range(n):
+        acc = Q[i, m - 1]
+        for j in range(m - 2, -1, -1):
+            acc = Q[i, j] + theta * acc
+        out[i] = y0[i] + h * theta * acc
+
+
+@kernel
+def all_finite(y):
+    """Whether every entry of ``y`` is finite (one branch on Σ y_i·0, NaN exactly when some y_i is not)."""
+    acc = 0.0
+    for i in range(y.shape[0]):
+        acc += y[i] * 0.0
+    return acc == 0.0
+
+
+@kernel
+def mode_flags(cst, nc):
+    """Bit c set when contact c sticks (the sample's mode; 1 = stick for a one-contact model)."""
+    flags = 0
+    for c in range(nc):
+        if np.int64(cst[CST * c]) == P.MODE_STICK:
+            flags |= 1 << c
+    return flags
+
+
+@kernel
+def event_value(kind, c, y, e0x, e0y, cst, md, F, N):
+    """Event function of ``kind`` for contact ``c`` at state ``y`` (module docstring).
+
+    ``F`` (2 nc,), ``N`` (nc,) are work arrays.
+    """
+    if kind == EVENT_SLIP:
+        vx, vy = P.slip_velocity(y, c, md)
+        return vx * e0x + vy * e0y
+    P.stick_forces(y, cst, np.int64(-1), md, F, N)
+    Fx = F[2 * c]
+    Fy = F[2 * c + 1]
+    return P.static_limit(md.m, model_sizes(md.kin, md.m)[0], c, N[c]) - math.sqrt(Fx * Fx + Fy * Fy)
+
+
+@kernel
+def regula_falsi_point(a, ga, b, gb):
+    """Secant point of the bracket [a, b] with values ga, gb of opposite sides, kept strictly inside."""
+    c = b - gb * (b - a) / (gb - ga)
+    if not (a < c < b):
+        c = 0.5 * (a + b)
+    return c
+
+
+@kernel
+def illinois_update(a, ga, b, gb, c, gc, before, side):
+    """One Illinois regula-falsi update: c (value gc) replaces a if ``before`` (c lies before the
+    root), else b; when the same end moves twice the other end's value is halved.
+
+    ``side`` is the end moved last (+1 a, −1 b, 0 none). Returns (a, ga, b, gb, side).
+    """
+    if before:
+        if side == 1:
+            gb *= 0.5
+        return c, gc, b, gb, 1
+    if side == -1:
+        ga *= 0.5
+    return a, ga, c, gc, -1
+
+
+@kernel
+def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
+    """First θ ∈ (0, 1] where the event function of contact ``c`` turns ≤ 0, located to
+    EVENT_TIME_TOL; −1.0 if no sign change is seen at the EVENT_CHECKS sample points.
+
+    The function is positive at θ = 0 by construction. Refinement: Illinois regula falsi.
+    """
+    a = 0.0
+    ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
+    b = -1.0
+    gb = 0.0
+    for j in range(1, EVENT_CHECKS + 1):
+        theta = j / EVENT_CHECKS
+        dense_state(y0, Q, h, theta, work)
+        g = event_value(kind, c, work, e0x, e0y, cst, md, F, N)
+        if g <= 0.0:
+            b = theta
+            gb = g
+            break
+        a = theta
+        ga = g
+    if b < 0.0:
+        return -1.0
+    tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
+    side = np.int64(0)  # not a literal: one compiled version of illinois_update
+    for _ in range(MAX_REFINEMENTS):
+        if gb == 0.0 or (b - a) <= tol:
+            break
+        cc = regula_falsi_point(a, ga, b, gb)
+        dense_state(y0, Q, h, cc, work)
+        gc = event_value(kind, c, work, e0x, e0y, cst, md, F, N)
+        a, ga, b, gb, side = illinois_update(a, ga, b, gb, cc, gc, gc > 0.0, side)
+    return b
+
+
+@kernel
+def time_to_zero_of(vx, vy, ax, ay):
+    """Time [s] to the closest approach of v = (vx, vy) to zero under constant dv/dt = (ax, ay).
+
+    −(v·v)/(v·a); +inf unless v heads for zero within 60° of head-on (a turning slip direction
+    is not an approach). Used to home the last step of an approach onto v = 0 and to scale the
+    steps of the approach.
+    """
+    va = vx * ax + vy * ay
+    if va >= -0.5 * math.sqrt((vx * vx + vy * vy) * (ax * ax + ay * ay)):  # cos 60° = 0.5
+        return math.inf
+    return -(vx * vx + vy * vy) / va
+
+
+@kernel
+def slip_event_possible(g0, dg0, g1, dg1):
+    """Whether the slip event g = v·e0 may reach zero inside a step (cheap pre-check).
+
+    ``g0, g1`` are its values at the ends of the step and ``dg0, dg1`` its derivatives with
+    respect to θ ∈ [0, 1] (h × dv/dt · e0). The cubic Hermite interpolant of these four numbers
+    is checked at θ = 1/4, 1/2, 3/4 and at the end; a possible crossing is any value at or below
+    half the smaller end value (so a dip that the cubic only approximates still gets the full
+    check on the step's dense output). A monotone approach (g falls from g0 to g1 > 0) needs none.
+    """
+    if g1 <= 0.0:
+        return True
+    floor = 0.5 * min(g0, g1)
+    for j in range(1, 4):
+        th = 0.25 * j
+        th2 = th * th
+        th3 = th2 * th
+        h00 = 2.0 * th3 - 3.0 * th2 + 1.0
+        h10 = th3 - 2.0 * th2 + th
+        h01 = -2.0 * th3 + 3.0 * th2
+        h11 = th3 - th2
+        if h00 * g0 + h10 * dg0 + h01 * g1 + h11 * dg1 <= floor:
+            return True
+    return False
+
+
+@kernel
+def breakaway_direction(Fx, Fy, dim):
+    """Slip direction at breakaway e = −F/|F| (for a 1-D contact ±1 in the first entry)."""
+    if dim == 1:
+        return (-1.0 if Fx > 0.0 else 1.0), 0.0
+    norm = math.sqrt(Fx * Fx + Fy * Fy)
+    if norm == 0.0:
+        return 1.0, 0.0
+    return -Fx / norm, -Fy / norm
+
+
+@kernel
+def arrival_speed(y, n, rtol, atol):
+    """|v| [m/s] at or below which slip has arrived at v = 0 for an integration at (rtol, atol).
+
+    The larger of STICK_SPEED_TOL and ten times the velocity resolution of the error control,
+    atol + rtol max|q̇_i|: below that, v is integration noise, its direction wanders and no step
+    can home further (seen at rtol 1e-8 with |q̇| ~ 3.5 rad/s: |v_r| hovered at 2e-8).
+    """
+    qd = 0.0
+    for i in range(n, 2 * n):
+        qd = max(qd, abs(y[i]))
+    return max(STICK_SPEED_TOL, 10.0 * (atol + rtol * qd))
+
+
+@kernel
+def try_stick(y, cst, c, md, speed_tol, F, N):
+    """At a zero of contact ``c``'s slip velocity: project and test stick admissibility (Eq. 10).
+
+    If |v_c| > ``speed_tol`` [m/s] nothing happens and ``(False, 0, 0)`` is returned. Otherwise
+    ``y`` is projected onto v = 0 for the sticking contacts and c (the residual ≤ speed_tol
+    removed by an impulsive friction force, booked as friction work) and either ``(True, 0, 0)``
+    (stick of c is admissible) or ``(False, ex, ey)``: the breakaway direction of the inadmissible
+    stick force, along which slip departs again (a velocity reversal through zero).
+    """
+    vx, vy = P.slip_velocity(y, c, md)
+    if math.sqrt(vx * vx + vy * vy) > speed_tol:
+        return False, 0.0, 0.0
+    P.project_velocities(y, cst, c, md)
+    P.stick_forces(y, cst, c, md, F, N)
+    n = model_sizes(md.kin, md.m)[0]
+    Fx = F[2 * c]
+    Fy = F[2 * c + 1]
+    if math.sqrt(Fx * Fx + Fy * Fy) <= P.static_limit(md.m, n, c, N[c]):
+        return True, 0.0, 0.0
+    ex, ey = breakaway_direction(Fx, Fy, P.contact_dim(md.kin, md.m, n, c))
+    return False, ex, ey
+
+
+@kernel
+def release_most_overloaded(y, cst, md, F, N):
+    """If some sticking contact's joint stick force exceeds μs N, release the most overloaded one
+    (quasi-static slip along its breakaway direction) and return its index; else −1."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    if P.stick_forces(y, cst, np.int64(-1), md, F, N) == 0:
+        return -1
+    worst = -1
+    worst_ratio = 1.0
+    for c in range(nc):
+        if np.int64(cst[CST * c]) != P.MODE_STICK:
+            continue
+        limit = P.static_limit(m, n, c, N[c])
+        Fx = F[2 * c]
+        Fy = F[2 * c + 1]
+        mag = math.sqrt(Fx * Fx + Fy * Fy)
+        ratio = mag / limit if limit > 0.0 else math.inf
+        if ratio > worst_ratio:
+            worst = c
+            worst_ratio = ratio
+    if worst >= 0:
+        ex, ey = breakaway_direction(F[2 * worst], F[2 * worst + 1], P.contact_dim(md.kin, m, n, worst))
+        cst[CST * worst] = P.MODE_SLIP_QUASI_STATIC
+        cst[CST * worst + 1] = ex
+        cst[CST * worst + 2] = ey
+        cst[CST * worst + 3] = math.inf
+    return worst
+
+
+@kernel
+def contact_lost(y, md):
+    """Index of the first contact whose normal force is ≤ 0 at ``y``, or −1."""
+    nc = model_sizes(md.kin, md.m)[1]
+    for c in range(nc):
+        if P.normal_force(y, c, md) <= 0.0:
+            return c
+    return -1
+
+
+@kernel
+def initial_modes(y, cst, md, rtol, atol, F, N):
+    """Modes a state starts in: each contact sticks if its v = 0 (to STICK_SPEED_TOL) and the joint
+    stick force is admissible; the others slip (the exact direction when sliding, the
+    quasi-static one from v = 0). Fills ``cst``; ``y`` may be projected."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    for c in range(nc):
+        cst[CST * c] = P.MODE_SLIP
+        cst[CST * c + 1] = 1.0
+        cst[CST * c + 2] = 0.0
+    for c in range(nc):
+        stick, ex, ey = try_stick(y, cst, c, md, STICK_SPEED_TOL, F, N)
+        if stick:
+            cst[CST * c] = P.MODE_STICK
+        elif ex != 0.0 or ey != 0.0:
+            cst[CST * c + 1] = ex
+            cst[CST * c + 2] = ey
+    for _ in range(MAX_SETTLE):
+        if release_most_overloaded(y, cst, md, F, N) < 0:
+            break
+    for c in range(nc):
+        if np.int64(cst[CST * c]) == P.MODE_STICK:
+            continue
+        vx, vy = P.slip_velocity(y, c, md)
+        speed = math.sqrt(vx * vx + vy * vy)
+        if speed > STICK_SPEED_TOL:
+            # a run that starts sliding is not departing from v = 0: watch it for stick at once
+            cst[CST * c] = P.MODE_SLIP_EXACT
+            cst[CST * c + 1] = vx / speed
+            cst[CST * c + 2] = vy / speed
+        else:
+            cst[CST * c] = P.MODE_SLIP_QUASI_STATIC
+            if speed > P.SPEED_FLOOR:
+                cst[CST * c + 1] = vx / speed
+                cst[CST * c + 2] = vy / speed

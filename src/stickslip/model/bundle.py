@@ -1,0 +1,144 @@
+"""The typed bundle through which a model reaches the compiled kernels.
+
+A model arrives in compiled code as one :class:`ModelData` = (``m``, ``kin``):
+
+``m``    one flat float64 array holding every number of the model, so that a kernel call passes
+         one array descriptor instead of a dozen;
+``kin``  the model's kinematics data, a NamedTuple whose *class* selects the contact frame at
+         compile time (:mod:`stickslip.model.kinematics`).
+
+Layout of ``m`` (n DOFs, nc contacts). Block offsets follow from n alone (:func:`offsets`), so
+that for kinematics classes that fix n the compiler folds them to constants:
+
+========================  =========================================================================
+header (``HEADER`` slots)  n, nc, diagonal flag (M, C, K all diagonal), low-speed band [m/s],
+                           constant-kinematics flag (G, w independent of q)
+M⁻¹ (n × n)                row-major; rows and columns of locked DOFs are 0
+M (n × n)                  for the kinetic energy
+C, K (n × n each)          damping, stiffness (K may be non-symmetric)
+f0 (n)                     constant generalised force
+free (n)                   1.0 for a free DOF, 0.0 for a locked one
+contacts (nc blocks)       block width ``contact_width(n)``: dim (1 or 2), N0 [N], the friction law
+                           row (:mod:`stickslip.model.friction`), the constant tangent rows G
+                           (2 × n), drive w (2), normal force gradients n (n) and n_v (n)
+========================  =========================================================================
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from .friction import LAW_WIDTH
+from .jit import inlined_kernel
+
+__all__ = ["ModelData", "pack", "offsets", "contact_offsets", "contact_width", "contact_state",
+           "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "C_DIM", "C_N0", "C_LAW", "C_G"]
+
+H_N, H_NC, H_DIAGONAL, H_BAND, H_CONSTANT = range(5)
+HEADER = 8
+
+#: Numbers per contact in the integration state ``cst``: mode, stored slip direction (ex, ey), and
+#: the extrapolated time to v = 0 at the start of the last step of an approach (∞ otherwise).
+CST = 4
+
+C_DIM = 0
+C_N0 = 1
+C_LAW = 2
+C_G = C_LAW + LAW_WIDTH
+
+
+class ModelData(NamedTuple):
+    """A model as the compiled kernels take it: flat numbers ``m`` and kinematics data ``kin``."""
+
+    m: np.ndarray
+    kin: Any
+
+
+@inlined_kernel
+def contact_width(n):
+    """Numbers in one contact block of a model with n DOFs."""
+    return C_G + 4 * n + 2
+
+
+@inlined_kernel
+def offsets(n):
+    """Offsets of (M⁻¹, M, C, K, f0, free, contact 0) in ``m`` for a model with n DOFs."""
+    nn = n * n
+    o_minv = HEADER
+    o_force = HEADER + 4 * nn
+    return o_minv, o_minv + nn, o_minv + 2 * nn, o_minv + 3 * nn, o_force, o_force + n, o_force + 2 * n
+
+
+@inlined_kernel
+def contact_offsets(n, c):
+    """(o, o_w, o_nq, o_nv): offsets of contact ``c``'s block, its drive w and its normal gradients."""
+    o = HEADER + 4 * n * n + 2 * n + c * contact_width(n)
+    ow = o + C_G + 2 * n
+    return o, ow, ow + 2, ow + 2 + n
+
+
+def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np.ndarray, free: np.ndarray,
+         contacts: list[dict], slip_band: float, constant_kinematics: bool) -> np.ndarray:
+    """Build the data array ``m`` (layout in the module docstring).
+
+    Parameters
+    ----------
+    mass, damping, stiffness : ndarray (n, n)
+        M (symmetric positive definite on the free DOFs), C, K.
+    force : ndarray (n,)
+        Constant generalised force f0.
+    free : ndarray (n,) of bool
+        Free DOFs; locked ones get zero rows and columns in M⁻¹ (they never move).
+    contacts : list of dict
+        Per contact: ``dim`` (1 or 2), ``N0``, ``law_row`` (LAW_WIDTH,), and for constant kinematics
+        ``G`` (dim, n), ``w`` (dim,), ``n_q`` (n,), ``n_v`` (n,) (zeros where absent).
+    slip_band : float
+        Low-speed band [m/s].
+    constant_kinematics : bool
+        Whether G and w are constant.
+    """
+    mass = np.asarray(mass, dtype=float)
+    n = mass.shape[0]
+    nc = len(contacts)
+    free = np.asarray(free, dtype=bool)
+    minv = np.zeros((n, n))
+    idx = np.flatnonzero(free)
+    minv[np.ix_(idx, idx)] = np.linalg.inv(mass[np.ix_(idx, idx)])
+    mats = [minv, mass, np.asarray(damping, float), np.asarray(stiffness, float)]
+    diagonal = all(np.count_nonzero(a - np.diag(np.diag(a))) == 0 for a in mats)
+    cw = contact_width.py_func(n)
+    m = np.zeros(HEADER + 4 * n * n + 2 * n + nc * cw)
+    m[H_N] = n
+    m[H_NC] = nc
+    m[H_DIAGONAL] = 1.0 if diagonal else 0.0
+    m[H_BAND] = slip_band
+    m[H_CONSTANT] = 1.0 if constant_kinematics else 0.0
+    o_minv, o_mass, o_damp, o_stiff, o_force, o_free, _ = offsets.py_func(n)
+    for o, a in zip((o_minv, o_mass, o_damp, o_stiff), mats):
+        m[o:o + n * n] = a.ravel()
+    m[o_force:o_force + n] = np.asarray(force, float)
+    m[o_free:o_free + n] = free.astype(float)
+    for c, spec in enumerate(contacts):
+        o, ow, onq, onv = contact_offsets.py_func(n, c)
+        dim = int(spec["dim"])
+        m[o + C_DIM] = dim
+        m[o + C_N0] = spec["N0"]
+        m[o + C_LAW:o + C_LAW + LAW_WIDTH] = spec["law_row"]
+        if "G" in spec:
+            G = np.zeros((2, n))
+            G[:dim] = np.asarray(spec["G"], float).reshape(dim, n)
+            m[o + C_G:ow] = G.ravel()
+            m[ow:ow + dim] = np.asarray(spec["w"], float).reshape(dim)
+        m[onq:onv] = np.asarray(spec.get("n_q", np.zeros(n)), float)
+        m[onv:onv + n] = np.asarray(spec.get("n_v", np.zeros(n)), float)
+    return m
+
+
+def contact_state(m: np.ndarray) -> np.ndarray:
+    """A fresh per-contact integration state (CST nc,: mode, ex, ey, τ per contact), slipping along +x."""
+    cst = np.zeros(CST * int(m[H_NC]))
+    cst[1::CST] = 1.0
+    cst[3::CST] = np.inf
+    return cst

@@ -1,0 +1,157 @@
+"""Contact kinematics: the one place where a model's geometry enters the compiled physics.
+
+Every contact c of a model has a slip velocity v_c = G_c(q) q̇ − w_c(q) (1 or 2 rows) and a
+normal force N_c(q, q̇). A model supplies these through a *frame function*
+
+    frame(kin, s, c, m, G, w) -> N
+
+that fills ``G`` (2, n) (rows beyond the contact's dimension are ignored) and ``w`` (2,) for
+contact ``c`` at state ``s`` = [q, q̇] and returns N_c. ``kin`` is the model's kinematics data, a
+``typing.NamedTuple`` of numbers (e.g. a radius and a drive speed); ``m`` is the model's data array
+(:mod:`stickslip.model.bundle`), for frames that read constant matrices from it.
+
+The frame function is chosen *at compile time* by the type of ``kin``: each kinematics class is
+registered once with :func:`register_kinematics`, and the generic kernels
+(:mod:`stickslip.model.physics`) call :func:`contact_frame`, which numba resolves to the
+registered function for that type. So a model's kernels are specialised and inlined like
+hand-written code, one compiled version per kinematics class (not per parameter value), and
+cached on disk because the class is found by its import path.
+
+Frames must work on ``float64`` and ``complex128`` states alike (the Jacobians and the
+acceleration bias Ġ q̇ are taken by complex step): use ``np.sin``, ``np.cos``, ``np.sqrt``,
+``np.exp`` and arithmetic, never ``abs`` or ``math.*`` on the state, and branch on real parts only.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, NamedTuple
+
+import numpy as np
+from numba.extending import overload
+
+from ..errors import StickSlipError
+from . import csmath as csm
+from . import stack
+from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, contact_offsets
+from .jit import inlined_kernel
+
+__all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "contact_frame",
+           "constant_frame", "KinematicsError", "model_sizes", "contact_dim"]
+
+
+class KinematicsError(StickSlipError, TypeError):
+    """A kinematics object whose class was not registered."""
+
+
+#: Registered frame functions by kinematics class.
+_FRAMES: dict[type, Callable] = {}
+#: Sizes fixed by a kinematics class (n, nc, diagonal), known to the compiler for speed.
+_SIZES: dict[type, tuple] = {}
+#: Contact dimension fixed by a kinematics class (or None).
+_DIMS: dict[type, int | None] = {}
+
+
+def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, ncontacts: int | None = None,
+                        diagonal: bool | None = None, dim: int | None = None) -> None:
+    """Make ``frame`` the contact frame of models whose kinematics data is a ``cls`` instance.
+
+    Parameters
+    ----------
+    cls : NamedTuple class
+        The kinematics data type (fields: numbers). Must be importable by its module path for the
+        compiled kernels to be cached across processes.
+    frame : numba-compilable function
+        ``frame(kin, s, c, m, G, w) -> N`` as described in the module docstring. Plain Python
+        functions are compiled on first use (they must follow numba's nopython subset).
+    ndof, ncontacts : int, optional
+        The number of DOFs and of contacts, when every model of this kinematics has the same ones:
+        the compiler then unrolls the kernels' loops (the plates: 6 and 1).
+    diagonal : bool, optional
+        Whether M, C and K are always diagonal for this kinematics (skips the dense products).
+    dim : {1, 2}, optional
+        The dimension of every contact's slip velocity, when fixed by the kinematics.
+    """
+    if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
+        raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
+    _FRAMES[cls] = frame
+    _SIZES[cls] = (ndof, ncontacts, diagonal)
+    _DIMS[cls] = dim
+    if ndof is not None and ncontacts is not None:
+        stack._STATIC[cls] = (ndof, ncontacts)
+
+
+def registered_kinematics() -> tuple[type, ...]:
+    """The kinematics classes known to the compiled kernels."""
+    return tuple(_FRAMES)
+
+
+def contact_frame(kin, s, c, m, G, w):  # pragma: no cover - resolved by numba (overload below)
+    """Fill G (2, n), w (2,) of contact ``c`` at state ``s`` and return its normal force [N]."""
+    raise NotImplementedError("contact_frame is called from compiled code only")
+
+
+@overload(contact_frame, inline="always")
+def _contact_frame(kin, s, c, m, G, w):
+    frame = _FRAMES.get(getattr(kin, "instance_class", None))
+    if frame is None:
+        return None
+    return getattr(frame, "py_func", frame)  # the Python source: numba compiles it into the caller
+
+
+def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below)
+    """(n, nc, diagonal) of a model: compile-time constants where its kinematics fixes them."""
+    raise NotImplementedError
+
+
+@overload(model_sizes, inline="always")
+def _model_sizes(kin, m):
+    n, nc, diagonal = _SIZES.get(getattr(kin, "instance_class", None), (None, None, None))
+    if n is not None and nc is not None and diagonal is not None:
+        def fixed(kin, m):
+            return n, nc, diagonal
+        return fixed
+
+    def sizes(kin, m):
+        return (np.int64(m[H_N]) if n is None else n, np.int64(m[H_NC]) if nc is None else nc,
+                (m[H_DIAGONAL] != 0.0) if diagonal is None else diagonal)
+    return sizes
+
+
+def contact_dim(kin, m, n, c):  # pragma: no cover - resolved by numba (overload below)
+    """Dimension (1 or 2) of contact ``c``'s slip velocity: fixed by the kinematics class, or read."""
+    raise NotImplementedError
+
+
+@overload(contact_dim, inline="always")
+def _contact_dim(kin, m, n, c):
+    dim = _DIMS.get(getattr(kin, "instance_class", None))
+    if dim is not None:
+        return lambda kin, m, n, c: dim
+    return lambda kin, m, n, c: np.int64(m[contact_offsets(n, c)[0] + C_DIM])
+
+
+class ConstantKinematics(NamedTuple):
+    """Kinematics of a model whose contact Jacobians G and drives w are constant (model files).
+
+    G, w and the affine normal force N = N0 + n·q + n_v·q̇ live in the model's data array.
+    """
+
+    constant: float = 1.0
+
+
+@inlined_kernel
+def constant_frame(kin, s, c, m, G, w):
+    """Frame of :class:`ConstantKinematics`: G and w copied from the data array, N affine in s."""
+    n, nc, diagonal = model_sizes(kin, m)
+    o, ow, onq, onv = contact_offsets(n, c)
+    normal = m[o + C_N0] + csm.zero(s[0])
+    for j in range(n):
+        G[0, j] = m[o + C_G + j]
+        G[1, j] = m[o + C_G + n + j]
+        normal += m[onq + j] * s[j] + m[onv + j] * s[n + j]
+    w[0] = m[ow]
+    w[1] = m[ow + 1]
+    return normal
+
+
+register_kinematics(ConstantKinematics, constant_frame)

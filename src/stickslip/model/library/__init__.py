@@ -1,0 +1,114 @@
+"""The model library: friction-contact models by name, and model files by path.
+
+==================  ==========================================================================
+``two-plates``      the paper's two rigid plates (default; :mod:`.two_plates`)
+``belt``            1-DOF mass on a moving belt, the bSTAB friction case (``belt.toml``)
+==================  ==========================================================================
+
+Library models stated as model files live beside this module as TOML; ``stickslip models``
+lists them. :func:`load_model` accepts a library name or the path of a model file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..model_file import load_model_file, model_from_spec
+from ..parameters import Parameters
+from ..system_model import DEFAULT_SLIP_BAND, FrictionModel, ModelError
+from ..variants import MODELS
+from .two_plates import NAME as TWO_PLATES
+from .two_plates import two_plates
+
+__all__ = ["load_model", "library", "two_plates", "TWO_PLATES", "describe_system", "system_from_description",
+           "resolve_system"]
+
+HERE = Path(__file__).resolve().parent
+
+
+def library() -> dict[str, str]:
+    """Library model names → one-line descriptions, the default first."""
+    out = {TWO_PLATES: two_plates().description}
+    for path in sorted(HERE.glob("*.toml")):
+        out[path.stem.replace("_", "-")] = load_model_file(path).description
+    return out
+
+
+def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
+    """A library model by name (``two-plates``, ``belt``, ...) or a model file by path."""
+    if isinstance(name, FrictionModel):
+        return name
+    text = str(name)
+    if text == TWO_PLATES:
+        return two_plates()
+    path = HERE / (text.replace("-", "_") + ".toml")
+    if "/" not in text and not text.endswith(".toml") and path.is_file():
+        return load_model_file(path, source=f"library:{text}")
+    if text.endswith(".toml") or Path(text).is_file():
+        return load_model_file(text)
+    raise ModelError(f"unknown model {text!r}; choose one of {', '.join(library())}, a plates variant "
+                     f"({', '.join(MODELS)}) or a model file (.toml)")
+
+
+def resolve_system(system=None, variant=None, slip_band: float | None = None) -> FrictionModel:
+    """The model a simulation or analysis runs on.
+
+    Parameters
+    ----------
+    system : FrictionModel, Parameters, str or None
+        A model; the plates' :class:`Parameters`; a library name or model file path; None for the
+        plates with Table 1 parameters.
+    variant : str, iterable of DOF names or FrictionModel, optional
+        The plates' variant (``full``, ``x``, ``y``, ``rotation`` or DOFs); also accepted here: a
+        library name, a model file or a FrictionModel (then ``system`` must be None or Parameters
+        of the plates is an error).
+    slip_band : float, optional
+        Low-speed band [m/s]; default the model's own.
+    """
+    if isinstance(variant, FrictionModel) or (isinstance(variant, (str, Path)) and _is_model_name(str(variant))):
+        model = load_model(variant)
+        if system is not None and not isinstance(system, FrictionModel):
+            raise ModelError(f"model {variant!s} is not the two plates: give its parameters with --set, "
+                             "not as plate Parameters")
+        model = model if system is None else system
+    elif isinstance(system, FrictionModel):
+        model = system
+    elif isinstance(system, (str, Path)):
+        model = load_model(system)
+    else:
+        if system is not None and not isinstance(system, Parameters):
+            raise ModelError(f"expected a FrictionModel, Parameters or a model name, got {type(system).__name__}")
+        model = two_plates(system, "full" if variant is None else variant,
+                           DEFAULT_SLIP_BAND if slip_band is None else slip_band)
+    if slip_band is not None:
+        model = model.with_slip_band(slip_band)
+    return model
+
+
+def _is_model_name(text: str) -> bool:
+    """Whether ``text`` names a model (library or file) rather than a plates variant."""
+    if text in MODELS or text.removeprefix("custom:").split(",")[0].strip() in ("x1", "y1", "x2", "y2", "phi", "psi"):
+        return False
+    return True
+
+
+def describe_system(system: FrictionModel) -> dict:
+    """What :func:`system_from_description` needs to rebuild ``system`` (JSON-ready)."""
+    out = {"name": system.name, "source": system.source, "parameters": dict(system.parameters),
+           "slip_band": system.slip_band, "dofs": list(system.dofs)}
+    if system.spec is not None:
+        out["spec"] = system.spec
+    return out
+
+
+def system_from_description(desc: dict) -> FrictionModel:
+    """Rebuild a model written into a result file (:func:`describe_system`)."""
+    slip_band = float(desc.get("slip_band", DEFAULT_SLIP_BAND))
+    if desc.get("name") == TWO_PLATES:
+        values = dict(desc["parameters"])
+        variant = values.pop("variant", "full")
+        return two_plates(Parameters.from_dict(values), variant, slip_band)
+    if "spec" in desc:
+        return model_from_spec(desc["spec"], source=desc.get("source", "python"), name=desc["name"]).with_slip_band(slip_band)
+    raise ModelError(f"the file's model {desc.get('name')!r} was defined in Python and cannot be rebuilt from the "
+                     "file; pass it as system= when loading")

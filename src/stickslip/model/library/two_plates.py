@@ -1,0 +1,51 @@
+"""The two plates of the paper as a :class:`~stickslip.model.FrictionModel` (paper Eqs. 1–9).
+
+q = [x1, y1, x2, y2, φ, ψ]: the upper plate's centre (x1, y1) and rotation φ, the lower plate's
+centre (x2, y2) and rotation ψ relative to its drive Ω t. M, C and K are diagonal (Table 1);
+the one 2-D contact has the kinematics of :mod:`.plate_kinematics`; the normal force is the
+preload N; the friction law is Eq. (4) (or Coulomb). The paper's Models 1–4 free subsets of the
+DOFs (:mod:`stickslip.model.variants`): a locked DOF gets zero inverse mass and never moves.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..friction import FrictionLaw
+from ..parameters import PARAMETER_UNITS, Parameters
+from ..system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel
+from ..variants import DOF_NAMES, resolve_variant
+from .plate_kinematics import PlateKinematics
+
+__all__ = ["two_plates", "NAME"]
+
+NAME = "two-plates"
+
+_UNITS = {"x1": "m", "y1": "m", "x2": "m", "y2": "m", "phi": "rad", "psi": "rad", **PARAMETER_UNITS}
+
+
+def two_plates(params: Parameters | None = None, variant="full", slip_band: float = DEFAULT_SLIP_BAND) -> FrictionModel:
+    """The two-plate model with ``params`` (default Table 1 at N = 50 N, Ω = 5 rad/s) and the
+    free DOFs of ``variant`` (``full``, ``x``, ``y``, ``rotation`` or DOF names)."""
+    P = Parameters() if params is None else params
+    v = resolve_variant(variant)
+    mass = np.diag([P.m_p, P.m_p, P.m_d, P.m_d, P.J_p, P.J_d])
+    damping = np.diag([P.c_px, P.c_py, P.c_dx, P.c_dy, P.c_pphi, P.c_dpsi])
+    stiffness = np.diag([P.k_px, P.k_py, P.k_dx, P.k_dy, P.k_pphi, P.k_dpsi])
+    law = FrictionLaw(P.friction_law, P.mu_k, P.delta_mu, P.alpha)
+    contact = Contact(dim=2, friction=law, normal_force=P.N, name="plates")
+
+    def builder(values: Mapping[str, Any]) -> FrictionModel:
+        values = dict(values)
+        var = values.pop("variant", v.name)
+        return two_plates(Parameters.from_dict(values), var, slip_band)
+
+    return FrictionModel(
+        name=NAME, dofs=DOF_NAMES, mass=mass, damping=damping * v.mask, stiffness=stiffness * v.mask,
+        force=np.zeros(6), contacts=(contact,), kinematics=PlateKinematics(P.r, P.Omega), free=v.mask,
+        parameters={**P.to_dict(), "variant": v.name}, builder=builder, source=f"library:{NAME}",
+        units=_UNITS, slip_band=slip_band, observed="phi",
+        description="two rigid plates in point contact, 2-D friction (Liu & Ouyang; the paper)",
+    )

@@ -1,0 +1,311 @@
+"""A friction-contact model, stated once and served by every solver and analysis.
+
+    M q̈ = f0 − C q̇ − K q + Σ_c G_c(q)ᵀ F_c,   v_c = G_c(q) q̇ − w_c(q),   N_c = N0 + n·q + n_v·q̇
+
+:class:`FrictionModel` holds the ingredients — named coordinates q, the matrices M, C, K, the
+force f0, the contacts (each with its slip-velocity dimension, normal force and friction law) and
+the kinematics data that selects the contact frame (constant G, w for model files; compiled
+functions for nonlinear kinematics such as the two plates) — plus the parameter values that
+``--set`` reaches and the rule that rebuilds the model from them. Everything else (equations of
+motion, stick multipliers, events, equilibrium, Jacobians, variational equations) is derived from
+these by the generic kernels (:mod:`stickslip.model.physics`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from functools import cached_property
+from typing import Any, Callable, Mapping, NamedTuple
+
+import numpy as np
+
+from ..errors import StickSlipError
+from .bundle import ModelData, pack
+from .friction import FrictionLaw
+from .kinematics import ConstantKinematics, registered_kinematics
+from .physics import SPEED_FLOOR
+from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
+
+__all__ = ["FrictionModel", "Contact", "ModelError", "DEFAULT_SLIP_BAND"]
+
+#: Default low-speed band [m/s]: below it the 2-D slip direction is the quasi-static one instead of
+#: v/|v|. Near v = 0 the direction of 2-D friction relaxes on the time scale |v| / (λ μ N) → 0 (a
+#: stiff mode that forces explicit steps of that size); inside the band the direction sits on its
+#: slow manifold, an O(|v|) approximation. Measured on the plates at N = 50 N, Ω = 5 rad/s and
+#: Ω = 0.5 rad/s, N = 30/50/70/120 N (100 s, rtol 1e-8, against band 1e-5 at rtol 1e-11): bands
+#: 1e-5, 1e-4 and 5e-4 give the same errors (≤ 6e-9 in frequency), 1e-3 and above start to show
+#: the band (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
+DEFAULT_SLIP_BAND = 5e-4
+
+
+class ModelError(StickSlipError, ValueError):
+    """A model that cannot be built as stated (the message names the entry and the fix)."""
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Contact:
+    """One point contact.
+
+    Attributes
+    ----------
+    dim : {1, 2}
+        Dimension of the tangential slip velocity (1: along a line; 2: in the contact plane).
+    friction : FrictionLaw
+        The contact's friction law.
+    normal_force : float
+        N0 [N], the constant part of the normal force (> 0).
+    tangent : ndarray (dim, n) or None
+        Constant contact Jacobian G (model files); None when the kinematics computes it.
+    drive : ndarray (dim,) or None
+        Constant surface velocity w, v = G q̇ − w [m/s]; None with computed kinematics.
+    normal_gradient, normal_rate_gradient : ndarray (n,)
+        n and n_v of N = N0 + n·q + n_v·q̇ [N/m, N s/m].
+    name : str
+        Label for output (``contact0`` …).
+    """
+
+    dim: int
+    friction: FrictionLaw
+    normal_force: float
+    tangent: np.ndarray | None = None
+    drive: np.ndarray | None = None
+    normal_gradient: np.ndarray | None = None
+    normal_rate_gradient: np.ndarray | None = None
+    name: str = ""
+
+    def spec(self, n: int) -> dict:
+        """The contact as :func:`stickslip.model.bundle.pack` takes it."""
+        out = {"dim": self.dim, "N0": self.normal_force, "law_row": self.friction.row(),
+               "n_q": np.zeros(n) if self.normal_gradient is None else self.normal_gradient,
+               "n_v": np.zeros(n) if self.normal_rate_gradient is None else self.normal_rate_gradient}
+        if self.tangent is not None:
+            out["G"] = self.tangent
+            out["w"] = self.drive
+        return out
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class FrictionModel:
+    """A friction-contact system (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        Short name (``belt``, ``two-plates``, the file's ``name``).
+    dofs : tuple of str
+        Names of q, in order; the states are the dofs then ``"d" + dof`` for each.
+    mass, damping, stiffness : ndarray (n, n)
+        M (symmetric positive definite on the free DOFs) [kg, kg m²], C, K (K may be non-symmetric).
+    force : ndarray (n,)
+        Constant generalised force f0.
+    contacts : tuple of Contact
+    kinematics : NamedTuple
+        Kinematics data; its class selects the compiled contact frame
+        (:class:`~stickslip.model.kinematics.ConstantKinematics` for constant G and w).
+    free : ndarray (n,) of bool
+        Free DOFs; locked ones never move (zero inverse mass).
+    parameters : mapping
+        Named parameter values (what ``--set`` changes), in the order they are listed.
+    builder : callable
+        ``builder(parameters) -> FrictionModel``: the model with other parameter values.
+    source : str
+        Where the model came from: ``library:NAME``, ``file:PATH`` or ``python``.
+    units : mapping
+        Unit of each DOF (``"m"``, ``"rad"``) and of each parameter, where known.
+    slip_band : float
+        Low-speed band of the 2-D slip direction [m/s] (:data:`DEFAULT_SLIP_BAND`).
+    description : str
+        One line for listings.
+    spec : mapping, optional
+        The model file's content, when it came from one (written into results so that they
+        reproduce themselves).
+    resolver : callable, optional
+        Maps an alias of a parameter name to its name in :attr:`parameters` (model files accept
+        dof names as indices and leave out the index of a one-entry vector).
+    observed : str, optional
+        The dof that summaries follow (frequency, extremes, peaks); default the first free dof.
+    """
+
+    name: str
+    dofs: tuple[str, ...]
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    force: np.ndarray
+    contacts: tuple[Contact, ...]
+    kinematics: NamedTuple = ConstantKinematics()
+    free: np.ndarray | None = None
+    parameters: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    builder: Callable[[Mapping[str, Any]], "FrictionModel"] | None = None
+    source: str = "python"
+    units: Mapping[str, str] = dataclasses.field(default_factory=dict)
+    slip_band: float = DEFAULT_SLIP_BAND
+    description: str = ""
+    spec: Mapping[str, Any] | None = None
+    resolver: Callable[[str], str] | None = None
+    observed: str | None = None
+
+    def __post_init__(self) -> None:
+        n = len(self.dofs)
+        if n == 0:
+            raise ModelError(f"model {self.name!r} has no degrees of freedom; list them in dofs")
+        if len(set(self.dofs)) != n:
+            raise ModelError(f"model {self.name!r}: dof names must be unique, got {list(self.dofs)}")
+        for key in ("mass", "damping", "stiffness"):
+            value = np.array(getattr(self, key), dtype=float)
+            if value.shape != (n, n):
+                raise ModelError(f"model {self.name!r}: {key} must be {n}×{n} (one row and column per dof), "
+                                 f"got shape {value.shape}")
+            if not np.all(np.isfinite(value)):
+                raise ModelError(f"model {self.name!r}: {key} has a non-finite entry; give finite numbers")
+            object.__setattr__(self, key, value)
+        force = np.zeros(n) if self.force is None else np.array(self.force, dtype=float).reshape(-1)
+        if force.shape != (n,) or not np.all(np.isfinite(force)):
+            raise ModelError(f"model {self.name!r}: force must be {n} finite numbers, got {force.tolist()}")
+        object.__setattr__(self, "force", force)
+        free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
+        object.__setattr__(self, "free", free)
+        object.__setattr__(self, "contacts", tuple(self.contacts))
+        object.__setattr__(self, "dofs", tuple(self.dofs))
+        self._check_mass()
+        self._check_contacts()
+        if not (math.isfinite(self.slip_band) and self.slip_band > SPEED_FLOOR):
+            raise ModelError(f"slip_band = {self.slip_band} must be a finite speed > {SPEED_FLOOR} m/s")
+
+    def _check_mass(self) -> None:
+        idx = np.flatnonzero(self.free)
+        M = self.mass[np.ix_(idx, idx)]
+        if not np.allclose(M, M.T, rtol=1e-12, atol=0.0):
+            raise ModelError(f"model {self.name!r}: mass must be symmetric; give M with M[i][j] = M[j][i]")
+        lam = np.linalg.eigvalsh(0.5 * (M + M.T)) if M.size else np.ones(1)
+        if lam.min() <= 0.0:
+            raise ModelError(f"model {self.name!r}: mass is not positive definite (smallest eigenvalue "
+                             f"{lam.min():.3g}); masses and inertias must be > 0")
+
+    def _check_contacts(self) -> None:
+        n = self.n
+        cls = type(self.kinematics)
+        if cls not in registered_kinematics():
+            raise ModelError(f"model {self.name!r}: kinematics class {cls.__name__} is not registered; "
+                             "call stickslip.model.register_kinematics(cls, frame) first")
+        constant = cls is ConstantKinematics
+        sizes = static_sizes(cls)
+        if sizes is not None and sizes != (n, len(self.contacts)):
+            raise ModelError(f"model {self.name!r}: kinematics {cls.__name__} is for {sizes[0]} dofs and "
+                             f"{sizes[1]} contact(s), the model has {n} and {len(self.contacts)}")
+        if sizes is None and (n > MAX_DOFS or len(self.contacts) > MAX_CONTACTS):
+            raise ModelError(f"model {self.name!r}: at most {MAX_DOFS} dofs and {MAX_CONTACTS} contacts are "
+                             f"supported, got {n} and {len(self.contacts)}")
+        if not self.contacts:
+            raise ModelError(f"model {self.name!r} has no contact; add a [[contact]] table")
+        for c, contact in enumerate(self.contacts):
+            where = f"model {self.name!r}: contact {c}"
+            if contact.dim not in (1, 2):
+                raise ModelError(f"{where}: the slip velocity has 1 or 2 components (tangent rows), got {contact.dim}")
+            if not (math.isfinite(contact.normal_force) and contact.normal_force > 0.0):
+                raise ModelError(f"{where}: normal_force = {contact.normal_force} must be > 0 (the contact must be pressed)")
+            for key in ("normal_gradient", "normal_rate_gradient"):
+                value = getattr(contact, key)
+                if value is not None:
+                    value = np.array(value, dtype=float).reshape(-1)
+                    if value.shape != (n,) or not np.all(np.isfinite(value)):
+                        raise ModelError(f"{where}: {key} must be {n} finite numbers")
+                    object.__setattr__(contact, key, value)
+            if constant:
+                if contact.tangent is None or contact.drive is None:
+                    raise ModelError(f"{where}: give tangent (G) and drive (w) for constant kinematics")
+                G = np.array(contact.tangent, dtype=float)
+                if G.ndim == 1:
+                    G = G.reshape(1, -1)
+                w = np.array(contact.drive, dtype=float).reshape(-1)
+                if G.shape != (contact.dim, n):
+                    raise ModelError(f"{where}: tangent must have {contact.dim} row(s) of {n} numbers, got shape {G.shape}")
+                if w.shape != (contact.dim,):
+                    raise ModelError(f"{where}: drive must have {contact.dim} number(s), one per tangent row")
+                if not (np.all(np.isfinite(G)) and np.all(np.isfinite(w))):
+                    raise ModelError(f"{where}: tangent and drive must be finite")
+                if not np.any(G[:, self.free]):
+                    raise ModelError(f"{where}: tangent is zero on every free dof; the contact cannot slip")
+                object.__setattr__(contact, "tangent", G)
+                object.__setattr__(contact, "drive", w)
+
+    # ------------------------------------------------------------------ structure
+    @property
+    def n(self) -> int:
+        """Number of generalised coordinates."""
+        return len(self.dofs)
+
+    @property
+    def n_contacts(self) -> int:
+        return len(self.contacts)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """The 2n states: the dofs, then ``d<dof>`` for each."""
+        return self.dofs + tuple("d" + d for d in self.dofs)
+
+    @property
+    def observed_index(self) -> int:
+        """Index of :attr:`observed` in q (default: the first free dof)."""
+        if self.observed is not None:
+            return self.dofs.index(self.observed)
+        return int(np.flatnonzero(self.free)[0])
+
+    @property
+    def constant_kinematics(self) -> bool:
+        """Whether G and w are constant (model files)."""
+        return type(self.kinematics) is ConstantKinematics
+
+    @cached_property
+    def data(self) -> ModelData:
+        """The model as the compiled kernels take it (:class:`~stickslip.model.bundle.ModelData`)."""
+        m = pack(self.mass, self.damping, self.stiffness, self.force, self.free,
+                 [contact.spec(self.n) for contact in self.contacts], self.slip_band, self.constant_kinematics)
+        return ModelData(m, self.kinematics)
+
+    def state_index(self, name: str) -> int:
+        """Index of a state by name (``x``, ``dx``, ...)."""
+        try:
+            return self.state_names.index(name)
+        except ValueError:
+            raise ModelError(f"unknown state {name!r} of model {self.name!r}; states are "
+                             f"{', '.join(self.state_names)}") from None
+
+    # ------------------------------------------------------------------ parameters
+    def replace(self, **changes: Any) -> "FrictionModel":
+        """The model with some parameters changed (names as in :attr:`parameters`)."""
+        if not changes:
+            return self
+        if self.resolver is not None:
+            changes = {self.resolver(k): v for k, v in changes.items()}
+        unknown = [k for k in changes if k not in self.parameters]
+        if unknown:
+            raise ModelError(f"unknown parameter(s) {', '.join(unknown)} of model {self.name!r}; "
+                             f"valid names: {', '.join(self.parameters)}")
+        if self.builder is None:
+            raise ModelError(f"model {self.name!r} was built directly and has no parameters to change")
+        values = dict(self.parameters)
+        values.update(changes)
+        return self.builder(values)
+
+    def with_slip_band(self, slip_band: float) -> "FrictionModel":
+        """The same model with another low-speed band [m/s]."""
+        if slip_band == self.slip_band:
+            return self
+        return dataclasses.replace(self, slip_band=float(slip_band))
+
+    def natural_frequencies(self) -> np.ndarray:
+        """Undamped natural frequencies [Hz] of the free DOFs without friction, ascending
+        (eigenvalues of M⁻¹ K; complex pairs of a non-symmetric K give their modulus)."""
+        idx = np.flatnonzero(self.free)
+        M = self.mass[np.ix_(idx, idx)]
+        K = self.stiffness[np.ix_(idx, idx)]
+        lam = np.linalg.eigvals(np.linalg.solve(M, K))
+        return np.sort(np.sqrt(np.abs(lam)) / (2.0 * np.pi))
+
+    def describe(self) -> dict:
+        """JSON-ready description: name, source, dofs, contacts, parameters (written into results)."""
+        return {"name": self.name, "source": self.source, "dofs": list(self.dofs),
+                "contacts": [{"dim": c.dim, **c.friction.to_dict()} for c in self.contacts],
+                "parameters": {k: v for k, v in self.parameters.items()}}

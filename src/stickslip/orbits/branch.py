@@ -1,0 +1,500 @@
+"""Pseudo-arclength continuation of periodic stick-slip orbits in one parameter: the driver and
+its result, :class:`Branch`.
+
+:func:`continue_orbit` starts from a periodic orbit (or a run that settled on one), takes
+predictor–corrector steps along the branch (:mod:`.arclength`), adapts the step to the
+corrector's effort, detects and locates special points between consecutive points
+(:mod:`.special_points`) and stops at the bounds, after ``max_points``, below ``min_step`` or
+where the branch ends (a vanishing stick phase, a Hopf point). With ``out=PATH`` every accepted
+point is journaled (:mod:`.branch_store`) and the same call again resumes from there.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ..files import open_ours
+from ..integrate.driver import SimulationError, simulate
+from ..integrate.result import Trajectory
+from ..model.kernels import DEFAULT_SLIP_BAND
+from ..model.parameters import ParameterError, Parameters
+from . import branch_store as store
+from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, ContinuationError, Point, Problem,
+                        correct_onto_bound, numeric_parameter, point_at, problem_of, step_from)
+from .layout import PHI
+from .problem import unstable_count
+from .section import OrbitError, Section, resolve_section
+from .shooting import PeriodicOrbit
+from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
+                             detect_after_renewal, distance_from_equilibrium)
+from .start import Start, start_orbit
+
+__all__ = ["Branch", "continue_orbit", "load_branch"]
+
+#: Corrector iterations at or below which the next step grows, and the growth/shrink factors.
+EASY_ITERATIONS, GROW, SHRINK = 4, 1.5, 0.5
+
+#: Corrector iterations above which the next step shrinks (between the two it is kept).
+HARD_ITERATIONS = 6
+
+#: Samples per period of the run that measures the amplitude of φ of each point.
+AMPLITUDE_SAMPLES = 400
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Branch:
+    """A branch of periodic orbits computed by :func:`continue_orbit`.
+
+    Attributes
+    ----------
+    param : str
+        Name of the continuation parameter (a :class:`~stickslip.Parameters` field).
+    values : ndarray (n,)
+        Parameter value of each orbit [unit of the parameter].
+    periods : ndarray (n,)
+        Periods [s].
+    states : ndarray (n, N_STATES)
+        States on the Poincaré section [m, rad, m/s, rad/s].
+    multipliers : ndarray (n, 2 n_free) complex
+        Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus
+        (NaN at points without a finite-difference Jacobian, see ``jacobian_every``).
+    stable : ndarray (n,) bool
+        Every non-trivial multiplier inside the unit circle.
+    n_unstable : ndarray (n,) int
+        Non-trivial multipliers outside the unit circle (−1 where not computed, ``jacobian_every``).
+    stick_phases : ndarray (n,) int
+        Slip → stick transitions per period (0: pure slip).
+    stick_time : ndarray (n,)
+        Total time in stick per period [s].
+    amplitude : ndarray (n,)
+        Peak-to-peak range of φ over one period [rad].
+    arclength : ndarray (n,)
+        Scaled pseudo-arclength from the first point [-].
+    residuals : ndarray (n,)
+        max |Φ(s0, T) − s0| / σ at each point [-].
+    iterations : ndarray (n,) int
+        Corrector iterations of each point (0 for the start).
+    special : list of SpecialPoint
+    stop_reason : str
+        Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``, ...).
+    params : Parameters
+        Base parameters (the continuation parameter at its start value).
+    model : str
+    section : Section
+    options : dict
+        Numerical options (rtol, atol, tol, fd_step, step bounds, scales).
+    timings : dict
+        ``total_s``, ``simulations``, ``points`` (and ``points_resumed`` when written to ``out``).
+    digest : str
+        Digest of everything that determines the branch (start and settings); a run writing to
+        the same ``out`` with another digest is refused.
+    """
+
+    param: str
+    values: np.ndarray
+    periods: np.ndarray
+    states: np.ndarray
+    multipliers: np.ndarray
+    stable: np.ndarray
+    n_unstable: np.ndarray
+    stick_phases: np.ndarray
+    stick_time: np.ndarray
+    amplitude: np.ndarray
+    arclength: np.ndarray
+    residuals: np.ndarray
+    iterations: np.ndarray
+    special: list
+    stop_reason: str
+    params: Parameters
+    model: str
+    section: Section
+    options: dict
+    timings: dict
+    digest: str = ""
+
+    def __len__(self) -> int:
+        return int(self.values.size)
+
+    def folds(self) -> list:
+        """The special points of kind ``fold``."""
+        return [p for p in self.special if p.kind == "fold"]
+
+    def orbit_params(self, i: int) -> Parameters:
+        """Parameters of orbit ``i``."""
+        return self.params.replace(**{self.param: float(self.values[i])})
+
+    def trajectory(self, i: int, periods: float = 1.0, sample_rate: float = 1000.0) -> Trajectory:
+        """Simulate orbit ``i`` from its section state (for plots)."""
+        o = self.options
+        return simulate(self.orbit_params(i), periods * float(self.periods[i]), model=self.model, ic=self.states[i],
+                        rtol=o["rtol"], atol=o["atol"], sample_rate=sample_rate, slip_band=o["slip_band"])
+    def to_xarray(self):
+        """``xarray.Dataset`` with dims ``point``, ``state``, ``multiplier`` and ``special``."""
+        return store.branch_dataset(self)
+
+    def to_netcdf(self, path) -> Path:
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
+        return store.write_dataset(self.to_xarray(), path)
+
+    @classmethod
+    def from_xarray(cls, ds) -> "Branch":
+        """The branch of a dataset written by :meth:`to_xarray` (files of this version: with
+        ``section_spec`` and the special points' multipliers)."""
+        fields = store.branch_fields(ds)
+        return cls(**{**fields, "special": [SpecialPoint(**q) for q in fields["special"]]})
+
+
+def load_branch(path):
+    """Read a branch written by :meth:`Branch.to_netcdf` as an ``xarray.Dataset``.
+
+    Raises
+    ------
+    stickslip.files.FileFormatError
+        If the file is missing, truncated, not a stickslip branch or of a newer format (a ValueError).
+    """
+    return open_ours(path, "branch", what="a .nc file written by `stickslip continue` (Branch.to_netcdf)")
+
+
+def _read_branch(path) -> tuple:
+    """(attrs, Branch) of a branch file, for :func:`.branch_store.open_output` (files of earlier
+    versions have no digest: they are refused by it, not read)."""
+    ds = load_branch(path)
+    return ds.attrs, (Branch.from_xarray(ds) if ds.attrs.get("digest") else None)
+
+
+def _amplitude(problem: Problem, s: np.ndarray, T: float, lam: float) -> float:
+    """Peak-to-peak φ over one period [rad] from a sampled run (NaN if it fails)."""
+    sp = problem.shooting
+    try:
+        traj = simulate(problem.params_at(lam), T, model=sp.model, ic=s, sample_rate=AMPLITUDE_SAMPLES / T,
+                        max_steps=int(sp.max_steps_per_second * max(T, 1.0)), **sp.options)
+    except SimulationError:
+        return float("nan")
+    return float(np.ptp(traj.states[:, PHI])) if traj.status == "success" else float("nan")
+
+
+def continue_orbit(
+    params: Parameters | None = None,
+    param: str = "Omega",
+    start=None,
+    *,
+    direction: int = 1,
+    step: float = 0.02,
+    min_step: float = 1e-4,
+    max_step: float = 0.2,
+    max_points: int = 200,
+    bounds: tuple[float, float] | None = None,
+    stop_on: Sequence[str] = (),
+    locate: bool = True,
+    model: str = "full",
+    section="phi_max",
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    tol: float = DEFAULT_TOL,
+    fd_step: float = DEFAULT_FD_STEP,
+    param_scale: float | None = None,
+    slip_band: float = DEFAULT_SLIP_BAND,
+    amplitude: bool = True,
+    min_stick_fraction: float = MIN_STICK_FRACTION,
+    jacobian_every: int = 1,
+    callback=None,
+    out=None,
+    resume: bool = True,
+    on_resume=None,
+) -> Branch:
+    """Continue a periodic orbit in one parameter by pseudo-arclength continuation.
+
+    Unknowns: the free states on the Poincaré section (except the section coordinate), the period T
+    and the parameter λ; equations: the shooting equations Φ(s0, T; λ) − s0 = 0 on the free states
+    (Φ the exact stick-slip flow of paper Eqs. 1–13, integrated by the ``event`` method) and the
+    arclength condition τᵀ (v − v_k) = h in scaled unknowns v = (s0/σ, T/T_0, λ/λ_s).
+
+    Parameters
+    ----------
+    params : Parameters, optional
+        Parameters of the start orbit (default: those of ``start`` if it is a PeriodicOrbit).
+    param : str
+        The parameter to vary: any numeric :class:`~stickslip.Parameters` field (``N`` [N],
+        ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...).
+    start : PeriodicOrbit, Trajectory, array-like (N_STATES,) or "equilibrium"
+        The first orbit; or a run that settled on it (shot by
+        :func:`~stickslip.orbits.start.start_orbit_from_run`, one
+        stick onset per period); or a state handed to :func:`~stickslip.orbits.periodic_orbit`.
+    direction : {+1, −1}
+        Start towards increasing (+1) or decreasing (−1) λ.
+    step, min_step, max_step : float
+        Initial, smallest and largest step in scaled arclength (≈ relative change of λ where the
+        branch is steep in λ) [-]. The step grows by 1.5 after a corrector converges in ≤ 3
+        iterations and halves after a failure; below ``min_step`` the continuation stops.
+    max_points : int
+        Branch points to compute (the start included).
+    bounds : (lo, hi), optional
+        Interval of λ; the continuation ends on its edge (the last point is corrected at λ = edge).
+    stop_on : sequence of str
+        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``.
+    locate : bool
+        Locate special points (Illinois/bisection); otherwise they are reported at the next point.
+    model, section, rtol, atol, slip_band
+        As :func:`~stickslip.orbits.periodic_orbit` (used when ``start`` is not an orbit).
+    tol : float
+        Corrector convergence: max |Φ(s0, T) − s0| / σ ≤ tol [-].
+    fd_step : float
+        Relative finite-difference step of the Jacobian columns [-].
+    param_scale : float, optional
+        λ_s, the unit of λ in the arclength (default |λ0|, or 1 if λ0 = 0).
+    amplitude : bool
+        Measure the peak-to-peak φ of every orbit (one extra run per point).
+    min_stick_fraction : float
+        Stop when the stick time per period of a stick-slip orbit falls below this fraction of
+        the period (the stick phase vanishes; a ``stick-vanishing`` point is reported) [-].
+    jacobian_every : int
+        Recompute the finite-difference Jacobian (2 (2 n_free + 1) simulations) at every
+        ``jacobian_every``-th point only; in between, the corrector's Broyden-updated Jacobian gives
+        the tangent, and the points have no multipliers (NaN; ``n_unstable`` −1). Period doubling
+        and Neimark–Sacker are then detected between points with multipliers. 1 (default): every
+        point has multipliers.
+    callback : callable, optional
+        ``callback(i, value, period, stable)`` after each accepted point (progress), once the
+        point is journaled when writing to ``out``.
+    out : path, optional
+        NetCDF output (``.nc``) written as the branch is computed: the start orbit and every
+        accepted point (with its special points and the step after it) are appended to the journal
+        ``OUT.nc.journal`` as they are found (:mod:`.branch_store`); at the end the branch is
+        written to ``out`` (:meth:`Branch.to_netcdf`) and the journal removed.
+    resume : bool
+        With ``out``: continue an interrupted run from its journal (the last journaled point, its
+        Jacobian, tangent and step: the resumed branch is the uninterrupted one), or return the
+        branch of a finished ``out``, when they were written with the same start and settings
+        (the same digest). False: delete ``out`` and its journal and start over.
+    on_resume : callable, optional
+        ``on_resume(k)`` once, before any computation, when ``k`` points are read from ``out`` or
+        its journal.
+
+    Returns
+    -------
+    Branch
+
+    Raises
+    ------
+    ContinuationError
+        If ``param`` is not numeric, the start orbit cannot be found, or the first Jacobian fails.
+    stickslip.orbits.branch_store.JournalMismatch
+        If ``out`` or its journal was written with another start or other settings (an
+        :class:`~stickslip.orbits.OrbitError`, like ContinuationError).
+    """
+    t_start = time.perf_counter()
+    _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
+    jacobian_every = int(jacobian_every)
+    if isinstance(start, (PeriodicOrbit, Trajectory)) and params is None:
+        params = start.params
+    params = Parameters() if params is None else params
+    numeric_parameter(param)
+    lo = hi = None
+    if bounds is not None:
+        lo, hi = float(bounds[0]), float(bounds[1])
+        lam_start = float(getattr(params if not isinstance(start, PeriodicOrbit) else start.params, param))
+        if not (lo < hi) or not (lo <= lam_start <= hi):
+            raise ContinuationError(f"bounds ({lo:g}, {hi:g}) must satisfy lo < hi and contain the start "
+                                    f"{param} = {lam_start:g}")
+    atol = 1e-3 * rtol if atol is None else float(atol)
+    section = resolve_section(section)
+    numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
+                    bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
+                    tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
+                    min_stick_fraction=min_stick_fraction, jacobian_every=jacobian_every)
+    settings = store.branch_settings(params, param, start, model, section, rtol, atol, slip_band, numerics)
+    digest = store.digest_of(settings)
+    journal = None
+    if out is not None:
+        journal, finished = store.open_output(out, "branch", digest, settings, resume, _read_branch)
+        if finished is not None:  # nothing left to compute
+            if on_resume is not None:
+                on_resume(len(finished))
+            return dataclasses.replace(finished, timings={**finished.timings, "points_resumed": len(finished)})
+    records = [] if journal is None else journal.records
+    start_rec = next((r["start"] for r in records if "start" in r), None)
+    if start_rec is None:
+        begin = Start.of(start_orbit(params, param, start, model, section, rtol, atol, slip_band))
+        if journal is not None:
+            journal.append({"start": store.start_record(begin)})
+    else:
+        begin = Start(**store.start_fields(start_rec))
+    problem = problem_of(begin, param, fd_step, param_scale)
+    measure = (lambda p: _amplitude(problem, *problem.unpack(p.v))) if amplitude else (lambda p: float("nan"))
+    walk = _walk_from_records(records)
+    resumed = 0 if walk is None else len(walk.points)
+    if walk is None:
+        walk = _first_walk(problem, begin, direction, step, measure)
+        _journal_point(journal, walk, problem, [], 0.0, t_start)
+    else:
+        problem.counter["simulations"] = walk.simulations
+        if on_resume is not None:
+            on_resume(len(walk.points))
+    size0 = distance_from_equilibrium(problem, begin.state, problem.unpack(walk.points[0].v)[2]) \
+        if begin.stick_phases == 0 else None
+    while walk.stop is None and len(walk.points) < max_points:
+        last = walk.points[-1]
+        fresh = (len(walk.points) - walk.fresh_index) >= jacobian_every
+        try:
+            new = step_from(problem, last, walk.h, tol, with_jacobian=fresh)
+            if float(new.tangent @ last.tangent) < MIN_TANGENT_COS:
+                raise OrbitError("tangent turned too far")
+        except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+            # step changes are not journaled: a resumed run repeats these deterministic retries
+            if not last.fresh:  # first renew the Broyden-updated Jacobian, then shrink
+                try:
+                    walk.points[-1] = point_at(problem, last.v, last.iterations, last.tangent)
+                    found, walk.stop = detect_after_renewal(problem, walk, tol, locate, size0, stop_on)
+                    walk.fresh_index = len(walk.points) - 1
+                    walk.special.extend(found)
+                    _journal_point(journal, walk, problem, found, walk.elapsed, t_start)  # replaces the record
+                    continue
+                except (OrbitError, SimulationError):
+                    pass
+            walk.h *= SHRINK
+            if walk.h < min_step:
+                walk.stop = "min_step"
+            continue
+        stop = None
+        lam_new = problem.unpack(new.v)[2]
+        if bounds is not None and not (lo <= lam_new <= hi):
+            try:
+                new = correct_onto_bound(problem, last, new, hi if lam_new > hi else lo, tol)
+            except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+                walk.stop = "bounds (last point before the edge)"
+                break
+            stop = "bounds"
+        walk.points.append(new)
+        walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
+        walk.amplitudes.append(measure(new))
+        found, stop, quiet = detect_after_point(problem, walk, last, new, stop, tol, locate, jacobian_every,
+                                                min_stick_fraction, size0, stop_on)
+        walk.special.extend(found)
+        walk.stop = stop
+        if stop is None:
+            if new.iterations <= EASY_ITERATIONS:
+                walk.h = min(walk.h * GROW, max_step)
+            elif new.iterations >= HARD_ITERATIONS:
+                walk.h = max(walk.h * SHRINK, min_step)
+        _journal_point(journal, walk, problem, found, walk.elapsed, t_start)
+        if callback is not None and not quiet:
+            _s, T_new, lam_cb = problem.unpack(new.v)
+            callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
+    stop_reason = walk.stop or "max_points"
+    if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
+        journal.append({"end": stop_reason})
+    branch = _assemble_branch(problem, begin, walk, stop_reason,
+                              dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
+                                   max_step=max_step, max_points=max_points, slip_band=problem.shooting.slip_band,
+                                   param_scale=problem.p_scale, period_scale=problem.T_scale,
+                                   bounds=None if bounds is None else [lo, hi], direction=direction,
+                                   jacobian_every=jacobian_every),
+                              walk.elapsed + time.perf_counter() - t_start, resumed if out is not None else None,
+                              digest)
+    if journal is not None:
+        branch.to_netcdf(out)
+        journal.remove()
+    return branch
+
+
+def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on) -> None:
+    """Refuse bad numerical options of :func:`continue_orbit` before computing (ContinuationError)."""
+    if direction not in (1, -1):
+        raise ContinuationError(f"direction must be +1 or -1, got {direction}")
+    if not (0.0 < min_step <= step <= max_step):
+        raise ContinuationError(f"need 0 < min_step <= step <= max_step, got {min_step}, {step}, {max_step}")
+    if max_points < 1:
+        raise ContinuationError(f"max_points must be >= 1, got {max_points}")
+    if int(jacobian_every) < 1:
+        raise ContinuationError(f"jacobian_every must be >= 1, got {jacobian_every}")
+    unknown = sorted(set(stop_on) - set(SPECIAL_KINDS))
+    if unknown:
+        raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
+
+
+def _first_walk(problem: Problem, begin: Start, direction: int, step: float, measure) -> "_Walk":
+    """The walk at its first point: the start orbit with its Jacobian, tangent and amplitude."""
+    v0 = problem.pack(begin.state, begin.period, float(getattr(begin.params, problem.param)))
+    try:
+        p0 = point_at(problem, v0, 0, None, float(direction))
+    except (OrbitError, SimulationError) as exc:
+        raise ContinuationError(f"the Jacobian at the start orbit failed: {exc}") from exc
+    return _Walk(points=[p0], arclength=[0.0], amplitudes=[measure(p0)], special=[], h=float(step))
+
+
+@dataclasses.dataclass(eq=False)
+class _Walk:
+    """The state of a continuation between two points (internal): what the journal records."""
+
+    points: list
+    arclength: list
+    amplitudes: list
+    special: list
+    h: float  # the next step
+    fresh_index: int = 0  # the last point with a finite-difference Jacobian
+    stop: str | None = None  # why it ends after the last point (None: it goes on)
+    simulations: int = 0  # flow maps up to the last journaled point
+    elapsed: float = 0.0  # wall time of earlier (interrupted) runs [s]
+
+
+def _journal_point(journal, walk: _Walk, problem: Problem, found: list, elapsed: float, t_start: float) -> None:
+    """Append the last point of ``walk``, the special points ``found`` with it and the state
+    after it (nothing if not writing)."""
+    if journal is None:
+        return
+    k = len(walk.points) - 1
+    rec = {"point": k, **store.point_record(walk.points[k]), "amplitude": float(walk.amplitudes[k]),
+           "arclength": float(walk.arclength[k]), "special": [q.to_record() for q in found], "h": float(walk.h),
+           "fresh_index": int(walk.fresh_index), "simulations": int(problem.counter["simulations"]),
+           "elapsed": float(elapsed + time.perf_counter() - t_start)}
+    if walk.stop is not None:
+        rec["stop"] = walk.stop
+    journal.append(rec)
+
+
+def _walk_from_records(records: list) -> _Walk | None:
+    """The :class:`_Walk` after the last journaled point (None if no point was journaled).
+
+    A later record of the same point (its Jacobian renewed) replaces the earlier one.
+    """
+    every = [r for r in records if "point" in r]
+    if not every:
+        return None
+    last = every[-1]
+    pts = list({int(r["point"]): r for r in every}.values())  # the last record of each point, in point order
+    ends = [r["end"] for r in records if "end" in r]
+    return _Walk(points=[Point(**store.point_fields(r)) for r in pts], arclength=[float(r["arclength"]) for r in pts],
+                 amplitudes=[float(r["amplitude"]) for r in pts],
+                 special=[SpecialPoint.from_record(q) for r in every for q in r["special"]], h=float(last["h"]),
+                 fresh_index=int(last["fresh_index"]), stop=last.get("stop") or (ends[-1] if ends else None),
+                 simulations=int(last["simulations"]), elapsed=float(last["elapsed"]))
+
+
+def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: str, options: dict,
+                     total_s: float, resumed: int | None, digest: str) -> Branch:
+    """The :class:`Branch` of a finished walk (``resumed``: points read from a journal, None if not writing)."""
+    points = walk.points
+    unpacked = [problem.unpack(p.v) for p in points]
+    states = np.array([u[0] for u in unpacked])
+    periods = np.array([u[1] for u in unpacked])
+    values = np.array([u[2] for u in unpacked])
+    mult = np.array([p.multipliers for p in points])
+    n_unst = np.array([unstable_count(p.multipliers) if p.fresh else -1 for p in points])
+    timings = {"total_s": total_s, "points": len(points), "simulations": problem.counter["simulations"]}
+    if resumed is not None:
+        timings["points_resumed"] = resumed
+    return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
+                  stable=n_unst == 0, n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
+                  stick_time=np.array([p.stick_time for p in points]),
+                  amplitude=np.array(walk.amplitudes, dtype=float), arclength=np.array(walk.arclength),
+                  residuals=np.array([p.residual for p in points]),
+                  iterations=np.array([p.iterations for p in points]), special=list(walk.special),
+                  stop_reason=stop_reason, params=begin.params, model=begin.model, section=begin.section,
+                  options=options, timings=timings, digest=digest)
+
+
