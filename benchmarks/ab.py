@@ -8,7 +8,7 @@ alternately with both, so each pair sees the same machine. It prints the minimum
 median and quartiles of the per-pair ratio new/baseline, and writes JSON. Two copies of the same
 code give a median ratio within ±1 % with 40 pairs (measured on the 2-core VM).
 
-    python benchmarks/ab.py [--rev HEAD] [--pairs 40] [--method aeom --dt 1e-3] [--t-end 100]
+    python benchmarks/ab.py [--rev HEAD] [--pairs 40] [--method aeom --dt 1e-3] [--t-end 100] [--sample-rate 1000]
 Writes benchmarks/results/ab.json.
 """
 
@@ -45,6 +45,7 @@ def main() -> None:
     ap.add_argument("--method", default="aeom")
     ap.add_argument("--dt", type=float, default=None, help="fixed step [s] (default 1e-3 for aeom/naeom)")
     ap.add_argument("--t-end", type=float, default=100.0)
+    ap.add_argument("--sample-rate", type=float, default=1000.0, help="output samples per second [Hz]")
     args = ap.parse_args()
     dt = args.dt if args.dt is not None or args.method == "event" else 1e-3
     with tempfile.TemporaryDirectory() as tmp:
@@ -53,7 +54,7 @@ def main() -> None:
         import stickslip
         import stickslip_baseline
 
-        kw = {"method": args.method, "dt": dt}
+        kw = {"method": args.method, "dt": dt, "sample_rate": args.sample_rate}
         pb, pn = stickslip_baseline.Parameters(), stickslip.Parameters()
         stickslip_baseline.simulate(pb, 1.0, **kw)  # compile both outside the timing
         stickslip.simulate(pn, 1.0, **kw)
