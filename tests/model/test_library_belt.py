@@ -7,6 +7,8 @@ whole stick-slip cycle is known; the slip end (x' back to V) is a root of that c
 """
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -118,3 +120,30 @@ def test_bstab_templates_reach_their_attractors():
     assert fp.states[-1, 0] == pytest.approx(mu_at_belt_speed * p["N"] / p["k"], abs=1e-3)
     assert np.max(np.abs(lc.states[late, 1])) > 0.2
     assert np.any(lc.mode[late] == 1) and np.any(lc.mode[late] == 0)
+
+
+def test_the_python_definition_in_the_docs_is_the_library_belt():
+    """docs/models.md defines the belt with FrictionModel directly; it runs as the library's file."""
+    text = (Path(__file__).resolve().parents[2] / "docs" / "models.md").read_text()
+    block = next(b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if 'name="my-belt"' in b)
+    namespace = {}
+    exec(block, namespace)
+    reference = simulate("belt", 100.0, ic={"x": 2.0, "dx": 2.0})
+    np.testing.assert_array_equal(namespace["traj"].states, reference.states)
+    np.testing.assert_array_equal(namespace["traj"].transitions.time, reference.transitions.time)
+
+
+@pytest.mark.parametrize("V", [0.8, 1.0, 1.1, 1.2, 1.5, 2.0])
+def test_steady_sliding_and_its_eigenvalues_are_the_analytic_ones(V):
+    """Linearised about steady sliding x = μ(V) N / k, the falling law adds −α Δμ e^(−αV) N to the
+    damping: x'' + (c − α Δμ e^(−αV) N) x' + k x = 0 (m = 1), unstable below V = ln(α Δμ N / c) / α."""
+    from stickslip.stability.analysis import stability
+
+    p, alpha, delta_mu = BSTAB, 2.0, 0.5
+    res = stability(load_model("belt").replace(**{"contact.0.drive": V}))
+    d = p["c"] - alpha * delta_mu * math.exp(-alpha * V) * p["N"]
+    expected = np.roots([p["m"], d, p["k"]])
+    np.testing.assert_allclose(np.sort_complex(res.eigenvalues), np.sort_complex(expected), rtol=0, atol=1e-13)
+    assert res.equilibrium[0] == pytest.approx((p["mu_k"] + delta_mu * math.exp(-alpha * V)) * p["N"] / p["k"],
+                                               rel=1e-13)
+    assert res.stable == (V > math.log(alpha * delta_mu * p["N"] / p["c"]) / alpha)
