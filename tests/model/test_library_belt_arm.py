@@ -100,28 +100,19 @@ def test_docs_show_the_tested_code():
     assert "register_kinematics(BeltArm, belt_arm_frame, ndof=1, ncontacts=1, dim=1)" in blocks
 
 
-#: A user's kinematics module (the worked example under another name), for the cache test.
+#: A user's kinematics module: the worked example's frame under a class of its own.
 VANISHING_MODULE = '''
 from typing import NamedTuple
-from stickslip.model import csmath as csm
-from stickslip.model.bundle import C_N0, contact_offsets
 from stickslip.model.friction import FrictionLaw
 from stickslip.model.kinematics import register_kinematics
 from stickslip.model.system_model import Contact, FrictionModel
+from stickslip.studies.models import belt_arm_frame
 
 class VanishingArm(NamedTuple):
     H: float
     V: float
 
-def frame(kin, s, c, m, G, w):
-    cos = csm.cos(s[0])
-    G[0, 0] = kin.H / (cos * cos)
-    G[1, 0] = 0.0
-    w[0] = kin.V
-    w[1] = 0.0
-    return m[contact_offsets(1, c)[0] + C_N0] + csm.zero(s[0])
-
-register_kinematics(VanishingArm, frame, ndof=1, ncontacts=1, dim=1)
+register_kinematics(VanishingArm, belt_arm_frame, ndof=1, ncontacts=1, dim=1)
 MODEL = FrictionModel(name="arm", dofs=("theta",), mass=[[1.0]], damping=[[0.0]], stiffness=[[1.0]], force=[0.0],
                       contacts=(Contact(dim=1, friction=FrictionLaw("coulomb", 0.2, 0.1), normal_force=1.0),),
                       kinematics=VanishingArm(1.0, 0.1))

@@ -88,7 +88,8 @@ class HoffmannSweep:
     polynomial_eigenvalues : ndarray (m, 4) complex
         Roots of det(λ² M + λ C + K(μ)), the characteristic polynomial of the model's matrices.
     onset : float
-        μ where the largest real part first exceeds ``threshold`` (bisection on ``stability``).
+        μ where the largest real part first exceeds 0 (damped) or 1e-6 (undamped, above the
+        round-off of the imaginary eigenvalues): :func:`flutter_onset`.
     damping : tuple of float
         (c_x, c_y) of the sweep.
     """
