@@ -129,12 +129,6 @@ print("ok")
 '''
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "numba's on-disk cache index of a kernel (physics.rhs, the event loop, ...) lists every "
-    "kinematics class it was compiled for, and loading the index unpickles them all: once a model "
-    "with kinematics from a module that is later not importable (a script, a temporary folder) has "
-    "run, every later process that loads that kernel from the cache fails with ModuleNotFoundError, "
-    "simulate('belt') included"))
 def test_kinematics_from_a_module_that_is_gone_do_not_break_other_models(tmp_path):
     """Two processes with a fresh kernel cache (~20 s of compiling)."""
     user = tmp_path / "user"

@@ -119,7 +119,7 @@ def test_transitions_and_states_match_the_hand_written_solution(y0):
     np.testing.assert_array_equal(tr.contact, [r[2] for r in ref])
     assert {0, 1} <= set(tr.contact[tr.kind == 1].tolist())  # both contacts stick
     # breakaway instants and states to 1e-9; a contact may enter stick once |v| ≤ STICK_SPEED_TOL,
-    # i.e. up to STICK_SPEED_TOL / |dv/dt| early (the integrator's stated bound; see the xfail below)
+    # i.e. up to STICK_SPEED_TOL / |dv/dt| early (the integrator's stated bound; in fact ~1e-10, below)
     bound = np.array([STICK_SPEED_TOL / r[4] if r[1] == 1 else 0.0 for r in ref]) + 1e-9
     assert np.all(np.abs(tr.time - [r[0] for r in ref]) <= bound)
     away = tr.kind == -1
@@ -127,11 +127,6 @@ def test_transitions_and_states_match_the_hand_written_solution(y0):
     np.testing.assert_allclose(traj.final_state, final, rtol=0, atol=1e-9)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "integrate/event_loop: on some approaches to stick each homing step onto v = 0 advances only "
-    "20 % of the extrapolated time (the full step is rejected, MIN_FACTOR 0.2), homing[c] reaches "
-    "MAX_RETAKES = 30 and try_stick accepts |v| ~ 1e-6 m/s: the entry is ~1e-6 s early at any "
-    "rtol (1e-10..1e-13), while breakaways and single-contact runs are located to ~1e-12 s"))
 @pytest.mark.parametrize("y0", Y0)
 def test_stick_entries_are_located_as_accurately_as_breakaways(y0):
     traj, ref, _ = run_both(y0)

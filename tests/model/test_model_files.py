@@ -258,19 +258,13 @@ def test_any_mass_that_is_not_positive_definite_is_refused(tmp_path, n, data):
     refused(write(tmp_path, spec), "mass", "positive definite")
 
 
-# --------------------------------------------------------------------------- found by the above
-@pytest.mark.xfail(strict=True, reason=(
-    "model_file._number calls math.isfinite on a TOML integer too large for a float (tomllib keeps "
-    "any size): OverflowError traceback instead of one line"))
+# --------------------------------------------------------------------------- found by the property tests
 def test_integer_too_large_for_a_float_is_refused(tmp_path):
     spec = copy.deepcopy(BASES[0])
     spec["stiffness"][0][0] = 10 ** 400
     refused(write(tmp_path, spec), "stiffness")
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "friction.FrictionLaw.from_mapping tests `law not in LAWS` (a dict): a law given as a list or "
-    "table raises TypeError (unhashable) instead of one line"))
 @pytest.mark.parametrize("law", [["coulomb"], {"name": "coulomb"}])
 def test_law_that_is_not_a_name_is_refused(tmp_path, law):
     spec = copy.deepcopy(BASES[0])

@@ -31,6 +31,7 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 
 from __future__ import annotations
 
+import pickle
 import warnings
 
 from numba import njit
@@ -41,6 +42,35 @@ from numba.core.errors import NumbaIRAssumptionWarning
 # correct (the float and complex paths agree to round-off in the tests), so the check's warnings
 # are not shown to users on the first, compiling run.
 warnings.filterwarnings("ignore", category=NumbaIRAssumptionWarning)
+
+
+def _tolerant_index_loading() -> None:
+    """Let numba's on-disk cache survive kinematics classes that can no longer be imported.
+
+    A kernel compiled for a model whose kinematics class lives in a user's script is indexed in the
+    kernel's cache by that class; when the script is gone, unpickling the index fails with an
+    ImportError in *every* later process, whatever model it runs. Such an index is treated as empty
+    instead: the kernel is compiled again for the models in use and the index rewritten.
+    """
+    try:
+        from numba.core.caching import IndexDataCacheFile
+    except ImportError:  # pragma: no cover - a numba without this class caches differently
+        return
+    load = IndexDataCacheFile._load_index
+    if getattr(load, "_stickslip_tolerant", False):
+        return
+
+    def _load_index(self):
+        try:
+            return load(self)
+        except (ImportError, AttributeError, EOFError, pickle.UnpicklingError):
+            return {}
+
+    _load_index._stickslip_tolerant = True
+    IndexDataCacheFile._load_index = _load_index
+
+
+_tolerant_index_loading()
 
 kernel = njit(cache=True, _nrt=False, error_model="numpy")
 inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy")
