@@ -12,7 +12,7 @@ form ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1] (every Runge–Kutt
 * several contacts: the multipliers of all sticking contacts are solved together; after any
   transition the sticking set is re-checked and a contact whose force exceeds its limit is
   released (:func:`release_most_overloaded`), the active-set view of Pfeiffer and Glocker.
-* a normal force that reaches zero ends the run (contact lost).
+* a normal force that reaches zero ends the run at that instant (``EVENT_NORMAL``: contact lost).
 """
 
 from __future__ import annotations
@@ -26,13 +26,14 @@ from ..model.bundle import CST
 from ..model.jit import kernel
 from ..model.kinematics import model_sizes
 
-__all__ = ["EVENT_SLIP", "EVENT_STICK", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP", "EVENT_TIME_TOL",
+__all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP", "EVENT_TIME_TOL",
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "contact_lost", "mode_flags"]
 
-EVENT_SLIP = 0   # slip → stick candidate: v_c · e0
-EVENT_STICK = 1  # stick → slip: μs N_c − |F_c|
+EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
+EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
+EVENT_NORMAL = 2  # contact lost: N_c
 
 TRANSITION_TO_STICK = 1
 TRANSITION_TO_SLIP = -1
@@ -108,6 +109,8 @@ def event_value(kind, c, y, e0x, e0y, cst, md, F, N):
     if kind == EVENT_SLIP:
         vx, vy = P.slip_velocity(y, c, md)
         return vx * e0x + vy * e0y
+    if kind == EVENT_NORMAL:
+        return P.normal_force(y, c, md)
     P.stick_forces(y, cst, np.int64(-1), md, F, N)
     Fx = F[2 * c]
     Fy = F[2 * c + 1]

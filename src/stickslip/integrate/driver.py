@@ -223,6 +223,10 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
     F = np.empty(2 * system.n_contacts)
     N = np.empty(system.n_contacts)
     cst = contact_state(md.m)
+    lost = E.contact_lost(y, md)
+    if lost >= 0:
+        raise SimulationError(f"the normal force of contact {lost} is ≤ 0 at the initial state: the contact is open; "
+                              "start from a state where every contact is pressed")
     compile_time = _warm_up(system, y, rtol, atol)
     E.initial_modes(y, cst, md, rtol, atol, F, N)
     h_max = dt if dt is not None else (t_end - t0)

@@ -260,6 +260,29 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             rejected = False
         q_ready = False  # the dense-output coefficients are formed only when needed
 
+        # ---- a normal force through zero: the model ends there (contact lost)
+        theta_lost = -1.0
+        for c in range(nc):
+            if P.normal_force(ynew, c, md) <= 0.0:
+                if not q_ready:
+                    DP.dense_coefficients(Kst, Q)
+                    q_ready = True
+                th = E.first_crossing(E.EVENT_NORMAL, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+                th = 1.0 if th <= 0.0 else th
+                if theta_lost < 0.0 or th < theta_lost:
+                    theta_lost = th
+                    lost = c
+        if theta_lost > 0.0:
+            idx = write_samples(idx, tau + theta_lost * h, y, Q, h, tau, t_base, cst, md, sample_times, out_s,
+                                out_mode, out_F, work, F, N, vv)
+            E.dense_state(y, Q, h, theta_lost, work)
+            for i in range(ns):
+                y[i] = work[i]
+            tau += theta_lost * h
+            stats[0] += 1
+            status = CONTACT_LOST
+            break
+
         # ---- slip contacts: departure overshoot, slip → stick roots inside the step
         retake = -1.0
         theta_slip = -1.0
@@ -458,10 +481,6 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             retakes = 0
         if not E.all_finite(y):
             status = NOT_FINITE
-            break
-        lost = E.contact_lost(y, md)
-        if lost >= 0:
-            status = CONTACT_LOST
             break
         if h_override > 0.0:
             h = h_override
