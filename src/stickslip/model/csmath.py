@@ -58,7 +58,7 @@ def _is_complex(x) -> bool:
     return isinstance(x, types.Complex)
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _real_sin(x):
     if abs(x) <= SMALL_ANGLE:
         x2 = x * x
@@ -66,7 +66,7 @@ def _real_sin(x):
     return math.sin(x)
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _real_cos(x):
     if abs(x) <= SMALL_ANGLE:
         x2 = x * x
@@ -74,7 +74,7 @@ def _real_cos(x):
     return math.cos(x)
 
 
-@overload(sin, inline="always")
+@overload(sin)
 def _sin(x):
     if _is_complex(x):
         def impl(x):
@@ -87,7 +87,7 @@ def _sin(x):
     return lambda x: _real_sin(x)
 
 
-@overload(cos, inline="always")
+@overload(cos)
 def _cos(x):
     if _is_complex(x):
         def impl(x):
@@ -100,7 +100,7 @@ def _cos(x):
     return lambda x: _real_cos(x)
 
 
-@overload(exp, inline="always")
+@overload(exp)
 def _exp(x):
     if _is_complex(x):
         def impl(x):
@@ -114,7 +114,7 @@ def _exp(x):
     return lambda x: math.exp(x)
 
 
-@overload(sqrt, inline="always")
+@overload(sqrt)
 def _sqrt(x):
     if _is_complex(x):
         def impl(x):
@@ -133,7 +133,7 @@ def zero(x):  # pragma: no cover
     return 0 * x
 
 
-@overload(zero, inline="always")
+@overload(zero)
 def _zero(x):
     if _is_complex(x):
         return lambda x: 0j

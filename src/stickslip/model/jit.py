@@ -32,16 +32,8 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 from __future__ import annotations
 
 import pickle
-import warnings
 
 from numba import njit
-from numba.core.errors import NumbaIRAssumptionWarning
-
-# numba's IR inliner runs a "pedantic" scope check that flags the accumulators of loops inside
-# overloads inlined at the IR level (physics.frame_with_bias) as out of scope; the compiled code is
-# correct (the float and complex paths agree to round-off in the tests), so the check's warnings
-# are not shown to users on the first, compiling run.
-warnings.filterwarnings("ignore", category=NumbaIRAssumptionWarning)
 
 
 def _tolerant_index_loading() -> None:

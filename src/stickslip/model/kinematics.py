@@ -103,7 +103,7 @@ def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below
     raise NotImplementedError
 
 
-@overload(model_sizes, inline="always")
+@overload(model_sizes)
 def _model_sizes(kin, m):
     n, nc, diagonal = _SIZES.get(getattr(kin, "instance_class", None), (None, None, None))
     if n is not None and nc is not None and diagonal is not None:
@@ -122,7 +122,7 @@ def contact_dim(kin, m, n, c):  # pragma: no cover - resolved by numba (overload
     raise NotImplementedError
 
 
-@overload(contact_dim, inline="always")
+@overload(contact_dim)
 def _contact_dim(kin, m, n, c):
     dim = _DIMS.get(getattr(kin, "instance_class", None))
     if dim is not None:

@@ -340,7 +340,7 @@ def _frame_bias_central(s, c, md, G2, w2, h2):
     return contact_frame(md.kin, s, c, m, G2, w2)
 
 
-@overload(frame_with_bias, inline="always")
+@overload(frame_with_bias)
 def _frame_with_bias(s, c, md, G2, w2, h2):
     from numba.core import types
 
@@ -407,8 +407,8 @@ def add_contact_force(G2, dim, n, F0, F1, f):
 @inlined_kernel
 def rotated(c, s, angle):
     """(cos(θ + a), sin(θ + a)) from (c, s) = (cos θ, sin θ) and the angle a [rad]."""
-    ca = math.cos(angle)
-    sa = math.sin(angle)
+    ca = csm.cos(angle)
+    sa = csm.sin(angle)
     return c * ca - s * sa, s * ca + c * sa
 
 
@@ -585,39 +585,57 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
     base_force(s, m, n, diagonal, f)
-    for stage in range(2):
-        for c in range(nc):
-            mode = np.int64(cst[CST * c])
-            if mode == MODE_STICK:
-                continue
-            dim = contact_dim(md.kin, m, n, c)
-            speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
-            exact = exact_direction(mode, speed.real, band)
-            if stage == 0 and exact:
-                inv = 1.0 / speed
-                F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
-            elif stage == 1 and not exact:
-                ex = cst[CST * c + 1]
-                ey = cst[CST * c + 2]
-                if dim == 2:
-                    # the force that would hold this contact (the others as they are), then the
-                    # direction on the slow manifold of the direction dynamics
-                    frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
-                    k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
-                    if k == 2:
-                        muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
-                        ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
-                                                        F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
-                F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
-            else:
-                continue
+    in_band = False
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            inv = 1.0 / speed
+            F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
             F[2 * c] = F0
             F[2 * c + 1] = F1
             add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
+        else:
+            in_band = True
+    if in_band:
+        band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A)
     if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
         for c in range(nc):
             if is_stick(cst, c):
                 add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+
+
+@kernel
+def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
+    """Slip forces of the contacts inside the low-speed band (after those with the exact direction,
+    whose forces are in ``f`` already): the quasi-static direction for a 2-D contact, found with the
+    force that would hold it (the others as they are), the stored direction for a 1-D contact."""
+    m = md.m
+    band = m[H_BAND]
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            continue
+        ex = cst[CST * c + 1]
+        ey = cst[CST * c + 2]
+        if dim == 2:
+            frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
+            k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
+            if k == 2:
+                muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
+                ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
+                                                F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
+        F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
+        F[2 * c] = F0
+        F[2 * c + 1] = F1
+        add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
 
 
 @kernel
@@ -869,7 +887,7 @@ def band_direction(s, cst, c, md, speed):
     return quasi_static_direction(a00, a01, a11, F[2 * c], F[2 * c + 1], muN, ex, ey)
 
 
-@inlined_kernel
+@kernel
 def slip_direction(s, cst, c, md, v0, v1):
     """Unit slip direction (e0, e1) of slipping contact ``c`` with slip velocity (v0, v1) at ``s``:
     v/|v| above the low-speed band, inside it :func:`band_direction`."""
