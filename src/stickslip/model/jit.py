@@ -64,8 +64,12 @@ def _tolerant_index_loading() -> None:
 
 _tolerant_index_loading()
 
+#: Options of every compiled kernel, also given to the overloads whose implementations numba
+#: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
+KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy"}
+
 kernel = njit(cache=True, _nrt=False, error_model="numpy")
 inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy")
 loop = njit(cache=True, error_model="numpy")
 
-__all__ = ["kernel", "inlined_kernel", "loop"]
+__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS"]
