@@ -7,7 +7,7 @@ which halves the cost of the right-hand side (measured 189 → 84 ns per call, N
 Ω = 5 rad/s). Functions that allocate (the integrator loops) use ``loop`` (plain cached
 ``njit``); they allocate only on entry and never reassign an array variable inside their main
 loop, since numba reference-counts loop-carried arrays on every iteration
-(``method_event.record_transition``).
+(``fixed_step.record_transition``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
 kernels on the innermost path (``kernels.dynamics_at``, ``slip_force_at``, ``rotated``) and for
