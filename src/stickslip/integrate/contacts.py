@@ -12,7 +12,7 @@ form ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1] (every Runge–Kutt
 * several contacts: the multipliers of all sticking contacts are solved together; after any
   transition the sticking set is re-checked and a contact whose force exceeds its limit is
   released (:func:`release_most_overloaded`), the active-set view of Pfeiffer and Glocker.
-* a normal force that reaches zero ends the run (contact lost).
+* a normal force that reaches zero ends the run at that instant (``EVENT_NORMAL``: contact lost).
 """
 
 from __future__ import annotations
@@ -26,13 +26,14 @@ from ..model.bundle import CST
 from ..model.jit import kernel
 from ..model.kinematics import model_sizes
 
-__all__ = ["EVENT_SLIP", "EVENT_STICK", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP", "EVENT_TIME_TOL",
+__all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP", "EVENT_TIME_TOL",
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "contact_lost", "mode_flags"]
 
-EVENT_SLIP = 0   # slip → stick candidate: v_c · e0
-EVENT_STICK = 1  # stick → slip: μs N_c − |F_c|
+EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
+EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
+EVENT_NORMAL = 2  # contact lost: N_c
 
 TRANSITION_TO_STICK = 1
 TRANSITION_TO_SLIP = -1
@@ -108,10 +109,9 @@ def event_value(kind, c, y, e0x, e0y, cst, md, F, N):
     if kind == EVENT_SLIP:
         vx, vy = P.slip_velocity(y, c, md)
         return vx * e0x + vy * e0y
-    P.stick_forces(y, cst, np.int64(-1), md, F, N)
-    Fx = F[2 * c]
-    Fy = F[2 * c + 1]
-    return P.static_limit(md.m, model_sizes(md.kin, md.m)[0], c, N[c]) - math.sqrt(Fx * Fx + Fy * Fy)
+    if kind == EVENT_NORMAL:
+        return P.normal_force(y, c, md)
+    return P.stick_margin(y, cst, c, md)
 
 
 @kernel
@@ -144,10 +144,12 @@ def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
     """First θ ∈ (0, 1] where the event function of contact ``c`` turns ≤ 0, located to
     EVENT_TIME_TOL; −1.0 if no sign change is seen at the EVENT_CHECKS sample points.
 
-    The function is positive at θ = 0 by construction. Refinement: Illinois regula falsi.
+    The function is positive at θ = 0 by construction, so its value there is computed only when
+    the crossing lies in the first sub-interval (it is the bracket's left end). Refinement:
+    Illinois regula falsi.
     """
     a = 0.0
-    ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
+    ga = -1.0  # not yet computed (the function is > 0 at θ = 0)
     b = -1.0
     gb = 0.0
     for j in range(1, EVENT_CHECKS + 1):
@@ -162,6 +164,8 @@ def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
         ga = g
     if b < 0.0:
         return -1.0
+    if ga < 0.0:
+        ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
     tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
     side = np.int64(0)  # not a literal: one compiled version of illinois_update
     for _ in range(MAX_REFINEMENTS):

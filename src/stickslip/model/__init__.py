@@ -1,8 +1,16 @@
-"""The two-plate model: parameters, variants (locked DOFs), friction laws, compiled kernels."""
+"""Friction-contact models: the model interface, model files, the library, friction laws,
+contact kinematics and the compiled physics written once for all of them."""
 
+from .friction import FrictionLaw
+from .kinematics import ConstantKinematics, register_kinematics
+from .library import library, load_model, resolve_system, two_plates
+from .model_file import ModelFileError, load_model_file, model_from_spec
 from .parameters import FRICTION_LAWS, ParameterError, Parameters
 from .system import System, assemble
+from .system_model import Contact, FrictionModel, ModelError
 from .variants import DOF_NAMES, MODELS, STATE_NAMES, Variant, resolve_variant
 
-__all__ = ["Parameters", "ParameterError", "FRICTION_LAWS", "System", "assemble",
+__all__ = ["FrictionModel", "Contact", "FrictionLaw", "ModelError", "ModelFileError", "load_model", "load_model_file",
+           "model_from_spec", "library", "resolve_system", "two_plates", "register_kinematics", "ConstantKinematics",
+           "Parameters", "ParameterError", "FRICTION_LAWS", "System", "assemble",
            "Variant", "resolve_variant", "MODELS", "DOF_NAMES", "STATE_NAMES"]

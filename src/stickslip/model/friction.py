@@ -115,7 +115,7 @@ class FrictionLaw:
     mu_v: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.law not in LAWS:
+        if not isinstance(self.law, str) or self.law not in LAWS:
             raise FrictionLawError(f"friction law {self.law!r} is unknown; choose one of {', '.join(LAWS)}")
         for name in ("mu_k", "delta_mu", "alpha", "mu_v"):
             value = getattr(self, name)
@@ -161,7 +161,7 @@ class FrictionLaw:
         if unknown:
             raise FrictionLawError(f"{where}: unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(sorted(known))}")
         law = table.get("law", "exponential")
-        if law not in LAWS:
+        if not isinstance(law, str) or law not in LAWS:
             raise FrictionLawError(f"{where}.law = {law!r} is unknown; choose one of {', '.join(LAWS)}")
         for key in ("mu_k", "delta_mu"):
             if key not in table:

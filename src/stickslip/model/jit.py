@@ -7,7 +7,7 @@ which halves the cost of the right-hand side (measured 189 → 84 ns per call, N
 Ω = 5 rad/s). Functions that allocate (the integrator loops) use ``loop`` (plain cached
 ``njit``); they allocate only on entry and never reassign an array variable inside their main
 loop, since numba reference-counts loop-carried arrays on every iteration
-(``method_event.record_transition``).
+(``fixed_step.record_transition``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
 kernels on the innermost path (``kernels.dynamics_at``, ``slip_force_at``, ``rotated``) and for
@@ -31,10 +31,45 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 
 from __future__ import annotations
 
+import pickle
+
 from numba import njit
+
+
+def _tolerant_index_loading() -> None:
+    """Let numba's on-disk cache survive kinematics classes that can no longer be imported.
+
+    A kernel compiled for a model whose kinematics class lives in a user's script is indexed in the
+    kernel's cache by that class; when the script is gone, unpickling the index fails with an
+    ImportError in *every* later process, whatever model it runs. Such an index is treated as empty
+    instead: the kernel is compiled again for the models in use and the index rewritten.
+    """
+    try:
+        from numba.core.caching import IndexDataCacheFile
+    except ImportError:  # pragma: no cover - a numba without this class caches differently
+        return
+    load = IndexDataCacheFile._load_index
+    if getattr(load, "_stickslip_tolerant", False):
+        return
+
+    def _load_index(self):
+        try:
+            return load(self)
+        except (ImportError, AttributeError, EOFError, pickle.UnpicklingError):
+            return {}
+
+    _load_index._stickslip_tolerant = True
+    IndexDataCacheFile._load_index = _load_index
+
+
+_tolerant_index_loading()
+
+#: Options of every compiled kernel, also given to the overloads whose implementations numba
+#: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
+KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy"}
 
 kernel = njit(cache=True, _nrt=False, error_model="numpy")
 inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy")
 loop = njit(cache=True, error_model="numpy")
 
-__all__ = ["kernel", "inlined_kernel", "loop"]
+__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS"]

@@ -60,9 +60,13 @@ class ModelFileError(ModelError):
 def _number(value, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ModelFileError(f"{where} = {value!r} is not a number; give a number")
-    if not math.isfinite(value):
+    try:
+        number = float(value)
+    except OverflowError:
+        raise ModelFileError(f"{where} = {value} is too large for a float; give a number below 1e308") from None
+    if not math.isfinite(number):
         raise ModelFileError(f"{where} = {value} is not finite; give a finite number")
-    return float(value)
+    return number
 
 
 def _vector(value, n: int, where: str) -> np.ndarray:
@@ -166,6 +170,7 @@ def model_from_spec(spec: Mapping[str, Any], *, source: str = "python", name: st
                                 normal_rate_gradient=rate, name=str(table.get("name", f"contact{c}"))))
     frozen = copy.deepcopy(dict(spec))
     frozen["contact"] = [dict(t) for t in tables]
+    frozen.setdefault("slip_band", slip_band)  # a parameter of every model file
     parameters = parameter_paths(frozen)
     return FrictionModel(
         name=model_name, dofs=tuple(dofs), mass=mats["mass"], damping=mats["damping"],

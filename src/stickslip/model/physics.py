@@ -33,17 +33,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import CST, C_LAW, H_BAND, H_CONSTANT, contact_offsets, offsets
 from .friction import LAW_WIDTH, friction_coefficient, static_coefficient
 from .jit import inlined_kernel, kernel
 from .kinematics import contact_dim, contact_frame, model_sizes
-from .stack import DOFS, ROWS, STATES, TWO, VECTORS, work_matrix
+from .stack import DOFS, ONE, ROWS, STATES, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
-           "rhs", "rhs_body", "contact_forces", "normal_force", "stick_forces", "project_velocities", "slip_velocity",
+           "rhs", "rhs_body", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP"]
 
@@ -138,7 +137,7 @@ def kinetic_energy(s, md):
 
 
 # ----------------------------------------------------------------------------- linear algebra
-@kernel
+@inlined_kernel
 def solve_psd_2x2(a11, a12, a22, b1, b2):
     """Minimal-norm solution of the symmetric positive semi-definite 2×2 system A x = b.
 
@@ -267,11 +266,7 @@ def frame_velocity(s, n, dim, G2, w2):
     return v0, v1
 
 
-def frame_with_bias(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by numba (overload below)
-    """Contact ``c``'s frame (G, w; returns N) and velocity bias h = Ġ q̇ − ẇ = dv/dt at q̈ = 0."""
-    raise NotImplementedError
-
-
+@inlined_kernel
 def _frame_bias_complex_step(s, c, md, G2, w2, h2):
     """Float state: the frame at q + iε q̇ gives G, w (real parts, exact) and h = Im[G q̇ − w]/ε
     (exact to round-off) in one evaluation; 0 for constant kinematics."""
@@ -281,23 +276,43 @@ def _frame_bias_complex_step(s, c, md, G2, w2, h2):
         h2[0] = 0.0
         h2[1] = 0.0
         return contact_frame(md.kin, s, c, m, G2, w2)
-    zc = work_matrix(md.kin, STATES, STATES, 1j)[0]
+    zc = work_matrix(md.kin, ONE, STATES, 1j)[0]
     cG = work_matrix(md.kin, TWO, DOFS, 1j)
-    cw = work_matrix(md.kin, TWO, TWO, 1j)[0]
+    cw = work_matrix(md.kin, ONE, TWO, 1j)[0]
     for j in range(n):
         zc[j] = complex(s[j], COMPLEX_STEP * s[n + j])
         zc[n + j] = s[n + j]
     normal = contact_frame(md.kin, zc, c, m, cG, cw)
-    for i in range(2):
-        acc = -cw[i].imag
-        w2[i] = cw[i].real
-        for j in range(n):
-            acc += cG[i, j].imag * s[n + j]
-            G2[i, j] = cG[i, j].real
-        h2[i] = acc / COMPLEX_STEP
+    split_complex_frame(s, n, cG, cw, G2, w2, h2)
     return normal.real
 
 
+@inlined_kernel
+def split_complex_frame(s, n, cG, cw, G2, w2, h2):
+    """G, w = real parts of the frame at q + iε q̇; h = Im[G q̇ − w]/ε."""
+    h0 = -cw[0].imag
+    h1 = -cw[1].imag
+    for j in range(n):
+        h0 += cG[0, j].imag * s[n + j]
+        h1 += cG[1, j].imag * s[n + j]
+        G2[0, j] = cG[0, j].real
+        G2[1, j] = cG[1, j].real
+    w2[0] = cw[0].real
+    w2[1] = cw[1].real
+    h2[0] = h0 / COMPLEX_STEP
+    h2[1] = h1 / COMPLEX_STEP
+
+
+@inlined_kernel
+def max_rate(s, n):
+    """max |Re q̇_j| of a (complex) state."""
+    speed = 0.0
+    for j in range(n):
+        speed = max(speed, abs(s[n + j].real))
+    return speed
+
+
+@kernel
 def _frame_bias_central(s, c, md, G2, w2, h2):
     """Complex state (inside a complex-step Jacobian): the frame itself, and h as the central
     difference of G(q ± ε q̇) q̇ − w(q ± ε q̇) over 2ε, ε = BIAS_TIME_STEP / max|q̇| (~1e-10 relative)."""
@@ -306,34 +321,28 @@ def _frame_bias_central(s, c, md, G2, w2, h2):
     h2[0] = 0j
     h2[1] = 0j
     if m[H_CONSTANT] == 0.0:
-        zc = work_matrix(md.kin, STATES, STATES, s)[0]
+        zc = work_matrix(md.kin, ONE, STATES, s)[0]
         cG = work_matrix(md.kin, TWO, DOFS, s)
-        cw = work_matrix(md.kin, TWO, TWO, s)[0]
-        speed = 0.0
-        for j in range(n):
-            speed = max(speed, abs(s[n + j].real))
-        eps = BIAS_TIME_STEP / max(speed, 1e-300)
+        cw = work_matrix(md.kin, ONE, TWO, s)[0]
+        eps = BIAS_TIME_STEP / max(max_rate(s, n), 1e-300)
         for side in (1.0, -1.0):
             for j in range(n):
                 zc[j] = s[j] + side * eps * s[n + j]
                 zc[n + j] = s[n + j]
             contact_frame(md.kin, zc, c, m, cG, cw)
-            for i in range(2):
-                acc = -cw[i]
-                for j in range(n):
-                    acc += cG[i, j] * s[n + j]
-                h2[i] += side * acc / (2.0 * eps)
+            v0, v1 = frame_velocity(s, n, 2, cG, cw)
+            h2[0] += side * v0 / (2.0 * eps)
+            h2[1] += side * v1 / (2.0 * eps)
     return contact_frame(md.kin, s, c, m, G2, w2)
 
 
-@overload(frame_with_bias)
-def _frame_with_bias(s, c, md, G2, w2, h2):
-    from numba.core import types
-
-    # the implementations are plain functions: numba compiles the one for the state's number type
-    if isinstance(s.dtype, types.Complex):
-        return _frame_bias_central
-    return _frame_bias_complex_step
+@kernel
+def frame_with_bias(s, c, md, G2, w2, h2):
+    """Contact ``c``'s frame (G, w; returns N) and velocity bias h = Ġ q̇ − ẇ = dv/dt at q̈ = 0:
+    by complex step in a float evaluation, by central difference inside a complex one."""
+    if isinstance(s[0], complex):  # resolved at compile time: one branch per number type
+        return _frame_bias_central(s, c, md, G2, w2, h2)
+    return _frame_bias_complex_step(s, c, md, G2, w2, h2)
 
 
 @inlined_kernel
@@ -393,8 +402,8 @@ def add_contact_force(G2, dim, n, F0, F1, f):
 @inlined_kernel
 def rotated(c, s, angle):
     """(cos(θ + a), sin(θ + a)) from (c, s) = (cos θ, sin θ) and the angle a [rad]."""
-    ca = math.cos(angle)
-    sa = math.sin(angle)
+    ca = csm.cos(angle)
+    sa = csm.sin(angle)
     return c * ca - s * sa, s * ca + c * sa
 
 
@@ -483,6 +492,81 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
 
 
 @inlined_kernel
+def stick_rows(md, m, n, nc, cst, extra):
+    """Stick rows of the sticking contacts and contact ``extra`` (≥ 0; −1: none): their number k and,
+    when k ≤ 2, the first two (contact c's row i is 2c + i; −1 for none)."""
+    k = 0
+    r0 = -1
+    r1 = -1
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(md.kin, m, n, c)):
+                if k == 0:
+                    r0 = 2 * c + i
+                elif k == 1:
+                    r1 = 2 * c + i
+                k += 1
+    return k, r0, r1
+
+
+@inlined_kernel
+def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
+    """:func:`stick_system` for one or two stick rows (``r0``, and ``r1`` ≥ 0 or −1), written out on
+    the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
+    G_S M⁻¹ G_Sᵀ (a01 = a11 = 0 for one row)."""
+    m = md.m
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    a = vec[0]
+    mg0 = vec[1]
+    mg1 = vec[2]
+    apply_inverse_mass(m, n, diagonal, f, a)
+    apply_inverse_mass(m, n, diagonal, G[r0], mg0)
+    a00 = csm.zero(s[0])
+    b0 = h[r0]
+    for j in range(n):
+        a00 += G[r0, j] * mg0[j]
+        b0 += G[r0, j] * a[j]
+    zero = csm.zero(b0)
+    if r1 < 0:
+        F[r0] = -b0 / a00 if a00.real > 0.0 else zero
+        if r0 % 2 == 0:
+            F[r0 + 1] = zero
+        return a00, zero, zero
+    apply_inverse_mass(m, n, diagonal, G[r1], mg1)
+    a01 = csm.zero(s[0])
+    a11 = csm.zero(s[0])
+    b1 = h[r1]
+    for j in range(n):
+        a01 += G[r0, j] * mg1[j]
+        a11 += G[r1, j] * mg1[j]
+        b1 += G[r1, j] * a[j]
+    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
+    F[r0] = x0
+    F[r1] = x1
+    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
+        F[r0 + 1] = zero
+    if r1 % 2 == 0:
+        F[r1 + 1] = zero
+    return a00, a01, a11
+
+
+@inlined_kernel
+def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    """Stick multipliers of the sticking contacts and contact ``extra`` (F written for those), by
+    :func:`small_stick_system` when there are at most two rows, else :func:`stick_system`. Returns
+    (k, a00, a01, a11): the rows and, for k = 2, the entries of G_S M⁻¹ G_Sᵀ."""
+    k, r0, r1 = stick_rows(md, md.m, n, nc, cst, extra)
+    zero = csm.zero(s[0])
+    if k == 0:
+        return 0, zero, zero, zero
+    if k <= 2:
+        a00, a01, a11 = small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
+        return k, a00, a01, a11
+    stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    return k, zero, zero, zero
+
+
+@inlined_kernel
 def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     """Every contact's friction force at ``s`` in the modes of ``cst`` (any mix of slip, band and
     stick); fills G, w, v, N, h, F and the total generalised force f = f0 − C q̇ − K q + Σ G_cᵀ F_c.
@@ -496,39 +580,57 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
     base_force(s, m, n, diagonal, f)
-    for stage in range(2):
-        for c in range(nc):
-            mode = np.int64(cst[CST * c])
-            if mode == MODE_STICK:
-                continue
-            dim = contact_dim(md.kin, m, n, c)
-            speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
-            exact = exact_direction(mode, speed.real, band)
-            if stage == 0 and exact:
-                inv = 1.0 / speed
-                F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
-            elif stage == 1 and not exact:
-                ex = cst[CST * c + 1]
-                ey = cst[CST * c + 2]
-                if dim == 2:
-                    # the force that would hold this contact (the others as they are), then the
-                    # direction on the slow manifold of the direction dynamics
-                    frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
-                    k = stick_system(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
-                    if k == 2:
-                        muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
-                        ex, ey = quasi_static_direction(A[0, 0].real, A[0, 1].real, A[1, 1].real,
-                                                        F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
-                F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
-            else:
-                continue
+    in_band = False
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            inv = 1.0 / speed
+            F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
             F[2 * c] = F0
             F[2 * c + 1] = F1
             add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
-    if stick_system(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A) > 0:
+        else:
+            in_band = True
+    if in_band:
+        band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A)
+    if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
         for c in range(nc):
             if is_stick(cst, c):
                 add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+
+
+@kernel
+def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
+    """Slip forces of the contacts inside the low-speed band (after those with the exact direction,
+    whose forces are in ``f`` already): the quasi-static direction for a 2-D contact, found with the
+    force that would hold it (the others as they are), the stored direction for a 1-D contact."""
+    m = md.m
+    band = m[H_BAND]
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            continue
+        ex = cst[CST * c + 1]
+        ey = cst[CST * c + 2]
+        if dim == 2:
+            frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
+            k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
+            if k == 2:
+                muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
+                ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
+                                                F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
+        F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
+        F[2 * c] = F0
+        F[2 * c + 1] = F1
+        add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
 
 
 @kernel
@@ -681,15 +783,16 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
     F = vec[4]
     f = vec[5]
     general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
-    for c in range(nc):
-        if is_stick(cst, c):  # remove the sticking contacts' forces: they are re-solved below
-            add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, -F[2 * c], -F[2 * c + 1], f)
     if extra >= 0 and not is_stick(cst, extra):
-        dim = contact_dim(md.kin, m, n, extra)
-        add_contact_force(G[2 * extra:2 * extra + 2], dim, n, -F[2 * extra], -F[2 * extra + 1], f)
+        # solve again with the extra contact held: remove the forces of the contacts to be solved
+        for c in range(nc):
+            if is_stick(cst, c) or c == extra:
+                add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, -F[2 * c], -F[2 * c + 1], f)
         frame_with_bias(s, extra, md, G[2 * extra:2 * extra + 2], w[2 * extra:2 * extra + 2],
                         h[2 * extra:2 * extra + 2])
-    k = stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+        k = solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)[0]
+    else:
+        k = stick_rows(md, m, n, nc, cst, np.int64(-1))[0]
     for c in range(nc):
         N_out[c] = N[c]
         F_out[2 * c] = F[2 * c]
@@ -698,12 +801,30 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
 
 
 @kernel
+def stick_margin(s, cst, c, md):
+    """μs N_c − |F_c| [N] of sticking contact ``c`` at ``s``: the stick → slip event (paper Eq. 10),
+    with the multipliers of all sticking contacts solved together."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    w = vec[0]
+    v = vec[1]
+    N = vec[2]
+    h = vec[3]
+    F = vec[4]
+    f = vec[5]
+    general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
+
+
+@kernel
 def slip_velocity(s, c, md):
     """Slip velocity (v0, v1) of contact ``c`` at ``s`` [m/s] (v1 = 0 for a 1-D contact)."""
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G2 = work_matrix(md.kin, TWO, DOFS, s)
-    w2 = work_matrix(md.kin, TWO, TWO, s)[0]
+    w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     contact_frame(md.kin, s, c, m, G2, w2)
     return frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
 
@@ -712,7 +833,7 @@ def slip_velocity(s, c, md):
 def normal_force(s, c, md):
     """Normal force N_c [N] of contact ``c`` at ``s``."""
     G2 = work_matrix(md.kin, TWO, DOFS, s)
-    w2 = work_matrix(md.kin, TWO, TWO, s)[0]
+    w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     return contact_frame(md.kin, s, c, md.m, G2, w2)
 
 
@@ -723,14 +844,29 @@ def slip_velocity_and_rate(s, ds, c, md):
     − w(q + iε q̇))."""
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
-    zc = work_matrix(md.kin, STATES, STATES, 1j)[0]
+    zc = work_matrix(md.kin, ONE, STATES, 1j)[0]
     cG = work_matrix(md.kin, TWO, DOFS, 1j)
-    cw = work_matrix(md.kin, TWO, TWO, 1j)[0]
-    for j in range(2 * n):
+    cw = work_matrix(md.kin, ONE, TWO, 1j)[0]
+    for j in range(n):
         zc[j] = complex(s[j], COMPLEX_STEP * ds[j])
+        zc[n + j] = s[n + j]
     contact_frame(md.kin, zc, c, m, cG, cw)
-    z0, z1 = frame_velocity(zc, n, contact_dim(md.kin, m, n, c), cG, cw)
-    return z0.real, z1.real, z0.imag / COMPLEX_STEP, z1.imag / COMPLEX_STEP
+    # Re and Im of G (q̇ + iε q̈) − w, written out: Im needs Im G q̇ + Re G ε q̈ only
+    v0 = -cw[0].real
+    v1 = -cw[1].real
+    a0 = -cw[0].imag
+    a1 = -cw[1].imag
+    for j in range(n):
+        qd = s[n + j]
+        qdd = COMPLEX_STEP * ds[n + j]
+        v0 += cG[0, j].real * qd
+        v1 += cG[1, j].real * qd
+        a0 += cG[0, j].imag * qd + cG[0, j].real * qdd
+        a1 += cG[1, j].imag * qd + cG[1, j].real * qdd
+    if contact_dim(md.kin, m, n, c) == 1:
+        v1 = 0.0
+        a1 = 0.0
+    return v0, v1, a0 / COMPLEX_STEP, a1 / COMPLEX_STEP
 
 
 @kernel
@@ -753,15 +889,18 @@ def band_direction(s, cst, c, md, speed):
     F = vec[4]
     f = vec[5]
     general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
-    add_contact_force(G[2 * c:2 * c + 2], 2, n, -F[2 * c], -F[2 * c + 1], f)
+    for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
+        if is_stick(cst, c2) or c2 == c:
+            add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)
     frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
-    if stick_system(s, md, n, nc, diagonal, cst, c, G, h, f, F, A) != 2:
+    k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
+    if k != 2:
         return ex, ey
     muN = friction_coefficient(speed, law_row(m, n, c)) * N[c]
-    return quasi_static_direction(A[0, 0], A[0, 1], A[1, 1], F[2 * c], F[2 * c + 1], muN, ex, ey)
+    return quasi_static_direction(a00, a01, a11, F[2 * c], F[2 * c + 1], muN, ex, ey)
 
 
-@inlined_kernel
+@kernel
 def slip_direction(s, cst, c, md, v0, v1):
     """Unit slip direction (e0, e1) of slipping contact ``c`` with slip velocity (v0, v1) at ``s``:
     v/|v| above the low-speed band, inside it :func:`band_direction`."""
