@@ -165,7 +165,8 @@ def simulate(
     duration = _parse_t_end(t_end, cap, steady_from)
     check_positive({"--sample-rate": settings["sample_rate"]})
     check_finite({"--perturb": perturb, "--steady-from": steady_from})
-    _check_window(steady_from, t0, t0 + duration, settings["sample_rate"])
+    if duration is not None:  # with --t-end auto the window is the last part of the settled run
+        _check_window(steady_from, t0, t0 + duration, settings["sample_rate"])
     time_flag = "--cap" if duration is None else "--t-end"
     longest = cap if duration is None else duration
     check_samples(longest, settings["sample_rate"], time_flag=time_flag)
