@@ -147,11 +147,11 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
                           for m in models])
     data = {
         "label": v(label, ("state",), {"long_name": "attractor reached from each initial state (-1: not classified)",
-                                        "_FillValue": np.int16(-1), **flags}),
-        "verdict": v(verdict, ("state",), {"long_name": "verdict of each state's run", "_FillValue": np.int8(-1),
+                                        **flags}),
+        "verdict": v(verdict, ("state",), {"long_name": "verdict of each state's run (-1: not classified)",
                                             "flag_values": np.arange(len(OUTCOMES), dtype=np.int8),
                                             "flag_meanings": " ".join(OUTCOMES)}),
-        "decided_by": v(decided, ("state",), {"long_name": "how the verdict was reached", "_FillValue": np.int8(-1),
+        "decided_by": v(decided, ("state",), {"long_name": "how the verdict was reached (-1: not classified)",
                                                "flag_values": np.arange(len(DECIDED), dtype=np.int8),
                                                "flag_meanings": " ".join(DECIDED)}),
         "t_decided": v(t_decided, ("state",), {"units": "s", "long_name": "simulated time at which the verdict was reached"}),
@@ -256,7 +256,7 @@ class BasinResult:
 
     def labels(self) -> np.ndarray:
         """Label name of every state ("" where not classified)."""
-        code = self.dataset["label"].values
+        code = np.nan_to_num(self.dataset["label"].values, nan=-1).astype(int)
         names = np.array(self.names + [""], dtype=object)
         return names[np.where(code >= 0, code, len(self.names))]
 

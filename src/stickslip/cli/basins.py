@@ -119,7 +119,7 @@ def basins(
     if not result.complete:
         err_console.print(f"interrupted: {int(result.dataset.attrs['states_done'])} of {result.dataset['done'].size} "
                           f"states classified, kept in {out}.journal; run the same command again to resume",
-                          highlight=False)
+                          highlight=False, soft_wrap=True)
         raise typer.Exit(130)
 
 
