@@ -74,8 +74,10 @@ def _models(model, param, values):
         return [model]
     try:
         return [model.replace(**{param: v}) for v in values]
-    except StickSlipError as exc:
-        raise BasinError(f"--param {param}: {exc}") from None
+    except StickSlipError as exc:  # the model names the path as --set does
+        text = str(exc)
+        raise BasinError("--param " + text[len("--set "):] if text.startswith("--set ") else f"--param {param}: {text}") \
+            from None
 
 
 def _contexts(models, keys):
