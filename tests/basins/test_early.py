@@ -119,3 +119,10 @@ def test_every_library_model_runs():
     res = basin_stability(hoffmann, box(hoffmann, {"y": (-3.0, -1.5)}, n=5, base="zero"), t_end=10.0,
                           executor="serial")
     assert res.names == ["contact-lost"]
+
+
+@pytest.mark.parametrize("n", [1, 2, 9, 10])
+def test_studies_of_a_few_states(n):
+    """The first states run in this process (compile, then timing); a study may have fewer."""
+    res = basin_stability(BELT, box(BELT, {"x": (-0.1, 0.1)}, n=n), executor="processes", workers=1)
+    assert res.complete and res.n == n and res.names == ["equilibrium"]

@@ -322,10 +322,11 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
         with interruptible() as stop:
             if todo.size:
                 record(*evaluate_batch(task(todo[:1])))  # compiles or loads the kernels
+                timed, rest = todo[1:1 + TIMED_STATES], todo[1 + TIMED_STATES:]
                 t = time.perf_counter()
-                record(*evaluate_batch(task(todo[1:1 + TIMED_STATES])))  # times a state
-                t_state = (time.perf_counter() - t) / max(todo[1:1 + TIMED_STATES].size, 1)
-                rest = todo[1 + TIMED_STATES:]
+                if timed.size:
+                    record(*evaluate_batch(task(timed)))  # times a state
+                t_state = (time.perf_counter() - t) / max(timed.size, 1)
                 size = _batch_size(batch_size, t_state, rest.size, workers, executor)
                 timing.update(batch_size=size, first_state_s=t_state)
                 tasks = (task(b) for b in _batches(rest, size, N))
