@@ -37,7 +37,7 @@ from collections import deque
 import numpy as np
 
 from .context import Context
-from .cycles import KMAX, MATCH_PERIODS, Cycle, Section, cycle_from_section, run_matches, section_of
+from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
 
 __all__ = ["Options", "Outcome", "classify_state", "OUTCOMES", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
            "RULE_PERIODS", "row_width", "DEFAULT_MAX_STEPS"]
@@ -99,7 +99,7 @@ class Options:
     t_end: float = 500.0
     rtol: float = 1e-8
     atol: float = 1e-10
-    match_rtol: float = 1e-2
+    match_rtol: float = MATCH_RTOL
     confirm: bool = True
     lyapunov: bool = False
     max_steps: int = DEFAULT_MAX_STEPS

@@ -74,7 +74,7 @@ def basins(
     t_end: float = typer.Option(500.0, "--t-end", help="Longest run of a state [s]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event integrator."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event integrator."),
-    match_rtol: float = typer.Option(1e-2, "--match-rtol", help="Tolerance of the cycle matches, relative to a "
+    match_rtol: float = typer.Option(1e-3, "--match-rtol", help="Tolerance of the cycle matches, relative to a "
                                      "cycle's amplitude and period."),
     no_confirm: bool = typer.Option(False, "--no-confirm", help="Do not shoot orbits to confirm periods of "
                                     "several maxima (such runs stay unsettled)."),
