@@ -115,8 +115,8 @@ def plot_fractions(result, ax=None, *, param_index: int = 0):
     se = ds["standard_error"].values
     pos = np.arange(len(names))
     ax.bar(pos, p, yerr=se, color=label_colors(names), capsize=4)
-    for x, v in zip(pos, p):
-        ax.text(x, v, f"{v:.3f}", ha="center", va="bottom", fontsize="small")
+    for x, v, e in zip(pos, p, se):
+        ax.text(x, v + e + 0.01, f"{v:.3f}", ha="center", va="bottom", fontsize="small")
     ax.set_xticks(pos, names, rotation=30, ha="right")
     ax.set_ylim(0, 1.08)
     ax.set_ylabel("basin stability (fraction of states)")
