@@ -50,3 +50,12 @@ def test_label_colours_are_fixed_per_name():
     a = label_colors(["equilibrium", "periodic", "periodic-2", "unsettled"])
     b = label_colors(["periodic-2", "unsettled", "equilibrium"])
     assert a[2] == b[0] and a[3] == b[1] and a[0] == b[2] and len(set(a)) == 4
+
+
+def test_dask_waits_through_poll_timeouts(serial, monkeypatch):
+    """Batches that outlast the polling interval (Ctrl-C is checked between polls) are waited for."""
+    from stickslip.basins import engine
+
+    monkeypatch.setattr(engine, "POLL_S", 1e-4)
+    res = basin_stability(BELT, STATES, executor="dask", workers=1, batch_size=20)
+    assert np.array_equal(res.labels(), serial.labels())

@@ -14,6 +14,7 @@ journal for the next run.
 
 from __future__ import annotations
 
+import asyncio
 import math
 import tempfile
 import time
@@ -138,8 +139,11 @@ def _dask(tasks, workers, address, stop, info):
         n_workers = max(1, len(client.scheduler_info().get("workers", {})))
         pending = {client.submit(evaluate_batch, t, pure=False) for _, t in zip(range(2 * n_workers), tasks)}
         while pending:
-            res = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED")
-            for fut in res.done:
+            try:
+                done = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED").done
+            except (TimeoutError, asyncio.TimeoutError):  # dask's wait raises when nothing finished in time
+                continue
+            for fut in done:
                 pending.discard(fut)
                 yield fut.result()
                 fut.release()

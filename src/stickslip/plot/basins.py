@@ -26,6 +26,14 @@ def _dataset(result):
     return getattr(result, "dataset", result)
 
 
+def _one(result, ax, param_index: int, figsize):
+    """The dataset of one parameter value, and the axes to draw on (a new figure's if None)."""
+    ds = _dataset(result)
+    if "param" in ds.dims:
+        ds = ds.isel(param=param_index)
+    return ds, (agg_figure(figsize).add_subplot() if ax is None else ax)
+
+
 def label_colors(names) -> list[str]:
     """One colour per attractor label, the same label always the same colour."""
     out = []
@@ -68,11 +76,7 @@ def plot_basins(result, ax=None, *, param_index: int = 0, legend: bool = True):
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
-    ds = _dataset(result)
-    if "param" in ds.dims:
-        ds = ds.isel(param=param_index)
-    if ax is None:
-        ax = agg_figure((5.5, 4.5)).add_subplot()
+    ds, ax = _one(result, ax, param_index, (5.5, 4.5))
     names = _names(ds)
     colors = label_colors(names)
     label = ds["label"].values
@@ -105,11 +109,7 @@ def plot_basins(result, ax=None, *, param_index: int = 0, legend: bool = True):
 
 def plot_fractions(result, ax=None, *, param_index: int = 0):
     """Bars of the fractions with ±1 standard error."""
-    ds = _dataset(result)
-    if "param" in ds.dims:
-        ds = ds.isel(param=param_index)
-    if ax is None:
-        ax = agg_figure((4.0, 4.0)).add_subplot()
+    ds, ax = _one(result, ax, param_index, (4.0, 4.0))
     names = _names(ds)
     p = ds["fraction"].values
     se = ds["standard_error"].values
