@@ -93,6 +93,7 @@ def test_parameter_study_gives_fractions_per_value_like_single_runs(tmp_path):
     (["--box", "x=0:1", "--model", "nomodel"], "unknown model 'nomodel'"),
     (["--box", "x=0:1", "--base", "far"], "--base far: choose one of equilibrium, zero"),
     (["--box", "x=0:1", "--t-end", "-1"], "t-end = -1.0 must be a finite number > 0"),
+    (["--box", "x=0:1", "--t-end", "0.5"], "--t-end 0.5 is shorter than the characteristic period"),
     (["--box", "x=0:1", "--match-rtol", "2"], "match-rtol = 2.0 must be < 1"),
     (["--box", "x=0:1", "--workers", "100000"], "more than the"),
     (["--box", "x=0:1", "--executor", "threads"], "unknown executor 'threads'"),

@@ -230,6 +230,10 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     models = _models(model, param, spec.values)
     keys = [register_model(m) for m in models]
     ctxs, info_models = _contexts(models, keys)
+    period = max(c.period for c in ctxs)
+    if t_end < period:
+        raise BasinError(f"--t-end {t_end:g} is shorter than the characteristic period T_c = {period:.4g} of model "
+                         f"{model.name!r} (its slowest oscillation); give several periods, e.g. --t-end {100 * period:.3g}")
     initial = np.stack([states.states(m, None if c.equilibrium is None else c.equilibrium[:m.n])
                         for m, c in zip(models, ctxs)])
     tmpdir = None
