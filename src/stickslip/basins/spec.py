@@ -15,7 +15,6 @@ from typing import Sequence
 
 import numpy as np
 
-from .. import __version__
 from .early import Options, row_width
 from .states import BasinError, StateSpec
 
@@ -78,10 +77,6 @@ class BasinSpec:
     def digest(self) -> str:
         """SHA-256 of :meth:`to_json` (with the format's major version)."""
         return hashlib.sha256(("basins-1:" + self.to_json()).encode()).hexdigest()
-
-    @property
-    def version(self) -> str:
-        return __version__
 
 
 def parse_param(text: str) -> tuple[str, list[float]]:
