@@ -46,6 +46,9 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=None, help="fixed step [s] (default 1e-3 for aeom/naeom)")
     ap.add_argument("--t-end", type=float, default=100.0)
     ap.add_argument("--sample-rate", type=float, default=1000.0, help="output samples per second [Hz]")
+    ap.add_argument("--fig12a", action="store_true",
+                    help="time the runs of the Fig. 12(a) sweep instead: 13 values of N from 10 to 130 N at "
+                         "Omega = 0.5 rad/s, 200 s each, summed per pair")
     args = ap.parse_args()
     dt = args.dt if args.dt is not None or args.method == "event" else 1e-3
     with tempfile.TemporaryDirectory() as tmp:
@@ -55,23 +58,29 @@ def main() -> None:
         import stickslip_baseline
 
         kw = {"method": args.method, "dt": dt, "sample_rate": args.sample_rate}
-        pb, pn = stickslip_baseline.Parameters(), stickslip.Parameters()
-        stickslip_baseline.simulate(pb, 1.0, **kw)  # compile both outside the timing
-        stickslip.simulate(pn, 1.0, **kw)
+        if args.fig12a:  # the points of the Fig. 12(a) sweep, as the sweep runs them (no samples kept)
+            loads = [10.0 + 10.0 * i for i in range(13)]
+            cases = [(dict(N=N, Omega=0.5), 200.0) for N in loads]
+            kw["sample_rate"] = 100.0
+        else:
+            cases = [({}, args.t_end)]
+        stickslip_baseline.simulate(stickslip_baseline.Parameters(), 1.0, **kw)  # compile both outside the timing
+        stickslip.simulate(stickslip.Parameters(), 1.0, **kw)
         base, new = [], []
         for i in range(args.pairs):
             order = (0, 1) if i % 2 else (1, 0)  # alternate which goes first
             for which in order:
-                if which == 0:
-                    base.append(stickslip_baseline.simulate(pb, args.t_end, **kw).stats.wall_time_s)
-                else:
-                    new.append(stickslip.simulate(pn, args.t_end, **kw).stats.wall_time_s)
+                pkg = stickslip_baseline if which == 0 else stickslip
+                wall = sum(pkg.simulate(pkg.Parameters(**values), t_end, **kw).stats.wall_time_s
+                           for values, t_end in cases)
+                (base if which == 0 else new).append(wall)
     ratios = sorted(n / b for n, b in zip(new, base))
     q = len(ratios) // 4
-    out = {"rev": args.rev, "case": {**kw, "t_end": args.t_end}, "pairs": args.pairs,
+    out = {"rev": args.rev, "case": {**kw, "t_end": args.t_end, "fig12a": args.fig12a}, "pairs": args.pairs,
            "baseline_min_s": min(base), "new_min_s": min(new), "ratio_median": ratios[len(ratios) // 2],
            "ratio_quartiles": [ratios[q], ratios[-q - 1]]}
-    print(f"{args.method} dt={dt} {args.t_end:g} s: baseline ({args.rev}) min {min(base):.4f} s, "
+    label = "Fig. 12(a) runs (13 N, 200 s)" if args.fig12a else f"{args.t_end:g} s"
+    print(f"{args.method} dt={dt} {label}: baseline ({args.rev}) min {min(base):.4f} s, "
           f"working tree min {min(new):.4f} s; new/baseline median {out['ratio_median']:.3f} "
           f"(quartiles {ratios[q]:.3f} … {ratios[-q - 1]:.3f}, {args.pairs} pairs)")
     path = ROOT / "benchmarks" / "results" / "ab.json"

@@ -111,10 +111,7 @@ def event_value(kind, c, y, e0x, e0y, cst, md, F, N):
         return vx * e0x + vy * e0y
     if kind == EVENT_NORMAL:
         return P.normal_force(y, c, md)
-    P.stick_forces(y, cst, np.int64(-1), md, F, N)
-    Fx = F[2 * c]
-    Fy = F[2 * c + 1]
-    return P.static_limit(md.m, model_sizes(md.kin, md.m)[0], c, N[c]) - math.sqrt(Fx * Fx + Fy * Fy)
+    return P.stick_margin(y, cst, c, md)
 
 
 @kernel
@@ -147,10 +144,12 @@ def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
     """First θ ∈ (0, 1] where the event function of contact ``c`` turns ≤ 0, located to
     EVENT_TIME_TOL; −1.0 if no sign change is seen at the EVENT_CHECKS sample points.
 
-    The function is positive at θ = 0 by construction. Refinement: Illinois regula falsi.
+    The function is positive at θ = 0 by construction, so its value there is computed only when
+    the crossing lies in the first sub-interval (it is the bracket's left end). Refinement:
+    Illinois regula falsi.
     """
     a = 0.0
-    ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
+    ga = -1.0  # not yet computed (the function is > 0 at θ = 0)
     b = -1.0
     gb = 0.0
     for j in range(1, EVENT_CHECKS + 1):
@@ -165,6 +164,8 @@ def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
         ga = g
     if b < 0.0:
         return -1.0
+    if ga < 0.0:
+        ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
     tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
     side = np.int64(0)  # not a literal: one compiled version of illinois_update
     for _ in range(MAX_REFINEMENTS):

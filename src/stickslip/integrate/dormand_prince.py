@@ -1,7 +1,7 @@
 """The Dormand–Prince 5(4) pair with its 4th-order dense output, shared by the compiled integrators.
 
 Dormand & Prince (1980), dense output after Shampine (1986): the coefficients of scipy's RK45.
-The integrators (:mod:`.method_event` on the 12 (+2) states, :mod:`stickslip.orbits.variational`
+The integrators (:mod:`.event_loop` on the 2n (+2) states, :mod:`stickslip.orbits.variational`
 on the 12 + 144 variational states) own their right-hand sides, error norms and events; this
 module owns the tableau and what is computed from it, as scalar constants so that the compiled
 stage sums are fully unrolled (A_ij: stage i from stage j; B: 5th-order weights; E: error

@@ -286,17 +286,14 @@ def _run_fixed_step(method: str, system: FrictionModel, y0: np.ndarray, t0: floa
     variant = values.pop("variant")
     plates = assemble(Parameters.from_dict(values), variant, system.slip_band)
     runner = run_aeom if method == "aeom" else run_naeom
-    message, keep, out_s, out_mode, out_F, transitions, stats = runner(plates, y0, t0, t_end, sample_times, rtol,
-                                                                       atol, dt, max_steps)
+    code, t_reached, keep, out_s, out_mode, out_F, transitions, stats = runner(plates, y0, t0, t_end, sample_times,
+                                                                            rtol, atol, dt, max_steps)
     buffers = _Buffers.__new__(_Buffers)
     buffers.out_s, buffers.out_mode, buffers.out_F = out_s, out_mode, out_F
-    code = Status.SUCCESS if message == "success" else next(
-        s for s in Status if s is not Status.SUCCESS and s.message(0.0).split(" at ")[0] == message.split(" at ")[0])
     n_kept = int(np.count_nonzero(keep))
-    t_reached = float(sample_times[n_kept - 1]) if code is not Status.SUCCESS and n_kept else t_end
     ns = out_s.shape[1]
     transitions = Transitions(transitions.time, transitions.kind,
-                              np.concatenate([transitions.state, np.zeros((len(transitions), ns - 12))], axis=1)[:, :ns],
+                              np.concatenate([transitions.state, np.zeros((len(transitions), ns - 12))], axis=1),
                               np.zeros(len(transitions), dtype=np.int8))
     return code, t_reached, -1, n_kept, buffers, transitions, stats
 

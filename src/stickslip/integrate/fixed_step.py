@@ -16,8 +16,8 @@ the stick step differs:
   grid is kept; uniform samples come from the cubic Hermite interpolant of each step.
 
 The slip direction below the low-speed band is the quasi-static one, with the band widened to
-what the step can resolve (:func:`step_band`). State layout as in
-:mod:`~stickslip.integrate.method_event`: 12 states, then the work of friction and of damping [J].
+what the step can resolve (:func:`step_band`). State layout: the plates' 12
+states, then the work of friction and of damping [J].
 """
 
 from __future__ import annotations
@@ -33,9 +33,53 @@ from ..model.jit import kernel, loop
 from . import events as E
 from . import rk4
 from .method_aeom import aeom_stick_branch, dependent_states
-from .method_event import (N_STATE, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_OK, STATUS_STEP_UNDERFLOW,
-                           record_transition, with_transition_room)
-from .method_naeom import MAX_NEWTON, STATUS_SOLVE_FAILED, VR_TOL, naeom_stick_branch
+from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
+from .status import MAX_STEPS as STATUS_MAX_STEPS
+from .status import NOT_FINITE as STATUS_NOT_FINITE
+from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
+from .status import STEP_UNDERFLOW as STATUS_STEP_UNDERFLOW
+from .status import SUCCESS as STATUS_OK
+from .status import Status
+
+N_STATE = 14  # the plates' 12 states + work of friction + work of damping
+
+#: Initial room for transitions per simulated second (stick-slip cycles have 2 per period); a run
+#: with more is run again with room for all (deterministic, same result).
+TRANSITIONS_PER_SECOND = 64
+MIN_TRANSITION_ROOM = 1024
+
+
+@kernel
+def record_transition(n, t, kind, y, tr_t, tr_kind, tr_s):
+    """Write transition ``n`` (time [s], kind, state) into the buffers if they have room.
+
+    The loop counts on past the capacity and :func:`with_transition_room` runs again with room for
+    all: buffers that grew inside the loop would be loop-carried arrays, which numba
+    reference-counts on every iteration.
+    """
+    if n < tr_t.shape[0]:
+        tr_t[n] = t
+        tr_kind[n] = kind
+        for i in range(tr_s.shape[1]):
+            tr_s[n, i] = y[i]
+
+
+def with_transition_room(run, duration: float, n_state: int = N_STATE):
+    """Call ``run(tr_t, tr_kind, tr_s)`` with transition buffers for a run of ``duration`` [s],
+    again with bigger ones if the transitions it found exceeded their room.
+
+    ``run`` returns ``(result, n_transitions)``. Returns ``(result, tr_t, tr_kind, tr_s)`` trimmed
+    to the transitions recorded.
+    """
+    capacity = MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * duration)
+    while True:
+        tr_t = np.empty(capacity)
+        tr_kind = np.empty(capacity, dtype=np.int8)
+        tr_s = np.empty((capacity, n_state))
+        result, n_tr = run(tr_t, tr_kind, tr_s)
+        if n_tr <= capacity:
+            return result, tr_t[:n_tr], tr_kind[:n_tr], tr_s[:n_tr]
+        capacity = n_tr
 
 __all__ = ["integrate_fixed_step", "run_aeom", "run_naeom", "check_step", "step_band", "kernel_parameters",
            "STABILITY_LIMIT", "METHOD_AEOM", "METHOD_NAEOM"]
@@ -288,12 +332,12 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
     """Integrate from ``y0`` (length N_STATE) over [t0, t_end] with the fixed step ``dt`` [s].
 
     ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step). Samples and
-    transitions are written as by ``method_event.integrate_event``.
+    transitions are written as by the event loop (:mod:`.event_loop`).
 
     Returns
     -------
     status : int
-        ``method_event.STATUS_*`` or ``method_naeom.STATUS_SOLVE_FAILED``.
+        A :mod:`.status` code.
     t : float
         Time reached [s].
     y : ndarray (N_STATE,)
@@ -459,15 +503,6 @@ def kernel_parameters(system, dt: float) -> np.ndarray:
     return p
 
 
-def _messages(status: int, t_reached: float) -> str:
-    return {
-        STATUS_OK: "success",
-        STATUS_STEP_UNDERFLOW: f"step size underflow at t = {t_reached:.6g} s",
-        STATUS_NOT_FINITE: f"state became non-finite at t = {t_reached:.6g} s",
-        STATUS_MAX_STEPS: f"max_steps reached at t = {t_reached:.6g} s",
-    }[status]
-
-
 def stats_dict(st, compile_time: float) -> dict:
     """The integrator counters as keyword arguments of ``result.Stats``."""
     from .result import Stats
@@ -530,7 +565,7 @@ def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float,
             f"iterations at t = {t_reached:.6g} s (dt = {dt:g} s); give a smaller dt"
         )
     keep = sample_times <= t_reached
-    return (_messages(status, t_reached), keep, out_s, out_mode, out_F,
+    return (Status(status), t_reached, keep, out_s, out_mode, out_F,
             Transitions(tr_t, tr_kind, tr_s[:, :12]), stats_dict(st, compile_time))
 
 

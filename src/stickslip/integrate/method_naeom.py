@@ -34,6 +34,7 @@ from ..model import kernels as K
 from ..model.jit import kernel
 from . import events as E
 from . import rk4
+from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
 
 __all__ = ["naeom_stick_branch", "solve_stick_step", "rk4_force_step", "VR_TOL", "MAX_NEWTON", "STATUS_SOLVE_FAILED"]
 
@@ -55,9 +56,6 @@ CONTRACTION = 0.5
 #: Relative force perturbation for the finite-difference Jacobian: ~√(machine ε) balances
 #: truncation and round-off of the one-sided difference.
 FD_REL_STEP = 1.5e-8
-
-#: Status of a run whose stick-force solve did not converge (see :data:`MAX_NEWTON`).
-STATUS_SOLVE_FAILED = 4
 
 
 @kernel

@@ -25,6 +25,8 @@ import math
 from numba.core import types
 from numba.extending import overload, register_jitable
 
+from .jit import KERNEL_OPTIONS
+
 __all__ = ["sin", "cos", "exp", "sqrt", "zero"]
 
 #: Largest |Im z| / max(1, |Re z|) for which the shortcut is exact (ε²/2 below half an ulp of 1).
@@ -58,7 +60,7 @@ def _is_complex(x) -> bool:
     return isinstance(x, types.Complex)
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _real_sin(x):
     if abs(x) <= SMALL_ANGLE:
         x2 = x * x
@@ -66,7 +68,7 @@ def _real_sin(x):
     return math.sin(x)
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _real_cos(x):
     if abs(x) <= SMALL_ANGLE:
         x2 = x * x
@@ -74,7 +76,7 @@ def _real_cos(x):
     return math.cos(x)
 
 
-@overload(sin, inline="always")
+@overload(sin, inline="always", jit_options=KERNEL_OPTIONS)
 def _sin(x):
     if _is_complex(x):
         def impl(x):
@@ -87,7 +89,7 @@ def _sin(x):
     return lambda x: _real_sin(x)
 
 
-@overload(cos, inline="always")
+@overload(cos, inline="always", jit_options=KERNEL_OPTIONS)
 def _cos(x):
     if _is_complex(x):
         def impl(x):
@@ -100,7 +102,7 @@ def _cos(x):
     return lambda x: _real_cos(x)
 
 
-@overload(exp, inline="always")
+@overload(exp, inline="always", jit_options=KERNEL_OPTIONS)
 def _exp(x):
     if _is_complex(x):
         def impl(x):
@@ -114,7 +116,7 @@ def _exp(x):
     return lambda x: math.exp(x)
 
 
-@overload(sqrt, inline="always")
+@overload(sqrt, inline="always", jit_options=KERNEL_OPTIONS)
 def _sqrt(x):
     if _is_complex(x):
         def impl(x):
@@ -133,7 +135,7 @@ def zero(x):  # pragma: no cover
     return 0 * x
 
 
-@overload(zero, inline="always")
+@overload(zero, inline="always", jit_options=KERNEL_OPTIONS)
 def _zero(x):
     if _is_complex(x):
         return lambda x: 0j

@@ -7,7 +7,7 @@ which halves the cost of the right-hand side (measured 189 → 84 ns per call, N
 Ω = 5 rad/s). Functions that allocate (the integrator loops) use ``loop`` (plain cached
 ``njit``); they allocate only on entry and never reassign an array variable inside their main
 loop, since numba reference-counts loop-carried arrays on every iteration
-(``method_event.record_transition``).
+(``fixed_step.record_transition``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
 kernels on the innermost path (``kernels.dynamics_at``, ``slip_force_at``, ``rotated``) and for
@@ -32,16 +32,8 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 from __future__ import annotations
 
 import pickle
-import warnings
 
 from numba import njit
-from numba.core.errors import NumbaIRAssumptionWarning
-
-# numba's IR inliner runs a "pedantic" scope check that flags the accumulators of loops inside
-# overloads inlined at the IR level (physics.frame_with_bias) as out of scope; the compiled code is
-# correct (the float and complex paths agree to round-off in the tests), so the check's warnings
-# are not shown to users on the first, compiling run.
-warnings.filterwarnings("ignore", category=NumbaIRAssumptionWarning)
 
 
 def _tolerant_index_loading() -> None:
@@ -72,8 +64,12 @@ def _tolerant_index_loading() -> None:
 
 _tolerant_index_loading()
 
+#: Options of every compiled kernel, also given to the overloads whose implementations numba
+#: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
+KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy"}
+
 kernel = njit(cache=True, _nrt=False, error_model="numpy")
 inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy")
 loop = njit(cache=True, error_model="numpy")
 
-__all__ = ["kernel", "inlined_kernel", "loop"]
+__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS"]

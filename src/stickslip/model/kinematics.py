@@ -33,7 +33,7 @@ from ..errors import StickSlipError
 from . import csmath as csm
 from . import stack
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, contact_offsets
-from .jit import inlined_kernel
+from .jit import KERNEL_OPTIONS, inlined_kernel
 
 __all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "contact_frame",
            "constant_frame", "KinematicsError", "model_sizes", "contact_dim"]
@@ -90,7 +90,7 @@ def contact_frame(kin, s, c, m, G, w):  # pragma: no cover - resolved by numba (
     raise NotImplementedError("contact_frame is called from compiled code only")
 
 
-@overload(contact_frame, inline="always")
+@overload(contact_frame, inline="always", jit_options=KERNEL_OPTIONS)
 def _contact_frame(kin, s, c, m, G, w):
     frame = _FRAMES.get(getattr(kin, "instance_class", None))
     if frame is None:
@@ -103,7 +103,7 @@ def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below
     raise NotImplementedError
 
 
-@overload(model_sizes, inline="always")
+@overload(model_sizes, jit_options=KERNEL_OPTIONS)
 def _model_sizes(kin, m):
     n, nc, diagonal = _SIZES.get(getattr(kin, "instance_class", None), (None, None, None))
     if n is not None and nc is not None and diagonal is not None:
@@ -122,7 +122,7 @@ def contact_dim(kin, m, n, c):  # pragma: no cover - resolved by numba (overload
     raise NotImplementedError
 
 
-@overload(contact_dim, inline="always")
+@overload(contact_dim, jit_options=KERNEL_OPTIONS)
 def _contact_dim(kin, m, n, c):
     dim = _DIMS.get(getattr(kin, "instance_class", None))
     if dim is not None:

@@ -33,17 +33,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import CST, C_LAW, H_BAND, H_CONSTANT, contact_offsets, offsets
 from .friction import LAW_WIDTH, friction_coefficient, static_coefficient
 from .jit import inlined_kernel, kernel
 from .kinematics import contact_dim, contact_frame, model_sizes
-from .stack import DOFS, ROWS, STATES, TWO, VECTORS, work_matrix
+from .stack import DOFS, ONE, ROWS, STATES, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
-           "rhs", "rhs_body", "contact_forces", "normal_force", "stick_forces", "project_velocities", "slip_velocity",
+           "rhs", "rhs_body", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP"]
 
@@ -267,11 +266,7 @@ def frame_velocity(s, n, dim, G2, w2):
     return v0, v1
 
 
-def frame_with_bias(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by numba (overload below)
-    """Contact ``c``'s frame (G, w; returns N) and velocity bias h = Ġ q̇ − ẇ = dv/dt at q̈ = 0."""
-    raise NotImplementedError
-
-
+@inlined_kernel
 def _frame_bias_complex_step(s, c, md, G2, w2, h2):
     """Float state: the frame at q + iε q̇ gives G, w (real parts, exact) and h = Im[G q̇ − w]/ε
     (exact to round-off) in one evaluation; 0 for constant kinematics."""
@@ -281,9 +276,9 @@ def _frame_bias_complex_step(s, c, md, G2, w2, h2):
         h2[0] = 0.0
         h2[1] = 0.0
         return contact_frame(md.kin, s, c, m, G2, w2)
-    zc = work_matrix(md.kin, STATES, STATES, 1j)[0]
+    zc = work_matrix(md.kin, ONE, STATES, 1j)[0]
     cG = work_matrix(md.kin, TWO, DOFS, 1j)
-    cw = work_matrix(md.kin, TWO, TWO, 1j)[0]
+    cw = work_matrix(md.kin, ONE, TWO, 1j)[0]
     for j in range(n):
         zc[j] = complex(s[j], COMPLEX_STEP * s[n + j])
         zc[n + j] = s[n + j]
@@ -317,6 +312,7 @@ def max_rate(s, n):
     return speed
 
 
+@kernel
 def _frame_bias_central(s, c, md, G2, w2, h2):
     """Complex state (inside a complex-step Jacobian): the frame itself, and h as the central
     difference of G(q ± ε q̇) q̇ − w(q ± ε q̇) over 2ε, ε = BIAS_TIME_STEP / max|q̇| (~1e-10 relative)."""
@@ -325,9 +321,9 @@ def _frame_bias_central(s, c, md, G2, w2, h2):
     h2[0] = 0j
     h2[1] = 0j
     if m[H_CONSTANT] == 0.0:
-        zc = work_matrix(md.kin, STATES, STATES, s)[0]
+        zc = work_matrix(md.kin, ONE, STATES, s)[0]
         cG = work_matrix(md.kin, TWO, DOFS, s)
-        cw = work_matrix(md.kin, TWO, TWO, s)[0]
+        cw = work_matrix(md.kin, ONE, TWO, s)[0]
         eps = BIAS_TIME_STEP / max(max_rate(s, n), 1e-300)
         for side in (1.0, -1.0):
             for j in range(n):
@@ -340,14 +336,13 @@ def _frame_bias_central(s, c, md, G2, w2, h2):
     return contact_frame(md.kin, s, c, m, G2, w2)
 
 
-@overload(frame_with_bias, inline="always")
-def _frame_with_bias(s, c, md, G2, w2, h2):
-    from numba.core import types
-
-    # the implementations are plain functions: numba compiles the one for the state's number type
-    if isinstance(s.dtype, types.Complex):
-        return _frame_bias_central
-    return _frame_bias_complex_step
+@kernel
+def frame_with_bias(s, c, md, G2, w2, h2):
+    """Contact ``c``'s frame (G, w; returns N) and velocity bias h = Ġ q̇ − ẇ = dv/dt at q̈ = 0:
+    by complex step in a float evaluation, by central difference inside a complex one."""
+    if isinstance(s[0], complex):  # resolved at compile time: one branch per number type
+        return _frame_bias_central(s, c, md, G2, w2, h2)
+    return _frame_bias_complex_step(s, c, md, G2, w2, h2)
 
 
 @inlined_kernel
@@ -407,8 +402,8 @@ def add_contact_force(G2, dim, n, F0, F1, f):
 @inlined_kernel
 def rotated(c, s, angle):
     """(cos(θ + a), sin(θ + a)) from (c, s) = (cos θ, sin θ) and the angle a [rad]."""
-    ca = math.cos(angle)
-    sa = math.sin(angle)
+    ca = csm.cos(angle)
+    sa = csm.sin(angle)
     return c * ca - s * sa, s * ca + c * sa
 
 
@@ -585,39 +580,57 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
     base_force(s, m, n, diagonal, f)
-    for stage in range(2):
-        for c in range(nc):
-            mode = np.int64(cst[CST * c])
-            if mode == MODE_STICK:
-                continue
-            dim = contact_dim(md.kin, m, n, c)
-            speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
-            exact = exact_direction(mode, speed.real, band)
-            if stage == 0 and exact:
-                inv = 1.0 / speed
-                F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
-            elif stage == 1 and not exact:
-                ex = cst[CST * c + 1]
-                ey = cst[CST * c + 2]
-                if dim == 2:
-                    # the force that would hold this contact (the others as they are), then the
-                    # direction on the slow manifold of the direction dynamics
-                    frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
-                    k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
-                    if k == 2:
-                        muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
-                        ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
-                                                        F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
-                F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
-            else:
-                continue
+    in_band = False
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            inv = 1.0 / speed
+            F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
             F[2 * c] = F0
             F[2 * c + 1] = F1
             add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
+        else:
+            in_band = True
+    if in_band:
+        band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A)
     if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
         for c in range(nc):
             if is_stick(cst, c):
                 add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+
+
+@kernel
+def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
+    """Slip forces of the contacts inside the low-speed band (after those with the exact direction,
+    whose forces are in ``f`` already): the quasi-static direction for a 2-D contact, found with the
+    force that would hold it (the others as they are), the stored direction for a 1-D contact."""
+    m = md.m
+    band = m[H_BAND]
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            continue
+        ex = cst[CST * c + 1]
+        ey = cst[CST * c + 2]
+        if dim == 2:
+            frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
+            k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
+            if k == 2:
+                muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
+                ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
+                                                F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
+        F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
+        F[2 * c] = F0
+        F[2 * c + 1] = F1
+        add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
 
 
 @kernel
@@ -788,12 +801,30 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
 
 
 @kernel
+def stick_margin(s, cst, c, md):
+    """μs N_c − |F_c| [N] of sticking contact ``c`` at ``s``: the stick → slip event (paper Eq. 10),
+    with the multipliers of all sticking contacts solved together."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    w = vec[0]
+    v = vec[1]
+    N = vec[2]
+    h = vec[3]
+    F = vec[4]
+    f = vec[5]
+    general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
+
+
+@kernel
 def slip_velocity(s, c, md):
     """Slip velocity (v0, v1) of contact ``c`` at ``s`` [m/s] (v1 = 0 for a 1-D contact)."""
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G2 = work_matrix(md.kin, TWO, DOFS, s)
-    w2 = work_matrix(md.kin, TWO, TWO, s)[0]
+    w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     contact_frame(md.kin, s, c, m, G2, w2)
     return frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
 
@@ -802,7 +833,7 @@ def slip_velocity(s, c, md):
 def normal_force(s, c, md):
     """Normal force N_c [N] of contact ``c`` at ``s``."""
     G2 = work_matrix(md.kin, TWO, DOFS, s)
-    w2 = work_matrix(md.kin, TWO, TWO, s)[0]
+    w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     return contact_frame(md.kin, s, c, md.m, G2, w2)
 
 
@@ -813,9 +844,9 @@ def slip_velocity_and_rate(s, ds, c, md):
     − w(q + iε q̇))."""
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
-    zc = work_matrix(md.kin, STATES, STATES, 1j)[0]
+    zc = work_matrix(md.kin, ONE, STATES, 1j)[0]
     cG = work_matrix(md.kin, TWO, DOFS, 1j)
-    cw = work_matrix(md.kin, TWO, TWO, 1j)[0]
+    cw = work_matrix(md.kin, ONE, TWO, 1j)[0]
     for j in range(n):
         zc[j] = complex(s[j], COMPLEX_STEP * ds[j])
         zc[n + j] = s[n + j]
@@ -869,7 +900,7 @@ def band_direction(s, cst, c, md, speed):
     return quasi_static_direction(a00, a01, a11, F[2 * c], F[2 * c + 1], muN, ex, ey)
 
 
-@inlined_kernel
+@kernel
 def slip_direction(s, cst, c, md, v0, v1):
     """Unit slip direction (e0, e1) of slipping contact ``c`` with slip velocity (v0, v1) at ``s``:
     v/|v| above the low-speed band, inside it :func:`band_direction`."""
