@@ -12,5 +12,6 @@ from . import reproduce  # noqa: E402,F401  (registers `stickslip reproduce`)
 from . import sweep  # noqa: E402,F401  (registers `stickslip sweep`, `bifurcation`, `regions`)
 from . import continue_  # noqa: E402,F401  (registers `stickslip continue`)
 from . import orbit  # noqa: E402,F401  (registers `stickslip orbit`, `lyapunov`)
+from . import basins  # noqa: E402,F401  (registers `stickslip basins`)
 
 __all__ = ["app"]

@@ -1,0 +1,359 @@
+"""The early-stopping classifier: one initial state, integrated in chunks until its attractor is known.
+
+Each state runs with the exact ``event`` integrator (:func:`stickslip.integrate.event_loop.integrate_event`,
+called chunk by chunk with the contacts' state carried over, so the run takes the same steps as
+one long call) for at most ``t_end``. After each chunk of :data:`~.context.CHUNK_PERIODS`
+characteristic periods, in this order:
+
+1. **Steady sliding reached** (only where it is linearly stable). The deviation δ = s − s_e of
+   the chunk's end is compared with the linear flow from its start, Φ δ0. In the norm of the
+   Lyapunov function V = δᵀPδ the linear flow contracts by c = |δ0| − |Φ δ0| per chunk; the
+   chunk counts as linear when no contact stuck and |δ − Φ δ0| ≤ :data:`LINEAR_MARGIN` · c.
+   Near an unstable cycle around the equilibrium the nonlinear terms cancel the contraction and
+   the test fails; in the linear regime they are a vanishing fraction of it, V keeps falling and
+   the run converges. :data:`LINEAR_CHUNKS` consecutive linear chunks, or |δ| below the context's
+   rest level, decide ``equilibrium``.
+2. **A known cycle reached**: the window's section crossings recur on a cycle already found
+   (:func:`.cycles.run_matches`).
+3. **A new cycle**: the maxima of the last :data:`RULE_PERIODS` T_c repeat by the package's
+   period rule (:func:`stickslip.analysis.period.return_map`); the window's verdict
+   (:func:`stickslip.analysis.settle.attractor`, which for k ≥ 2 maxima per period needs the shot
+   orbit to confirm it) then decides ``periodic`` and gives the cycle's features.
+4. At ``t_end``: the verdict of :func:`~stickslip.analysis.settle.attractor` on the window
+   (``equilibrium``, ``periodic``, ``quasiperiodic``, ``chaotic`` or ``unsettled``); a run that
+   stops early is ``unbounded`` (non-finite state), ``contact-lost`` (a normal force reached 0)
+   or ``failed`` (step size underflow, step cap).
+
+The outcome is a fixed-length row of numbers (:class:`Outcome`), journaled by the study.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections import deque
+
+import numpy as np
+
+from .context import Context
+from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
+
+__all__ = ["Options", "Outcome", "classify_state", "OUTCOMES", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
+           "RULE_PERIODS", "row_width", "DEFAULT_MAX_STEPS"]
+
+#: Verdicts of one state: the attractor verdicts (:data:`stickslip.analysis.settle.ATTRACTORS`),
+#: then a run that lost a contact, and one the integrator could not finish.
+OUTCOMES = ("equilibrium", "periodic", "quasiperiodic", "chaotic", "unbounded", "unsettled", "contact-lost", "failed")
+
+#: How the verdict was reached (``matched-at-end``: set when the study is assembled, for a run
+#: unsettled at t_end whose last crossings recur on a cycle found from another state).
+DECIDED = ("linear", "at-rest", "matched", "period-rule", "end-verdict", "stopped", "matched-at-end")
+
+#: Fraction of the linear flow's contraction (in the Lyapunov norm) that the nonlinear part of a
+#: chunk may reach for the chunk to count as linear.
+LINEAR_MARGIN = 0.05
+
+#: Consecutive linear chunks that decide the equilibrium.
+LINEAR_CHUNKS = 2
+
+#: Trailing span of the window, in T_c, on which the period rule is tried during the run (the
+#: rule needs nine periods).
+RULE_PERIODS = 16
+
+#: Default cap on the integration steps of one state (a state that stalls ends as ``failed``).
+DEFAULT_MAX_STEPS = 10_000_000
+
+#: Section crossings an outcome keeps (enough to match a cycle of KMAX maxima per period).
+N_CROSSINGS = MATCH_PERIODS * KMAX + 1
+
+_HEAD = ("verdict", "decided_by", "t_decided", "period", "multiplicity", "amplitude", "stick_fraction", "steps",
+         "wall_time")
+
+
+def row_width(n: int) -> int:
+    """Numbers per outcome row of a model with n coordinates."""
+    return len(_HEAD) + KMAX + 2 * n + 3 * N_CROSSINGS
+
+
+@dataclasses.dataclass(frozen=True)
+class Options:
+    """Integration and decision options of a study (the same for every state).
+
+    Attributes
+    ----------
+    t_end : float
+        Longest run of a state [s].
+    rtol, atol : float
+        Tolerances of the event integrator.
+    match_rtol : float
+        Tolerance of the cycle matches (:mod:`.cycles`).
+    confirm : bool
+        Shoot the orbit of a period claim of k ≥ 2 maxima (:func:`stickslip.analysis.settle.attractor`).
+    lyapunov : bool
+        Compute Lyapunov exponents for a stationary non-periodic window at t_end (chaos or torus).
+    max_steps : int
+        Cap on the integration steps of one state.
+    """
+
+    t_end: float = 500.0
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    match_rtol: float = MATCH_RTOL
+    confirm: bool = True
+    lyapunov: bool = False
+    max_steps: int = DEFAULT_MAX_STEPS
+
+
+@dataclasses.dataclass(frozen=True)
+class Outcome:
+    """What one state reached.
+
+    Attributes
+    ----------
+    verdict : str
+        One of :data:`OUTCOMES`.
+    decided_by : str
+        One of :data:`DECIDED`.
+    t_decided : float
+        Simulated time at which the verdict was reached [s].
+    cycle : Cycle or None
+        The cycle's features (``periodic``).
+    state : ndarray (2n,)
+        The state it ended in (a state on the cycle for ``periodic``).
+    section : Section or None
+        The run's last :data:`N_CROSSINGS` section crossings (kept for matching at the end).
+    steps : int
+        Integration steps taken.
+    wall_time : float
+        Seconds spent on this state.
+    """
+
+    verdict: str
+    decided_by: str
+    t_decided: float
+    cycle: Cycle | None
+    state: np.ndarray
+    section: Section | None = None
+    steps: int = 0
+    wall_time: float = 0.0
+
+    def to_row(self) -> np.ndarray:
+        """The outcome as a row of :func:`row_width` numbers."""
+        n2 = self.state.size
+        row = np.full(row_width(n2 // 2), np.nan)
+        c = self.cycle
+        row[:len(_HEAD)] = (OUTCOMES.index(self.verdict), DECIDED.index(self.decided_by), self.t_decided,
+                            math.nan if c is None else c.period, 0 if c is None else c.multiplicity,
+                            math.nan if c is None else c.amplitude, math.nan if c is None else c.stick_fraction,
+                            self.steps, self.wall_time)
+        o = len(_HEAD)
+        if c is not None:
+            row[o:o + c.multiplicity] = c.peaks
+        o += KMAX
+        row[o:o + n2] = self.state
+        o += n2
+        if self.section is not None:
+            s = self.section.last(min(len(self.section), N_CROSSINGS))
+            m = len(s)
+            for j, values in enumerate((s.times, s.maxima, s.minima)):
+                row[o + j * N_CROSSINGS + N_CROSSINGS - m:o + (j + 1) * N_CROSSINGS] = values
+        return row
+
+    @classmethod
+    def from_row(cls, row: np.ndarray, n: int) -> "Outcome":
+        """The outcome written by :meth:`to_row` (n: the model's coordinates)."""
+        verdict, decided, t, period, k, amp, stick, steps, wall = row[:len(_HEAD)]
+        o = len(_HEAD)
+        k = int(k)
+        state = row[o + KMAX:o + KMAX + 2 * n].copy()
+        cycle = Cycle(k, float(period), float(amp), row[o:o + k].copy(), float(stick), state) if k > 0 else None
+        o += KMAX + 2 * n
+        times, maxima, minima = (row[o + j * N_CROSSINGS:o + (j + 1) * N_CROSSINGS] for j in range(3))
+        keep = np.isfinite(times)
+        section = Section(times[keep], maxima[keep], minima[keep]) if np.any(keep) else None
+        return cls(OUTCOMES[int(verdict)], DECIDED[int(decided)], float(t), cycle, state, section, int(steps),
+                   float(wall))
+
+
+class _Window:
+    """The run's last samples (on the global sample grid t_i = i dt) and transitions, kept in
+    chunks and trimmed to the context's window."""
+
+    def __init__(self, limit: int):
+        self.limit = limit
+        self.chunks: deque = deque()
+        self.size = 0
+        self.first = 0  # global index of the first sample kept
+        self._joined = None
+
+    def add(self, t, states, mode, friction, transitions) -> None:
+        self.chunks.append((t, states, mode, friction, transitions))
+        self.size += t.size
+        while self.size - self.chunks[0][0].size >= self.limit:
+            dropped = self.chunks.popleft()[0].size
+            self.size -= dropped
+            self.first += dropped
+        self._joined = None
+
+    def arrays(self):
+        """(t, states, mode, friction, [transition times, kinds, contacts, states]) of the window."""
+        if self._joined is None:
+            t, s, mode, friction, tr = zip(*self.chunks)
+            self._joined = (np.concatenate(t), np.concatenate(s), np.concatenate(mode), np.concatenate(friction),
+                            [np.concatenate([x[i] for x in tr]) for i in range(4)])
+        return self._joined
+
+
+def _trajectory(model, ctx: Context, opts: Options, window: _Window, t_end: float, steps: int):
+    """The window as a :class:`~stickslip.integrate.result.Trajectory` (for the verdict)."""
+    from ..integrate.result import Stats, Trajectory, Transitions
+
+    t, states, mode, friction, (tt, kind, contact, ts) = window.arrays()
+    return Trajectory(t=t, states=states, mode=mode, friction=friction, work=np.zeros((t.size, 2)),
+                      transitions=Transitions(tt, kind, ts, contact), stats=Stats(accepted_steps=steps),
+                      status="success", system=model, method="event",
+                      options={"rtol": opts.rtol, "atol": opts.atol, "dt": None, "sample_rate": 1.0 / ctx.dt,
+                               "ic": "explicit", "perturbation": None, "t0": float(t[0]), "t_end": t_end,
+                               "slip_band": model.slip_band},
+                      steady_from=float(t[0]))
+
+
+def _verdict(model, ctx, opts, window, t_from, t_end, steps, cache):
+    """The verdict of :func:`stickslip.analysis.settle.attractor` on the window from ``t_from``."""
+    from ..analysis.settle import attractor
+
+    traj = _trajectory(model, ctx, opts, window, t_end, steps)
+    return traj, attractor(traj, t_from, confirm=opts.confirm, lyapunov=opts.lyapunov, cache=cache)
+
+
+def _linear(ctx: Context, d0: np.ndarray, d1: np.ndarray) -> tuple[bool, bool]:
+    """(at rest, linear) for the deviations from s_e at a chunk's start and end (free states)."""
+    P = ctx.lyapunov
+
+    def norm(d):
+        return math.sqrt(max(float(d @ P @ d), 0.0))
+
+    n1 = norm(d1)
+    if n1 <= ctx.rest:
+        return True, True
+    lin = ctx.flow @ d0
+    contraction = norm(d0) - norm(lin)
+    return False, contraction > 0.0 and norm(d1 - lin) <= LINEAR_MARGIN * contraction
+
+
+def classify_state(ctx: Context, model, s0: np.ndarray, cycles, opts: Options) -> Outcome:
+    """Integrate one state until its attractor is known (module docstring) or ``opts.t_end``.
+
+    Parameters
+    ----------
+    ctx : Context
+        The model's context (:func:`.context.make_context`).
+    model : FrictionModel
+    s0 : ndarray (2n,)
+        The initial state.
+    cycles : sequence of Cycle
+        Cycles already found for this model.
+    opts : Options
+
+    Returns
+    -------
+    Outcome
+    """
+    from ..analysis.peaks import Peaks
+    from ..analysis.period import MIN_PERIODS, return_map
+    from ..integrate import contacts as E
+    from ..integrate.event_loop import N_EXTRA, integrate_event
+    from ..integrate.status import CHUNK_END, CONTACT_LOST, NOT_FINITE, SUCCESS
+    from ..model.bundle import contact_state
+
+    start = time.perf_counter()
+    md = model.data
+    n = model.n
+    n2 = 2 * n
+    nc = model.n_contacts
+    y = np.zeros(n2 + N_EXTRA)
+    y[:n2] = s0
+    if E.contact_lost(y, md) >= 0:
+        return Outcome("contact-lost", "stopped", 0.0, None, np.array(s0, dtype=float),
+                       wall_time=time.perf_counter() - start)
+    F = np.empty(2 * nc)
+    N = np.empty(nc)
+    cst = contact_state(md.m)
+    E.initial_modes(y, cst, md, opts.rtol, opts.atol, F, N)
+    m, dt, t_end = ctx.chunk, ctx.dt, float(opts.t_end)
+    h_max = m * dt  # a step never passes more than one chunk of samples
+    out_s = np.empty((2 * m + 2, n2 + N_EXTRA))
+    out_mode = np.empty(2 * m + 2, dtype=np.int8)
+    out_F = np.empty((2 * m + 2, 2 * nc))
+    window = _Window(ctx.window)
+    free, se, j = ctx.free, ctx.equilibrium, model.observed_index
+    t, h, steps, linear_run, next_sample, room = 0.0, min(1e-3, h_max), 0, 0, 0, 64
+    cache: dict = {}
+    while True:
+        target = max(next_sample + m - 1, m)  # the chunk ends at this sample
+        times = np.arange(next_sample, target + m + 2) * dt
+        saved = (y.copy(), cst.copy(), h)
+        while True:  # again from the chunk's start with room for every transition, if needed
+            tr = (np.empty(room), np.empty(room, np.int8), np.empty(room, np.int8), np.empty((room, n2 + N_EXTRA)))
+            status, tau, y, h, idx, n_tr, st, _ = integrate_event(
+                y, cst, t, target * dt - t, t_end - t, md, opts.rtol, opts.atol, h, h_max, opts.max_steps - steps,
+                times, 0, out_s, out_mode, out_F, tr[0], tr[1], tr[2], tr[3], 0)
+            if n_tr <= room:
+                break
+            room = 2 * n_tr
+            y, cst, h = saved[0].copy(), saved[1].copy(), saved[2]
+        t += tau
+        steps += int(st[0] + st[1])
+        next_sample += idx
+        if idx:
+            window.add(times[:idx].copy(), out_s[:idx, :n2].copy(), out_mode[:idx].copy(), out_F[:idx].copy(),
+                       (tr[0][:n_tr].copy(), tr[1][:n_tr].copy(), tr[2][:n_tr].copy(), tr[3][:n_tr, :n2].copy()))
+        tw, sw, mw, _, trw = window.arrays()
+
+        def outcome(verdict, decided, cycle=None, state=None, section=None):
+            last = sw[-1].copy() if idx else y[:n2].copy()
+            return Outcome(verdict, decided, t, cycle, last if state is None else state, section, steps,
+                           time.perf_counter() - start)
+
+        if status not in (CHUNK_END, SUCCESS):
+            return outcome({NOT_FINITE: "unbounded", CONTACT_LOST: "contact-lost"}.get(status, "failed"), "stopped")
+        # 1. steady sliding reached: the last m samples against the linear flow
+        a, b = target - m - window.first, target - window.first
+        if ctx.stable and a >= 0 and b < tw.size:
+            stuck = bool(np.any(mw[a:b + 1])) or bool(np.any((trw[0] > tw[a]) & (trw[0] <= tw[b])))
+            rest, linear = _linear(ctx, sw[a, free] - se[free], sw[b, free] - se[free])
+            if rest:
+                return outcome("equilibrium", "at-rest")
+            linear_run = linear_run + 1 if linear and not stuck else 0
+            if linear_run >= LINEAR_CHUNKS:
+                return outcome("equilibrium", "linear")
+        section = section_of(tw, sw[:, j], sw[:, n + j])
+        # 2. a known cycle reached
+        for cycle in cycles:
+            if run_matches(cycle, section, opts.match_rtol):
+                return outcome("periodic", "matched", cycle, cycle.state)
+        # 4. the verdict at t_end
+        if status == SUCCESS:
+            traj, v = _verdict(model, ctx, opts, window, float(tw[0]), t_end, steps, cache)
+            if v.attractor == "periodic":
+                cyc = _cycle(section, traj, v)
+                return outcome("periodic", "period-rule", cyc, cyc.state)
+            return outcome(v.attractor, "end-verdict", section=section)
+        # 3. a new cycle: the period rule on the last RULE_PERIODS T_c, then the window's verdict
+        t_from = t - RULE_PERIODS * ctx.period
+        recent = section.times >= t_from
+        if np.count_nonzero(recent) > MIN_PERIODS and tw[0] <= t_from:
+            x = sw[tw >= t_from, j]
+            settled, _ = return_map(Peaks(section.times[recent], section.maxima[recent]), float(np.ptp(x)))
+            if settled is not None:
+                traj, v = _verdict(model, ctx, opts, window, t_from, t_end, steps, cache)
+                if v.attractor == "periodic":
+                    cyc = _cycle(section, traj, v)
+                    return outcome("periodic", "period-rule", cyc, cyc.state)
+
+
+def _cycle(section: Section, traj, verdict) -> Cycle:
+    """The features of the window's settled periodic verdict."""
+    return cycle_from_section(section, traj.t, traj.states, verdict.period_count, verdict.period_s,
+                              verdict.classification.stick_fraction)

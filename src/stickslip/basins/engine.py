@@ -1,0 +1,385 @@
+"""The basin-stability driver: models → initial states → batches → executor → journal → NetCDF.
+
+Per parameter value the model's context (steady sliding, its stability, the linear flow;
+:mod:`.context`) and initial states are made here once. States go to the executor in batches
+(``serial`` in this process, ``processes`` in a pool of worker processes, ``dask`` on a
+LocalCluster or a scheduler, from :mod:`stickslip.sweep.executors`); each batch carries the
+cycles found so far for its parameter value, so that later states stop as soon as they reach
+one. Outcomes are journaled as batches arrive; the dataset is assembled from the journal
+(:func:`.result.assemble`), so a study killed at any moment and started again computes only the
+missing states and gives the same labels. Ctrl-C stops handing out batches, waits for those
+running (each about :data:`TARGET_BATCH_S` of work), writes the partial result and keeps the
+journal for the next run.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import StickSlipError
+from ..files import FileFormatError
+from ..integrate.interrupt import interruptible
+from .context import Context, make_context, model_of, register_model
+from .cycles import find_cycle
+from .early import Options, Outcome, classify_state
+from .result import BasinResult, assemble
+from .spec import BasinSpec, build_spec
+from .states import BasinError, StateSpec
+from .store import Journal, journal_dir, load_basins, write_dataset
+
+__all__ = ["basin_stability", "EXECUTORS", "TARGET_BATCH_S", "evaluate_batch"]
+
+EXECUTORS = ("serial", "processes", "dask")
+
+#: Wall time aimed at per batch [s]: small enough that cycles found by one worker reach the
+#: others soon and that Ctrl-C is answered within about this long, large enough that a task's
+#: overhead (~1 ms in a pool, ~5–20 ms in dask) stays near 1 %.
+TARGET_BATCH_S = {"serial": 0.25, "processes": 0.5, "dask": 1.0}
+MIN_BATCHES_PER_WORKER = 4
+MAX_BATCH_STATES = 4096
+#: States classified in this process after the first (which compiles or loads the kernels) to
+#: time a state for the automatic batch size.
+TIMED_STATES = 8
+
+#: Polling interval of the executors while waiting for batches [s] (Ctrl-C is checked between).
+POLL_S = 0.2
+
+
+def evaluate_batch(task):
+    """Classify a batch of states; module-level so that executors can pickle it.
+
+    ``task`` = (context, flat indices (m,), initial states (m, 2n), cycles, options); returns
+    (flat indices, outcome rows (m, width)).
+    """
+    ctx, indices, states, cycles, opts = task
+    model = model_of(ctx.key)
+    cycles = list(cycles)
+    rows = []
+    for s0 in states:
+        o = classify_state(ctx, model, s0, cycles, opts)
+        if o.verdict == "periodic" and find_cycle(cycles, o.cycle, opts.match_rtol) < 0:
+            cycles.append(o.cycle)
+        rows.append(o.to_row())
+    return indices, np.array(rows)
+
+
+def _models(model, param, values):
+    """The models of the parameter values (the model itself without a parameter)."""
+    if param is None:
+        return [model]
+    try:
+        return [model.replace(**{param: v}) for v in values]
+    except StickSlipError as exc:  # the model names the path as --set does
+        text = str(exc)
+        raise BasinError("--param " + text[len("--set "):] if text.startswith("--set ") else f"--param {param}: {text}") \
+            from None
+
+
+def _contexts(models, keys):
+    ctxs = [make_context(m, key=k) for m, k in zip(models, keys)]
+    info = [{"equilibrium": c.equilibrium, "stable": c.stable, "max_real_part": c.max_real_part, "period": c.period}
+            for c in ctxs]
+    return ctxs, info
+
+
+def _progress(total, done, label):
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                   TextColumn("{task.fields[rate]}"), TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn())
+    bar.start()
+    return bar, bar.add_task(label, total=total, completed=done, rate="")
+
+
+def _serial(tasks, stop, info):
+    for task in tasks:
+        if stop.requested:
+            return
+        yield evaluate_batch(task)
+
+
+def _processes(tasks, workers, stop, info):
+    from concurrent.futures import FIRST_COMPLETED, wait
+
+    from ..sweep.executors import worker_pool
+
+    start = time.perf_counter()
+    with worker_pool(workers) as pool:
+        info["pool_start_s"] = time.perf_counter() - start
+        pending = set()
+        for task in tasks:
+            pending.add(pool.submit(evaluate_batch, task))
+            if len(pending) >= 2 * workers:
+                break
+        while pending:
+            done, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
+            for fut in done:
+                yield fut.result()
+                task = None if stop.requested else next(tasks, None)
+                if task is not None:
+                    pending.add(pool.submit(evaluate_batch, task))
+
+
+def _dask(tasks, workers, address, stop, info):
+    from distributed import Client, wait
+
+    from ..sweep.executors import connect, local_cluster
+
+    start = time.perf_counter()
+    cluster = None
+    client = connect(address) if address else Client(cluster := local_cluster(workers))
+    try:
+        info["cluster_start_s"] = time.perf_counter() - start
+        n_workers = max(1, len(client.scheduler_info().get("workers", {})))
+        pending = {client.submit(evaluate_batch, t, pure=False) for _, t in zip(range(2 * n_workers), tasks)}
+        while pending:
+            try:
+                done = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED").done
+            except (TimeoutError, asyncio.TimeoutError):  # dask's wait raises when nothing finished in time
+                continue
+            for fut in done:
+                pending.discard(fut)
+                yield fut.result()
+                fut.release()
+                task = None if stop.requested else next(tasks, None)
+                if task is not None:
+                    pending.add(client.submit(evaluate_batch, task, pure=False))
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def basin_stability(model, states: StateSpec, *, param: str | None = None, values=(), out=None,
+                    t_end: float = 500.0, executor: str = "processes", workers: int | None = None,
+                    address: str | None = None, batch_size: int | str = "auto", progress: bool = False,
+                    overwrite: bool = False, snapshot_interval: float = 60.0, keep_journal: bool = False,
+                    **options) -> BasinResult:
+    """Which attractor each initial state reaches, and the basin stability (fraction) of each.
+
+    Parameters
+    ----------
+    model : FrictionModel or str
+        The model (a library name such as ``belt`` or ``two-plates``, a model file, or a model).
+    states : StateSpec
+        The initial states (:func:`.states.box`, :func:`.states.grid`, :func:`.states.from_csv`).
+    param : str, optional
+        A parameter path of the model (``contact.0.drive``, the plates' ``N``): the study is
+        repeated for each of ``values``.
+    values : sequence of float
+        The parameter's values.
+    out : path, optional
+        NetCDF output (``.nc``); classified states are journaled beside it and a study killed and
+        started again with the same arguments resumes. Default: a temporary file.
+    t_end : float
+        Longest run of a state [s].
+    executor : {"serial", "processes", "dask"}
+    workers : int, optional
+        Worker processes (default all CPUs available to this process, also the most allowed);
+        with ``dask`` and no ``address``, the LocalCluster's size.
+    address : str, optional
+        A dask scheduler address (``tcp://host:8786``).
+    batch_size : int or "auto"
+        States per task; ``auto`` times the first state here and aims at :data:`TARGET_BATCH_S`.
+    progress : bool
+        Show a progress bar.
+    overwrite : bool
+        Discard an output or journal of a different study instead of refusing.
+    snapshot_interval : float
+        Seconds between snapshots of the partial result [s].
+    keep_journal : bool
+        Keep the journal after the result is written.
+    **options
+        ``rtol``, ``atol``, ``match_rtol``, ``confirm``, ``lyapunov``, ``max_steps``
+        (:class:`.early.Options`).
+
+    Returns
+    -------
+    BasinResult
+        ``complete`` is False when the study was interrupted (Ctrl-C); the journal is then kept.
+
+    Raises
+    ------
+    BasinError
+        Invalid states, parameter or options, or an output of a different study.
+    stickslip.files.LockError
+        Another process is writing the same output.
+    stickslip.files.WriteError
+        The disk is full (the journal keeps every classified state).
+    """
+    from ..model.library import load_model
+    from ..sweep.executors import check_workers
+
+    t_start = time.perf_counter()
+    if executor not in EXECUTORS:
+        raise BasinError(f"unknown executor {executor!r}; choose one of {', '.join(EXECUTORS)}")
+    model = load_model(model)
+    unknown = set(options) - {"rtol", "atol", "match_rtol", "confirm", "lyapunov", "max_steps"}
+    if unknown:
+        raise BasinError(f"unknown option(s) {', '.join(sorted(unknown))}")
+    opts = Options(t_end=t_end, **options)
+    key = register_model(model)
+    spec = build_spec(model, states, param=param, values=values, options=opts, key=key)
+    workers = check_workers(workers, address=address)
+    models = _models(model, param, spec.values)
+    keys = [register_model(m) for m in models]
+    ctxs, info_models = _contexts(models, keys)
+    period = max(c.period for c in ctxs)
+    if t_end < period:
+        raise BasinError(f"--t-end {t_end:g} is shorter than the characteristic period T_c = {period:.4g} of model "
+                         f"{model.name!r} (its slowest oscillation); give several periods, e.g. --t-end {100 * period:.3g}")
+    initial = np.stack([states.states(m, None if c.equilibrium is None else c.equilibrium[:m.n])
+                        for m, c in zip(models, ctxs)])
+    tmpdir = None
+    if out is None:
+        tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-basins-")
+        out = Path(tmpdir.name) / "basins.nc"
+    out = Path(out)
+    if out.suffix != ".nc":
+        raise BasinError(f"output {out}: give a path ending in .nc")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.exists() and not journal_dir(out).exists() and not overwrite:
+        try:
+            ds = load_basins(out)
+        except FileFormatError as exc:
+            raise BasinError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
+        if ds.attrs.get("digest") != spec.digest:
+            raise BasinError(f"{out} holds a different basin study; pass overwrite=True (--overwrite) or choose another "
+                             "output")
+        if int(ds.attrs.get("complete", 0)):
+            return BasinResult(out, ds, {"total_s": time.perf_counter() - t_start, "states_computed": 0,
+                                         "states_resumed": spec.size, "executor": executor, "workers": workers,
+                                         "interrupted": False})
+    journal = Journal(out, spec, overwrite=overwrite)
+    timing = {"executor": executor, "workers": workers, "interrupted": False}
+    try:
+        result = _run(spec, ctxs, info_models, initial, journal, out, timing, executor=executor, workers=workers,
+                      address=address, batch_size=batch_size, progress=progress,
+                      snapshot_interval=snapshot_interval)
+        if timing["interrupted"] or keep_journal:
+            journal.close()
+        else:
+            journal.remove()
+    except BaseException:
+        journal.close()
+        raise
+    if tmpdir is not None:
+        tmpdir.cleanup()
+        result = BasinResult(None, result.dataset, result.timings)
+    result.timings["total_s"] = time.perf_counter() - t_start
+    return result
+
+
+def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Journal, out: Path, timing: dict, *,
+         executor, workers, address, batch_size, progress, snapshot_interval) -> BasinResult:
+    """Classify the states the journal lacks, journaling each batch, and write the result."""
+    N, n = spec.n_states, spec.n_dofs
+    indices, rows = journal.read()
+    registry: list[list] = [[] for _ in range(spec.n_params)]
+
+    def learn(idx, rws):
+        for flat, row in zip(idx, rws):
+            o = Outcome.from_row(row, n)
+            reg = registry[int(flat) // N]
+            if o.verdict == "periodic" and find_cycle(reg, o.cycle, spec.options.match_rtol) < 0:
+                reg.append(o.cycle)
+
+    learn(indices, rows)
+    done = np.zeros(spec.size, dtype=bool)
+    done[indices] = True
+    todo = np.flatnonzero(~done)
+    timing.update(states_resumed=int(done.sum()), states_computed=int(todo.size))
+    store = {"idx": [indices], "rows": [rows]}
+    last_snapshot = time.perf_counter()
+
+    def dataset(extra=None):
+        idx = np.concatenate(store["idx"])
+        rws = np.concatenate(store["rows"]) if idx.size else np.empty((0, spec.row_width))
+        return assemble(spec, info_models, initial, idx, rws, attrs={"executor": timing["executor"], **(extra or {})})
+
+    bar = task_id = None
+    if progress:
+        bar, task_id = _progress(spec.size, int(done.sum()), f"basins {spec.size} states")
+    compute_start = time.perf_counter()
+    n_new = 0
+
+    def record(idx, rws):
+        nonlocal last_snapshot, n_new
+        journal.append(idx, rws)
+        store["idx"].append(np.asarray(idx, dtype=np.int64))
+        store["rows"].append(rws)
+        learn(idx, rws)
+        n_new += len(idx)
+        if bar is not None:
+            bar.update(task_id, advance=len(idx), rate=f"{n_new / max(time.perf_counter() - compute_start, 1e-9):.1f} st/s")
+        if time.perf_counter() - last_snapshot > snapshot_interval:
+            write_dataset(dataset(), out, journal)
+            last_snapshot = time.perf_counter()
+
+    def task(flat):
+        p = int(flat[0]) // N
+        return (ctxs[p], flat, initial[p, flat % N], tuple(registry[p]), spec.options)
+
+    try:
+        with interruptible() as stop:
+            if todo.size:
+                record(*evaluate_batch(task(todo[:1])))  # compiles or loads the kernels
+                timed, rest = todo[1:1 + TIMED_STATES], todo[1 + TIMED_STATES:]
+                t = time.perf_counter()
+                if timed.size:
+                    record(*evaluate_batch(task(timed)))  # times a state
+                t_state = (time.perf_counter() - t) / max(timed.size, 1)
+                size = _batch_size(batch_size, t_state, rest.size, workers, executor)
+                timing.update(batch_size=size, first_state_s=t_state)
+                tasks = (task(b) for b in _batches(rest, size, N))
+                if executor == "serial":
+                    results = _serial(tasks, stop, timing)
+                elif executor == "processes":
+                    results = _processes(tasks, workers, stop, timing)
+                else:
+                    results = _dask(tasks, workers, address, stop, timing)
+                for idx, rws in results:
+                    record(idx, rws)
+            timing["interrupted"] = bool(stop.requested) and n_new < todo.size
+    finally:
+        if bar is not None:
+            bar.stop()
+    timing["compute_s"] = time.perf_counter() - compute_start
+    ds = dataset({"compute_s": timing["compute_s"]})
+    write_dataset(ds, out, journal)
+    return BasinResult(out, ds, timing)
+
+
+def _batch_size(batch_size, t_state: float, remaining: int, workers: int, executor: str) -> int:
+    if batch_size != "auto":
+        try:
+            size = int(batch_size)
+        except (TypeError, ValueError):
+            size = 0
+        if size < 1:
+            raise BasinError(f"batch_size must be >= 1 or 'auto', got {batch_size!r}")
+        return size
+    size = min(MAX_BATCH_STATES, max(1, math.ceil(TARGET_BATCH_S[executor] / max(t_state, 1e-6))))
+    if executor != "serial":
+        size = min(size, max(1, remaining // (MIN_BATCHES_PER_WORKER * workers)))
+    return size
+
+
+def _batches(flat: np.ndarray, size: int, per_param: int):
+    """Consecutive runs of at most ``size`` flat indices, never across parameter values."""
+    p = flat // per_param
+    breaks = np.flatnonzero(np.diff(p)) + 1
+    for group in np.split(flat, breaks):
+        for i in range(0, group.size, size):
+            yield group[i:i + size]
+
+
+def load_result(path) -> BasinResult:
+    """A :class:`BasinResult` from a file written by :func:`basin_stability`."""
+    return BasinResult(Path(path), load_basins(path), {})

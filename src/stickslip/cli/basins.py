@@ -1,0 +1,149 @@
+"""``stickslip basins``: basin stability of any model, with exact stick.
+
+Parse → library call (:func:`stickslip.basins.basin_stability`) → NetCDF, a figure and a
+summary; no physics here. The command resumes: run it again with the same arguments and it
+classifies only the states it had not finished (none, if the output is complete).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+from rich.table import Table
+
+from ._app import app, check_nc_path, console, err_console, parse_assignments, user_errors
+
+_BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
+             "other states are held at the base state.")
+
+
+def _states(model, box, n, seed, grid, ics, base, state):
+    """The initial states from the options (one line naming the fix for a bad combination)."""
+    from ..basins import box as random_box, from_csv, grid as regular_grid, parse_range
+
+    if ics is not None:
+        if box or grid or state or base is not None:
+            raise ValueError("--ics gives every state of every row; drop --box, --grid, --base and --state")
+        if n is not None:
+            raise ValueError("--ics gives the states itself; drop --n")
+        return from_csv(model, ics)
+    ranges = [parse_range(text) for text in box or []]
+    fixed = parse_assignments(state)
+    base = base or "equilibrium"
+    if grid is not None:
+        if n is not None:
+            raise ValueError("--grid gives the number of states per axis; drop --n (random draws)")
+        try:
+            counts = [int(k) for k in grid.split(",")]
+        except ValueError:
+            raise ValueError(f"--grid {grid}: give points per axis, one integer or one per --box (e.g. 50 or 50,40)") from None
+        return regular_grid(model, ranges, counts[0] if len(counts) == 1 else counts, base=base, fixed=fixed)
+    return random_box(model, ranges, 1000 if n is None else n, seed=seed, base=base, fixed=fixed)
+
+
+def _model(name: str, assignments):
+    from ..model.library import load_model
+
+    model = load_model(name)
+    changes = parse_assignments(assignments)
+    return model.replace(**changes) if changes else model
+
+
+@app.command()
+def basins(
+    model: str = typer.Option("two-plates", "--model", help="Library model (belt, two-plates, hoffmann, "
+                              "popp-stelter) or a model file (.toml)."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help="A model parameter as PATH=VALUE (repeatable), "
+                                             "e.g. --set contact.0.drive=1.2 or --set N=50 for the plates."),
+    box: Optional[List[str]] = typer.Option(None, "--box", help=_BOX_HELP),
+    n: Optional[int] = typer.Option(None, "--n", help="Uniform random states in the box (default 1000)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the random states."),
+    grid: Optional[str] = typer.Option(None, "--grid", help="A regular grid over the box instead of random "
+                                       "states: points per axis, one number or one per --box (e.g. 50 or 50,40)."),
+    ics: Optional[Path] = typer.Option(None, "--ics", help="CSV file of initial states: a header naming every "
+                                       "state, one state per row (results keep the row order)."),
+    base: Optional[str] = typer.Option(None, "--base", help="State outside the box: equilibrium (steady sliding, "
+                                       "default) or zero (at rest)."),
+    state: Optional[List[str]] = typer.Option(None, "--state", help="Fix a state outside the box, NAME=VALUE "
+                                              "(repeatable), e.g. --state dy1=1.7."),
+    param: Optional[str] = typer.Option(None, "--param", help="Basin stability against a parameter: "
+                                        "PATH=LO:HI:K (any --set path), e.g. contact.0.drive=0.8:2:13."),
+    t_end: float = typer.Option(500.0, "--t-end", help="Longest run of a state [s]."),
+    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event integrator."),
+    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event integrator."),
+    match_rtol: float = typer.Option(1e-3, "--match-rtol", help="Tolerance of the cycle matches, relative to a "
+                                     "cycle's amplitude and period."),
+    no_confirm: bool = typer.Option(False, "--no-confirm", help="Do not shoot orbits to confirm periods of "
+                                    "several maxima (such runs stay unsettled)."),
+    lyapunov: bool = typer.Option(False, "--lyapunov", help="Compute Lyapunov exponents of runs still "
+                                  "non-periodic at --t-end (chaos or torus claims; the plates only)."),
+    executor: Optional[str] = typer.Option(None, "--executor", help="serial | processes | dask (default processes; "
+                                           "dask when --scheduler is given)."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Worker processes (default: all cores)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="dask.distributed scheduler address, e.g. "
+                                            "tcp://head:8786 (implies --executor dask)."),
+    out: Path = typer.Option(Path("basins.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an output (or journal) of a different study."),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print {n, fractions, standard_errors, attractors} as JSON."),
+) -> None:
+    """Basin stability: which attractor each initial state reaches (exact stick), and how often."""
+    from ..basins import basin_stability, parse_param
+
+    with user_errors():
+        check_nc_path(out)
+        m = _model(model, set_)
+        states = _states(m, box, n, seed, grid, ics, base, state)
+        path, values = parse_param(param) if param is not None else (None, ())
+        if executor is None:
+            executor = "dask" if scheduler else "processes"
+        if scheduler and executor != "dask":
+            raise ValueError(f"--scheduler needs --executor dask (got --executor {executor})")
+        result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, executor=executor,
+                                 workers=workers, address=scheduler, progress=not (no_progress or as_json),
+                                 overwrite=overwrite, rtol=rtol, atol=atol, match_rtol=match_rtol,
+                                 confirm=not no_confirm, lyapunov=lyapunov)
+        figure = None
+        if not no_plot:
+            from ..plot.basins import save_basins_figure
+
+            figure = save_basins_figure(result, out.with_suffix(".png"))
+    if as_json:
+        print(json.dumps(result.to_json()))
+    else:
+        _print_summary(result, out, figure)
+    if not result.complete:
+        err_console.print(f"interrupted: {int(result.dataset.attrs['states_done'])} of {result.dataset['done'].size} "
+                          f"states classified, kept in {out}.journal; run the same command again to resume",
+                          highlight=False, soft_wrap=True)
+        raise typer.Exit(130)
+
+
+def _print_summary(result, out: Path, figure) -> None:
+    ds = result.dataset
+    timings = result.timings
+    if "param" in ds.dims:
+        table = Table(title=f"basin stability of {ds.attrs['model']} against {ds.attrs['param']}")
+        table.add_column(ds.attrs["param"])
+        for name in result.names:
+            table.add_column(name)
+        for p, value in enumerate(ds["param"].values):
+            table.add_row(f"{value:g}", *(f"{ds['fraction'].values[p, i]:.3f} ± {ds['standard_error'].values[p, i]:.3f}"
+                                          for i in range(len(result.names))))
+    else:
+        table = Table(title=f"basin stability of {ds.attrs['model']}: {result.n} states")
+        for col in ("attractor", "fraction ± se", "period", "amplitude", "stick fraction"):
+            table.add_column(col)
+        for a in result.attractors():
+            table.add_row(a["name"], f"{a['fraction']:.4f} ± {a['standard_error']:.4f}",
+                          "–" if a["period"] is None else f"{a['period']:.6g}",
+                          "–" if a["amplitude"] is None else f"{a['amplitude']:.4g}",
+                          "–" if a["stick_fraction"] is None else f"{a['stick_fraction']:.3f}")
+    console.print(table)
+    computed = timings.get("states_computed", 0)
+    console.print(f"states computed / resumed: {computed} / {timings.get('states_resumed', 0)}; "
+                  f"{timings.get('total_s', 0.0):.1f} s; wrote {out}" + ("" if figure is None else f", {figure}"))
