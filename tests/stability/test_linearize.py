@@ -1,13 +1,16 @@
-"""The differentiable slip right-hand side against the simulator's kernels, finite differences
-and the paper's Appendix matrices."""
+"""The plates' linearisation through the generic derivation (complex step of the model's one
+right-hand side) against the paper's own kernels, finite differences and the Appendix matrices."""
 
 import numpy as np
 import pytest
 
 from stickslip import Parameters
 from stickslip.model import MODELS, assemble, kernels
+from stickslip.model.bundle import CST
+from stickslip.model.derivatives import state_jacobian
+from stickslip.model.physics import MODE_SLIP_EXACT, rhs
 from stickslip.stability import equilibrium, linearization
-from stickslip.stability import linearize as L
+from stickslip.stability.equilibrium import plates_model
 
 from appendix import appendix_matrices
 
@@ -25,6 +28,25 @@ def slip_state(system, scale=0.05):
             return s
 
 
+def _slip_modes():
+    cst = np.zeros(CST)
+    cst[0], cst[3] = MODE_SLIP_EXACT, np.inf
+    return cst
+
+
+def generic_rhs(s, system):
+    """The model's right-hand side (the seam's physics) in exact slip."""
+    ds = np.zeros(12)
+    rhs(s, _slip_modes(), plates_model(system).data, ds)
+    return ds
+
+
+def generic_jacobian(s, system):
+    J = np.empty((12, 12))
+    state_jacobian(s, _slip_modes(), plates_model(system).data, J, np.zeros(12, complex), np.zeros(12, complex))
+    return J
+
+
 def kernel_rhs(s, system):
     ds = np.zeros(12)
     kernels.rhs(s, kernels.MODE_SLIP, 1.0, 0.0, system.minv, system.damp, system.stiff, system.p, ds)
@@ -33,12 +55,11 @@ def kernel_rhs(s, system):
 
 @pytest.mark.parametrize("model", list(MODELS))
 @pytest.mark.parametrize("law", ["exponential", "coulomb"])
-def test_slip_rhs_equals_simulator_kernel(model, law):
+def test_generic_rhs_equals_the_plates_kernel(model, law):
     system = assemble(Parameters(friction_law=law, N=70.0, Omega=3.0), model)
     for _ in range(20):
         s = slip_state(system)
-        ds = np.zeros(12)
-        L.slip_rhs(s, system.minv, system.damp, system.stiff, system.p, ds)
+        ds = generic_rhs(s, system)
         ref = kernel_rhs(s, system)
         # the same floating-point operations as the kernel: only round-off (a few ulps) may differ
         assert np.max(np.abs(ds - ref)) <= 1e-14 * np.max(np.abs(ref))
@@ -61,7 +82,7 @@ def test_jacobian_matches_central_differences(model):
     q = equilibrium(system.params, model)
     states = [np.concatenate([q, np.zeros(6)])] + [slip_state(system) for _ in range(5)]
     for s in states:
-        J = L.state_jacobian(s, system.minv, system.damp, system.stiff, system.p)
+        J = generic_jacobian(s, system)
         J_fd = central_difference_jacobian(s, system)
         # brief: agreement to 1e-6 relative (FD error is ~1e-9 here, see central_difference_jacobian)
         assert np.max(np.abs(J - J_fd)) <= 1e-6 * np.max(np.abs(J))
@@ -77,7 +98,7 @@ def test_reduced_jacobian_is_the_free_block_of_the_full_one():
     q = equilibrium(system.params, "x")
     free = system.variant.free_indices
     idx = np.concatenate([free, 6 + free])
-    full = L.state_jacobian(np.concatenate([q, np.zeros(6)]), system.minv, system.damp, system.stiff, system.p)
+    full = generic_jacobian(np.concatenate([q, np.zeros(6)]), system)
     J, K_L, C_L = linearization(system, q)
     np.testing.assert_array_equal(J, full[np.ix_(idx, idx)])
     M = system.mass[free]

@@ -1,4 +1,4 @@
-"""Steady sliding: equilibrium (Eq. 14), linear stability (Eq. 15) and (N, Ω) stability maps."""
+"""Steady sliding of any model: equilibrium (plates: Eq. 14), linear stability (Eq. 15) and stability maps."""
 
 from .analysis import StabilityResult, linearization, stability
 from .equilibrium import EquilibriumError, equilibrium, equilibrium_residual

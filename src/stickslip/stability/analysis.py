@@ -9,12 +9,11 @@ import math
 import numpy as np
 
 from ..model.parameters import Parameters, parameter_attrs
-from ..model.system import System, assemble
+from ..model.system import System
 from ..model.variants import DOF_NAMES
-from . import linearize
-from .equilibrium import EquilibriumError, solve_equilibrium
+from .equilibrium import EquilibriumError, _where, plates_model, solve_steady
 
-__all__ = ["StabilityResult", "stability", "linearization"]
+__all__ = ["StabilityResult", "stability", "linearization", "model_stability", "jacobian_at"]
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class StabilityResult:
@@ -160,7 +159,10 @@ class StabilityResult:
 
 
 def linearization(system: System, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Reduced Jacobian, K_L and C_L (Eq. 15) of the slip equations about (q, q̇ = 0).
+    """Reduced Jacobian, K_L and C_L (Eq. 15) of the plates' slip equations about (q, q̇ = 0).
+
+    The complex-step Jacobian of the simulator's right-hand side (:func:`jacobian_at`) on the
+    plates' model of the assembled ``system``.
 
     Returns
     -------
@@ -168,15 +170,36 @@ def linearization(system: System, q: np.ndarray) -> tuple[np.ndarray, np.ndarray
     K_L, C_L : ndarray (k, k)
         −∂Q/∂q and −∂Q/∂q̇ on the free DOFs (Q = Gᵀ F − C q̇ − K q).
     """
-    free = system.variant.free_indices.astype(np.int64)
+    return jacobian_at(plates_model(system), q)
+
+
+def jacobian_at(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Jacobian of the slip equations of any model at (q, q̇ = 0), reduced to the free DOFs.
+
+    Returns
+    -------
+    jacobian : ndarray (2k, 2k)
+        ∂(ds/dt)/∂s on [q_free, q̇_free] [1/s², 1/s].
+    K_L, C_L : ndarray (k, k)
+        −M ∂q̈/∂q and −M ∂q̈/∂q̇ on the free DOFs.
+    """
+    from ..model.bundle import CST, contact_state
+    from ..model.derivatives import state_jacobian
+    from ..model.physics import MODE_SLIP_EXACT
+
+    n = system.n
+    s = np.zeros(2 * n)
+    s[:n] = q
+    cst = contact_state(system.data.m)
+    cst[0::CST] = MODE_SLIP_EXACT
+    J_full = np.empty((2 * n, 2 * n))
+    state_jacobian(s, cst, system.data, J_full, np.zeros(2 * n, dtype=complex), np.zeros(2 * n, dtype=complex))
+    free = np.flatnonzero(system.free)
     k = free.size
-    s = np.zeros(12)
-    s[:6] = q
-    cols = np.concatenate([free, 6 + free]).astype(np.int64)
-    dQ = np.empty((6, 2 * k))
-    linearize.force_jacobian(s, system.damp, system.stiff, system.p, cols, dQ)
-    J = linearize.reduced_jacobian(np.asarray(q, dtype=float), free, system.minv, system.damp, system.stiff, system.p)
-    return J, -dQ[free, :k], -dQ[free, k:]
+    idx = np.concatenate([free, n + free])
+    J = J_full[np.ix_(idx, idx)]
+    M = system.mass[np.ix_(free, free)]
+    return J, -M @ J[k:, :k], -M @ J[k:, k:]
 
 
 def stability(params=None, model="full") -> StabilityResult:
@@ -208,88 +231,41 @@ def stability(params=None, model="full") -> StabilityResult:
         overflows (values far outside physical size).
     """
     from ..model.library import resolve_system
-    from ..model.library.two_plates import NAME as TWO_PLATES
 
     if params is not None and not isinstance(params, (Parameters, str)) and not hasattr(params, "data"):
         raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
-    system = resolve_system(params, model)
-    if system.name == TWO_PLATES:
-        values = dict(system.parameters)
-        return _plates_stability(Parameters.from_dict({k: v for k, v in values.items() if k != "variant"}),
-                                 values["variant"], system)
-    return model_stability(system)
+    return model_stability(resolve_system(params, model))
 
 
 def model_stability(system) -> StabilityResult:
-    """:func:`stability` of a :class:`~stickslip.model.FrictionModel` (the generic path)."""
-    from ..model.bundle import CST, contact_state
-    from ..model.derivatives import state_jacobian
-    from ..model.physics import MODE_SLIP_EXACT
-    from .equilibrium import steady_sliding, steady_residual
+    """:func:`stability` of a :class:`~stickslip.model.FrictionModel`."""
+    from ..model.library.two_plates import NAME as TWO_PLATES
 
-    q = steady_sliding(system)
-    n = system.n
-    s = np.zeros(2 * n)
-    s[:n] = q
-    cst = contact_state(system.data.m)
-    cst[0::CST] = MODE_SLIP_EXACT
-    J_full = np.empty((2 * n, 2 * n))
-    state_jacobian(s, cst, system.data, J_full, np.zeros(2 * n, dtype=complex), np.zeros(2 * n, dtype=complex))
+    q, residual, _ = solve_steady(system)
+    J, K_L, C_L = jacobian_at(system, q)
+    if not np.all(np.isfinite(J)):
+        raise EquilibriumError(f"the linearisation at steady sliding is not finite ({_where(system)}: overflow); "
+                               "give values of physical size")
+    lam, vec = np.linalg.eig(J)
+    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
+    lam = lam[order]
+    vec = vec[:, order]
     free = np.flatnonzero(system.free)
     k = free.size
-    idx = np.concatenate([free, n + free])
-    J = J_full[np.ix_(idx, idx)]
+    shapes = vec[:k, :].T.copy()
+    for j in range(shapes.shape[0]):
+        m = int(np.argmax(np.abs(shapes[j])))
+        if shapes[j, m] != 0:
+            shapes[j] /= shapes[j, m]
     M = system.mass[np.ix_(free, free)]
-    K_L = -M @ J[k:, :k]
-    C_L = -M @ J[k:, k:]
-    lam, vec = np.linalg.eig(J)
-    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
-    lam = lam[order]
-    vec = vec[:, order]
-    shapes = vec[:k, :].T.copy()
-    for j in range(shapes.shape[0]):
-        m = int(np.argmax(np.abs(shapes[j])))
-        if shapes[j, m] != 0:
-            shapes[j] /= shapes[j, m]
     diagonal = np.count_nonzero(M - np.diag(np.diag(M))) == 0
+    plates = system.name == TWO_PLATES
+    params = None
+    if plates:
+        params = Parameters.from_dict({key: v for key, v in system.parameters.items() if key != "variant"})
     return StabilityResult(
-        params=None, model=system.name, dofs=tuple(system.dofs[i] for i in free), equilibrium=q,
-        residual=steady_residual(system, q), jacobian=J, stiffness=K_L, damping=C_L,
-        mass=np.diag(M).copy() if diagonal else M, eigenvalues=lam, mode_shapes=shapes, system=system,
-        all_dofs=tuple(system.dofs),
-    )
-
-
-def _plates_stability(params: Parameters, model, system_model) -> StabilityResult:
-    """The plates' stability through their assembled arrays."""
-    system = assemble(params, model)
-    q, residual, _ = solve_equilibrium(system)
-    J, K_L, C_L = linearization(system, q)
-    if not np.all(np.isfinite(J)):
-        raise EquilibriumError(f"the linearisation at steady sliding is not finite (N = {params.N:g} N, "
-                               f"Ω = {params.Omega:g} rad/s overflow); give values of physical size")
-    lam, vec = np.linalg.eig(J)
-    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
-    lam = lam[order]
-    vec = vec[:, order]
-    free = system.variant.free_indices
-    k = free.size
-    shapes = vec[:k, :].T.copy()
-    for j in range(shapes.shape[0]):
-        m = int(np.argmax(np.abs(shapes[j])))
-        if shapes[j, m] != 0:
-            shapes[j] /= shapes[j, m]
-    return StabilityResult(
-        params=params,
-        model=system.variant.name,
-        dofs=tuple(DOF_NAMES[i] for i in free),
-        equilibrium=q,
-        residual=residual,
-        jacobian=J,
-        stiffness=K_L,
-        damping=C_L,
-        mass=system.mass[free],
-        eigenvalues=lam,
-        mode_shapes=shapes,
-        system=system_model,
+        params=params, model=system.parameters["variant"] if plates else system.name,
+        dofs=tuple(system.dofs[i] for i in free), equilibrium=q, residual=residual, jacobian=J,
+        stiffness=K_L, damping=C_L, mass=np.diag(M).copy() if diagonal else M, eigenvalues=lam,
+        mode_shapes=shapes, system=system, all_dofs=tuple(system.dofs),
     )

@@ -1,9 +1,10 @@
-"""Steady-sliding equilibrium K x = b(x) (paper Eq. 14, Appendix A.1).
+"""Steady-sliding equilibrium of any friction model (for the plates: paper Eq. 14, Appendix A.1).
 
-Solved by damped Newton from x = 0 with the exact Jacobian −K_L of the slip right-hand side
-(complex-step differentiation, :mod:`stickslip.stability.linearize`) — with continuation in the
-load N as a fallback near the fold where steady sliding ceases to exist — then checked with the
-simulator's own kernel (:func:`equilibrium_residual`).
+q̇ = 0 and f0 − K q + Σ_c G_cᵀ F_c(q, 0) = 0 with every contact slipping, solved by damped Newton
+from q = 0 with the exact Jacobian of the simulator's own right-hand side (complex step), with a
+continuation in the normal load as a fallback near the fold where steady sliding ceases to exist
+(:mod:`stickslip.stability.steady`, compiled). The plates' functions (:func:`equilibrium`,
+:func:`solve_equilibrium`, :func:`equilibrium_residual`) are this on the plates' model.
 """
 
 from __future__ import annotations
@@ -16,49 +17,188 @@ from ..errors import StickSlipError
 from ..model import kernels
 from ..model.parameters import Parameters
 from ..model.system import System, assemble
-from . import linearize
+from . import steady
 
 __all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "solve_equilibrium", "RESIDUAL_TOL",
-           "steady_sliding", "steady_residual"]
+           "steady_sliding", "steady_residual", "solve_steady", "plates_model"]
 
-#: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved (Eq. 14). Newton reaches
-#: ~1e-16 (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while
-#: still pinning x far below any physical resolution.
+#: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved. Newton reaches ~1e-16
+#: (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while still
+#: pinning x far below any physical resolution.
 RESIDUAL_TOL = 1e-10
 
 #: Newton iterations allowed per solve. Converging cases take 3–8 from x = 0 (quadratic
 #: convergence); 60 leaves room for the damped phase of strongly deflected cases.
 MAX_ITER = 60
 
+_REASONS = {
+    steady.NEWTON_MAX_ITER: f"Newton did not converge in {MAX_ITER} iterations",
+    steady.NEWTON_SINGULAR: "the Jacobian K_L became singular (is a free DOF without stiffness?)",
+    steady.NEWTON_NOT_FINITE: "the iteration produced non-finite values",
+    steady.NEWTON_NO_DESCENT: "Newton stalled (no step reduces the residual)",
+}
+
 
 class EquilibriumError(StickSlipError, RuntimeError):
     """No steady-sliding equilibrium could be found."""
 
 
-def equilibrium_residual(system: System, q: np.ndarray) -> np.ndarray:
-    """Force residual K q − Gᵀ F(v_r = Ω(Y, −X)) at rest (q̇ = 0), shape (6,) [N or N m].
+def plates_model(system: System):
+    """The :class:`~stickslip.model.FrictionModel` of an assembled plates :class:`System`."""
+    from ..model.library.two_plates import two_plates
 
-    This is −M q̈ of the slip equations at q̇ = 0, evaluated by the simulator's own kernel, so
+    return two_plates(system.params, system.variant, float(system.p[kernels.P_SLIP_BAND]))
+
+
+def _is_plates(system) -> bool:
+    from ..model.library.two_plates import NAME
+
+    return system.name == NAME
+
+
+def _where(system) -> str:
+    """The point in words for messages: the plates' N, Ω and variant, else the model's name."""
+    if _is_plates(system):
+        p = system.parameters
+        return f"N = {p['N']:g} N, Omega = {p['Omega']:g} rad/s, model {p['variant']!r}"
+    return f"model {system.name!r}"
+
+
+def _speeds(system, q: np.ndarray) -> list[float]:
+    """Sliding speed of each contact at (q, q̇ = 0) [m/s]."""
+    from ..model.physics import slip_velocity
+
+    s = np.zeros(2 * system.n)
+    s[:system.n] = q
+    return [float(np.hypot(*slip_velocity(s, c, system.data))) for c in range(system.n_contacts)]
+
+
+def _not_sliding_message(system, q: np.ndarray) -> str:
+    plates = _is_plates(system)
+    for c, (speed, contact) in enumerate(zip(_speeds(system, q), system.contacts)):
+        if speed == 0.0:
+            if plates:
+                return ("no steady sliding at Omega = 0: the relative velocity vanishes at rest and the friction "
+                        "direction is undefined; choose Omega != 0")
+            return (f"no steady sliding: contact {c} does not slide at rest (its drive is 0); "
+                    "give the contact a non-zero drive")
+        if contact.dim == 2 and speed <= system.slip_band:
+            fix = "increase |Omega|" if plates else "increase the drive"
+            name = "|Omega| R" if plates else f"of contact {c}"
+            return (f"sliding speed at equilibrium {name} = {speed:.3g} m/s is inside the simulator's low-speed band "
+                    f"({system.slip_band:g} m/s), where its slip direction is not v/|v| and steady sliding is not an "
+                    f"equilibrium of the simulated equations; {fix}")
+    return "steady sliding is not an equilibrium of the simulated equations"
+
+
+def _failure_message(system, q: np.ndarray, status: int, rel: float) -> str:
+    reason = _REASONS.get(int(status), "the residual check failed")
+    hint = ""
+    if _is_plates(system) and np.all(np.isfinite(q)):
+        r = system.parameters["r"]
+        R = math.hypot(q[0] - q[2] + r * math.cos(q[4]), q[1] - q[3] + r * math.sin(q[4]))
+        if R < 0.5 * r:
+            hint = (f"; the iterate has the contact point at R = {R:.3g} m from the centre O2 (r = {r:g} m): the "
+                    "friction load mu N drags the contact point onto the centre of the lower plate and steady "
+                    "sliding does not exist beyond that load (a fold of Eq. 14); reduce N or mu")
+    elif not _is_plates(system):
+        hint = ("; steady sliding may not exist at these parameters (e.g. a friction load that drags the "
+                "contact into a fold)")
+    return (f"no steady-sliding equilibrium found for {_where(system)}: {reason} (relative residual "
+            f"{rel:.2e} > {RESIDUAL_TOL:g}){hint}")
+
+
+def solve_steady(system) -> tuple[np.ndarray, float, int]:
+    """Steady sliding of a :class:`~stickslip.model.FrictionModel`.
+
+    Returns
+    -------
+    q : ndarray (n,)
+        Equilibrium coordinates (locked DOFs 0) [units of the dofs].
+    relative_residual : float
+        max|M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) on the free DOFs, by the simulator's right-hand side.
+    iterations : int
+
+    Raises
+    ------
+    EquilibriumError
+        No solution to :data:`RESIDUAL_TOL`, or a contact that does not slide at the solution (speed
+        0) or, for a 2-D contact, slides inside the low-speed band (the simulator's slip direction
+        there is not v/|v|, so steady sliding is not an equilibrium of the simulated equations).
+    """
+    if _is_plates(system) and system.parameters["Omega"] == 0.0:
+        raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
+    free = np.flatnonzero(system.free).astype(np.int64)
+    q, status, rel, iterations = steady.steady_sliding_point(system.data, free, MAX_ITER)
+    if status == steady.NEWTON_NOT_SLIDING:
+        raise EquilibriumError(_not_sliding_message(system, q))
+    if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
+        if np.all(np.isfinite(q)) and min(_speeds(system, q)) == 0.0:
+            raise EquilibriumError(_not_sliding_message(system, q))
+        raise EquilibriumError(_failure_message(system, q, status, rel))
+    return q, float(rel), int(iterations)
+
+
+def steady_sliding(system) -> np.ndarray:
+    """Steady-sliding equilibrium q_e (n,) of any friction model (see :func:`solve_steady`)."""
+    return solve_steady(system)[0]
+
+
+def steady_residual(system, q: np.ndarray) -> float:
+    """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)."""
+    from ..model.bundle import CST
+    from ..model.physics import MODE_SLIP_EXACT, rhs
+
+    n = system.n
+    s = np.zeros(2 * n)
+    s[:n] = q
+    ds = np.zeros(2 * n)
+    cst = np.zeros(CST * system.n_contacts)
+    cst[0::CST] = MODE_SLIP_EXACT
+    cst[3::CST] = np.inf
+    rhs(s, cst, system.data, ds)
+    free = np.flatnonzero(system.free)
+    Q = (system.mass @ ds[n:])[free]
+    Kq = (system.stiffness @ np.asarray(q, float))[free]
+    f0 = system.force[free]
+    num = float(np.max(np.abs(Q), initial=0.0))
+    scale = max(float(np.max(np.abs(Kq), initial=0.0)), float(np.max(np.abs(f0), initial=0.0)),
+                float(np.max(np.abs(Q + Kq - f0), initial=0.0)))
+    if num == 0.0:
+        return 0.0
+    return num / scale if scale > 0.0 and np.isfinite(num) else math.inf
+
+
+# --------------------------------------------------------------------------- the plates' API
+def equilibrium_residual(system: System, q: np.ndarray) -> np.ndarray:
+    """Force residual K q − Gᵀ F(v_r = Ω(Y, −X)) at rest (q̇ = 0) of the plates, shape (6,) [N or N m].
+
+    This is −M q̈ of the slip equations at q̇ = 0, evaluated by the simulator's right-hand side, so
     its zero is exactly the steady sliding state the simulator sees. Locked DOFs give 0.
     """
+    from ..model.bundle import CST
+    from ..model.physics import MODE_SLIP_EXACT, rhs
+
+    model = plates_model(system)
     s = np.zeros(12)
     s[:6] = q
     ds = np.zeros(12)
-    Fx, Fy = kernels.contact_force(s, kernels.MODE_SLIP, 1.0, 0.0, system.minv, system.damp, system.stiff, system.p)
-    kernels.dynamics(s, Fx, Fy, system.minv, system.damp, system.stiff, system.p, ds)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(system.minv > 0, -ds[6:] / np.where(system.minv > 0, system.minv, 1.0), 0.0)
+    cst = np.zeros(CST)
+    cst[0] = MODE_SLIP_EXACT
+    cst[3] = np.inf
+    rhs(s, cst, model.data, ds)
+    return np.where(system.minv > 0, -(model.mass @ ds[6:]), 0.0)
 
 
 def solve_equilibrium(system: System) -> tuple[np.ndarray, float, int]:
-    """Newton solution of Eq. (14) for an assembled system.
+    """Steady sliding (Eq. 14) of an assembled plates :class:`System`: :func:`solve_steady` on its model.
 
     Returns
     -------
     q : ndarray (6,)
         Equilibrium [m, m, m, m, rad, rad]; locked DOFs are 0.
     relative_residual : float
-        max|K x − b| / max(|K x|, |b|), evaluated with the simulator's kernel.
+        max|K x − b| / max(|K x|, |b|), evaluated with the simulator's right-hand side.
     iterations : int
 
     Raises
@@ -66,48 +206,7 @@ def solve_equilibrium(system: System) -> tuple[np.ndarray, float, int]:
     EquilibriumError
         See :func:`equilibrium`.
     """
-    P = system.params
-    if P.Omega == 0.0:
-        raise EquilibriumError(
-            "no steady sliding at Omega = 0: the relative velocity vanishes at rest and the friction "
-            "direction is undefined; choose Omega != 0"
-        )
-    free = system.variant.free_indices.astype(np.int64)
-    q, status, rel, iterations = linearize.newton_equilibrium(free, system.damp, system.stiff, system.p, MAX_ITER)
-    band = system.p[kernels.P_SLIP_BAND]
-    speed = abs(P.Omega) * math.hypot(q[0] - q[2] + P.r * math.cos(q[4]), q[1] - q[3] + P.r * math.sin(q[4]))
-    if rel <= RESIDUAL_TOL and speed <= band:
-        raise EquilibriumError(
-            f"sliding speed at equilibrium |Omega| R = {speed:.3g} m/s is inside the simulator's low-speed band "
-            f"({band:g} m/s), where its slip direction is not v_r/|v_r| and steady sliding is not an equilibrium "
-            "of the simulated equations; increase |Omega|"
-        )
-    # independent check with the simulator's kernel (not the differentiated copy)
-    res = equilibrium_residual(system, q)[free]
-    scale = max(float(np.max(np.abs(system.stiff[free] * q[free]))),
-                float(np.max(np.abs(system.stiff[free] * q[free] - res))))
-    kernel_rel = 0.0 if not np.any(res) else (float(np.max(np.abs(res))) / scale if scale > 0 else math.inf)
-    if not np.all(np.isfinite(q)) or not (kernel_rel <= RESIDUAL_TOL):
-        X = q[0] - q[2] + P.r * math.cos(q[4])
-        Y = q[1] - q[3] + P.r * math.sin(q[4])
-        reason = {
-            linearize.NEWTON_MAX_ITER: f"Newton did not converge in {MAX_ITER} iterations",
-            linearize.NEWTON_SINGULAR: "the Jacobian K_L became singular (is a free DOF without stiffness?)",
-            linearize.NEWTON_NOT_FINITE: "the iteration produced non-finite values",
-            linearize.NEWTON_NO_DESCENT: "Newton stalled (no step reduces the residual)",
-        }.get(int(status), "the residual check failed")
-        hint = ""
-        if math.hypot(X, Y) < 0.5 * P.r:
-            hint = (f"; the iterate has the contact point at R = {math.hypot(X, Y):.3g} m from the centre O2 "
-                    f"(r = {P.r:g} m): the friction load mu N drags the contact point onto the centre of the "
-                    "lower plate and steady sliding does not exist beyond that load (a fold of Eq. 14); "
-                    "reduce N or mu")
-        raise EquilibriumError(
-            f"no steady-sliding equilibrium found for N = {P.N:g} N, Omega = {P.Omega:g} rad/s, model "
-            f"{system.variant.name!r}: {reason} (relative residual {max(rel, kernel_rel):.2e} > {RESIDUAL_TOL:g})"
-            f"{hint}"
-        )
-    return q, kernel_rel, int(iterations)
+    return solve_steady(plates_model(system))
 
 
 def equilibrium(params: Parameters, model="full") -> np.ndarray:
@@ -143,128 +242,3 @@ def equilibrium(params: Parameters, model="full") -> np.ndarray:
     return q
 
 
-# --------------------------------------------------------------------------- any friction model
-#: Newton iterations of :func:`steady_sliding` per homotopy level.
-STEADY_MAX_ITER = 50
-
-#: Homotopy levels of the friction load tried when Newton from q = 0 at full load fails.
-HOMOTOPY_LEVELS = (0.25, 0.5, 0.75, 0.9, 1.0)
-
-
-def _sliding_state(system) -> np.ndarray:
-    """Contact states for steady sliding: every contact slipping with the exact direction."""
-    from ..model.bundle import CST, contact_state
-    from ..model.physics import MODE_SLIP_EXACT
-
-    cst = contact_state(system.data.m)
-    cst[0::CST] = MODE_SLIP_EXACT
-    return cst
-
-
-def _newton_steady(system, md, q0: np.ndarray, free: np.ndarray, max_iter: int):
-    """Damped Newton on the accelerations at rest; returns (q, |residual| relative, iterations)."""
-    from ..model.derivatives import acceleration_jacobian
-
-    n = system.n
-    cst = _sliding_state(system)
-    Jqq = np.empty((n, n))
-    acc = np.empty(n)
-    z = np.zeros(2 * n, dtype=complex)
-    dz = np.zeros(2 * n, dtype=complex)
-    q = q0.copy()
-    M = system.mass[np.ix_(free, free)]
-    K = system.stiffness[np.ix_(free, free)]
-    f0 = system.force[free]
-
-    def relative(a, qv):
-        res = M @ a[free]
-        scale = max(np.max(np.abs(K @ qv[free])), np.max(np.abs(f0)), np.max(np.abs(res + K @ qv[free] - f0)), 1e-300)
-        return float(np.max(np.abs(res)) / scale)
-
-    acceleration_jacobian(q, cst, md, Jqq, acc, z, dz)
-    rel = relative(acc, q)
-    for it in range(max_iter):
-        if rel <= NEWTON_TARGET_GENERIC or not np.isfinite(rel):
-            return q, rel, it
-        try:
-            step = np.linalg.solve(Jqq[np.ix_(free, free)], -acc[free])
-        except np.linalg.LinAlgError:
-            return q, rel, it
-        lam = 1.0
-        for _ in range(30):  # backtracking: accept the first step that reduces the residual
-            trial = q.copy()
-            trial[free] += lam * step
-            acceleration_jacobian(trial, cst, md, Jqq, acc, z, dz)
-            rel_trial = relative(acc, trial)
-            if np.isfinite(rel_trial) and rel_trial < rel:
-                q, rel = trial, rel_trial
-                break
-            lam *= 0.5
-        else:
-            return q, rel, it
-    acceleration_jacobian(q, cst, md, Jqq, acc, z, dz)
-    return q, relative(acc, q), max_iter
-
-
-#: Relative residual at which the generic Newton stops (a few ulps above round-off).
-NEWTON_TARGET_GENERIC = 1e-14
-
-
-def steady_residual(system, q: np.ndarray) -> float:
-    """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)."""
-    free = np.flatnonzero(system.free)
-    _, rel, _ = _newton_steady(system, system.data, np.asarray(q, dtype=float), free, 0)
-    return rel
-
-
-def steady_sliding(system) -> np.ndarray:
-    """Steady-sliding equilibrium q_e (n,) of any friction model: q̇ = 0 and
-    f0 − K q + Σ_c G_cᵀ F_c(q, q̇ = 0) = 0 with every contact slipping.
-
-    Damped Newton from q = 0 with the exact Jacobian of the simulator's right-hand side (complex
-    step, :mod:`stickslip.model.derivatives`); when that fails, a homotopy in the normal forces
-    (friction load 25 %, 50 %, ... 100 %) from the unloaded equilibrium.
-
-    Raises
-    ------
-    EquilibriumError
-        No solution to :data:`RESIDUAL_TOL`, or a slip velocity at equilibrium that is zero (no
-        sliding: the friction direction is undefined) or inside the low-speed band of a 2-D
-        contact (the simulator's slip direction there is not v/|v|, so steady sliding is not an
-        equilibrium of the simulated equations).
-    """
-    from ..model.bundle import C_N0, ModelData, contact_offsets
-    from ..model.physics import slip_velocity
-
-    free = np.flatnonzero(system.free)
-    md = system.data
-    q, rel, _ = _newton_steady(system, md, np.zeros(system.n), free, STEADY_MAX_ITER)
-    if not rel <= RESIDUAL_TOL:
-        q = np.zeros(system.n)
-        for level in HOMOTOPY_LEVELS:
-            m = md.m.copy()
-            for c in range(system.n_contacts):
-                o = contact_offsets.py_func(system.n, c)[0]
-                m[o + C_N0] *= level
-            q, rel, _ = _newton_steady(system, ModelData(m, md.kin), q, free, STEADY_MAX_ITER)
-            if not rel <= RESIDUAL_TOL:
-                break
-    if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
-        raise EquilibriumError(
-            f"no steady-sliding equilibrium found for model {system.name!r}: Newton reached a relative "
-            f"residual of {rel:.2e} > {RESIDUAL_TOL:g} (steady sliding may not exist at these parameters: "
-            "e.g. a friction load that drags the contact into a fold)")
-    s = np.zeros(2 * system.n)
-    s[:system.n] = q
-    for c, contact in enumerate(system.contacts):
-        v = np.array(slip_velocity(s, c, md))
-        speed = float(np.hypot(*v))
-        if speed == 0.0:
-            raise EquilibriumError(f"no steady sliding: contact {c} does not slide at rest (its drive is 0); "
-                                   "give the contact a non-zero drive")
-        if contact.dim == 2 and speed <= system.slip_band:
-            raise EquilibriumError(
-                f"sliding speed at equilibrium {speed:.3g} m/s of contact {c} is inside the simulator's low-speed "
-                f"band ({system.slip_band:g} m/s), where its slip direction is not v/|v| and steady sliding is not an "
-                "equilibrium of the simulated equations; increase the drive")
-    return q

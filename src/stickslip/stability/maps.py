@@ -1,6 +1,13 @@
-"""Stability maps over (N, Ω) for a family of a third parameter (paper Figs. 3 and 4).
+"""Stability maps of steady sliding over any two parameters of any model (paper Figs. 3 and 4).
 
-Computing only; figures are drawn by :mod:`stickslip.plot.stability`.
+For each grid point the equilibrium and the Jacobian are computed in one compiled call over the
+whole grid (:func:`stickslip.stability.steady.jacobian_points`), the eigenvalues by NumPy's batched
+LAPACK, and the boundary where max Re λ crosses 0 along the second axis by brentq.
+
+A point's model is not rebuilt in Python: each axis is a table of data arrays (one row per value,
+:class:`_Axis`), and a point takes the first axis' row with the second axis' entries put in. This is
+exact when the two parameters set disjoint numbers of the model (checked; otherwise every point is
+built). Computing only; figures are drawn by :mod:`stickslip.plot.stability`.
 """
 
 from __future__ import annotations
@@ -16,18 +23,17 @@ import numpy as np
 from scipy import optimize
 
 from ..files import atomic_write, format_name, open_ours
-from ..model import kernels
 from ..model.parameters import PARAMETER_UNITS, ParameterError, Parameters, parameter_attrs
-from ..model.system import System, assemble
+from ..model.system import System
 from ..model.variants import resolve_variant
-from . import linearize
-from .equilibrium import MAX_ITER, RESIDUAL_TOL
+from . import steady
+from .equilibrium import MAX_ITER, RESIDUAL_TOL, plates_model
 
 __all__ = ["StabilityMap", "stability_map", "max_real_part", "boundary_omegas", "load_stability_map",
-           "parse_family"]
+           "parse_family", "MapGrid"]
 
-#: Absolute tolerance [rad/s] of the boundary Ω_c(N) by brentq: far below any physical
-#: resolution of Ω and ~1e-11 relative for the Ω of the paper (0.1–20 rad/s); brentq's own
+#: Absolute tolerance of the boundary along the second axis by brentq (for the plates' Ω
+#: [rad/s]: far below any physical resolution and ~1e-11 relative for 0.1–20 rad/s); brentq's own
 #: rtol (4 eps) governs where that is tighter.
 BOUNDARY_XTOL = 1e-10
 
@@ -35,6 +41,8 @@ BOUNDARY_XTOL = 1e-10
 #: bracket values is a jump of max Re λ (equilibrium branch switching), not a smooth crossing.
 JUMP_FRACTION = 1e-6
 
+#: Points per compiled call (bounds the Jacobians held at once: 4096 × 12 × 12 × 8 B = 4.7 MB).
+CHUNK_POINTS = 4096
 
 _SYMBOLS = {"delta_mu": "Δμ", "mu_k": "μk", "alpha": "α", "r": "r"}
 _PAPER_MODEL = {"full": 1, "x": 2, "y": 3, "rotation": 4}
@@ -69,62 +77,169 @@ def parse_family(text: str | None) -> tuple[str, list] | None:
         raise ValueError(f"family {text!r}: the values of {name} must be numbers") from None
 
 
-def _family_systems(params: Parameters, model, family) -> tuple[str, list, list[System]]:
-    if family is None:
-        return "", [""], [assemble(params, model)]
-    if isinstance(family, Mapping):
-        if len(family) != 1:
-            raise ValueError("family must name exactly one parameter, e.g. {'delta_mu': [0.1, 0.2]}")
-        family = next(iter(family.items()))
-    if isinstance(family, str):
-        family = parse_family(family)
-    name, values = family
-    values = list(values)
-    if not values:
-        raise ValueError(f"family {name!r} has no values")
-    if name == "model":
-        return name, [resolve_variant(v).name for v in values], [assemble(params, v) for v in values]
-    if name in ("N", "Omega"):
-        raise ValueError(f"family parameter {name!r} is already an axis of the map; choose another parameter")
-    if name not in Parameters.names():
-        raise ParameterError(f"unknown family parameter {name!r}; use 'model' or one of {', '.join(Parameters.names())}")
-    return name, values, [assemble(params.replace(**{name: v}), model) for v in values]
+def _is_plates(system) -> bool:
+    from ..model.library.two_plates import NAME
+
+    return system.name == NAME
 
 
-def max_real_part(system: System, N: float, Omega: float) -> float:
-    """Largest real part of the eigenvalues at steady sliding for (N, Ω) [1/s]; NaN without equilibrium."""
-    free = system.variant.free_indices.astype(np.int64)
-    p = system.p.copy()
-    p[kernels.P_N] = N
-    p[kernels.P_OMEGA] = Omega
-    k = free.size
-    J = np.empty((2 * k, 2 * k))
-    if not linearize.equilibrium_jacobian(free, system.minv, system.damp, system.stiff, p, MAX_ITER, RESIDUAL_TOL, J):
-        return math.nan
-    return float(np.max(np.linalg.eigvals(J).real))
+def _row(system) -> np.ndarray:
+    """The model's data array and its kinematics fields, one row (L + nf,)."""
+    kin = system.data.kin
+    kv = steady.kinematics_values(kin) if _float_fields(kin) else np.empty(0)
+    return np.concatenate([system.data.m, kv])
 
 
-def _grid_max_real_part(system: System, N: np.ndarray, Omega: np.ndarray, chunk_points: int = 4096) -> np.ndarray:
-    """max Re λ over N × Ω (numba Jacobians, NumPy batched eigenvalues), chunked by rows of N."""
-    free = system.variant.free_indices.astype(np.int64)
-    k2 = 2 * free.size
-    out = np.empty((N.size, Omega.size))
-    rows = max(1, chunk_points // Omega.size)
-    for a in range(0, N.size, rows):
-        Nc = N[a:a + rows]
-        J = np.empty((Nc.size, Omega.size, k2, k2))
-        linearize.jacobian_grid(free, system.minv, system.damp, system.stiff, system.p, Nc, Omega,
-                                MAX_ITER, RESIDUAL_TOL, J)
-        ok = np.isfinite(J[:, :, 0, 0])
-        res = np.full((Nc.size, Omega.size), np.nan)
-        if np.any(ok):
-            res[ok] = np.linalg.eigvals(J[ok]).real.max(axis=-1)
-        out[a:a + rows] = res
+def _float_fields(kin) -> bool:
+    try:
+        steady.kinematics_values(kin)
+        return True
+    except TypeError:
+        return False
+
+
+class _Axis:
+    """One map axis: the rows (:func:`_row`) of the model with parameter ``name`` set to any value.
+
+    Rows are built by ``replace`` at three probe values; entries that equal the value are set to
+    it, entries affine in it (to 1e-13) are interpolated, and any other dependence (e.g. M⁻¹ of a
+    mass) makes every row a ``replace``.
+    """
+
+    def __init__(self, base, name: str, values: np.ndarray):
+        self.base, self.name = base, name
+        lo, hi = float(values[0]), float(values[-1])
+        probes = [lo, hi, 0.5 * (lo + hi)] if hi != lo else [lo]
+        rows = np.array([_row(self._model(v)) for v in probes])
+        self.base_row = rows[0]
+        self.changed = np.any(rows != rows[0], axis=0)
+        self.fast = False
+        if len(probes) == 3 and rows.shape[1] == _row(base).shape[0]:
+            v = np.array(probes)
+            slope = (rows[1] - rows[0]) / (v[1] - v[0])
+            icpt = rows[0] - slope * v[0]
+            pred = icpt + slope * v[2]
+            scale = np.maximum(np.abs(rows).max(axis=0), 1e-300)
+            self.identity = self.changed & np.all(rows == v[:, None], axis=0)
+            self.slope, self.icpt = slope, icpt
+            self.fast = bool(np.all(np.abs(pred - rows[2]) <= 1e-13 * scale))
+        nf = self.base_row.size - base.data.m.size
+        if nf and np.any(self.changed[-nf:]) and not _float_fields(base.data.kin):
+            raise ValueError(f"{name} changes kinematics data that are not numbers; it cannot be a map axis")
+
+    def _model(self, value: float):
+        return self.base.replace(**{self.name: float(value)})
+
+    def rows(self, values) -> np.ndarray:
+        """Rows (len(values), L + nf) of the model at ``values``."""
+        values = np.atleast_1d(np.asarray(values, dtype=float))
+        if not self.fast:
+            return np.array([_row(self._model(v)) for v in values])
+        out = np.repeat(self.base_row[None, :], values.size, axis=0)
+        c = self.changed
+        out[:, c] = self.icpt[c] + self.slope[c] * values[:, None]
+        out[:, self.identity] = values[:, None]
+        return out
+
+
+@dataclasses.dataclass
+class MapGrid:
+    """A model over a grid of two parameters, as the compiled kernel takes it.
+
+    ``rows_a`` (nA, L + nf) and ``rows_b`` (nB, L + nf) are the model's rows along each axis;
+    point (i, j) is ``rows_a[i]`` with the entries ``mask_b`` from ``rows_b[j]``. Where the two
+    parameters are not separable (they set the same numbers), ``rows_a`` holds every point
+    (nA·nB rows, A-major) and ``mask_b`` is all False.
+    """
+
+    system: object
+    names: tuple
+    a: np.ndarray
+    b: np.ndarray
+    axis_a: _Axis
+    axis_b: _Axis
+    rows_a: np.ndarray
+    rows_b: np.ndarray
+    mask_b: np.ndarray
+    separable: bool
+
+    @classmethod
+    def build(cls, system, names: tuple[str, str], a: np.ndarray, b: np.ndarray) -> "MapGrid":
+        if names[0] == names[1]:
+            raise ValueError(f"the two axes of a map must be different parameters, got {names[0]!r} twice")
+        axis_a, axis_b = _Axis(system, names[0], a), _Axis(system, names[1], b)
+        rows_a, rows_b = axis_a.rows(a), axis_b.rows(b)
+        mask_b = axis_b.changed
+        separable = not np.any(axis_a.changed & mask_b)
+        if separable:  # check the far corner against a full build
+            corner = rows_a[-1].copy()
+            corner[mask_b] = rows_b[-1][mask_b]
+            full = _row(system.replace(**{names[0]: float(a[-1]), names[1]: float(b[-1])}))
+            separable = np.array_equal(np.abs(corner - full) <= 1e-13 * np.maximum(np.abs(full), 1e-300),
+                                       np.ones_like(full, dtype=bool))
+        if not separable:
+            rows_a = np.array([_row(system.replace(**{names[0]: float(x), names[1]: float(y)}))
+                               for x in a for y in b])
+            mask_b = np.zeros_like(mask_b)
+        return cls(system, tuple(names), a, b, axis_a, axis_b, rows_a, rows_b, mask_b, bool(separable))
+
+    def jacobians(self, ia: np.ndarray, ib: np.ndarray, rows_b: np.ndarray | None = None) -> np.ndarray:
+        """Jacobians (P, 2k, 2k) at the points (ia[p], ib[p]); NaN where no steady sliding exists."""
+        system = self.system
+        L = system.data.m.size
+        rb = self.rows_b if rows_b is None else rows_b
+        free = np.flatnonzero(system.free).astype(np.int64)
+        out = np.empty((ia.size, 2 * free.size, 2 * free.size))
+        ra = self.rows_a
+        if not self.separable:
+            ra, ia = ra[ia * self.b.size + ib], np.arange(ia.size, dtype=np.int64)
+        steady.jacobian_points(ra[:, :L], rb[:, :L], self.mask_b[:L], ra[:, L:], rb[:, L:], self.mask_b[L:],
+                               ia.astype(np.int64), ib.astype(np.int64), system.data.kin, free,
+                               MAX_ITER, RESIDUAL_TOL, out)
+        return out
+
+    def max_real_part(self) -> np.ndarray:
+        """max Re λ over the grid (nA, nB) [1/s], NaN where no steady sliding exists."""
+        nA, nB = self.a.size, self.b.size
+        ia_all = np.repeat(np.arange(nA, dtype=np.int64), nB)
+        ib_all = np.tile(np.arange(nB, dtype=np.int64), nA)
+        out = np.full(nA * nB, np.nan)
+        for p0 in range(0, nA * nB, CHUNK_POINTS):
+            sl = slice(p0, p0 + CHUNK_POINTS)
+            J = self.jacobians(ia_all[sl], ib_all[sl])
+            ok = np.isfinite(J[:, 0, 0])
+            if np.any(ok):
+                out[sl][ok] = np.linalg.eigvals(J[ok]).real.max(axis=-1)
+        return out.reshape(nA, nB)
+
+    def value_at(self, i: int, y: float) -> float:
+        """max Re λ at the first axis' value ``a[i]`` and the second parameter = ``y`` [1/s]."""
+        if self.separable:
+            J = self.jacobians(np.array([i]), np.array([0]), self.axis_b.rows([y]))
+        else:
+            J = _jacobian_of(self.system.replace(**{self.names[0]: float(self.a[i]), self.names[1]: float(y)}))
+        return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
+
+
+def _jacobian_of(system) -> np.ndarray:
+    """The steady-sliding Jacobian (1, 2k, 2k) of one model (NaN without steady sliding)."""
+    free = np.flatnonzero(system.free).astype(np.int64)
+    out = np.empty((1, 2 * free.size, 2 * free.size))
+    steady.steady_jacobian(system.data, free, MAX_ITER, RESIDUAL_TOL, out[0])
     return out
 
 
-def boundary_omegas(system: System, N: float, Omega: np.ndarray, values: np.ndarray | None = None):
-    """Stability boundaries Ω_c along Ω at fixed N, by brentq on max Re λ(Ω) [rad/s].
+def max_real_part(system, N: float, Omega: float, names: tuple[str, str] = ("N", "Omega")) -> float:
+    """Largest real part of the eigenvalues at steady sliding with the parameters ``names`` set to
+    (N, Ω) [1/s]; NaN without steady sliding. ``system``: a plates :class:`System` or any model."""
+    if isinstance(system, System):
+        system = plates_model(system)
+    J = _jacobian_of(system.replace(**{names[0]: float(N), names[1]: float(Omega)}))
+    return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
+
+
+def boundary_omegas(grid: MapGrid, i: int, values: np.ndarray):
+    """Stability boundaries along the second axis at the first axis' value ``grid.a[i]``, by brentq.
 
     Every sign change of max Re λ between adjacent grid points with an equilibrium on both is
     refined to :data:`BOUNDARY_XTOL`.
@@ -133,20 +248,19 @@ def boundary_omegas(system: System, N: float, Omega: np.ndarray, values: np.ndar
     -------
     roots : list of float
     directions : list of int
-        +1 where the equilibrium becomes unstable as Ω increases, −1 where it becomes stable.
+        +1 where the equilibrium becomes unstable as the parameter increases, −1 where it becomes stable.
     jumps : list of bool
         True where max Re λ jumps across zero instead of crossing it smoothly.
     """
-    if values is None:
-        values = np.array([max_real_part(system, N, w) for w in Omega])
     roots, directions, jumps = [], [], []
-    f = lambda w: max_real_part(system, N, w)  # noqa: E731
-    for b in range(Omega.size - 1):
+    f = lambda w: grid.value_at(i, w)  # noqa: E731
+    Y = grid.b
+    for b in range(Y.size - 1):
         fa, fb = values[b], values[b + 1]
         if not (np.isfinite(fa) and np.isfinite(fb)) or (fa < 0) == (fb < 0) or fa == 0.0:
             continue
         try:
-            root = optimize.brentq(f, Omega[b], Omega[b + 1], xtol=BOUNDARY_XTOL)
+            root = optimize.brentq(f, Y[b], Y[b + 1], xtol=BOUNDARY_XTOL)
         except ValueError:  # NaN (equilibrium lost) inside the bracket
             continue
         froot = f(root)
@@ -158,34 +272,41 @@ def boundary_omegas(system: System, N: float, Omega: np.ndarray, values: np.ndar
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class StabilityMap:
-    """Stability of steady sliding over an (N, Ω) grid for a family of a third parameter.
+    """Stability of steady sliding over a grid of two parameters, for a family of a third.
 
     Attributes
     ----------
-    params : Parameters
-        Base parameters (the family value replaces one of them per member).
+    params : Parameters or None
+        The plates' base parameters (None for other models: see ``system``).
     model : str
-        Model of the base (per-member models in ``family_values`` when the family is ``model``).
-    N : ndarray (nN,)
-        Normal loads [N].
-    Omega : ndarray (nΩ,)
-        Angular velocities of the lower plate [rad/s].
+        The plates' variant of the base (per-member variants in ``family_values`` when the family
+        is ``model``), or the model's name.
+    N : ndarray (nA,)
+        Values of the first axis (``axes[0]``; for the plates' maps the normal load N [N]).
+    Omega : ndarray (nB,)
+        Values of the second axis (``axes[1]``; for the plates' maps Ω [rad/s]).
     family_name : str
         Name of the varied parameter, ``"model"``, or ``""`` for a single map.
     family_values : list
-    max_real_part : ndarray (nF, nN, nΩ)
+    max_real_part : ndarray (nF, nA, nB)
         Largest real part of the eigenvalues [1/s]; NaN where no equilibrium was found.
-    boundary : ndarray (nF, nN, nC)
-        Ω_c where max Re λ crosses 0 along Ω at each N (brentq), NaN-padded [rad/s].
-    boundary_direction : ndarray (nF, nN, nC) int8
-        +1: unstable above Ω_c; −1: stable above Ω_c; 0: padding.
-    boundary_jump : ndarray (nF, nN, nC) bool
+    boundary : ndarray (nF, nA, nC)
+        Values of the second parameter where max Re λ crosses 0 at each value of the first
+        (brentq), NaN-padded.
+    boundary_direction : ndarray (nF, nA, nC) int8
+        +1: unstable above the crossing; −1: stable above it; 0: padding.
+    boundary_jump : ndarray (nF, nA, nC) bool
         True where max Re λ jumps across zero (branch switch) rather than crossing it.
     timings : dict
         Wall times [s] of the grid and the boundary search.
+    axes : (str, str)
+        The parameters of the two axes (plates names such as ``N``, or model paths such as
+        ``contact.0.friction.mu_k``).
+    system : FrictionModel or None
+        The base model.
     """
 
-    params: Parameters
+    params: Parameters | None
     model: str
     N: np.ndarray
     Omega: np.ndarray
@@ -196,10 +317,12 @@ class StabilityMap:
     boundary_direction: np.ndarray
     boundary_jump: np.ndarray
     timings: dict
+    axes: tuple = ("N", "Omega")
+    system: object = None
 
     @property
     def stable(self) -> np.ndarray:
-        """Boolean (nF, nN, nΩ): max Re λ < 0 (False where no equilibrium exists)."""
+        """Boolean (nF, nA, nB): max Re λ < 0 (False where no equilibrium exists)."""
         with np.errstate(invalid="ignore"):
             return self.max_real_part < 0.0
 
@@ -213,50 +336,64 @@ class StabilityMap:
         symbol = _SYMBOLS.get(self.family_name, self.family_name)
         return [f"{symbol} = {v:g}" for v in self.family_values]
 
+    def _parameters(self) -> dict:
+        return self.params.to_dict() if self.params is not None else dict(self.system.parameters)
+
     def to_xarray(self):
-        """``xarray.Dataset`` (family, N, Omega) with units and the full parameter set in attrs."""
+        """``xarray.Dataset`` (family, axis 1, axis 2) with units and the full parameter set in attrs."""
         import xarray as xr
 
         from .. import __version__
+        from ..model.library import describe_system
 
+        a, b = self.axes
         fam = self.family_values if self.family_name else [self.model]
         fam_coord = np.asarray([str(v) for v in fam]) if (self.family_name in ("model", "")) else np.asarray(fam, float)
         fam_attrs = {"long_name": self.family_name or "model"}
         if self.family_name in PARAMETER_UNITS and PARAMETER_UNITS[self.family_name]:
             fam_attrs["units"] = PARAMETER_UNITS[self.family_name]
+        grid = ("family", a, b)
+        bname = "boundary_omega" if b == "Omega" else "boundary"
+        battrs = {"long_name": f"{b} where max Re(lambda) = 0 (brentq along {b})"}
+        if PARAMETER_UNITS.get(b):
+            battrs["units"] = PARAMETER_UNITS[b]
         data = {
-            "max_real_part": (("family", "N", "Omega"), self.max_real_part,
+            "max_real_part": (grid, self.max_real_part,
                               {"units": "1/s", "long_name": "largest real part of the eigenvalues at steady sliding"}),
-            "stable": (("family", "N", "Omega"), self.stable.astype(np.int8),
+            "stable": (grid, self.stable.astype(np.int8),
                        {"long_name": "steady sliding asymptotically stable", "flag_values": "0 1",
                         "flag_meanings": "unstable_or_no_equilibrium stable"}),
-            "equilibrium_found": (("family", "N", "Omega"), np.isfinite(self.max_real_part).astype(np.int8),
-                                  {"long_name": "steady-sliding equilibrium found (Eq. 14)"}),
-            "boundary_omega": (("family", "N", "crossing"), self.boundary,
-                               {"units": "rad/s", "long_name": "Omega where max Re(lambda) = 0 (brentq along Omega)"}),
-            "boundary_direction": (("family", "N", "crossing"), self.boundary_direction.astype(np.int8),
+            "equilibrium_found": (grid, np.isfinite(self.max_real_part).astype(np.int8),
+                                  {"long_name": "steady-sliding equilibrium found"}),
+            bname: (("family", a, "crossing"), self.boundary, battrs),
+            "boundary_direction": (("family", a, "crossing"), self.boundary_direction.astype(np.int8),
                                    {"long_name": "+1 unstable above the crossing, -1 stable above, 0 none"}),
-            "boundary_jump": (("family", "N", "crossing"), self.boundary_jump.astype(np.int8),
+            "boundary_jump": (("family", a, "crossing"), self.boundary_jump.astype(np.int8),
                               {"long_name": "1 where max Re(lambda) jumps across 0 instead of crossing it"}),
         }
-        coords = {
-            "family": ("family", fam_coord, fam_attrs),
-            "N": ("N", self.N, {"units": "N", "long_name": "normal preload"}),
-            "Omega": ("Omega", self.Omega, {"units": "rad/s", "long_name": "angular velocity of the lower plate"}),
-            "crossing": ("crossing", np.arange(self.boundary.shape[2])),
-        }
+        long_names = {"N": "normal preload", "Omega": "angular velocity of the lower plate"}
+        coords = {"family": ("family", fam_coord, fam_attrs), "crossing": ("crossing", np.arange(self.boundary.shape[2]))}
+        for name, values in ((a, self.N), (b, self.Omega)):
+            attrs = {"long_name": long_names.get(name, name)}
+            if PARAMETER_UNITS.get(name):
+                attrs["units"] = PARAMETER_UNITS[name]
+            coords[name] = (name, values, attrs)
         attrs = {
-            "title": "stickslip stability map of steady sliding (paper Sect. 4.1)",
+            "title": "stickslip stability map of steady sliding",
             "format": format_name("stabilitymap", 1),
             "stickslip_version": __version__,
             "model": self.model,
             "family_name": self.family_name,
-            "parameters": json.dumps(self.params.to_dict()),
+            "axes": json.dumps(list(self.axes)),
+            "parameters": json.dumps(self._parameters()),
             "timings": json.dumps(self.timings),
             "boundary_xtol": BOUNDARY_XTOL,
-            "boundary_xtol_units": "rad/s",
         }
-        attrs.update(parameter_attrs(self.params.to_dict()))
+        if self.system is not None:
+            attrs["system"] = json.dumps(describe_system(self.system))
+        if self.params is not None:
+            attrs["boundary_xtol_units"] = "rad/s"
+            attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def to_netcdf(self, path: str | Path) -> Path:
@@ -273,45 +410,80 @@ class StabilityMap:
 
 def load_stability_map(path: str | Path) -> StabilityMap:
     """Read a map written by :meth:`StabilityMap.to_netcdf`."""
+    from ..model.library import system_from_description
+
     ds = open_ours(path, "stabilitymap", noun="stability map", what="a .nc file written by `stickslip stability-map`")
     name = ds.attrs["family_name"]
     fam = [str(v) for v in ds["family"].values] if name in ("model", "") else [float(v) for v in ds["family"].values]
+    a, b = json.loads(ds.attrs["axes"]) if "axes" in ds.attrs else ("N", "Omega")
+    system = system_from_description(json.loads(ds.attrs["system"])) if "system" in ds.attrs else None
+    params = Parameters.from_dict(json.loads(ds.attrs["parameters"])) if "param_N" in ds.attrs else None
     return StabilityMap(
-        params=Parameters.from_dict(json.loads(ds.attrs["parameters"])),
-        model=ds.attrs["model"], N=ds["N"].values, Omega=ds["Omega"].values,
+        params=params, model=ds.attrs["model"], N=ds[a].values, Omega=ds[b].values,
         family_name=name, family_values=fam if name else [],
-        max_real_part=ds["max_real_part"].values, boundary=ds["boundary_omega"].values,
+        max_real_part=ds["max_real_part"].values,
+        boundary=ds["boundary_omega" if "boundary_omega" in ds else "boundary"].values,
         boundary_direction=ds["boundary_direction"].values, boundary_jump=ds["boundary_jump"].values.astype(bool),
-        timings=json.loads(ds.attrs["timings"]),
+        timings=json.loads(ds.attrs["timings"]), axes=(a, b), system=system,
     )
 
 
+def _members(system, family) -> tuple[str, list, list]:
+    """(family name, values, member models) of a family over the base model ``system``."""
+    if family is None:
+        return "", [""], [system]
+    if isinstance(family, Mapping):
+        if len(family) != 1:
+            raise ValueError("family must name exactly one parameter, e.g. {'delta_mu': [0.1, 0.2]}")
+        family = next(iter(family.items()))
+    if isinstance(family, str):
+        family = parse_family(family)
+    name, values = family
+    values = list(values)
+    if not values:
+        raise ValueError(f"family {name!r} has no values")
+    if name == "model":
+        if not _is_plates(system):
+            raise ValueError("a family of models needs the plates (variants full, x, y, rotation); "
+                             f"model {system.name!r} has none: vary one of its parameters instead")
+        names = [resolve_variant(v).name for v in values]
+        return name, names, [system.replace(variant=v) for v in names]
+    if _is_plates(system) and name not in Parameters.names():
+        raise ParameterError(f"unknown family parameter {name!r}; use 'model' or one of {', '.join(Parameters.names())}")
+    return name, values, [system.replace(**{name: float(v)}) for v in values]
+
+
 def stability_map(
-    params: Parameters | None = None,
+    params=None,
     N: Sequence[float] = tuple(np.linspace(5.0, 200.0, 40)),
     Omega: Sequence[float] = tuple(np.linspace(0.25, 20.0, 80)),
     *,
     model="full",
     family: "tuple[str, Sequence] | Mapping[str, Sequence] | str | None" = None,
     boundary: bool = True,
+    axes: tuple[str, str] = ("N", "Omega"),
 ) -> StabilityMap:
-    """Max real part of the eigenvalues over an (N, Ω) grid, and the stability boundary Ω_c(N).
+    """Max real part of the eigenvalues over a grid of two parameters, and the stability boundary.
 
     Parameters
     ----------
-    params : Parameters, optional
-        Base parameters (default Table 1, μk = 0.2, Δμ = 0.1, α = 5).
-    N : sequence of float
-        Normal loads [N], strictly increasing, > 0.
-    Omega : sequence of float
-        Angular velocities [rad/s], strictly increasing, non-zero.
+    params : Parameters, FrictionModel or str, optional
+        The plates' base parameters (default Table 1, μk = 0.2, Δμ = 0.1, α = 5), or any model
+        (a FrictionModel, a library name or a model file path).
+    N, Omega : sequence of float
+        Values of the first and second parameter (``axes``), strictly increasing; for the plates'
+        default axes the normal loads [N] (> 0) and angular velocities [rad/s] (non-zero).
     model : str or iterable of DOF names
-        ``full`` (Model 1) … ``rotation`` (Model 4).
+        The plates' variant, ``full`` (Model 1) … ``rotation`` (Model 4).
     family : (name, values), {name: values}, "name=v1,v2" or None
-        A third parameter varied over the map, any :class:`Parameters` field other than N, Ω,
-        or ``"model"`` (e.g. ``("model", ["full", "rotation"])`` for paper Fig. 4).
+        A third parameter varied over the map (any parameter of the model other than the axes), or
+        for the plates ``"model"`` (e.g. ``("model", ["full", "rotation"])`` for paper Fig. 4).
     boundary : bool
-        Locate Ω_c(N) for every N by brentq on max Re λ along Ω (bracketed by the grid).
+        Locate the crossings of max Re λ = 0 along the second axis for every value of the first
+        by brentq (bracketed by the grid).
+    axes : (str, str)
+        The two parameters: plates names (``N``, ``Omega``, ``delta_mu``, ...) or a model's
+        parameter paths (``contact.0.normal_force``, ``contact.0.friction.mu_k``, ``stiffness.x.y``).
 
     Returns
     -------
@@ -319,29 +491,41 @@ def stability_map(
 
     Raises
     ------
-    ValueError, ParameterError, VariantError
-        For an empty or non-increasing grid, N ≤ 0, Ω = 0, or an unknown family parameter.
+    ValueError, ParameterError, ModelError, VariantError
+        For an empty or non-increasing grid, N ≤ 0, Ω = 0 (plates), an unknown parameter, or a
+        value that makes the model invalid.
     """
-    params = Parameters() if params is None else params
-    if not isinstance(params, Parameters):
-        raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
-    N = _as_float_array("N", N)
-    Omega = _as_float_array("Omega", Omega)
-    if np.any(N <= 0):
-        raise ValueError("N must be > 0 (the plates must be pressed together)")
-    if np.any(Omega == 0):
-        raise ValueError("Omega = 0 has no steady sliding (the friction direction is undefined); leave it out of the grid")
-    name, values, systems = _family_systems(params, model, family)
+    from ..model.library import resolve_system
+
+    if params is not None and not isinstance(params, (Parameters, str, Path)) and not hasattr(params, "data"):
+        raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
+    system = resolve_system(params, model)
+    axes = tuple(axes)
+    N = _as_float_array(axes[0], N)
+    Omega = _as_float_array(axes[1], Omega)
+    if _is_plates(system):
+        for name, values in zip(axes, (N, Omega)):
+            if name == "N" and np.any(values <= 0):
+                raise ValueError("N must be > 0 (the plates must be pressed together)")
+            if name == "Omega" and np.any(values == 0):
+                raise ValueError("Omega = 0 has no steady sliding (the friction direction is undefined); "
+                                 "leave it out of the grid")
+    fam = family if not isinstance(family, str) else parse_family(family)
+    fam_name = (next(iter(fam)) if isinstance(fam, Mapping) else fam[0]) if fam is not None else ""
+    if fam_name in axes:
+        raise ValueError(f"family parameter {fam_name!r} is already an axis of the map; choose another parameter")
+    name, values, systems = _members(system, fam)
     t0 = time.perf_counter()
-    mrp = np.stack([_grid_max_real_part(sy, N, Omega) for sy in systems])
+    grids = [MapGrid.build(sy, axes, N, Omega) for sy in systems]
+    mrp = np.stack([g.max_real_part() for g in grids])
     t1 = time.perf_counter()
     per = [[([], [], []) for _ in N] for _ in systems]
     if boundary:
-        for f, sy in enumerate(systems):
-            for a, n in enumerate(N):
-                per[f][a] = boundary_omegas(sy, float(n), Omega, mrp[f, a])
+        for f, g in enumerate(grids):
+            for a in range(N.size):
+                per[f][a] = boundary_omegas(g, a, mrp[f, a])
     t2 = time.perf_counter()
-    nc = max([1] + [len(r[0]) for fam in per for r in fam])
+    nc = max([1] + [len(r[0]) for fam_rows in per for r in fam_rows])
     bnd = np.full((len(systems), N.size, nc), np.nan)
     bdir = np.zeros((len(systems), N.size, nc), dtype=np.int8)
     bjump = np.zeros((len(systems), N.size, nc), dtype=bool)
@@ -351,9 +535,13 @@ def stability_map(
             bnd[f, a, :len(roots)] = roots
             bdir[f, a, :len(dirs)] = dirs
             bjump[f, a, :len(jumps)] = jumps
+    plates = _is_plates(system)
+    base_params = None
+    if plates:
+        base_params = Parameters.from_dict({k: v for k, v in system.parameters.items() if k != "variant"})
     return StabilityMap(
-        params=params, model=resolve_variant(model).name, N=N, Omega=Omega,
+        params=base_params, model=system.parameters["variant"] if plates else system.name, N=N, Omega=Omega,
         family_name=name, family_values=values if name else [],
         max_real_part=mrp, boundary=bnd, boundary_direction=bdir, boundary_jump=bjump,
-        timings={"grid_s": t1 - t0, "boundary_s": t2 - t1, "points": int(mrp.size)},
+        timings={"grid_s": t1 - t0, "boundary_s": t2 - t1, "points": int(mrp.size)}, axes=axes, system=system,
     )

@@ -1,0 +1,347 @@
+"""Compiled steady sliding of any friction model, and its Jacobian, at one point or over a grid.
+
+Steady sliding is q̇ = 0 and f0 − K q + Σ_c G_cᵀ F_c(q, 0) = 0 with every contact slipping. The
+residual is the simulator's own right-hand side (:func:`stickslip.model.physics.rhs`) at rest,
+as forces Q = M q̈; its Jacobian is the complex step of the same right-hand side
+(:func:`stickslip.model.derivatives.acceleration_jacobian`), so nothing is derived by hand and
+nothing can drift from what the integrator sees.
+
+Newton starts from q = 0. Close to a fold of the equilibrium branch it can stall although a
+solution exists; then the normal forces N0 of all contacts are ramped from a fraction of their
+value, each solution starting the next (step doubled on success, halved on failure, down to 1e-3).
+
+Models arrive as :class:`~stickslip.model.bundle.ModelData`. Over a grid, each point's data array
+is assembled inside the kernel from two axis tables (:func:`jacobian_points`), and its kinematics
+data rebuilt from a row of numbers (:func:`kinematics_from`), so one compiled call serves a whole
+map.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba.extending import overload
+
+from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
+from ..model.derivatives import acceleration_jacobian, state_jacobian
+from ..model.jit import KERNEL_OPTIONS, kernel, loop
+from ..model.kinematics import model_sizes
+from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
+
+__all__ = ["NEWTON_OK", "NEWTON_MAX_ITER", "NEWTON_SINGULAR", "NEWTON_NOT_FINITE", "NEWTON_NO_DESCENT",
+           "NEWTON_NOT_SLIDING", "NEWTON_TARGET", "CONTINUATION_ACCEPT", "steady_sliding_point",
+           "steady_jacobian", "jacobian_points", "kinematics_from", "kinematics_values"]
+
+NEWTON_OK = 0
+NEWTON_MAX_ITER = 1
+NEWTON_SINGULAR = 2
+NEWTON_NOT_FINITE = 3
+NEWTON_NO_DESCENT = 4
+#: Converged, but a contact does not slide (speed 0) or a 2-D contact slides inside the low-speed
+#: band, where the simulator's slip direction is not v/|v|: no steady sliding of the simulated equations.
+NEWTON_NOT_SLIDING = 5
+
+#: Relative residual at which Newton stops (a few ulps above the round-off of the force balance).
+NEWTON_TARGET = 1e-14
+
+#: Relative residual below which a solve counts as converged for the load continuation.
+CONTINUATION_ACCEPT = 1e-10
+
+
+def kinematics_values(kin) -> np.ndarray:
+    """The fields of a kinematics NamedTuple as floats (nf,), for :func:`kinematics_from`.
+
+    Raises
+    ------
+    TypeError
+        When a field is not a number (such kinematics cannot be varied over a grid).
+    """
+    try:
+        return np.array([float(v) for v in kin], dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"the kinematics data {type(kin).__name__} has fields that are not numbers") from None
+
+
+def kinematics_from(kin, values):  # pragma: no cover - resolved by numba (overload below)
+    """A kinematics NamedTuple of the class of ``kin`` with the fields ``values`` (nf,)."""
+    raise NotImplementedError
+
+
+@overload(kinematics_from, jit_options=KERNEL_OPTIONS)
+def _kinematics_from(kin, values):
+    cls = getattr(kin, "instance_class", None)
+    types = getattr(kin, "types", ())
+    if cls is None or not all(str(t) == "float64" for t in types):
+        def same(kin, values):  # fields that are not all floats are never varied
+            return kin
+        return same
+    args = ", ".join(f"values[{i}]" for i in range(len(types)))
+    namespace = {"cls": cls}
+    exec(f"def build(kin, values):\n    return cls({args})\n", namespace)  # noqa: S102 - fixed template
+    return namespace["build"]
+
+
+@kernel
+def _sliding_modes(cst, nc):
+    """Every contact slipping with the exact direction v/|v| (the modes of steady sliding)."""
+    for c in range(nc):
+        cst[c * CST] = MODE_SLIP_EXACT
+        cst[c * CST + 1] = 1.0
+        cst[c * CST + 2] = 0.0
+        cst[c * CST + 3] = np.inf
+
+
+@kernel
+def _residual(q, cst, md, free, s, ds, Q):
+    """Forces Q = M q̈ at rest (free DOFs) into ``Q``; returns max|Q| / max(|K q|, |f0|, |Σ Gᵀ F|)."""
+    m = md.m
+    n = q.shape[0]
+    o_minv, o_mass, o_damp, o_stiff, o_force, o_free, o_c = offsets(n)
+    for i in range(n):
+        s[i] = q[i]
+        s[n + i] = 0.0
+    rhs(s, cst, md, ds)
+    num = 0.0
+    scale = 0.0
+    for a in range(free.shape[0]):
+        i = free[a]
+        f = 0.0
+        kq = 0.0
+        for j in range(n):
+            f += m[o_mass + i * n + j] * ds[n + j]
+            kq += m[o_stiff + i * n + j] * q[j]
+        Q[i] = f
+        num = max(num, abs(f))
+        scale = max(scale, abs(kq), abs(m[o_force + i]), abs(f + kq - m[o_force + i]))
+    if num == 0.0:
+        return 0.0
+    if scale == 0.0 or not np.isfinite(num):
+        return np.inf
+    return num / scale
+
+
+@kernel
+def _solve_inplace(A, b):
+    """Gaussian elimination with partial pivoting; returns False if A is singular (to round-off)."""
+    n = A.shape[0]
+    amax = 0.0
+    for i in range(n):
+        for j in range(n):
+            amax = max(amax, abs(A[i, j]))
+    if amax == 0.0:
+        return False
+    for c in range(n):
+        piv = c
+        for i in range(c + 1, n):
+            if abs(A[i, c]) > abs(A[piv, c]):
+                piv = i
+        # a pivot below n·eps of the largest entry means the matrix is singular to round-off
+        if abs(A[piv, c]) <= 1e-14 * amax:
+            return False
+        if piv != c:
+            for j in range(n):
+                A[c, j], A[piv, j] = A[piv, j], A[c, j]
+            b[c], b[piv] = b[piv], b[c]
+        for i in range(c + 1, n):
+            f = A[i, c] / A[c, c]
+            for j in range(c, n):
+                A[i, j] -= f * A[c, j]
+            b[i] -= f * b[c]
+    for c in range(n - 1, -1, -1):
+        acc = b[c]
+        for j in range(c + 1, n):
+            acc -= A[c, j] * b[j]
+        b[c] = acc / A[c, c]
+    return True
+
+
+@loop
+def _newton_from(q, cst, md, free, max_iter):
+    """Damped Newton on the forces at rest from ``q`` (changed in place).
+
+    The step solves (M ∂q̈/∂q) dx = −Q on the free DOFs and is halved until ‖Q‖² decreases
+    (Armijo, c = 1e-4). Returns (status, relative residual, iterations).
+    """
+    m = md.m
+    n = q.shape[0]
+    k = free.shape[0]
+    o_mass = offsets(n)[1]
+    s = np.zeros(2 * n)
+    ds = np.zeros(2 * n)
+    Q = np.zeros(n)
+    trial_Q = np.zeros(n)
+    trial = np.zeros(n)
+    Jqq = np.empty((n, n))
+    acc = np.empty(n)
+    z = np.zeros(2 * n, dtype=np.complex128)
+    dz = np.zeros(2 * n, dtype=np.complex128)
+    A = np.empty((k, k))
+    dx = np.empty(k)
+    rel = _residual(q, cst, md, free, s, ds, Q)
+    for it in range(max_iter):
+        if not np.isfinite(rel):
+            return NEWTON_NOT_FINITE, rel, it
+        if rel <= NEWTON_TARGET:
+            return NEWTON_OK, rel, it
+        acceleration_jacobian(q, cst, md, Jqq, acc, z, dz)
+        norm0 = 0.0
+        for a in range(k):
+            i = free[a]
+            dx[a] = -Q[i]
+            norm0 += Q[i] ** 2
+            for b in range(k):
+                v = 0.0
+                for j in range(n):
+                    v += m[o_mass + i * n + j] * Jqq[j, free[b]]
+                A[a, b] = v
+        if not _solve_inplace(A, dx):
+            return NEWTON_SINGULAR, rel, it
+        t = 1.0
+        accepted = False
+        trial_rel = rel
+        for _ in range(40):  # 2^-40 ≈ 1e-12: a shorter step cannot change q beyond round-off
+            for i in range(n):
+                trial[i] = q[i]
+            for a in range(k):
+                trial[free[a]] += t * dx[a]
+            trial_rel = _residual(trial, cst, md, free, s, ds, trial_Q)
+            norm1 = 0.0
+            for a in range(k):
+                norm1 += trial_Q[free[a]] ** 2
+            if np.isfinite(norm1) and norm1 <= (1.0 - 1e-4 * t) * norm0:
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            # no decrease along the Newton direction: at round-off level this is convergence
+            return NEWTON_NO_DESCENT, rel, it
+        for i in range(n):
+            q[i] = trial[i]
+            Q[i] = trial_Q[i]
+        rel = trial_rel
+    if rel <= NEWTON_TARGET:
+        return NEWTON_OK, rel, max_iter
+    return NEWTON_MAX_ITER, rel, max_iter
+
+
+@loop
+def steady_sliding_point(md, free, max_iter):
+    """Steady sliding of the model ``md``: Newton from q = 0, load continuation as a fallback.
+
+    Parameters
+    ----------
+    md : ModelData
+    free : ndarray (k,) int64
+        Indices of the free DOFs.
+    max_iter : int
+        Newton iterations per solve.
+
+    Returns
+    -------
+    q : ndarray (n,)
+        Last iterate (locked DOFs 0).
+    status : int
+        ``NEWTON_*`` code (:data:`NEWTON_NOT_SLIDING` when converged but not sliding).
+    rel : float
+        Relative force residual of ``q``.
+    iterations : int
+        Newton iterations in all.
+    """
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    cst = np.zeros(CST * nc)
+    _sliding_modes(cst, nc)
+    q = np.zeros(n)
+    status, rel, iterations = _newton_from(q, cst, md, free, max_iter)
+    if not rel <= CONTINUATION_ACCEPT:
+        mw = m.copy()
+        mdw = ModelData(mw, md.kin)
+        lam = 0.0
+        step = 0.125
+        qc = np.zeros(n)
+        qt = np.zeros(n)
+        while lam < 1.0:
+            trial = min(1.0, lam + step)
+            for c in range(nc):
+                o = contact_offsets(n, c)[0]
+                mw[o + C_N0] = trial * m[o + C_N0]
+            for i in range(n):
+                qt[i] = qc[i]
+            # from the previous load's solution Newton converges in a few steps or not at all
+            st, rt, it = _newton_from(qt, cst, mdw, free, min(max_iter, 20))
+            iterations += it
+            if rt <= CONTINUATION_ACCEPT:
+                lam = trial
+                for i in range(n):
+                    qc[i] = qt[i]
+                    q[i] = qt[i]
+                status, rel = st, rt
+                step = min(2.0 * step, 0.25)
+            else:
+                step *= 0.5
+                if step < 1e-3:  # the equilibrium branch from N0 = 0 ends (fold) before the full load
+                    for i in range(n):
+                        q[i] = qt[i]
+                    return q, st, rt, iterations
+    if rel <= CONTINUATION_ACCEPT:
+        s = np.zeros(2 * n)
+        for i in range(n):
+            s[i] = q[i]
+        for c in range(nc):
+            v0, v1 = slip_velocity(s, c, md)
+            speed = np.sqrt(v0 * v0 + v1 * v1)
+            o = contact_offsets(n, c)[0]
+            if speed == 0.0 or (m[o + C_DIM] == 2.0 and speed <= m[H_BAND]):
+                return q, NEWTON_NOT_SLIDING, rel, iterations
+    return q, status, rel, iterations
+
+
+@loop
+def steady_jacobian(md, free, max_iter, tol, J):
+    """Steady sliding, then the Jacobian of the slip equations there, reduced to the free DOFs.
+
+    Writes J (2k × 2k) = ∂(ds/dt)/∂s on [q_free, q̇_free] and returns True when Newton reached the
+    relative residual ``tol`` with every contact sliding; otherwise ``J`` is NaN.
+    """
+    n, nc, diagonal = model_sizes(md.kin, md.m)
+    k = free.shape[0]
+    q, status, rel, _ = steady_sliding_point(md, free, max_iter)
+    if not (rel <= tol) or status == NEWTON_NOT_SLIDING:
+        for i in range(2 * k):
+            for j in range(2 * k):
+                J[i, j] = np.nan
+        return False
+    s = np.zeros(2 * n)
+    for i in range(n):
+        s[i] = q[i]
+    cst = np.zeros(CST * nc)
+    _sliding_modes(cst, nc)
+    full = np.empty((2 * n, 2 * n))
+    state_jacobian(s, cst, md, full, np.zeros(2 * n, dtype=np.complex128), np.zeros(2 * n, dtype=np.complex128))
+    for a in range(k):
+        for b in range(k):
+            J[a, b] = full[free[a], free[b]]
+            J[a, k + b] = full[free[a], n + free[b]]
+            J[k + a, b] = full[n + free[a], free[b]]
+            J[k + a, k + b] = full[n + free[a], n + free[b]]
+    return True
+
+
+@loop
+def jacobian_points(m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib, kin0, free, max_iter, tol, out):
+    """:func:`steady_jacobian` at points assembled from two axis tables, into ``out`` (P, 2k, 2k).
+
+    Point p has the data array ``m_a[ia[p]]`` with the entries flagged in ``mask_b`` taken from
+    ``m_b[ib[p]]``, and kinematics ``kinematics_from(kin0, kv)`` with kv = ``kv_a[ia[p]]`` and the
+    fields flagged in ``kmask_b`` from ``kv_b[ib[p]]``. A map whose two parameters touch disjoint
+    entries is thus nA + nB tables instead of nA × nB models. NaN where no steady sliding exists.
+    """
+    mw = np.empty(m_a.shape[1])
+    kv = np.empty(kv_a.shape[1])
+    for p in range(ia.shape[0]):
+        a = ia[p]
+        b = ib[p]
+        for i in range(mw.shape[0]):
+            mw[i] = m_b[b, i] if mask_b[i] else m_a[a, i]
+        for i in range(kv.shape[0]):
+            kv[i] = kv_b[b, i] if kmask_b[i] else kv_a[a, i]
+        steady_jacobian(ModelData(mw, kinematics_from(kin0, kv)), free, max_iter, tol, out[p])
