@@ -5,8 +5,13 @@
 3. A baseline in the same run: scipy ``root`` (hybr) on the simulator kernel's residual for the
    equilibrium, a central-difference Jacobian of the kernel and ``numpy.linalg.eigvals``, per
    point on a subset, to give the speed-up ratio of the compiled Newton + complex-step path.
+4. With ``--rev REV``: the same maps with the package at git revision REV (imported beside the
+   working tree's, as ``benchmarks/ab.py`` does), timed alternately in the same process, with the
+   largest differences of max Re λ and of the boundaries of the paper's Figs. 3(a), 3(b) and 4,
+   and of all eigenvalues at sample points, old against new.
 
-Run: ``python benchmarks/stability_map.py``; writes benchmarks/results/stability_map.json.
+Run: ``python benchmarks/stability_map.py [--rev main] [--pairs 5]``; writes
+benchmarks/results/stability_map.json.
 """
 
 import os
@@ -15,8 +20,11 @@ import os
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ[var] = "1"
 
+import argparse  # noqa: E402
 import json  # noqa: E402
 import platform  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -62,7 +70,77 @@ def baseline_point(system, N, Omega):
     return float(np.max(np.linalg.eigvals(J).real))
 
 
+def _max_abs_diff(a, b) -> float:
+    """Largest |a − b| where both are finite; inf where only one of them is."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if a.shape != b.shape:
+        return float("inf")
+    if not np.array_equal(np.isfinite(a), np.isfinite(b)):
+        return float("inf")
+    both = np.isfinite(a)
+    return float(np.max(np.abs(a[both] - b[both]), initial=0.0))
+
+
+def compare_with(rev: str, pairs: int) -> dict:
+    """Timing ratio and differences of the maps against the package at ``rev`` (same process)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from ab import baseline_package
+
+    tmp = tempfile.mkdtemp(prefix="stickslip_baseline_")
+    baseline_package(rev, Path(tmp))
+    sys.path.insert(0, tmp)
+    import stickslip_baseline as old
+
+    N = np.linspace(2.0, 200.0, 200)
+    W = np.linspace(0.2, 20.0, 200)
+    old.stability_map(old.Parameters(), N[:3], W[:3])  # compile outside the timing
+    t_old, t_new = [], []
+    for i in range(pairs):
+        for which in ((0, 1) if i % 2 else (1, 0)):
+            pkg = old if which == 0 else stickslip
+            t = time.perf_counter()
+            m = pkg.stability_map(pkg.Parameters(), N, W, boundary=False)
+            (t_old if which == 0 else t_new).append(time.perf_counter() - t)
+            if which == 0:
+                m_old = m
+            else:
+                m_new = m
+    ratios = sorted(n / o for n, o in zip(t_new, t_old))
+    out = {"rev": rev, "pairs": pairs, "map_200x200_old_min_s": min(t_old), "map_200x200_new_min_s": min(t_new),
+           "map_ratio_new_over_old_median": ratios[len(ratios) // 2],
+           "map_max_real_part_max_abs_diff": _max_abs_diff(m_old.max_real_part, m_new.max_real_part),
+           "map_nan_points_old": int(np.isnan(m_old.max_real_part).sum()),
+           "map_nan_points_new": int(np.isnan(m_new.max_real_part).sum())}
+    # boundaries of the paper's maps (100 × 100 as docs/stability.md), old vs new, with timing
+    Nf, Wf = np.linspace(2.0, 200.0, 100), np.linspace(0.2, 20.0, 100)
+    figures = {"fig3a": ("delta_mu", [0.1, 0.2, 0.3]), "fig3b": ("alpha", [2.0, 5.0, 10.0]),
+               "fig4": ("model", ["full", "rotation"])}
+    for name, fam in figures.items():
+        maps, times = {}, {}
+        for label, pkg in (("old", old), ("new", stickslip)):
+            t = time.perf_counter()
+            maps[label] = pkg.stability_map(pkg.Parameters(), Nf, Wf, family=fam)
+            times[label] = time.perf_counter() - t
+        out[name] = {"boundary_max_abs_diff_rad_s": _max_abs_diff(maps["old"].boundary, maps["new"].boundary),
+                     "boundary_roots": int(np.isfinite(maps["new"].boundary).sum()),
+                     "max_real_part_max_abs_diff": _max_abs_diff(maps["old"].max_real_part, maps["new"].max_real_part),
+                     "old_s": times["old"], "new_s": times["new"], "ratio_new_over_old": times["new"] / times["old"]}
+    # every eigenvalue at sample points of all four models
+    worst = 0.0
+    for model in ("full", "x", "y", "rotation"):
+        for Nv, Wv in ((10.0, 0.5), (50.0, 5.0), (100.0, 3.0), (150.0, 12.0), (80.0, -2.0)):
+            a = old.stability.stability(old.Parameters(N=Nv, Omega=Wv), model).eigenvalues
+            b = stickslip.stability.stability(stickslip.Parameters(N=Nv, Omega=Wv), model).eigenvalues
+            worst = max(worst, float(np.max(np.abs(a - b)) / np.max(np.abs(a))))
+    out["eigenvalues_max_relative_diff"] = worst
+    return out
+
+
 def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rev", default=None, help="git revision to compare with (e.g. main)")
+    ap.add_argument("--pairs", type=int, default=5, help="alternating timing pairs of the 200 × 200 map")
+    args = ap.parse_args()
     P = Parameters()
     N = np.linspace(2.0, 200.0, 200)
     W = np.linspace(0.2, 20.0, 200)
@@ -112,6 +190,9 @@ def main():
                      "speedup_ours_vs_baseline": base_per_point / ours_per_point,
                      "max_abs_difference_of_max_real_part": agree},
     }
+    if args.rev is not None:
+        result["against_revision"] = cmp = compare_with(args.rev, args.pairs)
+        print(json.dumps(cmp, indent=1), flush=True)
     print(f"compile / cache load           {compile_s:8.2f} s")
     print(f"200 x 200 map                  {map_s:8.2f} s   goal {GOAL_MAP_S:g} s   ratio {map_s / GOAL_MAP_S:.2f}"
           f"   ({1e6 * ours_per_point:.1f} us/point)")

@@ -8,10 +8,12 @@ the trajectory outlives the point and memory stays flat as the grid grows.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import math
 import time
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -22,7 +24,7 @@ from ..model.parameters import Parameters
 from ..model.variants import DOF_NAMES, STATE_NAMES, resolve_variant
 
 __all__ = ["SweepSpec", "SweepError", "NAMED_ICS", "initial_condition", "COLUMNS", "evaluate", "evaluate_batch",
-           "NEAR_PERTURBATION"]
+           "NEAR_PERTURBATION", "spec_system"]
 
 #: Perturbation of φ added to the equilibrium by the ``near`` initial condition [rad]:
 #: 5 % of φ_e ≈ 0.0197 rad at N = 50 N (Eq. 14), small enough to stay in the basin of a stable
@@ -34,9 +36,13 @@ NAMED_ICS = {
     "zero": "plates at rest, springs undeformed (q = 0, q̇ = 0)",
     "far": "q = 0 with the upper plate carried along by the lower plate's surface (v_r = 0 at "
            "t = 0): ẏ1 = Ω r when y1 is free, else φ̇ = Ω",
-    "near": f"the equilibrium of Eq. (14) with φ raised by {NEAR_PERTURBATION:g} rad",
-    "equilibrium": "the equilibrium of Eq. (14) exactly",
+    "near": f"the equilibrium of Eq. (14) with φ raised by {NEAR_PERTURBATION:g} rad (other models: their "
+            "observed coordinate)",
+    "equilibrium": "the equilibrium of Eq. (14) exactly (other models: their steady sliding)",
 }
+
+#: Named initial conditions that only the plates have.
+PLATES_ONLY_ICS = ("far",)
 
 _SPECIAL_DIMS = ("model", "ic")
 
@@ -49,6 +55,8 @@ def initial_condition(name: str, params: Parameters, model) -> tuple[Any, float 
     """(ic, perturbation) arguments of :func:`stickslip.simulate` for a named initial condition."""
     if name == "zero":
         return "zero", None
+    if params is None and name in PLATES_ONLY_ICS:
+        raise SweepError(f"initial condition {name!r} is defined for the plates only")
     if name == "equilibrium":
         return "equilibrium", None
     if name == "near":
@@ -66,8 +74,14 @@ def initial_condition(name: str, params: Parameters, model) -> tuple[Any, float 
 
 
 # ----------------------------------------------------------------------------- the row schema
-def _columns(n_peaks: int):
-    """(name, width, attrs) of each reduced quantity, in row order."""
+def _columns(n_peaks: int, observed: str | None = None):
+    """(name, width, attrs) of each reduced quantity, in row order.
+
+    ``observed``: None for the plates (the response is φ; the intensities and angles of Eq. 16 and
+    Fig. 11); for any other model the name of its observed coordinate, which the ``phi_*``,
+    ``amplitude`` and ``peaks`` columns then follow, with one ``intensity`` of it instead of the
+    plates' intensities and angles.
+    """
     cols = [
         ("kind", 1, {"long_name": "steady-state kind", "flag_values": "-1 0 1 2 3",
                      "flag_meanings": "failed equilibrium periodic-slip periodic-stick-slip non-periodic",
@@ -103,7 +117,25 @@ def _columns(n_peaks: int):
         ("wall_time", 1, {"units": "s", "long_name": "wall time of the point (simulation and reduction)"}),
         ("peaks", n_peaks, {"units": "rad", "long_name": "last peak values of phi in the steady window (events dphi = 0)"}),
     ]
-    return cols
+    if observed is None:
+        return cols
+    plates_only = ("intensity_r_phi", "intensity_x1", "intensity_y1", "intensity_translation", "angle_min", "angle_max")
+    out = []
+    for name, width, attrs in cols:
+        if name in plates_only:
+            if name == "intensity_r_phi":
+                out.append(("intensity", 1, {"long_name": f"intensity index I of {observed} about steady sliding, "
+                                                          "Eq. (16)", "comment": "unit of the coordinate times s-1/2"}))
+            continue
+        attrs = dict(attrs)
+        for key in ("long_name", "comment"):
+            if key in attrs:
+                attrs[key] = attrs[key].replace("phi", observed)
+        if name in ("amplitude", "phi_min", "phi_max", "phi_mean", "peaks"):
+            attrs.pop("units", None)
+            attrs["coordinate"] = observed
+        out.append((name, width, attrs))
+    return out
 
 
 #: Columns of the default schema (64 peaks), for reference.
@@ -149,6 +181,10 @@ class SweepSpec:
         Number of (last) peak values kept per point.
     method : str
         Integration method.
+    system : dict or None
+        A model other than the plates, as :func:`~stickslip.model.library.describe_system` writes
+        it (then ``params`` are its parameters, ``model`` its name, and a dimension name is one of
+        its parameter paths, e.g. ``contact.0.drive``); None for the plates.
     """
 
     dims: tuple
@@ -166,43 +202,58 @@ class SweepSpec:
     max_steps: int = 5_000_000
     n_peaks: int = 64
     method: str = "event"
+    system: dict | None = None
 
     @classmethod
-    def build(cls, grid: Mapping[str, Sequence], params: Parameters | None = None, *, t_end: float = 200.0,
+    def build(cls, grid: Mapping[str, Sequence], params=None, *, t_end: float = 200.0,
               t_from: float | None = None, **options) -> "SweepSpec":
-        """Validate a grid ``{name: values}`` and options into a spec (see the attributes)."""
-        params = Parameters() if params is None else params
-        if not isinstance(params, Parameters):
-            raise SweepError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
+        """Validate a grid ``{name: values}`` and options into a spec (see the attributes).
+
+        ``params``: the plates' :class:`Parameters` (default Table 1), or any model (a
+        FrictionModel, library name or model file; also accepted as the ``model`` option).
+        """
+        system = _resolve_model(params, options)
+        if system is None:
+            params = Parameters() if params is None else params
+            fields = {f.name for f in dataclasses.fields(Parameters)} - {"friction_law"}
+            states = STATE_NAMES
+        else:
+            fields = {k for k, v in system.parameters.items() if not isinstance(v, str)}
+            states = tuple(system.dofs) + tuple("d" + d for d in system.dofs)
         if not grid:
             raise SweepError("the grid is empty; give at least one dimension, e.g. {'N': [30, 50, 70]}")
-        fields = {f.name for f in dataclasses.fields(Parameters)} - {"friction_law"}
         dims = []
         for name, values in grid.items():
             values = list(np.atleast_1d(np.asarray(values, dtype=object)))
             if not values:
                 raise SweepError(f"dimension {name!r} has no values")
+            if system is not None and name not in _SPECIAL_DIMS and not name.startswith("perturb_"):
+                name = _canonical(system, name)
             if name in _SPECIAL_DIMS:
                 values = [str(v) for v in values]
                 for v in values:
-                    if name == "ic" and v not in NAMED_ICS:
-                        raise SweepError(f"ic value {v!r} unknown; choose from {', '.join(NAMED_ICS)}")
+                    if name == "ic":
+                        _check_ic(v, system)
                     if name == "model":
+                        if system is not None:
+                            raise SweepError(f"cannot sweep 'model' with model {system.name!r}: the variants "
+                                             "belong to the plates; run one sweep per model")
                         resolve_variant(v)
-            elif name in fields or (name.startswith("perturb_") and name[8:] in STATE_NAMES):
+            elif name in fields or (name.startswith("perturb_") and name[8:] in states):
                 try:
                     values = [float(v) for v in values]
                 except (TypeError, ValueError):
                     raise SweepError(f"dimension {name!r} needs numbers, got {values!r}") from None
                 if not all(math.isfinite(v) for v in values):
                     raise SweepError(f"dimension {name!r} has non-finite values")
-                if name in fields:
-                    params.replace(**{name: values[0]})  # validates (e.g. N > 0) before any run
-                    params.replace(**{name: values[-1]})
+                if name in fields:  # validates (e.g. N > 0) before any run
+                    for v in (values[0], values[-1]):
+                        (params if system is None else system).replace(**{name: v})
             else:
+                special = "'ic'" if system is not None else "'model', 'ic'"
                 raise SweepError(
-                    f"cannot sweep {name!r}: give a parameter ({', '.join(sorted(fields))}), 'model', 'ic' "
-                    f"or perturb_<state> with state one of {', '.join(STATE_NAMES)}"
+                    f"cannot sweep {name!r}: give a parameter ({', '.join(sorted(fields))}), {special} "
+                    f"or perturb_<state> with state one of {', '.join(states)}"
                 )
             if len(set(values)) != len(values):
                 raise SweepError(f"dimension {name!r} repeats a value")
@@ -211,12 +262,18 @@ class SweepSpec:
         t_from = 0.5 * t_end if t_from is None else float(t_from)
         if not 0.0 <= t_from < t_end:
             raise SweepError(f"t_from = {t_from} s must lie in [0, t_end = {t_end} s)")
-        model = str(options.pop("model", "full"))
-        resolve_variant(model)
         ic = str(options.pop("ic", "zero"))
-        if ic not in NAMED_ICS:
-            raise SweepError(f"ic {ic!r} unknown; choose from {', '.join(NAMED_ICS)}")
-        spec = cls(dims=tuple(dims), params=params.to_dict(), model=model, ic=ic, t_end=t_end, t_from=t_from, **options)
+        _check_ic(ic, system)
+        if system is None:
+            model = str(options.pop("model", "full"))
+            resolve_variant(model)
+            base = dict(params=params.to_dict(), model=model)
+        else:
+            from ..model.library import describe_system
+
+            options.pop("model", None)
+            base = dict(params=dict(system.parameters), model=system.name, system=describe_system(system))
+        spec = cls(dims=tuple(dims), ic=ic, t_end=t_end, t_from=t_from, **base, **options)
         if spec.n_peaks < 1:
             raise SweepError("n_peaks must be >= 1")
         if spec.sample_rate * (t_end - t_from) < 8:
@@ -240,7 +297,10 @@ class SweepSpec:
 
     @property
     def columns(self):
-        return _columns(self.n_peaks)
+        if self.system is None:
+            return _columns(self.n_peaks)
+        system = spec_system(self)
+        return _columns(self.n_peaks, system.dofs[system.observed_index])
 
     @property
     def row_width(self) -> int:
@@ -254,6 +314,8 @@ class SweepSpec:
     def to_json(self) -> str:
         d = dataclasses.asdict(self)
         d["dims"] = [[n, list(v)] for n, v in self.dims]
+        if d["system"] is None:  # the plates' specs (and digests) read as before models were added
+            del d["system"]
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -268,6 +330,61 @@ class SweepSpec:
         return hashlib.sha256(self.to_json().encode()).hexdigest()[:16]
 
 
+def _resolve_model(params, options: dict):
+    """The model of a sweep other than the plates, or None for the plates (variants, Parameters)."""
+    from ..model.library import resolve_system
+    from ..model.library.two_plates import NAME as TWO_PLATES
+    from ..model.system_model import FrictionModel
+
+    model = options.get("model")
+    if params is not None and not isinstance(params, (Parameters, FrictionModel, str, Path)):
+        raise SweepError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
+    if isinstance(params, Parameters) or (params is None and (model is None or isinstance(model, str)
+                                                              and not _is_model_name(model))):
+        return None
+    system = resolve_system(params, model)
+    if system.name == TWO_PLATES:
+        raise SweepError("give the plates as Parameters with model= one of full, x, y, rotation")
+    if system.builder is None or system.spec is None:
+        raise SweepError(f"model {system.name!r} was defined in Python and cannot be rebuilt by the sweep's workers; "
+                         "state it as a model file (.toml)")
+    return system
+
+
+def _is_model_name(text: str) -> bool:
+    from ..model.library import _is_model_name as is_model
+
+    return is_model(text)
+
+
+def _canonical(system, name: str) -> str:
+    """The model's own name of a parameter path (``stiffness.x.x`` → ``stiffness.0.0``)."""
+    try:
+        return system.resolver(name) if system.resolver is not None else name
+    except Exception:  # an unknown path is reported with the valid names below
+        return name
+
+
+def _check_ic(ic: str, system) -> None:
+    if ic not in NAMED_ICS:
+        raise SweepError(f"ic {ic!r} unknown; choose from {', '.join(NAMED_ICS)}")
+    if system is not None and ic in PLATES_ONLY_ICS:
+        raise SweepError(f"ic {ic!r} is defined for the plates only; for model {system.name!r} choose from "
+                         f"{', '.join(k for k in NAMED_ICS if k not in PLATES_ONLY_ICS)}")
+
+
+@functools.lru_cache(maxsize=8)
+def _system_from_json(text: str):
+    from ..model.library import system_from_description
+
+    return system_from_description(json.loads(text))
+
+
+def spec_system(spec: "SweepSpec"):
+    """The model of a sweep other than the plates (rebuilt once per process), or None."""
+    return None if spec.system is None else _system_from_json(json.dumps(spec.system, sort_keys=True))
+
+
 # ----------------------------------------------------------------------------- one point
 def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     """Simulate one grid point and reduce it to a row of :attr:`SweepSpec.row_width` numbers."""
@@ -280,16 +397,24 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     start = time.perf_counter()
     values = spec.point(flat_index)
     changes = {k: v for k, v in values.items() if k not in _SPECIAL_DIMS and not k.startswith("perturb_")}
-    params = Parameters.from_dict(spec.params).replace(**changes) if changes else Parameters.from_dict(spec.params)
-    model = values.get("model", spec.model)
-    ic, pert = initial_condition(values.get("ic", spec.ic), params, model)
+    system = spec_system(spec)
+    if system is None:
+        params = Parameters.from_dict(spec.params).replace(**changes) if changes else Parameters.from_dict(spec.params)
+        model = values.get("model", spec.model)
+        ic, pert = initial_condition(values.get("ic", spec.ic), params, model)
+        n, observed, state_names = 6, 4, STATE_NAMES
+    else:
+        params = system.replace(**changes) if changes else system
+        model = None
+        ic, pert = initial_condition(values.get("ic", spec.ic), None, None)
+        n, observed, state_names = params.n, params.observed_index, tuple(params.dofs) + tuple("d" + d for d in params.dofs)
     deltas = {k[8:]: v for k, v in values.items() if k.startswith("perturb_")}
     if deltas:
-        vec = np.zeros(12)
+        vec = np.zeros(2 * n)
         if pert is not None:
-            vec[4] += pert
+            vec[observed] += pert
         for name, v in deltas.items():
-            vec[STATE_NAMES.index(name)] += v
+            vec[state_names.index(name)] += v
         pert = vec
     out = {name: math.nan for name, _, _ in spec.columns}
     peaks = np.full(spec.n_peaks, math.nan)
@@ -318,7 +443,7 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         c = verdict.classification
         t_from = traj.steady_from
         sel = traj.t >= t_from
-        phi = traj.states[sel, 4]
+        phi = traj.states[sel, observed]
         out.update(kind=float(kind_code(verdict.kind)), attractor=float(verdict.code), settled=float(verdict.settled),
                    period_count=float(verdict.period_count or 0), period=verdict.period_s,
                    fundamental_frequency=_nan(verdict.fundamental_frequency_hz), frequency=c.frequency_hz,
@@ -329,9 +454,12 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
                    n_peaks=float(len(c.peaks)))
         tt = traj.transitions.time
         out["n_transitions"] = float(np.sum((tt > t_from) & (tt <= traj.t[-1])))
-        for key, val in trajectory_intensities(traj, t_from).items():
-            out[f"intensity_{key}"] = val
-        out["angle_min"], out["angle_max"] = angle_range(traj, t_from)
+        if system is None:
+            for key, val in trajectory_intensities(traj, t_from).items():
+                out[f"intensity_{key}"] = val
+            out["angle_min"], out["angle_max"] = angle_range(traj, t_from)
+        else:
+            out["intensity"] = _observed_intensity(traj, params, observed, t_from)
         last = c.peaks.value[-spec.n_peaks:]
         peaks[: last.size] = last
     out["wall_time"] = time.perf_counter() - start
@@ -341,6 +469,18 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         row[j : j + width] = peaks if name == "peaks" else out[name]
         j += width
     return row
+
+
+def _observed_intensity(traj, system, observed: int, t_from: float) -> float:
+    """Eq. (16) of the observed coordinate about its steady-sliding value (NaN without one)."""
+    from ..analysis.intensity import intensity
+    from ..stability.equilibrium import EquilibriumError, steady_sliding
+
+    try:
+        q_e = steady_sliding(system)[observed]
+    except EquilibriumError:
+        return math.nan
+    return intensity(traj.t, traj.states[:, observed], q_e, t_from=t_from)
 
 
 def _nan(x) -> float:

@@ -258,7 +258,8 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
     attrs = {
         "format": FORMAT,
         "stickslip_version": __version__,
-        "title": "stickslip parameter sweep of the two-plate friction model (reductions per point)",
+        "title": f"stickslip parameter sweep of the {'two-plate' if spec.system is None else spec.model} friction "
+                 "model (reductions per point)",
         "spec": spec.to_json(),
         "digest": spec.digest,
         "parameters": json.dumps(spec.params),
@@ -269,6 +270,12 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
         "complete": int(done.all()),
     }
     attrs.update(parameter_attrs(spec.params))
+    if spec.system is not None:
+        from .spec import spec_system
+
+        system = spec_system(spec)
+        attrs["system"] = json.dumps(spec.system)
+        attrs["observed"] = system.dofs[system.observed_index]
     attrs.update(extra_attrs or {})
     base = xr.Dataset({"done": (spec.names, done.reshape(spec.shape).astype(np.int8),
                                 {"long_name": "point computed (1) or pending (0)"})},
