@@ -33,6 +33,9 @@ _SCHEDULER_HELP = "dask.distributed scheduler address, e.g. tcp://head-node:8786
 _TEND_HELP = "Simulated time of every grid point [s]."
 _TFROM_HELP = "Start of the steady-state window [s] (default t_end/2)."
 _SET_HELP = "Any base parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."
+_SETTLE_HELP = ("Extend every run from its end until it has settled (or reaches --cap); --t-end is then the first "
+                "run's length and --t-end minus --t-from the window and the step.")
+_CAP_HELP = "Longest run of a point when settling [s] (default 2000)."
 
 
 def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
@@ -114,6 +117,18 @@ def _executor(executor: str | None, scheduler: str | None) -> str:
     return executor
 
 
+def _settle_options(settle: bool, cap: float | None, t_end: float) -> dict:
+    """``settle`` and ``cap`` of the sweep spec from ``--settle`` / ``--cap``."""
+    if cap is None:
+        return {"settle": True} if settle else {}
+    if not settle:
+        raise CLIError("--cap is the longest run when settling; give --settle with it")
+    check_positive({"--cap": cap})
+    if not cap >= t_end:
+        raise CLIError(f"--cap {cap:g} must be >= --t-end {t_end:g} (the first run's length)")
+    return {"settle": True, "cap": cap}
+
+
 def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
     if workers is not None and workers < 1:
         raise CLIError(f"--workers must be >= 1, got {workers}")
@@ -169,6 +184,8 @@ def sweep_command(
     sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
+    settle: bool = typer.Option(False, "--settle", help=_SETTLE_HELP),
+    cap: Optional[float] = typer.Option(None, "--cap", help=_CAP_HELP),
     set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
@@ -199,6 +216,7 @@ def sweep_command(
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
     _check_grid(values)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+    options.update(_settle_options(settle, cap, t_end))
     check_resumable_output(out, not no_plot, overwrite)
     result = run_sweep(values, params, out=out, model=model, ic=ic, **options)
     figure = None
@@ -229,6 +247,8 @@ def bifurcation(
     sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
+    settle: bool = typer.Option(False, "--settle", help=_SETTLE_HELP),
+    cap: Optional[float] = typer.Option(None, "--cap", help=_CAP_HELP),
     set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
@@ -255,6 +275,7 @@ def bifurcation(
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
     _check_grid(grid, n_peaks)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
+    options.update(_settle_options(settle, cap, t_end))
     check_resumable_output(out, not no_plot, overwrite)
     result = run_sweep(grid, params, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
     figure = None
