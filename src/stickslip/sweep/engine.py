@@ -98,7 +98,7 @@ def _progress_bar():
                     transient=False)
 
 
-def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = None, *, out=None,
+def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
           executor: str = "processes", workers: int | None = None, address: str | None = None,
           batch_size: int | str = "auto", progress: bool = False, overwrite: bool = False,
           snapshot_interval: float = 60.0, keep_journal: bool = False, t_end: float = 200.0,
@@ -108,11 +108,14 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params: Parameters | None = 
     Parameters
     ----------
     grid : dict of name → values, or SweepSpec
-        Swept dimensions in order: parameter names (``N`` [N], ``Omega`` [rad/s], ``delta_mu``,
-        ``alpha`` [s/m], any field of :class:`~stickslip.Parameters`), ``model``, ``ic`` (named
-        initial conditions, :data:`~stickslip.sweep.spec.NAMED_ICS`) or ``perturb_<state>``.
-    params : Parameters, optional
-        Base parameters (default Table 1 with N = 50 N, Ω = 5 rad/s).
+        Swept dimensions in order: parameter names (for the plates ``N`` [N], ``Omega`` [rad/s],
+        ``delta_mu``, ``alpha`` [s/m], any field of :class:`~stickslip.Parameters`; for another
+        model its parameter paths, e.g. ``contact.0.drive``), ``model`` (the plates' variants),
+        ``ic`` (named initial conditions, :data:`~stickslip.sweep.spec.NAMED_ICS`) or
+        ``perturb_<state>``.
+    params : Parameters, FrictionModel or str, optional
+        The plates' base parameters (default Table 1 with N = 50 N, Ω = 5 rad/s), or any model
+        stated as a model file (a FrictionModel read from one, a library name or a path).
     out : path, optional
         NetCDF output (``.nc``). Finished points are journaled beside it (``OUT.nc.journal``) as
         they arrive; a sweep killed and restarted with the same arguments recomputes nothing it
