@@ -99,8 +99,10 @@ def _grid_axes(ax, smap):
     (ne, ns), (we, ws) = cell_edges(smap.N), cell_edges(smap.Omega)
     grid_axis(ax, "x", ne, ns)
     grid_axis(ax, "y", we, ws)
-    ax.set_xlabel("normal load N [N]")
-    ax.set_ylabel("Ω [rad/s]")
+    axes = getattr(smap, "axes", ("N", "Omega"))
+    plates = tuple(axes) == ("N", "Omega")
+    ax.set_xlabel("normal load N [N]" if plates else axes[0])
+    ax.set_ylabel("Ω [rad/s]" if plates else axes[1])
     return ne, we
 
 
@@ -143,6 +145,8 @@ def _draw_boundaries(ax, smap):
 def _fixed_text(smap) -> str:
     """``"model full, μk = 0.2, Δμ = 0.1, α = 5 s/m"``: what all members share."""
     p = smap.params
+    if p is None:  # a model other than the plates: its name
+        return f"model {smap.model}"
     fixed = {name: param_text(name, getattr(p, name)) for name in ("mu_k", "delta_mu", "alpha")}
     fixed.pop(smap.family_name, None)
     model = "" if smap.family_name == "model" else f"model {smap.model}, "
