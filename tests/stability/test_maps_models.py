@@ -132,3 +132,12 @@ def test_map_bad_axes():
     with pytest.raises(ValueError, match="family of models"):
         stability_map("belt", [1.0, 2.0], [1.0, 2.0], axes=("contact.0.normal_force", "contact.0.drive"),
                       family=("model", ["full"]))
+
+
+def test_figure_of_a_model_map_names_its_parameters(tmp_path):
+    from stickslip.plot.stability import plot_stability_map, save_stability_map_figure
+
+    m = stability_map("belt", [0.5, 1.0, 1.5], [0.5, 1.5, 2.5], axes=("contact.0.normal_force", "contact.0.drive"))
+    assert save_stability_map_figure(m, tmp_path / "belt.png").stat().st_size > 10_000
+    ax = plot_stability_map(m)
+    assert ax.get_xlabel() == "contact.0.normal_force" and ax.get_ylabel() == "contact.0.drive"
