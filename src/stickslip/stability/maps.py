@@ -114,7 +114,7 @@ class _Axis:
         self.base_row = rows[0]
         self.changed = np.any(rows != rows[0], axis=0)
         self.fast = False
-        if len(probes) == 3 and rows.shape[1] == _row(base).shape[0]:
+        if len(probes) == 3:
             v = np.array(probes)
             slope = (rows[1] - rows[0]) / (v[1] - v[0])
             icpt = rows[0] - slope * v[0]
