@@ -14,8 +14,8 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_finite, check_memory,
-                   check_outputs, console)
+from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
+                   check_memory, check_outputs, console)
 
 _N_HELP = "Normal preload N [N] (default 50)."
 _OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
@@ -28,22 +28,24 @@ def stability(
     mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
-    """Equilibrium of steady sliding (Eq. 14) and its eigenvalues (Eq. 15)."""
+    """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
     from ..stability.analysis import stability as run_stability
 
-    params, _ = build_parameters(config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-    result = run_stability(params, model=model)
+    system, _ = build_system(model, config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    result = run_stability(system)
     if as_json:
         print(json.dumps(result.summary()))
         return
     p = result.params
-    eq = Table(title=f"steady sliding: model {result.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
-                     f"μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}")
+    title = f"steady sliding: model {result.model}"
+    if p is not None:
+        title += f", N = {p.N:g} N, Ω = {p.Omega:g} rad/s, μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}"
+    eq = Table(title=title)
     for name in result.dofs:
         eq.add_column(name, justify="right")
     eq.add_row(*[f"{result.equilibrium_dict[d]:.6g}" for d in result.dofs])
@@ -93,36 +95,47 @@ def stability_map(
     omega_min: float = typer.Option(0.2, "--omega-min", help="Smallest Ω [rad/s] (the range must not straddle 0)."),
     omega_max: float = typer.Option(20.0, "--omega-max", help="Largest Ω [rad/s]."),
     omega_points: int = typer.Option(100, "--omega-points", help="Number of Ω values (brackets for the boundary search)."),
-    family: Optional[str] = typer.Option(None, "--family", help="Third parameter and its values, e.g. delta_mu=0.1,0.2,0.3 or model=full,rotation."),
+    axis: Optional[List[str]] = typer.Option(None, "--axis", help="An axis as PATH=start:stop:count or PATH=v1,v2,... "
+                                             "(give two: the first is x, the boundary is sought along the second), "
+                                             "e.g. --axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57. "
+                                             "Default for the plates: N and Ω from the options above."),
+    family: Optional[str] = typer.Option(None, "--family", help="Third parameter and its values, e.g. delta_mu=0.1,0.2,0.3, "
+                                         "model=full,rotation or contact.0.friction.alpha=1.5,2."),
     mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help="full | x | y | rotation or DOFs (ignored with --family model=...)."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP + " (Plates variants are ignored with --family model=...)"),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    no_boundary: bool = typer.Option(False, "--no-boundary", help="Skip the root-finding of the boundary Ω_c(N)."),
+    no_boundary: bool = typer.Option(False, "--no-boundary", help="Skip the root-finding of the boundary along the second axis."),
     out: Path = typer.Option(Path("stability_map.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary instead of the table."),
 ) -> None:
-    """Stable/unstable regions of steady sliding over (N, Ω), with the boundary by root finding (Figs. 3, 4)."""
+    """Stable/unstable regions of steady sliding over two parameters of any model, with the boundary by
+    root finding (plates: (N, Ω), Figs. 3, 4)."""
     from ..stability.maps import parse_family
     from ..stability.maps import stability_map as run_map
 
-    params, _ = build_parameters(config, set_, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-    _check_axis("N", n_min, n_max, n_points)
-    _check_axis("omega", omega_min, omega_max, omega_points)
     try:
         members = parse_family(family)
     except ValueError as exc:  # the parser's messages name the fix; here they also name the option
         raise CLIError(f"--family: {exc}") from None
-    if members is not None and members[0] in ("N", "Omega"):
+    names, values = _map_axes(axis, (n_min, n_max, n_points), (omega_min, omega_max, omega_points))
+    if members is not None and members[0] in names:
         raise CLIError(f"--family {family}: {members[0]} is an axis of the map; choose another parameter or model")
-    _check_grid_memory(n_points, omega_points, 1 if members is None else len(members[1]))
+    swept = ({name: f"--axis {name}" for name in names} if axis else
+             {"N": "--N-min/--N-max", "Omega": "--omega-min/--omega-max"})
+    if members is not None and members[0] != "model":
+        swept[members[0]] = f"--family {members[0]}"
+    system, _ = build_system(model, config, set_, swept=swept, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    if axis is None and system.name != "two-plates":
+        raise CLIError(f"model {system.name!r} has no N and Ω: give its two axes, e.g. "
+                       "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
+    _check_grid_memory(values[0].size, values[1].size, 1 if members is None else len(members[1]))
     check_outputs(out, not no_plot, overwrite)
-    N, W = np.linspace(n_min, n_max, n_points), np.linspace(omega_min, omega_max, omega_points)
-    smap = run_map(params, N, W, model=model, family=members, boundary=not no_boundary)
+    smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
     out.parent.mkdir(parents=True, exist_ok=True)
     smap.to_netcdf(out)
     figure = None
@@ -141,10 +154,11 @@ def stability_map(
             "boundary_points": int(np.sum(np.isfinite(smap.boundary[f]))),
         })
     if as_json:
-        print(json.dumps({"out": str(out), "figure": None if figure is None else str(figure),
+        print(json.dumps({"out": str(out), "figure": None if figure is None else str(figure), "axes": list(names),
                           "family": smap.family_name, "members": rows, "timings": smap.timings}))
         return
-    table = Table(title=f"stability map {n_points} × {omega_points} (N × Ω), model {smap.model}")
+    table = Table(title=f"stability map {values[0].size} × {values[1].size} ({names[0]} × {names[1]}), "
+                        f"model {smap.model}")
     for head in ("member", "unstable fraction", "no equilibrium", "boundary points"):
         table.add_column(head)
     for r in rows:
@@ -154,3 +168,29 @@ def stability_map(
     t = smap.timings
     console.print(f"grid {t['grid_s']:.2f} s, boundary {t['boundary_s']:.2f} s; wrote {out}"
                   + ("" if figure is None else f", {figure}"))
+
+
+def _map_axes(axis: list[str] | None, n_range: tuple, omega_range: tuple) -> tuple[tuple[str, str], list]:
+    """The map's two parameter names and values: from ``--axis`` (two), else N and Ω of the plates' options."""
+    from .sweep import parse_values
+
+    if not axis:
+        _check_axis("N", *n_range)
+        _check_axis("omega", *omega_range)
+        return ("N", "Omega"), [np.linspace(*n_range), np.linspace(*omega_range)]
+    if len(axis) != 2:
+        raise CLIError(f"give --axis exactly twice (the map's two parameters), got {len(axis)}")
+    names, values = [], []
+    for item in axis:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise CLIError(f"--axis expects PATH=VALUES, got {item!r}; e.g. --axis contact.0.drive=0.2:3:57")
+        vals = np.asarray(parse_values(name, text, option="--axis"), dtype=float)
+        if vals.size < 2 or not np.all(np.diff(vals) > 0):
+            raise CLIError(f"--axis {item}: give at least 2 increasing values, e.g. {name}=0.2:3:57")
+        names.append(name)
+        values.append(vals)
+    if names[0] == names[1]:
+        raise CLIError(f"--axis {names[0]} given twice; the map needs two different parameters")
+    return (names[0], names[1]), values

@@ -16,8 +16,9 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_finite, check_memory,
-                   check_positive, check_resumable_output, check_samples, config_values, console, parse_assignments)
+from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
+                   check_finite, check_memory, check_positive, check_resumable_output, check_samples, config_values,
+                   console, parse_assignments)
 
 _CATEGORICAL = ("model", "ic")
 
@@ -32,7 +33,7 @@ _WORKERS_HELP = "Worker processes (default: all cores); with dask and no --sched
 _SCHEDULER_HELP = "dask.distributed scheduler address, e.g. tcp://head-node:8786 (implies --executor dask)."
 _TEND_HELP = "Simulated time of every grid point [s]."
 _TFROM_HELP = "Start of the steady-state window [s] (default t_end/2)."
-_SET_HELP = "Any base parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."
+_SET_HELP = SET_HELP
 _SETTLE_HELP = ("Extend every run from its end until it has settled (or reaches --cap); --t-end is then the first "
                 "run's length and --t-end minus --t-from the window and the step.")
 _CAP_HELP = "Longest run of a point when settling [s] (default 2000)."
@@ -129,6 +130,26 @@ def _settle_options(settle: bool, cap: float | None, t_end: float) -> dict:
     return {"settle": True, "cap": cap}
 
 
+def _sweep_target(system) -> tuple:
+    """(params, model) for the sweep library: the plates' Parameters and variant, or the model itself."""
+    from ..model.parameters import Parameters
+
+    if system.name != "two-plates":
+        return system, None
+    values = dict(system.parameters)
+    variant = values.pop("variant", "full")
+    return Parameters.from_dict(values), variant
+
+
+def _plot_columns(system) -> tuple[str, ...]:
+    """The reductions a sweep of ``system`` keeps (those ``--plot`` may draw)."""
+    from ..sweep.spec import COLUMNS, _columns
+
+    if system.name == "two-plates":
+        return COLUMNS
+    return tuple(c[0] for c in _columns(64, system.dofs[system.observed_index]))
+
+
 def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
     if workers is not None and workers < 1:
         raise CLIError(f"--workers must be >= 1, got {workers}")
@@ -175,9 +196,10 @@ def _report(title: str, out: Path, figure, timings: dict, ds, as_json: bool, ext
 @app.command("sweep")
 def sweep_command(
     grid: Optional[List[str]] = typer.Option(None, "--grid", help="Swept dimension NAME=start:stop:count or NAME=v1,v2,... "
-                                             "(repeatable; order = dimension order). NAME: a parameter (N, Omega, "
-                                             "delta_mu, alpha, mu_k, k_px, ...), model, ic or perturb_<state>."),
-    model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) when not swept."),
+                                             "(repeatable; order = dimension order). NAME: a parameter (plates: N, "
+                                             "Omega, delta_mu, alpha, mu_k, k_px, ...; other models: a path such as "
+                                             "contact.0.drive), model (plates variants), ic or perturb_<state>."),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP + " (Plates: the variant when not swept.)"),
     ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium (see docs/sweeps.md) when not swept."),
     t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
     t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
@@ -206,19 +228,18 @@ def sweep_command(
     frequency, stick fraction, intensity (Eq. 16), relative-motion angle.
     """
     from ..sweep import sweep as run_sweep
-    from ..sweep.spec import COLUMNS
-
-    from ..model.parameters import Parameters
 
     values = parse_grid(grid)
-    params, _ = build_parameters(config, set_, swept={k: f"--grid {k}" for k in values if k in Parameters.names()})
-    if plot_var not in COLUMNS or plot_var == "peaks":
-        raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in COLUMNS if c != 'peaks')}")
+    system, _ = build_system(model, config, set_, swept={k: f"--grid {k}" for k in values})
+    target, variant = _sweep_target(system)
+    columns = _plot_columns(system)
+    if plot_var not in columns or plot_var == "peaks":
+        raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in columns if c != 'peaks')}")
     _check_grid(values)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     options.update(_settle_options(settle, cap, t_end))
     check_resumable_output(out, not no_plot, overwrite)
-    result = run_sweep(values, params, out=out, model=model, ic=ic, **options)
+    result = run_sweep(values, target, out=out, model=variant, ic=ic, **options)
     figure = None
     if not no_plot:
         from ..plot.sweep import save_sweep_figure
@@ -231,7 +252,8 @@ def sweep_command(
 # ----------------------------------------------------------------------------- stickslip bifurcation
 @app.command("bifurcation")
 def bifurcation(
-    param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter."),
+    param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter "
+                                                  "of the plates; for another model a path such as contact.0.drive."),
     range_: str = typer.Option("10:130:121", "--range", help="Its values: start:stop:count or v1,v2,..."),
     N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not the control parameter (default 50)."),
     omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not the control parameter "
@@ -239,7 +261,8 @@ def bifurcation(
     mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
     delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
     alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help="full | x | y | rotation, or a comma list (one panel each, Fig. 14)."),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP + " For the plates also a comma list of variants "
+                                                                  "(one panel each, Fig. 14)."),
     ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium."),
     t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
     t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
@@ -266,10 +289,20 @@ def bifurcation(
     if param in _CATEGORICAL:
         raise CLIError(f"--param {param}: the control parameter must be numeric; use --model full,x,y,rotation "
                        "for one panel per model")
+    from ..model.library import plates_variant
+
     named = dict(N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
-    params = _bifurcation_parameters(config, set_, named, param)
     values = parse_values(param, range_, option="--range")
     models = parse_values("model", model, option="--model") if "," in model else [model]
+    coordinate = "φ"
+    if plates_variant(models[0]) is None:  # a library model or a model file
+        if len(models) > 1:
+            raise CLIError(f"--model {model}: a list of models is for the plates' variants; give one model")
+        target, _ = build_system(models[0], config, set_, swept={param: f"--param {param}"}, **named)
+        coordinate = target.dofs[target.observed_index]
+        models = [None]
+    else:
+        target = _bifurcation_parameters(config, set_, named, param)
     grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
@@ -277,13 +310,13 @@ def bifurcation(
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     options.update(_settle_options(settle, cap, t_end))
     check_resumable_output(out, not no_plot, overwrite)
-    result = run_sweep(grid, params, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
+    result = run_sweep(grid, target, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
     figure = None
     if not no_plot:
         from ..plot.sweep import save_bifurcation_figure
 
         figure = save_bifurcation_figure(result, out.with_suffix(".png"))
-    _report(f"bifurcation diagram of φ against {param}", out, figure, result.timings, result.dataset, as_json)
+    _report(f"bifurcation diagram of {coordinate} against {param}", out, figure, result.timings, result.dataset, as_json)
 
 
 #: Base values of the paper's bifurcation diagrams (Figs. 12–14): N = 50 N and Ω = 0.5 rad/s
