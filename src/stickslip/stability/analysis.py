@@ -11,7 +11,7 @@ import numpy as np
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system import System
 from ..model.variants import DOF_NAMES
-from .equilibrium import EquilibriumError, _where, plates_model, solve_steady
+from .equilibrium import EquilibriumError, point_text, plates_model, solve_steady
 
 __all__ = ["StabilityResult", "stability", "linearization", "model_stability", "jacobian_at"]
 
@@ -244,7 +244,7 @@ def model_stability(system) -> StabilityResult:
     q, residual, _ = solve_steady(system)
     J, K_L, C_L = jacobian_at(system, q)
     if not np.all(np.isfinite(J)):
-        raise EquilibriumError(f"the linearisation at steady sliding is not finite ({_where(system)}: overflow); "
+        raise EquilibriumError(f"the linearisation at steady sliding is not finite ({point_text(system)}: overflow); "
                                "give values of physical size")
     lam, vec = np.linalg.eig(J)
     order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending

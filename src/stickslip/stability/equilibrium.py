@@ -20,7 +20,7 @@ from ..model.system import System, assemble
 from . import steady
 
 __all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "solve_equilibrium", "RESIDUAL_TOL",
-           "steady_sliding", "steady_residual", "solve_steady", "plates_model"]
+           "steady_sliding", "steady_residual", "solve_steady", "plates_model", "point_text"]
 
 #: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved. Newton reaches ~1e-16
 #: (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while still
@@ -56,7 +56,7 @@ def _is_plates(system) -> bool:
     return system.name == NAME
 
 
-def _where(system) -> str:
+def point_text(system) -> str:
     """The point in words for messages: the plates' N, Ω and variant, else the model's name."""
     if _is_plates(system):
         p = system.parameters
@@ -104,7 +104,7 @@ def _failure_message(system, q: np.ndarray, status: int, rel: float) -> str:
     elif not _is_plates(system):
         hint = ("; steady sliding may not exist at these parameters (e.g. a friction load that drags the "
                 "contact into a fold)")
-    return (f"no steady-sliding equilibrium found for {_where(system)}: {reason} (relative residual "
+    return (f"no steady-sliding equilibrium found for {point_text(system)}: {reason} (relative residual "
             f"{rel:.2e} > {RESIDUAL_TOL:g}){hint}")
 
 
