@@ -1,0 +1,254 @@
+"""Compiled variational equations of any friction-contact model, and the gradients of its events.
+
+The linearised flow of a smooth segment (every contact in a fixed mode) is Φ̇ = J(s) Φ with J the
+Jacobian of the generic right-hand side :func:`stickslip.model.physics.rhs`: its complex step
+(:func:`stickslip.model.derivatives.state_jacobian`), or, while a 2-D contact slips inside the
+low-speed band (its quasi-static direction is found by a Newton iteration on real numbers, which the
+complex step does not see), central differences of the real right-hand side. Nothing is
+differentiated by hand, so every model the simulator runs has its variational equations.
+
+:func:`integrate_segment` integrates y = [s (2n), Φ (2n × 2n, row-major)] with Dormand–Prince 5(4)
+and stops at the first event of any contact (:data:`EV_MARGIN`, :data:`EV_ZERO`, :data:`EV_ARRIVE`,
+:data:`EV_BAND`), located on the dense output. :func:`contact_gradients` gives the complex-step
+gradients ∂v_c/∂s, ∂F_c/∂s, ∂N_c/∂s of one contact, from which the saltation matrices are built
+(:mod:`.saltation`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..integrate import contacts as E
+from ..integrate import dormand_prince as DP
+from ..model import physics as P
+from ..model.derivatives import state_jacobian
+from ..model.jit import kernel, loop
+
+__all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "integrate_segment", "variational_rhs",
+           "contact_gradients", "event_value"]
+
+#: Per-contact event kinds of a segment. Each event function starts positive; the event is its
+#: first zero. ``EV_MARGIN``: μs N_c − |F_c| of a sticking contact (breakaway).
+#: ``EV_ZERO``: e·v_c of a slipping 1-D contact along its stored direction e (arrival at v_c = 0).
+#: ``EV_ARRIVE``: |v_c| − level of a 2-D contact slipping with the exact direction (the approach to
+#: stick is stopped at a small speed, see :mod:`.saltation`). ``EV_BAND``: level − |v_c| of a 2-D
+#: contact slipping with the quasi-static direction (leaving the low-speed band).
+EV_NONE = 0
+EV_MARGIN = 1
+EV_ZERO = 2
+EV_ARRIVE = 3
+EV_BAND = 4
+
+#: Points per step at which the dense output is checked for an event (as the event integrator).
+EV_CHECKS = 4
+#: Event instants are located on the dense output to this time [s].
+EV_TIME_TOL = 1e-13
+
+
+@kernel
+def event_value(kind, c, s, level, e0, cst, md):
+    """Event function of contact ``c`` of ``kind`` at the state ``s`` (module constants)."""
+    if kind == EV_MARGIN:
+        return P.stick_margin(s, cst, c, md)
+    v0, v1 = P.slip_velocity(s, c, md)
+    if kind == EV_ZERO:
+        return v0 * e0
+    speed = math.sqrt(v0 * v0 + v1 * v1)
+    if kind == EV_ARRIVE:
+        return speed - level
+    if kind == EV_BAND:
+        return level - speed
+    return 1.0
+
+
+@kernel
+def variational_rhs(y, cst, md, n2, steps, use_fd, dy, J, s, z, dz, fp, fm):
+    """d/dt of y = [s, Φ]: ṡ = f(s), Φ̇ = J(s) Φ, in the modes of ``cst``. Fills ``J`` (2n × 2n).
+
+    ``use_fd``: J by central differences of the real right-hand side with ``steps`` (2n,) [state
+    units] (0: column left zero, a locked state); else by complex step. ``s``, ``fp``, ``fm``: float
+    work (2n,); ``z``, ``dz``: complex work (2n,).
+    """
+    for i in range(n2):
+        s[i] = y[i]
+    P.rhs(s, cst, md, dy[:n2])
+    if use_fd:
+        for j in range(n2):
+            h = steps[j]
+            if h == 0.0:
+                for i in range(n2):
+                    J[i, j] = 0.0
+                continue
+            s[j] = y[j] + h
+            P.rhs(s, cst, md, fp)
+            s[j] = y[j] - h
+            P.rhs(s, cst, md, fm)
+            s[j] = y[j]
+            for i in range(n2):
+                J[i, j] = (fp[i] - fm[i]) / (2.0 * h)
+    else:
+        state_jacobian(s, cst, md, J, z, dz)
+    for i in range(n2):
+        for k in range(n2):
+            acc = 0.0
+            for j in range(n2):
+                acc += J[i, j] * y[n2 + n2 * j + k]
+            dy[n2 + n2 * i + k] = acc
+
+
+@kernel
+def _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, s):
+    """(θ, contact) of the earliest event in the accepted step from ``y`` (θ ∈ (0, 1]), or (−1, −1).
+
+    ``g0`` (nc,): the event values at the step start (updated to the step end when none fires).
+    """
+    nc = ev_kind.shape[0]
+    best = -1.0
+    best_c = -1
+    for c in range(nc):
+        kind = ev_kind[c]
+        if kind == EV_NONE:
+            continue
+        a = 0.0
+        ga = g0[c]
+        b = -1.0
+        gb = 0.0
+        for k in range(1, EV_CHECKS + 1):
+            th = k / EV_CHECKS
+            if k == EV_CHECKS:
+                for i in range(n2):
+                    s[i] = ynew[i]
+            else:
+                E.dense_state(y, Q, h, th, work)
+                for i in range(n2):
+                    s[i] = work[i]
+            g = event_value(kind, c, s, ev_level[c], ev_e[c], cst, md)
+            if ga > 0.0 and g <= 0.0:
+                b = th
+                gb = g
+                break
+            a = th
+            ga = g
+        if b < 0.0:
+            continue
+        tol = EV_TIME_TOL / h
+        side = np.int64(0)
+        for _ in range(E.MAX_REFINEMENTS):
+            if gb == 0.0 or (b - a) <= tol:
+                break
+            cc = E.regula_falsi_point(a, ga, b, gb)
+            E.dense_state(y, Q, h, cc, work)
+            for i in range(n2):
+                s[i] = work[i]
+            gc = event_value(kind, c, s, ev_level[c], ev_e[c], cst, md)
+            a, ga, b, gb, side = E.illinois_update(a, ga, b, gb, cc, gc, gc > 0.0, side)
+        if best < 0.0 or b < best:
+            best = b
+            best_c = c
+    return best, best_c
+
+
+@loop
+def integrate_segment(y0, t0, t1, cst, md, n2, steps, use_fd, rtol, atol, ev_kind, ev_level, ev_e, max_steps):
+    """Dormand–Prince 5(4) on y = [s, Φ] (2n + 4n²,) from ``t0`` towards ``t1`` in the modes of
+    ``cst``, stopping at the first event of any contact.
+
+    Parameters
+    ----------
+    ev_kind : ndarray (nc,) int64
+        Event kind of each contact (``EV_*``; ``EV_NONE``: not watched).
+    ev_level : ndarray (nc,)
+        Speed level of ``EV_ARRIVE`` / ``EV_BAND`` [m/s].
+    ev_e : ndarray (nc,)
+        Stored slip direction (±1) of ``EV_ZERO``.
+    atol : ndarray (2n + 4n²,)
+        Absolute tolerances; error control is the RMS of the local error over ``atol + rtol |y|``.
+
+    Returns
+    -------
+    status : int
+        0 reached ``t1``, 1 event, 2 step underflow, 3 ``max_steps``.
+    t : float
+        Time reached [s].
+    y : ndarray
+        State and variations there.
+    contact : int
+        Contact of the event (−1 without).
+    """
+    n = y0.shape[0]
+    nc = ev_kind.shape[0]
+    y = y0.copy()
+    ynew = np.empty(n)
+    ytmp = np.empty(n)
+    work = np.empty(n)
+    Kst = np.empty((7, n))
+    Q = np.empty((n, 4))
+    J = np.empty((n2, n2))
+    s = np.empty(n2)
+    fp = np.empty(n2)
+    fm = np.empty(n2)
+    z = np.empty(n2, dtype=np.complex128)
+    dz = np.empty(n2, dtype=np.complex128)
+    g0 = np.empty(max(nc, 1))
+    for c in range(nc):
+        for i in range(n2):
+            s[i] = y[i]
+        g0[c] = event_value(ev_kind[c], c, s, ev_level[c], ev_e[c], cst, md)
+    variational_rhs(y, cst, md, n2, steps, use_fd, Kst[0], J, s, z, dz, fp, fm)
+    t = t0
+    h = min(1e-4, t1 - t0)  # the controller grows it ×5 per step
+    n_steps = 0
+    while t < t1:
+        if n_steps >= max_steps:
+            return 3, t, y, -1
+        n_steps += 1
+        h = min(h, t1 - t)
+        if h <= 1e-15 * max(1.0, abs(t)):
+            return 2, t, y, -1
+        for stage in range(1, 6):
+            DP.stage_state(y, Kst, h, stage, ytmp)
+            variational_rhs(ytmp, cst, md, n2, steps, use_fd, Kst[stage], J, s, z, dz, fp, fm)
+        DP.stage_state(y, Kst, h, np.int64(6), ynew)
+        variational_rhs(ynew, cst, md, n2, steps, use_fd, Kst[6], J, s, z, dz, fp, fm)
+        total = 0.0
+        for i in range(n):
+            sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
+            total += (DP.local_error(Kst, h, i) / sc) ** 2
+        err_norm = math.sqrt(total / n)
+        if not math.isfinite(err_norm) or err_norm > 1.0:
+            h *= 0.2 if not math.isfinite(err_norm) else max(0.2, 0.9 * err_norm ** -0.2)
+            continue
+        DP.dense_coefficients(Kst, Q)
+        theta, c_ev = _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, s)
+        if c_ev >= 0:
+            E.dense_state(y, Q, h, theta, work)
+            return 1, t + theta * h, work.copy(), c_ev
+        for c in range(nc):
+            for i in range(n2):
+                s[i] = ynew[i]
+            g0[c] = event_value(ev_kind[c], c, s, ev_level[c], ev_e[c], cst, md)
+        t += h
+        for i in range(n):
+            y[i] = ynew[i]
+            Kst[0, i] = Kst[6, i]
+        h *= 5.0 if err_norm == 0.0 else min(5.0, 0.9 * err_norm ** -0.2)
+    return 0, t, y, -1
+
+
+@kernel
+def contact_gradients(s, cst, c, md, n2, Dv, DF, DN, z, F, N, v):
+    """Complex-step gradients of contact ``c`` at the float state ``s`` in the modes of ``cst``:
+    ∂v_c/∂s into ``Dv`` (2 × 2n), ∂F_c/∂s into ``DF`` (2 × 2n; the stick multiplier if c sticks),
+    ∂N_c/∂s into ``DN`` (2n,). ``z`` (2n,), ``F`` (2 nc,), ``N`` (nc,), ``v`` (2 nc,): complex work."""
+    for i in range(n2):
+        z[i] = s[i]
+    for j in range(n2):
+        z[j] = complex(s[j], P.COMPLEX_STEP)
+        P.contact_forces(z, cst, md, F, N, v)
+        for i in range(2):
+            Dv[i, j] = v[2 * c + i].imag / P.COMPLEX_STEP
+            DF[i, j] = F[2 * c + i].imag / P.COMPLEX_STEP
+        DN[j] = N[c].imag / P.COMPLEX_STEP
+        z[j] = s[j]
