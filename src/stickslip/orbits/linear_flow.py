@@ -23,7 +23,6 @@ import numpy as np
 
 from .. import __version__
 from ..integrate import contacts as E
-from ..integrate.driver import SimulationError
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from . import saltation as S
@@ -31,17 +30,13 @@ from . import var_kernels as V
 from .layout import free_states
 from .section import OrbitError, flow
 
-__all__ = ["FlowJacobian", "flow_jacobian", "propagate", "ARRIVAL_SPEED", "FD_REL_STEP"]
+__all__ = ["FlowJacobian", "flow_jacobian", "propagate", "initial_contacts", "ARRIVAL_SPEED"]
 
 #: |v_c| [m/s] at which the integration of a 2-D contact's approach to stick stops and the arrival
 #: jump is applied (the rest of the approach, τ = ρ_c/|dv_c/dt|, enters to first order in τ,
 #: :func:`.saltation.arrival_jump`). With the first-order term the trivial multiplier of the
 #: plates' orbits was 3e-8 off at ρ_c = 1e-7 and 1e-8 m/s alike; without it ≈ 10 ρ_c.
 ARRIVAL_SPEED = 1e-7
-
-#: Relative central-difference step (of the state scale σ) where the Jacobian is differenced
-#: (a 2-D contact inside the low-speed band): ε^(1/3) ≈ 6e-6 balances truncation and round-off.
-FD_REL_STEP = 6e-6
 
 #: Tolerances of the variational segments: rtol as the event integrator of the flow maps; atol on
 #: the states and on the variations.
@@ -110,12 +105,12 @@ class FlowJacobian:
         return xr.Dataset(data, coords={"state": names, "state_0": names}, attrs=attrs)
 
 
-def _steps(system, scale) -> np.ndarray:
-    """Difference steps (2n,) on the free states: FD_REL_STEP × σ (default σ = 1 in each unit)."""
-    free = free_states(system)
-    steps = np.zeros(2 * system.n)
-    steps[free] = FD_REL_STEP * (1.0 if scale is None else np.asarray(scale, dtype=float))
-    return steps
+def _sigma(system, scale) -> np.ndarray:
+    """State scales (2n,) of the consistency checks: σ on the free states (default 1), 1 elsewhere."""
+    sigma = np.ones(2 * system.n)
+    if scale is not None:
+        sigma[free_states(system)] = np.asarray(scale, dtype=float)
+    return sigma
 
 
 def flow_jacobian(system, s0, duration: float, *, rtol: float = 1e-10, atol: float | None = None,
@@ -133,7 +128,7 @@ def flow_jacobian(system, s0, duration: float, *, rtol: float = 1e-10, atol: flo
     rtol, atol : float
         Tolerances of the ``event`` run that gives the transitions (``atol`` default 1e-3 rtol).
     scale : array-like (2 n_free,), optional
-        State scales σ of the free states (difference steps and consistency checks; default 1).
+        State scales σ of the free states (of the consistency checks; default 1).
 
     Raises
     ------
@@ -182,12 +177,12 @@ def initial_contacts(system, s0, rtol: float, atol: float):
 
 def _events_of(system, cst):
     """Per-contact event kinds, levels and stored 1-D directions of a segment in the modes of ``cst``,
-    and whether its Jacobian must be differenced (a 2-D contact in the quasi-static band)."""
+    and whether a 2-D contact slips inside the low-speed band (its direction turns with the state)."""
     nc = system.n_contacts
     kind = np.zeros(nc, dtype=np.int64)
     level = np.zeros(nc)
     e = np.zeros(nc)
-    use_fd = False
+    band = False
     for c in range(nc):
         mode = int(cst[CST * c])
         if mode == P.MODE_STICK:
@@ -199,18 +194,18 @@ def _events_of(system, cst):
             kind[c], level[c] = V.EV_ARRIVE, ARRIVAL_SPEED
         else:
             kind[c], level[c] = V.EV_BAND, system.slip_band
-            use_fd = True
-    return kind, level, e, use_fd
+            band = True
+    return kind, level, e, band
 
 
-def _segment(system, y, Phi, t0, t1, cst, steps, rtol):
+def _segment(system, y, Phi, t0, t1, cst, rtol):
     """Integrate [s, Φ] from t0 towards t1 in the modes of ``cst`` until the first event."""
     n2 = 2 * system.n
-    kind, level, e, use_fd = _events_of(system, cst)
+    kind, level, e, band = _events_of(system, cst)
     y0 = np.concatenate([y[:n2], Phi.ravel()])
     atol = np.full(y0.size, VAR_ATOL_PHI)
     atol[:n2] = VAR_ATOL_STATE
-    status, t, y_end, c = V.integrate_segment(y0, float(t0), float(t1), cst, system.data, n2, steps, use_fd,
+    status, t, y_end, c = V.integrate_segment(y0, float(t0), float(t1), cst, system.data, n2, band,
                                               float(rtol), atol, kind, level, e, MAX_SEGMENT_STEPS)
     if status > 1:
         raise OrbitError(f"variational integration failed at t = {t} s "
@@ -237,7 +232,7 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
     Phi : ndarray (2n, k)
         Initial variations (columns).
     scale : array-like (2 n_free,), optional
-        State scales σ (difference steps, consistency checks).
+        State scales σ of the free states (consistency checks).
     after : callable (t, Phi) -> Phi, optional
         Called after every smooth piece and every jump (e.g. QR re-orthonormalisation).
     max_interval : float
@@ -254,9 +249,7 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
     n2 = 2 * system.n
     free = free_states(system)
     free_q = free[: free.size // 2]
-    steps = _steps(system, scale)
-    sigma = steps / FD_REL_STEP
-    sigma[sigma == 0.0] = 1.0
+    sigma = _sigma(system, scale)
     atol = 1e-3 * rtol if atol is None else atol
     events = []
     mismatch = 0.0
@@ -291,7 +284,7 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
     while t < T:
         t_next = float(tr.time[k]) if k < n_tr else T
         t1 = min(t + max_interval, t_next + 1.0 if k < n_tr else T)
-        seg = _segment(system, y, Phi, t, t1, cst, steps, rtol)
+        seg = _segment(system, y, Phi, t, t1, cst, rtol)
         if not seg.event:
             if k < n_tr and seg.t >= t_next + MATCH_TIME_TOL:
                 raise OrbitError(f"the re-integration did not meet the integrator's transition at {t_next:.9f} s")
@@ -351,5 +344,3 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
     check(y, np.asarray(end)[:n2])
     return Phi[:, :k_cols], events, mismatch
 
-
-__all__ += ["initial_contacts", "SimulationError"]

@@ -3,9 +3,11 @@
 The linearised flow of a smooth segment (every contact in a fixed mode) is Φ̇ = J(s) Φ with J the
 Jacobian of the generic right-hand side :func:`stickslip.model.physics.rhs`: its complex step
 (:func:`stickslip.model.derivatives.state_jacobian`), or, while a 2-D contact slips inside the
-low-speed band (its quasi-static direction is found by a Newton iteration on real numbers, which the
-complex step does not see), central differences of the real right-hand side. Nothing is
-differentiated by hand, so every model the simulator runs has its variational equations.
+low-speed band, the complex step at the quasi-static direction (found by a Newton iteration on real
+numbers, which the complex step does not see) plus the turn of that direction with the state, by the
+implicit function theorem on its defining residual g(θ, s) = 0 (:func:`direction_gradient`, the
+complex step of g at fixed θ). Nothing is differentiated by hand, so every model the simulator runs
+has its variational equations.
 
 :func:`integrate_segment` integrates y = [s (2n), Φ (2n × 2n, row-major)] with Dormand–Prince 5(4)
 and stops at the first event of any contact (:data:`EV_MARGIN`, :data:`EV_ZERO`, :data:`EV_ARRIVE`,
@@ -22,9 +24,14 @@ import numpy as np
 
 from ..integrate import contacts as E
 from ..integrate import dormand_prince as DP
+from ..model import csmath as csm
 from ..model import physics as P
+from ..model.bundle import CST, H_BAND
 from ..model.derivatives import state_jacobian
+from ..model.friction import friction_coefficient
 from ..model.jit import kernel, loop
+from ..model.kinematics import contact_dim, model_sizes
+from ..model.stack import DOFS, ROWS, VECTORS, work_matrix
 
 __all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "integrate_segment", "variational_rhs",
            "contact_gradients", "event_value"]
@@ -64,32 +71,95 @@ def event_value(kind, c, s, level, e0, cst, md):
 
 
 @kernel
-def variational_rhs(y, cst, md, n2, steps, use_fd, dy, J, s, z, dz, fp, fm):
+def direction_residual(s, cst, c, md, ct, st):
+    """(g, ∂g/∂θ, μN, k) of 2-D contact ``c`` slipping inside the low-speed band at the direction
+    e = (ct, st) = (cos θ, sin θ): g = e × A (μ(|v|) N e + F_s), whose stable root is the quasi-static
+    direction (:func:`stickslip.model.physics.quasi_static_direction`), A = G_c M⁻¹ G_cᵀ, F_s the force
+    that would hold the contact with the other sticking contacts; k the stick rows (the direction is
+    quasi-static only for k = 2, no other contact sticking). Generic in the number type of ``s``."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    A = work_matrix(md.kin, ROWS, ROWS, s)
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    w = vec[0]
+    v = vec[1]
+    N = vec[2]
+    h = vec[3]
+    F = vec[4]
+    f = vec[5]
+    P.general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
+        if P.is_stick(cst, c2) or c2 == c:
+            P.add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)
+    P.frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
+    k, a00, a01, a11 = P.solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
+    speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+    muN = friction_coefficient(speed, P.law_row(m, n, c)) * N[c]
+    wx = a00 * F[2 * c] + a01 * F[2 * c + 1]
+    wy = a01 * F[2 * c] + a11 * F[2 * c + 1]
+    c2 = ct * ct - st * st
+    s2 = 2.0 * ct * st
+    g = muN * (a01 * c2 + 0.5 * (a11 - a00) * s2) + (ct * wy - st * wx)
+    dg = muN * (-2.0 * a01 * s2 + (a11 - a00) * c2) - (ct * wx + st * wy)
+    return g, dg, muN, k
+
+
+@kernel
+def band_correction(s, cst, md, n2, J, z, gq):
+    """Add to ``J`` the turn of the quasi-static direction of every 2-D contact inside the low-speed
+    band: J += [0; M⁻¹ G_cᵀ ∂F_c/∂θ] ∇θ, ∇θ = −∇_s g / (∂g/∂θ) (complex step of g at fixed θ), where
+    the direction is quasi-static (k = 2 stick rows and ∂g/∂θ > 0, as the kernel's Newton iteration
+    requires; elsewhere the kernel keeps the stored direction and the complex step alone is exact).
+    ``z`` (2n,) complex, ``gq`` (n,) float work."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    band = m[H_BAND]
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == P.MODE_STICK or mode == P.MODE_SLIP_EXACT or contact_dim(md.kin, m, n, c) != 2:
+            continue
+        v0, v1 = P.slip_velocity(s, c, md)
+        speed = math.sqrt(v0 * v0 + v1 * v1)
+        if mode == P.MODE_SLIP and speed > band:
+            continue
+        ct, st = P.band_direction(s, cst, c, md, speed)
+        g, dg, muN, k = direction_residual(s, cst, c, md, ct, st)
+        if k != 2 or not dg > 0.0:
+            continue
+        # ∂F/∂θ = −μN (−sin θ, cos θ); its generalised force G_cᵀ ∂F/∂θ, through M⁻¹
+        for i in range(n2):
+            z[i] = s[i]
+        for j in range(n):
+            z[n + j] = complex(s[n + j], 1.0)
+            a0, a1 = P.slip_velocity(z, c, md)  # linear in q̇: Im is the column G_c[:, j]
+            gq[j] = muN * st * a0.imag - muN * ct * a1.imag
+            z[n + j] = s[n + j]
+        acc = work_matrix(md.kin, VECTORS, VECTORS, s)[0]
+        P.apply_inverse_mass(m, n, diagonal, gq, acc)
+        for j in range(n2):
+            z[j] = complex(s[j], P.COMPLEX_STEP)
+            gz = direction_residual(z, cst, c, md, ct, st)[0]
+            z[j] = s[j]
+            dtheta = -(gz.imag / P.COMPLEX_STEP) / dg
+            for i in range(n):
+                J[n + i, j] += acc[i] * dtheta
+
+
+@kernel
+def variational_rhs(y, cst, md, n2, band, dy, J, s, z, dz, gq):
     """d/dt of y = [s, Φ]: ṡ = f(s), Φ̇ = J(s) Φ, in the modes of ``cst``. Fills ``J`` (2n × 2n).
 
-    ``use_fd``: J by central differences of the real right-hand side with ``steps`` (2n,) [state
-    units] (0: column left zero, a locked state); else by complex step. ``s``, ``fp``, ``fm``: float
-    work (2n,); ``z``, ``dz``: complex work (2n,).
+    J is the complex step of the right-hand side; ``band``: some 2-D contact slips inside the
+    low-speed band, whose direction turn :func:`band_correction` adds. ``s`` (2n,), ``gq`` (n,):
+    float work; ``z``, ``dz``: complex work (2n,).
     """
     for i in range(n2):
         s[i] = y[i]
     P.rhs(s, cst, md, dy[:n2])
-    if use_fd:
-        for j in range(n2):
-            h = steps[j]
-            if h == 0.0:
-                for i in range(n2):
-                    J[i, j] = 0.0
-                continue
-            s[j] = y[j] + h
-            P.rhs(s, cst, md, fp)
-            s[j] = y[j] - h
-            P.rhs(s, cst, md, fm)
-            s[j] = y[j]
-            for i in range(n2):
-                J[i, j] = (fp[i] - fm[i]) / (2.0 * h)
-    else:
-        state_jacobian(s, cst, md, J, z, dz)
+    state_jacobian(s, cst, md, J, z, dz)
+    if band:
+        band_correction(s, cst, md, n2, J, z, gq)
     for i in range(n2):
         for k in range(n2):
             acc = 0.0
@@ -151,7 +221,7 @@ def _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, 
 
 
 @loop
-def integrate_segment(y0, t0, t1, cst, md, n2, steps, use_fd, rtol, atol, ev_kind, ev_level, ev_e, max_steps):
+def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_level, ev_e, max_steps):
     """Dormand–Prince 5(4) on y = [s, Φ] (2n + 4n²,) from ``t0`` towards ``t1`` in the modes of
     ``cst``, stopping at the first event of any contact.
 
@@ -187,8 +257,7 @@ def integrate_segment(y0, t0, t1, cst, md, n2, steps, use_fd, rtol, atol, ev_kin
     Q = np.empty((n, 4))
     J = np.empty((n2, n2))
     s = np.empty(n2)
-    fp = np.empty(n2)
-    fm = np.empty(n2)
+    gq = np.empty(n2)
     z = np.empty(n2, dtype=np.complex128)
     dz = np.empty(n2, dtype=np.complex128)
     g0 = np.empty(max(nc, 1))
@@ -196,7 +265,7 @@ def integrate_segment(y0, t0, t1, cst, md, n2, steps, use_fd, rtol, atol, ev_kin
         for i in range(n2):
             s[i] = y[i]
         g0[c] = event_value(ev_kind[c], c, s, ev_level[c], ev_e[c], cst, md)
-    variational_rhs(y, cst, md, n2, steps, use_fd, Kst[0], J, s, z, dz, fp, fm)
+    variational_rhs(y, cst, md, n2, band, Kst[0], J, s, z, dz, gq)
     t = t0
     h = min(1e-4, t1 - t0)  # the controller grows it ×5 per step
     n_steps = 0
@@ -209,9 +278,9 @@ def integrate_segment(y0, t0, t1, cst, md, n2, steps, use_fd, rtol, atol, ev_kin
             return 2, t, y, -1
         for stage in range(1, 6):
             DP.stage_state(y, Kst, h, stage, ytmp)
-            variational_rhs(ytmp, cst, md, n2, steps, use_fd, Kst[stage], J, s, z, dz, fp, fm)
+            variational_rhs(ytmp, cst, md, n2, band, Kst[stage], J, s, z, dz, gq)
         DP.stage_state(y, Kst, h, np.int64(6), ynew)
-        variational_rhs(ynew, cst, md, n2, steps, use_fd, Kst[6], J, s, z, dz, fp, fm)
+        variational_rhs(ynew, cst, md, n2, band, Kst[6], J, s, z, dz, gq)
         total = 0.0
         for i in range(n):
             sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
