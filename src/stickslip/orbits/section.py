@@ -128,12 +128,13 @@ def flow(system, s0: np.ndarray, T: float, *, rtol: float, atol: float, max_step
     return traj.final_state, traj.transitions
 
 
-def _state_rates(system, states: np.ndarray, mode: np.ndarray, index: int) -> np.ndarray:
-    """d s[index]/dt at each sample (k,): a velocity for positions, the vector field for velocities."""
+def _state_rates(system, states: np.ndarray, mode: np.ndarray, index: int, where: np.ndarray) -> np.ndarray:
+    """d s[index]/dt at the samples ``where`` (k,; NaN elsewhere): a velocity for positions, the
+    vector field for velocities."""
     if index < system.n:
         return states[:, index + system.n].copy()
-    out = np.empty(states.shape[0])
-    for i in range(states.shape[0]):
+    out = np.full(states.shape[0], np.nan)
+    for i in where:
         out[i] = vector_field(system, states[i], int(mode[i]))[index]
     return out
 
@@ -159,7 +160,8 @@ def section_crossings(system, section: Section, t, states, mode):
         Sample interval [t[i], t[i+1]] of each crossing.
     """
     g = section.direction * (states[:, section.index] - section.value)
-    dg = section.direction * _state_rates(system, states, mode, section.index)
+    up = np.flatnonzero((g[:-1] < 0.0) & (g[1:] >= 0.0))  # the intervals whose ends need the rate
+    dg = section.direction * _state_rates(system, states, mode, section.index, np.union1d(up, up + 1))
     return _hermite_crossings(np.asarray(t, dtype=float), g, dg, 0.0)
 
 
