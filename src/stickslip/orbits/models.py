@@ -17,7 +17,8 @@ from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel, ModelError
 from .section import OrbitError
 
-__all__ = ["resolve", "ModelResult", "parameter_value", "with_parameter", "model_attrs", "is_plates"]
+__all__ = ["resolve", "ModelResult", "parameter_value", "with_parameter", "model_attrs", "is_plates",
+           "plates_parameters"]
 
 
 def resolve(system=None, model=None, slip_band: float | None = None) -> FrictionModel:
@@ -37,6 +38,15 @@ def resolve(system=None, model=None, slip_band: float | None = None) -> Friction
 def is_plates(system: FrictionModel) -> bool:
     """Whether ``system`` is the paper's two plates."""
     return system.name == TWO_PLATES
+
+
+def plates_parameters(system: FrictionModel) -> Parameters | None:
+    """The plates' :class:`Parameters` of ``system`` (None for other models)."""
+    if not is_plates(system):
+        return None
+    values = dict(system.parameters)
+    values.pop("variant", None)
+    return Parameters.from_dict(values)
 
 
 def parameter_value(system: FrictionModel, name: str) -> float:
@@ -89,11 +99,7 @@ class ModelResult:
     @property
     def params(self) -> Parameters | None:
         """The plates' :class:`Parameters` (None for other models: see ``system.parameters``)."""
-        if not is_plates(self.system):
-            return None
-        values = dict(self.system.parameters)
-        values.pop("variant", None)
-        return Parameters.from_dict(values)
+        return plates_parameters(self.system)
 
     @property
     def model(self) -> str:
