@@ -57,7 +57,10 @@ def parameter_value(system: FrictionModel, name: str) -> float:
     OrbitError
         If the model has no such parameter or it is not a finite number.
     """
-    key = system.resolver(name) if system.resolver is not None else name
+    try:
+        key = system.resolver(name) if system.resolver is not None else name
+    except ModelError:
+        key = None
     if key not in system.parameters:
         raise OrbitError(f"unknown parameter {name!r} of model {system.name!r}; valid names: "
                          f"{', '.join(system.parameters)}")
