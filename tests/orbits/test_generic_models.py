@@ -143,3 +143,22 @@ def test_bad_continuation_parameter_and_section():
         continue_orbit(param="contact.0.friction.law", start=start, max_points=2)
     with pytest.raises(OrbitError, match="dof of x"):
         periodic_orbit("belt", {"x": 0.0, "dx": 1.5}, section="phi_max")
+
+
+def test_popp_stelter_spectrum_equals_powers_of_the_fd_monodromy():
+    """Lyapunov spectrum of a model file: over exactly 20 periods of the popp-stelter orbit from
+    its section state, the variational spectrum equals the finite-time exponents of (M_FD)^20, M_FD
+    the finite-difference monodromy (independent of the variational code); the direction that
+    stick collapses is round-off on both sides and not compared."""
+    from tests.orbits.test_lyapunov import finite_time_exponents
+
+    from stickslip.orbits import lyapunov_spectrum
+
+    orbit = periodic_orbit("popp-stelter", {"x1": 0.5, "x2": -0.5}, search_time=200.0, section="x2_max")
+    n = 20
+    L = lyapunov_spectrum(ic=orbit, t_transient=orbit.period, t_average=n * orbit.period)
+    assert L.model == "popp-stelter" and L.exponents.size == 4
+    ref = finite_time_exponents(monodromy(orbit, "finite-difference").matrix, L.scale, n, orbit.period)
+    # the collapsed direction: ln(round-off) per stick phase, and ln(1e-10)/T from the FD matrix's noise
+    assert L.exponents[3] < -20.0 and ref[3] < -5.0
+    assert np.max(np.abs(L.exponents[:3] - ref[:3])) < 1e-5       # measured 1.6e-9 1/s
