@@ -1,9 +1,10 @@
 """Compiled variational equations of any friction-contact model, and the gradients of its events.
 
 The linearised flow of a smooth segment (every contact in a fixed mode) is Φ̇ = J(s) Φ with J the
-Jacobian of the generic right-hand side :func:`stickslip.model.physics.rhs`: its complex step
-(:func:`stickslip.model.derivatives.state_jacobian`), or, while a 2-D contact slips inside the
-low-speed band, the complex step at the quasi-static direction (found by a Newton iteration on real
+Jacobian of the generic right-hand side :func:`stickslip.model.physics.rhs`: J Φ is its directional
+complex step along each column of Φ (as :func:`stickslip.model.derivatives.state_jacobian` takes it
+along each state), or, while a 2-D contact slips inside the low-speed band, that at the quasi-static
+direction (found by a Newton iteration on real
 numbers, which the complex step does not see) plus the turn of that direction with the state, by the
 implicit function theorem on its defining residual g(θ, s) = 0 (:func:`direction_gradient`, the
 complex step of g at fixed θ). Nothing is differentiated by hand, so every model the simulator runs
@@ -27,7 +28,6 @@ from ..integrate import dormand_prince as DP
 from ..model import csmath as csm
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
-from ..model.derivatives import state_jacobian
 from ..model.friction import friction_coefficient
 from ..model.jit import kernel, loop
 from ..model.kinematics import contact_dim, model_sizes
@@ -106,10 +106,11 @@ def direction_residual(s, cst, c, md, ct, st):
 
 
 @kernel
-def band_correction(s, cst, md, n2, J, z, gq):
-    """Add to ``J`` the turn of the quasi-static direction of every 2-D contact inside the low-speed
-    band: J += [0; M⁻¹ G_cᵀ ∂F_c/∂θ] ∇θ, ∇θ = −∇_s g / (∂g/∂θ) (complex step of g at fixed θ), where
-    the direction is quasi-static (k = 2 stick rows and ∂g/∂θ > 0, as the kernel's Newton iteration
+def band_correction(s, cst, md, n2, Phi, out, z, gq):
+    """Add to ``out`` (2n × k) the turn of the quasi-static direction of every 2-D contact inside the
+    low-speed band along the variations ``Phi`` (2n × k): out += [0; M⁻¹ G_cᵀ ∂F_c/∂θ] (∇θ · Φ), with
+    ∇θ · Φ[:, k] = −(∂g/∂s · Φ[:, k]) / (∂g/∂θ) (directional complex step of g at fixed θ), where the
+    direction is quasi-static (k = 2 stick rows and ∂g/∂θ > 0, as the kernel's Newton iteration
     requires; elsewhere the kernel keeps the stored direction and the complex step alone is exact).
     ``z`` (2n,) complex, ``gq`` (n,) float work."""
     m = md.m
@@ -137,35 +138,45 @@ def band_correction(s, cst, md, n2, J, z, gq):
             z[n + j] = s[n + j]
         acc = work_matrix(md.kin, VECTORS, VECTORS, s)[0]
         P.apply_inverse_mass(m, n, diagonal, gq, acc)
-        for j in range(n2):
-            z[j] = complex(s[j], P.COMPLEX_STEP)
+        for col in range(Phi.shape[1]):
+            for j in range(n2):
+                z[j] = complex(s[j], P.COMPLEX_STEP * Phi[j, col])
             gz = direction_residual(z, cst, c, md, ct, st)[0]
-            z[j] = s[j]
             dtheta = -(gz.imag / P.COMPLEX_STEP) / dg
             for i in range(n):
-                J[n + i, j] += acc[i] * dtheta
+                out[n + i, col] += acc[i] * dtheta
 
 
 @kernel
-def variational_rhs(y, cst, md, n2, band, dy, J, s, z, dz, gq):
-    """d/dt of y = [s, Φ]: ṡ = f(s), Φ̇ = J(s) Φ, in the modes of ``cst``. Fills ``J`` (2n × 2n).
+def variational_rhs(y, cst, md, n2, band, dy, s, z, dz, gq):
+    """d/dt of y = [s, Φ]: ṡ = f(s), Φ̇ = J(s) Φ, in the modes of ``cst``.
 
-    J is the complex step of the right-hand side; ``band``: some 2-D contact slips inside the
-    low-speed band, whose direction turn :func:`band_correction` adds. ``s`` (2n,), ``gq`` (n,):
+    J Φ column by column as the directional complex step of the right-hand side,
+    J Φ[:, k] = Im f(s + i ε Φ[:, k]) / ε (no Jacobian is formed, no matrix product: one complex
+    evaluation a column, as many as the Jacobian would take); ``band``: some 2-D contact slips inside
+    the low-speed band, whose direction turn :func:`band_correction` adds. ``s`` (2n,), ``gq`` (n,):
     float work; ``z``, ``dz``: complex work (2n,).
     """
     for i in range(n2):
         s[i] = y[i]
     P.rhs(s, cst, md, dy[:n2])
-    state_jacobian(s, cst, md, J, z, dz)
+    Phi = y[n2:].reshape((n2, n2))
+    out = dy[n2:].reshape((n2, n2))
+    h = P.COMPLEX_STEP
+    for k in range(n2):
+        nonzero = False
+        for i in range(n2):
+            z[i] = complex(s[i], h * Phi[i, k])
+            nonzero = nonzero or Phi[i, k] != 0.0
+        if nonzero:
+            P.rhs(z, cst, md, dz)
+            for i in range(n2):
+                out[i, k] = dz[i].imag / h
+        else:
+            for i in range(n2):
+                out[i, k] = 0.0
     if band:
-        band_correction(s, cst, md, n2, J, z, gq)
-    for i in range(n2):
-        for k in range(n2):
-            acc = 0.0
-            for j in range(n2):
-                acc += J[i, j] * y[n2 + n2 * j + k]
-            dy[n2 + n2 * i + k] = acc
+        band_correction(s, cst, md, n2, Phi, out, z, gq)
 
 
 @kernel
@@ -255,7 +266,6 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
     work = np.empty(n)
     Kst = np.empty((7, n))
     Q = np.empty((n, 4))
-    J = np.empty((n2, n2))
     s = np.empty(n2)
     gq = np.empty(n2)
     z = np.empty(n2, dtype=np.complex128)
@@ -265,7 +275,7 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
         for i in range(n2):
             s[i] = y[i]
         g0[c] = event_value(ev_kind[c], c, s, ev_level[c], ev_e[c], cst, md)
-    variational_rhs(y, cst, md, n2, band, Kst[0], J, s, z, dz, gq)
+    variational_rhs(y, cst, md, n2, band, Kst[0], s, z, dz, gq)
     t = t0
     h = min(1e-4, t1 - t0)  # the controller grows it ×5 per step
     n_steps = 0
@@ -278,9 +288,9 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
             return 2, t, y, -1
         for stage in range(1, 6):
             DP.stage_state(y, Kst, h, stage, ytmp)
-            variational_rhs(ytmp, cst, md, n2, band, Kst[stage], J, s, z, dz, gq)
+            variational_rhs(ytmp, cst, md, n2, band, Kst[stage], s, z, dz, gq)
         DP.stage_state(y, Kst, h, np.int64(6), ynew)
-        variational_rhs(ynew, cst, md, n2, band, Kst[6], J, s, z, dz, gq)
+        variational_rhs(ynew, cst, md, n2, band, Kst[6], s, z, dz, gq)
         total = 0.0
         for i in range(n):
             sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
