@@ -235,7 +235,7 @@ class LyapunovSpectrum(ModelResult):
     ----------
     exponents : ndarray (k,)
         λ_1 ≥ … ≥ λ_k over the whole averaging time [1/s] (k = 2 n_free). Directions that a
-        stick phase collapses (v_r = 0 is two conditions) have λ = −∞ in exact arithmetic; they
+        stick phase collapses (v_c = 0 is dim conditions per contact) have λ = −∞ in exact arithmetic; they
         come out as large negative numbers set by round-off (~ln 1e-16 per stick phase).
     time : ndarray (n,)
         Averaging time at each record [s].
@@ -355,7 +355,7 @@ def lyapunov_spectrum(
         reference, advanced by the ``event`` integrator chunk by chunk (τ = ``chunk``) and
         re-orthonormalised by QR after each chunk (the saltation is then inside the
         differences; needs no variational re-integration, so it also works where that one
-        refuses, e.g. velocity reversals and in-band returns to v_r ≈ 0; directions collapsed
+        refuses, e.g. velocity reversals and in-band returns to v ≈ 0; directions collapsed
         by stick come out at ln(integration noise / d0) per chunk instead of −∞).
     chunk, d0 : float
         Chunk length [s] and scaled separation [-] of ``finite-difference``.
@@ -436,7 +436,7 @@ def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation
         starts = [problem.perturbed(s_ref, Q[:, j], d0) for j in range(k)]
         s_new, tr = problem.flow(s_ref, chunk)
         sticks += stick_count(tr)
-        # columns Φ P Q_j: the chunk's flow after the projection onto v_r = 0 that a stuck
+        # columns Φ P Q_j: the chunk's flow after the projection onto v_c = 0 that a stuck
         # reference implies (part of the physical map: stick collapses those directions)
         A = np.column_stack([(problem.flow(sp, chunk)[0][free] - s_new[free]) / sigma for sp in starts]) / d0
         Q, log_r = _qr(A)

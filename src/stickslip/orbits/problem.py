@@ -7,7 +7,7 @@ free states, their scales σ, the section and the integration options, and gives
   with an optional cap on the steps per simulated second and a count of the runs);
 * the shooting residual F = (Φ(s0, T) − s0)[free] / σ;
 * ∂Φ/∂s0 on the free states from the variational equations with saltation matrices
-  (:func:`.variational.flow_jacobian`) or from central differences of Φ (two runs a column, the
+  (:func:`.linear_flow.flow_jacobian`) or from central differences of Φ (two runs a column, the
   saltation then inside the differences);
 * the scaled Jacobian of F in the unknowns (the section states but the coordinate the section
   fixes, in units of σ, and T), whose T column is exact, f(Φ) from the vector field;
@@ -81,7 +81,7 @@ def check_section(section: Section, system: FrictionModel) -> None:
 
 def scales(ptp: np.ndarray, free: np.ndarray) -> np.ndarray:
     """σ (2 n_free,) of the free states from their peak-to-peak ranges ``ptp`` (all states),
-    floored per kind, positions and velocities (see :data:`SCALE_FLOOR`) [SI units]."""
+    floored per kind, positions and velocities (see :data:`SCALE_FLOOR`) [state units]."""
     sigma = ptp[free].astype(float).copy()
     n = free.size // 2
     for part in (slice(0, n), slice(n, 2 * n)):
@@ -98,12 +98,12 @@ def central_differences(end_of, s0, free: np.ndarray, h: np.ndarray, cols=None) 
     Parameters
     ----------
     end_of : callable
-        ``end_of(s)`` → Φ(s) (all states) [SI].
+        ``end_of(s)`` → Φ(s) (all states).
     s0 : array-like (2n,)
     free : ndarray (2 n_free,)
         State indices of the free states.
     h : ndarray (2 n_free,)
-        Steps of the free states [SI].
+        Steps of the free states [state units].
     cols : sequence of int, optional
         Positions in ``free`` of the columns (default: all).
 
@@ -158,7 +158,7 @@ class NewtonResult(NamedTuple):
     state: np.ndarray  # (2n,) on the section
     period: float  # [s]
     residual: np.ndarray  # F at the solution (2 n_free,) [-]
-    end: np.ndarray  # Φ(state, period) [SI]
+    end: np.ndarray  # Φ(state, period)
     transitions: object  # of the run over one period
     history: list  # max |F| before each iteration and at the end [-]
     iterations: int

@@ -183,8 +183,8 @@ def periodic_orbit(
     ----------
     system : FrictionModel, Parameters, str, optional
         The model, as :func:`stickslip.simulate` takes it: a FrictionModel, a library name or model
-        file, or the plates' Parameters (default: the model of ``guess`` if it is a Trajectory, else
-        the plates with Table 1).
+        file, or the plates' Parameters (with a Trajectory ``guess``: by default its model, and plates'
+        Parameters take its variant; otherwise the plates with Table 1 by default).
     guess : Trajectory, array-like (2n,), mapping, or "equilibrium"/"zero"
         A Trajectory near the orbit (its last ``period_multiplicity + 1`` section crossings give
         the starting state and period), or an initial state (:func:`stickslip.integrate.driver.initial_state`)
@@ -233,8 +233,10 @@ def periodic_orbit(
         If no crossings are found, the section is crossed in stick, or Newton does not reach
         ``tol`` within ``max_iter`` iterations (the message gives the residual history).
     """
-    if isinstance(guess, Trajectory):
+    if isinstance(guess, Trajectory) and system is None and model is None:
         system = guess.system.with_slip_band(guess.system.slip_band if slip_band is None else slip_band)
+    elif isinstance(guess, Trajectory) and guess.is_plates and model is None:
+        system = resolve(system, guess.model, slip_band)  # the plates' parameters given: the run's variant
     else:
         system = resolve(system, model, slip_band)
     k = int(period_multiplicity)
