@@ -1,8 +1,12 @@
-"""stickslip: exact 2-D stick-slip simulation of two rigid plates in point frictional contact.
+"""stickslip: exact stick-slip simulation and analysis of friction-contact systems.
 
 ==========================  ==============================================================
-``Parameters``              physical parameters (paper Table 1), validated, TOML I/O
+``FrictionModel``           a friction-contact model (``Contact``, ``FrictionLaw``): every tool takes one
+``load_model``              a library model by name (``belt``, ``hoffmann``, ...) or a model file (TOML)
+``Parameters``              the two plates' parameters (paper Table 1), validated, TOML I/O
 ``simulate``                run a simulation, returns a ``Trajectory``
+``attractor``               what a run settles to, honestly (``simulate_until_settled``: run until it does)
+``basin_stability``         fractions of initial states reaching each attractor, with standard errors
 ``Trajectory``              typed result: samples, modes, forces, transitions, ``.to_xarray()``
 ``load_trajectory``         read a run written with ``Trajectory.to_netcdf``
 ``equilibrium``             steady-sliding equilibrium (Eq. 14)
@@ -28,6 +32,8 @@ first use (PEP 562), so ``import stickslip`` stays fast.
 """
 
 import importlib
+import sys
+import types
 
 __version__ = "0.1.0"
 
@@ -40,6 +46,9 @@ from .model.variants import DOF_NAMES, MODELS, STATE_NAMES, VariantError
 
 #: Public names imported on first access, by the module that defines them.
 _LAZY = {
+    **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model"], ".model"),
+    **dict.fromkeys(["basin_stability", "BasinResult"], ".basins"),
+    **dict.fromkeys(["attractor", "simulate_until_settled", "Attractor"], ".analysis.settle"),
     **dict.fromkeys(["StabilityMap", "StabilityResult", "load_stability_map", "stability", "stability_map"],
                     ".stability"),
     **dict.fromkeys(["EquilibriumError", "equilibrium"], ".stability.equilibrium"),
@@ -51,6 +60,22 @@ _LAZY = {
     **dict.fromkeys(["Branch", "ContinuationError", "FoldCurve", "SpecialPoint", "continue_orbit", "fold_curve",
                      "load_branch", "unstable_cycle"], ".orbits.continuation"),
 }
+
+
+#: Public functions named like the subpackage that defines them (``stickslip.stability``,
+#: ``stickslip.sweep``): the package attribute stays the function even after the subpackage is
+#: imported (the import system would otherwise bind the subpackage over it).
+_FUNCTIONS_OVER_PACKAGES = frozenset({"stability", "sweep"})
+
+
+class _Package(types.ModuleType):
+    def __setattr__(self, name, value):
+        if name in _FUNCTIONS_OVER_PACKAGES and isinstance(value, types.ModuleType):
+            return  # a subpackage being bound: its function is found by __getattr__ instead
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name):
@@ -67,6 +92,8 @@ def __dir__():
 
 __all__ = [
     "__version__", "StickSlipError",
+    "FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model",
+    "basin_stability", "BasinResult", "attractor", "simulate_until_settled", "Attractor",
     "Parameters", "ParameterError",
     "simulate", "SimulationError",
     "Trajectory", "load_trajectory", "FileFormatError",

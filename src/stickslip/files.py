@@ -42,6 +42,7 @@ from typing import Callable
 from .errors import StickSlipError
 
 __all__ = ["FileFormatError", "LockError", "WriteError", "OutputLock", "lock", "lock_path", "atomic_write",
+           "atomic_write_text",
            "temporary_path", "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name",
            "writing_errors"]
 
@@ -272,6 +273,11 @@ class AppendLog:
 
     def __del__(self):
         self.close()
+
+
+def atomic_write_text(path, text: str) -> Path:
+    """Replace the text file ``path`` by ``text`` (UTF-8) all at once (:func:`atomic_write`)."""
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 # --------------------------------------------------------------------------- one writer per output

@@ -81,7 +81,7 @@ def test_user_input_in_a_summary_is_printed_as_given(tmp_path, monkeypatch):
 
 
 #: Options without a unit (counts, names, flags, and dimensionless numbers).
-DIMENSIONLESS = {"--mu-k", "--delta-mu", "--rtol", "--atol", "--tol", "--step", "--max-step"}
+DIMENSIONLESS = {"--mu-k", "--delta-mu", "--rtol", "--atol", "--tol", "--step", "--max-step", "--match-rtol"}
 
 
 def test_every_float_option_states_its_unit():

@@ -80,9 +80,15 @@ def make_trajectory(t_end=100.0, steady_from=50.0, *, periodic=True, frequency=2
     steady = SteadyState(t_from=steady_from, t_to=t_end, fundamental_frequency_hz=frequency, periodic=periodic,
                          period_multiplicity=1 if periodic else 0, stick_fraction=float(mode.mean()),
                          n_transitions=0, phi_min=-0.01, phi_max=0.01)
-    return SimpleNamespace(t=t, states=states, mode=mode, friction_magnitude=np.where(mode == 1, 15.0, 10.0),
-                           params=Parameters(N=50.0, Omega=5.0), steady_from=steady_from, steady=steady,
-                           model="full", method="event")
+    from stickslip.model.library import two_plates
+
+    params = Parameters(N=50.0, Omega=5.0)
+    friction = np.zeros((t.size, 2))
+    friction[:, 0] = np.where(mode == 1, 15.0, 10.0)
+    return SimpleNamespace(t=t, states=states, mode=mode, friction=friction, friction_magnitude=friction[:, 0],
+                           normal_force=np.full((t.size, 1), params.N), params=params, system=two_plates(params),
+                           is_plates=True, observed=4, steady_from=steady_from, steady=steady, model="full",
+                           method="event")
 
 
 def filled_colours(ax):

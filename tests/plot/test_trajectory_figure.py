@@ -63,3 +63,31 @@ def test_title_gives_every_parameter_with_its_unit():
     fig = plot_trajectory(make_trajectory())
     title = fig.get_suptitle()
     assert "N = 50 N" in title and "Ω = 5 rad/s" in title and "α = 5 s/m" in title
+
+
+def test_a_model_with_two_contacts_draws_each_contact_and_its_stick_limit():
+    from stickslip import load_model, simulate
+
+    traj = simulate(load_model("popp-stelter"), 20.0, sample_rate=50.0)
+    fig = plot_trajectory(traj)
+    coords, force, phase, spec = _panels(fig)
+    assert [line.get_label() for line in force.get_lines()] == ["|F| mass 1", "μs N mass 1", "|F| mass 2",
+                                                                "μs N mass 2"]
+    assert [line.get_label() for line in coords.get_lines()] == ["x1", "x2"]
+    assert "x1" in phase.get_xlabel() and "x1" in _title(spec)
+
+
+def test_stick_limit_follows_a_normal_force_that_depends_on_the_state():
+    import numpy as np
+
+    from stickslip import load_model, simulate
+
+    # hoffmann: N = N0 + k3 y (normal_gradient [0, 1]); the drawn limit is μs N(t), the closed form
+    model = load_model("hoffmann")
+    traj = simulate(model, 20.0, ic={"x": 0.1, "y": 0.2}, sample_rate=50.0)
+    assert traj.normal_force[:, 0] == pytest.approx(1.0 + traj.states[:, 1], rel=1e-12)
+    limit = plot_trajectory(traj).axes[1].get_lines()[1].get_ydata()
+    mu_s = model.contacts[0].friction.mu_s
+    shown = traj.t >= traj.t[-1] - 10.0
+    assert limit == pytest.approx(mu_s * (1.0 + traj.states[shown, 1]), rel=1e-12)
+    assert np.ptp(limit) > 0.01

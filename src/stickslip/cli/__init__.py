@@ -13,5 +13,6 @@ from . import sweep  # noqa: E402,F401  (registers `stickslip sweep`, `bifurcati
 from . import continue_  # noqa: E402,F401  (registers `stickslip continue`)
 from . import orbit  # noqa: E402,F401  (registers `stickslip orbit`, `lyapunov`)
 from . import basins  # noqa: E402,F401  (registers `stickslip basins`)
+from . import models  # noqa: E402,F401  (registers `stickslip models`)
 
 __all__ = ["app"]

@@ -171,7 +171,7 @@ app = typer.Typer(
 
 
 # ----------------------------------------------------------------------------- option parsing
-def parse_assignments(items: list[str] | None) -> dict:
+def parse_assignments(items: list[str] | None, option: str = "--set") -> dict:
     """``["N=50", "friction_law=coulomb"]`` → ``{"N": 50.0, "friction_law": "coulomb"}``.
 
     Raises
@@ -184,9 +184,10 @@ def parse_assignments(items: list[str] | None) -> dict:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise CLIError(f"--set expects NAME=VALUE, got {item!r}; e.g. --set k_px=400")
+            raise CLIError(f"{option} expects NAME=VALUE, got {item!r}; e.g. {option} "
+                           + ("k_px=400" if option == "--set" else "dx=1"))
         if name in values:
-            raise CLIError(f"--set {name} is given twice; give each parameter once")
+            raise CLIError(f"{option} {name} is given twice; give each once")
         text = text.strip()
         try:
             values[name] = float(text)
@@ -259,6 +260,83 @@ def build_parameters(config, assignments, base=None, swept: dict | None = None, 
     given += [f"--set {k}" for k in changes] + [PARAMETER_FLAGS.get(k, f"--{k}") for k in named]
     changes.update(named)
     return (params.replace(**changes) if changes else params), given
+
+
+#: Help text of ``--model`` for commands that take any model.
+MODEL_HELP = ("The model: a library name (two-plates, belt, hoffmann, popp-stelter; see 'stickslip models'), a model "
+              "file (.toml), or a variant of the two plates: full | x | y | rotation (paper Models 1–4) or DOFs, "
+              "e.g. phi,psi.")
+
+#: Help text of ``--set`` for commands that take any model.
+SET_HELP = ("A parameter as PATH=VALUE (repeatable): a plates parameter (--set k_px=400) or a model file's number "
+            "by its path (--set contact.0.drive=1.8; 'stickslip models NAME' lists them).")
+
+
+def build_system(model: str, config, assignments, *, base=None, swept: dict | None = None, **named):
+    """The model a command runs on, from ``--model``, ``--config``, ``--set`` and the plates' named options.
+
+    Parameters
+    ----------
+    model : str
+        ``--model``: a library name, a model file path, or a variant of the two plates.
+    config : path or None
+        ``--config`` (a TOML file with a [parameters] table of names or paths).
+    assignments : list of str or None
+        ``--set`` items, ``PATH=VALUE``.
+    base : FrictionModel, optional
+        The model the options change (a continued run's) when ``model`` names it or a variant of
+        the plates it is; default the one ``model`` names.
+    swept : dict of parameter name → option, optional
+        Parameters the command varies itself; setting one of them too is refused.
+    **named
+        The plates' named options by parameter name (``N=``, ``Omega=``, ...; None: not given).
+
+    Returns
+    -------
+    system : FrictionModel
+    given : list of str
+        The options that set a parameter, in order.
+
+    Raises
+    ------
+    CLIError, ModelError
+        For an unknown model or parameter, a plates option given for another model, or two
+        options that set the same parameter.
+    """
+    from ..model.library import load_model, plates_variant, two_plates
+    from ..model.parameters import Parameters
+
+    variant = plates_variant(model)
+    if base is not None and base.name == "two-plates" and variant is None:
+        variant = str(base.parameters.get("variant", "full"))
+    if variant is not None:
+        base_params = None
+        if base is not None and base.name == "two-plates":
+            values = dict(base.parameters)
+            values.pop("variant", None)
+            base_params = Parameters.from_dict(values)
+        params, given = build_parameters(config, assignments, base=base_params, swept=swept, **named)
+        system = two_plates(params, variant)
+        return (system if base is None else system.with_slip_band(base.slip_band)), given
+    system = base if base is not None and base.name == model else load_model(model)
+    plates_only = [PARAMETER_FLAGS.get(name, f"--{name}") for name, value in named.items() if value is not None]
+    if plates_only:
+        raise CLIError(f"{plates_only[0]} is a parameter of the two plates; model {system.name!r} takes its numbers "
+                       f"as --set PATH=VALUE ('stickslip models {model}' lists the paths)")
+    changes, given = {}, []
+    if config is not None:
+        try:
+            changes.update(tomllib.loads(Path(config).read_text()).get("parameters", {}))
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
+        given.append("--config")
+    assigned = parse_assignments(assignments)
+    for name in assigned:
+        if name in (swept or {}):
+            raise CLIError(f"{swept[name]} and --set {name} both set {name}; give one of them")
+    changes.update(assigned)
+    given += [f"--set {k}" for k in assigned]
+    return system.replace(**changes), given
 
 
 def check_nc_path(out, flag: str = "--out") -> None:

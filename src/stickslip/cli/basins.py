@@ -14,7 +14,7 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import app, check_nc_path, console, err_console, parse_assignments, user_errors
+from ._app import MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, err_console, parse_assignments
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")
@@ -26,38 +26,28 @@ def _states(model, box, n, seed, grid, ics, base, state):
 
     if ics is not None:
         if box or grid or state or base is not None:
-            raise ValueError("--ics gives every state of every row; drop --box, --grid, --base and --state")
+            raise CLIError("--ics gives every state of every row; drop --box, --grid, --base and --state")
         if n is not None:
-            raise ValueError("--ics gives the states itself; drop --n")
+            raise CLIError("--ics gives the states itself; drop --n")
         return from_csv(model, ics)
     ranges = [parse_range(text) for text in box or []]
-    fixed = parse_assignments(state)
+    fixed = parse_assignments(state, option="--state")
     base = base or "equilibrium"
     if grid is not None:
         if n is not None:
-            raise ValueError("--grid gives the number of states per axis; drop --n (random draws)")
+            raise CLIError("--grid gives the number of states per axis; drop --n (random draws)")
         try:
             counts = [int(k) for k in grid.split(",")]
         except ValueError:
-            raise ValueError(f"--grid {grid}: give points per axis, one integer or one per --box (e.g. 50 or 50,40)") from None
+            raise CLIError(f"--grid {grid}: give points per axis, one integer or one per --box (e.g. 50 or 50,40)") from None
         return regular_grid(model, ranges, counts[0] if len(counts) == 1 else counts, base=base, fixed=fixed)
     return random_box(model, ranges, 1000 if n is None else n, seed=seed, base=base, fixed=fixed)
 
 
-def _model(name: str, assignments):
-    from ..model.library import load_model
-
-    model = load_model(name)
-    changes = parse_assignments(assignments)
-    return model.replace(**changes) if changes else model
-
-
 @app.command()
 def basins(
-    model: str = typer.Option("two-plates", "--model", help="Library model (belt, two-plates, hoffmann, "
-                              "popp-stelter) or a model file (.toml)."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="A model parameter as PATH=VALUE (repeatable), "
-                                             "e.g. --set contact.0.drive=1.2 or --set N=50 for the plates."),
+    model: str = typer.Option("two-plates", "--model", help=MODEL_HELP),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     box: Optional[List[str]] = typer.Option(None, "--box", help=_BOX_HELP),
     n: Optional[int] = typer.Option(None, "--n", help="Uniform random states in the box (default 1000)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the random states."),
@@ -94,24 +84,23 @@ def basins(
     """Basin stability: which attractor each initial state reaches (exact stick), and how often."""
     from ..basins import basin_stability, parse_param
 
-    with user_errors():
-        check_nc_path(out)
-        m = _model(model, set_)
-        states = _states(m, box, n, seed, grid, ics, base, state)
-        path, values = parse_param(param) if param is not None else (None, ())
-        if executor is None:
-            executor = "dask" if scheduler else "processes"
-        if scheduler and executor != "dask":
-            raise ValueError(f"--scheduler needs --executor dask (got --executor {executor})")
-        result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, executor=executor,
-                                 workers=workers, address=scheduler, progress=not (no_progress or as_json),
-                                 overwrite=overwrite, rtol=rtol, atol=atol, match_rtol=match_rtol,
-                                 confirm=not no_confirm, lyapunov=lyapunov)
-        figure = None
-        if not no_plot:
-            from ..plot.basins import save_basins_figure
+    check_nc_path(out)
+    m, _ = build_system(model, None, set_)
+    states = _states(m, box, n, seed, grid, ics, base, state)
+    path, values = parse_param(param) if param is not None else (None, ())
+    if executor is None:
+        executor = "dask" if scheduler else "processes"
+    if scheduler and executor != "dask":
+        raise CLIError(f"--scheduler needs --executor dask (got --executor {executor})")
+    result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, executor=executor,
+                             workers=workers, address=scheduler, progress=not (no_progress or as_json),
+                             overwrite=overwrite, rtol=rtol, atol=atol, match_rtol=match_rtol,
+                             confirm=not no_confirm, lyapunov=lyapunov)
+    figure = None
+    if not no_plot:
+        from ..plot.basins import save_basins_figure
 
-            figure = save_basins_figure(result, out.with_suffix(".png"))
+        figure = save_basins_figure(result, out.with_suffix(".png"))
     if as_json:
         print(json.dumps(result.to_json()))
     else:

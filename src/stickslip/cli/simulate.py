@@ -18,8 +18,9 @@ from rich.text import Text
 
 from ..integrate.interrupt import on_ctrl_c
 from ..integrate.status import Status
-from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_finite, check_outputs,
-                   check_positive, check_samples, console, err_console, error_line, given, note_line, warning_line)
+from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
+                   check_outputs, check_positive, check_samples, console, err_console, error_line, given, note_line,
+                   warning_line)
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
@@ -35,12 +36,21 @@ _SETTINGS = {"--model": "model", "--method": "method", "--rtol": "rtol", "--atol
 
 
 def _parse_ic(text: str):
-    """'zero' | 'equilibrium' | FILE.nc | 12 comma-separated numbers."""
+    """'zero' | 'equilibrium' | FILE.nc | NAME=VALUE,... (by state name, the others 0) | 2n numbers."""
+    if "=" in text:
+        values = {}
+        for item in text.split(","):
+            name, _, value = item.partition("=")
+            try:
+                values[name.strip()] = float(value)
+            except ValueError:
+                raise CLIError(f"--ic {text}: {item.strip()!r} is not NAME=NUMBER; e.g. --ic x=1,dx=0.5") from None
+        return values
     if "," in text:
         try:
             return [float(v) for v in text.split(",")]
         except ValueError:
-            raise CLIError(f"--ic {text}: give 12 comma-separated numbers") from None
+            raise CLIError(f"--ic {text}: give one number per state, or NAME=VALUE pairs (e.g. x=1,dx=0.5)") from None
     return text
 
 
@@ -49,8 +59,8 @@ def _continuation(ctx: typer.Context, ic: str, settings: dict):
 
     Returns
     -------
-    params : Parameters
-        The saved run's.
+    system : FrictionModel
+        The saved run's model, with its parameters.
     t0 : float
         Time of its last sample [s], where the continuation starts.
     settings : dict
@@ -67,7 +77,7 @@ def _continuation(ctx: typer.Context, ic: str, settings: dict):
                 for name, value in settings.items()}
     if stored.get("slip_band") is not None:
         settings["slip_band"] = stored["slip_band"]
-    return saved.params, float(saved.t[-1]), settings, overridden
+    return saved.system, float(saved.t[-1]), settings, overridden
 
 
 def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rate: float) -> None:
@@ -109,26 +119,32 @@ def _check_steps(duration: float, dt: float | None, time_flag: str = "--t-end") 
                        f"--dt {duration / MAX_RUN_STEPS:.3g} or more, or a shorter {time_flag}")
 
 
-def _warn_aliasing(params, model: str, sample_rate: float) -> None:
+def _warn_aliasing(system, sample_rate: float) -> None:
     """One warning line when the samples cannot resolve the model's fastest linear mode."""
-    from ..model.modes import natural_frequencies
-
-    highest = float(natural_frequencies(params, model).max(initial=0.0))
+    highest = float(system.natural_frequencies().max(initial=0.0))
     if sample_rate < 2.0 * highest:
+        observed = system.dofs[system.observed_index]
         warning_line(f"--sample-rate {sample_rate:g} Hz is below twice the highest linear mode frequency of model "
-                     f"{model} ({highest:.4g} Hz): the spectrum and the frequency of φ alias; give --sample-rate "
-                     f"{math.ceil(2.0 * highest)} or more")
+                     f"{_model_label(system)} ({highest:.4g} Hz): the spectrum and the frequency of {observed} alias; "
+                     f"give --sample-rate {math.ceil(2.0 * highest)} or more")
+
+
+def _model_label(system) -> str:
+    """The model's name, with the plates' variant."""
+    variant = system.parameters.get("variant") if system.name == "two-plates" else None
+    return system.name + (f" ({variant})" if variant else "")
 
 
 @app.command()
 def simulate(
     ctx: typer.Context,
-    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] (default 50)."),
-    omega: Optional[float] = typer.Option(None, "--omega", help="Angular velocity Ω of the lower plate [rad/s] (default 5)."),
-    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
-    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
-    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi,psi."),
+    N: Optional[float] = typer.Option(None, "--N", help="The plates: normal preload N [N] (default 50)."),
+    omega: Optional[float] = typer.Option(None, "--omega", help="The plates: angular velocity Ω of the lower plate "
+                                          "[rad/s] (default 5)."),
+    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="The plates: kinetic friction coefficient μk (default 0.2)."),
+    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="The plates: μs − μk (default 0.1)."),
+    alpha: Optional[float] = typer.Option(None, "--alpha", help="The plates: decay factor α of Eq. (4) [s/m] (default 5)."),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP),
     t_end: str = typer.Option("100", "--t-end", help="Simulated time [s], or 'auto': extend the run until it has "
                               "settled, up to --cap (the steady window is then the last 100 s). With --ic RUN.nc, "
                               "the time added after the end of that run."),
@@ -137,13 +153,15 @@ def simulate(
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
     rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance (event)."),
     atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance (event)."),
-    ic: str = typer.Option("zero", "--ic", help="zero | equilibrium | 12 comma-separated numbers | RUN.nc: continue "
+    ic: str = typer.Option("zero", "--ic", help="zero | equilibrium (steady sliding) | NAME=VALUE,... by state name "
+                           "(e.g. x=1,dx=1; the others 0) | one number per state, comma-separated | RUN.nc: continue "
                            "that run from its end, with its model, parameters and settings unless given here."),
-    perturb: Optional[float] = typer.Option(None, "--perturb", help="Added to φ of the initial state [rad]."),
+    perturb: Optional[float] = typer.Option(None, "--perturb", help="Added to the observed coordinate of the initial "
+                                            "state (the plates' φ [rad])."),
     sample_rate: float = typer.Option(1000.0, "--sample-rate", help="Output samples per second [Hz]."),
     steady_from: Optional[float] = typer.Option(None, "--steady-from", help="Start of the steady-state window, in the "
                                                 "run's time [s] (default: the last half of the run)."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable), e.g. --set k_px=400."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Optional[Path] = typer.Option(None, "--out", help="NetCDF output (default run.nc; with --json, nothing is "
                                        "written unless --out is given); the figure goes beside it as .png."),
@@ -151,7 +169,7 @@ def simulate(
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     as_json: bool = typer.Option(False, "--json", help="Print the steady-state summary as one JSON object."),
 ) -> None:
-    """Simulate the two-plate model (defaults: Table 1, N = 50 N, Ω = 5 rad/s, 100 s)."""
+    """Simulate a model with exact stick-slip (default: the two plates, Table 1, N = 50 N, Ω = 5 rad/s, 100 s)."""
     from ..integrate.driver import simulate as run_simulation
 
     start = _parse_ic(ic)
@@ -160,16 +178,18 @@ def simulate(
     base, t0, overridden = None, 0.0, []
     if run_file is not None:
         base, t0, settings, overridden = _continuation(ctx, start, settings)
-    params, set_by = build_parameters(config, set_, base=base, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu,
-                                      alpha=alpha)
+    system, set_by = build_system(settings.pop("model"), config, set_, base=base, N=N, Omega=omega, mu_k=mu_k,
+                                  delta_mu=delta_mu, alpha=alpha)
+    if "slip_band" in settings:
+        system = system.with_slip_band(settings.pop("slip_band"))
     duration = _parse_t_end(t_end, cap, steady_from)
     check_positive({"--sample-rate": settings["sample_rate"]})
     check_finite({"--perturb": perturb, "--steady-from": steady_from})
-    if duration is not None:  # with --t-end auto the window is the last part of the settled run
-        _check_window(steady_from, t0, t0 + duration, settings["sample_rate"])
     time_flag = "--cap" if duration is None else "--t-end"
     longest = cap if duration is None else duration
     check_samples(longest, settings["sample_rate"], time_flag=time_flag)
+    if duration is not None:  # with --t-end auto the window is the last part of the settled run
+        _check_window(steady_from, t0, t0 + duration, settings["sample_rate"])
     _check_steps(longest, settings["dt"], time_flag)
     write = out is not None or not as_json
     out = Path("run.nc") if out is None else out
@@ -179,15 +199,15 @@ def simulate(
         overridden = set_by + overridden
         note_line(f"continuing {run_file} from t = {t0:g} s with its model, parameters and settings"
                   + (f"; overridden: {', '.join(overridden)}" if overridden else ""))
-    _warn_aliasing(params, settings["model"], settings["sample_rate"])
+    _warn_aliasing(system, settings["sample_rate"])
 
     with on_ctrl_c(partial=True):  # Ctrl-C ends the run with the part done, which is written below
         if duration is None:
             from ..analysis.settle import simulate_until_settled
 
-            traj = simulate_until_settled(params, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
+            traj = simulate_until_settled(system, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
         else:
-            traj = run_simulation(params, t0 + duration, t0=t0, ic=start, perturbation=perturb,
+            traj = run_simulation(system, t0 + duration, t0=t0, ic=start, perturbation=perturb,
                                   steady_from=steady_from, **settings)
     # a run that stopped early can be too short for its steady-state window, which the file needs
     keep = write and int(np.count_nonzero(traj.t >= traj.steady_from)) >= 2
@@ -217,10 +237,15 @@ def simulate(
 def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     s = traj.steady
     p = traj.params
-    table = Table(title=f"stickslip: model {traj.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
-                        f"μk = {p.mu_k:g}, Δμ = {p.delta_mu:g}, α = {p.alpha:g}", show_header=False)
+    system = traj.system
+    observed = system.dofs[system.observed_index]
+    symbol = "φ" if p is not None else observed
+    title = (f"stickslip: model {traj.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, μk = {p.mu_k:g}, "
+             f"Δμ = {p.delta_mu:g}, α = {p.alpha:g}" if p is not None else
+             f"stickslip: model {system.name} ({system.source}; parameters: stickslip models)")
+    table = Table(title=Text(title), show_header=False)
     freq, dominant = summary["fundamental_frequency_hz"], summary["dominant_frequency_hz"]
-    kind = summary["attractor"] + (f", {summary['period_count']} peak(s) of φ per period" if summary["period_count"] else "")
+    kind = summary["attractor"] + (f", {summary['period_count']} peak(s) of {symbol} per period" if summary["period_count"] else "")
     kind += (f" (settled by {summary['settle_time_s']:g} s)" if summary["settled"]
              else f" ({summary['evidence'].get('reason', 'no verdict')})")
     wrote = "nothing" if out is None else str(out) + ("" if figure is None else f", {figure}")
@@ -229,11 +254,12 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
         ("time", f"{traj.t[0]:g} – {traj.t[-1]:g} s"),
         ("steady window", f"{s.t_from:g} – {s.t_to:g} s"),
         ("response", kind),
-        ("fundamental frequency of φ", "–" if freq is None else f"{freq:.6g} Hz"),
-        ("dominant frequency of φ", "–" if dominant is None else f"{dominant:.6g} Hz"),
+        (f"fundamental frequency of {symbol}", "–" if freq is None else f"{freq:.6g} Hz"),
+        (f"dominant frequency of {symbol}", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         ("transitions in window", str(s.n_transitions)),
-        ("φ min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g} rad"),
+        (f"{symbol} min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g}" + (" rad" if p is not None else
+                                                                        f" {system.units.get(observed, '')}".rstrip(" -"))),
         ("steps (accepted + rejected)", f"{traj.stats.steps} ({traj.method})"),
         ("wall time", f"{traj.stats.wall_time_s:.3f} s"),
         ("wrote", wrote),
@@ -243,7 +269,7 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     console.print(table)
     if not summary["settled"]:
         console.print("not settled in the window: no period is claimed (the dominant frequency is the highest "
-                      "peak of the φ spectrum); run longer or use --t-end auto", style="dim")
+                      "peak of the spectrum); run longer or use --t-end auto", style="dim")
     if traj.stats.compile_time_s > 0:
         console.print(f"first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
                       "(not included in the wall time)", style="dim")

@@ -96,6 +96,17 @@ def _slip_velocities(states, md, nc):
     return out
 
 
+@njit(cache=True)
+def _normal_forces(states, md, nc):
+    """Normal force of every contact (k, nc) at each sample [N]."""
+    k = states.shape[0]
+    out = np.empty((k, nc))
+    for i in range(k):
+        for c in range(nc):
+            out[i, c] = physics.normal_force(states[i], c, md)
+    return out
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class Trajectory:
     """Result of :func:`stickslip.simulate`.
@@ -200,6 +211,11 @@ class Trajectory:
         with np.errstate(invalid="ignore"):
             angle = np.degrees(np.arctan2(Y * vy + X * vx, vx * Y - vy * X))
         return np.where((vx == 0.0) & (vy == 0.0), np.nan, angle)
+
+    @cached_property
+    def normal_force(self) -> np.ndarray:
+        """Normal force N of each contact (k, nc) [N]."""
+        return _normal_forces(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
 
     @property
     def friction_magnitude(self) -> np.ndarray:

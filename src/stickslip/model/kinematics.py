@@ -33,7 +33,7 @@ from ..errors import StickSlipError
 from . import csmath as csm
 from . import stack
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, contact_offsets
-from .jit import KERNEL_OPTIONS, inlined_kernel
+from .jit import KERNEL_OPTIONS, kernel
 
 __all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "contact_frame",
            "constant_frame", "KinematicsError", "model_sizes", "contact_dim"]
@@ -90,12 +90,14 @@ def contact_frame(kin, s, c, m, G, w):  # pragma: no cover - resolved by numba (
     raise NotImplementedError("contact_frame is called from compiled code only")
 
 
-@overload(contact_frame, inline="always", jit_options=KERNEL_OPTIONS)
+@overload(contact_frame, jit_options=KERNEL_OPTIONS)
 def _contact_frame(kin, s, c, m, G, w):
     frame = _FRAMES.get(getattr(kin, "instance_class", None))
     if frame is None:
         return None
-    return getattr(frame, "py_func", frame)  # the Python source: numba compiles it into the caller
+    # the Python source, compiled for each caller's types as an ordinary call (LLVM inlines it): numba's
+    # IR-level inlining mis-scoped the accumulator of constant_frame's loop (a 'not in scope' warning)
+    return getattr(frame, "py_func", frame)
 
 
 def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below)
@@ -139,7 +141,7 @@ class ConstantKinematics(NamedTuple):
     constant: float = 1.0
 
 
-@inlined_kernel
+@kernel
 def constant_frame(kin, s, c, m, G, w):
     """Frame of :class:`ConstantKinematics`: G and w copied from the data array, N affine in s."""
     n, nc, diagonal = model_sizes(kin, m)

@@ -3,8 +3,11 @@ parameter labels with units, and a figure on the Agg canvas. Nothing here comput
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from ..files import atomic_write
 from ..model.parameters import PARAMETER_UNITS
 
 #: Symbols of the parameters that name axes and titles.
@@ -16,6 +19,14 @@ MODEL_LABELS = {"full": "Model 1 (full)", "x": "Model 2 (x translation)", "y": "
 
 #: Relative tolerance on the ratio of neighbours for a grid to count as geometric (log axis).
 GEOMETRIC_RTOL = 1e-6
+
+
+def save_figure(fig, path, **savefig_kwargs) -> Path:
+    """Write ``fig`` to ``path`` all at once (a temporary beside it, then a rename): an interrupted
+    write never leaves a truncated image in place of a good one. The format follows the suffix."""
+    path = Path(path)
+    fmt = path.suffix.lstrip(".") or "png"
+    return atomic_write(path, lambda tmp: fig.savefig(tmp, format=fmt, **savefig_kwargs))
 
 
 def unit_text(units: str | None) -> str:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import agg_figure, cell_edges, param_label
+from ._common import agg_figure, cell_edges, param_label, save_figure
 
 __all__ = ["plot_basins", "plot_fractions", "plot_parameter_study", "save_basins_figure", "label_colors"]
 
@@ -161,5 +161,5 @@ def save_basins_figure(result, path) -> Path:
         plot_basins(ds, a)
         plot_fractions(ds, b)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     return path

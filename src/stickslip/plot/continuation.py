@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import SYMBOLS, param_label, param_text
+from ._common import SYMBOLS, param_label, param_text, save_figure
 
 __all__ = ["plot_branch", "save_branch_figure", "plot_region_edge", "SPECIAL_MARKERS"]
 
@@ -128,7 +128,7 @@ def save_branch_figure(branch, path, *, dpi: int = 110) -> Path:
     fig.suptitle(f"Branch of periodic orbits in {SYMBOLS.get(d['param'], d['param'])} (model {d['model']}; {fixed}"
                  f"{ends})", fontsize=10)
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     plt.close(fig)
     return path
 

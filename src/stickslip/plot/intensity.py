@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ._common import save_figure
 from .sweep import _new_figure, plot_reduction
 
 __all__ = ["FIG16_PANELS", "save_intensity_figure"]
@@ -54,5 +55,5 @@ def save_intensity_figure(result, path, *, ic: str | None = "far", dpi: int = 11
     fig.suptitle("Intensity of oscillation, Eq. (16), in the steady window"
                  + (f" (initial condition {ic})" if ic is not None else ""), fontsize=10)
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     return path

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import agg_figure
+from ._common import agg_figure, save_figure
 from .trajectory import stick_intervals
 
 __all__ = ["plot_hoffmann", "plot_belt", "plot_popp_stelter", "save_hoffmann_figure", "save_belt_figure",
@@ -164,7 +164,7 @@ def plot_popp_stelter(traj, periods_shown=3.0, period=None, fig=None):
 
 def _save(fig, path) -> Path:
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     return path
 
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._common import save_figure
 from .trajectory import _shade_stick, stick_intervals
 
 #: Exponents at or below this [1/s] are left out of :func:`plot_lyapunov_spectrum` by default:
@@ -217,6 +218,6 @@ def _save(fig, path, dpi: int) -> Path:
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     plt.close(fig)
     return path

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import MODEL_LABELS, cell_edges, grid_axis, is_geometric, param_text
+from ._common import MODEL_LABELS, cell_edges, grid_axis, is_geometric, param_text, save_figure
 from .sweep import _new_figure
 
 __all__ = ["plot_regions", "plot_stick_slip_domains", "save_regions_figure", "REGION_STYLE", "MODEL_LABELS"]
@@ -150,5 +150,5 @@ def save_regions_figure(rmap, path, *, dpi: int = 110) -> Path:
         plot_stick_slip_domains(ds, axes[-1])
     fig.suptitle(f"Steady-state regions over (N, Ω)\n{_params_line(ds)}", fontsize=10)
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     return path

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import agg_figure, cell_edges, grid_axis, param_text
+from ._common import agg_figure, cell_edges, grid_axis, param_text, save_figure
 
 __all__ = ["plot_stability_map", "save_stability_map_figure", "STABLE_COLOUR", "MISSING_COLOUR"]
 
@@ -212,5 +212,5 @@ def save_stability_map_figure(smap, path: str | Path, *, dpi: int = 110, **kwarg
             plot_stability_map(smap, fig.add_subplot(rows, cols, f + 2), member=f, **kwargs)
         fig.suptitle("Stability of steady sliding: " + _fixed_text(smap), fontsize=11)
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     return path

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from ..model.parameters import PARAMETER_UNITS
-from ._common import MODEL_LABELS, SYMBOLS, agg_figure, cell_edges, grid_axis, is_geometric, param_text, unit_text
+from ._common import (MODEL_LABELS, SYMBOLS, agg_figure, cell_edges, grid_axis, is_geometric, param_text, save_figure,
+                      unit_text)
 
 __all__ = ["plot_reduction", "save_sweep_figure", "plot_bifurcation", "save_bifurcation_figure", "KIND_STYLE",
            "kind_styles", "axis_label"]
@@ -335,7 +336,7 @@ def save_sweep_figure(result, path, var: str = "frequency", *, dpi: int = 110) -
         title += f" (first {len(shown)} of {len(combos)} panels)"
     fig.suptitle(title, fontsize=10)
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     return path
 
 
@@ -441,5 +442,5 @@ def save_bifurcation_figure(result, path, *, dpi: int = 130) -> Path:
     fig.suptitle(f"Bifurcation diagram: peak values of φ against {axis_label(ds, x)}\n{_conditions(ds, skip=(x,))}",
                  fontsize=10)
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi=dpi)
     return path

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ._common import save_figure
+
 __all__ = ["plot_timestep_method", "plot_timestep_errors", "save_timestep_figures"]
 
 _PAPER_FIG = {"aeom": "Fig. 5", "naeom": "Fig. 6"}
@@ -103,10 +105,10 @@ def save_timestep_figures(study, out_dir) -> dict:
         if study.fixed(method):
             fig = plot_timestep_method(study, method)
             paths[method] = out / name
-            fig.savefig(paths[method], dpi=120)
+            save_figure(fig, paths[method], dpi=120)
             plt.close(fig)
     fig = plot_timestep_errors(study)
     paths["errors"] = out / "timestep_errors.png"
-    fig.savefig(paths["errors"], dpi=120)
+    save_figure(fig, paths["errors"], dpi=120)
     plt.close(fig)
     return paths

@@ -1,4 +1,5 @@
-"""Overview figure of one trajectory: φ, ψ with stick shaded, |F| against μs N, phase plot, spectrum."""
+"""Overview figure of one trajectory: coordinates with stick shaded, |F| against μs N per contact, the
+phase plot and spectrum of the observed coordinate (the plates: φ, ψ and the φ spectrum)."""
 
 from __future__ import annotations
 
@@ -7,26 +8,26 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.steady import spectrum
-from ._common import param_text
+from ._common import param_text, save_figure
 
 __all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals"]
 
 
 def stick_intervals(t: np.ndarray, mode: np.ndarray) -> list[tuple[float, float]]:
-    """Contiguous stick intervals (start, end) [s] of a sampled mode series (1 = stick)."""
-    m = np.asarray(mode).astype(np.int8)
+    """Contiguous stick intervals (start, end) [s] of a sampled mode series (non-zero: a contact sticks)."""
+    m = (np.asarray(mode) != 0).astype(np.int8)
     edges = np.diff(np.concatenate([[0], m, [0]]))
     starts = np.flatnonzero(edges == 1)
     ends = np.flatnonzero(edges == -1) - 1
     return [(float(t[a]), float(t[b])) for a, b in zip(starts, ends)]
 
 
-def _shade_stick(ax, intervals, t_lo, t_hi, label=True):
+def _shade_stick(ax, intervals, t_lo, t_hi, label="stick"):
     first = True
     for a, b in intervals:
         if b < t_lo or a > t_hi:
             continue
-        ax.axvspan(a, b, color="tab:orange", alpha=0.25, lw=0, label="stick" if (first and label) else None)
+        ax.axvspan(a, b, color="tab:orange", alpha=0.25, lw=0, label=label if first and label else None)
         first = False
 
 
@@ -66,29 +67,39 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
     ax_spec = fig.add_subplot(gs[2, 1])
     above = {"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "frameon": False, "fontsize": 9}  # hides no data
 
-    ax_phi.plot(t[show], traj.states[show, 4], lw=1.0, label="φ")
-    ax_phi.plot(t[show], traj.states[show, 5], lw=1.0, label="ψ")
-    _shade_stick(ax_phi, intervals, t_lo, t_hi)
+    system = traj.system
+    shown, unit = _shown_coordinates(system)
+    for j in shown:
+        ax_phi.plot(t[show], traj.states[show, j], lw=1.0, label=_SYMBOL.get(system.dofs[j], system.dofs[j]))
+    _shade_stick(ax_phi, intervals, t_lo, t_hi, label="stick" if system.n_contacts == 1 else "a contact sticks")
     ax_phi.set_xlim(t_lo, t_hi)
-    ax_phi.set_ylabel("angle [rad]")
+    ax_phi.set_ylabel(("angle" if traj.is_plates else "coordinate") + (f" [{unit}]" if unit else ""))
     whole = t_lo <= t_first
     span = f"{_g(t_lo)}–{_g(t_hi)} s"
     ax_phi.set_title(f"the whole run, {span}" if whole else f"last {_g(t_hi - t_lo)} s of the run ({span} of "
                      f"{_g(t_first)}–{_g(t_hi)} s)", fontsize=10, loc="left")
     ax_phi.legend(ncol=3, **above)
 
-    ax_F.plot(t[show], traj.friction_magnitude[show], lw=1.0, color="tab:green", label="|F|")
-    ax_F.axhline(traj.params.mu_s * traj.params.N, color="k", ls="--", lw=0.8, label="μs N")
-    _shade_stick(ax_F, intervals, t_lo, t_hi, label=False)
+    nc = system.n_contacts
+    for c, contact in enumerate(system.contacts):
+        tag = "" if nc == 1 else f" {contact.name or c}"
+        F = np.hypot(traj.friction[:, 2 * c], traj.friction[:, 2 * c + 1])
+        line, = ax_F.plot(t[show], F[show], lw=1.0, color="tab:green" if nc == 1 else None, label=f"|F|{tag}")
+        ax_F.plot(t[show], contact.friction.mu_s * traj.normal_force[show, c], color="k" if nc == 1 else line.get_color(),
+                  ls="--", lw=0.8, label=f"μs N{tag}")
+    _shade_stick(ax_F, intervals, t_lo, t_hi, label=None)
     ax_F.set_xlabel("t [s]")
     ax_F.set_ylabel("friction force [N]")
-    ax_F.legend(ncol=2, **above)
+    ax_F.legend(ncol=2 * nc, **above)
 
     steady_span = f"steady window {_g(t_steady)}–{_g(t_hi)} s"
-    phi, dphi = traj.states[steady, 4], traj.states[steady, 10]
+    k = traj.observed
+    symbol = _SYMBOL.get(system.dofs[k], system.dofs[k])
+    unit = system.units.get(system.dofs[k], "").strip("-")
+    phi, dphi = traj.states[steady, k], traj.states[steady, system.n + k]
     ax_phase.plot(phi, dphi, lw=0.6)
-    ax_phase.set_xlabel("φ [rad]")
-    ax_phase.set_ylabel("dφ/dt [rad/s]")
+    ax_phase.set_xlabel(symbol + (f" [{unit}]" if unit else ""))
+    ax_phase.set_ylabel(f"d{symbol}/dt" + (f" [{unit}/s]" if unit else ""))
     ax_phase.set_title(f"phase plot ({steady_span})", fontsize=10)
 
     f, a = spectrum(t[steady], phi)
@@ -102,12 +113,34 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
         ax_spec.legend(loc="best")
         ax_spec.set_xlim(0, min(f[-1], 10 * s.fundamental_frequency_hz + 1))
     ax_spec.set_xlabel("frequency [Hz]")
-    ax_spec.set_ylabel("amplitude of φ [rad]")
-    ax_spec.set_title(f"spectrum of φ ({steady_span})", fontsize=10)
+    ax_spec.set_ylabel(f"amplitude of {symbol}" + (f" [{unit}]" if unit else ""))
+    ax_spec.set_title(f"spectrum of {symbol} ({steady_span})", fontsize=10)
     p = traj.params
-    fig.suptitle(f"model {traj.model}: " + ", ".join(param_text(k, getattr(p, k)) for k in
-                                                     ("N", "Omega", "mu_k", "delta_mu", "alpha")) + f" ({traj.method})")
+    if p is not None:
+        fig.suptitle(f"model {traj.model}: " + ", ".join(param_text(k, getattr(p, k)) for k in
+                                                         ("N", "Omega", "mu_k", "delta_mu", "alpha")) + f" ({traj.method})")
+    else:
+        fig.suptitle(f"model {system.name} ({system.source}; {traj.method})")
     return fig
+
+
+#: Symbols of the plates' coordinates in labels.
+_SYMBOL = {"phi": "φ", "psi": "ψ"}
+
+#: Most coordinates drawn in the time history of a model other than the plates.
+MAX_SHOWN = 4
+
+
+def _shown_coordinates(system) -> tuple[list[int], str]:
+    """Indices of the coordinates of the time history and their common unit ("" if they differ):
+    the plates' rotations φ, ψ; else the free DOFs, at most :data:`MAX_SHOWN`, the observed first."""
+    if system.name == "two-plates":
+        shown = [system.dofs.index("phi"), system.dofs.index("psi")]
+    else:
+        free = [j for j in range(system.n) if system.free[j]]
+        shown = ([system.observed_index] + [j for j in free if j != system.observed_index])[:MAX_SHOWN]
+    units = {system.units.get(system.dofs[j], "").strip("-") for j in shown}
+    return shown, units.pop() if len(units) == 1 else ""
 
 
 def _g(value: float) -> str:
@@ -124,6 +157,6 @@ def save_trajectory_figure(traj, path: str | Path, **kwargs) -> Path:
 
     fig = plot_trajectory(traj, **kwargs)
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path

@@ -38,6 +38,9 @@ from typing import Callable
 
 import numpy as np
 
+from ..files import atomic_write_text
+from ..plot._common import save_figure
+
 __all__ = ["Resolution", "RESOLUTIONS", "Recipe", "RecipeResult", "Row", "RECIPES", "NOT_YET",
            "recipe_names", "reproduce", "render_report"]
 
@@ -309,7 +312,7 @@ def _recipe_fig7(out: Path, res: Resolution, cache: dict) -> RecipeResult:
                         f"(window {t_from:g}–{res.fig7_t_end:g} s)",
                         _yes(tuple(ss) == (pf, pn)),
                         "stick-slip (stick in the window, not at equilibrium) from each IC as in the paper"))
-    fig.savefig(out / "fig7.png", dpi=110)
+    save_figure(fig, out / "fig7.png", dpi=110)
     plt.close(fig)
     return RecipeResult(["fig7.png"], rows, measured)
 
@@ -389,7 +392,7 @@ def _recipe_fig10(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     axes[-1, 0].set_xlabel("t [s]")
     axes[-1, 1].set_xlabel("φ [rad]")
     axes[-1, 2].set_xlabel("f [Hz]")
-    fig.savefig(out / "fig10.png", dpi=100)
+    save_figure(fig, out / "fig10.png", dpi=100)
     plt.close(fig)
     fr = [(n, m["frequency_hz"]) for n, m in measured.items()]
     falling = len(fr) >= 2 and all(a[1] is not None and b[1] is not None and b[1] < a[1] for a, b in zip(fr, fr[1:]))
@@ -423,7 +426,7 @@ def _recipe_fig11(out: Path, res: Resolution, cache: dict) -> RecipeResult:
                         "both ends within 2.5° of the paper's"))
     axes[0, 0].legend(fontsize=8)
     axes[-1, 0].set_xlabel("t [s]")
-    fig.savefig(out / "fig11.png", dpi=110)
+    save_figure(fig, out / "fig11.png", dpi=110)
     plt.close(fig)
     return RecipeResult(["fig11.png"], rows, {str(k): v for k, v in measured.items()})
 
@@ -968,9 +971,9 @@ def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str
     t_start = time.perf_counter()
 
     def write(pending):
-        report.write_text(render_report(entries, res, pending, time.perf_counter() - t_start), encoding="utf-8")
-        (out / "results.json").write_text(json.dumps(jsonable({"resolution": dataclasses.asdict(res),
-                                                                "recipes": entries}), indent=1), encoding="utf-8")
+        atomic_write_text(report, render_report(entries, res, pending, time.perf_counter() - t_start))
+        atomic_write_text(out / "results.json", json.dumps(jsonable({"resolution": dataclasses.asdict(res),
+                                                                     "recipes": entries}), indent=1))
 
     for i, recipe in enumerate(selected):
         write([r.title for r in selected[i:]])

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..files import atomic_write_text
 from ..integrate.driver import simulate
 from ..model.parameters import Parameters
 
@@ -227,9 +228,9 @@ class TimestepStudy:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         md = out / "timestep.md"
-        md.write_text(self.markdown())
+        atomic_write_text(md, self.markdown())
         js = out / "timestep.json"
-        js.write_text(json.dumps(self.to_dict(), indent=2, default=_json_default))
+        atomic_write_text(js, json.dumps(self.to_dict(), indent=2, default=_json_default))
         return {"markdown": md, "json": js}
 
 

@@ -3,6 +3,8 @@
 ==================  ==========================================================================
 ``two-plates``      the paper's two rigid plates (default; :mod:`.two_plates`)
 ``belt``            1-DOF mass on a moving belt, the bSTAB friction case (``belt.toml``)
+``hoffmann``        2-DOF mode-coupling (flutter) model (``hoffmann.toml``)
+``popp-stelter``    two masses on one belt, two contacts (``popp_stelter.toml``)
 ==================  ==========================================================================
 
 Library models stated as model files live beside this module as TOML; ``stickslip models``
@@ -21,7 +23,7 @@ from .two_plates import NAME as TWO_PLATES
 from .two_plates import two_plates
 
 __all__ = ["load_model", "library", "two_plates", "TWO_PLATES", "describe_system", "system_from_description",
-           "resolve_system"]
+           "resolve_system", "plates_variant"]
 
 HERE = Path(__file__).resolve().parent
 
@@ -65,7 +67,7 @@ def resolve_system(system=None, variant=None, slip_band: float | None = None) ->
     slip_band : float, optional
         Low-speed band [m/s]; default the model's own.
     """
-    if isinstance(variant, FrictionModel) or (isinstance(variant, (str, Path)) and _is_model_name(str(variant))):
+    if isinstance(variant, FrictionModel) or (isinstance(variant, (str, Path)) and plates_variant(str(variant)) is None):
         model = load_model(variant)
         if system is not None and not isinstance(system, FrictionModel):
             raise ModelError(f"model {variant!s} is not the two plates: give its parameters with --set, "
@@ -85,11 +87,15 @@ def resolve_system(system=None, variant=None, slip_band: float | None = None) ->
     return model
 
 
-def _is_model_name(text: str) -> bool:
-    """Whether ``text`` names a model (library or file) rather than a plates variant."""
+def plates_variant(text: str) -> str | None:
+    """The plates' variant that ``text`` names (``full``, ``x``, ``y``, ``rotation``, DOF names, or
+    ``two-plates`` for ``full``), or None when it names another model (library name or file)."""
+    text = text.strip()
+    if text == TWO_PLATES:
+        return "full"
     if text in MODELS or text.removeprefix("custom:").split(",")[0].strip() in ("x1", "y1", "x2", "y2", "phi", "psi"):
-        return False
-    return True
+        return text
+    return None
 
 
 def describe_system(system: FrictionModel) -> dict:

@@ -16,7 +16,7 @@ from typing import NamedTuple
 
 from .. import csmath as csm
 from ..bundle import C_N0, contact_offsets
-from ..jit import inlined_kernel
+from ..jit import kernel
 from ..kinematics import register_kinematics
 
 __all__ = ["PlateKinematics", "plate_frame"]
@@ -29,7 +29,7 @@ class PlateKinematics(NamedTuple):
     Omega: float
 
 
-@inlined_kernel
+@kernel
 def plate_frame(kin, s, c, m, G, w):
     """Contact frame of the plates (module docstring); returns the preload N [N]."""
     r = kin.r
