@@ -21,7 +21,7 @@ from .models import ModelResult, is_plates, parameter_value, plates_parameters, 
 from .section import OrbitError, Section, resolve_section, section_crossings
 from .shooting import PeriodicOrbit, periodic_orbit
 
-__all__ = ["start_run", "crossings_per_stick", "start_orbit_from_run", "Start", "start_orbit", "START_RUN", "START_RATE"]
+__all__ = ["start_run", "named_start", "crossings_per_stick", "start_orbit_from_run", "Start", "start_orbit", "START_RUN", "START_RATE"]
 
 #: Length [s] and sample rate [Hz] of the run from the ``far`` initial condition that gives the
 #: start orbit of each N (the stick-slip oscillation settles within ~20 s at Ω = 5 rad/s).
@@ -47,16 +47,8 @@ def start_run(system, ic="far", *, model=None, t_end: float = START_RUN, rtol: f
     slip_band : float, optional
         Low-speed band of the slip direction [m/s] (default: the model's).
     """
-    from ..sweep.spec import NEAR_PERTURBATION, initial_condition
-
     system = resolve(system, model, slip_band)
-    if is_plates(system) and isinstance(ic, str):
-        state, pert = initial_condition(ic, plates_parameters(system), ModelResult.label(system))
-    elif isinstance(ic, str) and ic == "far":
-        raise ContinuationError(f"ic 'far' is the plates' start; for model {system.name!r} use zero, equilibrium, "
-                                "near or a state")
-    else:
-        state, pert = ("equilibrium", NEAR_PERTURBATION) if isinstance(ic, str) and ic == "near" else (ic, None)
+    state, pert = named_start(system, ic)
     try:
         run = simulate(system, t_end, ic=state, perturbation=pert, sample_rate=START_RATE, rtol=rtol,
                        atol=1e-3 * rtol)
@@ -65,6 +57,27 @@ def start_run(system, ic="far", *, model=None, t_end: float = START_RUN, rtol: f
     if run.status != "success":
         raise ContinuationError(f"the start run from ic {ic!r} failed: {run.status}")
     return run
+
+
+def named_start(system: FrictionModel, ic):
+    """(ic, perturbation) arguments of :func:`stickslip.simulate` for the start ``ic`` of ``system``:
+    ``zero``, ``equilibrium``, ``near`` (the equilibrium, the observed dof moved by
+    :data:`~stickslip.sweep.spec.NEAR_PERTURBATION`), the plates' ``far``, or a state as ``simulate``
+    takes it (returned as it is).
+
+    Raises
+    ------
+    ContinuationError
+        For ``far`` on a model other than the plates.
+    """
+    from ..sweep.spec import NEAR_PERTURBATION, initial_condition
+
+    if is_plates(system) and isinstance(ic, str):
+        return initial_condition(ic, plates_parameters(system), ModelResult.label(system))
+    if isinstance(ic, str) and ic == "far":
+        raise ContinuationError(f"ic 'far' is the plates' start; for model {system.name!r} use zero, equilibrium, "
+                                "near or a state (NAME=VALUE,...)")
+    return ("equilibrium", NEAR_PERTURBATION) if isinstance(ic, str) and ic == "near" else (ic, None)
 
 
 def crossings_per_stick(run: Trajectory, section="max") -> int:
