@@ -14,7 +14,7 @@ import typer
 from rich.table import Table
 
 from ..errors import StickSlipError
-from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_choice,
+from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one,
                    check_finite, check_positive, check_resumable_output, check_samples, console, note_line)
 from .orbit import model_system, parse_section, parse_start
 
