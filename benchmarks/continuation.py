@@ -3,7 +3,14 @@ Region II edge (end of the stick-slip branch) over 20 values of N on 2 cores.
 
 Goals: branch ≤ 60 s (one core); edge curve ≤ 300 s (2 cores).
 
+``--ab REV`` instead times a shorter branch (``--points``, default 30) alternately with the working
+tree and with the package at git revision REV (imported beside it as ``stickslip_baseline``, as
+benchmarks/ab.py does; ``--pairs`` pairs), prints the median ratio new/baseline and how far the two
+branches' periods and multipliers are apart, and a belt model-file branch over ``contact.0.drive``
+(working tree only: REV may not continue model files).
+
     python benchmarks/continuation.py [--quick] [--workers 2] [--curve-out /tmp/fold_curve.nc]
+    python benchmarks/continuation.py --ab main [--points 30] [--pairs 3]
 
 Prints measured times against the goals and writes benchmarks/results/continuation.json.
 """
@@ -20,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from stickslip import Parameters, simulate
+from stickslip.model.library import load_model
 from stickslip.orbits import periodic_orbit
 from stickslip.orbits.continuation import continue_orbit, fold_curve
 from stickslip.sweep.spec import initial_condition
@@ -61,14 +69,85 @@ def bench_curve(n: int, workers: int, out: str | None) -> dict:
             "kind": list(fc.kind), "points": fc.points.tolist(), "seconds": fc.seconds.tolist()}
 
 
+def bench_ab(rev: str, points: int, pairs: int) -> dict:
+    """The same Model 1 branch (N = 50 N from Ω = 8 rad/s) with the working tree and with ``rev``."""
+    import sys
+    import tempfile
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from ab import baseline_package
+
+    with tempfile.TemporaryDirectory() as tmp:
+        baseline_package(rev, Path(tmp))
+        sys.path.insert(0, tmp)
+        import stickslip_baseline as base
+        import stickslip_baseline.orbits.continuation as base_cont
+        import stickslip_baseline.sweep.spec as base_spec
+
+        def branch(which):
+            pkg, cont, spec = (base, base_cont, base_spec) if which == 0 else (None, None, None)
+            if which == 0:
+                p = pkg.Parameters(N=50.0, Omega=8.0)
+                ic, pert = spec.initial_condition("far", p, "full")
+                run = pkg.simulate(p, 60.0, ic=ic, perturbation=pert, sample_rate=2000.0, rtol=1e-10, atol=1e-13)
+                orbit = pkg.orbits.periodic_orbit(p, run)
+                go = cont.continue_orbit
+            else:
+                orbit, go = start_orbit(), continue_orbit
+            t0 = time.perf_counter()
+            b = go(start=orbit, param="Omega", step=0.02, max_step=0.02, max_points=points, bounds=(8.0, 40.0),
+                   amplitude=False)
+            return time.perf_counter() - t0, b
+
+        walls = {0: [], 1: []}
+        ratios = []
+        for i in range(pairs):
+            for which in ((0, 1) if i % 2 else (1, 0)):
+                wall, b = branch(which)
+                walls[which].append(wall)
+                if which == 0:
+                    b_old = b
+                else:
+                    b_new = b
+            ratios.append(walls[1][-1] / walls[0][-1])
+    ratios.sort()
+    n = min(len(b_old), len(b_new))
+    belt = load_model("belt")
+    t0 = time.perf_counter()
+    bb = continue_orbit(belt, "contact.0.drive", start=periodic_orbit(belt, {"x": 0.0, "dx": 1.5}, search_time=60.0),
+                        step=0.02, max_step=0.05, max_points=points, bounds=(1.5, 3.0), amplitude=False)
+    return {"rev": rev, "points": points, "pairs": pairs, "baseline_min_s": min(walls[0]), "new_min_s": min(walls[1]),
+            "ratio_median": ratios[len(ratios) // 2], "ratios": ratios,
+            "max_period_rel_difference": float(np.max(np.abs(b_new.periods[:n] / b_old.periods[:n] - 1.0))),
+            "max_multiplier_abs_difference": float(np.max(np.abs(np.sort(np.abs(b_new.multipliers[:n]), axis=1)
+                                                              - np.sort(np.abs(b_old.multipliers[:n]), axis=1)))),
+            "belt_drive_branch": {"points": len(bb), "wall_s": time.perf_counter() - t0,
+                                  "drive_range": [float(bb.values[0]), float(bb.values[-1])],
+                                  "stop_reason": bb.stop_reason}}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--ab", default=None, metavar="REV", help="time a branch against git revision REV")
+    ap.add_argument("--points", type=int, default=30)
+    ap.add_argument("--pairs", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="50-point branch, 4 values of N")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--curve-out", default=None, help="also write the edge curve as NetCDF")
     ap.add_argument("--only", choices=["branch", "curve"], default=None)
     args = ap.parse_args()
     start_orbit(N=50.0, Omega=8.0)  # compile/load the kernels outside the timings
+    if args.ab:
+        r = bench_ab(args.ab, args.points, args.pairs)
+        print(f"branch of {r['points']} orbits: {r['new_min_s']:.2f} s, {args.ab} {r['baseline_min_s']:.2f} s, median "
+              f"ratio {r['ratio_median']:.3f} over {r['pairs']} pairs; periods apart {r['max_period_rel_difference']:.1e} "
+              f"(relative), |multipliers| {r['max_multiplier_abs_difference']:.1e}; belt over contact.0.drive: "
+              f"{r['belt_drive_branch']['points']} orbits in {r['belt_drive_branch']['wall_s']:.2f} s")
+        out = Path(__file__).parent / "results" / "continuation_ab.json"
+        out.parent.mkdir(exist_ok=True)
+        out.write_text(json.dumps(r, indent=1))
+        print(f"wrote {out}")
+        return
     res = {"machine": f"{platform.machine()}, {os.cpu_count()} cores (shared), {platform.python_version()}",
            "load_average_start": os.getloadavg()}
     if args.only in (None, "branch"):

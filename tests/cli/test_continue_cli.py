@@ -18,8 +18,8 @@ BAND = 1e-5
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--param", "foo", "--from", "1", "--to", "2"], "--param foo: not a numeric parameter"),
-    (["--param", "friction_law", "--from", "1", "--to", "2"], "--param friction_law: not a numeric parameter"),
+    (["--param", "foo", "--from", "1", "--to", "2"], "--param foo: unknown parameter 'foo' of model 'two-plates'"),
+    (["--param", "friction_law", "--from", "1", "--to", "2"], "is 'exponential', not a finite number"),
     (["--from", "3", "--to", "3"], "--from and --to are both 3"),
     (["--from", "nan", "--to", "3"], "--from must be a finite number"),
     (["--from", "3", "--to", "inf"], "--to must be a finite number"),
@@ -119,3 +119,28 @@ def test_same_command_resumes_and_other_settings_are_refused(tmp_path):
     lines = [ln for ln in other.output.splitlines() if ln.strip()]
     assert len(lines) == 1 and lines[0].startswith("error:") and "choose another output (--out) or delete" in lines[0]
     assert load_branch(out)["value"].size == 4  # the finished file is left as it was
+
+
+def test_continue_a_model_file_over_a_set_path(tmp_path):
+    """`stickslip continue --model belt --param contact.0.drive`: the branch file holds the library's
+    branch over the same path (the same start run and options)."""
+    from stickslip.model.library import load_model
+
+    out = tmp_path / "belt.nc"
+    res = runner.invoke(app, ["continue", "--model", "belt", "--param", "contact.0.drive", "--from", "1.5", "--to",
+                              "1.6", "--ic", "x=0,dx=1.5", "--max-points", "6", "--step", "0.02", "--max-step", "0.05",
+                              "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.output)
+    assert s["param"] == "contact.0.drive" and s["from"] == 1.5
+    belt = load_model("belt")
+    run = start_run(belt, {"x": 0.0, "dx": 1.5}, t_end=60.0)
+    ref = continue_orbit(belt, "contact.0.drive", start=run, step=0.02, max_step=0.05, max_points=6,
+                         bounds=(1.5, 1.6))
+    ds = load_branch(out)
+    assert ds.attrs["model"] == "belt" and list(ds["state"].values) == ["x", "dx"]
+    assert np.array_equal(ds["value"].values, ref.values) and np.array_equal(ds["period"].values, ref.periods)
+    assert (tmp_path / "belt.png").stat().st_size > 0
+    bad = runner.invoke(app, ["continue", "--model", "belt", "--param", "Omega", "--from", "1", "--to", "2",
+                              "--out", str(tmp_path / "b.nc")])
+    assert bad.exit_code == 2 and "unknown parameter 'Omega' of model 'belt'" in bad.output

@@ -43,7 +43,7 @@ def _one_error_line(res, message):
     (["--monodromy", "exact"], "--monodromy exact: choose one of saltation, finite-difference"),
     (["--period-multiplicity", "0"], "--period-multiplicity must be >= 1"),
     (["--out", "o.txt"], "--out o.txt: give a path ending in .nc"),
-    (["--model", "xyz"], "--model xyz"),
+    (["--model", "xyz"], "unknown model 'xyz'"),
     (["--set", "k_px"], "--set expects NAME=VALUE"),
     (["--N", "-5"], "N"),
 ])
@@ -61,7 +61,7 @@ def test_orbit_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
     (["--rtol", "nan"], "--rtol must be a finite number > 0"),
     (["--method", "qr"], "--method qr: choose one of variational, finite-difference"),
     (["--out", "l.csv"], "--out l.csv: give a path ending in .nc"),
-    (["--model", "xyz"], "--model xyz"),
+    (["--model", "xyz"], "unknown model 'xyz'"),
     (["--config", "missing.toml"], "missing.toml"),
 ])
 def test_lyapunov_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
@@ -135,3 +135,44 @@ def test_lyapunov_human_summary(tmp_path):
     assert res.exit_code == 0, res.output
     assert "λ [1/s]" in res.output and "wall time" in res.output
     assert (tmp_path / "l.nc").exists() and not (tmp_path / "l.png").exists()
+
+
+def test_orbit_and_lyapunov_of_a_model_file(tmp_path):
+    """--model on a library model file, --ic by state name, --section on a named dof: the files hold
+    what the library computes; the figures are drawn for a model without φ."""
+    out = tmp_path / "belt.nc"
+    res = runner.invoke(app, ["orbit", "--model", "belt", "--ic", "x=0,dx=1.5", "--search-time", "60",
+                              "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.output)
+    ref = periodic_orbit("belt", {"x": 0.0, "dx": 1.5}, search_time=60.0)
+    assert s["model"] == "belt" and s["period_s"] == pytest.approx(ref.period, rel=1e-12)
+    assert s["stick_phases"] == 1 and s["max_nontrivial_multiplier_abs"] < 1e-8
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert list(ds["state"].values) == ["x", "dx"] and ds.attrs["model"] == "belt"
+    assert (tmp_path / "belt.png").stat().st_size > 0
+    ps = tmp_path / "ps.nc"
+    res = runner.invoke(app, ["orbit", "--model", "popp-stelter", "--ic", "x1=0.5,x2=-0.5", "--search-time", "200",
+                              "--section", "x2_max", "--out", str(ps), "--json", "--no-plot"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.output)["stick_phases"] == 2
+    ly = tmp_path / "ly.nc"
+    res = runner.invoke(app, ["lyapunov", "--model", "belt", "--ic", "x=0,dx=1.5", "--t-transient", "20",
+                              "--t-average", "60", "--out", str(ly), "--json"])
+    assert res.exit_code == 0, res.output
+    ex = json.loads(res.output)["exponents"]
+    ref = lyapunov_spectrum("belt", {"x": 0.0, "dx": 1.5}, t_transient=20.0, t_average=60.0)
+    assert np.allclose(ex, ref.exponents, rtol=1e-12)
+
+
+@pytest.mark.parametrize("cmd, args, message", [
+    ("orbit", ["--model", "belt", "--ic", "far"], "ic 'far' is the plates' start"),
+    ("orbit", ["--model", "belt", "--N", "40"], "--N is a parameter of the two plates"),
+    ("orbit", ["--model", "belt", "--section", "phi_max", "--ic", "zero"], "unknown section 'phi_max'"),
+    ("orbit", ["--model", "belt", "--section", "x=high"], "--section x=high"),
+    ("lyapunov", ["--model", "belt", "--set", "contact.0.drive=fast"], "contact.0.drive"),
+])
+def test_model_file_bad_input_is_one_line_and_exit_2(tmp_path, cmd, args, message):
+    res = runner.invoke(app, [cmd, *args, "--out", str(tmp_path / "o.nc"), "--search-time", "1"]
+                        if cmd == "orbit" else [cmd, *args, "--out", str(tmp_path / "o.nc")])
+    _one_error_line(res, message)

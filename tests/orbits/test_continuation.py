@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from stickslip import Parameters, simulate
+from stickslip.model.library import two_plates
 from stickslip.orbits import PeriodicOrbit, periodic_orbit, resolve_section
 from stickslip.orbits import arclength, region_edge
 from stickslip.orbits import continuation as C
@@ -23,6 +24,9 @@ from stickslip.orbits.continuation import ContinuationError, continue_orbit, loa
 
 
 # --------------------------------------------------------------------------- constructed problem
+ROTATION = two_plates(Parameters(alpha=5.0), "rotation", 1e-12)
+
+
 def _constructed_orbit():
     """A PeriodicOrbit of model ``rotation`` whose shooting map is replaced by an algebraic one.
 
@@ -35,7 +39,7 @@ def _constructed_orbit():
     return PeriodicOrbit(state=state, period=0.5, multiplicity=1, stick_phases=1, residual=0.0, iterations=0,
                          residual_history=np.zeros(1), multipliers=np.ones(4, complex), monodromy=np.eye(4),
                          free_states=("phi", "psi", "phi_dot", "psi_dot"), scale=sigma,
-                         params=Parameters(alpha=5.0), model="rotation", section=resolve_section("phi_max"),
+                         system=ROTATION, section=resolve_section("phi_max", ROTATION),
                          options=dict(rtol=1e-10, atol=1e-13, slip_band=1e-12, tol=1e-8, fd_step=1e-5, max_iter=20))
 
 

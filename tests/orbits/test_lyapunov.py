@@ -89,7 +89,7 @@ def test_model1_spectrum_equals_powers_of_the_fd_monodromy(orbit):
     the variational spectrum equals the finite-time exponents of (M_FD)^30, M_FD the
     finite-difference monodromy (independent of the variational code). The two collapsed
     directions (λ = −∞ in exact arithmetic) are round-off on both sides and not compared."""
-    from stickslip.orbits.variational import monodromy
+    from stickslip.orbits import monodromy
 
     n = 30
     # one period of "transient" returns to the section state (to ~1e-10), so the frame starts there
@@ -115,7 +115,7 @@ def test_model1_spectrum_converges_to_floquet_exponents(orbit):
     Σ ln|μ_i|/T. The individual exponents converge like 1/t with a large constant (two
     complex pairs of nearly equal modulus, 0.994131 and 0.994108: measured spread ±0.008
     1/s around −0.0091 after 400 s), so only their sum is compared."""
-    from stickslip.orbits.variational import monodromy
+    from stickslip.orbits import monodromy
 
     mult = monodromy(orbit, "finite-difference").multipliers
     L = lyapunov_spectrum(ic=orbit, t_transient=1.0, t_average=400.0)

@@ -1,9 +1,10 @@
-"""Monodromy from the variational equations with saltation matrices (issue 6).
+"""Monodromy from the variational equations with saltation matrices, on the plates.
 
-Evidence: the Jacobian kernels against central differences of the kernels' own vector field;
-the linearised flow of a linear oscillator against its closed form; the monodromy of the
-belt oscillator against a closed form derived from the stick collapse; Model 1 multipliers
-against the finite-difference (perturbed-shooting) monodromy.
+Evidence: the band-phase Jacobian against central differences of the simulator's own vector field;
+the linearised flow of a linear oscillator against its closed form; the monodromy of the belt
+oscillator against a closed form derived from the stick collapse; Model 1 multipliers and the
+linearised flow over transients against the finite-difference (perturbed-shooting) monodromy.
+The same machinery on the model-file models: tests/orbits/test_generic_models.py.
 """
 
 import math
@@ -13,12 +14,15 @@ import pytest
 from scipy.optimize import linear_sum_assignment
 
 from stickslip import Parameters
-from stickslip.model import kernels as K
-from stickslip.model.kernels import DEFAULT_SLIP_BAND as P_BAND
-from stickslip.model.system import assemble
+from stickslip.model import physics as PH
+from stickslip.model.library import two_plates
 from stickslip.orbits import OrbitError, periodic_orbit
-from stickslip.orbits.variational import (Monodromy, field, flow_jacobian, monodromy, saltation_matrix,
-                                          state_jacobian)
+from stickslip.orbits.layout import free_states
+from stickslip.orbits.linear_flow import flow_jacobian
+from stickslip.orbits.problem import Monodromy, central_differences, monodromy
+from stickslip.orbits.saltation import field, saltation_matrix, with_mode
+from stickslip.orbits.section import flow
+from stickslip.orbits import var_kernels as V
 
 
 def matched_distance(a, b):
@@ -28,31 +32,54 @@ def matched_distance(a, b):
     return float(C[r, c].max())
 
 
-def fd_field_jacobian(system, s, mode, e, free, h=1e-8):
-    """Central differences of kernels.rhs (12 × 12 on the free columns), step h [SI]."""
-    J = np.zeros((12, 12))
-    for j in free:
+def fd_flow_jacobian(system, s0, T, h):
+    """Central differences of the event integrator's flow map on the free states, steps h (2 n_free,)."""
+    free = free_states(system)
+    return central_differences(lambda s: flow(system, s, T, rtol=1e-10, atol=1e-13)[0], s0, free, h)
+
+
+def kinds(events):
+    return [k for _, k, _ in events]
+
+
+@pytest.mark.parametrize("band", [True, False])
+def test_band_jacobian_turns_with_the_quasi_static_direction(band):
+    """Right after a breakaway (|v_r| = 3e-6 m/s, inside the low-speed band) the slip direction is
+    the quasi-static one, a function of the state found by a Newton iteration on real numbers. The
+    variational Jacobian (complex step + the direction's turn, band=True) against central
+    differences of the simulator's own right-hand side with steps far below |v_r| (1e-3 of the
+    orbit's ranges); the complex step alone (band=False) misses the turn and is refused here."""
+    from stickslip import simulate
+
+    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0,
+                       monodromy="finite-difference")
+    system = o.system
+    traj = simulate(system, 0.634, ic=o.state, rtol=1e-10, atol=1e-13, sample_rate=1 / 0.634)
+    s = traj.final_state
+    t_b = traj.transitions
+    assert t_b.kind[-1] == -1 and 0.634 - t_b.time[-1] < 1e-3       # 0.5 ms after the breakaway
+    Fs = np.empty(2)
+    PH.stick_forces(t_b.state[-1], with_mode(np.zeros(4), 0, PH.MODE_STICK), -1, system.data, Fs, np.empty(1))
+    e = -Fs / np.hypot(*Fs)
+    cst = with_mode(np.zeros(4), 0, PH.MODE_SLIP_QUASI_STATIC, e)
+    y = np.concatenate([s, np.eye(12).ravel()])         # Φ = I: the variational rhs is J itself
+    dy = np.empty(y.size)
+    V.variational_rhs(y, cst, system.data, 12, band, dy, np.empty(12), np.empty(12, complex), np.empty(12, complex),
+                      np.empty(12))
+    J = dy[12:].reshape(12, 12)
+    h = np.zeros(12)
+    h[free_states(system)] = 1e-8 * o.scale
+    Jfd = np.zeros((12, 12))
+    for j in range(12):
         sp, sm = s.copy(), s.copy()
-        sp[j] += h
-        sm[j] -= h
-        J[:, j] = (field(system, sp, mode, e) - field(system, sm, mode, e)) / (2 * h)
-    return J
-
-
-@pytest.mark.parametrize("mode", [K.MODE_SLIP_EXACT, K.MODE_STICK])
-def test_state_jacobian_against_differences_of_the_vector_field(mode):
-    P = Parameters(N=50.0, Omega=0.5)
-    system = assemble(P, "full")
-    rng = np.random.default_rng(1)
-    s = np.concatenate([rng.normal(0, 1e-3, 4), rng.normal(0, 1e-2, 2), rng.normal(0, 1e-2, 4), rng.normal(0, 0.1, 2)])
-    vx, vy = K.relative_velocity(s, system.p)
-    assert math.hypot(vx, vy) > 1e-2      # a slip state well outside the low-speed band
-    steps = 6e-6 * np.array([1e-3] * 4 + [1e-2] * 2 + [1e-2] * 4 + [1e-1] * 2)
-    J = np.empty((12, 12))
-    state_jacobian(s, mode, 1.0, 0.0, system.minv, system.damp, system.stiff, system.p, steps, J)
-    Jfd = fd_field_jacobian(system, s, mode, (1.0, 0.0), range(12))
-    # central differences with h = 1e-8 are good to ~1e-7 relative of the largest entry (~300)
-    assert np.max(np.abs(J - Jfd)) < 1e-6 * np.max(np.abs(Jfd))
+        sp[j] += h[j]
+        sm[j] -= h[j]
+        Jfd[:, j] = (field(system, sp, cst) - field(system, sm, cst)) / (2 * h[j])
+    error = np.max(np.abs(J - Jfd)) / np.max(np.abs(Jfd))
+    if band:
+        assert error < 1e-6       # measured 1e-7 (the differences' own truncation and round-off)
+    else:
+        assert error > 1e-4       # measured 1.6e-3: the direction's turn is not in the complex step
 
 
 def test_saltation_matrix_maps_the_field_across_the_event():
@@ -75,7 +102,7 @@ def test_linear_oscillator_flow():
     s0 = np.zeros(12)
     s0[4] = P.mu_k * P.N * P.r / P.k_pphi + 0.01
     t = 0.3
-    fj = flow_jacobian(P, "phi", s0, t)
+    fj = flow_jacobian(two_plates(P, "phi"), s0, t)
     M = fj.matrix[np.ix_([4, 10], [4, 10])]
     c, s = math.cos(omega * t), math.sin(omega * t)
     exact = np.array([[c, s / omega], [-omega * s, c]])
@@ -126,7 +153,7 @@ def test_belt_exponential_law_rank_one_collapse():
     assert np.abs(M[0]).max() < 1e-5 * scale      # measured 2e-7 relative
     assert abs(np.trace(M) - 1.0) < 1e-5          # measured 3e-7
     assert matched_distance(m.multipliers, np.array([1.0, 0.0])) < 1e-5
-    assert [k for _, k in m.events] == ["stick", "breakaway", "band"]
+    assert kinds(m.events) == ["stick", "breakaway", "band"]
 
 
 @pytest.fixture(scope="module")
@@ -142,7 +169,7 @@ def test_model1_saltation_matches_finite_differences(orbit50):
     assert o.options["monodromy"] == "finite-difference"
     m = monodromy(o, "saltation")
     assert isinstance(m, Monodromy) and m.matrix.shape == (12, 12)
-    assert [k for _, k in m.events] == ["stick", "breakaway", "band"]
+    assert kinds(m.events) == ["stick", "breakaway", "band"]
     # measured: 2.8e-8 between the two sets; the FD matrix is good to ~1e-8 (trivial multiplier)
     assert matched_distance(m.multipliers, o.multipliers) < 1e-5
     assert abs(m.trivial_multiplier - 1.0) < 1e-5                 # measured 2.7e-8
@@ -169,56 +196,45 @@ def test_bad_method(orbit50):
         periodic_orbit(Parameters(), np.zeros(12), monodromy="nonsense")
 
 
-def test_compiled_segments_agree_with_scipy_dop853(orbit50, monkeypatch):
-    """The compiled Dormand–Prince 5(4) variational integrator against scipy's DOP853 on the
-    same segments (an independent integrator of the same equations)."""
-    import stickslip.orbits.variational as V
-
-    o = orbit50
-    a = flow_jacobian(o.params, o.model, o.state, o.period, scale=o.scale).matrix
-    monkeypatch.setattr(V, "SEGMENT_METHOD", "DOP853")
-    b = flow_jacobian(o.params, o.model, o.state, o.period, scale=o.scale).matrix
-    # both at rtol 1e-10; measured 1.7e-7 on entries up to 15 (1e-8 relative)
-    assert np.max(np.abs(a - b)) < 1e-6 * np.max(np.abs(b))
-
-
 @pytest.mark.parametrize("model, N, duration", [("x", 50.0, 1.0), ("full", 120.0, 3.0)])
 def test_flow_jacobian_of_a_transient_against_finite_differences(model, N, duration):
     """Not an orbit: the linearised flow over a stretch of a transient with several stick
     phases (Model 2: 3 stick + 3 breakaway, Model 1 at N = 120 N: 3 + 2) against central
     differences of the flow map (step 1e-5 σ)."""
     from stickslip import simulate
-    from stickslip.orbits.variational import fd_monodromy, free_states
 
     P = Parameters(N=N, Omega=0.5)
-    system = assemble(P, model)
+    system = two_plates(P, model)
     free = free_states(system)
-    tr = simulate(P, 30.0, model=model, ic="equilibrium", perturbation=1e-3, rtol=1e-10, atol=1e-13,
+    tr = simulate(system, 30.0, ic="equilibrium", perturbation=1e-3, rtol=1e-10, atol=1e-13,
                   sample_rate=100)
     sigma = np.ptp(tr.states[tr.t >= 15.0], axis=0)[free]
     sigma = np.maximum(sigma, 1e-4 * sigma.max())
-    fj = flow_jacobian(P, model, tr.final_state, duration, scale=sigma)
-    assert sum(k == "stick" for _, k in fj.events) == 3
+    fj = flow_jacobian(system, tr.final_state, duration, scale=sigma)
+    assert kinds(fj.events).count("stick") == 3
     M = fj.matrix[np.ix_(free, free)]
     # Step 1e-5 σ: the adaptive flow map carries round-off-level noise (rtol 1e-10) that central
     # differences divide by the step. Measured for Model 1 against the variational matrix: step
     # 1e-7 σ 1.2e-4, 1e-6 σ 1.1e-5 to 1.5e-5 (it depends on the start state's last bits), 1e-5 σ
     # 1.1e-6, where the variational matrices of two code versions agree to 1e-8.
-    Mfd = fd_monodromy(P, model, tr.final_state, duration, free, 1e-5 * sigma, rtol=1e-10, atol=1e-13,
-                       slip_band=1e-4)
+    Mfd = fd_flow_jacobian(system.with_slip_band(1e-4), tr.final_state, duration, 1e-5 * sigma)
     assert np.max(np.abs(M - Mfd)) < 1e-5 * np.max(np.abs(Mfd))
 
 
 def test_newton_with_the_saltation_jacobian_converges_to_the_same_orbit(orbit50):
-    """periodic_orbit's default Newton Jacobian (saltation) against the FD Newton (orbit50 was
-    found with the default): same period and section state, to the shooting tolerance."""
-    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0,
-                       newton_jacobian="finite-difference", monodromy="finite-difference")
-    assert orbit50.options["newton_jacobian"] == "saltation"
+    """periodic_orbit's default Newton Jacobian (saltation) against the FD Newton: same period and
+    section state. Both are solved to 1e-11 σ: at the default tol 1e-8 an iterate may stop at a
+    residual of ~1e-9 σ (measured: the saltation Newton's last one, 1.1e-9), whose period is then
+    only good to ~1e-9 relative."""
+    kw = dict(search_time=30.0, monodromy="finite-difference", tol=1e-11)
+    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", newton_jacobian="finite-difference",
+                       **kw)
+    s = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", **kw)
+    assert s.options["newton_jacobian"] == "saltation"
     assert o.options["newton_jacobian"] == "finite-difference"
-    assert o.period == pytest.approx(orbit50.period, rel=1e-9)
-    assert np.allclose(o.state, orbit50.state, rtol=0, atol=1e-8 * np.abs(orbit50.state).max())
-    ds = flow_jacobian(o.params, o.model, o.state, o.period, scale=o.scale).to_xarray()
+    assert o.period == pytest.approx(s.period, rel=1e-10)
+    assert np.allclose(o.state, s.state, rtol=0, atol=1e-9 * np.abs(s.state).max())
+    ds = flow_jacobian(o.system, o.state, o.period, scale=o.scale).to_xarray()
     assert ds["flow_jacobian"].shape == (12, 12) and ds.attrs["duration"] == o.period
 
 
@@ -228,16 +244,14 @@ def test_velocity_reversals_against_finite_differences(law):
     through zero where the stick force is inadmissible (the integrator projects and slips on,
     recording no transition). The reversal jump (saltation with f⁺ the departing slip field,
     no projection) against central differences of the flow map over 1 s (4 reversals)."""
-    from stickslip.orbits.variational import fd_monodromy
-
     P = Parameters(Omega=0.5, friction_law=law)
     s0 = np.zeros(12)
     s0[4] = 0.3
     sigma = np.array([0.6, 8.0])   # φ and φ̇ ranges of the motion [rad, rad/s]
-    fj = flow_jacobian(P, "phi", s0, 1.0, scale=sigma)
-    assert [k for _, k in fj.events].count("reversal") == 4
+    system = two_plates(P, "phi")
+    fj = flow_jacobian(system, s0, 1.0, scale=sigma)
+    assert kinds(fj.events).count("reversal") == 4
     M = fj.matrix[np.ix_([4, 10], [4, 10])]
-    Mfd = fd_monodromy(P, "phi", s0, 1.0, np.array([4, 10]), 1e-6 * sigma, rtol=1e-10, atol=1e-13,
-                       slip_band=P_BAND)
+    Mfd = fd_flow_jacobian(system, s0, 1.0, 1e-6 * sigma)
     # measured 5e-8 (Coulomb) and 7e-8 (exponential) relative; the same with FD step 1e-5 σ
     assert np.max(np.abs(M - Mfd)) < 1e-5 * np.max(np.abs(Mfd))

@@ -52,14 +52,15 @@ def test_branch_figure_axis_and_title_use_symbols_units_and_say_why_it_ends(tmp_
 
 
 def _spectrum(exponents):
+    from stickslip.model.library import two_plates
     from stickslip.orbits import LyapunovSpectrum
 
     exponents = np.asarray(exponents, float)
     time = np.linspace(1.0, 200.0, 50)
     estimate = exponents[None, :] + 1.0 / time[:, None]
     return LyapunovSpectrum(exponents=exponents, time=time, estimate=estimate, t_transient=50.0,
-                            scale=np.ones(exponents.size), stick_phases=540, wall_time=1.0, params=Parameters(N=50.0),
-                            model="full", options={})
+                            scale=np.ones(exponents.size), stick_phases=540, wall_time=1.0,
+                            system=two_plates(Parameters(N=50.0), "full"), options={})
 
 
 def test_lyapunov_spectrum_says_which_exponents_it_leaves_out():

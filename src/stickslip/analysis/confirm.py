@@ -70,20 +70,18 @@ def _sections_in_slip(traj, dof: str, t_from: float, period: float):
     """Sections crossed only in slip in the window, with their crossings per period: on ``dof``
     first, then on the model's other free coordinates; on each, its maxima, its minima, then
     up- and down-crossings of :data:`LEVELS` of its range in the window."""
-    from ..model.kernels import DEFAULT_SLIP_BAND
-    from ..model.system import assemble
-    from ..model.variants import DOF_NAMES
     from ..orbits.section import Section, section_crossings
 
-    system = assemble(traj.params, traj.model, traj.options.get("slip_band", DEFAULT_SLIP_BAND))
+    system = traj.system
+    n = system.n
     sel = traj.t >= t_from
     t, states, mode = traj.t[sel], traj.states[sel], traj.mode[sel]
     span = float(t[-1] - t[0])
-    first = DOF_NAMES.index(dof)
-    for j in [first] + [int(i) for i in system.variant.free_indices if i != first]:
-        name = DOF_NAMES[j]
+    first = system.dofs.index(dof)
+    for j in [first] + [int(i) for i in np.flatnonzero(system.free) if i != first]:
+        name = system.dofs[j]
         lo, hi = float(states[:, j].min()), float(states[:, j].max())
-        candidates = [Section(6 + j, 0.0, -1, f"{name}_max"), Section(6 + j, 0.0, 1, f"{name}_min")]
+        candidates = [Section(n + j, 0.0, -1, f"{name}_max"), Section(n + j, 0.0, 1, f"{name}_min")]
         for frac in LEVELS:
             level = lo + frac * (hi - lo)
             candidates += [Section(j, level, 1, f"{name}={level:.6g} up"),
@@ -106,7 +104,7 @@ def confirm_period(traj, k: int, period: float, *, dof: str | None = None, t_fro
     period : float
         Period claimed by the signal [s].
     dof : str
-        The coordinate analysed (a name of :data:`stickslip.DOF_NAMES`).
+        The coordinate analysed (a dof of the run's model; default its observed one).
     t_from : float, optional
         Start of the window [s]; default ``traj.steady_from``.
 
@@ -119,21 +117,18 @@ def confirm_period(traj, k: int, period: float, *, dof: str | None = None, t_fro
     """
     from ..orbits import periodic_orbit
 
-    if not traj.is_plates:
-        return {"confirmed": False, "reason": f"shooting periodic orbits serves the two plates only so far, not model "
-                                              f"{traj.system.name!r}"}
     dof = traj.system.dofs[dof_index(traj, dof)]
     t_from = traj.steady_from if t_from is None else float(t_from)
     reasons = []
     for section, mult in _sections_in_slip(traj, dof, t_from, period):
         try:
-            orbit = periodic_orbit(traj.params, traj, section=section, period_multiplicity=mult)
+            orbit = periodic_orbit(None, traj, section=section, period_multiplicity=mult)
             run = orbit.trajectory(periods=ORBIT_PERIODS, sample_rate=max(200.0, 100.0 * k / orbit.period))
         except (StickSlipError, ArithmeticError, np.linalg.LinAlgError) as exc:
             reasons.append(f"{section.name}: {exc}")
             continue
         j = dof_index(traj, dof)
-        own = detect_period(run.t, run.states[:, j], run.states[:, 6 + j])
+        own = detect_period(run.t, run.states[:, j], run.states[:, traj.system.n + j])
         out = {"section": section.name, "period_s": float(orbit.period), "multiplicity": int(own.multiplicity),
                "stable": bool(orbit.stable), "stick_phases": int(orbit.stick_phases), "residual": float(orbit.residual),
                "max_multiplier": float(np.max(np.abs(orbit.nontrivial_multipliers)))}
@@ -171,13 +166,10 @@ def lyapunov_sign(traj, *, averaging: float = LYAPUNOV_TIME_S) -> dict:
     """
     from ..orbits import lyapunov_exponent
 
-    if not traj.is_plates:
-        return {"sign": None, "reason": f"Lyapunov exponents serve the two plates only so far, not model "
-                                        f"{traj.system.name!r}"}
     lams, ses = [], []
     for d0 in SEPARATIONS:
         try:
-            res = lyapunov_exponent(traj.params, traj.final_state, model=traj.model, t_transient=20.0,
+            res = lyapunov_exponent(traj.system, traj.final_state, t_transient=20.0,
                                     t_average=averaging, d0=d0)
         except (StickSlipError, ArithmeticError) as exc:
             return {"sign": None, "reason": f"Lyapunov exponent failed: {exc}"}

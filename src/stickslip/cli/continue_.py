@@ -13,25 +13,20 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import (CONFIG_HELP, RESTART_HELP, CLIError, app, build_parameters, check_below_one, check_choice,
+from ..errors import StickSlipError
+from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one,
                    check_finite, check_positive, check_resumable_output, check_samples, console, note_line)
+from .orbit import model_system, parse_section, parse_start
 
-_ICS = ("far", "near", "zero", "equilibrium")
 
-
-def _check(param: str, start: float, stop: float, ic: str, max_points: int, step: float,
-           max_step: float, search_time: float, rtol: float, tol: float, stop_on: list[str]) -> None:
+def _check(start: float, stop: float, max_points: int, step: float, max_step: float, search_time: float,
+           rtol: float, tol: float, stop_on: list[str]) -> None:
     """Validate the options before anything is computed (one-line CLIError naming the fix)."""
-    from ..model.parameters import Parameters
     from ..orbits.continuation import SPECIAL_KINDS
 
-    numeric = [n for n in Parameters.names() if n != "friction_law"]
-    if param not in numeric:
-        raise CLIError(f"--param {param}: not a numeric parameter; choose one of {', '.join(numeric)}")
     check_finite({"--from": start, "--to": stop})
     if start == stop:
         raise CLIError(f"--from and --to are both {start:g}; give the end of the range to continue to")
-    check_choice("--ic", ic, _ICS)
     if max_points < 2:
         raise CLIError(f"--max-points must be >= 2, got {max_points}")
     check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--rtol": rtol,
@@ -51,15 +46,19 @@ def _note_resume(k: int) -> None:
 
 @app.command("continue")
 def continue_command(
-    param: str = typer.Option("Omega", "--param", help="Parameter to vary: N, Omega, delta_mu, alpha, mu_k, k_px, ..."),
+    param: str = typer.Option("Omega", "--param", help="Parameter to vary: any numeric parameter of the model, the "
+                              "plates' N, Omega, delta_mu, alpha, mu_k, k_px, ... or a model file's path such as "
+                              "contact.0.drive ('stickslip models NAME' lists them)."),
     start: float = typer.Option(..., "--from", help="Start value of the parameter [its unit: N for N, rad/s for "
                                 "Omega, ...]; the first orbit is found there."),
     stop: float = typer.Option(..., "--to", help="End of the range [the unit of --param]; the branch goes from "
                                "--from towards it."),
     N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
     omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
-    model: str = typer.Option("full", "--model", help="full | x | y | rotation (paper Models 1–4)."),
-    ic: str = typer.Option("far", "--ic", help="Start run: far | near | zero | equilibrium (docs/sweeps.md)."),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP),
+    ic: str = typer.Option("far", "--ic", help="Start run: far (the plates) | near | zero | equilibrium "
+                           "(docs/sweeps.md) | NAME=VALUE,... by state name."),
+    section: str = typer.Option("max", "--section", help="Poincaré section: max | DOF_max | DOF=LEVEL."),
     search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run [s]."),
     max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
     step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
@@ -70,7 +69,7 @@ def continue_command(
     tol: float = typer.Option(1e-8, "--tol", help="Corrector tolerance (scaled shooting residual)."),
     slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction [m/s] "
                                               "(default: that of stickslip.simulate)."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output, journaled as it goes (OUT.nc.journal): "
                              "the same command again resumes; the figure goes beside it as .png."),
@@ -83,25 +82,32 @@ def continue_command(
 
     The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused).
     """
+    from ..orbits import resolve_section
     from ..orbits.continuation import START_RATE, continue_orbit, start_run
+    from ..orbits.models import parameter_value, with_parameter
 
     stop_on = list(stop_on or [])
-    _check(param, start, stop, ic, max_points, step, max_step, search_time, rtol, tol, stop_on)
+    _check(start, stop, max_points, step, max_step, search_time, rtol, tol, stop_on)
+    ic_start = parse_start(ic)
     check_positive({"--slip-band": slip_band})
     check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
-    band = {} if slip_band is None else {"slip_band": slip_band}
-    params, _ = build_parameters(config, set_, swept={param: f"--param {param}"}, N=N, Omega=omega)
-    params = params.replace(**{param: start})
+    system = model_system(model, config, set_, slip_band, swept={param: f"--param {param}"}, N=N, Omega=omega)
+    try:
+        parameter_value(system, param)
+        system = with_parameter(system, param, start)
+    except StickSlipError as exc:
+        raise CLIError(f"--param {param}: {exc}") from None
+    sec = resolve_section(parse_section(section), system)
     check_resumable_output(out, not no_plot, overwrite)
     progress = None if (no_progress or as_json) else (
         lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
                                           f"{'stable' if st else 'unstable'}"))
-    run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
+    run = start_run(system, ic_start, t_end=search_time, rtol=rtol)
     out.parent.mkdir(parents=True, exist_ok=True)
-    branch = continue_orbit(params, param, start=run, direction=1 if stop > start else -1, step=step,
+    branch = continue_orbit(system, param, start=run, direction=1 if stop > start else -1, step=step,
                             max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
-                            stop_on=tuple(stop_on), model=model, rtol=rtol, tol=tol, callback=progress, out=out,
-                            on_resume=_note_resume, resume=not overwrite, **band)
+                            stop_on=tuple(stop_on), section=sec, rtol=rtol, tol=tol, callback=progress, out=out,
+                            on_resume=_note_resume, resume=not overwrite)
     figure = None
     if not no_plot:
         from ..plot.continuation import save_branch_figure

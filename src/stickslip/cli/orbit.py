@@ -18,45 +18,56 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..errors import StickSlipError
-from ._app import (CONFIG_HELP, OVERWRITE_HELP, CLIError, app, build_parameters, check_below_one, check_choice,
-                   check_outputs, check_positive, check_samples, console)
+from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
+                   check_choice, check_outputs, check_positive, check_samples, console)
+from .simulate import _parse_ic
 
-#: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``).
+#: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``); ``far`` is the plates'.
 _ICS = ("far", "near", "zero", "equilibrium")
 
 #: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
 _METHODS = ("saltation", "finite-difference")
 _LYAPUNOV_METHODS = ("variational", "finite-difference")
 
-_N_HELP = "Normal preload N [N] (default 50)."
-_OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
-_MODEL_HELP = "full | x | y | rotation (paper Models 1–4) or DOFs, e.g. phi."
-_IC_HELP = "Start run: far | near | zero | equilibrium (docs/sweeps.md)."
+_N_HELP = "The plates: normal preload N [N] (default 50)."
+_OMEGA_HELP = "The plates: angular velocity Ω of the lower plate [rad/s] (default 5)."
+_IC_HELP = ("Start run: far (the plates) | near | zero | equilibrium (docs/sweeps.md) | NAME=VALUE,... by state "
+            "name, e.g. x=0,dx=1.5.")
+_SECTION_HELP = ("Poincaré section: max (maximum of the model's observed coordinate, the plates' φ) | DOF_max | "
+                 "DOF=LEVEL (up-crossing of a level), e.g. x2_max.")
 _BAND_HELP = "Low-speed band of the slip direction [m/s] (default: that of stickslip.simulate)."
 
 
-def _check_common(ic: str, model: str, positive: dict) -> None:
-    """Checks shared by both commands (one-line CLIError naming the fix), before any computing.
+def parse_start(ic: str):
+    """``--ic``: a name of :data:`_ICS` or a state (``NAME=VALUE,...`` or 2n numbers), checked for its form."""
+    start = _parse_ic(ic)
+    if isinstance(start, str):
+        check_choice("--ic", start, _ICS)
+    return start
 
-    Parameters
-    ----------
-    ic : str
-        One of :data:`_ICS`.
-    model : str
-        A model variant name (resolved here so that a typo fails before the start run).
-    positive : dict
-        ``{flag: value}`` of options that must be finite and > 0 (times [s], tolerances [-],
-        bands [m/s]); ``None`` values (not given) are skipped.
-    """
-    from ..model.variants import resolve_variant
 
-    check_choice("--ic", ic, _ICS)
-    check_positive(positive)
-    try:
-        resolve_variant(model)
-    except StickSlipError as exc:
-        raise CLIError(f"--model {model}: {exc}") from None
+def model_system(model: str, config, assignments, slip_band, *, swept=None, **named):
+    """The FrictionModel of ``--model``, ``--config``, ``--set``, the plates' named options (the CLI's
+    :func:`~._app.build_system`) and ``--slip-band``."""
+    system, _ = build_system(model, config, assignments, swept=swept, **named)
+    return system if slip_band is None else system.with_slip_band(slip_band)
+
+
+def model_label(result) -> str:
+    """The model of a result for titles: the plates' variant with N and Ω, or the model's name."""
+    p = result.params
+    return result.model if p is None else f"{result.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s"
+
+
+def parse_section(text: str):
+    """``--section``: ``max``, ``DOF_max`` or ``DOF=LEVEL`` as :func:`stickslip.orbits.resolve_section` takes it."""
+    if "=" in text:
+        dof, _, level = text.partition("=")
+        try:
+            return dof.strip(), float(level)
+        except ValueError:
+            raise CLIError(f"--section {text}: {level!r} is not a number; e.g. --section x1=0.5") from None
+    return text
 
 
 def _finite_or_none(x: float):
@@ -69,16 +80,17 @@ def _finite_or_none(x: float):
 def orbit_command(
     N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
-    model: str = typer.Option("full", "--model", help=_MODEL_HELP),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP),
     ic: str = typer.Option("far", "--ic", help=_IC_HELP),
+    section: str = typer.Option("max", "--section", help=_SECTION_HELP),
     search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run [s]; the guess is "
                                       "taken from its last section crossings."),
-    period_multiplicity: int = typer.Option(1, "--period-multiplicity", help="Section crossings (maxima of φ) per period."),
+    period_multiplicity: int = typer.Option(1, "--period-multiplicity", help="Section crossings per period."),
     monodromy: str = typer.Option("saltation", "--monodromy", help="Monodromy matrix: saltation | finite-difference."),
     rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map (atol = 1e-3 rtol)."),
     tol: float = typer.Option(1e-8, "--tol", help="Newton tolerance (scaled shooting residual)."),
     slip_band: Optional[float] = typer.Option(None, "--slip-band", help=_BAND_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("orbit.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
@@ -90,22 +102,23 @@ def orbit_command(
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
     from ..analysis.steady import stick_time
-    from ..orbits import periodic_orbit
+    from ..orbits import periodic_orbit, resolve_section
     from ..orbits.continuation import START_RATE, start_run
 
-    _check_common(ic, model, {"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
+    start = parse_start(ic)
+    check_positive({"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
     check_below_one({"--tol": tol})
     check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
     check_choice("--monodromy", monodromy, _METHODS)
     if period_multiplicity < 1:
         raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
-    band = {} if slip_band is None else {"slip_band": slip_band}
-    params, _ = build_parameters(config, set_, N=N, Omega=omega)
+    system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
+    sec = resolve_section(parse_section(section), system)
     check_outputs(out, not no_plot, overwrite)
     t0 = time.perf_counter()
-    run = start_run(params, ic, model=model, t_end=search_time, rtol=rtol, **band)
-    orbit = periodic_orbit(params, run, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
-                           monodromy=monodromy, **band)
+    run = start_run(system, start, t_end=search_time, rtol=rtol)
+    orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
+                           monodromy=monodromy)
     wall = time.perf_counter() - t0
     one_period = orbit.trajectory(1.0)
     stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
@@ -130,8 +143,7 @@ def orbit_command(
     if as_json:
         print(json.dumps(summary))
         return
-    p = orbit.params
-    table = Table(title=f"stickslip orbit ({orbit.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s)", show_header=False)
+    table = Table(title=f"stickslip orbit ({model_label(orbit)})", show_header=False)
     table.add_row("period", f"{summary['period_s']:.10g} s ({summary['frequency_hz']:.8g} Hz)")
     table.add_row("stick", f"{summary['stick_phases']} phase(s), {summary['stick_fraction']:.4f} of the period")
     if summary["max_nontrivial_multiplier_abs"] is not None:
@@ -148,7 +160,7 @@ def orbit_command(
 def lyapunov_command(
     N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
-    model: str = typer.Option("full", "--model", help=_MODEL_HELP),
+    model: str = typer.Option("full", "--model", help=MODEL_HELP),
     ic: str = typer.Option("far", "--ic", help=_IC_HELP),
     t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first [s]."),
     t_average: float = typer.Option(200.0, "--t-average", help="Averaging time [s]."),
@@ -156,7 +168,7 @@ def lyapunov_command(
                                "finite-difference (perturbed trajectories; works where the variational one refuses)."),
     rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of the runs (atol = 1e-3 rtol)."),
     slip_band: Optional[float] = typer.Option(None, "--slip-band", help=_BAND_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Any parameter as NAME=VALUE (repeatable)."),
+    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
     config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
     out: Path = typer.Option(Path("lyapunov.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
@@ -168,17 +180,16 @@ def lyapunov_command(
     Runs --t-transient seconds from --ic, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
     """
     from ..orbits import lyapunov_spectrum
-    from ..sweep.spec import initial_condition
+    from ..orbits.start import named_start
 
-    _check_common(ic, model, {"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol,
-                              "--slip-band": slip_band})
+    start = parse_start(ic)
+    check_positive({"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol, "--slip-band": slip_band})
     check_choice("--method", method, _LYAPUNOV_METHODS)
-    band = {} if slip_band is None else {"slip_band": slip_band}
-    params, _ = build_parameters(config, set_, N=N, Omega=omega)
+    system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
     check_outputs(out, not no_plot, overwrite)
-    start, perturbation = initial_condition(ic, params, model)
-    spectrum = lyapunov_spectrum(params, start, model=model, t_transient=t_transient, t_average=t_average,
-                                 perturbation=perturbation, rtol=rtol, method=method, **band)
+    start, perturbation = named_start(system, start)
+    spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average,
+                                 perturbation=perturbation, rtol=rtol, method=method)
     out.parent.mkdir(parents=True, exist_ok=True)
     spectrum.to_xarray().to_netcdf(out, engine="h5netcdf")
     figure = None
@@ -196,8 +207,7 @@ def lyapunov_command(
     if as_json:
         print(json.dumps(summary))
         return
-    p = spectrum.params
-    console.print(f"stickslip lyapunov: {spectrum.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s, {method}",
+    console.print(f"stickslip lyapunov: {model_label(spectrum)}, {method}",
                   soft_wrap=True)
     table = Table()
     table.add_column("#", justify="right")

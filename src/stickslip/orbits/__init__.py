@@ -3,7 +3,7 @@
 ==========================  ==============================================================
 ``periodic_orbit``          Newton shooting on a Poincaré section → ``PeriodicOrbit``
 ``PeriodicOrbit``           state on the section, period, stick phases, Floquet multipliers
-``Section``                 a Poincaré section (``"phi_max"``, ``("phi", level)``)
+``Section``                 a Poincaré section (``"max"``, ``"<dof>_max"``, ``(dof, level)``)
 ``lyapunov_exponent``       largest Lyapunov exponent (Benettin) → ``LyapunovResult``
 ``lyapunov_spectrum``       all Lyapunov exponents (variational + saltation + QR) → ``LyapunovSpectrum``
 ``monodromy``               monodromy matrix of an orbit, saltation or FD → ``Monodromy``
@@ -16,7 +16,7 @@ from .lyapunov import LyapunovResult, LyapunovSpectrum, lyapunov_exponent, lyapu
 from .section import OrbitError, Section, resolve_section
 from .problem import Monodromy, monodromy
 from .shooting import PeriodicOrbit, periodic_orbit
-from .variational import FlowJacobian, flow_jacobian
+from .linear_flow import FlowJacobian, flow_jacobian
 
 __all__ = ["periodic_orbit", "PeriodicOrbit", "Section", "resolve_section", "lyapunov_exponent",
            "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum", "monodromy", "Monodromy",

@@ -1,7 +1,8 @@
 """The pseudo-arclength corrector: the shooting problem with the parameter as an unknown.
 
 The orbit is the zero of the shooting map of :class:`.problem.ShootingProblem`, now with the
-parameter λ (any numeric field of :class:`~stickslip.Parameters`) as an extra unknown. In
+parameter λ (any numeric parameter of the model: the plates' ``N``, ``Omega``, ...; a model file's
+``--set`` path such as ``contact.0.drive``) as an extra unknown. In
 scaled unknowns v = (z, T/T_s, λ/λ_s) — z the unknown section states in units of σ — the
 2 n_free equations are
 
@@ -25,7 +26,8 @@ import dataclasses
 
 import numpy as np
 
-from ..model.parameters import Parameters
+from ..model.system_model import FrictionModel
+from .models import parameter_value, with_parameter
 from .problem import DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, sorted_eigenvalues, stick_count, stick_time
 from .section import OrbitError
 
@@ -66,9 +68,9 @@ class Problem:
         """``{"simulations": flow maps run}``."""
         return self.shooting.counter
 
-    def params_at(self, lam: float) -> Parameters:
-        """Parameters with the continuation parameter set to ``lam``."""
-        return self.shooting.params.replace(**{self.param: float(lam)})
+    def system_at(self, lam: float) -> FrictionModel:
+        """The model with the continuation parameter set to ``lam``."""
+        return with_parameter(self.shooting.system, self.param, lam)
 
     def unpack(self, v: np.ndarray):
         """Scaled unknowns (n_unknown + 2,) → (state on the section, T [s], λ)."""
@@ -79,31 +81,31 @@ class Problem:
         return np.concatenate([self.shooting.unknowns(s), [T / self.T_scale, lam / self.p_scale]])
 
 
-def numeric_parameter(param: str) -> None:
-    """Refuse a continuation parameter that is not a numeric field of Parameters (ContinuationError)."""
-    if param not in Parameters.names() or param == "friction_law":
-        raise ContinuationError(f"cannot continue in {param!r}; choose a numeric parameter: "
-                                + ", ".join(n for n in Parameters.names() if n != "friction_law"))
+def numeric_parameter(system: FrictionModel, param: str) -> float:
+    """The value of continuation parameter ``param`` of ``system``; ContinuationError if the model
+    has no such parameter or it is not numeric."""
+    try:
+        return parameter_value(system, param)
+    except OrbitError as exc:
+        raise ContinuationError(f"cannot continue in {param!r}: {exc}") from None
 
 
 def problem_of(start, param: str, fd_step: float, param_scale: float | None) -> Problem:
-    """The continuation problem of a start orbit (state, period, scale, params, model, section, options)."""
-    numeric_parameter(param)
-    lam0 = float(getattr(start.params, param))
+    """The continuation problem of a start orbit (state, period, scale, system, section, options)."""
+    lam0 = numeric_parameter(start.system, param)
     scale = abs(lam0) if param_scale is None else float(param_scale)
     if not (np.isfinite(scale) and scale > 0.0):
         scale = 1.0  # λ0 = 0: work in the parameter's own unit
     o = start.options
-    shooting = ShootingProblem.build(start.params, start.model, sigma=start.scale, section=start.section,
-                                     rtol=o["rtol"], atol=o["atol"], slip_band=o["slip_band"], fd_step=fd_step,
-                                     max_steps_per_second=MAX_STEPS_PER_SECOND)
+    shooting = ShootingProblem.build(start.system, sigma=start.scale, section=start.section, rtol=o["rtol"],
+                                     atol=o["atol"], fd_step=fd_step, max_steps_per_second=MAX_STEPS_PER_SECOND)
     return Problem(shooting=shooting, param=param, T_scale=float(start.period), p_scale=scale)
 
 
 def _residual(problem: Problem, v: np.ndarray):
     """F(v) (2 n_free,) in units of σ, the end state and the transitions of the run."""
     s, T, lam = problem.unpack(v)
-    return problem.shooting.residual(s, T, problem.params_at(lam))
+    return problem.shooting.residual(s, T, problem.system_at(lam))
 
 
 def _jacobian(problem: Problem, v: np.ndarray, end: np.ndarray):
@@ -117,17 +119,17 @@ def _jacobian(problem: Problem, v: np.ndarray, end: np.ndarray):
     J : ndarray (2 n_free, 2 n_free + 1)
         In scaled units (rows / σ, columns × σ, T_s, λ_s).
     M : ndarray (2 n_free, 2 n_free)
-        ∂Φ(s0, T)/∂s0 on the free states [SI].
+        ∂Φ(s0, T)/∂s0 on the free states [state units].
     """
     s, T, lam = problem.unpack(v)
-    params = problem.params_at(lam)
+    system = problem.system_at(lam)
     sp = problem.shooting
-    M = sp.fd_monodromy(s, T, params=params)
+    M = sp.fd_monodromy(s, T, system=system)
     J = np.empty((sp.free.size, sp.free.size + 1))
-    J[:, :-1] = sp.jacobian(M[:, sp.unknown], end, params, problem.T_scale)
+    J[:, :-1] = sp.jacobian(M[:, sp.unknown], end, system, problem.T_scale)
     dl = sp.fd_step * problem.p_scale
-    ep = sp.flow(s, T, problem.params_at(lam + dl))[0][sp.free]
-    em = sp.flow(s, T, problem.params_at(lam - dl))[0][sp.free]
+    ep = sp.flow(s, T, problem.system_at(lam + dl))[0][sp.free]
+    em = sp.flow(s, T, problem.system_at(lam - dl))[0][sp.free]
     J[:, -1] = (ep - em) / (2.0 * dl) / sp.sigma * problem.p_scale
     return J, M
 

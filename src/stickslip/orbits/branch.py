@@ -21,17 +21,17 @@ import numpy as np
 from ..files import open_ours
 from ..integrate.driver import SimulationError, simulate
 from ..integrate.result import Trajectory
-from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import ParameterError, Parameters
+from ..model.system_model import FrictionModel, ModelError
 from . import branch_store as store
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, ContinuationError, Point, Problem,
                         correct_onto_bound, numeric_parameter, point_at, problem_of, step_from)
-from .layout import PHI
 from .problem import unstable_count
 from .section import OrbitError, Section, resolve_section
 from .shooting import PeriodicOrbit
 from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
                              detect_after_renewal, distance_from_equilibrium)
+from .models import ModelResult, plates_parameters, resolve, with_parameter
 from .start import Start, start_orbit
 
 __all__ = ["Branch", "continue_orbit", "load_branch"]
@@ -47,19 +47,20 @@ AMPLITUDE_SAMPLES = 400
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class Branch:
+class Branch(ModelResult):
     """A branch of periodic orbits computed by :func:`continue_orbit`.
 
     Attributes
     ----------
     param : str
-        Name of the continuation parameter (a :class:`~stickslip.Parameters` field).
+        Name of the continuation parameter (a name of ``system.parameters``: the plates' ``N``,
+        ``Omega``, ...; a model file's ``--set`` path).
     values : ndarray (n,)
         Parameter value of each orbit [unit of the parameter].
     periods : ndarray (n,)
         Periods [s].
-    states : ndarray (n, N_STATES)
-        States on the Poincaré section [m, rad, m/s, rad/s].
+    states : ndarray (n, 2n)
+        States on the Poincaré section (the model's ``state_names``).
     multipliers : ndarray (n, 2 n_free) complex
         Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus
         (NaN at points without a finite-difference Jacobian, see ``jacobian_every``).
@@ -72,7 +73,7 @@ class Branch:
     stick_time : ndarray (n,)
         Total time in stick per period [s].
     amplitude : ndarray (n,)
-        Peak-to-peak range of φ over one period [rad].
+        Peak-to-peak range of the model's observed dof (the plates' φ [rad]) over one period.
     arclength : ndarray (n,)
         Scaled pseudo-arclength from the first point [-].
     residuals : ndarray (n,)
@@ -82,9 +83,9 @@ class Branch:
     special : list of SpecialPoint
     stop_reason : str
         Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``, ...).
-    params : Parameters
-        Base parameters (the continuation parameter at its start value).
-    model : str
+    system : FrictionModel
+        The model at the start (the continuation parameter at its start value); ``params`` and
+        ``model``: the plates' Parameters and variant, or None and the model's name.
     section : Section
     options : dict
         Numerical options (rtol, atol, tol, fd_step, step bounds, scales).
@@ -110,8 +111,7 @@ class Branch:
     iterations: np.ndarray
     special: list
     stop_reason: str
-    params: Parameters
-    model: str
+    system: FrictionModel
     section: Section
     options: dict
     timings: dict
@@ -124,15 +124,19 @@ class Branch:
         """The special points of kind ``fold``."""
         return [p for p in self.special if p.kind == "fold"]
 
-    def orbit_params(self, i: int) -> Parameters:
-        """Parameters of orbit ``i``."""
-        return self.params.replace(**{self.param: float(self.values[i])})
+    def orbit_system(self, i: int) -> FrictionModel:
+        """The model of orbit ``i``."""
+        return with_parameter(self.system, self.param, float(self.values[i]))
+
+    def orbit_params(self, i: int) -> Parameters | None:
+        """The plates' Parameters of orbit ``i`` (None for other models: :meth:`orbit_system`)."""
+        return plates_parameters(self.orbit_system(i))
 
     def trajectory(self, i: int, periods: float = 1.0, sample_rate: float = 1000.0) -> Trajectory:
         """Simulate orbit ``i`` from its section state (for plots)."""
         o = self.options
-        return simulate(self.orbit_params(i), periods * float(self.periods[i]), model=self.model, ic=self.states[i],
-                        rtol=o["rtol"], atol=o["atol"], sample_rate=sample_rate, slip_band=o["slip_band"])
+        return simulate(self.orbit_system(i), periods * float(self.periods[i]), ic=self.states[i], rtol=o["rtol"],
+                        atol=o["atol"], sample_rate=sample_rate)
     def to_xarray(self):
         """``xarray.Dataset`` with dims ``point``, ``state``, ``multiplier`` and ``special``."""
         return store.branch_dataset(self)
@@ -168,18 +172,20 @@ def _read_branch(path) -> tuple:
 
 
 def _amplitude(problem: Problem, s: np.ndarray, T: float, lam: float) -> float:
-    """Peak-to-peak φ over one period [rad] from a sampled run (NaN if it fails)."""
+    """Peak-to-peak range of the observed dof (the plates' φ [rad]) over one period from a sampled
+    run (NaN if it fails)."""
     sp = problem.shooting
+    system = problem.system_at(lam)
     try:
-        traj = simulate(problem.params_at(lam), T, model=sp.model, ic=s, sample_rate=AMPLITUDE_SAMPLES / T,
-                        max_steps=int(sp.max_steps_per_second * max(T, 1.0)), **sp.options)
+        traj = simulate(system, T, ic=s, sample_rate=AMPLITUDE_SAMPLES / T,
+                        max_steps=int(sp.max_steps_per_second * max(T, 1.0)), rtol=sp.rtol, atol=sp.atol)
     except SimulationError:
         return float("nan")
-    return float(np.ptp(traj.states[:, PHI])) if traj.status == "success" else float("nan")
+    return float(np.ptp(traj.states[:, system.observed_index])) if traj.status == "success" else float("nan")
 
 
 def continue_orbit(
-    params: Parameters | None = None,
+    system=None,
     param: str = "Omega",
     start=None,
     *,
@@ -191,14 +197,14 @@ def continue_orbit(
     bounds: tuple[float, float] | None = None,
     stop_on: Sequence[str] = (),
     locate: bool = True,
-    model: str = "full",
-    section="phi_max",
+    model=None,
+    section="max",
     rtol: float = 1e-10,
     atol: float | None = None,
     tol: float = DEFAULT_TOL,
     fd_step: float = DEFAULT_FD_STEP,
     param_scale: float | None = None,
-    slip_band: float = DEFAULT_SLIP_BAND,
+    slip_band: float | None = None,
     amplitude: bool = True,
     min_stick_fraction: float = MIN_STICK_FRACTION,
     jacobian_every: int = 1,
@@ -216,12 +222,14 @@ def continue_orbit(
 
     Parameters
     ----------
-    params : Parameters, optional
-        Parameters of the start orbit (default: those of ``start`` if it is a PeriodicOrbit).
+    system : FrictionModel, Parameters, str, optional
+        The model at the start, as :func:`stickslip.simulate` takes it (default: that of ``start``
+        if it is a PeriodicOrbit or a run, else the plates with Table 1).
     param : str
-        The parameter to vary: any numeric :class:`~stickslip.Parameters` field (``N`` [N],
-        ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...).
-    start : PeriodicOrbit, Trajectory, array-like (N_STATES,) or "equilibrium"
+        The parameter to vary: any numeric parameter of the model — the plates' fields (``N`` [N],
+        ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...) or a model file's
+        ``--set`` path (``contact.0.drive``, ``stiffness.x.x``, ...).
+    start : PeriodicOrbit, Trajectory, array-like (2n,), mapping or "equilibrium"
         The first orbit; or a run that settled on it (shot by
         :func:`~stickslip.orbits.start.start_orbit_from_run`, one
         stick onset per period); or a state handed to :func:`~stickslip.orbits.periodic_orbit`.
@@ -290,24 +298,23 @@ def continue_orbit(
     t_start = time.perf_counter()
     _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
     jacobian_every = int(jacobian_every)
-    if isinstance(start, (PeriodicOrbit, Trajectory)) and params is None:
-        params = start.params
-    params = Parameters() if params is None else params
-    numeric_parameter(param)
+    if isinstance(start, (PeriodicOrbit, Trajectory)) and system is None and model is None:
+        system = start.system
+    system = resolve(system, model, slip_band)
+    lam_start = numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system, param)
     lo = hi = None
     if bounds is not None:
         lo, hi = float(bounds[0]), float(bounds[1])
-        lam_start = float(getattr(params if not isinstance(start, PeriodicOrbit) else start.params, param))
         if not (lo < hi) or not (lo <= lam_start <= hi):
             raise ContinuationError(f"bounds ({lo:g}, {hi:g}) must satisfy lo < hi and contain the start "
                                     f"{param} = {lam_start:g}")
     atol = 1e-3 * rtol if atol is None else float(atol)
-    section = resolve_section(section)
+    section = resolve_section(section, system)
     numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
                     bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
                     tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
                     min_stick_fraction=min_stick_fraction, jacobian_every=jacobian_every)
-    settings = store.branch_settings(params, param, start, model, section, rtol, atol, slip_band, numerics)
+    settings = store.branch_settings(system, param, start, section, rtol, atol, numerics)
     digest = store.digest_of(settings)
     journal = None
     if out is not None:
@@ -319,7 +326,7 @@ def continue_orbit(
     records = [] if journal is None else journal.records
     start_rec = next((r["start"] for r in records if "start" in r), None)
     if start_rec is None:
-        begin = Start.of(start_orbit(params, param, start, model, section, rtol, atol, slip_band))
+        begin = Start.of(start_orbit(system, param, start, section, rtol, atol))
         if journal is not None:
             journal.append({"start": store.start_record(begin)})
     else:
@@ -344,7 +351,7 @@ def continue_orbit(
             new = step_from(problem, last, walk.h, tol, with_jacobian=fresh)
             if float(new.tangent @ last.tangent) < MIN_TANGENT_COS:
                 raise OrbitError("tangent turned too far")
-        except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+        except (OrbitError, SimulationError, ParameterError, ModelError, np.linalg.LinAlgError):
             # step changes are not journaled: a resumed run repeats these deterministic retries
             if not last.fresh:  # first renew the Broyden-updated Jacobian, then shrink
                 try:
@@ -365,7 +372,7 @@ def continue_orbit(
         if bounds is not None and not (lo <= lam_new <= hi):
             try:
                 new = correct_onto_bound(problem, last, new, hi if lam_new > hi else lo, tol)
-            except (OrbitError, SimulationError, ParameterError, np.linalg.LinAlgError):
+            except (OrbitError, SimulationError, ParameterError, ModelError, np.linalg.LinAlgError):
                 walk.stop = "bounds (last point before the edge)"
                 break
             stop = "bounds"
@@ -390,7 +397,7 @@ def continue_orbit(
         journal.append({"end": stop_reason})
     branch = _assemble_branch(problem, begin, walk, stop_reason,
                               dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
-                                   max_step=max_step, max_points=max_points, slip_band=problem.shooting.slip_band,
+                                   max_step=max_step, max_points=max_points, slip_band=problem.shooting.system.slip_band,
                                    param_scale=problem.p_scale, period_scale=problem.T_scale,
                                    bounds=None if bounds is None else [lo, hi], direction=direction,
                                    jacobian_every=jacobian_every),
@@ -419,7 +426,7 @@ def _check_request(direction, step, min_step, max_step, max_points, jacobian_eve
 
 def _first_walk(problem: Problem, begin: Start, direction: int, step: float, measure) -> "_Walk":
     """The walk at its first point: the start orbit with its Jacobian, tangent and amplitude."""
-    v0 = problem.pack(begin.state, begin.period, float(getattr(begin.params, problem.param)))
+    v0 = problem.pack(begin.state, begin.period, numeric_parameter(begin.system, problem.param))
     try:
         p0 = point_at(problem, v0, 0, None, float(direction))
     except (OrbitError, SimulationError) as exc:
@@ -494,7 +501,7 @@ def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: s
                   amplitude=np.array(walk.amplitudes, dtype=float), arclength=np.array(walk.arclength),
                   residuals=np.array([p.residual for p in points]),
                   iterations=np.array([p.iterations for p in points]), special=list(walk.special),
-                  stop_reason=stop_reason, params=begin.params, model=begin.model, section=begin.section,
+                  stop_reason=stop_reason, system=begin.system, section=begin.section,
                   options=options, timings=timings, digest=digest)
 
 

@@ -46,8 +46,10 @@ import numpy as np
 from .. import __version__
 from ..files import AppendLog, FileFormatError, OutputLock, atomic_write, fsync_dir
 from ..integrate.result import Trajectory
+from ..model.library import describe_system, system_from_description
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
-from .layout import N_STATES, STATE_NAMES, STATE_UNITS
+from .layout import state_units
+from .models import model_attrs
 from .section import OrbitError, Section
 from .shooting import PeriodicOrbit
 
@@ -281,10 +283,10 @@ def point_fields(rec: dict) -> dict:
 
 
 def start_record(start) -> dict:
-    """What a branch keeps of its start orbit (state, period, stick phases, scale, params, model,
-    section, options) as a JSON-ready dict (exact floats)."""
+    """What a branch keeps of its start orbit (state, period, stick phases, scale, the model's
+    description, section, options) as a JSON-ready dict (exact floats)."""
     return {"state": start.state.tolist(), "period": start.period, "stick_phases": start.stick_phases,
-            "scale": start.scale.tolist(), "params": start.params.to_dict(), "model": start.model,
+            "scale": start.scale.tolist(), "system": describe_system(start.system),
             "section": section_spec(start.section), "options": start.options}
 
 
@@ -292,30 +294,30 @@ def start_fields(rec: dict) -> dict:
     """Inverse of :func:`start_record`: the fields of the start."""
     return dict(state=np.array(rec["state"], dtype=float), period=float(rec["period"]),
                 stick_phases=int(rec["stick_phases"]), scale=np.array(rec["scale"], dtype=float),
-                params=Parameters.from_dict(rec["params"]), model=rec["model"], section=section_of(rec["section"]),
+                system=system_from_description(rec["system"]), section=section_of(rec["section"]),
                 options=dict(rec["options"]))
 
 
-def start_digest(start, params: Parameters, model: str) -> str:
-    """Digest of the ``start`` argument of ``continue_orbit`` (an orbit, a run or a state)."""
+def start_digest(start, system) -> str:
+    """Digest of the ``start`` argument of ``continue_orbit`` (an orbit, a run or a state) of ``system``."""
     if isinstance(start, PeriodicOrbit):
         return digest_of({"orbit": array_digest(start.state, np.array([start.period]), start.scale),
-                          "params": start.params.to_dict(), "model": start.model,
-                          "section": section_spec(start.section),
+                          "system": describe_system(start.system), "section": section_spec(start.section),
                           "options": {k: start.options.get(k) for k in ("rtol", "atol", "slip_band")}})
     if isinstance(start, Trajectory):
         return digest_of({"run": array_digest(start.t, start.states, start.mode),
-                          "params": start.params.to_dict(), "model": start.model})
+                          "system": describe_system(start.system)})
     if start is None or isinstance(start, str):
-        return digest_of({"start": repr(start), "params": params.to_dict(), "model": model})
-    return digest_of({"state": array_digest(np.asarray(start, dtype=float)), "params": params.to_dict(),
-                      "model": model})
+        return digest_of({"start": repr(start), "system": describe_system(system)})
+    if isinstance(start, dict):
+        return digest_of({"state": {k: float(v) for k, v in start.items()}, "system": describe_system(system)})
+    return digest_of({"state": array_digest(np.asarray(start, dtype=float)), "system": describe_system(system)})
 
 
-def branch_settings(params, param, start, model, section, rtol, atol, slip_band, numerics: dict) -> dict:
+def branch_settings(system, param, start, section, rtol, atol, numerics: dict) -> dict:
     """Everything that determines a branch (its digest; the journal header)."""
-    return {"start": start_digest(start, params, model), "params": params.to_dict(), "param": param,
-            "model": model, "section": section_spec(section), "rtol": rtol, "atol": atol, "slip_band": slip_band,
+    return {"start": start_digest(start, system), "system": describe_system(system), "param": param,
+            "section": section_spec(section), "rtol": rtol, "atol": atol, "slip_band": system.slip_band,
             **numerics}
 
 
@@ -329,20 +331,22 @@ def branch_dataset(branch):
     """``xarray.Dataset`` of a branch with dims ``point``, ``state``, ``multiplier`` and ``special``."""
     import xarray as xr
 
-    unit = PARAMETER_UNITS.get(branch.param, "")
+    unit = branch.system.units.get(branch.param, PARAMETER_UNITS.get(branch.param, ""))
+    observed = branch.system.dofs[branch.system.observed_index]
     sp = branch.special
     data = {
         "value": ("point", branch.values, {"long_name": f"continuation parameter {branch.param}", "units": unit}),
         "period": ("point", branch.periods, {"long_name": "period", "units": "s"}),
         "state_on_section": (("point", "state"), branch.states, {"long_name": "state on the Poincaré section",
-                                                                 "units": " ".join(STATE_UNITS)}),
+                                                                 "units": " ".join(state_units(branch.system))}),
         "multiplier_real": (("point", "multiplier"), branch.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
         "multiplier_imag": (("point", "multiplier"), branch.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
         "stable": ("point", branch.stable.astype(np.int8), {"long_name": "1 if every non-trivial multiplier is inside the unit circle"}),
         "n_unstable": ("point", branch.n_unstable.astype(np.int16), {"long_name": "non-trivial multipliers outside the unit circle"}),
         "stick_phases": ("point", branch.stick_phases.astype(np.int16), {"long_name": "stick phases per period"}),
         "stick_time": ("point", branch.stick_time, {"long_name": "time in stick per period", "units": "s"}),
-        "amplitude": ("point", branch.amplitude, {"long_name": "peak-to-peak range of phi over one period", "units": "rad"}),
+        "amplitude": ("point", branch.amplitude, {"long_name": f"peak-to-peak range of {observed} over one period",
+                                                  "units": branch.system.units.get(observed, "")}),
         "arclength": ("point", branch.arclength, {"long_name": "scaled pseudo-arclength", "units": "1"}),
         "residual": ("point", branch.residuals, {"long_name": "scaled shooting residual", "units": "1"}),
         "iterations": ("point", branch.iterations.astype(np.int16), {"long_name": "corrector iterations"}),
@@ -355,7 +359,7 @@ def branch_dataset(branch):
         "special_after": ("special", np.array([p.after for p in sp], dtype=float), {"long_name": "test function after"}),
         "special_bracket": ("special", np.array([p.bracket for p in sp], dtype=float), {"long_name": "final bracket width", "units": unit}),
         "special_located": ("special", np.array([p.located for p in sp], dtype=np.int8), {"long_name": "1 if located to tolerance"}),
-        "special_state": (("special", "state"), np.array([p.state for p in sp], dtype=float).reshape(len(sp), N_STATES),
+        "special_state": (("special", "state"), np.array([p.state for p in sp], dtype=float).reshape(len(sp), 2 * branch.system.n),
                           {"long_name": "state on the section at the special point"}),
         "special_multiplier_real": (("special", "multiplier"), np.array([np.real(p.multipliers) for p in sp], dtype=float)
                                     .reshape(len(sp), branch.multipliers.shape[1]),
@@ -364,22 +368,21 @@ def branch_dataset(branch):
                                     .reshape(len(sp), branch.multipliers.shape[1]),
                                     {"long_name": "Floquet multiplier at the special point, imaginary part", "units": "1"}),
     }
-    coords = {"point": np.arange(len(branch)), "state": list(STATE_NAMES),
+    coords = {"point": np.arange(len(branch)), "state": list(branch.system.state_names),
               "multiplier": np.arange(branch.multipliers.shape[1]), "special": np.arange(len(sp))}
     attrs = {
         "title": f"stickslip branch of periodic orbits in {branch.param} (pseudo-arclength continuation)",
         "format": "stickslip-branch-1",
         "stickslip_version": __version__,
         "param": branch.param, "param_units": unit,
-        "model": branch.model, "section": branch.section.name,
+        "section": branch.section.name,
         "section_spec": json.dumps(section_spec(branch.section)),
         "digest": branch.digest,
         "stop_reason": branch.stop_reason,
         "options": json.dumps(branch.options),
         "timings": json.dumps(branch.timings),
-        "parameters": json.dumps(branch.params.to_dict()),
+        **model_attrs(branch.system),
     }
-    attrs.update(parameter_attrs(branch.params.to_dict()))
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -401,7 +404,7 @@ def branch_fields(ds) -> dict:
                 stick_time=ds["stick_time"].values, amplitude=ds["amplitude"].values,
                 arclength=ds["arclength"].values, residuals=ds["residual"].values,
                 iterations=ds["iterations"].values.astype(int), special=special, stop_reason=ds.attrs["stop_reason"],
-                params=Parameters.from_dict(json.loads(ds.attrs["parameters"])), model=ds.attrs["model"],
+                system=system_from_description(json.loads(ds.attrs["system"])),
                 section=section_of(json.loads(ds.attrs["section_spec"])), options=json.loads(ds.attrs["options"]),
                 timings=json.loads(ds.attrs["timings"]), digest=str(ds.attrs.get("digest", "")))
 

@@ -1,67 +1,59 @@
-"""The state layout the orbit tools assume, in one place: the two plates' 12 states.
+"""The state layout of a model as the orbit tools use it: states, free states, units, projections.
 
-The orbit tools (sections, shooting, continuation, Lyapunov exponents) work on a state
-s = [q, q̇] of :data:`N_DOFS` generalised coordinates followed by their velocities, as
-:data:`stickslip.STATE_NAMES` orders them; a model variant frees some of the DOFs. Everything
-they need to know about that layout — its size, where a velocity sits, which states are free,
-where φ and φ̇ are, the units, the steady-sliding state, the projection onto the stick
-constraint — is here, so that a model that describes its own states can replace this module.
+Every model's state is s = [q, q̇] (:attr:`FrictionModel.state_names`: the dofs, then ``d`` + each
+dof); a model frees some of its dofs (:attr:`FrictionModel.free`). Everything the orbit tools need
+to know about that layout — which states are free, the units, the steady-sliding state, the
+projection onto the stick constraint of the contacts at rest — is here.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..model import kernels as K
-from ..model.variants import DOF_NAMES, STATE_NAMES
+from ..integrate.contacts import STICK_SPEED_TOL
+from ..model import physics as P
+from ..model.bundle import CST, contact_state
 
-__all__ = ["N_DOFS", "N_STATES", "PHI", "PHI_DOT", "STATE_UNITS", "STATE_NAMES", "free_states",
-           "velocity_of", "equilibrium_state", "stick_projected", "kernel_state", "KERNEL_STATE"]
-
-#: Generalised coordinates q (x1, y1, x2, y2, φ, ψ) and states s = [q, q̇].
-N_DOFS = len(DOF_NAMES)
-N_STATES = len(STATE_NAMES)
-
-#: Indices of φ (the upper plate's rotation) and of φ̇ in the state.
-PHI = STATE_NAMES.index("phi")
-PHI_DOT = STATE_NAMES.index("dphi")
-
-#: Units of the states, in state order.
-STATE_UNITS = ("m", "m", "m", "m", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "rad/s", "rad/s")
-
-#: Length of the integrator kernels' work vector: the states and two stick-multiplier slots.
-KERNEL_STATE = N_STATES + 2
-
-
-def velocity_of(index: int) -> int:
-    """State index of the velocity of coordinate ``index`` (< :data:`N_DOFS`)."""
-    return index + N_DOFS
+__all__ = ["free_states", "state_units", "equilibrium_state", "stick_projected", "resting_contacts"]
 
 
 def free_states(system) -> np.ndarray:
-    """Indices (2 n_free,) of the free states of the system's variant: positions, then velocities."""
-    dofs = system.variant.free_indices
-    return np.concatenate([dofs, dofs + N_DOFS])
+    """Indices (2 n_free,) of the free states of ``system``: positions, then velocities."""
+    dofs = np.flatnonzero(system.free)
+    return np.concatenate([dofs, dofs + system.n])
 
 
-def equilibrium_state(params, model) -> np.ndarray:
-    """The steady-sliding state (N_STATES,) of paper Eq. (14): q at the equilibrium, q̇ = 0."""
-    from ..stability import equilibrium
+def state_units(system) -> tuple[str, ...]:
+    """Units of the 2n states ("" where the model does not say): a dof's unit, then its unit per second."""
+    units = tuple(system.units.get(d, "") for d in system.dofs)
+    return units + tuple(f"{u}/s" if u and u != "-" else u for u in units)
 
-    s = np.zeros(N_STATES)
-    s[:N_DOFS] = equilibrium(params, model)
+
+def equilibrium_state(system) -> np.ndarray:
+    """The steady-sliding state (2n,): q at the equilibrium, q̇ = 0."""
+    from ..stability.equilibrium import steady_sliding
+
+    s = np.zeros(2 * system.n)
+    s[:system.n] = steady_sliding(system)
     return s
 
 
-def kernel_state(s: np.ndarray) -> np.ndarray:
-    """The kernels' work vector (N_STATES + 2,) holding state ``s``."""
-    y = np.zeros(KERNEL_STATE)
-    y[:N_STATES] = s[:N_STATES]
+def resting_contacts(system, s: np.ndarray) -> np.ndarray:
+    """Contact states (CST nc,) with every contact whose |v_c| ≤ STICK_SPEED_TOL marked as sticking."""
+    md = system.data
+    cst = contact_state(md.m)
+    y = np.ascontiguousarray(s[:2 * system.n], dtype=float)
+    for c in range(system.n_contacts):
+        v0, v1 = P.slip_velocity(y, c, md)
+        if np.hypot(v0, v1) <= STICK_SPEED_TOL:
+            cst[CST * c] = P.MODE_STICK
+    return cst
+
+
+def stick_projected(system, s: np.ndarray, cst: np.ndarray | None = None) -> np.ndarray:
+    """The state with q̇ projected onto v_c = 0 (mass metric) for the sticking contacts of ``cst``
+    (default: the contacts at rest in ``s``, :func:`resting_contacts`)."""
+    y = np.ascontiguousarray(s[:2 * system.n], dtype=float).copy()
+    cst = resting_contacts(system, y) if cst is None else cst
+    P.project_velocities(y, cst, np.int64(-1), system.data)
     return y
-
-
-def stick_projected(system, s: np.ndarray) -> np.ndarray:
-    """The state with q̇ projected onto v_r = 0 in the mass metric (:func:`kernels.project_velocity`)."""
-    y = kernel_state(s)
-    K.project_velocity(y, system.minv, system.p)
-    return y[:N_STATES].copy()

@@ -27,14 +27,13 @@ import numpy as np
 
 from .. import __version__
 from ..integrate.driver import SimulationError, initial_state, simulate
-from ..model.kernels import DEFAULT_SLIP_BAND
-from ..model.parameters import Parameters
-from ..model.system import assemble
-from .layout import N_STATES, free_states
+from ..model.system_model import FrictionModel
+from .layout import free_states
+from .linear_flow import propagate
+from .models import ModelResult, model_attrs, resolve
 from .problem import ShootingProblem, scales, stick_count
 from .section import OrbitError
 from .shooting import PeriodicOrbit
-from .variational import propagate
 
 __all__ = ["LyapunovResult", "lyapunov_exponent", "LyapunovSpectrum", "lyapunov_spectrum"]
 
@@ -44,7 +43,7 @@ DEFAULT_D0 = 1e-7
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class LyapunovResult:
+class LyapunovResult(ModelResult):
     """Largest Lyapunov exponent with its convergence history.
 
     Attributes
@@ -64,9 +63,8 @@ class LyapunovResult:
     t_transient : float
         Discarded transient before averaging [s].
     scale : ndarray (2 n_free,)
-        Scales σ of the norm [SI units].
-    params : Parameters
-    model : str
+        Scales σ of the norm [state units].
+    system : FrictionModel
     options : dict
     """
 
@@ -78,8 +76,7 @@ class LyapunovResult:
     d0: float
     t_transient: float
     scale: np.ndarray
-    params: Parameters
-    model: str
+    system: FrictionModel
     options: dict
 
     @property
@@ -100,59 +97,54 @@ class LyapunovResult:
         attrs = {
             "title": "stickslip largest Lyapunov exponent (Benettin)",
             "stickslip_version": __version__,
-            "model": self.model,
             "exponent": self.exponent, "exponent_units": "1/s",
             "standard_error": self.standard_error,
             "chunk": self.chunk, "chunk_units": "s",
             "d0": self.d0,
             "t_transient": self.t_transient,
             "options": json.dumps(self.options),
-            "parameters": json.dumps(self.params.to_dict()),
+            **model_attrs(self.system),
         }
         coords = {"time": ("time", self.time, {"units": "s", "long_name": "averaging time"})}
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, slip_band):
+def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band):
     """The common start of the Lyapunov computations: resolve the start, run the transient.
 
-    ``ic`` may be a :class:`PeriodicOrbit` (its parameters and model are then the defaults).
+    ``ic`` may be a :class:`PeriodicOrbit` (its model is then the default).
     Returns the flow map as a :class:`.problem.ShootingProblem` without a section (σ: the
     peak-to-peak ranges over the transient's second half) and the exact state at the end of the
     transient.
     """
     if isinstance(ic, PeriodicOrbit):
-        params = ic.params if params is None else params
-        model = ic.model
+        system = ic.system if system is None and model is None else system
         ic = ic.state
-    params = Parameters() if params is None else params
+    system = resolve(system, model, slip_band)
     atol = 1e-3 * rtol if atol is None else float(atol)
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
-    system = assemble(params, model, slip_band)
     if perturbation is None and isinstance(ic, str) and ic == "equilibrium":
         perturbation = 1e-3
     try:
         s = initial_state(system, ic, perturbation)
     except SimulationError as exc:
         raise OrbitError(f"bad initial condition: {exc}") from exc
-    model = system.variant.name
-    tr = simulate(params, t_transient, model=model, ic=s, sample_rate=max(200.0, 1.0 / t_transient), rtol=rtol,
-                  atol=atol, slip_band=slip_band)
+    tr = simulate(system, t_transient, ic=s, sample_rate=max(200.0, 1.0 / t_transient), rtol=rtol, atol=atol)
     if tr.status != "success":
         raise OrbitError(f"the transient run failed: {tr.status}")
     half = tr.t >= 0.5 * t_transient
-    problem = ShootingProblem.build(params, model, sigma=scales(np.ptp(tr.states[half], axis=0), free_states(system)),
-                                    system=system, rtol=rtol, atol=atol, slip_band=slip_band)
+    problem = ShootingProblem.build(system, sigma=scales(np.ptp(tr.states[half], axis=0), free_states(system)),
+                                    rtol=rtol, atol=atol)
     s_ref, _ = problem.flow(s, t_transient)  # exact end of the transient
     return problem, s_ref
 
 
 def lyapunov_exponent(
-    params: Parameters | None = None,
+    system=None,
     ic="equilibrium",
     *,
-    model="full",
+    model=None,
     t_transient: float = 50.0,
     t_average: float = 200.0,
     chunk: float = 1.0,
@@ -161,18 +153,18 @@ def lyapunov_exponent(
     rtol: float = 1e-10,
     atol: float | None = None,
     seed: int = 0,
-    slip_band: float = DEFAULT_SLIP_BAND,
+    slip_band: float | None = None,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the attractor reached from ``ic``.
 
     Parameters
     ----------
-    params : Parameters, optional
-        Default: the orbit's or Table 1.
-    ic : "equilibrium", "zero", array-like (N_STATES,), Trajectory or PeriodicOrbit
-        Start of the transient run (a PeriodicOrbit: its section state, and its params/model).
-    model : str
-        Model variant.
+    system : FrictionModel, Parameters, str, optional
+        The model as :func:`stickslip.simulate` takes it (default: the orbit's, else the plates, Table 1).
+    ic : "equilibrium", "zero", array-like (2n,), Trajectory or PeriodicOrbit
+        Start of the transient run (a PeriodicOrbit: its section state and model).
+    model : str, optional
+        The plates' variant, or a library name / model file as ``system``.
     t_transient : float
         Transient simulated and discarded first [s] (> 0: it also sets the norm's scales).
     t_average : float
@@ -203,7 +195,7 @@ def lyapunov_exponent(
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
-    problem, s_ref = _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band)
     free, sigma = problem.free, problem.sigma
 
     def perturbed(direction):
@@ -230,20 +222,20 @@ def lyapunov_exponent(
     estimate = np.cumsum(growth) / time
     return LyapunovResult(
         exponent=float(estimate[-1]), time=time, estimate=estimate, log_growth=growth, chunk=float(chunk),
-        d0=float(d0), t_transient=float(t_transient), scale=sigma, params=problem.params, model=problem.model,
+        d0=float(d0), t_transient=float(t_transient), scale=sigma, system=problem.system,
         options=dict(problem.options, seed=seed, perturbation=perturbation),
     )
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class LyapunovSpectrum:
+class LyapunovSpectrum(ModelResult):
     """Full Lyapunov spectrum with its convergence history.
 
     Attributes
     ----------
     exponents : ndarray (k,)
         λ_1 ≥ … ≥ λ_k over the whole averaging time [1/s] (k = 2 n_free). Directions that a
-        stick phase collapses (v_r = 0 is two conditions) have λ = −∞ in exact arithmetic; they
+        stick phase collapses (v_c = 0 is dim conditions per contact) have λ = −∞ in exact arithmetic; they
         come out as large negative numbers set by round-off (~ln 1e-16 per stick phase).
     time : ndarray (n,)
         Averaging time at each record [s].
@@ -252,13 +244,12 @@ class LyapunovSpectrum:
     t_transient : float
         Discarded transient [s].
     scale : ndarray (k,)
-        Scales σ of the norm [SI units].
+        Scales σ of the norm [state units].
     stick_phases : int
         Slip → stick transitions during the averaging time.
     wall_time : float
         Seconds taken.
-    params : Parameters
-    model : str
+    system : FrictionModel
     options : dict
     """
 
@@ -269,8 +260,7 @@ class LyapunovSpectrum:
     scale: np.ndarray
     stick_phases: int
     wall_time: float
-    params: Parameters
-    model: str
+    system: FrictionModel
     options: dict
 
     @property
@@ -290,12 +280,11 @@ class LyapunovSpectrum:
         attrs = {
             "title": "stickslip Lyapunov spectrum (variational equations, saltation matrices, QR)",
             "stickslip_version": __version__,
-            "model": self.model,
             "t_transient": self.t_transient,
             "stick_phases": self.stick_phases,
             "wall_time_s": self.wall_time,
             "options": json.dumps(self.options),
-            "parameters": json.dumps(self.params.to_dict()),
+            **model_attrs(self.system),
         }
         coords = {"time": ("time", self.time, {"units": "s", "long_name": "averaging time"}),
                   "index": np.arange(1, self.exponents.size + 1)}
@@ -318,36 +307,36 @@ QR_INTERVAL = 1.0
 
 
 def lyapunov_spectrum(
-    params: Parameters | None = None,
+    system=None,
     ic="equilibrium",
     *,
-    model="full",
+    model=None,
     t_transient: float = 50.0,
     t_average: float = 200.0,
     record: float = 1.0,
     perturbation: float | None = None,
     rtol: float = 1e-10,
     atol: float | None = None,
-    slip_band: float = DEFAULT_SLIP_BAND,
+    slip_band: float | None = None,
     method: str = "variational",
     chunk: float = 1.0,
     d0: float = DEFAULT_D0,
 ) -> LyapunovSpectrum:
     """All Lyapunov exponents of the attractor reached from ``ic`` (Benettin–Shimada–Nagashima).
 
-    The variational equations with saltation matrices (:func:`.variational.propagate`) carry
+    The variational equations with saltation matrices (:func:`.linear_flow.propagate`) carry
     an orthonormal frame (in the σ-scaled norm) along the ``event`` integrator's trajectory; it
     is re-orthonormalised by QR after every jump and at least every :data:`QR_INTERVAL`
     seconds, and λ_i = Σ ln |R_ii| / t.
 
     Parameters
     ----------
-    params : Parameters, optional
-        Default: the orbit's or Table 1.
-    ic : "equilibrium", "zero", array-like (N_STATES,), Trajectory or PeriodicOrbit
-        Start of the transient run (a PeriodicOrbit: its section state, params and model).
-    model : str
-        Model variant.
+    system : FrictionModel, Parameters, str, optional
+        The model as :func:`stickslip.simulate` takes it (default: the orbit's, else the plates, Table 1).
+    ic : "equilibrium", "zero", array-like (2n,), Trajectory or PeriodicOrbit
+        Start of the transient run (a PeriodicOrbit: its section state and model).
+    model : str, optional
+        The plates' variant, or a library name / model file as ``system``.
     t_transient : float
         Transient simulated and discarded first [s] (> 0: it sets the norm's scales).
     t_average : float
@@ -366,7 +355,7 @@ def lyapunov_spectrum(
         reference, advanced by the ``event`` integrator chunk by chunk (τ = ``chunk``) and
         re-orthonormalised by QR after each chunk (the saltation is then inside the
         differences; needs no variational re-integration, so it also works where that one
-        refuses, e.g. velocity reversals and in-band returns to v_r ≈ 0; directions collapsed
+        refuses, e.g. velocity reversals and in-band returns to v ≈ 0; directions collapsed
         by stick come out at ln(integration noise / d0) per chunk instead of −∞).
     chunk, d0 : float
         Chunk length [s] and scaled separation [-] of ``finite-difference``.
@@ -383,7 +372,7 @@ def lyapunov_spectrum(
     t_start = _time.perf_counter()
     if t_average <= 0.0:
         raise OrbitError(f"t_average = {t_average} s must be > 0")
-    problem, s_ref = _after_transient(params, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band)
     if method == "finite-difference":
         return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
     if method != "variational":
@@ -392,7 +381,7 @@ def lyapunov_spectrum(
     free, sigma = problem.free, problem.sigma
 
     k = free.size
-    D = np.zeros((N_STATES, k))
+    D = np.zeros((2 * problem.system.n, k))
     D[free, np.arange(k)] = sigma          # columns: σ-scaled unit vectors
     log_sum = np.zeros(k)
     times, sums = [0.0], [np.zeros(k)]
@@ -400,7 +389,7 @@ def lyapunov_spectrum(
     def reorthonormalise(t, P):
         Q, log_r = _qr(P[free] / sigma[:, None])
         log_sum[:] += log_r
-        out = np.zeros((N_STATES, k))
+        out = np.zeros((2 * problem.system.n, k))
         out[free] = Q * sigma[:, None]
         if t - times[-1] >= record or t >= t_average:
             times.append(t)
@@ -427,7 +416,7 @@ def _spectrum(problem, estimate, time, t_transient, stick_phases, t_start, optio
     return LyapunovSpectrum(
         exponents=estimate[-1].copy(), time=time, estimate=estimate, t_transient=float(t_transient),
         scale=problem.sigma, stick_phases=stick_phases, wall_time=_time.perf_counter() - t_start,
-        params=problem.params, model=problem.model, options=dict(problem.options, **options),
+        system=problem.system, options=dict(problem.options, **options),
     )
 
 
@@ -447,7 +436,7 @@ def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation
         starts = [problem.perturbed(s_ref, Q[:, j], d0) for j in range(k)]
         s_new, tr = problem.flow(s_ref, chunk)
         sticks += stick_count(tr)
-        # columns Φ P Q_j: the chunk's flow after the projection onto v_r = 0 that a stuck
+        # columns Φ P Q_j: the chunk's flow after the projection onto v_c = 0 that a stuck
         # reference implies (part of the physical map: stick collapses those directions)
         A = np.column_stack([(problem.flow(sp, chunk)[0][free] - s_new[free]) / sigma for sp in starts]) / d0
         Q, log_r = _qr(A)

@@ -7,7 +7,7 @@ free states, their scales σ, the section and the integration options, and gives
   with an optional cap on the steps per simulated second and a count of the runs);
 * the shooting residual F = (Φ(s0, T) − s0)[free] / σ;
 * ∂Φ/∂s0 on the free states from the variational equations with saltation matrices
-  (:func:`.variational.flow_jacobian`) or from central differences of Φ (two runs a column, the
+  (:func:`.linear_flow.flow_jacobian`) or from central differences of Φ (two runs a column, the
   saltation then inside the differences);
 * the scaled Jacobian of F in the unknowns (the section states but the coordinate the section
   fixes, in units of σ, and T), whose T column is exact, f(Φ) from the vector field;
@@ -31,15 +31,15 @@ import numpy as np
 
 from .. import __version__
 from ..integrate.driver import SimulationError
-from ..integrate.events import STICK_SPEED_TOL
-from ..model import kernels as K
-from ..model.parameters import Parameters, parameter_attrs
-from ..model.system import System, assemble
-from . import variational as _var
-from .layout import N_STATES, STATE_NAMES, free_states, stick_projected
+from ..model.bundle import CST
+from ..model.physics import MODE_STICK
+from ..model.system_model import FrictionModel
+from . import linear_flow as _lin
+from .layout import free_states, resting_contacts, stick_projected
+from .models import ModelResult, model_attrs
 from .section import OrbitError, Section, flow, vector_field
 
-__all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "fd_monodromy", "central_differences",
+__all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
            "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time",
            "check_method", "check_section", "METHODS", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
 
@@ -72,16 +72,16 @@ def check_method(method: str, what: str = "monodromy method") -> None:
         raise OrbitError(f"unknown {what} {method!r}; use one of {METHODS}")
 
 
-def check_section(section: Section, system: System) -> None:
-    """Refuse a section that fixes a state the system's variant locks (OrbitError)."""
+def check_section(section: Section, system: FrictionModel) -> None:
+    """Refuse a section that fixes a state the model locks (OrbitError)."""
     if section.index not in free_states(system):
-        raise OrbitError(f"section {section.name} fixes {STATE_NAMES[section.index]}, which is locked in model "
-                         f"{system.variant.name!r}")
+        raise OrbitError(f"section {section.name} fixes {system.state_names[section.index]}, which is locked in "
+                         f"model {ModelResult.label(system)!r}")
 
 
 def scales(ptp: np.ndarray, free: np.ndarray) -> np.ndarray:
     """σ (2 n_free,) of the free states from their peak-to-peak ranges ``ptp`` (all states),
-    floored per kind, positions and velocities (see :data:`SCALE_FLOOR`) [SI units]."""
+    floored per kind, positions and velocities (see :data:`SCALE_FLOOR`) [state units]."""
     sigma = ptp[free].astype(float).copy()
     n = free.size // 2
     for part in (slice(0, n), slice(n, 2 * n)):
@@ -98,12 +98,12 @@ def central_differences(end_of, s0, free: np.ndarray, h: np.ndarray, cols=None) 
     Parameters
     ----------
     end_of : callable
-        ``end_of(s)`` → Φ(s) (all states) [SI].
-    s0 : array-like (N_STATES,)
+        ``end_of(s)`` → Φ(s) (all states).
+    s0 : array-like (2n,)
     free : ndarray (2 n_free,)
         State indices of the free states.
     h : ndarray (2 n_free,)
-        Steps of the free states [SI].
+        Steps of the free states [state units].
     cols : sequence of int, optional
         Positions in ``free`` of the columns (default: all).
 
@@ -155,10 +155,10 @@ def stick_time(transitions) -> float:
 class NewtonResult(NamedTuple):
     """A converged orbit of :meth:`ShootingProblem.newton`."""
 
-    state: np.ndarray  # (N_STATES,) on the section [SI]
+    state: np.ndarray  # (2n,) on the section
     period: float  # [s]
     residual: np.ndarray  # F at the solution (2 n_free,) [-]
-    end: np.ndarray  # Φ(state, period) [SI]
+    end: np.ndarray  # Φ(state, period)
     transitions: object  # of the run over one period
     history: list  # max |F| before each iteration and at the end [-]
     iterations: int
@@ -170,19 +170,14 @@ class ShootingProblem:
 
     Attributes
     ----------
-    params : Parameters
-    model : str
-        Variant name.
-    system : System
-        ``assemble(params, model, slip_band)``.
+    system : FrictionModel
+        The model (its slip band included).
     free : ndarray (2 n_free,)
         State indices of the free states (:func:`.layout.free_states`).
     sigma : ndarray (2 n_free,)
-        Their scales [SI]: residuals are in units of σ, differences steps of ``fd_step`` σ.
+        Their scales [state units]: residuals are in units of σ, differences steps of ``fd_step`` σ.
     rtol, atol : float
         Tolerances of every flow map.
-    slip_band : float
-        Low-speed band of the slip direction [m/s].
     fd_step : float
         Relative finite-difference step [-].
     section : Section, optional
@@ -193,40 +188,35 @@ class ShootingProblem:
         ``{"simulations": flow maps run}``.
     """
 
-    params: Parameters
-    model: str
-    system: System
+    system: FrictionModel
     free: np.ndarray
     sigma: np.ndarray
     rtol: float
     atol: float
-    slip_band: float
     fd_step: float = DEFAULT_FD_STEP
     section: Section | None = None
     max_steps_per_second: float | None = None
     counter: dict = dataclasses.field(default_factory=lambda: {"simulations": 0})
 
     @classmethod
-    def build(cls, params: Parameters, model: str, *, sigma, rtol: float, atol: float, slip_band: float,
-              section: Section | None = None, system: System | None = None, **options) -> "ShootingProblem":
-        """The problem of ``model`` at ``params`` (``options``: fd_step, max_steps_per_second).
+    def build(cls, system: FrictionModel, *, sigma, rtol: float, atol: float, section: Section | None = None,
+              **options) -> "ShootingProblem":
+        """The problem of ``system`` (``options``: fd_step, max_steps_per_second).
 
         Raises
         ------
         OrbitError
             If ``section`` fixes a state the model locks.
         """
-        system = assemble(params, model, slip_band) if system is None else system
         if section is not None:
             check_section(section, system)
-        return cls(params=params, model=system.variant.name, system=system, free=free_states(system),
-                   sigma=np.asarray(sigma, dtype=float), rtol=rtol, atol=atol, slip_band=slip_band, section=section,
-                   **options)
+        return cls(system=system, free=free_states(system), sigma=np.asarray(sigma, dtype=float), rtol=rtol,
+                   atol=atol, section=section, **options)
 
     @property
     def options(self) -> dict:
         """The integration options of every flow map: rtol, atol, slip_band."""
-        return dict(rtol=self.rtol, atol=self.atol, slip_band=self.slip_band)
+        return dict(rtol=self.rtol, atol=self.atol, slip_band=self.system.slip_band)
 
     @functools.cached_property
     def unknown(self) -> np.ndarray:
@@ -234,20 +224,20 @@ class ShootingProblem:
         return np.array([k for k, j in enumerate(self.free) if j != self.section.index])
 
     # ------------------------------------------------------------------ the return map
-    def flow(self, s0: np.ndarray, T: float, params: Parameters | None = None):
-        """Φ(s0, T) and the run's transitions (:func:`.section.flow`), at ``params`` if given."""
+    def flow(self, s0: np.ndarray, T: float, system: FrictionModel | None = None):
+        """Φ(s0, T) and the run's transitions (:func:`.section.flow`), of ``system`` if given."""
         self.counter["simulations"] += 1
         cap = None if self.max_steps_per_second is None else int(self.max_steps_per_second * max(T, 1.0))
-        return flow(self.params if params is None else params, self.model, s0, T, max_steps=cap, **self.options)
+        return flow(self.system if system is None else system, s0, T, rtol=self.rtol, atol=self.atol, max_steps=cap)
 
-    def residual(self, s: np.ndarray, T: float, params: Parameters | None = None):
+    def residual(self, s: np.ndarray, T: float, system: FrictionModel | None = None):
         """F (2 n_free,) [σ], the end state Φ(s, T) and the run's transitions."""
-        end, tr = self.flow(s, T, params)
+        end, tr = self.flow(s, T, system)
         return (end[self.free] - s[self.free]) / self.sigma, end, tr
 
     def state(self, z: np.ndarray) -> np.ndarray:
-        """The state on the section (N_STATES,) of the unknowns ``z`` [σ]."""
-        s = np.zeros(N_STATES)
+        """The state on the section (2n,) of the unknowns ``z`` [σ]."""
+        s = np.zeros(2 * self.system.n)
         k = self.unknown
         s[self.free[k]] = z * self.sigma[k]
         s[self.section.index] = self.section.value
@@ -259,18 +249,18 @@ class ShootingProblem:
         return s[self.free[k]] / self.sigma[k]
 
     # ------------------------------------------------------------------ derivatives
-    def fd_monodromy(self, s0: np.ndarray, T: float, cols=None, params: Parameters | None = None) -> np.ndarray:
+    def fd_monodromy(self, s0: np.ndarray, T: float, cols=None, system: FrictionModel | None = None) -> np.ndarray:
         """∂Φ(s0, T)/∂s0 by central differences (steps ``fd_step`` σ), free rows × ``cols``
         (positions in :attr:`free`; default all): two flow maps a column."""
-        return central_differences(lambda s: self.flow(s, T, params)[0], s0, self.free, self.fd_step * self.sigma,
+        return central_differences(lambda s: self.flow(s, T, system)[0], s0, self.free, self.fd_step * self.sigma,
                                    cols)
 
     def monodromy(self, s0: np.ndarray, T: float, method: str = "saltation"):
-        """∂Φ(s0, T)/∂s0 on the free states (2 n_free × 2 n_free) [SI] and the jumps applied
-        (``saltation``: :func:`.variational.flow_jacobian`, which raises where it cannot follow the
+        """∂Φ(s0, T)/∂s0 on the free states (2 n_free × 2 n_free) and the jumps applied
+        (``saltation``: :func:`.linear_flow.flow_jacobian`, which raises where it cannot follow the
         event sequence; ``finite-difference``: :meth:`fd_monodromy`, no jumps)."""
         if method == "saltation":
-            fj = _var.flow_jacobian(self.params, self.model, s0, T, scale=self.sigma, **self.options)
+            fj = _lin.flow_jacobian(self.system, s0, T, scale=self.sigma, rtol=self.rtol, atol=self.atol)
             return fj.matrix[np.ix_(self.free, self.free)], fj.events
         return self.fd_monodromy(s0, T), ()
 
@@ -285,18 +275,17 @@ class ShootingProblem:
                 pass
         return self.fd_monodromy(s0, T, self.unknown)
 
-    def jacobian(self, columns: np.ndarray, end: np.ndarray, params: Parameters | None = None,
+    def jacobian(self, columns: np.ndarray, end: np.ndarray, system: FrictionModel | None = None,
                  T_scale: float = 1.0) -> np.ndarray:
         """∂F/∂(z, T/T_scale) (2 n_free × n_unknown + 1) from ∂Φ/∂s0 on the unknown ``columns``.
 
         The state columns are (∂Φ/∂s0 − I) in units of σ; the T column is exact, f(Φ) from the
-        vector field (at ``params`` if given) times ``T_scale`` [s].
+        vector field (of ``system`` if given) times ``T_scale`` [s].
         """
         free, sigma, k = self.free, self.sigma, self.unknown
-        system = self.system if params is None else assemble(params, self.model, self.slip_band)
         A = np.empty((free.size, k.size + 1))
         A[:, :-1] = (columns - np.eye(free.size)[:, k]) * sigma[k][None, :] / sigma[:, None]
-        A[:, -1] = vector_field(system, end)[free] / sigma * T_scale
+        A[:, -1] = vector_field(self.system if system is None else system, end)[free] / sigma * T_scale
         return A
 
     # ------------------------------------------------------------------ Newton
@@ -347,14 +336,14 @@ class ShootingProblem:
 
     # ------------------------------------------------------------------ perturbations
     def perturbed(self, s: np.ndarray, direction: np.ndarray, d: float) -> np.ndarray:
-        """``s`` moved by ``d`` along the σ-scaled ``direction`` (2 n_free,); projected onto v_r = 0
-        if ``s`` sticks (a perturbed stuck state sticks too, so this is the dynamics' own first
+        """``s`` moved by ``d`` along the σ-scaled ``direction`` (2 n_free,); projected onto v_c = 0
+        for the contacts at rest in ``s`` (a perturbed stuck state sticks too, so this is the dynamics' own first
         instant, and the integrator need not resolve a 1e-9 m/s slip against the constraint)."""
         sp = s.copy()
         sp[self.free] += d * direction * self.sigma
-        vx, vy = K.relative_velocity(s, self.system.p)
-        if np.hypot(vx, vy) <= STICK_SPEED_TOL:
-            sp = stick_projected(self.system, sp)
+        at_rest = resting_contacts(self.system, s)
+        if np.any(at_rest[::CST] == MODE_STICK):
+            sp = stick_projected(self.system, sp, at_rest)
         return sp
 
 
@@ -390,13 +379,13 @@ def multiplier_variables(multipliers: np.ndarray, dims) -> dict:
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class Monodromy(Multipliers):
+class Monodromy(ModelResult, Multipliers):
     """Monodromy matrix and Floquet multipliers of a periodic orbit.
 
     Attributes
     ----------
     matrix : ndarray (2 n_free, 2 n_free)
-        ∂Φ(s0, T)/∂s0 on the free states [SI units].
+        ∂Φ(s0, T)/∂s0 on the free states [state units].
     multipliers : ndarray (2 n_free,) complex
         Its eigenvalues by decreasing modulus [-].
     method : str
@@ -404,12 +393,11 @@ class Monodromy(Multipliers):
     period : float
         T [s].
     free_states : tuple of str
-    events : tuple of (float, str)
-        Jumps applied (saltation only): (instant [s], "stick" | "breakaway" | "band").
+    events : tuple of (float, str, int)
+        Jumps applied (saltation only): (instant [s], "stick" | "breakaway" | "band" | "reversal", contact).
     wall_time : float
         Seconds taken.
-    params : Parameters
-    model : str
+    system : FrictionModel
     """
 
     matrix: np.ndarray
@@ -419,8 +407,7 @@ class Monodromy(Multipliers):
     free_states: tuple
     events: tuple
     wall_time: float
-    params: Parameters
-    model: str
+    system: FrictionModel
 
     def to_xarray(self):
         """``xarray.Dataset``: matrix and multipliers, method and period as attributes."""
@@ -428,14 +415,12 @@ class Monodromy(Multipliers):
 
         data = {
             "monodromy": (("free_state", "free_state_0"), self.matrix,
-                          {"long_name": f"monodromy matrix d s(T) / d s(0) ({self.method})", "units": "SI"}),
+                          {"long_name": f"monodromy matrix d s(T) / d s(0) ({self.method})"}),
             **multiplier_variables(self.multipliers, "multiplier"),
         }
-        attrs = {"title": "stickslip monodromy matrix", "stickslip_version": __version__, "model": self.model,
+        attrs = {"title": "stickslip monodromy matrix", "stickslip_version": __version__,
                  "method": self.method, "period": self.period, "period_units": "s",
-                 "wall_time_s": self.wall_time, "events": json.dumps(self.events),
-                 "parameters": json.dumps(self.params.to_dict())}
-        attrs.update(parameter_attrs(self.params.to_dict()))
+                 "wall_time_s": self.wall_time, "events": json.dumps(self.events), **model_attrs(self.system)}
         coords = {"free_state": list(self.free_states), "free_state_0": list(self.free_states)}
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
@@ -446,11 +431,11 @@ def monodromy(orbit, method: str = "saltation", *, fd_step: float | None = None)
     Parameters
     ----------
     orbit : PeriodicOrbit
-        From :func:`stickslip.orbits.periodic_orbit` (state, period, params, model, scale,
-        options rtol/atol/slip_band/fd_step are used).
+        From :func:`stickslip.orbits.periodic_orbit` (state, period, system, scale and the options
+        rtol/atol/fd_step are used).
     method : {"saltation", "finite-difference"}
         ``saltation``: variational equations along the orbit with jump matrices at every
-        stick↔slip transition (:func:`~stickslip.orbits.variational.flow_jacobian`).
+        transition (:func:`~stickslip.orbits.linear_flow.flow_jacobian`).
         ``finite-difference``: central differences of the flow map, two ``event`` runs per column
         (perturbed shooting).
     fd_step : float, optional
@@ -463,19 +448,9 @@ def monodromy(orbit, method: str = "saltation", *, fd_step: float | None = None)
     check_method(method)
     t0 = _time.perf_counter()
     opt = orbit.options
-    problem = ShootingProblem.build(orbit.params, orbit.model, sigma=orbit.scale, rtol=opt["rtol"], atol=opt["atol"],
-                                    slip_band=opt["slip_band"],
+    problem = ShootingProblem.build(orbit.system, sigma=orbit.scale, rtol=opt["rtol"], atol=opt["atol"],
                                     fd_step=opt.get("fd_step", DEFAULT_FD_STEP) if fd_step is None else fd_step)
     M, events = problem.monodromy(orbit.state, orbit.period, method)
     return Monodromy(matrix=M, multipliers=sorted_eigenvalues(M), method=method, period=float(orbit.period),
-                     free_states=tuple(STATE_NAMES[j] for j in problem.free), events=tuple(events),
-                     wall_time=_time.perf_counter() - t0, params=orbit.params, model=orbit.model)
-
-
-def fd_monodromy(params, model, s0, T, free, h_free, *, rtol, atol, slip_band, cols=None) -> np.ndarray:
-    """Central-difference columns ∂Φ(s0, T)/∂s0[j] (free-state rows) for the state indices
-    ``cols`` (default: all free states), steps ``h_free`` (2 n_free,) on the free states [SI]."""
-    free = np.asarray(free)
-    positions = None if cols is None else [list(free).index(j) for j in cols]
-    return central_differences(lambda s: flow(params, model, s, T, rtol=rtol, atol=atol, slip_band=slip_band)[0],
-                               s0, free, np.asarray(h_free, dtype=float), positions)
+                     free_states=tuple(orbit.system.state_names[j] for j in problem.free), events=tuple(events),
+                     wall_time=_time.perf_counter() - t0, system=orbit.system)

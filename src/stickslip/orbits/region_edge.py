@@ -19,12 +19,12 @@ import numpy as np
 
 from ..files import open_ours
 from ..integrate.driver import SimulationError, simulate
-from ..model.kernels import DEFAULT_SLIP_BAND
 from ..model.parameters import Parameters
 from . import branch_store as store
 from .arclength import ContinuationError
 from .branch import Branch, continue_orbit
-from .layout import PHI, equilibrium_state
+from .layout import equilibrium_state
+from .models import resolve
 from .section import OrbitError
 from .shooting import PeriodicOrbit, periodic_orbit
 from .start import START_RATE, start_orbit_from_run, start_run
@@ -140,8 +140,8 @@ EDGE_BISECTIONS, EDGE_PROBE, EDGE_WINDOW = 40, 60.0, 20.0
 EDGE_SEPARATION = 0.05
 
 
-def unstable_cycle(params: Parameters, orbit_state: np.ndarray, *, model: str = "full", rtol: float = 1e-10,
-                   slip_band: float = DEFAULT_SLIP_BAND, section="phi_max") -> PeriodicOrbit:
+def unstable_cycle(system, orbit_state: np.ndarray, *, model=None, rtol: float = 1e-10,
+                   slip_band: float | None = None, section="max") -> PeriodicOrbit:
     """The saddle cycle on the boundary between the basins of a stable orbit and the equilibrium.
 
     Edge tracking: on the segment s(a) = s_eq + a (s_orbit − s_eq), a ∈ [0, 1], from the
@@ -153,8 +153,9 @@ def unstable_cycle(params: Parameters, orbit_state: np.ndarray, *, model: str = 
 
     Parameters
     ----------
-    params : Parameters
-    orbit_state : ndarray (N_STATES,)
+    system : FrictionModel, Parameters, str
+        The model (as :func:`stickslip.simulate` takes it; e.g. ``Branch.orbit_system(i)``).
+    orbit_state : ndarray (2n,)
         A state on the stable stick-slip orbit (e.g. ``Branch.states[i]``).
     model, rtol, slip_band, section
         As :func:`~stickslip.orbits.periodic_orbit`.
@@ -168,13 +169,14 @@ def unstable_cycle(params: Parameters, orbit_state: np.ndarray, *, model: str = 
     ContinuationError
         If the equilibrium end does not go to the equilibrium or the orbit end does not stick.
     """
-    s_eq = equilibrium_state(params, model)
+    system = resolve(system, model, slip_band)
+    s_eq = equilibrium_state(system)
     s_orb = np.asarray(orbit_state, dtype=float)
     atol = 1e-3 * rtol
+    obs = system.observed_index
 
     def run(a, t_end=EDGE_PROBE, rate=100.0):
-        return simulate(params, t_end, model=model, ic=s_eq + a * (s_orb - s_eq), sample_rate=rate, rtol=rtol,
-                        atol=atol, slip_band=slip_band)
+        return simulate(system, t_end, ic=s_eq + a * (s_orb - s_eq), sample_rate=rate, rtol=rtol, atol=atol)
 
     def sticks(a):
         tr = run(a)
@@ -183,18 +185,18 @@ def unstable_cycle(params: Parameters, orbit_state: np.ndarray, *, model: str = 
     lo, hi = 0.0, 1.0
     if not sticks(hi) or sticks(1e-3):
         raise ContinuationError("edge tracking needs a stable stick-slip orbit and a stable equilibrium "
-                                f"(Region II) at {params.N:g} N, {params.Omega:g} rad/s")
+                                "(Region II) at these parameters")
     for _ in range(EDGE_BISECTIONS):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if sticks(mid) else (mid, hi)
     a_lo, a_hi = run(lo, rate=START_RATE), run(hi, rate=START_RATE)
-    scale = max(float(np.ptp(a_hi.states[a_hi.t >= EDGE_PROBE - EDGE_WINDOW, PHI])), 1e-12)
-    apart = np.flatnonzero(np.abs(a_lo.states[:, PHI] - a_hi.states[:, PHI]) > EDGE_SEPARATION * scale)
+    scale = max(float(np.ptp(a_hi.states[a_hi.t >= EDGE_PROBE - EDGE_WINDOW, obs])), 1e-12)
+    apart = np.flatnonzero(np.abs(a_lo.states[:, obs] - a_hi.states[:, obs]) > EDGE_SEPARATION * scale)
     t_sep = a_lo.t[apart[0]] if apart.size else EDGE_PROBE
     m = int(np.searchsorted(a_lo.t, 0.9 * t_sep))
     guess = dataclasses.replace(a_lo, t=a_lo.t[:m], states=a_lo.states[:m], mode=a_lo.mode[:m])
     try:
-        return periodic_orbit(params, guess, section=section, rtol=rtol, slip_band=slip_band, max_iter=40)
+        return periodic_orbit(None, guess, section=section, rtol=rtol, max_iter=40)
     except (OrbitError, SimulationError) as exc:
         raise ContinuationError(f"no saddle cycle from the edge run (it lingered {0.9 * t_sep:.1f} s): {exc}") from exc
 
@@ -213,7 +215,7 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
     """One N of :func:`fold_curve` (runs in a worker process)."""
     t0 = time.perf_counter()
     rtol = options.get("rtol", 1e-10)
-    band = options.get("slip_band", DEFAULT_SLIP_BAND)
+    band = options.get("slip_band")
     errors = []
     for omega in (omega_start, START_FALLBACK * omega_start):
         p = params.replace(N=float(N), Omega=float(omega))

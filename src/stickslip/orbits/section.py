@@ -1,9 +1,10 @@
-"""Poincaré sections and the exact flow map used by the shooting method.
+"""Poincaré sections and the exact flow map used by the shooting method, for any model.
 
 A section is one state coordinate at a fixed value crossed in one direction:
 
-* ``"phi_max"``: φ̇ = 0 with φ̈ < 0 (a maximum of φ, a down-crossing of φ̇ through 0);
-* ``("phi", level)``: an up-crossing of φ through ``level`` [rad] (φ̇ > 0).
+* ``"max"``: a maximum of the model's observed dof (its velocity down-crossing 0); ``"<dof>_max"``
+  the same for a named dof (``"phi_max"`` for the plates' φ, the default there);
+* ``(dof, level)``: an up-crossing of a dof through ``level`` (its velocity > 0).
 
 The flow map Φ(s, T) is :func:`stickslip.simulate` with the ``event`` integrator from s over
 exactly T seconds: the run is asked for samples at the rate 1/T' with T' = 1/(1/T) (T to one
@@ -20,9 +21,8 @@ import numpy as np
 from ..errors import StickSlipError
 from ..analysis.steady import _hermite_crossings
 from ..integrate.driver import simulate
-from ..model import kernels as K
-from ..model.system import System
-from .layout import KERNEL_STATE, N_DOFS, N_STATES, PHI_DOT, STATE_NAMES, velocity_of
+from ..model import physics as P
+from ..model.bundle import CST, contact_state
 
 __all__ = ["Section", "resolve_section", "OrbitError", "flow", "vector_field", "section_crossings"]
 
@@ -38,9 +38,9 @@ class Section:
     Attributes
     ----------
     index : int
-        State index (:data:`stickslip.STATE_NAMES` order) fixed on the section.
+        State index (the model's ``state_names`` order) fixed on the section.
     value : float
-        Its value on the section [m, rad, m/s or rad/s].
+        Its value on the section [the state's unit].
     direction : int
         +1: up-crossing of ``s[index]``; −1: down-crossing.
     name : str
@@ -53,40 +53,55 @@ class Section:
     name: str
 
     def g(self, s: np.ndarray) -> float:
-        """Section function of one state (N_STATES,); zero on the section, increasing through it."""
+        """Section function of one state (2n,); zero on the section, increasing through it."""
         return self.direction * (float(s[self.index]) - self.value)
 
 
-def resolve_section(section) -> Section:
-    """Turn ``"phi_max"``, ``("phi", level)`` or a :class:`Section` into a :class:`Section`."""
+def resolve_section(section, system) -> Section:
+    """Turn ``"max"``, ``"<dof>_max"``, ``(dof, level)`` or a :class:`Section` into a :class:`Section`
+    of ``system`` (a FrictionModel)."""
     if isinstance(section, Section):
         return section
-    if isinstance(section, str) and section == "phi_max":
-        return Section(index=PHI_DOT, value=0.0, direction=-1, name="phi_max")
-    if isinstance(section, tuple) and len(section) == 2 and section[0] in STATE_NAMES[:N_DOFS]:
-        j = STATE_NAMES.index(section[0])
+    dofs = system.dofs
+    if isinstance(section, str) and (section == "max" or (section.endswith("_max") and section[:-4] in dofs)):
+        dof = dofs[system.observed_index] if section == "max" else section[:-4]
+        return Section(index=system.n + dofs.index(dof), value=0.0, direction=-1, name=f"{dof}_max")
+    if isinstance(section, tuple) and len(section) == 2 and section[0] in dofs:
         level = float(section[1])
-        return Section(index=j, value=level, direction=1, name=f"{section[0]}={level:g} up")
+        return Section(index=dofs.index(section[0]), value=level, direction=1, name=f"{section[0]}={level:g} up")
     raise OrbitError(
-        f"unknown section {section!r}; use 'phi_max' (phi maximum), ('phi', level) (up-crossing "
-        "of a phi level [rad]) or a stickslip.orbits.Section"
+        f"unknown section {section!r}; use 'max' (maximum of {dofs[system.observed_index]}), '<dof>_max', "
+        f"(dof, level) (up-crossing of a level) with a dof of {', '.join(dofs)}, or a stickslip.orbits.Section"
     )
 
 
-def vector_field(system: System, s: np.ndarray, mode: int = K.MODE_SLIP_EXACT) -> np.ndarray:
-    """ds/dt (N_STATES,) at state ``s`` in ``mode`` (slip with the exact direction v_r/|v_r| by default)."""
-    y = np.zeros(KERNEL_STATE)  # inline, not kernel_state(): called once per sample by section_crossings
-    y[:N_STATES] = s
-    ds = np.zeros(KERNEL_STATE)
-    vx, vy = K.relative_velocity(y, system.p)
-    speed = float(np.hypot(vx, vy))
-    ex, ey = (vx / speed, vy / speed) if speed > 0.0 else (1.0, 0.0)
-    K.rhs(y, int(mode), ex, ey, system.minv, system.damp, system.stiff, system.p, ds)
-    return ds[:N_STATES].copy()
+def modes_at(system, s: np.ndarray, stick_flags: int = 0) -> np.ndarray:
+    """Contact states at ``s``: the contacts whose bit is set in ``stick_flags`` stick, the others
+    slip with the exact direction v_c/|v_c| (a Trajectory's ``mode`` gives the flags)."""
+    md = system.data
+    cst = contact_state(md.m)
+    for c in range(system.n_contacts):
+        if (int(stick_flags) >> c) & 1:
+            cst[CST * c] = P.MODE_STICK
+            continue
+        v0, v1 = P.slip_velocity(np.ascontiguousarray(s[:2 * system.n], dtype=float), c, md)
+        speed = float(np.hypot(v0, v1))
+        cst[CST * c] = P.MODE_SLIP_EXACT
+        if speed > 0.0:
+            cst[CST * c + 1] = v0 / speed
+            cst[CST * c + 2] = v1 / speed
+    return cst
 
 
-def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, slip_band: float,
-         max_steps: int | None = None):
+def vector_field(system, s: np.ndarray, stick_flags: int = 0) -> np.ndarray:
+    """ds/dt (2n,) at state ``s`` (:func:`modes_at`: slip with the exact direction by default)."""
+    y = np.ascontiguousarray(s[:2 * system.n], dtype=float)
+    ds = np.zeros(2 * system.n)
+    P.rhs(y, modes_at(system, y, stick_flags), system.data, ds)
+    return ds
+
+
+def flow(system, s0: np.ndarray, T: float, *, rtol: float, atol: float, max_steps: int | None = None):
     """Φ(s0, T): the state after exactly T seconds, and the run's transitions.
 
     ``max_steps`` caps the integrator's steps (None: the driver's default): a stalled integration
@@ -94,7 +109,7 @@ def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, s
 
     Returns
     -------
-    state : ndarray (N_STATES,)
+    state : ndarray (2n,)
     transitions : stickslip.integrate.result.Transitions
 
     Raises
@@ -107,46 +122,46 @@ def flow(params, model, s0: np.ndarray, T: float, *, rtol: float, atol: float, s
     rate = 1.0 / T
     T_exact = 1.0 / rate  # the last sample time the driver will compute, so it lands on t_end
     cap = {} if max_steps is None else {"max_steps": int(max_steps)}
-    traj = simulate(params, T_exact, model=model, ic=s0, rtol=rtol, atol=atol, sample_rate=rate,
-                    slip_band=slip_band, **cap)
+    traj = simulate(system, T_exact, ic=s0, rtol=rtol, atol=atol, sample_rate=rate, **cap)
     if traj.status != "success" or traj.t[-1] != T_exact:
         raise OrbitError(f"the flow map over T = {T} s failed: {traj.status}")
     return traj.final_state, traj.transitions
 
 
-def _state_rates(system: System, states: np.ndarray, mode: np.ndarray, index: int) -> np.ndarray:
-    """d s[index]/dt at each sample (n,): a state for positions, the vector field for velocities."""
-    if index < N_DOFS:
-        return states[:, velocity_of(index)].copy()
-    out = np.empty(states.shape[0])
-    for i in range(states.shape[0]):
-        m = K.MODE_STICK if mode[i] == 1 else K.MODE_SLIP_EXACT
-        out[i] = vector_field(system, states[i], m)[index]
+def _state_rates(system, states: np.ndarray, mode: np.ndarray, index: int, where: np.ndarray) -> np.ndarray:
+    """d s[index]/dt at the samples ``where`` (k,; NaN elsewhere): a velocity for positions, the
+    vector field for velocities."""
+    if index < system.n:
+        return states[:, index + system.n].copy()
+    out = np.full(states.shape[0], np.nan)
+    for i in where:
+        out[i] = vector_field(system, states[i], int(mode[i]))[index]
     return out
 
 
-def section_crossings(system: System, section: Section, t, states, mode):
+def section_crossings(system, section: Section, t, states, mode):
     """Crossings of the section in uniformly sampled data, on the cubic Hermite interpolant.
 
     Parameters
     ----------
-    system : System
+    system : FrictionModel
     section : Section
-    t : ndarray (n,)
+    t : ndarray (k,)
         Sample times [s].
-    states : ndarray (n, N_STATES)
-    mode : ndarray (n,) int8
-        1 in stick.
+    states : ndarray (k, 2n)
+    mode : ndarray (k,) int8
+        Stick flags of the samples (bit c: contact c sticks).
 
     Returns
     -------
-    times : ndarray (k,)
+    times : ndarray (m,)
         Crossing instants [s], fourth-order accurate in the sample interval.
-    index : ndarray (k,) int
+    index : ndarray (m,) int
         Sample interval [t[i], t[i+1]] of each crossing.
     """
     g = section.direction * (states[:, section.index] - section.value)
-    dg = section.direction * _state_rates(system, states, mode, section.index)
+    up = np.flatnonzero((g[:-1] < 0.0) & (g[1:] >= 0.0))  # the intervals whose ends need the rate
+    dg = section.direction * _state_rates(system, states, mode, section.index, np.union1d(up, up + 1))
     return _hermite_crossings(np.asarray(t, dtype=float), g, dg, 0.0)
 
 
@@ -155,23 +170,22 @@ def section_crossings(system: System, section: Section, t, states, mode):
 LANDING_ITERATIONS = 4
 
 
-def land_on_section(params, model, system: System, section: Section, s_before: np.ndarray, dt: float,
-                    *, rtol: float, atol: float, slip_band: float):
+def land_on_section(system, section: Section, s_before: np.ndarray, dt: float, *, rtol: float, atol: float):
     """Integrate from ``s_before`` exactly onto the section, starting from the guess ``dt`` [s].
 
     Newton on the crossing time with dg/dt from the vector field; each iterate re-simulates from
-    ``s_before``. Returns (state on the section (N_STATES,), time from ``s_before`` [s], |g| before
-    the coordinate is set to the section value [unit of the coordinate]).
+    ``s_before``. Returns (state on the section (2n,), time from ``s_before`` [s], |g| before the
+    coordinate is set to the section value [unit of the coordinate]).
     """
     s = s_before
     for _ in range(LANDING_ITERATIONS):
-        s, _tr = flow(params, model, s_before, dt, rtol=rtol, atol=atol, slip_band=slip_band)
+        s, _tr = flow(system, s_before, dt, rtol=rtol, atol=atol)
         g = section.g(s)
         dg = section.direction * vector_field(system, s)[section.index]
         if dg <= 0.0:
             raise OrbitError(f"the flow does not cross section {section.name} transversally at t = {dt} s")
         dt = dt - g / dg
-    s, _tr = flow(params, model, s_before, dt, rtol=rtol, atol=atol, slip_band=slip_band)
+    s, _tr = flow(system, s_before, dt, rtol=rtol, atol=atol)
     miss = abs(section.g(s))
     s = s.copy()
     s[section.index] = section.value

@@ -12,10 +12,11 @@ from the vector field. The guess — the section state, the period and the scale
 the last section crossings of a run.
 
 At the converged orbit the full-state monodromy matrix ∂Φ/∂s0 (2 n_free × 2 n_free) is
-computed from the variational equations with saltation matrices (:mod:`.variational`; default)
+computed from the variational equations with saltation matrices (:mod:`.linear_flow`; default)
 or differenced once more (``monodromy="finite-difference"``); its eigenvalues are the Floquet
 multipliers. One of them is 1 (a shift along the orbit); stick phases collapse the directions
-that violate v_r = 0, which gives multipliers 0.
+that violate v_c = 0, which gives multipliers 0. Every model the simulator runs has its orbits:
+the states are the model's ``state_names``, the unknowns its free states.
 """
 from __future__ import annotations
 
@@ -28,10 +29,9 @@ import numpy as np
 from .. import __version__
 from ..integrate.driver import SimulationError, initial_state, simulate
 from ..integrate.result import Trajectory
-from ..model.kernels import DEFAULT_SLIP_BAND
-from ..model.parameters import Parameters, parameter_attrs
-from ..model.system import assemble
-from .layout import STATE_NAMES, STATE_UNITS, free_states
+from ..model.system_model import FrictionModel
+from .layout import free_states, state_units
+from .models import ModelResult, model_attrs, resolve
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
                       check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
 from .section import OrbitError, Section, land_on_section, resolve_section, section_crossings
@@ -45,13 +45,13 @@ SEARCH_TIME = 30.0
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class PeriodicOrbit(Multipliers):
+class PeriodicOrbit(ModelResult, Multipliers):
     """A periodic orbit found by :func:`periodic_orbit`.
 
     Attributes
     ----------
-    state : ndarray (N_STATES,)
-        State on the section, s = [q, q̇] [m, rad, m/s, rad/s].
+    state : ndarray (2n,)
+        State on the section, s = [q, q̇] (the model's ``state_names``).
     period : float
         Period T [s] (of ``multiplicity`` section returns).
     multiplicity : int
@@ -67,14 +67,14 @@ class PeriodicOrbit(Multipliers):
     multipliers : ndarray (2 n_free,) complex
         Floquet multipliers (eigenvalues of :attr:`monodromy`), by decreasing modulus [-].
     monodromy : ndarray (2 n_free, 2 n_free)
-        ∂Φ(s0, T)/∂s0 on the free states, in SI units, by ``options["monodromy"]``
+        ∂Φ(s0, T)/∂s0 on the free states, in the states' units, by ``options["monodromy"]``
         (``"saltation"``: variational equations with jump matrices; ``"finite-difference"``).
     free_states : tuple of str
         Names of the free states (rows/columns of :attr:`monodromy`).
     scale : ndarray (2 n_free,)
-        State scales σ used for residual and differences [SI units].
-    params : Parameters
-    model : str
+        State scales σ used for residual and differences [state units].
+    system : FrictionModel
+        The model (``params`` and ``model``: the plates' Parameters and variant, or None and the name).
     section : Section
     options : dict
         rtol, atol, tol, fd_step, slip_band, max_iter, monodromy (the method used).
@@ -91,8 +91,7 @@ class PeriodicOrbit(Multipliers):
     monodromy: np.ndarray
     free_states: tuple
     scale: np.ndarray
-    params: Parameters
-    model: str
+    system: FrictionModel
     section: Section
     options: dict
 
@@ -104,8 +103,8 @@ class PeriodicOrbit(Multipliers):
     def trajectory(self, periods: float = 1.0, sample_rate: float = 1000.0) -> Trajectory:
         """Simulate the orbit from its section state over ``periods`` periods (for plots)."""
         opt = self.options
-        return simulate(self.params, periods * self.period, model=self.model, ic=self.state,
-                        rtol=opt["rtol"], atol=opt["atol"], sample_rate=sample_rate, slip_band=opt["slip_band"])
+        return simulate(self.system, periods * self.period, ic=self.state, rtol=opt["rtol"], atol=opt["atol"],
+                        sample_rate=sample_rate)
 
     def to_xarray(self):
         """``xarray.Dataset``: section state, multipliers, monodromy; period etc. as attributes."""
@@ -113,20 +112,19 @@ class PeriodicOrbit(Multipliers):
 
         data = {
             "state_on_section": ("state", self.state, {"long_name": "state on the Poincaré section",
-                                                       "units": " ".join(STATE_UNITS)}),
+                                                       "units": " ".join(state_units(self.system))}),
             **multiplier_variables(self.multipliers, "multiplier"),
             "monodromy": (("free_state", "free_state_0"), self.monodromy,
                           {"long_name": f"monodromy matrix d s(T) / d s(0) on the free states ({self.options.get('monodromy', 'finite-difference')})",
-                           "units": "SI"}),
-            "scale": ("free_state", self.scale, {"long_name": "state scale sigma of residual and differences", "units": "SI"}),
+                           }),
+            "scale": ("free_state", self.scale, {"long_name": "state scale sigma of residual and differences"}),
             "residual_history": ("iteration", self.residual_history, {"long_name": "scaled Newton residual", "units": "1"}),
         }
-        coords = {"state": list(STATE_NAMES), "free_state": list(self.free_states),
+        coords = {"state": list(self.system.state_names), "free_state": list(self.free_states),
                   "free_state_0": list(self.free_states)}
         attrs = {
             "title": "stickslip periodic orbit (shooting on a Poincaré section)",
             "stickslip_version": __version__,
-            "model": self.model,
             "section": self.section.name,
             "period": self.period, "period_units": "s",
             "frequency": self.frequency, "frequency_units": "Hz",
@@ -136,13 +134,12 @@ class PeriodicOrbit(Multipliers):
             "iterations": self.iterations,
             "stable": int(self.stable),
             "options": json.dumps(self.options),
-            "parameters": json.dumps(self.params.to_dict()),
+            **model_attrs(self.system),
         }
-        attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _guess_from_samples(params, model, system, section, t, states, mode, multiplicity, *, rtol, atol, slip_band):
+def _guess_from_samples(system, section, t, states, mode, multiplicity, *, rtol, atol):
     """Section state, period guess and scales from sampled data: the last ``multiplicity + 1``
     crossings; the first of them is landed on exactly by re-simulation."""
     times, idx = section_crossings(system, section, t, states, mode)
@@ -154,22 +151,21 @@ def _guess_from_samples(params, model, system, section, t, states, mode, multipl
         )
     c = times.size - 1 - multiplicity
     i = max(int(idx[c]) - 1, 0)  # start one sample early, so the landing time is ≥ one interval
-    if mode[i] == 1 or mode[int(idx[c]) + 1] == 1:
+    if mode[i] != 0 or mode[int(idx[c]) + 1] != 0:
         raise OrbitError(f"section {section.name} is crossed in stick; choose a section crossed in slip")
     T0 = float(times[c + multiplicity] - times[c])
-    s0, _, miss = land_on_section(params, model, system, section, states[i], float(times[c] - t[i]),
-                                  rtol=rtol, atol=atol, slip_band=slip_band)
+    s0, _, miss = land_on_section(system, section, states[i], float(times[c] - t[i]), rtol=rtol, atol=atol)
     window = (t >= times[c]) & (t <= times[c + multiplicity])
     ptp = np.ptp(states[window], axis=0) if window.sum() > 1 else np.ptp(states, axis=0)
     return s0, T0, ptp, miss
 
 
 def periodic_orbit(
-    params: Parameters | None = None,
+    system=None,
     guess=None,
     *,
-    model="full",
-    section="phi_max",
+    model=None,
+    section="max",
     period_multiplicity: int = 1,
     rtol: float = 1e-10,
     atol: float | None = None,
@@ -177,7 +173,7 @@ def periodic_orbit(
     max_iter: int = 20,
     fd_step: float = DEFAULT_FD_STEP,
     search_time: float = SEARCH_TIME,
-    slip_band: float = DEFAULT_SLIP_BAND,
+    slip_band: float | None = None,
     monodromy: str = "saltation",
     newton_jacobian: str = "saltation",
 ) -> PeriodicOrbit:
@@ -185,18 +181,21 @@ def periodic_orbit(
 
     Parameters
     ----------
-    params : Parameters, optional
-        Physical parameters (default: those of ``guess`` if it is a Trajectory, else Table 1).
-    guess : Trajectory, array-like (N_STATES,), or "equilibrium"/"zero"
+    system : FrictionModel, Parameters, str, optional
+        The model, as :func:`stickslip.simulate` takes it: a FrictionModel, a library name or model
+        file, or the plates' Parameters (with a Trajectory ``guess``: by default its model, and plates'
+        Parameters take its variant; otherwise the plates with Table 1 by default).
+    guess : Trajectory, array-like (2n,), mapping, or "equilibrium"/"zero"
         A Trajectory near the orbit (its last ``period_multiplicity + 1`` section crossings give
-        the starting state and period), or an initial state from which a ``search_time`` run
-        is made to find them.
-    model : str
-        Model variant (ignored when ``guess`` is a Trajectory: its model is used). Only its
-        free DOFs are unknowns.
-    section : "phi_max", ("phi", level) or Section
-        Poincaré section: a maximum of φ (φ̇ = 0, φ̈ < 0; default) or an up-crossing of a level
-        [rad] of a coordinate. It must be crossed in slip.
+        the starting state and period), or an initial state (:func:`stickslip.integrate.driver.initial_state`)
+        from which a ``search_time`` run is made to find them.
+    model : str, optional
+        The plates' variant (``full`` by default), or a library name / model file as ``system``
+        (ignored when ``guess`` is a Trajectory: its model is used). Only its free DOFs are unknowns.
+    section : "max", "<dof>_max", (dof, level) or Section
+        Poincaré section: a maximum of the model's observed dof (its velocity through 0 downwards;
+        the plates' φ, default), of a named dof, or an up-crossing of a level of a dof. It must be
+        crossed in slip.
     period_multiplicity : int
         Section crossings per period (k for a period-k orbit of the return map).
     rtol, atol : float
@@ -212,11 +211,11 @@ def periodic_orbit(
         Finite-difference step relative to σ [-].
     search_time : float
         Length of the search run from a state guess [s].
-    slip_band : float
-        Low-speed band of the slip direction [m/s] (see :func:`stickslip.simulate`).
+    slip_band : float, optional
+        Low-speed band of the slip direction [m/s] (default: the model's; see :func:`stickslip.simulate`).
     monodromy : {"saltation", "finite-difference"}
         How the monodromy matrix of the converged orbit is computed: variational equations with
-        saltation matrices (:func:`stickslip.orbits.variational.monodromy`; default; falls back
+        saltation matrices (:func:`stickslip.orbits.monodromy`; default; falls back
         to finite differences with a warning if the re-integration does not reproduce the
         orbit's event sequence), or central differences of the flow map.
     newton_jacobian : {"saltation", "finite-difference"}
@@ -234,21 +233,21 @@ def periodic_orbit(
         If no crossings are found, the section is crossed in stick, or Newton does not reach
         ``tol`` within ``max_iter`` iterations (the message gives the residual history).
     """
-    if isinstance(guess, Trajectory):
-        params = guess.params if params is None else params
-        model = guess.model
-    params = Parameters() if params is None else params
+    if isinstance(guess, Trajectory) and system is None and model is None:
+        system = guess.system.with_slip_band(guess.system.slip_band if slip_band is None else slip_band)
+    elif isinstance(guess, Trajectory) and guess.is_plates and model is None:
+        system = resolve(system, guess.model, slip_band)  # the plates' parameters given: the run's variant
+    else:
+        system = resolve(system, model, slip_band)
     k = int(period_multiplicity)
     if k < 1:
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")
     check_method(monodromy)
     check_method(newton_jacobian, "newton_jacobian")
     atol = 1e-3 * rtol if atol is None else float(atol)
-    sec = resolve_section(section)
-    system = assemble(params, model, slip_band)
-    model = system.variant.name
+    sec = resolve_section(section, system)
     check_section(sec, system)
-    opts = dict(rtol=rtol, atol=atol, slip_band=slip_band)
+    opts = dict(rtol=rtol, atol=atol)
 
     if guess is None:
         raise OrbitError("give a guess: a Trajectory near the orbit or an initial state")
@@ -257,12 +256,12 @@ def periodic_orbit(
             s_init = initial_state(system, guess)
         except SimulationError as exc:
             raise OrbitError(f"bad guess: {exc}") from exc
-        guess = simulate(params, search_time, model=model, ic=s_init, sample_rate=SEARCH_RATE, **opts)
+        guess = simulate(system, search_time, ic=s_init, sample_rate=SEARCH_RATE, **opts)
         if guess.status != "success":
             raise OrbitError(f"the search run failed: {guess.status}")
-    s0, T, ptp, _ = _guess_from_samples(params, model, system, sec, guess.t, guess.states, guess.mode, k, **opts)
-    problem = ShootingProblem.build(params, model, sigma=scales(ptp, free_states(system)), section=sec, system=system,
-                                    fd_step=fd_step, **opts)
+    s0, T, ptp, _ = _guess_from_samples(system, sec, guess.t, guess.states, guess.mode, k, **opts)
+    problem = ShootingProblem.build(system, sigma=scales(ptp, free_states(system)), section=sec, fd_step=fd_step,
+                                    **opts)
     orbit = problem.newton(s0, T, tol=tol, max_iter=max_iter, method=newton_jacobian)
     method = monodromy
     if method == "saltation":
@@ -277,8 +276,8 @@ def periodic_orbit(
     return PeriodicOrbit(
         state=orbit.state, period=orbit.period, multiplicity=k, stick_phases=stick_count(orbit.transitions),
         residual=orbit.history[-1], iterations=orbit.iterations, residual_history=np.array(orbit.history),
-        multipliers=sorted_eigenvalues(M), monodromy=M, free_states=tuple(STATE_NAMES[j] for j in problem.free),
-        scale=problem.sigma, params=params, model=model, section=sec,
-        options=dict(opts, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method,
+        multipliers=sorted_eigenvalues(M), monodromy=M, free_states=tuple(system.state_names[j] for j in problem.free),
+        scale=problem.sigma, system=system, section=sec,
+        options=dict(opts, slip_band=system.slip_band, tol=tol, fd_step=fd_step, max_iter=max_iter, monodromy=method,
                      newton_jacobian=newton_jacobian),
     )

@@ -80,7 +80,7 @@ class SpecialPoint:
         Parameter value at the special point [unit of the parameter].
     period : float
         Period there [s].
-    state : ndarray (N_STATES,)
+    state : ndarray (2n,)
         State on the section there.
     multipliers : ndarray complex
         Floquet multipliers there (at the nearest evaluated point for discrete tests) [-].
@@ -282,7 +282,7 @@ def _stop_reason(found: list, stop_on) -> str | None:
 def distance_from_equilibrium(problem: Problem, state: np.ndarray, lam: float) -> float:
     """‖(s − s_eq)/σ‖ on the free states: the size of a slip cycle about the equilibrium of Eq. (14)."""
     sp = problem.shooting
-    s_eq = equilibrium_state(problem.params_at(lam), sp.model)
+    s_eq = equilibrium_state(problem.system_at(lam))
     return float(np.linalg.norm((state - s_eq)[sp.free] / sp.sigma))
 
 

@@ -15,62 +15,87 @@ import numpy as np
 
 from ..integrate.driver import SimulationError, simulate
 from ..integrate.result import Trajectory
-from ..model.kernels import DEFAULT_SLIP_BAND
-from ..model.parameters import Parameters
-from ..model.system import assemble
+from ..model.system_model import FrictionModel
 from .arclength import ContinuationError
+from .models import ModelResult, is_plates, parameter_value, plates_parameters, resolve
 from .section import OrbitError, Section, resolve_section, section_crossings
 from .shooting import PeriodicOrbit, periodic_orbit
 
-__all__ = ["start_run", "crossings_per_stick", "start_orbit_from_run", "Start", "start_orbit", "START_RUN", "START_RATE"]
+__all__ = ["start_run", "named_start", "crossings_per_stick", "start_orbit_from_run", "Start", "start_orbit", "START_RUN", "START_RATE"]
 
 #: Length [s] and sample rate [Hz] of the run from the ``far`` initial condition that gives the
 #: start orbit of each N (the stick-slip oscillation settles within ~20 s at Ω = 5 rad/s).
 START_RUN, START_RATE = 60.0, 2000.0
 
 
-def start_run(params: Parameters, ic: str = "far", *, model: str = "full", t_end: float = START_RUN,
-              rtol: float = 1e-10, slip_band: float = DEFAULT_SLIP_BAND) -> Trajectory:
+def start_run(system, ic="far", *, model=None, t_end: float = START_RUN, rtol: float = 1e-10,
+              slip_band: float | None = None) -> Trajectory:
     """A run from a named initial condition, to hand to ``continue_orbit`` as ``start``.
 
     Parameters
     ----------
-    params : Parameters
-    ic : str
-        ``far``, ``near``, ``zero`` or ``equilibrium`` (:data:`stickslip.sweep.NAMED_ICS`).
-    model : str
+    system : FrictionModel, Parameters, str
+        The model (as :func:`stickslip.simulate` takes it; ``model``: the plates' variant).
+    ic : str, array-like (2n,) or mapping
+        ``zero``, ``equilibrium``, ``near`` (the equilibrium, the observed dof moved by 1e-3), the
+        plates' ``far`` (:data:`stickslip.sweep.NAMED_ICS`), or a state as ``simulate`` takes it.
+    model : str, optional
     t_end : float
         Run length [s]; the orbit guess is taken from its last section crossings.
     rtol : float
         Integration tolerance (``atol`` = 1e-3 rtol).
-    slip_band : float
-        Low-speed band of the slip direction [m/s] (see :func:`stickslip.simulate`).
+    slip_band : float, optional
+        Low-speed band of the slip direction [m/s] (default: the model's).
     """
-    from ..sweep.spec import initial_condition
-
-    state, pert = initial_condition(ic, params, model)
-    run = simulate(params, t_end, model=model, ic=state, perturbation=pert, sample_rate=START_RATE,
-                   rtol=rtol, atol=1e-3 * rtol, slip_band=slip_band)
+    system = resolve(system, model, slip_band)
+    state, pert = named_start(system, ic)
+    try:
+        run = simulate(system, t_end, ic=state, perturbation=pert, sample_rate=START_RATE, rtol=rtol,
+                       atol=1e-3 * rtol)
+    except SimulationError as exc:
+        raise ContinuationError(f"the start run from ic {ic!r} failed: {exc}") from exc
     if run.status != "success":
         raise ContinuationError(f"the start run from ic {ic!r} failed: {run.status}")
     return run
 
 
-def crossings_per_stick(run: Trajectory, section="phi_max") -> int:
+def named_start(system: FrictionModel, ic):
+    """(ic, perturbation) arguments of :func:`stickslip.simulate` for the start ``ic`` of ``system``:
+    ``zero``, ``equilibrium``, ``near`` (the equilibrium, the observed dof moved by
+    :data:`~stickslip.sweep.spec.NEAR_PERTURBATION`), the plates' ``far``, or a state as ``simulate``
+    takes it (returned as it is).
+
+    Raises
+    ------
+    ContinuationError
+        For ``far`` on a model other than the plates.
+    """
+    from ..sweep.spec import NEAR_PERTURBATION, initial_condition
+
+    if is_plates(system) and isinstance(ic, str):
+        return initial_condition(ic, plates_parameters(system), ModelResult.label(system))
+    if isinstance(ic, str) and ic == "far":
+        raise ContinuationError(f"ic 'far' is the plates' start; for model {system.name!r} use zero, equilibrium, "
+                                "near or a state (NAME=VALUE,...)")
+    return ("equilibrium", NEAR_PERTURBATION) if isinstance(ic, str) and ic == "near" else (ic, None)
+
+
+def crossings_per_stick(run: Trajectory, section="max") -> int:
     """Section crossings between the last two stick onsets of a run (≥ 1): the period
     multiplicity to shoot with when the orbit has one stick phase per period (at low N the
-    stick-slip orbit of Model 1 has several maxima of φ per period)."""
-    sec = resolve_section(section)
-    onsets = run.transitions.time[run.transitions.kind == 1]
+    stick-slip orbit of Model 1 has several maxima of φ per period). With several contacts the
+    stick onsets of contact 0 count."""
+    sec = resolve_section(section, run.system)
+    tr = run.transitions
+    onsets = tr.time[(tr.kind == 1) & (tr.contact == 0)]
     if onsets.size < 2:
         return 1
-    system = assemble(run.params, run.model)
-    times, _ = section_crossings(system, sec, run.t, run.states, run.mode)
+    times, _ = section_crossings(run.system, sec, run.t, run.states, run.mode)
     return max(int(np.sum((times > onsets[-2]) & (times <= onsets[-1]))), 1)
 
 
-def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e-10, atol: float | None = None,
-                         slip_band: float = DEFAULT_SLIP_BAND) -> PeriodicOrbit:
+def start_orbit_from_run(run: Trajectory, *, section="max", rtol: float = 1e-10, atol: float | None = None,
+                         slip_band: float | None = None) -> PeriodicOrbit:
     """Shoot the stick-slip orbit a run has settled on, with one stick onset per period.
 
     The period multiplicity is :func:`crossings_per_stick`. Where some section crossings lie in
@@ -83,7 +108,8 @@ def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e
         If no cut gives a converged orbit.
     """
     k = crossings_per_stick(run, section)
-    onsets = run.transitions.time[run.transitions.kind == 1]
+    tr = run.transitions
+    onsets = tr.time[(tr.kind == 1) & (tr.contact == 0)]
     span = float(onsets[-1] - onsets[-2]) if onsets.size >= 2 else 1.0
     cut_step = max(int(round(span / (run.t[1] - run.t[0]) / (4 * k))), 1)  # a quarter of a crossing interval
     error = None
@@ -91,7 +117,7 @@ def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e
         m = run.t.size - cut * cut_step
         part = dataclasses.replace(run, t=run.t[:m], states=run.states[:m], mode=run.mode[:m])
         try:
-            return periodic_orbit(run.params, part, section=section, rtol=rtol, atol=atol, period_multiplicity=k,
+            return periodic_orbit(None, part, section=section, rtol=rtol, atol=atol, period_multiplicity=k,
                                   slip_band=slip_band)
         except OrbitError as exc:
             error = exc
@@ -101,15 +127,14 @@ def start_orbit_from_run(run: Trajectory, *, section="phi_max", rtol: float = 1e
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class Start:
+class Start(ModelResult):
     """What a branch keeps of its start orbit (journaled, so a resumed run needs no shooting)."""
 
-    state: np.ndarray  # (N_STATES,) on the section [SI]
+    state: np.ndarray  # (2n,) on the section
     period: float  # [s]
     stick_phases: int
-    scale: np.ndarray  # σ of the free states [SI]
-    params: Parameters
-    model: str
+    scale: np.ndarray  # σ of the free states
+    system: FrictionModel
     section: Section
     options: dict  # rtol, atol, slip_band
 
@@ -119,11 +144,11 @@ class Start:
         o = orbit.options
         return cls(state=np.asarray(orbit.state, dtype=float), period=float(orbit.period),
                    stick_phases=int(orbit.stick_phases), scale=np.asarray(orbit.scale, dtype=float),
-                   params=orbit.params, model=orbit.model, section=orbit.section,
+                   system=orbit.system, section=orbit.section,
                    options={"rtol": o["rtol"], "atol": o["atol"], "slip_band": o["slip_band"]})
 
 
-def start_orbit(params, param, start, model, section, rtol, atol, slip_band) -> PeriodicOrbit:
+def start_orbit(system: FrictionModel, param, start, section, rtol, atol) -> PeriodicOrbit:
     """The periodic orbit ``start`` is, or that a run ``start`` settled on, or that shooting from
     the state ``start`` finds (the ``start`` argument of ``continue_orbit``).
 
@@ -136,8 +161,9 @@ def start_orbit(params, param, start, model, section, rtol, atol, slip_band) -> 
         return start
     try:
         if isinstance(start, Trajectory):  # one stick onset per period (several φ maxima at low N)
-            run = start if start.params == params else dataclasses.replace(start, params=params)
-            return start_orbit_from_run(run, section=section, rtol=rtol, atol=atol, slip_band=slip_band)
-        return periodic_orbit(params, start, model=model, section=section, rtol=rtol, atol=atol, slip_band=slip_band)
+            run = start if start.system is system else dataclasses.replace(start, system=system)
+            return start_orbit_from_run(run, section=section, rtol=rtol, atol=atol)
+        return periodic_orbit(system, start, section=section, rtol=rtol, atol=atol)
     except (OrbitError, SimulationError) as exc:
-        raise ContinuationError(f"no periodic orbit to start from at {param} = {getattr(params, param):g}: {exc}") from exc
+        raise ContinuationError(f"no periodic orbit to start from at {param} = {parameter_value(system, param):g}: "
+                                f"{exc}") from exc

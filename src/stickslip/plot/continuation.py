@@ -36,7 +36,8 @@ def _branch_data(branch) -> dict:
         return {"param": branch.param, "value": branch.values, "period": branch.periods,
                 "amplitude": branch.amplitude, "stick_time": branch.stick_time, "stable": branch.stable.astype(bool),
                 "special": [(p.kind, p.index, p.value) for p in sp], "model": branch.model,
-                "N": branch.params.N, "Omega": branch.params.Omega, "stop_reason": branch.stop_reason}
+                "N": getattr(branch.params, "N", None), "Omega": getattr(branch.params, "Omega", None),
+                "stop_reason": branch.stop_reason}
     ds = branch
     return {"param": ds.attrs["param"], "value": ds["value"].values, "period": ds["period"].values,
             "amplitude": ds["amplitude"].values, "stick_time": ds["stick_time"].values,

@@ -26,6 +26,12 @@ def _figure_axes(ax, figsize):
     return plt.subplots(figsize=figsize, constrained_layout=True)
 
 
+def _model_text(result) -> str:
+    """The model of an orbit result: the plates' variant with N and Ω, or the model's name."""
+    p = result.params
+    return result.model if p is None else f"{result.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s"
+
+
 def plot_lyapunov_convergence(results, labels=None, ax=None):
     """Running estimate of λ_max against averaging time, one curve per result.
 
@@ -41,7 +47,7 @@ def plot_lyapunov_convergence(results, labels=None, ax=None):
     """
     if not isinstance(results, (list, tuple)):
         results = [results]
-    labels = labels or [f"{r.model}, N = {r.params.N:g} N, Ω = {r.params.Omega:g} rad/s" for r in results]
+    labels = labels or [_model_text(r) for r in results]
     fig, ax = _figure_axes(ax, (6.4, 3.6))
     for r, lab in zip(results, labels):
         ax.plot(r.time, r.estimate, label=f"{lab}: λ = {r.exponent:.4f} ± {r.standard_error:.4f} 1/s")
@@ -86,8 +92,7 @@ def plot_lyapunov_spectrum(spectrum, reference=None, n_show=None, ax=None):
             if v > SHOWN_ABOVE:
                 ax.axhline(v, color="0.4", lw=0.6, ls="--")
     ax.axhline(0.0, color="k", lw=0.6)
-    p = spectrum.params
-    title = (f"model {spectrum.model}, N = {p.N:g} N, Ω = {p.Omega:g} rad/s: averaged over "
+    title = (f"model {_model_text(spectrum)}: averaged over "
              f"{spectrum.time[-1]:g} s after a {spectrum.t_transient:g} s transient")
     if len(order) < spectrum.exponents.size:
         title += f"\n({left_out})"
@@ -100,7 +105,7 @@ def plot_lyapunov_spectrum(spectrum, reference=None, n_show=None, ax=None):
 
 
 def plot_orbit(orbit, traj, ax=None):
-    """φ over one period of a periodic orbit, stick phases shaded.
+    """The observed coordinate (the plates' φ) over one period of a periodic orbit, stick phases shaded.
 
     Parameters
     ----------
@@ -115,10 +120,12 @@ def plot_orbit(orbit, traj, ax=None):
     """
     fig, ax = _figure_axes(ax, (6.4, 3.6))
     _shade_stick(ax, stick_intervals(traj.t, traj.mode), traj.t[0], traj.t[-1])
-    ax.plot(traj.t, traj.states[:, 4], color="tab:blue", lw=1.2, label="φ")
+    j = orbit.system.observed_index
+    name = orbit.system.dofs[j]
+    ax.plot(traj.t, traj.states[:, j], color="tab:blue", lw=1.2, label="φ" if name == "phi" else name)
     ax.set_xlim(0.0, orbit.period)
     ax.set_xlabel("time from the section [s]")
-    ax.set_ylabel("φ [rad]")
+    ax.set_ylabel(f"{'φ' if name == 'phi' else name} [{orbit.system.units.get(name, '-')}]")
     ax.set_title(f"T = {orbit.period:.6g} s ({orbit.frequency:.6g} Hz), {orbit.stick_phases} stick phase(s)",
                  fontsize=9)
     ax.legend(fontsize=7, loc="best")
@@ -180,9 +187,7 @@ def save_orbit_figure(orbit, traj, path, *, dpi: int = 110) -> Path:
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained", width_ratios=(1.6, 1.0))
     plot_orbit(orbit, traj, axes[0])
     plot_multipliers(orbit, axes[1])
-    p = orbit.params
-    fig.suptitle(f"Periodic orbit, model {orbit.model}: N = {p.N:g} N, Ω = {p.Omega:g} rad/s, "
-                 f"section {orbit.section.name}", fontsize=10)
+    fig.suptitle(f"Periodic orbit, model {_model_text(orbit)}, section {orbit.section.name}", fontsize=10)
     return _save(fig, path, dpi)
 
 

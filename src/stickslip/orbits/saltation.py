@@ -1,0 +1,245 @@
+"""Jump matrices of the variations at the transitions of any friction-contact model.
+
+Each is built from the one generic definition: the vector fields f⁻, f⁺ are the right-hand side
+:func:`stickslip.model.physics.rhs` in the modes before and after, and the event gradients are
+complex steps of the contact's slip velocity, friction and normal force
+(:func:`.var_kernels.contact_gradients`). With h the event function of the transition,
+
+    S = I + (f⁺ − f⁻) ∇hᵀ / (∇h · f⁻)                                   (saltation matrix)
+
+* **stick → slip** of contact c (:func:`breakaway_jump`): h = μs N_c − |F_c|, F_c the stick
+  multiplier solved with the other sticking contacts; f⁺ slips along e = −F_c/|F_c|.
+* **leaving the low-speed band** of a 2-D contact (:func:`band_exit_jump`): h = |v_c| − band,
+  f⁻ with the quasi-static direction, f⁺ with the exact one.
+* **slip → stick of a 1-D contact** (:func:`arrival_jump` with ``dim`` 1): h = e·v_c. Since
+  ∇h·f⁺ = dv_c/dt in stick = 0, S maps every variation onto ∇h·δs = 0, the stick manifold; the
+  linearised projection :func:`stick_projection` after it only removes round-off.
+* **slip → stick of a 2-D contact** (``dim`` 2; the integration stops at |v_c| = ρ_c): the
+  friction direction's dynamics remove the variation β = u·δv_c transverse to the arrival
+  direction e through a friction impulse B u J, J = −β/(uᵀ A u) (A = G_c M̃⁻¹ G_cᵀ, B = [0; M̃⁻¹ G_cᵀ],
+  M̃⁻¹ the inverse mass with the other sticking contacts held); then the rest of the approach to
+  first order, I + τ J_reg (τ = ρ_c / (−e·v̇_c), J_reg the Jacobian with the direction frozen);
+  then S with h = e·v_c; then the projection onto the stick manifold. docs/orbits.md derives it.
+* **velocity reversal** (v_c reaches 0 where stick cannot hold, so slip departs again along the
+  breakaway direction, not a recorded transition): the same without projection and with f⁺ the
+  departing slip field.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..integrate import contacts as E
+from ..model import physics as P
+from ..model.bundle import CST
+from ..model.derivatives import state_jacobian
+from ..model.friction import static_coefficient
+from .section import OrbitError
+from .var_kernels import contact_gradients
+
+__all__ = ["saltation_matrix", "field", "ContactState", "contact_at", "stick_projection", "breakaway_jump",
+           "band_exit_jump", "arrival_jump", "inverse_mass", "sticking", "with_mode"]
+
+
+def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray) -> np.ndarray:
+    """S = I + (f⁺ − f⁻) ∇hᵀ / (∇h · f⁻) (2n × 2n) for a transversal crossing of h(s) = 0.
+
+    Parameters
+    ----------
+    f_minus, f_plus : ndarray (2n,)
+        Vector fields before and after the event at the event state [state units / s].
+    grad_h : ndarray (2n,)
+        Gradient of the event function [unit of h per state unit].
+
+    Raises
+    ------
+    OrbitError
+        If the crossing is tangential (∇h · f⁻ = 0): no saltation matrix exists (grazing).
+    """
+    rate = float(grad_h @ f_minus)
+    if rate == 0.0 or not np.isfinite(rate):
+        raise OrbitError("tangential event crossing (dh/dt = 0): grazing, no saltation matrix")
+    return np.eye(f_minus.size) + np.outer(f_plus - f_minus, grad_h) / rate
+
+
+def field(system, s: np.ndarray, cst: np.ndarray) -> np.ndarray:
+    """Right-hand side f(s) (2n,) in the modes of ``cst`` [state units / s]."""
+    ds = np.zeros(2 * system.n)
+    P.rhs(np.ascontiguousarray(s[:2 * system.n], dtype=float), cst, system.data, ds)
+    return ds
+
+
+def with_mode(cst: np.ndarray, c: int, mode: int, e=(1.0, 0.0)) -> np.ndarray:
+    """A copy of the contact states with contact ``c`` in ``mode`` along the direction ``e``."""
+    out = cst.copy()
+    out[CST * c] = mode
+    out[CST * c + 1] = e[0]
+    out[CST * c + 2] = e[1]
+    out[CST * c + 3] = np.inf
+    return out
+
+
+def sticking(cst: np.ndarray, exclude: int = -1) -> list[int]:
+    """Contacts that stick in ``cst``, without ``exclude``."""
+    return [c for c in range(cst.size // CST) if int(cst[CST * c]) == P.MODE_STICK and c != exclude]
+
+
+class ContactState:
+    """One contact at a state: values and complex-step gradients (module docstring).
+
+    Attributes
+    ----------
+    v, F : ndarray (2,)
+        Slip velocity [m/s] and friction force [N] (the stick multiplier if it sticks).
+    N : float
+        Normal force [N].
+    Dv, DF : ndarray (2, 2n)
+        ∂v/∂s and ∂F/∂s.
+    DN : ndarray (2n,)
+        ∂N/∂s.
+    """
+
+    def __init__(self, system, s, cst, c):
+        n2 = 2 * system.n
+        nc = system.n_contacts
+        s = np.ascontiguousarray(s[:n2], dtype=float)
+        F = np.empty(2 * nc)
+        N = np.empty(nc)
+        v = np.empty(2 * nc)
+        P.contact_forces(s, cst, system.data, F, N, v)
+        self.v, self.F, self.N = v[2 * c:2 * c + 2].copy(), F[2 * c:2 * c + 2].copy(), float(N[c])
+        self.Dv, self.DF, self.DN = np.empty((2, n2)), np.empty((2, n2)), np.empty(n2)
+        contact_gradients(s, cst, c, system.data, n2, self.Dv, self.DF, self.DN, np.empty(n2, complex),
+                          np.empty(2 * nc, complex), np.empty(nc, complex), np.empty(2 * nc, complex))
+        self.dim = system.contacts[c].dim
+
+
+def contact_at(system, s, cst, c) -> ContactState:
+    """:class:`ContactState` of contact ``c`` at ``s`` in the modes of ``cst``."""
+    return ContactState(system, s, cst, c)
+
+
+def inverse_mass(system) -> np.ndarray:
+    """M⁻¹ (n × n) on the free DOFs, zero rows and columns for the locked ones."""
+    free = np.flatnonzero(system.free)
+    Minv = np.zeros((system.n, system.n))
+    Minv[np.ix_(free, free)] = np.linalg.inv(system.mass[np.ix_(free, free)])
+    return Minv
+
+
+def _rows(system, s, cst, contacts) -> np.ndarray:
+    """∂v/∂s of the given contacts, stacked (k × 2n; one row per slip direction)."""
+    rows = [contact_at(system, s, cst, c).Dv[:system.contacts[c].dim] for c in contacts]
+    return np.concatenate(rows) if rows else np.zeros((0, 2 * system.n))
+
+
+def _held_inverse_mass(system, Minv, Dv_held) -> np.ndarray:
+    """M̃⁻¹ = M⁻¹ − M⁻¹ G_Sᵀ (G_S M⁻¹ G_Sᵀ)⁺ G_S M⁻¹: the response to a force with the contacts S held."""
+    if Dv_held.shape[0] == 0:
+        return Minv
+    n = system.n
+    G = Dv_held[:, n:]
+    A = G @ Minv @ G.T
+    return Minv - Minv @ G.T @ np.linalg.pinv(A, rcond=P.RANK_TOL, hermitian=True) @ G @ Minv
+
+
+def stick_projection(system, s: np.ndarray, cst: np.ndarray) -> np.ndarray:
+    """Linearised projection onto the stick manifold of the sticking contacts of ``cst`` (2n × 2n):
+    P = I − [0; M⁻¹ G_Sᵀ A⁺ ∂v_S/∂s], the derivative of :func:`stickslip.model.physics.project_velocities`
+    on v_S = 0 (A = G_S M⁻¹ G_Sᵀ, minimal-norm inverse where it is rank-deficient)."""
+    n = system.n
+    Dv = _rows(system, s, cst, sticking(cst))
+    out = np.eye(2 * n)
+    if Dv.shape[0] == 0:
+        return out
+    Minv = inverse_mass(system)
+    G = Dv[:, n:]
+    A = G @ Minv @ G.T
+    out[n:] -= Minv @ G.T @ np.linalg.pinv(A, rcond=P.RANK_TOL, hermitian=True) @ Dv
+    return out
+
+
+def breakaway_jump(system, s_b: np.ndarray, cst: np.ndarray, c: int):
+    """Saltation matrix (2n × 2n) at stick → slip of contact ``c`` at ``s_b`` (``cst``: c sticks),
+    h = μs N_c − |F_c|, after the projection onto the stick manifold (removes constraint drift of
+    the stick variations). Returns (S, the contact states after: c slips along −F_c/|F_c|)."""
+    k = contact_at(system, s_b, cst, c)
+    mu_s = static_coefficient(system.contacts[c].friction.row())
+    norm = float(np.hypot(*k.F))
+    e = E.breakaway_direction(k.F[0], k.F[1], k.dim)
+    grad_h = mu_s * k.DN - (k.F @ k.DF) / norm
+    after = with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, e)
+    S = saltation_matrix(field(system, s_b, cst), field(system, s_b, after), grad_h)
+    return S @ stick_projection(system, s_b, cst), after
+
+
+def band_exit_jump(system, s: np.ndarray, cst: np.ndarray, c: int):
+    """Saltation matrix (2n × 2n) where 2-D contact ``c`` leaves the low-speed band (h = |v_c| − band):
+    the slip force switches from the quasi-static to the exact direction. Returns (S, contact states after)."""
+    k = contact_at(system, s, cst, c)
+    speed = float(np.hypot(*k.v))
+    grad_h = (k.v / speed) @ k.Dv
+    after = with_mode(cst, c, P.MODE_SLIP_EXACT, tuple(k.v / speed))
+    return saltation_matrix(field(system, s, cst), field(system, s, after), grad_h), after
+
+
+def arrival_jump(system, s_c: np.ndarray, cst: np.ndarray, c: int, s_stick: np.ndarray, departure=None):
+    """Jump matrix (2n × 2n) of the variations at slip → stick of contact ``c`` (module docstring).
+
+    Parameters
+    ----------
+    s_c : ndarray (2n,)
+        Where the re-integration stopped: v_c = 0 (1-D contact) or |v_c| = ρ_c (2-D).
+    cst : ndarray
+        Contact states before (c slipping).
+    s_stick : ndarray (2n,)
+        The event integrator's state at the onset of stick (on the stick manifold).
+    departure : tuple, optional
+        For a velocity reversal, the breakaway direction e_b along which slip departs again: f⁺ is
+        that slip field and there is no projection.
+
+    Returns
+    -------
+    jump : ndarray (2n × 2n)
+    after : ndarray
+        Contact states after (c sticks, or slips along ``departure``).
+    """
+    n2 = 2 * system.n
+    k = contact_at(system, s_c, cst, c)
+    after = (with_mode(cst, c, P.MODE_STICK, (0.0, 0.0)) if departure is None
+             else with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, departure))
+    f_minus = field(system, s_c, cst)
+    f_plus = field(system, s_c, after)
+    pre = np.eye(n2)
+    if k.dim == 1:
+        e = np.array([float(cst[CST * c + 1]), 0.0])
+        grad_h = e @ k.Dv
+    else:
+        speed = float(np.hypot(*k.v))
+        e = k.v / speed
+        u = np.array([-e[1], e[0]])
+        n = system.n
+        Minv = _held_inverse_mass(system, inverse_mass(system), _rows(system, s_c, cst, sticking(cst, c)))
+        G = k.Dv[:, n:]
+        A = G @ Minv @ G.T
+        B = np.zeros((n2, 2))
+        B[n:] = Minv @ G.T
+        grad_h = e @ k.Dv
+        auu = float(u @ A @ u)
+        if auu > P.RANK_TOL * np.trace(A):  # rank 1: friction cannot act along u, and β ≡ 0
+            pre = pre - np.outer(B @ u, u @ k.Dv) / auu
+        approach = -float(grad_h @ f_minus)  # −e·dv/dt > 0 on an approach
+        if not approach > 0.0:
+            raise OrbitError("the slip velocity does not head into zero at the stick arrival (grazing); "
+                             "no saltation matrix")
+        mu = -float(e @ k.F) / k.N  # the friction coefficient at |v_c|
+        J = np.empty((n2, n2))
+        state_jacobian(np.ascontiguousarray(s_c[:n2], dtype=float), cst, system.data, J,
+                       np.empty(n2, complex), np.empty(n2, complex))
+        # the slip Jacobian without the rotation of the friction direction, −μN (I − e eᵀ)/|v| ∂v/∂s
+        J_reg = J + B @ (mu * k.N / speed * (np.eye(2) - np.outer(e, e))) @ k.Dv
+        pre = (np.eye(n2) + speed / approach * J_reg) @ pre
+    S = saltation_matrix(f_minus, f_plus, grad_h)
+    if departure is not None:
+        return S @ pre, after
+    return stick_projection(system, s_stick, after) @ S @ pre, after
