@@ -31,8 +31,11 @@ MAX_SAMPLES = 20_000_000
 #: two plates only.
 METHODS = ("event", "aeom", "naeom")
 
-#: Wall-clock length [s] a chunk of the compiled loop aims at: Ctrl-C is answered between chunks.
-CHUNK_WALL = 0.25
+#: Steps (accepted and rejected) a chunk of the compiled loop aims at: Ctrl-C is answered between
+#: chunks, after about 0.1 s (the plates take ~1 µs a step). Chunk lengths follow from step
+#: counts, not from wall time, so a run's chunks, and with them the round-off of its local
+#: times, are the same however loaded the machine is: the same inputs give the same result.
+CHUNK_STEPS = 100_000
 #: Simulated time [s] of the first chunk, before its speed is known.
 FIRST_CHUNK = 20.0
 
@@ -208,7 +211,7 @@ def _warm_up(system: FrictionModel, y: np.ndarray, rtol, atol) -> float:
 
 def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
                rtol: float, atol: float, dt: float | None, max_steps: int):
-    """The ``event`` method, in chunks of about :data:`CHUNK_WALL` seconds of wall time.
+    """The ``event`` method, in chunks of about :data:`CHUNK_STEPS` steps.
 
     Each chunk integrates in its own local time from the previous chunk's end (absolute time
     never enters a step or an event tolerance, so runs of any length keep their resolution) and
@@ -246,7 +249,6 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
             tau_stop = min(chunk, tau_end)
             start_state = (y.copy(), cst.copy(), h, idx)
             capacity = None
-            wall = time.perf_counter()
             while True:
                 tr = _Buffers.transition_room(tau_stop, ns, capacity)
                 res = integrate_event(y, cst, t, tau_stop, tau_end, md, rtol, atol, h, h_max, steps_left, sample_times,
@@ -256,14 +258,14 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
                     break
                 capacity = n_tr  # rerun this chunk from its start with room for all its transitions
                 y, cst, h, idx = start_state[0].copy(), start_state[1].copy(), start_state[2], start_state[3]
-            wall = time.perf_counter() - wall
             status, tau, y, h, idx, _, st, lost = res
             buffers.add_transitions(tr, n_tr)
             stats += st
             steps_left = max_steps - int(stats[0] + stats[1])
             t = t + tau
-            if tau > 0.0 and wall > 0.0:  # aim the next chunk at CHUNK_WALL seconds of wall time
-                chunk = min(max(tau * CHUNK_WALL / wall, 1e-3), 10.0 * max(tau, 1e-3))
+            taken = int(st[0] + st[1])
+            if tau > 0.0 and taken > 0:  # aim the next chunk at CHUNK_STEPS steps
+                chunk = min(max(tau * CHUNK_STEPS / taken, 1e-3), 10.0 * max(tau, 1e-3))
         interrupted = stop.requested and status == CHUNK_END
     if stop.requested and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
         raise KeyboardInterrupt
