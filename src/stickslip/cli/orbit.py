@@ -18,6 +18,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..files import atomic_write
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
                    check_choice, check_outputs, check_positive, check_samples, console)
 from .simulate import _parse_ic
@@ -124,7 +125,8 @@ def orbit_command(
     stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
                        one_period.transitions.kind)
     out.parent.mkdir(parents=True, exist_ok=True)
-    orbit.to_xarray().to_netcdf(out, engine="h5netcdf")
+    ds = orbit.to_xarray()
+    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
     figure = None
     if not no_plot:
         from ..plot.orbits import save_orbit_figure
@@ -191,7 +193,8 @@ def lyapunov_command(
     spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average,
                                  perturbation=perturbation, rtol=rtol, method=method)
     out.parent.mkdir(parents=True, exist_ok=True)
-    spectrum.to_xarray().to_netcdf(out, engine="h5netcdf")
+    ds = spectrum.to_xarray()
+    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
     figure = None
     if not no_plot:
         from ..plot.orbits import save_lyapunov_spectrum_figure

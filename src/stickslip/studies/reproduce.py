@@ -60,7 +60,7 @@ class Resolution:
     fig10_N: tuple               # normal loads of Fig. 10 [N]
     fig12_N: int                 # points of the Fig. 12(a) sweep over 10–130 N
     fig12_t_end: float
-    workers: int = 2
+    workers: int | None = None   # worker processes (None: every CPU this process may use)
     executor: str = "processes"
     # Figs. 8, 9, 16: region maps over N in [10, 130] N × Ω in [1, 15] rad/s, two ICs, all four models
     regions_N: int = 100
