@@ -1,6 +1,6 @@
 """The paper's Appendix (A.2) matrices C_L and K_L, transcribed entry by entry as printed.
 
-Used only as a cross-check of the complex-step linearisation (DESIGN.md §1.3). The printed
+Used only as a cross-check of the complex-step linearisation. The printed
 entries are kept verbatim here, typos included; ``corrected=True`` applies the
 corrections documented in docs/stability.md. Row/column order of the printed matrices is
 (x1, y1, x2, y2, φ, ψ), the order of q (the printed M_L = diag(m_p, m_p, J_p, m_d, m_d, J_d)

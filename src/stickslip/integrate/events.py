@@ -1,4 +1,4 @@
-"""Transition logic shared by all integrators (DESIGN.md §1, "Transitions").
+"""Transition logic shared by all integrators.
 
 Event functions are evaluated on a state vector; the root finder works on any callable-free
 "dense output" described by a polynomial ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1]
@@ -265,7 +265,7 @@ def slip_event_possible(g0, dg0, g1, dg1):
 
 @kernel
 def breakaway_direction(Fx, Fy):
-    """Slip direction at breakaway e = −F_stick/|F_stick| (DESIGN.md §1)."""
+    """Slip direction at breakaway e = −F_stick/|F_stick| (docs/numerics.md)."""
     norm = math.sqrt(Fx * Fx + Fy * Fy)
     if norm == 0.0:
         return 1.0, 0.0

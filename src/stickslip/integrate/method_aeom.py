@@ -15,7 +15,7 @@ constraint (Eq. 11, lines 3–4). That elimination is exactly the multiplier sol
 above: no second copy of the model. What is specific to AEOM, and kept, is that x2, y2 are *not*
 integrated by RK4 but by the trapezoidal rule (Eqs. 11–12), with its O(Δt²) error.
 
-Model variants (DESIGN.md §1.1). The trick eliminates x2 (y2) through the x (y) component of
+Model variants. The trick eliminates x2 (y2) through the x (y) component of
 v_r = 0; a locked x2 or y2 (zero inverse mass) cannot absorb its component. Our choice:
 
 * x2 and y2 free (Model 1): Eq. (12) as printed (the two trapezoidal relations are coupled
@@ -24,7 +24,7 @@ v_r = 0; a locked x2 or y2 (zero inverse mass) cannot absorb its component. Our 
   one, with the locked one at 0 (w = y2 − y1 = −y1, or u = −x1); the other component of
   v_r = 0 is carried by the constrained accelerations of the remaining DOFs;
 * neither free (Model 4, and custom models without x2, y2): there is nothing to eliminate, the
-  stick phase is RK4 on the constrained dynamics (rank-1 multiplier, DESIGN.md §1.2).
+  stick phase is RK4 on the constrained dynamics (rank-1 multiplier, rank-deficient G M⁻¹ Gᵀ).
 
 Whenever a component of v_r = 0 is not enforced by construction (the last two cases), the
 velocities are projected onto v_r = 0 in the M-metric after the step (``kernels.project_velocity``,

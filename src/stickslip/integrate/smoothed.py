@@ -1,4 +1,4 @@
-"""Independent reference: smoothed friction integrated by scipy (verification layer 4, DESIGN.md §4).
+"""Independent reference: smoothed friction integrated by scipy.
 
 The slip law Eq. (3) is regularised as F = −μ(|v_r|) N v_r / √(|v_r|² + ε²), which removes stick
 (the regularised solution creeps at |v_r| ~ ε instead) and turns the system into one smooth,

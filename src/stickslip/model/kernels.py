@@ -3,12 +3,12 @@
 All kernels are module-level functions on flat float64 arrays:
 
 ``s``      state (≥ 12): q = [x1, y1, x2, y2, φ, ψ] then dq/dt; extra entries are ignored.
-``minv``   (6,) inverse masses/inertias, 0 for a locked DOF (DESIGN.md §1.1).
+``minv``   (6,) inverse masses/inertias, 0 for a locked DOF.
 ``damp``   (6,) viscous damping, diagonal of C.
 ``stiff``  (6,) stiffness, diagonal of K.
 ``p``      (8,) contact and friction data, indexed by the ``P_*`` constants.
 
-The model in matrix form (DESIGN.md §1): M q̈ = f + Gᵀ F, f = −C q̇ − K q, with the 2×6
+The model in matrix form: M q̈ = f + Gᵀ F, f = −C q̇ − K q, with the 2×6
 contact Jacobian
 
     G = [[1, 0, −1,  0, −r sin φ,  Y],
@@ -51,8 +51,8 @@ SPEED_FLOOR = 1e-13
 #: (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
 DEFAULT_SLIP_BAND = 5e-4
 
-#: Relative size below which the smaller eigenvalue of G M⁻¹ Gᵀ counts as zero (rank 1,
-#: DESIGN.md §1.2). In Model 4 it is exactly 0 up to round-off (~1e-16 relative).
+#: Relative size below which the smaller eigenvalue of G M⁻¹ Gᵀ counts as zero (rank 1, as in
+#: Model 4, where it is exactly 0 up to round-off, ~1e-16 relative).
 RANK_TOL = 1e-10
 
 #: Largest angle [rad] that :func:`rotated` turns by with its Taylor series (sin a to a⁹, cos a
@@ -203,7 +203,7 @@ def constraint_metric_at(sphi, cphi, X, Y, minv, p):
 def stick_force(s, minv, damp, stiff, p):
     """Friction force that keeps v_r = 0, the Lagrange multiplier of the stick constraint [N].
 
-    From dv_r/dt = G q̈ + h = 0 with M q̈ = f + Gᵀ F (DESIGN.md §1):
+    From dv_r/dt = G q̈ + h = 0 with M q̈ = f + Gᵀ F (docs/numerics.md):
     (G M⁻¹ Gᵀ) F = −(h + G M⁻¹ f), h = Ġ q̇ + Ω d(Y, −X)/dt, solved minimal-norm (rank-1 safe).
     Returns (Fx, Fy, rank).
     """
@@ -445,7 +445,7 @@ def _kinetic_energy(s, minv):
 
 @kernel
 def project_velocity(s, minv, p):
-    """Project q̇ onto v_r = 0 in the M-metric, in place (DESIGN.md §1); returns ΔE_kin [J].
+    """Project q̇ onto v_r = 0 in the M-metric, in place (docs/numerics.md); returns ΔE_kin [J].
 
     Δq̇ = −M⁻¹ Gᵀ (G M⁻¹ Gᵀ)⁺ v_r, the smallest kinetic-energy change that removes v_r: an
     impulsive friction force Gᵀλ that stops the residual slip (a perfectly plastic tangential

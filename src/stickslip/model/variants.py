@@ -1,7 +1,7 @@
 """Model variants as locked degrees of freedom (paper Sect. 4.2.3, Models 1–4).
 
-A locked DOF gets zero inverse mass and a zero state, so the same kernels serve every variant
-(DESIGN.md §1.1). Besides the paper's four, any subset of DOFs may be freed, e.g. ``("phi",)``:
+A locked DOF gets zero inverse mass and a zero state, so the same kernels serve every variant.
+Besides the paper's four, any subset of DOFs may be freed, e.g. ``("phi",)``:
 the upper plate rotating against a rigidly driven lower plate, the 1-DOF belt oscillator.
 """
 
