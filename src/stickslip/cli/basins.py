@@ -69,7 +69,7 @@ def basins(
     no_confirm: bool = typer.Option(False, "--no-confirm", help="Do not shoot orbits to confirm periods of "
                                     "several maxima (such runs stay unsettled)."),
     lyapunov: bool = typer.Option(False, "--lyapunov", help="Compute Lyapunov exponents of runs still "
-                                  "non-periodic at --t-end (chaos or torus claims; the plates only)."),
+                                  "non-periodic at --t-end (needed for a chaos claim)."),
     executor: Optional[str] = typer.Option(None, "--executor", help="serial | processes | dask (default processes; "
                                            "dask when --scheduler is given)."),
     workers: Optional[int] = typer.Option(None, "--workers", help="Worker processes (default: all cores)."),
