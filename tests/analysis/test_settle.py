@@ -236,3 +236,16 @@ def test_bad_settle_options_say_what_to_do():
         simulate_until_settled(None, cap=math.nan)
     with pytest.raises(stickslip.SimulationError, match="t_end"):
         simulate_until_settled(None, t_end=100.0)
+
+
+def test_samples_that_alias_the_motion_carry_no_verdict():
+    # The plates' defaults settle on a period-1 stick-slip cycle of 2.7035 Hz. Sampled at 1 Hz
+    # (below twice the fastest linear mode, 2.757 Hz) its section crossings are aliases: such a
+    # window was called a settled torus. The same run sampled at 200 Hz is the periodic cycle.
+    sparse = stickslip.simulate(t_end=1500.0, sample_rate=1.0)
+    v = attractor(sparse, 1000.0)
+    assert (v.attractor, v.settled, v.period_count) == ("unsettled", False, None)
+    assert "alias" in v.evidence["reason"] and "at least 6" in v.evidence["reason"]
+    dense = attractor(stickslip.simulate(t_end=1500.0, sample_rate=200.0), 1400.0)
+    assert (dense.attractor, dense.period_count) == ("periodic", 1)
+    assert dense.fundamental_frequency_hz == pytest.approx(2.7035, abs=1e-4)

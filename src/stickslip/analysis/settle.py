@@ -14,7 +14,8 @@
 ``quasiperiodic``  stationary, not periodic, largest exponent zero for both, and the
                    crossings unchanged over 1000 s (:func:`.confirm.span_change`)
 ``unbounded``      the state became non-finite
-``unsettled``      anything else: a transient, an unconfirmed claim, a failed run
+``unsettled``      anything else: a transient, an unconfirmed claim, a failed run, or samples
+                   too sparse to resolve the motion (:func:`undersampled`)
 =================  ======================================================================
 
 ``settled`` is True for every verdict but ``unsettled``. The evidence (spreads, drifts,
@@ -171,6 +172,7 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
     c = classify(traj, t_from, dof)
     evidence = dict(c.evidence)
     dominant = _finite(c.fft_frequency_hz)
+    sparse = undersampled(traj)
 
     def verdict(name, k=None, period=math.nan, **more):
         evidence.update(more)
@@ -178,6 +180,8 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
         return Attractor(name, settled, k, period, 1.0 / period if settled and k else None, dominant,
                          end if settled else None, c, evidence)
 
+    if sparse:
+        return verdict("unsettled", reason=sparse)
     if c.attractor in ("equilibrium", "decaying"):
         if "stability" not in cache:
             cache["stability"] = _equilibrium_stability(traj)
@@ -220,6 +224,28 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
                        reason=f"largest Lyapunov exponent ≈ 0, but a torus is claimed only when the crossings stay "
                               f"unchanged over {QUASI_SPAN_S:g} s and {why}")
     return verdict("unsettled", reason="the window still drifts")
+
+
+def undersampled(traj) -> str | None:
+    """Why the samples of ``traj`` cannot carry a verdict, or None when they can.
+
+    Samples slower than twice the model's highest linear mode frequency (Nyquist) alias the
+    motion: a stick-slip cycle sampled once per period looks at rest, one sampled at an
+    incommensurate rate looks like a torus, and section crossings read off the interpolant are
+    not the motion's. No verdict is drawn from such samples.
+    """
+    rate = traj.options.get("sample_rate") if traj.options else None
+    if rate is None and traj.t.size > 1:
+        rate = 1.0 / float(traj.t[1] - traj.t[0])
+    system = getattr(traj, "system", None)
+    if rate is None or system is None:
+        return None
+    highest = float(system.natural_frequencies().max(initial=0.0))
+    if rate >= 2.0 * highest:
+        return None
+    return (f"the samples ({rate:g} per unit time) are slower than twice the highest linear mode frequency "
+            f"({highest:.4g}), so they alias the motion; run with a sample rate of at least "
+            f"{math.ceil(2.0 * highest)} for a verdict")
 
 
 def _equilibrium_stability(traj) -> dict:

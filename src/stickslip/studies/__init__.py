@@ -3,6 +3,8 @@
 
 ==========================  ==============================================================
 ``timestep``                paper Sect. 4.2.1: AEOM / NAEOM step-size study (Table 2, Figs. 5–6)
+``reproduce``               every figure of the paper beside it, with a report (``stickslip reproduce``)
+``models``                  the library models' figures (docs/models/)
 ==========================  ==============================================================
 """
 

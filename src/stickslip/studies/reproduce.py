@@ -21,9 +21,8 @@ run still drifting at the cap is "unsettled" and counted as neither.
 Resolutions (:data:`RESOLUTIONS`): ``full`` is the paper's (stability maps 100 × 100, 100 s
 time-step study down to Δt = 1e-5 s, 121-point bifurcation diagrams over N and 100-point ones
 over Ω, Δμ, α, 100 × 100 region maps of 300 s runs from two ICs for four models), ``quick`` uses
-coarse grids (7 × 8 region maps, 11–41-point bifurcation diagrams; measured 189 s for all
-figures on the shared 2-core machine, 406 s under heavier load and before the event integrator's
-change of the slip force law; docs/reproduce.md), ``micro`` is for tests.
+coarse grids (7 × 8 region maps, 11–41-point bifurcation diagrams; a few minutes on 2 cores,
+timings in docs/reproduce.md), ``micro`` is for tests.
 
 This module holds the command's driver and the list of recipes; the rest is split by what it
 does:
