@@ -1,0 +1,345 @@
+"""Friction forces of all contacts in their modes: slip, the low-speed band and stick.
+
+* slip: F_c = −μ(|v_c|) N_c e_c with e_c = v_c/|v_c| (:func:`slip_force`); which modes and speeds
+  take that direction is :func:`exact_direction`'s decision;
+* inside the low-speed band: the quasi-static direction for a 2-D contact
+  (:func:`quasi_static_direction`, found with the force that would hold the contact,
+  :func:`band_forces`), the stored direction for a 1-D contact;
+* stick: the Lagrange multipliers of all sticking contacts, solved together
+  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more).
+
+:func:`sliding_forces` computes the common case, every contact sliding outside the band, on the
+caller's stack arrays; :func:`general_forces_body` any mix of modes. Both fill the generalised
+force f = f0 − C q̇ − K q + Σ G_cᵀ F_c, from which :mod:`stickslip.model.physics` writes the state
+derivative and answers its per-contact queries.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import csmath as csm
+from .bundle import CST, H_BAND
+from .friction import friction_coefficient
+from .frames import all_frames, frame_velocity, frame_with_bias
+from .jit import inlined_kernel, kernel
+from .kinematics import contact_dim, contact_frame
+from .linalg import solve_psd, solve_psd_2x2
+from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
+                         is_stick, law_row)
+from .stack import DOFS, ROWS, VECTORS, work_matrix
+
+__all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
+           "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
+           "general_forces", "sliding_forces"]
+
+
+# ----------------------------------------------------------------------------- slip forces
+@inlined_kernel
+def exact_direction(mode, speed, band):
+    """Whether slip in ``mode`` at |v| = ``speed`` takes the direction v/|v| (else the quasi-static one).
+
+    ``MODE_SLIP``: exact above the low-speed band, quasi-static inside it (right after breakaway
+    |v| grows like t² and the direction relaxes onto its slow manifold at once).
+    ``MODE_SLIP_EXACT``: exact at every speed (the approach to stick). ``MODE_SLIP_QUASI_STATIC``:
+    quasi-static at every speed (steps that start inside the band, so that the force law does
+    not switch inside a step).
+    """
+    if mode == MODE_SLIP_EXACT:
+        return speed > SPEED_FLOOR
+    if mode == MODE_SLIP:
+        return speed > band
+    return False
+
+
+@inlined_kernel
+def slip_force(m, n, c, dim, speed, e0, e1, normal):
+    """Slip friction force −μ(|v|) N e of contact ``c`` along the unit direction e [N]."""
+    scale = -friction_coefficient(speed, law_row(m, n, c)) * normal
+    if dim == 2:
+        return scale * e0, scale * e1
+    return scale * e0, csm.zero(scale)
+
+
+@inlined_kernel
+def add_contact_force(G2, dim, n, F0, F1, f):
+    """f += G_cᵀ F_c for one contact's frame rows G2."""
+    for j in range(n):
+        f[j] += G2[0, j] * F0
+    if dim == 2:
+        for j in range(n):
+            f[j] += G2[1, j] * F1
+
+
+@inlined_kernel
+def rotated(c, s, angle):
+    """(cos(θ + a), sin(θ + a)) from (c, s) = (cos θ, sin θ) and the angle a [rad]."""
+    ca = csm.cos(angle)
+    sa = csm.sin(angle)
+    return c * ca - s * sa, s * ca + c * sa
+
+
+@kernel
+def quasi_static_direction(a11, a12, a22, Fx, Fy, muN, ex, ey):
+    """Slip direction on the slow manifold of the 2-D direction dynamics at |v| → 0.
+
+    With F = −μ N e, dv/dt = −A (μ N e + F_s), A = G M⁻¹ Gᵀ (the contact's block), F_s the force
+    that would keep v = 0. The direction angle θ obeys θ̇ = −g(θ)/|v| with g = e × A (μ N e + F_s),
+    so for small |v| it sits at a stable root g = 0 (g' > 0), where v grows or shrinks along e
+    itself. At breakaway e = −F_s/|F_s| is such a root. Newton from the previous direction
+    (ex, ey), turning the unit vector by each step. Real arithmetic: the Jacobians take the band's
+    direction from this same residual (:mod:`stickslip.model.derivatives`).
+    """
+    wx = a11 * Fx + a12 * Fy
+    wy = a12 * Fx + a22 * Fy
+    norm = math.sqrt(ex * ex + ey * ey)
+    if norm > 0.0:
+        c = ex / norm
+        sn = ey / norm
+    else:
+        c = 1.0
+        sn = 0.0
+    for _ in range(8):
+        c2 = c * c - sn * sn
+        s2 = 2.0 * c * sn
+        g = muN * (a12 * c2 + 0.5 * (a22 - a11) * s2) + (c * wy - sn * wx)
+        dg = muN * (-2.0 * a12 * s2 + (a22 - a11) * c2) - (c * wx + sn * wy)
+        if dg <= 0.0:  # not near a stable root: keep the previous direction
+            break
+        step = g / dg
+        c, sn = rotated(c, sn, -step)
+        if abs(step) < 1e-14:  # converged to round-off of an angle
+            break
+    return c, sn
+
+
+# ----------------------------------------------------------------------------- stick forces
+@kernel
+def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    """Stick multipliers of the contacts in stick and of contact ``extra`` (≥ 0; −1: none), solved
+    together: (G_S M⁻¹ G_Sᵀ) F_S = −(h_S + G_S M⁻¹ f), with h_S already in ``h``.
+
+    Writes F of those contacts; ``A`` (≥ 2 nc square) receives G_S M⁻¹ G_Sᵀ (intact when k ≤ 2).
+    ``f`` is the generalised force of everything else (not changed). Returns the rows k (0: none).
+    """
+    m = md.m
+    MG = work_matrix(md.kin, ROWS, DOFS, s)
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    a = vec[0]
+    b = vec[1]
+    x = vec[2]
+    V = work_matrix(md.kin, ROWS, ROWS, s)
+    apply_inverse_mass(m, n, diagonal, f, a)
+    k = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(md.kin, m, n, c)):
+                apply_inverse_mass(m, n, diagonal, G[2 * c + i], MG[k])
+                acc = h[2 * c + i]
+                for j in range(n):
+                    acc += G[2 * c + i, j] * a[j]
+                b[k] = -acc
+                k += 1
+    if k == 0:
+        return 0
+    r = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(md.kin, m, n, c)):
+                for r2 in range(k):
+                    acc = csm.zero(s[0])
+                    for j in range(n):
+                        acc += G[2 * c + i, j] * MG[r2, j]
+                    A[r, r2] = acc
+                r += 1
+    solve_psd(A, b, x, V, k)
+    r = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            dim = contact_dim(md.kin, m, n, c)
+            F[2 * c] = x[r]
+            F[2 * c + 1] = x[r + 1] if dim == 2 else csm.zero(s[0])
+            r += dim
+    return k
+
+
+@inlined_kernel
+def stick_rows(md, m, n, nc, cst, extra):
+    """Stick rows of the sticking contacts and contact ``extra`` (≥ 0; −1: none): their number k and,
+    when k ≤ 2, the first two (contact c's row i is 2c + i; −1 for none)."""
+    k = 0
+    r0 = -1
+    r1 = -1
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(md.kin, m, n, c)):
+                if k == 0:
+                    r0 = 2 * c + i
+                elif k == 1:
+                    r1 = 2 * c + i
+                k += 1
+    return k, r0, r1
+
+
+@inlined_kernel
+def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
+    """:func:`stick_system` for one or two stick rows (``r0``, and ``r1`` ≥ 0 or −1), written out on
+    the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
+    G_S M⁻¹ G_Sᵀ (a01 = a11 = 0 for one row)."""
+    m = md.m
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    a = vec[0]
+    mg0 = vec[1]
+    mg1 = vec[2]
+    apply_inverse_mass(m, n, diagonal, f, a)
+    apply_inverse_mass(m, n, diagonal, G[r0], mg0)
+    a00 = csm.zero(s[0])
+    b0 = h[r0]
+    for j in range(n):
+        a00 += G[r0, j] * mg0[j]
+        b0 += G[r0, j] * a[j]
+    zero = csm.zero(b0)
+    if r1 < 0:
+        F[r0] = -b0 / a00 if a00.real > 0.0 else zero
+        if r0 % 2 == 0:
+            F[r0 + 1] = zero
+        return a00, zero, zero
+    apply_inverse_mass(m, n, diagonal, G[r1], mg1)
+    a01 = csm.zero(s[0])
+    a11 = csm.zero(s[0])
+    b1 = h[r1]
+    for j in range(n):
+        a01 += G[r0, j] * mg1[j]
+        a11 += G[r1, j] * mg1[j]
+        b1 += G[r1, j] * a[j]
+    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
+    F[r0] = x0
+    F[r1] = x1
+    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
+        F[r0 + 1] = zero
+    if r1 % 2 == 0:
+        F[r1 + 1] = zero
+    return a00, a01, a11
+
+
+@inlined_kernel
+def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    """Stick multipliers of the sticking contacts and contact ``extra`` (F written for those), by
+    :func:`small_stick_system` when there are at most two rows, else :func:`stick_system`. Returns
+    (k, a00, a01, a11): the rows and, for k = 2, the entries of G_S M⁻¹ G_Sᵀ."""
+    k, r0, r1 = stick_rows(md, md.m, n, nc, cst, extra)
+    zero = csm.zero(s[0])
+    if k == 0:
+        return 0, zero, zero, zero
+    if k <= 2:
+        a00, a01, a11 = small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
+        return k, a00, a01, a11
+    stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    return k, zero, zero, zero
+
+
+# ----------------------------------------------------------------------------- forces of all contacts
+@inlined_kernel
+def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
+    """Every contact's friction force at ``s`` in the modes of ``cst`` (any mix of slip, band and
+    stick); fills G, w, v, N, h, F and the total generalised force f = f0 − C q̇ − K q + Σ G_cᵀ F_c.
+
+    Order: slip forces with the exact direction, then those inside the low-speed band (their
+    quasi-static direction sees the forces already known), then the stick multipliers of all
+    sticking contacts together.
+    """
+    m = md.m
+    band = m[H_BAND]
+    A = work_matrix(md.kin, ROWS, ROWS, s)
+    all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
+    base_force(s, m, n, diagonal, f)
+    in_band = False
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            inv = 1.0 / speed
+            F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
+            F[2 * c] = F0
+            F[2 * c + 1] = F1
+            add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
+        else:
+            in_band = True
+    if in_band:
+        band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A)
+    if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
+        for c in range(nc):
+            if is_stick(cst, c):
+                add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+
+
+@kernel
+def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
+    """Slip forces of the contacts inside the low-speed band (after those with the exact direction,
+    whose forces are in ``f`` already): the quasi-static direction for a 2-D contact, found with the
+    force that would hold it (the others as they are), the stored direction for a 1-D contact."""
+    m = md.m
+    band = m[H_BAND]
+    for c in range(nc):
+        mode = np.int64(cst[CST * c])
+        if mode == MODE_STICK:
+            continue
+        dim = contact_dim(md.kin, m, n, c)
+        speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
+        if exact_direction(mode, speed.real, band):
+            continue
+        ex = cst[CST * c + 1]
+        ey = cst[CST * c + 2]
+        if dim == 2:
+            frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
+            k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
+            if k == 2:
+                muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
+                ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
+                                                F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
+        F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
+        F[2 * c] = F0
+        F[2 * c + 1] = F1
+        add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
+
+
+@kernel
+def general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
+    """:func:`general_forces_body` as a call (for the queries; :func:`~stickslip.model.physics.general_rhs`
+    inlines it)."""
+    general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+
+
+@inlined_kernel
+def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+    """The common case on the caller's (stack) arrays: every contact sliding outside the low-speed
+    band. Fills G, w, v, N, F and f = f0 − C q̇ − K q + Σ G_cᵀ F_c and returns True; returns False
+    (arrays incomplete) as soon as a contact sticks or is inside the band."""
+    m = md.m
+    for c in range(nc):
+        if is_stick(cst, c):
+            return False
+    band = m[H_BAND]
+    base_force(s, m, n, diagonal, f)
+    for c in range(nc):
+        G2 = G[2 * c:2 * c + 2]
+        normal = contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
+        N[c] = normal
+        dim = contact_dim(md.kin, m, n, c)
+        v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
+        v[2 * c] = v0
+        v[2 * c + 1] = v1
+        speed = csm.sqrt(v0 * v0 + v1 * v1)
+        if not exact_direction(np.int64(cst[CST * c]), speed.real, band):
+            return False
+        inv = 1.0 / speed
+        F0, F1 = slip_force(m, n, c, dim, speed, v0 * inv, v1 * inv, normal)
+        F[2 * c] = F0
+        F[2 * c + 1] = F1
+        add_contact_force(G2, dim, n, F0, F1, f)
+    return True

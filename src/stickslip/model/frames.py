@@ -1,0 +1,142 @@
+"""Contact frames with their velocity bias: v = G q̇ − w and h = Ġ q̇ − ẇ.
+
+Each contact's frame (tangent rows G, drive w, normal force N) comes from the model's kinematics
+(:func:`stickslip.model.kinematics.contact_frame`). The stick multipliers also need the velocity
+bias h, the derivative of v along q̇ at fixed q̇ (dv/dt at q̈ = 0). :func:`frame_with_bias` gives
+both: in a float evaluation by a complex step of the frame at q + iε q̇ (exact to round-off,
+:data:`COMPLEX_STEP`), inside a complex evaluation (a complex-step Jacobian, whose state is
+complex already) by a central difference (:data:`BIAS_TIME_STEP`); h = 0 for constant
+kinematics. :func:`all_frames` fills the frames of every contact for the friction forces
+(:mod:`stickslip.model.forces`).
+"""
+
+from __future__ import annotations
+
+from . import csmath as csm
+from .bundle import H_CONSTANT
+from .jit import inlined_kernel, kernel
+from .kinematics import contact_dim, contact_frame, model_sizes
+from .model_data import is_stick
+from .stack import DOFS, ONE, STATES, TWO, work_matrix
+
+__all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "frame_velocity", "split_complex_frame", "max_rate", "frame_with_bias",
+           "all_frames"]
+
+#: Complex step [-] of the velocity bias: h² ≪ round-off and h·|∂f| far above the smallest
+#: normal double, so Im f(x + i h d)/h is the directional derivative exactly.
+COMPLEX_STEP = 1e-150
+
+#: Central-difference step [s] of the velocity bias inside a complex evaluation, scaled by
+#: 1/max|q̇|: the positions move by ~1e-5 of their unit, truncation and round-off ~1e-10 relative.
+BIAS_TIME_STEP = 1e-5
+
+
+# ----------------------------------------------------------------------------- frames
+@inlined_kernel
+def frame_velocity(s, n, dim, G2, w2):
+    """(v0, v1) = G q̇ − w of one contact from its frame rows (v1 = 0 for a 1-D contact)."""
+    v0 = -w2[0]
+    for j in range(n):
+        v0 += G2[0, j] * s[n + j]
+    v1 = csm.zero(s[0])
+    if dim == 2:
+        v1 = -w2[1]
+        for j in range(n):
+            v1 += G2[1, j] * s[n + j]
+    return v0, v1
+
+
+@inlined_kernel
+def _frame_bias_complex_step(s, c, md, G2, w2, h2):
+    """Float state: the frame at q + iε q̇ gives G, w (real parts, exact) and h = Im[G q̇ − w]/ε
+    (exact to round-off) in one evaluation; 0 for constant kinematics."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    if m[H_CONSTANT] != 0.0:
+        h2[0] = 0.0
+        h2[1] = 0.0
+        return contact_frame(md.kin, s, c, m, G2, w2)
+    zc = work_matrix(md.kin, ONE, STATES, 1j)[0]
+    cG = work_matrix(md.kin, TWO, DOFS, 1j)
+    cw = work_matrix(md.kin, ONE, TWO, 1j)[0]
+    for j in range(n):
+        zc[j] = complex(s[j], COMPLEX_STEP * s[n + j])
+        zc[n + j] = s[n + j]
+    normal = contact_frame(md.kin, zc, c, m, cG, cw)
+    split_complex_frame(s, n, cG, cw, G2, w2, h2)
+    return normal.real
+
+
+@inlined_kernel
+def split_complex_frame(s, n, cG, cw, G2, w2, h2):
+    """G, w = real parts of the frame at q + iε q̇; h = Im[G q̇ − w]/ε."""
+    h0 = -cw[0].imag
+    h1 = -cw[1].imag
+    for j in range(n):
+        h0 += cG[0, j].imag * s[n + j]
+        h1 += cG[1, j].imag * s[n + j]
+        G2[0, j] = cG[0, j].real
+        G2[1, j] = cG[1, j].real
+    w2[0] = cw[0].real
+    w2[1] = cw[1].real
+    h2[0] = h0 / COMPLEX_STEP
+    h2[1] = h1 / COMPLEX_STEP
+
+
+@inlined_kernel
+def max_rate(s, n):
+    """max |Re q̇_j| of a (complex) state."""
+    speed = 0.0
+    for j in range(n):
+        speed = max(speed, abs(s[n + j].real))
+    return speed
+
+
+@kernel
+def _frame_bias_central(s, c, md, G2, w2, h2):
+    """Complex state (inside a complex-step Jacobian): the frame itself, and h as the central
+    difference of G(q ± ε q̇) q̇ − w(q ± ε q̇) over 2ε, ε = BIAS_TIME_STEP / max|q̇| (~1e-10 relative)."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    h2[0] = 0j
+    h2[1] = 0j
+    if m[H_CONSTANT] == 0.0:
+        zc = work_matrix(md.kin, ONE, STATES, s)[0]
+        cG = work_matrix(md.kin, TWO, DOFS, s)
+        cw = work_matrix(md.kin, ONE, TWO, s)[0]
+        eps = BIAS_TIME_STEP / max(max_rate(s, n), 1e-300)
+        for side in (1.0, -1.0):
+            for j in range(n):
+                zc[j] = s[j] + side * eps * s[n + j]
+                zc[n + j] = s[n + j]
+            contact_frame(md.kin, zc, c, m, cG, cw)
+            v0, v1 = frame_velocity(s, n, 2, cG, cw)
+            h2[0] += side * v0 / (2.0 * eps)
+            h2[1] += side * v1 / (2.0 * eps)
+    return contact_frame(md.kin, s, c, m, G2, w2)
+
+
+@kernel
+def frame_with_bias(s, c, md, G2, w2, h2):
+    """Contact ``c``'s frame (G, w; returns N) and velocity bias h = Ġ q̇ − ẇ = dv/dt at q̈ = 0:
+    by complex step in a float evaluation, by central difference inside a complex one."""
+    if isinstance(s[0], complex):  # resolved at compile time: one branch per number type
+        return _frame_bias_central(s, c, md, G2, w2, h2)
+    return _frame_bias_complex_step(s, c, md, G2, w2, h2)
+
+
+@inlined_kernel
+def all_frames(s, cst, md, n, nc, G, w, v, N, h, with_bias):
+    """Each contact's G (rows 2c, 2c+1), w, v = G q̇ − w (entries 2c, 2c+1) and N (entry c) at
+    ``s``; with the velocity bias h for contacts in stick (all contacts if ``with_bias`` is 2)."""
+    m = md.m
+    for c in range(nc):
+        G2 = G[2 * c:2 * c + 2]
+        w2 = w[2 * c:2 * c + 2]
+        if with_bias == 2 or (with_bias == 1 and is_stick(cst, c)):
+            N[c] = frame_with_bias(s, c, md, G2, w2, h[2 * c:2 * c + 2])
+        else:
+            N[c] = contact_frame(md.kin, s, c, m, G2, w2)
+        v0, v1 = frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
+        v[2 * c] = v0
+        v[2 * c + 1] = v1

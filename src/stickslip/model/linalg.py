@@ -1,0 +1,140 @@
+"""Minimal-norm solutions of the small symmetric positive semi-definite systems of stick.
+
+The stick multipliers of the sticking contacts solve (G_S M⁻¹ G_Sᵀ) F_S = b
+(:mod:`stickslip.model.forces`), and the velocity projection onto stick solves a system with the
+same matrix (:func:`stickslip.model.physics.project_velocities`). That matrix is rank-deficient
+for some models (the plates' Model 4, where an eigenvalue is 0 up to round-off), so the solution
+taken is the minimal-norm one: in closed form for one or two rows (:func:`solve_psd_2x2`, the
+common case), by cyclic Jacobi rotations for more (:func:`solve_psd`). Generic in the number type:
+decisions read real parts only, so a complex step through the solves stays exact.
+"""
+
+from __future__ import annotations
+
+from . import csmath as csm
+from .jit import inlined_kernel, kernel
+
+__all__ = ["RANK_TOL", "JACOBI_SWEEPS", "solve_psd_2x2", "solve_psd"]
+
+#: Relative size below which an eigenvalue of G_S M⁻¹ G_Sᵀ counts as zero (rank deficiency,
+#: e.g. the plates' Model 4, where it is exactly 0 up to round-off ~1e-16 relative).
+RANK_TOL = 1e-10
+
+#: Sweeps of cyclic Jacobi before giving up (each sweep roughly squares the off-diagonal norm;
+#: 30 is far more than the ~6–10 a small symmetric matrix needs).
+JACOBI_SWEEPS = 30
+
+
+# ----------------------------------------------------------------------------- linear algebra
+@inlined_kernel
+def solve_psd_2x2(a11, a12, a22, b1, b2):
+    """Minimal-norm solution of the symmetric positive semi-definite 2×2 system A x = b.
+
+    Full rank: the exact inverse. Rank 1 (smaller eigenvalue below RANK_TOL of the larger):
+    x = u (u·b)/λ1 along the eigenvector u of the non-zero eigenvalue λ1. Rank 0: x = 0.
+    Returns (x1, x2, rank). Decisions read real parts (complex-step safe).
+    """
+    tr = a11 + a22
+    if tr.real <= 0.0:
+        return csm.zero(b1), csm.zero(b2), 0
+    det = a11 * a22 - a12 * a12
+    if det.real > RANK_TOL * (tr * tr).real:  # λ1 λ2 > RANK_TOL tr² ≥ RANK_TOL λ1²: full rank
+        return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det, 2
+    half_gap = csm.sqrt(0.25 * (a11 - a22) ** 2 + a12 * a12)
+    lam1 = 0.5 * tr + half_gap
+    lam2 = 0.5 * tr - half_gap
+    if lam2.real > RANK_TOL * lam1.real:
+        return (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det, 2
+    # eigenvector of lam1: the better conditioned of the two row forms
+    u1, u2 = a12, lam1 - a11
+    w1, w2 = lam1 - a22, a12
+    if (w1 * w1 + w2 * w2).real > (u1 * u1 + u2 * u2).real:
+        u1, u2 = w1, w2
+    norm2 = u1 * u1 + u2 * u2
+    if norm2.real == 0.0:  # A = lam1 along an axis (a12 = 0, one diagonal entry zero)
+        one = 1.0 + csm.zero(a11)
+        if a11.real >= a22.real:
+            u1, u2, norm2 = one, csm.zero(a11), one
+        else:
+            u1, u2, norm2 = csm.zero(a11), one, one
+    c = (u1 * b1 + u2 * b2) / (lam1 * norm2)
+    return c * u1, c * u2, 1
+
+
+@kernel
+def solve_psd(A, b, x, V, k):
+    """Minimal-norm solution x (k,) of the symmetric PSD system A[:k, :k] x = b[:k]; returns the rank.
+
+    k ≤ 2 in closed form (:func:`solve_psd_2x2`); larger systems (several sticking 2-D contacts)
+    by cyclic Jacobi rotations A → Vᵀ A V = Λ, x = V Λ⁺ Vᵀ b, eigenvalues below RANK_TOL of the
+    largest treated as zero. ``A`` and ``V`` (≥ k × k) are overwritten when k > 2.
+    """
+    if k == 0:
+        return 0
+    if k == 1:
+        if A[0, 0].real > 0.0:
+            x[0] = b[0] / A[0, 0]
+            return 1
+        x[0] = csm.zero(b[0])
+        return 0
+    if k == 2:
+        x0, x1, rank = solve_psd_2x2(A[0, 0], A[0, 1], A[1, 1], b[0], b[1])
+        x[0] = x0
+        x[1] = x1
+        return rank
+    for i in range(k):
+        for j in range(k):
+            V[i, j] = 1.0 if i == j else 0.0
+    scale = 0.0
+    for i in range(k):
+        for j in range(k):
+            scale += (A[i, j] * A[i, j]).real
+    for _ in range(JACOBI_SWEEPS):
+        off = 0.0
+        for p in range(k):
+            for q in range(p + 1, k):
+                off += (A[p, q] * A[p, q]).real
+        if off <= 1e-32 * scale:
+            break
+        for p in range(k):
+            for q in range(p + 1, k):
+                apq = A[p, q]
+                if apq.real == 0.0:
+                    continue
+                theta = (A[q, q] - A[p, p]) / (2.0 * apq)
+                sign = 1.0 if theta.real >= 0.0 else -1.0
+                t = sign / (sign * theta + csm.sqrt(theta * theta + 1.0))
+                c = 1.0 / csm.sqrt(t * t + 1.0)
+                sn = t * c
+                for r in range(k):  # A ← A J
+                    arp = A[r, p]
+                    arq = A[r, q]
+                    A[r, p] = c * arp - sn * arq
+                    A[r, q] = sn * arp + c * arq
+                for r in range(k):  # A ← Jᵀ A
+                    apr = A[p, r]
+                    aqr = A[q, r]
+                    A[p, r] = c * apr - sn * aqr
+                    A[q, r] = sn * apr + c * aqr
+                for r in range(k):  # V ← V J
+                    vrp = V[r, p]
+                    vrq = V[r, q]
+                    V[r, p] = c * vrp - sn * vrq
+                    V[r, q] = sn * vrp + c * vrq
+    lam_max = 0.0
+    for i in range(k):
+        lam_max = max(lam_max, A[i, i].real)
+    rank = 0
+    for i in range(k):
+        x[i] = csm.zero(b[0])
+    for j in range(k):
+        if A[j, j].real <= RANK_TOL * lam_max:
+            continue
+        rank += 1
+        coef = csm.zero(b[0])
+        for i in range(k):
+            coef += V[i, j] * b[i]
+        coef /= A[j, j]
+        for i in range(k):
+            x[i] += V[i, j] * coef
+    return rank

@@ -1,0 +1,100 @@
+"""What every physics kernel reads: the contact modes and the packed model.
+
+A contact's integration state ``cst`` (:data:`~stickslip.model.bundle.CST` numbers per contact)
+starts with its mode, one of the ``MODE_*`` codes defined here; the packed model ``m``
+(:mod:`stickslip.model.bundle`) holds each contact's friction law row and M⁻¹, M, C, K, f0. The
+small kernels here read them: the friction law row and the static limit μs N of a contact,
+whether it sticks, M⁻¹ f, the force without friction f0 − C q̇ − K q and the kinetic energy.
+
+They sit below the frames (:mod:`stickslip.model.frames`), the friction forces
+(:mod:`stickslip.model.forces`) and the right-hand side (:mod:`stickslip.model.physics`), which
+all need them, so that none of those imports another in a circle. The integrators, orbits and
+tests read the mode codes and :data:`SPEED_FLOOR` as ``physics.MODE_STICK`` …:
+:mod:`stickslip.model.physics` re-exports them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import csmath as csm
+from .bundle import CST, C_LAW, contact_offsets, offsets
+from .friction import LAW_WIDTH, static_coefficient
+from .jit import inlined_kernel, kernel
+from .kinematics import model_sizes
+
+__all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
+           "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy"]
+
+MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
+MODE_STICK = 1       # stick: friction is the constraint force
+MODE_SLIP_EXACT = 2  # slip with the exact direction v/|v| at every speed (approach to stick)
+MODE_SLIP_QUASI_STATIC = 3  # slip with the quasi-static direction at every speed
+
+#: Speed [m/s] below which a slip velocity counts as exactly zero (round-off after projection).
+SPEED_FLOOR = 1e-13
+
+
+# ----------------------------------------------------------------------------- model data
+@inlined_kernel
+def law_row(m, n, c):
+    """Friction law row of contact ``c`` (a view of ``m``)."""
+    o = contact_offsets(n, c)[0] + C_LAW
+    return m[o:o + LAW_WIDTH]
+
+
+@inlined_kernel
+def static_limit(m, n, c, normal):
+    """Largest admissible stick force μs N [N] of contact ``c`` (paper Eq. 10)."""
+    return static_coefficient(law_row(m, n, c)) * normal.real
+
+
+@inlined_kernel
+def is_stick(cst, c):
+    return np.int64(cst[CST * c]) == MODE_STICK
+
+
+@inlined_kernel
+def apply_inverse_mass(m, n, diagonal, f, a):
+    """a = M⁻¹ f (locked DOFs: 0)."""
+    o = offsets(n)[0]
+    if diagonal:
+        for i in range(n):
+            a[i] = m[o + i * (n + 1)] * f[i]
+    else:
+        for i in range(n):
+            acc = csm.zero(f[0])
+            for j in range(n):
+                acc += m[o + i * n + j] * f[j]
+            a[i] = acc
+
+
+@inlined_kernel
+def base_force(s, m, n, diagonal, f):
+    """f = f0 − C q̇ − K q, the generalised force without friction."""
+    o_minv, o_mass, oc, ok, of, o_free, o_c = offsets(n)
+    if diagonal:
+        for i in range(n):
+            f[i] = m[of + i] - m[oc + i * (n + 1)] * s[n + i] - m[ok + i * (n + 1)] * s[i]
+    else:
+        for i in range(n):
+            acc = m[of + i] + csm.zero(s[0])
+            for j in range(n):
+                acc -= m[oc + i * n + j] * s[n + j] + m[ok + i * n + j] * s[j]
+            f[i] = acc
+
+
+@kernel
+def kinetic_energy(s, md):
+    """½ q̇ᵀ M q̇ [J]."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    o = offsets(n)[1]
+    e = 0.0
+    for i in range(n):
+        if diagonal:
+            e += 0.5 * m[o + i * (n + 1)] * s[n + i] * s[n + i]
+        else:
+            for j in range(n):
+                e += 0.5 * s[n + i] * m[o + i * n + j] * s[n + j]
+    return e
