@@ -8,7 +8,7 @@ function (compiled ones prefixed ``JIT:``, library ones such as ``__sincos_fma``
 A function's range is taken up to the next known address, so a share is exact per function but
 copies of a callee linked into several libraries are counted apart.
 
-    python benchmarks/profile_jit.py [--method aeom] [--dt 1e-3] [--seconds 10] [--top 25]
+    python benchmarks/profile_jit.py [--method aeom] [--dt 1e-3] [--seconds 10] [--top 25] [--sample-rate 1000]
 
 Needs Linux ``perf`` with permission to record this process. Development tool: not run by CI.
 """
@@ -77,6 +77,7 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=1e-3, help="fixed step [s] (aeom, naeom)")
     ap.add_argument("--seconds", type=float, default=10.0, help="recording time [s]")
     ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--sample-rate", type=float, default=1000.0, help="output samples per second [Hz]")
     args = ap.parse_args()
     if shutil.which("perf") is None:
         sys.exit("perf not found: install linux perf (e.g. apt install linux-perf) to profile")
@@ -85,7 +86,9 @@ def main() -> None:
     os.environ["NUMBA_CACHE_DIR"] = cache  # compile afresh: the libraries stay in memory
     import stickslip
 
-    kw = {} if args.method == "event" else {"method": args.method, "dt": args.dt}
+    kw = {"sample_rate": args.sample_rate}
+    if args.method != "event":
+        kw.update(method=args.method, dt=args.dt)
     params = stickslip.Parameters()
     stickslip.simulate(params, 0.01, **kw)  # compile
     starts_names = function_addresses(stickslip)
