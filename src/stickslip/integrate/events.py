@@ -1,8 +1,10 @@
-"""Transition logic shared by all integrators.
+"""Transitions of the paper's fixed-step methods (AEOM, NAEOM) on the plates' own kernels.
 
-Event functions are evaluated on a state vector; the root finder works on any callable-free
-"dense output" described by a polynomial ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1]
-(the form of every Runge–Kutta interpolant used here; a linear interpolant is Q with one column).
+The event codes, tolerances and the root-finding steps (dense output, Illinois regula falsi) are
+the generic event integrator's (:mod:`.contacts`); this module holds what the fixed-step
+methods add on the plates' kernels: event functions of the plates' state, the step's Hermite
+interpolant (a dense output ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)`` with three columns) and the
+bisection on re-stepping.
 
 * slip → stick: ``slip_event`` is the projection of v_r on its direction at the start of the step.
   A sign change means the 2-D velocity passed (near) zero; at the located root, if |v_r| is below
@@ -20,30 +22,11 @@ import numpy as np
 
 from ..model import kernels as K
 from ..model.jit import kernel
+# the event codes, tolerances and root-finding steps are those of the generic event integrator
+from .contacts import (ARRIVAL_TIME_TOL, EVENT_CHECKS, EVENT_SLIP, EVENT_STICK, EVENT_TIME_TOL,  # noqa: F401
+                       MAX_REFINEMENTS, STICK_SPEED_TOL, TRANSITION_TO_SLIP, TRANSITION_TO_STICK, dense_state,
+                       illinois_update, regula_falsi_point)
 
-EVENT_SLIP = 0   # slip → stick candidate: v_r · e0
-EVENT_STICK = 1  # stick → slip: μs N − |F_stick|
-
-TRANSITION_TO_STICK = 1
-TRANSITION_TO_SLIP = -1
-
-#: Time resolution [s] to which transition instants are located on the dense output.
-EVENT_TIME_TOL = 1e-12
-
-#: Extrapolated time [s] to v_r = 0 below which slip counts as arrived (the issue's resolution of
-#: transition instants); homing steps shorter than this are dominated by the direction
-#: singularity of v_r/|v_r| at zero and get rejected.
-ARRIVAL_TIME_TOL = 1e-10
-
-#: |v_r| [m/s] at or below which slip is close enough to v_r = 0 to finish the approach. When
-#: v_r heads for zero (within 60° of head-on) the last steps are homed onto it until the
-#: extrapolated time left is below ARRIVAL_TIME_TOL; when it spirals in (anisotropic
-#: G M⁻¹ Gᵀ: the stiff direction dynamics turn v_r faster than it shrinks, and explicit steps
-#: at their stability limit can hover, seen at |v_r| ~ 2e-8 m/s for N = 80 N, Ω = 1 rad/s)
-#: the residual ≤ 1e-6 m/s is removed by the projection at once: an impulse of at most
-#: 1e-6 m/s × mass and an instant error of ≤ 1e-6 / |dv_r/dt| (~1e-7 s). A mere turn of the slip
-#: direction keeps |v_r| of the order of the sliding speed (0.1–1 m/s in the paper's cases).
-STICK_SPEED_TOL = 1e-6
 
 #: Largest number of bisections of one transition bracket (fixed-step methods): the bracket
 #: halves each time, so 200 is far more than the ~40 needed to go from Δt = 0.1 s to
@@ -57,28 +40,6 @@ MAX_BISECTIONS = 200
 #: Δt = 1e-4 s and within 1e-6 at Δt = 1e-3 s (Sect. 4.2.1 case); the width affects only the
 #: number of trials, never the root.
 ROOT_BRACKET = 1e-7
-
-#: Cap on the Illinois iterations refining one root (each at least halves the bracket every
-#: few steps; ~40 are needed from a step of 0.1 s down to EVENT_TIME_TOL).
-MAX_REFINEMENTS = 200
-
-#: Sub-intervals of a step on which the event function is sampled for a sign change.
-EVENT_CHECKS = 4
-
-
-@kernel
-def dense_state(y0, Q, h, theta, out):
-    """Evaluate ``out = y0 + h Σ_j Q[:, j] θ^(j+1)`` (Horner)."""
-    n, m = Q.shape
-    if m == 4:  # Dormand–Prince dense output: unrolled (the samples' inner loop)
-        for i in range(n):
-            out[i] = y0[i] + h * theta * (Q[i, 0] + theta * (Q[i, 1] + theta * (Q[i, 2] + theta * Q[i, 3])))
-        return
-    for i in range(n):
-        acc = Q[i, m - 1]
-        for j in range(m - 2, -1, -1):
-            acc = Q[i, j] + theta * acc
-        out[i] = y0[i] + h * theta * acc
 
 
 @kernel
@@ -195,31 +156,6 @@ def bisection_point(a, b, estimate, h):
                 return estimate + w
             w *= 10.0
     return 0.5 * (a + b)
-
-
-@kernel
-def regula_falsi_point(a, ga, b, gb):
-    """Secant point of the bracket [a, b] with values ga, gb of opposite sides, kept strictly inside."""
-    c = b - gb * (b - a) / (gb - ga)
-    if not (a < c < b):
-        c = 0.5 * (a + b)
-    return c
-
-
-@kernel
-def illinois_update(a, ga, b, gb, c, gc, before, side):
-    """One Illinois regula-falsi update: c (value gc) replaces a if ``before`` (c lies before the
-    root), else b; when the same end moves twice the other end's value is halved.
-
-    ``side`` is the end moved last (+1 a, −1 b, 0 none). Returns (a, ga, b, gb, side).
-    """
-    if before:
-        if side == 1:
-            gb *= 0.5
-        return c, gc, b, gb, 1
-    if side == -1:
-        ga *= 0.5
-    return a, ga, c, gc, -1
 
 
 @kernel
