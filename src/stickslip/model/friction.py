@@ -6,61 +6,43 @@ Built-in laws (``law`` code in the contact's data row):
 ``exponential``   μ(v) = μk + Δμ exp(−α v) + μv v (paper Eq. 4 with an optional viscous term
                   μv), so μ(0) = μs = μk + Δμ: the static coefficient is the limit of the kinetic one.
 
-A *user law* is any numba-compilable function ``mu(speed, coefficients) -> float`` registered with
-:func:`register_law`; its static coefficient is ``mu(0, coefficients)``. Laws are evaluated by
-compiled code through :func:`friction_coefficient` (slip) and :func:`static_coefficient` (stick),
-on ``float64`` or ``complex128`` speeds alike (the complex step of the Jacobians differentiates
-through them), so they use ``np.exp``-style functions and no ``abs``.
+Laws are evaluated by compiled code through :func:`friction_coefficient` (slip) and
+:func:`static_coefficient` (stick), on ``float64`` or ``complex128`` speeds alike (the complex
+step of the Jacobians differentiates through them), so they use ``exp``-style functions and no
+``abs``. A law of the user's own (a compiled function of |v|) is not available yet.
 
 Each contact's law is one row of :data:`LAW_WIDTH` numbers in the model's data array
-(``[law, mu_k, delta_mu, alpha, mu_v, user 0, user 1, ...]``, see :mod:`stickslip.model.bundle`).
+(``[law, mu_k, delta_mu, alpha, mu_v]``, see :mod:`stickslip.model.bundle`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable, Mapping
+from typing import Mapping
 
 import numpy as np
 
 from ..errors import StickSlipError
 from . import csmath as csm
-from .jit import inlined_kernel, kernel
+from .jit import inlined_kernel
 
-__all__ = ["FrictionLaw", "FrictionLawError", "LAWS", "LAW_COULOMB", "LAW_EXPONENTIAL", "LAW_USER",
-           "LAW_WIDTH", "USER_COEFFICIENTS", "register_law", "friction_coefficient", "static_coefficient"]
+__all__ = ["FrictionLaw", "FrictionLawError", "LAWS", "LAW_COULOMB", "LAW_EXPONENTIAL", "LAW_WIDTH",
+           "friction_coefficient", "static_coefficient"]
 
 LAW_EXPONENTIAL = 0
 LAW_COULOMB = 1
-LAW_USER = 2
 #: Law names as they appear in model files and ``--set``.
 LAWS = {"exponential": LAW_EXPONENTIAL, "coulomb": LAW_COULOMB}
 
 #: Offsets inside a law row.
-L_LAW, L_MU_K, L_DELTA_MU, L_ALPHA, L_MU_V, L_USER = range(6)
-#: Coefficients a user law may take (its row entries from L_USER on).
-USER_COEFFICIENTS = 6
+L_LAW, L_MU_K, L_DELTA_MU, L_ALPHA, L_MU_V = range(5)
 #: Numbers per law row.
-LAW_WIDTH = L_USER + USER_COEFFICIENTS
+LAW_WIDTH = 5
 
 
 class FrictionLawError(StickSlipError, ValueError):
     """A friction law that cannot be used (unknown name, negative coefficient, ...)."""
-
-
-#: The one registered user law: numba function mu(speed, coefficients (USER_COEFFICIENTS,)).
-_USER_LAW: list[Callable] = []
-
-
-def _user_law_placeholder(speed, coefficients):  # pragma: no cover - replaced when a law is registered
-    return coefficients[0] + 0.0 * speed
-
-
-@kernel
-def _no_user_law(speed, coefficients):
-    """Stand-in until :func:`register_law` installs a user law: μk (never reached for built-ins)."""
-    return coefficients[0] + 0.0 * speed
 
 
 @inlined_kernel
@@ -72,22 +54,14 @@ def friction_coefficient(speed, row):
     law = row[L_LAW]
     if law == LAW_COULOMB:
         return row[L_MU_K] + 0.0 * speed
-    if law == LAW_EXPONENTIAL:
-        return row[L_MU_K] + row[L_DELTA_MU] * csm.exp(-row[L_ALPHA] * speed) + row[L_MU_V] * speed
-    return _no_user_law(speed, row[L_USER:])
+    return row[L_MU_K] + row[L_DELTA_MU] * csm.exp(-row[L_ALPHA] * speed) + row[L_MU_V] * speed
 
 
 @inlined_kernel
 def static_coefficient(row):
-    """Static friction coefficient μs [-]: stick holds while |F| ≤ μs N (paper Eq. 10)."""
-    law = row[L_LAW]
-    if law == LAW_COULOMB or law == LAW_EXPONENTIAL:
-        return row[L_MU_K] + row[L_DELTA_MU]
-    return _no_user_law(0.0, row[L_USER:])
-
-
-def register_law(function: Callable) -> None:  # pragma: no cover - filled in below
-    raise NotImplementedError
+    """Static friction coefficient μs [-]: stick holds while |F| ≤ μs N (paper Eq. 10); for both
+    laws μs = μk + Δμ (the exponential law's μ(0))."""
+    return row[L_MU_K] + row[L_DELTA_MU]
 
 
 @dataclasses.dataclass(frozen=True)
