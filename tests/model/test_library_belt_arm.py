@@ -129,6 +129,7 @@ print("ok")
 '''
 
 
+@pytest.mark.slow  # ~36 s: compiles a kinematics class in fresh processes
 def test_kinematics_from_a_module_that_is_gone_do_not_break_other_models(tmp_path):
     """Two processes with a fresh kernel cache (~20 s of compiling)."""
     user = tmp_path / "user"

@@ -80,9 +80,11 @@ def test_every_paper_figure_has_a_recipe():
 @pytest.mark.parametrize("fixture, names, items", [
     ("region_report", REGION_FIGS, ("Fig. 8, regions", "Fig. 8, trend", "Fig. 8 vs Fig. 7", "Fig. 9, Model 4",
                                     "Fig. 9, translation", "Fig. 16(a), (b)", "Fig. 16(c)")),
-    ("bifurcation_report", BIFURCATION_FIGS, ("Fig. 12(b), period", "Fig. 12(b), kind", "Fig. 13(a)", "Fig. 13(b)",
-                                              "Fig. 14(a)(b), Model 2", "Fig. 14(c)(d), Model 3",
-                                              "Fig. 14(e)(f), Model 4", "Fig. 15")),
+    # ~50 s (four bifurcation diagrams settled point by point): with the slow studies
+    pytest.param("bifurcation_report", BIFURCATION_FIGS, ("Fig. 12(b), period", "Fig. 12(b), kind", "Fig. 13(a)",
+                                                          "Fig. 13(b)", "Fig. 14(a)(b), Model 2",
+                                                          "Fig. 14(c)(d), Model 3", "Fig. 14(e)(f), Model 4",
+                                                          "Fig. 15"), marks=pytest.mark.slow),
 ])
 def test_new_figures_rows_and_pngs(request, fixture, names, items):
     out, report = request.getfixturevalue(fixture)
