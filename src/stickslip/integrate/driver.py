@@ -194,10 +194,8 @@ class _Buffers:
         return np.empty(cap), np.empty(cap, dtype=np.int8), np.empty(cap, dtype=np.int8), np.empty((cap, ns))
 
 
-def _warm_up(system: FrictionModel, y: np.ndarray, rtol, atol) -> float:
-    """Compile (or load from cache) the event loop for this kinematics class on a 1 µs run;
-    returns the seconds spent (0 if it was ready)."""
-    start = time.perf_counter()
+def _warm_up(system: FrictionModel, y: np.ndarray, rtol, atol) -> None:
+    """Compile (or load from cache) the event loop for this kinematics class on a 1 µs run."""
     ns = y.size
     cst = contact_state(system.data.m)
     st = np.array([0.0])
@@ -205,8 +203,6 @@ def _warm_up(system: FrictionModel, y: np.ndarray, rtol, atol) -> float:
     integrate_event(y.copy(), cst, 0.0, 1e-6, 1e-6, system.data, rtol, atol, 1e-7, 1e-6, 10, st, 0,
                     np.empty((1, ns)), np.empty(1, dtype=np.int8), np.empty((1, 2 * system.n_contacts)),
                     tr[0], tr[1], tr[2], tr[3], 0)
-    spent = time.perf_counter() - start
-    return spent if spent > 0.05 else 0.0  # a cached or compiled loop answers in microseconds
 
 
 def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
@@ -219,6 +215,7 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
     so the chunks take the same steps as one long call. A KeyboardInterrupt between chunks ends
     the run with what is done (status INTERRUPTED).
     """
+    prepared = time.perf_counter()
     md = system.data
     ns = 2 * system.n + N_EXTRA
     y = np.zeros(ns)
@@ -230,8 +227,12 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
     if lost >= 0:
         raise SimulationError(f"the normal force of contact {lost} is ≤ 0 at the initial state: the contact is open; "
                               "start from a state where every contact is pressed")
-    compile_time = _warm_up(system, y, rtol, atol)
+    _warm_up(system, y, rtol, atol)
     E.initial_modes(y, cst, md, rtol, atol, F, N)
+    # everything before the loop: compiling or loading the kernels when it is the first run of a
+    # process (seconds), else microseconds
+    compile_time = time.perf_counter() - prepared
+    compile_time = compile_time if compile_time > 0.05 else 0.0
     h_max = dt if dt is not None else (t_end - t0)
     h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
     buffers = _Buffers(system, sample_times)
