@@ -229,8 +229,8 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
                               "start from a state where every contact is pressed")
     _warm_up(system, y, rtol, atol)
     E.initial_modes(y, cst, md, rtol, atol, F, N)
-    # everything before the loop: compiling or loading the kernels when it is the first run of a
-    # process (seconds), else microseconds
+    # everything before the loop (packing the model, compiling or loading the kernels) when it is
+    # the first run of a process (seconds; numba's own start is ~0.4 s of it), else microseconds
     compile_time = time.perf_counter() - prepared
     compile_time = compile_time if compile_time > 0.05 else 0.0
     h_max = dt if dt is not None else (t_end - t0)
@@ -390,15 +390,10 @@ def simulate(
     sample_times = t0 + np.arange(n_samples) / sample_rate
 
     start = time.perf_counter()
-    system.data  # packed once per model; the first pack of a process starts numba (~0.4 s): not integration
-    setup = time.perf_counter() - start
-    setup = setup if setup > 0.05 else 0.0  # as _warm_up: a packed model answers in microseconds
-    start = time.perf_counter()
     runner = _run_event if method == "event" else (lambda *a: _run_fixed_step(method, *a))
     code, t_reached, lost, n_kept, buffers, transitions, stats = runner(
         system, y0, t0, t_end, sample_times, rtol, atol, dt, NO_STEP_CAP if max_steps is None else int(max_steps))
     wall = time.perf_counter() - start - stats.get("compile_time_s", 0.0)  # integration only
-    stats["compile_time_s"] = stats.get("compile_time_s", 0.0) + setup
     if n_kept == 0:
         raise SimulationError(f"the run ended before its first sample ({code.message(t_reached, lost)})")
 
