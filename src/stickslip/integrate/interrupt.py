@@ -7,6 +7,11 @@ which replaces the SIGINT handler by one that only records the request; the call
 :attr:`interruptible.requested` between chunks and returns what is done. A second Ctrl-C raises
 KeyboardInterrupt at once (the previous handler's behaviour), for a user who wants out now.
 
+A process started with SIGINT ignored (``nohup``, a background job of a script) keeps ignoring
+it, as Python itself does: the handler is installed only over the default one or a handler of the
+caller's, never over SIG_IGN. Otherwise a Ctrl-C would be honoured only when it happened to land
+inside a run, and lost in between.
+
 Work made of many runs (a sweep, a continuation, shooting) has no use for a partial run: inside
 ``on_ctrl_c(partial=False)`` an interrupted run raises KeyboardInterrupt once its chunk ends.
 """
@@ -41,8 +46,8 @@ def partial_on_ctrl_c() -> bool:
 class interruptible:
     """Context manager: ``with interruptible() as stop: ... if stop.requested: break``.
 
-    Only the main thread can own signal handlers; elsewhere (worker threads) this is inert and
-    ``requested`` stays False.
+    Only the main thread can own signal handlers; elsewhere (worker threads), and in a process
+    that ignores SIGINT (module docstring), this is inert and ``requested`` stays False.
     """
 
     def __init__(self) -> None:
@@ -55,7 +60,8 @@ class interruptible:
         self.requested = True
 
     def __enter__(self) -> "interruptible":
-        if threading.current_thread() is threading.main_thread():
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN):
             try:
                 self._previous = signal.signal(signal.SIGINT, self._handler)
             except ValueError:  # pragma: no cover - not the main interpreter
