@@ -3,7 +3,7 @@
 Each contact's frame (tangent rows G, drive w, normal force N) comes from the model's kinematics
 (:func:`stickslip.model.kinematics.contact_frame`). The stick multipliers also need the velocity
 bias h, the derivative of v along q̇ at fixed q̇ (dv/dt at q̈ = 0). :func:`frame_with_bias` gives
-both: in a float evaluation by a complex step of the frame at q + iε q̇ (exact to round-off,
+both: in closed form where the kinematics class registered a bias function, otherwise in a float evaluation by a complex step of the frame at q + iε q̇ (exact to round-off,
 :data:`COMPLEX_STEP`), inside a complex evaluation (a complex-step Jacobian, whose state is
 complex already) by a central difference (:data:`BIAS_TIME_STEP`); h = 0 for constant
 kinematics. :func:`all_frames` fills the frames of every contact for the friction forces
@@ -12,10 +12,13 @@ kinematics. :func:`all_frames` fills the frames of every contact for the frictio
 
 from __future__ import annotations
 
+from numba import types
+from numba.extending import overload
+
 from . import csmath as csm
 from .bundle import H_CONSTANT
-from .jit import inlined_kernel, kernel
-from .kinematics import contact_dim, contact_frame, model_sizes
+from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
+from .kinematics import contact_dim, contact_frame, model_sizes, registered_frame_bias
 from .model_data import is_stick
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
 
@@ -116,13 +119,28 @@ def _frame_bias_central(s, c, md, G2, w2, h2):
     return contact_frame(md.kin, s, c, m, G2, w2)
 
 
-@kernel
-def frame_with_bias(s, c, md, G2, w2, h2):
+def frame_with_bias(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by numba (overload below)
     """Contact ``c``'s frame (G, w; returns N) and velocity bias h = Ġ q̇ − ẇ = dv/dt at q̈ = 0:
-    by complex step in a float evaluation, by central difference inside a complex one."""
-    if isinstance(s[0], complex):  # resolved at compile time: one branch per number type
-        return _frame_bias_central(s, c, md, G2, w2, h2)
-    return _frame_bias_complex_step(s, c, md, G2, w2, h2)
+    in closed form where the kinematics class registered one, else by complex step in a float
+    evaluation and by central difference inside a complex one."""
+    raise NotImplementedError("frame_with_bias is called from compiled code only")
+
+
+@overload(frame_with_bias, jit_options=KERNEL_OPTIONS)
+def _frame_with_bias(s, c, md, G2, w2, h2):
+    closed_form = registered_frame_bias(md.types[md.fields.index("kin")])
+    if closed_form is not None:  # chosen at compile time, like the frame itself
+        def with_closed_form(s, c, md, G2, w2, h2):
+            return closed_form(md.kin, s, c, md.m, G2, w2, h2)
+        return with_closed_form
+    if isinstance(s.dtype, types.Complex):
+        def by_central_difference(s, c, md, G2, w2, h2):
+            return _frame_bias_central(s, c, md, G2, w2, h2)
+        return by_central_difference
+
+    def by_complex_step(s, c, md, G2, w2, h2):
+        return _frame_bias_complex_step(s, c, md, G2, w2, h2)
+    return by_complex_step
 
 
 @inlined_kernel

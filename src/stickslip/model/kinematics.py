@@ -17,6 +17,16 @@ registered function for that type. So a model's kernels are specialised and inli
 hand-written code, one compiled version per kinematics class (not per parameter value), and
 cached on disk because the class is found by its import path.
 
+A kinematics class may also register a *bias function*
+
+    frame_bias(kin, s, c, m, G, w, h) -> N
+
+that fills the frame as above and the velocity bias ``h`` (2,) = Ġ q̇ − ẇ (the rate of v at q̈ = 0)
+in closed form. It is optional: without it the bias is a complex step of the frame (exact to
+round-off, :mod:`stickslip.model.frames`), which costs one complex evaluation of the frame per
+stick multiplier and event; the closed form is the fast path for a model whose frame is dear
+(the plates' trigonometry), and a test checks it against the complex step.
+
 Frames must work on ``float64`` and ``complex128`` states alike (the Jacobians and the
 acceleration bias Ġ q̇ are taken by complex step): use ``np.sin``, ``np.cos``, ``np.sqrt``,
 ``np.exp`` and arithmetic, never ``abs`` or ``math.*`` on the state, and branch on real parts only.
@@ -27,6 +37,7 @@ from __future__ import annotations
 from typing import Callable, NamedTuple
 
 import numpy as np
+from numba import njit
 from numba.extending import overload
 
 from ..errors import StickSlipError
@@ -35,7 +46,7 @@ from . import stack
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, contact_offsets
 from .jit import KERNEL_OPTIONS, kernel
 
-__all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "contact_frame",
+__all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "registered_frame_bias", "contact_frame",
            "constant_frame", "KinematicsError", "model_sizes", "contact_dim"]
 
 
@@ -49,10 +60,13 @@ _FRAMES: dict[type, Callable] = {}
 _SIZES: dict[type, tuple] = {}
 #: Contact dimension fixed by a kinematics class (or None).
 _DIMS: dict[type, int | None] = {}
+#: Closed-form frame-and-bias functions by kinematics class (optional).
+_BIASES: dict[type, Callable] = {}
 
 
 def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, ncontacts: int | None = None,
-                        diagonal: bool | None = None, dim: int | None = None) -> None:
+                        diagonal: bool | None = None, dim: int | None = None,
+                        frame_bias: Callable | None = None) -> None:
     """Make ``frame`` the contact frame of models whose kinematics data is a ``cls`` instance.
 
     Parameters
@@ -70,12 +84,20 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         Whether M, C and K are always diagonal for this kinematics (skips the dense products).
     dim : {1, 2}, optional
         The dimension of every contact's slip velocity, when fixed by the kinematics.
+    frame_bias : numba-compilable function, optional
+        ``frame_bias(kin, s, c, m, G, w, h) -> N``: the frame and the velocity bias h = Ġ q̇ − ẇ
+        (2,) [m/s²] in closed form (module docstring); complex-safe like ``frame``. Without it
+        the bias is taken by complex step of ``frame``.
     """
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
     _FRAMES[cls] = frame
     _SIZES[cls] = (ndof, ncontacts, diagonal)
     _DIMS[cls] = dim
+    if frame_bias is None:
+        _BIASES.pop(cls, None)
+    else:
+        _BIASES[cls] = frame_bias if hasattr(frame_bias, "py_func") else njit(**KERNEL_OPTIONS)(frame_bias)
     if ndof is not None and ncontacts is not None:
         stack._STATIC[cls] = (ndof, ncontacts)
 
@@ -83,6 +105,12 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
 def registered_kinematics() -> tuple[type, ...]:
     """The kinematics classes known to the compiled kernels."""
     return tuple(_FRAMES)
+
+
+def registered_frame_bias(kin_type) -> Callable | None:
+    """The compiled closed-form frame-and-bias function registered for the numba type ``kin_type``
+    of a kinematics object, or None."""
+    return _BIASES.get(getattr(kin_type, "instance_class", None))
 
 
 def contact_frame(kin, s, c, m, G, w):  # pragma: no cover - resolved by numba (overload below)

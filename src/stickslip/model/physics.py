@@ -54,7 +54,7 @@ from .kinematics import contact_dim, contact_frame, model_sizes
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
                          apply_inverse_mass, is_stick, kinetic_energy, law_row, static_limit)
-from .stack import DOFS, ONE, ROWS, STATES, TWO, VECTORS, work_matrix
+from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
            "rhs", "rhs_body", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
@@ -235,34 +235,23 @@ def normal_force(s, c, md):
 
 @kernel
 def slip_velocity_and_rate(s, ds, c, md):
-    """(v0, v1, a0, a1): slip velocity of contact ``c`` [m/s] and its rate dv/dt [m/s²] along the
-    state derivative ``ds`` (one complex-step frame: v = Re, dv/dt = Im / ε of G(q + iε q̇)(q̇ + iε q̈)
-    − w(q + iε q̇))."""
+    """(v0, v1, a0, a1): slip velocity of contact ``c`` [m/s] and its rate dv/dt = G q̈ + h [m/s²]
+    along the state derivative ``ds`` (h the velocity bias of :func:`frame_with_bias`)."""
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
-    zc = work_matrix(md.kin, ONE, STATES, 1j)[0]
-    cG = work_matrix(md.kin, TWO, DOFS, 1j)
-    cw = work_matrix(md.kin, ONE, TWO, 1j)[0]
+    G2 = work_matrix(md.kin, TWO, DOFS, s)
+    wh = work_matrix(md.kin, TWO, TWO, s)
+    frame_with_bias(s, c, md, G2, wh[0], wh[1])
+    dim = contact_dim(md.kin, m, n, c)
+    v0, v1 = frame_velocity(s, n, dim, G2, wh[0])
+    a0 = wh[1, 0]
+    a1 = wh[1, 1]
     for j in range(n):
-        zc[j] = complex(s[j], COMPLEX_STEP * ds[j])
-        zc[n + j] = s[n + j]
-    contact_frame(md.kin, zc, c, m, cG, cw)
-    # Re and Im of G (q̇ + iε q̈) − w, written out: Im needs Im G q̇ + Re G ε q̈ only
-    v0 = -cw[0].real
-    v1 = -cw[1].real
-    a0 = -cw[0].imag
-    a1 = -cw[1].imag
-    for j in range(n):
-        qd = s[n + j]
-        qdd = COMPLEX_STEP * ds[n + j]
-        v0 += cG[0, j].real * qd
-        v1 += cG[1, j].real * qd
-        a0 += cG[0, j].imag * qd + cG[0, j].real * qdd
-        a1 += cG[1, j].imag * qd + cG[1, j].real * qdd
-    if contact_dim(md.kin, m, n, c) == 1:
-        v1 = 0.0
+        a0 += G2[0, j] * ds[n + j]
+        a1 += G2[1, j] * ds[n + j]
+    if dim == 1:
         a1 = 0.0
-    return v0, v1, a0 / COMPLEX_STEP, a1 / COMPLEX_STEP
+    return v0, v1, a0, a1
 
 
 @kernel
