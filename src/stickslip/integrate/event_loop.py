@@ -32,7 +32,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
-from ..model.jit import kernel, loop
+from ..model.jit import inlined_kernel, kernel, loop
 from ..model.kinematics import model_sizes
 from . import contacts as E
 from . import dormand_prince as DP
@@ -93,7 +93,7 @@ def error_norm(y, ynew, Kst, h, md, rtol, atol):
     return math.sqrt(total / count)
 
 
-@kernel
+@inlined_kernel
 def store_sample(idx, y, cst, md, F, N, v, out_s, out_mode, out_F):
     """Write sample ``idx``: the state, the mode flags (bit c: contact c sticks) and each contact's
     friction force at ``y``."""

@@ -9,7 +9,7 @@
   (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more).
 
 :func:`sliding_forces` computes the common case, every contact sliding outside the band, on the
-caller's stack arrays; :func:`general_forces_body` any mix of modes. Both fill the generalised
+caller's stack arrays (:func:`sliding_friction` its friction forces alone, for the queries); :func:`general_forces_body` any mix of modes. Both fill the generalised
 force f = f0 − C q̇ − K q + Σ G_cᵀ F_c, from which :mod:`stickslip.model.physics` writes the state
 derivative and answers its per-contact queries.
 """
@@ -33,7 +33,7 @@ from .stack import DOFS, ROWS, VECTORS, work_matrix
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
-           "general_forces", "sliding_forces"]
+           "general_forces", "sliding_friction", "sliding_forces"]
 
 
 # ----------------------------------------------------------------------------- slip forces
@@ -316,16 +316,15 @@ def general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
 
 
 @inlined_kernel
-def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
-    """The common case on the caller's (stack) arrays: every contact sliding outside the low-speed
-    band. Fills G, w, v, N, F and f = f0 − C q̇ − K q + Σ G_cᵀ F_c and returns True; returns False
-    (arrays incomplete) as soon as a contact sticks or is inside the band."""
+def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
+    """The friction forces of the common case, every contact sliding outside the low-speed band:
+    fills G, w, v, N and F and returns True; returns False (arrays incomplete) as soon as a
+    contact sticks or is inside the band."""
     m = md.m
     for c in range(nc):
         if is_stick(cst, c):
             return False
     band = m[H_BAND]
-    base_force(s, m, n, diagonal, f)
     for c in range(nc):
         G2 = G[2 * c:2 * c + 2]
         normal = contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
@@ -341,5 +340,17 @@ def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
         F0, F1 = slip_force(m, n, c, dim, speed, v0 * inv, v1 * inv, normal)
         F[2 * c] = F0
         F[2 * c + 1] = F1
-        add_contact_force(G2, dim, n, F0, F1, f)
+    return True
+
+
+@inlined_kernel
+def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+    """:func:`sliding_friction` and the generalised force f = f0 − C q̇ − K q + Σ G_cᵀ F_c on the
+    caller's (stack) arrays; False (arrays incomplete) when a contact sticks or is in the band."""
+    if not sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
+        return False
+    m = md.m
+    base_force(s, m, n, diagonal, f)
+    for c in range(nc):
+        add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
     return True

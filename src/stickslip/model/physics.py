@@ -46,7 +46,7 @@ import numpy as np
 from . import csmath as csm
 from .bundle import CST, H_BAND, offsets
 from .forces import (add_contact_force, general_forces, general_forces_body, quasi_static_direction, sliding_forces,
-                     solve_stick_rows, stick_rows)
+                     sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
 from .friction import friction_coefficient
 from .jit import inlined_kernel, kernel
@@ -154,7 +154,7 @@ def contact_forces(s, cst, md, F_out, N_out, v_out):
     h = vec[3]
     F = vec[4]
     f = vec[5]
-    if not sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+    if not sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
         general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     for c in range(nc):
         N_out[c] = N[c]
