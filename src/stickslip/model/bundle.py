@@ -1,11 +1,13 @@
 """The typed bundle through which a model reaches the compiled kernels.
 
-A model arrives in compiled code as one :class:`ModelData` = (``m``, ``kin``):
+A model arrives in compiled code as one :class:`ModelData` = (``m``, ``kin``, ``law``):
 
 ``m``    one flat float64 array holding every number of the model, so that a kernel call passes
          one array descriptor instead of a dozen;
 ``kin``  the model's kinematics data, a NamedTuple whose *class* selects the contact frame at
-         compile time (:mod:`stickslip.model.kinematics`).
+         compile time (:mod:`stickslip.model.kinematics`);
+``law``  the model's user friction law, a NamedTuple whose class selects its compiled function
+         (:mod:`stickslip.model.friction`; :class:`~stickslip.model.friction.NoUserLaw` if none).
 
 Layout of ``m`` (n DOFs, nc contacts). Block offsets follow from n alone (:func:`offsets`), so
 that for kinematics classes that fix n the compiler folds them to constants:
@@ -30,7 +32,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .friction import LAW_WIDTH
+from .friction import LAW_WIDTH, NoUserLaw
 from .jit import inlined_kernel
 
 __all__ = ["ModelData", "pack", "offsets", "contact_offsets", "contact_width", "contact_state",
@@ -50,10 +52,12 @@ C_G = C_LAW + LAW_WIDTH
 
 
 class ModelData(NamedTuple):
-    """A model as the compiled kernels take it: flat numbers ``m`` and kinematics data ``kin``."""
+    """A model as the compiled kernels take it: flat numbers ``m``, kinematics data ``kin`` and the
+    user friction law ``law``."""
 
     m: np.ndarray
     kin: Any
+    law: Any = NoUserLaw()
 
 
 @inlined_kernel

@@ -22,13 +22,12 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, H_BAND
-from .friction import friction_coefficient
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel
 from .kinematics import contact_dim, contact_frame
 from .linalg import solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
-                         is_stick, law_row)
+                         is_stick, kinetic_coefficient)
 from .stack import DOFS, ROWS, VECTORS, work_matrix
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
@@ -55,9 +54,9 @@ def exact_direction(mode, speed, band):
 
 
 @inlined_kernel
-def slip_force(m, n, c, dim, speed, e0, e1, normal):
+def slip_force(md, n, c, dim, speed, e0, e1, normal):
     """Slip friction force −μ(|v|) N e of contact ``c`` along the unit direction e [N]."""
-    scale = -friction_coefficient(speed, law_row(m, n, c)) * normal
+    scale = -kinetic_coefficient(md, n, c, speed) * normal
     if dim == 2:
         return scale * e0, scale * e1
     return scale * e0, csm.zero(scale)
@@ -264,7 +263,7 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
         speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
         if exact_direction(mode, speed.real, band):
             inv = 1.0 / speed
-            F0, F1 = slip_force(m, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
+            F0, F1 = slip_force(md, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
             F[2 * c] = F0
             F[2 * c + 1] = F1
             add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
@@ -299,10 +298,10 @@ def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
             frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
             k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
             if k == 2:
-                muN = (friction_coefficient(speed, law_row(m, n, c)) * N[c]).real
+                muN = (kinetic_coefficient(md, n, c, speed) * N[c]).real
                 ex, ey = quasi_static_direction(a00.real, a01.real, a11.real,
                                                 F[2 * c].real, F[2 * c + 1].real, muN, ex, ey)
-        F0, F1 = slip_force(m, n, c, dim, speed, ex, ey, N[c])
+        F0, F1 = slip_force(md, n, c, dim, speed, ex, ey, N[c])
         F[2 * c] = F0
         F[2 * c + 1] = F1
         add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
@@ -337,7 +336,7 @@ def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
         if not exact_direction(np.int64(cst[CST * c]), speed.real, band):
             return False
         inv = 1.0 / speed
-        F0, F1 = slip_force(m, n, c, dim, speed, v0 * inv, v1 * inv, normal)
+        F0, F1 = slip_force(md, n, c, dim, speed, v0 * inv, v1 * inv, normal)
         F[2 * c] = F0
         F[2 * c + 1] = F1
     return True

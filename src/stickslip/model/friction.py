@@ -6,32 +6,49 @@ Built-in laws (``law`` code in the contact's data row):
 ``exponential``   μ(v) = μk + Δμ exp(−α v) + μv v (paper Eq. 4 with an optional viscous term
                   μv), so μ(0) = μs = μk + Δμ: the static coefficient is the limit of the kinetic one.
 
+``user``          μ(v) = a compiled function of |v| of the user's own (below); μs given with it
+                  (default μ(0)).
+
 Laws are evaluated by compiled code through :func:`friction_coefficient` (slip) and
 :func:`static_coefficient` (stick), on ``float64`` or ``complex128`` speeds alike (the complex
 step of the Jacobians differentiates through them), so they use ``exp``-style functions and no
-``abs``. A law of the user's own (a compiled function of |v|) is not available yet.
+``abs``.
 
 Each contact's law is one row of :data:`LAW_WIDTH` numbers in the model's data array
-(``[law, mu_k, delta_mu, alpha, mu_v]``, see :mod:`stickslip.model.bundle`).
+(``[law, mu_k, delta_mu, alpha, mu_v]``, see :mod:`stickslip.model.bundle`); a user law's row is
+``[user, mu_s, 0, 0, 0]``.
+
+**A user law** is a ``typing.NamedTuple`` class of its parameters (numbers) and a numba-compilable
+function ``mu(law, speed) -> μ`` of an instance and the slip speed |v| ≥ 0 [m/s], registered once
+with :func:`register_friction_law`; a contact takes it as ``FrictionLaw.from_user(instance, mu_s)``.
+Like a kinematics class, the law's class travels in the model's compiled bundle
+(``ModelData.law``), so the kernels are compiled for it (once, then cached on disk by its import
+path) and call it like hand-written code. The function must be complex-safe: use
+:mod:`stickslip.model.csmath` (``exp``, ``sqrt``, ``sin``, ``cos``) and arithmetic, no ``abs`` or
+``math.*`` on the speed, branches on ``speed.real`` only. All contacts of a model that use a user
+law share one instance. :mod:`stickslip.model.library.laws` holds a Stribeck law written this way.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Mapping
+from typing import Any, Callable, Mapping, NamedTuple
 
 import numpy as np
+from numba import njit
+from numba.extending import overload
 
 from ..errors import StickSlipError
 from . import csmath as csm
-from .jit import inlined_kernel
+from .jit import KERNEL_OPTIONS, inlined_kernel
 
-__all__ = ["FrictionLaw", "FrictionLawError", "LAWS", "LAW_COULOMB", "LAW_EXPONENTIAL", "LAW_WIDTH",
-           "friction_coefficient", "static_coefficient"]
+__all__ = ["FrictionLaw", "FrictionLawError", "LAWS", "LAW_COULOMB", "LAW_EXPONENTIAL", "LAW_USER", "LAW_WIDTH",
+           "NoUserLaw", "register_friction_law", "friction_coefficient", "static_coefficient"]
 
 LAW_EXPONENTIAL = 0
 LAW_COULOMB = 1
+LAW_USER = 2
 #: Law names as they appear in model files and ``--set``.
 LAWS = {"exponential": LAW_EXPONENTIAL, "coulomb": LAW_COULOMB}
 
@@ -45,22 +62,67 @@ class FrictionLawError(StickSlipError, ValueError):
     """A friction law that cannot be used (unknown name, negative coefficient, ...)."""
 
 
+# ----------------------------------------------------------------------------- user laws
+class NoUserLaw(NamedTuple):
+    """The user-law slot of a model whose contacts all use built-in laws."""
+
+    unused: float = 0.0
+
+
+#: Registered user-law functions by law class (compiled).
+_USER_LAWS: dict[type, Callable] = {}
+
+
+def register_friction_law(cls: type, mu: Callable) -> None:
+    """Make ``mu(law, speed) -> μ`` the friction coefficient of contacts whose law is a ``cls`` instance.
+
+    Parameters
+    ----------
+    cls : NamedTuple class
+        The law's parameters (fields: numbers). Keep it importable under the same module path: the
+        compiled kernels are cached on disk by it.
+    mu : numba-compilable function
+        Kinetic coefficient [-] at slip speed ``speed`` = |v| ≥ 0 [m/s] (float or complex:
+        complex-safe as the module docstring says). Plain Python functions are compiled.
+    """
+    if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
+        raise FrictionLawError(f"friction law class {cls!r} must be a NamedTuple of numbers")
+    _USER_LAWS[cls] = mu if hasattr(mu, "py_func") else njit(**KERNEL_OPTIONS)(mu)
+
+
+def user_coefficient(law, speed):  # pragma: no cover - resolved by numba (overload below)
+    """μ(|v|) of the registered user law ``law``."""
+    raise NotImplementedError("user_coefficient is called from compiled code only")
+
+
+@overload(user_coefficient, jit_options=KERNEL_OPTIONS)
+def _user_coefficient(law, speed):
+    mu = _USER_LAWS.get(getattr(law, "instance_class", None))
+    if mu is None:  # NoUserLaw: no contact has the user law code (checked when the model is built)
+        return lambda law, speed: speed * 0.0 + np.nan
+    return lambda law, speed: mu(law, speed)
+
+
+# ----------------------------------------------------------------------------- compiled laws
 @inlined_kernel
-def friction_coefficient(speed, row):
-    """Kinetic friction coefficient μ(|v|) [-] of the law ``row`` (a contact's law row).
+def friction_coefficient(speed, row, law):
+    """Kinetic friction coefficient μ(|v|) [-] of the law ``row`` (a contact's law row); ``law``
+    the model's user-law instance (:class:`NoUserLaw` if none).
 
     ``speed`` may be complex (complex-step differentiation); branches read only the law code.
     """
-    law = row[L_LAW]
-    if law == LAW_COULOMB:
+    code = row[L_LAW]
+    if code == LAW_COULOMB:
         return row[L_MU_K] + 0.0 * speed
+    if code == LAW_USER:
+        return user_coefficient(law, speed) + 0.0 * speed
     return row[L_MU_K] + row[L_DELTA_MU] * csm.exp(-row[L_ALPHA] * speed) + row[L_MU_V] * speed
 
 
 @inlined_kernel
 def static_coefficient(row):
-    """Static friction coefficient μs [-]: stick holds while |F| ≤ μs N (paper Eq. 10); for both
-    laws μs = μk + Δμ (the exponential law's μ(0))."""
+    """Static friction coefficient μs [-]: stick holds while |F| ≤ μs N (paper Eq. 10); for the
+    built-in laws μs = μk + Δμ (the exponential law's μ(0)), a user law's row holds μs there."""
     return row[L_MU_K] + row[L_DELTA_MU]
 
 
@@ -70,8 +132,9 @@ class FrictionLaw:
 
     Attributes
     ----------
-    law : {"exponential", "coulomb"}
-        ``exponential``: μ = μk + Δμ exp(−α|v|) + μv |v|; ``coulomb``: μ = μk in slip.
+    law : {"exponential", "coulomb", "user"}
+        ``exponential``: μ = μk + Δμ exp(−α|v|) + μv |v|; ``coulomb``: μ = μk in slip; ``user``: a
+        registered law of the user's own (build it with :meth:`from_user`).
     mu_k : float
         Kinetic coefficient μk [-] (≥ 0).
     delta_mu : float
@@ -80,6 +143,8 @@ class FrictionLaw:
         Decay of the exponential law [s/m] (≥ 0).
     mu_v : float
         Viscous term of the exponential law [s/m] (≥ 0).
+    user : NamedTuple, optional
+        The user law's instance (law ``"user"`` only); then ``mu_k`` holds its μs and ``delta_mu`` is 0.
     """
 
     law: str = "exponential"
@@ -87,10 +152,28 @@ class FrictionLaw:
     delta_mu: float = 0.1
     alpha: float = 5.0
     mu_v: float = 0.0
+    user: Any = None
+
+    @classmethod
+    def from_user(cls, law: Any, mu_s: float | None = None) -> "FrictionLaw":
+        """A contact's law from a user law instance (its class registered with
+        :func:`register_friction_law`); stick holds while |F| ≤ μs N, μs default μ(0)."""
+        if type(law) not in _USER_LAWS:
+            raise FrictionLawError(f"friction law {law!r}: its class is not registered; call "
+                                   "stickslip.model.friction.register_friction_law(cls, mu) first")
+        if mu_s is None:
+            mu_s = float(np.real(_USER_LAWS[type(law)].py_func(law, 0.0)))
+        return cls("user", mu_k=mu_s, delta_mu=0.0, alpha=0.0, mu_v=0.0, user=law)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.law, str) or self.law not in LAWS:
+        if self.law == "user":
+            if self.user is None or type(self.user) not in _USER_LAWS:
+                raise FrictionLawError("friction law 'user' needs a registered law instance; build it with "
+                                       "FrictionLaw.from_user(instance, mu_s)")
+        elif not isinstance(self.law, str) or self.law not in LAWS:
             raise FrictionLawError(f"friction law {self.law!r} is unknown; choose one of {', '.join(LAWS)}")
+        elif self.user is not None:
+            raise FrictionLawError(f"friction law {self.law!r} takes no user law instance; use law='user'")
         for name in ("mu_k", "delta_mu", "alpha", "mu_v"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -107,7 +190,7 @@ class FrictionLaw:
     def row(self) -> np.ndarray:
         """The law as a data row (:data:`LAW_WIDTH`,) for the compiled kernels."""
         row = np.zeros(LAW_WIDTH)
-        row[L_LAW] = LAWS[self.law]
+        row[L_LAW] = LAW_USER if self.law == "user" else LAWS[self.law]
         row[L_MU_K] = self.mu_k
         row[L_DELTA_MU] = self.delta_mu
         row[L_ALPHA] = self.alpha
@@ -117,11 +200,18 @@ class FrictionLaw:
     def coefficient(self, speed) -> np.ndarray:
         """μ(|v|) [-] for an array of speeds [m/s] (numpy; for plots and checks)."""
         speed = np.abs(np.asarray(speed, dtype=float))
+        if self.law == "user":
+            mu = _USER_LAWS[type(self.user)].py_func
+            return np.vectorize(lambda v: float(np.real(mu(self.user, v))), otypes=[float])(speed)
         if self.law == "coulomb":
             return np.full_like(speed, self.mu_k)
         return self.mu_k + self.delta_mu * np.exp(-self.alpha * speed) + self.mu_v * speed
 
     def to_dict(self) -> dict:
+        if self.law == "user":
+            kind = type(self.user)
+            return {"law": "user", "function": f"{kind.__module__}.{kind.__qualname__}", "mu_s": self.mu_s,
+                    **{k: float(v) for k, v in self.user._asdict().items()}}
         out = {"law": self.law, "mu_k": self.mu_k, "delta_mu": self.delta_mu}
         if self.law == "exponential":
             out.update(alpha=self.alpha, mu_v=self.mu_v)
@@ -135,6 +225,10 @@ class FrictionLaw:
         if unknown:
             raise FrictionLawError(f"{where}: unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(sorted(known))}")
         law = table.get("law", "exponential")
+        if law == "user":
+            raise FrictionLawError(f"{where}.law = 'user' is a law of your own in Python and cannot be stated in a "
+                                   "file; define the model in Python (FrictionLaw.from_user) or choose one of "
+                                   f"{', '.join(LAWS)}")
         if not isinstance(law, str) or law not in LAWS:
             raise FrictionLawError(f"{where}.law = {law!r} is unknown; choose one of {', '.join(LAWS)}")
         for key in ("mu_k", "delta_mu"):

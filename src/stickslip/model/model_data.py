@@ -19,12 +19,12 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, C_LAW, contact_offsets, offsets
-from .friction import LAW_WIDTH, static_coefficient
+from .friction import LAW_WIDTH, friction_coefficient, static_coefficient
 from .jit import inlined_kernel, kernel
 from .kinematics import model_sizes
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
-           "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy"]
+           "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy"]
 
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
@@ -41,6 +41,12 @@ def law_row(m, n, c):
     """Friction law row of contact ``c`` (a view of ``m``)."""
     o = contact_offsets(n, c)[0] + C_LAW
     return m[o:o + LAW_WIDTH]
+
+
+@inlined_kernel
+def kinetic_coefficient(md, n, c, speed):
+    """Kinetic friction coefficient μ(|v| = ``speed``) [-] of contact ``c`` (float or complex speed)."""
+    return friction_coefficient(speed, law_row(md.m, n, c), md.law)
 
 
 @inlined_kernel

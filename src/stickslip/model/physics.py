@@ -48,12 +48,11 @@ from .bundle import CST, H_BAND, offsets
 from .forces import (add_contact_force, general_forces, general_forces_body, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
-from .friction import friction_coefficient
 from .jit import inlined_kernel, kernel
 from .kinematics import contact_dim, contact_frame, model_sizes
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
-                         apply_inverse_mass, is_stick, kinetic_energy, law_row, static_limit)
+                         apply_inverse_mass, is_stick, kinetic_coefficient, kinetic_energy, law_row, static_limit)
 from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
@@ -62,7 +61,7 @@ __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP",
            # used by the orbits' variational kernels (orbits/var_kernels.py)
            "general_forces", "solve_stick_rows", "quasi_static_direction", "add_contact_force", "apply_inverse_mass",
-           "is_stick", "law_row"]
+           "is_stick", "law_row", "kinetic_coefficient"]
 
 
 # ----------------------------------------------------------------------------- derivative
@@ -281,7 +280,7 @@ def band_direction(s, cst, c, md, speed):
     k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
     if k != 2:
         return ex, ey
-    muN = friction_coefficient(speed, law_row(m, n, c)) * N[c]
+    muN = kinetic_coefficient(md, n, c, speed) * N[c]
     return quasi_static_direction(a00, a01, a11, F[2 * c], F[2 * c + 1], muN, ex, ey)
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import StickSlipError
 from .bundle import ModelData, pack
-from .friction import FrictionLaw
+from .friction import FrictionLaw, NoUserLaw
 from .kinematics import ConstantKinematics, registered_kinematics
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
@@ -262,7 +262,17 @@ class FrictionModel:
         """The model as the compiled kernels take it (:class:`~stickslip.model.bundle.ModelData`)."""
         m = pack(self.mass, self.damping, self.stiffness, self.force, self.free,
                  [contact.spec(self.n) for contact in self.contacts], self.slip_band, self.constant_kinematics)
-        return ModelData(m, self.kinematics)
+        return ModelData(m, self.kinematics, self.user_law)
+
+    @property
+    def user_law(self):
+        """The user friction law instance the contacts share (:class:`~stickslip.model.friction.NoUserLaw`
+        if none)."""
+        laws = {c.friction.user for c in self.contacts if c.friction.law == "user"}
+        if len(laws) > 1:
+            raise ModelError(f"model {self.name!r}: contacts with a user friction law must share one instance "
+                             f"(got {len(laws)}); give them the same FrictionLaw.from_user(...)")
+        return laws.pop() if laws else NoUserLaw()
 
     def state_index(self, name: str) -> int:
         """Index of a state by name (``x``, ``dx``, ...)."""

@@ -28,7 +28,6 @@ from ..integrate import dormand_prince as DP
 from ..model import csmath as csm
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
-from ..model.friction import friction_coefficient
 from ..model.jit import kernel, loop
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, VECTORS, work_matrix
@@ -95,7 +94,7 @@ def direction_residual(s, cst, c, md, ct, st):
     P.frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
     k, a00, a01, a11 = P.solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
     speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
-    muN = friction_coefficient(speed, P.law_row(m, n, c)) * N[c]
+    muN = P.kinetic_coefficient(md, n, c, speed) * N[c]
     wx = a00 * F[2 * c] + a01 * F[2 * c + 1]
     wy = a01 * F[2 * c] + a11 * F[2 * c + 1]
     c2 = ct * ct - st * st

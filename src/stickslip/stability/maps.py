@@ -110,7 +110,11 @@ class _Axis:
         self.base, self.name = base, name
         lo, hi = float(values[0]), float(values[-1])
         probes = [lo, hi, 0.5 * (lo + hi)] if hi != lo else [lo]
-        rows = np.array([_row(self._model(v)) for v in probes])
+        models = [self._model(v) for v in probes]
+        if any(model.data.law != base.data.law for model in models):
+            raise ValueError(f"{name} changes the parameters of the model's user friction law; it cannot be a "
+                             "stability-map axis (run a sweep over it instead)")
+        rows = np.array([_row(model) for model in models])
         self.base_row = rows[0]
         self.changed = np.any(rows != rows[0], axis=0)
         self.fast = False
@@ -194,7 +198,7 @@ class MapGrid:
         if not self.separable:
             ra, ia = ra[ia * self.b.size + ib], np.arange(ia.size, dtype=np.int64)
         steady.jacobian_points(ra[:, :L], rb[:, :L], self.mask_b[:L], ra[:, L:], rb[:, L:], self.mask_b[L:],
-                               ia.astype(np.int64), ib.astype(np.int64), system.data.kin, free,
+                               ia.astype(np.int64), ib.astype(np.int64), system.data.kin, system.data.law, free,
                                MAX_ITER, RESIDUAL_TOL, out)
         return out
 

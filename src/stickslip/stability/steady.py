@@ -254,7 +254,7 @@ def steady_sliding_point(md, free, max_iter):
     status, rel, iterations = _newton_from(q, cst, md, free, max_iter)
     if not rel <= CONTINUATION_ACCEPT:
         mw = m.copy()
-        mdw = ModelData(mw, md.kin)
+        mdw = ModelData(mw, md.kin, md.law)
         lam = 0.0
         step = 0.125
         qc = np.zeros(n)
@@ -327,12 +327,13 @@ def steady_jacobian(md, free, max_iter, tol, J):
 
 
 @loop
-def jacobian_points(m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib, kin0, free, max_iter, tol, out):
+def jacobian_points(m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib, kin0, law, free, max_iter, tol, out):
     """:func:`steady_jacobian` at points assembled from two axis tables, into ``out`` (P, 2k, 2k).
 
     Point p has the data array ``m_a[ia[p]]`` with the entries flagged in ``mask_b`` taken from
     ``m_b[ib[p]]``, and kinematics ``kinematics_from(kin0, kv)`` with kv = ``kv_a[ia[p]]`` and the
-    fields flagged in ``kmask_b`` from ``kv_b[ib[p]]``. A map whose two parameters touch disjoint
+    fields flagged in ``kmask_b`` from ``kv_b[ib[p]]``, and the user friction law ``law`` of the
+    model (:class:`~stickslip.model.friction.NoUserLaw` if none). A map whose two parameters touch disjoint
     entries is thus nA + nB tables instead of nA × nB models. NaN where no steady sliding exists.
     """
     mw = np.empty(m_a.shape[1])
@@ -344,4 +345,4 @@ def jacobian_points(m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib, kin0, free, m
             mw[i] = m_b[b, i] if mask_b[i] else m_a[a, i]
         for i in range(kv.shape[0]):
             kv[i] = kv_b[b, i] if kmask_b[i] else kv_a[a, i]
-        steady_jacobian(ModelData(mw, kinematics_from(kin0, kv)), free, max_iter, tol, out[p])
+        steady_jacobian(ModelData(mw, kinematics_from(kin0, kv), law), free, max_iter, tol, out[p])
