@@ -25,10 +25,9 @@ import math
 import numpy as np
 
 from .jit import inlined_kernel, kernel
+# Indices into the packed contact/friction array ``p`` (the assembled System's layout).
+from .system import N_P, P_ALPHA, P_DELTA_MU, P_LAW, P_MU_K, P_N, P_OMEGA, P_R, P_SLIP_BAND  # noqa: F401
 
-# Indices into the packed contact/friction array ``p``.
-P_R, P_N, P_OMEGA, P_MU_K, P_DELTA_MU, P_ALPHA, P_LAW, P_SLIP_BAND = range(8)
-N_P = 8
 LAW_EXPONENTIAL = 0  # paper Eq. (4)
 LAW_COULOMB = 1      # μ = μk in slip, μs = μk + Δμ in stick
 

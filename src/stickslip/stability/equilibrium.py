@@ -14,7 +14,6 @@ import math
 import numpy as np
 
 from ..errors import StickSlipError
-from ..model import kernels
 from ..model.parameters import Parameters
 from ..model.system import System, assemble
 from . import steady
@@ -45,9 +44,7 @@ class EquilibriumError(StickSlipError, RuntimeError):
 
 def plates_model(system: System):
     """The :class:`~stickslip.model.FrictionModel` of an assembled plates :class:`System`."""
-    from ..model.library.two_plates import two_plates
-
-    return two_plates(system.params, system.variant, float(system.p[kernels.P_SLIP_BAND]))
+    return system.model()
 
 
 def _is_plates(system) -> bool:
@@ -234,7 +231,7 @@ def equilibrium(params: Parameters, model="full") -> np.ndarray:
         sliding), or when Newton does not reach a relative residual of :data:`RESIDUAL_TOL`
         (e.g. at large N and small Ω, where the contact point is dragged to the centre of the
         lower plate and steady sliding ceases to exist), or when the sliding speed |Ω| R at
-        equilibrium is inside the simulator's low-speed band (``kernels.DEFAULT_SLIP_BAND``).
+        equilibrium is inside the simulator's low-speed band (``model.system_model.DEFAULT_SLIP_BAND``).
     """
     if not isinstance(params, Parameters):
         raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
