@@ -8,8 +8,8 @@ import pytest
 
 import stickslip
 from stickslip import Parameters, SimulationError
-from stickslip.model import assemble
-from stickslip.model import kernels as K
+from stickslip.model.bundle import H_BAND
+from stickslip.model.library import two_plates
 
 
 def _vr_norm(traj):
@@ -129,7 +129,7 @@ def test_variants_no_nan_and_vr_zero_in_stick(model):
         # can act on v_r·e_x, so only the controllable component is held
         vr = vr[:, 1:]
     assert np.abs(vr).max() < 1e-12
-    locked = ~assemble(params, model).variant.mask
+    locked = ~two_plates(params, model).free
     assert np.all(traj.states[:, :6][:, locked] == 0.0)
 
 
@@ -151,12 +151,14 @@ def test_agrees_with_event_100s():
 
 
 def test_step_band_formula():
-    from stickslip.integrate.fixed_step import kernel_parameters, step_band
+    from stickslip.integrate.fixed_step import step_band, step_data
 
-    system = assemble(Parameters(), "full")
+    model = two_plates(Parameters(), "full")
     # Δt μs N tr(G M⁻¹ Gᵀ) at R = r: 1e-4 * 15 * (1 + 1 + 0.1 + 0.1 + 0.04/0.5 + 0.04/5)
-    assert step_band(system, 1e-4) == pytest.approx(1e-4 * 15 * 2.288)
-    assert kernel_parameters(system, 1e-6)[K.P_SLIP_BAND] == system.p[K.P_SLIP_BAND]
+    assert step_band(model, 1e-4) == pytest.approx(1e-4 * 15 * 2.288)
+    assert step_data(model, 1e-4).m[H_BAND] == pytest.approx(1e-4 * 15 * 2.288)
+    assert step_data(model, 1e-6).m[H_BAND] == model.slip_band  # the model's band where that is wider
+    assert step_data(model, 1e-6).kin == model.data.kin
 
 
 @pytest.mark.parametrize("method", ["aeom", "naeom"])

@@ -8,8 +8,9 @@ import stickslip
 from stickslip import Parameters, SimulationError
 from stickslip.integrate import fixed_step as F
 from stickslip.integrate import method_naeom as N
-from stickslip.model import assemble
-from stickslip.model import kernels as K
+from stickslip.model import physics as P
+from stickslip.model.bundle import contact_state
+from stickslip.model.library import two_plates
 
 
 def _stick_state():
@@ -22,23 +23,24 @@ def _stick_state():
 
 @pytest.mark.parametrize("h", [1e-3, 1e-4, 1e-5])
 def test_solve_reaches_tolerance_and_is_a_real_solve(h):
-    system = assemble(Parameters(), "full")
+    md = two_plates(Parameters(), "full").data
     y = _stick_state()
     n = 14
-    ynew, ytmp, k1, k2, k3, k4 = (np.zeros(n) for _ in range(6))
+    ynew, ytmp = np.zeros(n), np.zeros(n)
     stats = np.zeros(8, dtype=np.int64)
-    Fx, Fy, it = N.solve_stick_step(y, h, 0.0, 0.0, system.minv, system.damp, system.stiff, system.p,
-                                    ynew, ytmp, k1, k2, k3, k4, stats)
+    Fx, Fy, it = N.solve_stick_step(y, h, 0.0, 0.0, md, ynew, ytmp, np.zeros((4, n)), stats)
     assert it > 0
-    assert np.hypot(*K.relative_velocity(ynew, system.p)) <= N.VR_TOL
+    assert np.hypot(*P.slip_velocity(ynew, 0, md)) <= N.VR_TOL
     # the solved constant force is the stick multiplier averaged over the step: O(h) from it
-    Fs = K.stick_force(y, system.minv, system.damp, system.stiff, system.p)[:2]
+    stick = contact_state(md.m)
+    stick[0] = P.MODE_STICK
+    Fs, normal = np.zeros(2), np.zeros(1)
+    P.stick_forces(y, stick, -1, md, Fs, normal)
     assert np.hypot(Fx - Fs[0], Fy - Fs[1]) < 1e3 * h
     # re-integrating with the returned force reproduces v_r(t_n) = 0 (independent check)
     out = np.zeros(n)
-    N.rk4_force_step(y, h, Fx, Fy, system.minv, system.damp, system.stiff, system.p, out,
-                     *(np.zeros(n) for _ in range(5)))
-    assert np.hypot(*K.relative_velocity(out, system.p)) <= N.VR_TOL
+    N.rk4_force_step(y, h, Fx, Fy, md, out, np.zeros(n), np.zeros((4, n)))
+    assert np.hypot(*P.slip_velocity(out, 0, md)) <= N.VR_TOL
 
 
 def test_iteration_cap_raises_clear_error(monkeypatch):

@@ -1,16 +1,19 @@
-"""Transitions of the paper's fixed-step methods (AEOM, NAEOM) on the plates' own kernels.
+"""Transitions of the paper's fixed-step methods (AEOM, NAEOM): what they add to the generic
+transition logic of :mod:`.contacts`.
 
-The event codes, tolerances and the root-finding steps (dense output, Illinois regula falsi) are
-the generic event integrator's (:mod:`.contacts`); this module holds what the fixed-step
-methods add on the plates' kernels: event functions of the plates' state, the step's Hermite
-interpolant (a dense output ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)`` with three columns) and the
-bisection on re-stepping.
+The event functions, the Illinois root refinement on a dense output, the stick test and the
+breakaway direction are those of the generic event integrator (:mod:`.contacts`, on the generic
+physics). This module holds what the fixed-step methods add: the step's cubic Hermite
+interpolant (a dense output ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)`` with three columns), the root of
+an event on it, the trial points of bisection on re-stepping and the mode a run starts in. The
+models have one contact (the plates), contact 0.
 
-* slip → stick: ``slip_event`` is the projection of v_r on its direction at the start of the step.
-  A sign change means the 2-D velocity passed (near) zero; at the located root, if |v_r| is below
-  :data:`STICK_SPEED_TOL` and the stick force is admissible (|F| ≤ μs N, Eq. 10), stick begins;
-  if it is not admissible, v_r is set to zero and slip departs as at breakaway.
-* stick → slip: ``stick_event`` = μs N − |F_stick|; its root is breakaway (Eq. 10). Slip starts
+* slip → stick: ``EVENT_SLIP`` is the projection of v_r on a reference direction (its direction at
+  the start of the step). A sign change means the 2-D velocity passed (near) zero; at the located
+  root, if |v_r| is below :data:`STICK_SPEED_TOL` and the stick force is admissible
+  (|F| ≤ μs N, Eq. 10), stick begins; if it is not admissible, v_r is set to zero and slip departs
+  as at breakaway.
+* stick → slip: ``EVENT_STICK`` = μs N − |F_stick|; its root is breakaway (Eq. 10). Slip starts
   with v_r = 0 in the direction e = −F_stick/|F_stick|, so F is continuous.
 """
 
@@ -20,13 +23,12 @@ import math
 
 import numpy as np
 
-from ..model import kernels as K
+from ..model import physics as P
 from ..model.jit import kernel
-# the event codes, tolerances and root-finding steps are those of the generic event integrator
-from .contacts import (ARRIVAL_TIME_TOL, EVENT_CHECKS, EVENT_SLIP, EVENT_STICK, EVENT_TIME_TOL,  # noqa: F401
-                       MAX_REFINEMENTS, STICK_SPEED_TOL, TRANSITION_TO_SLIP, TRANSITION_TO_STICK, dense_state,
-                       illinois_update, regula_falsi_point)
-
+# the event codes, tolerances and transition steps are those of the generic event integrator
+from .contacts import (EVENT_SLIP, EVENT_STICK, EVENT_TIME_TOL, STICK_SPEED_TOL, TRANSITION_TO_SLIP,  # noqa: F401
+                       TRANSITION_TO_STICK, all_finite, breakaway_direction, dense_state, event_value, first_crossing,
+                       try_stick)
 
 #: Largest number of bisections of one transition bracket (fixed-step methods): the bracket
 #: halves each time, so 200 is far more than the ~40 needed to go from Δt = 0.1 s to
@@ -47,7 +49,7 @@ def hermite_coefficients(y0, f0, y1, f1, h, Q):
     """Cubic Hermite interpolant of a step as ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)`` (3 columns).
 
     Matches y and dy/dt = f at both ends (θ = 0, 1); 3rd order in h, the form used by
-    ``events.dense_state``.
+    ``contacts.dense_state``.
     """
     for i in range(y0.shape[0]):
         d = (y1[i] - y0[i]) / h
@@ -57,80 +59,22 @@ def hermite_coefficients(y0, f0, y1, f1, h, Q):
 
 
 @kernel
-def all_finite(y):
-    """Whether every entry of ``y`` is finite: one branch on Σ y_i·0, which is NaN exactly when
-    some y_i is ±inf or NaN (and never overflows), instead of one per entry (checked every step)."""
-    acc = 0.0
-    for i in range(y.shape[0]):
-        acc += y[i] * 0.0
-    return acc == 0.0
-
-
-@kernel
-def store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F):
-    """Write the state, the mode flag (1 = stick, 0 = slip) and the friction force of sample ``idx``."""
-    for i in range(y.shape[0]):
-        out_s[idx, i] = y[i]
-    out_mode[idx] = 1 if mode == K.MODE_STICK else 0
-    out_F[idx, 0] = Fx
-    out_F[idx, 1] = Fy
-
-
-@kernel
-def event_value(kind, y, e0x, e0y, minv, damp, stiff, p):
-    """Event function of ``kind`` at state ``y`` (see module docstring)."""
-    if kind == EVENT_SLIP:
-        vx, vy = K.relative_velocity(y, p)
-        return vx * e0x + vy * e0y
-    Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
-    return K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy)
-
-
-@kernel
-def first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work):
-    """First θ ∈ (0, 1] where the event function turns ≤ 0, located to EVENT_TIME_TOL.
-
-    The function is positive at θ = 0 by construction. Returns -1.0 if no sign change is seen
-    at the EVENT_CHECKS sample points. Root refinement: Illinois regula falsi.
-    """
-    a = 0.0
-    ga = event_value(kind, y0, e0x, e0y, minv, damp, stiff, p)
-    b = -1.0
-    gb = 0.0
-    for j in range(1, EVENT_CHECKS + 1):
-        theta = j / EVENT_CHECKS
-        dense_state(y0, Q, h, theta, work)
-        g = event_value(kind, work, e0x, e0y, minv, damp, stiff, p)
-        if g <= 0.0:
-            b = theta
-            gb = g
-            break
-        a = theta
-        ga = g
-    if b < 0.0:
-        return -1.0
-    tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
-    side = np.int64(0)  # not a literal: one compiled version of illinois_update
-    for _ in range(MAX_REFINEMENTS):
-        if gb == 0.0 or (b - a) <= tol:
-            break
-        c = regula_falsi_point(a, ga, b, gb)
-        dense_state(y0, Q, h, c, work)
-        gc = event_value(kind, work, e0x, e0y, minv, damp, stiff, p)
-        a, ga, b, gb, side = illinois_update(a, ga, b, gb, c, gc, gc > 0.0, side)
-    return b
-
-
-@kernel
-def interpolated_crossing(kind, y0, f0, y1, f1, h, e0x, e0y, minv, damp, stiff, p, Q, work):
-    """Root θ ∈ (0, 1] of the event ``kind`` on the cubic Hermite interpolant of a step from
-    (y0, f0 = dy/dt) to (y1, f1) of length ``h`` [s] (:func:`first_crossing`); −1.0 if the
-    interpolant shows none. ``Q`` (n, 3) and ``work`` (n,) are work arrays.
+def interpolated_crossing(kind, y0, f0, y1, f1, h, stick, md, Q, work, F, N):
+    """Root θ ∈ (0, 1] of the event ``kind`` (reference direction none: the stick event) on the
+    cubic Hermite interpolant of a step from (y0, f0 = dy/dt) to (y1, f1) of length ``h`` [s]
+    (``contacts.first_crossing``); −1.0 if the interpolant shows none. ``Q`` (n, 3), ``work``
+    (n,), ``F`` (2,), ``N`` (1,) are work arrays.
 
     The estimate that bisection on re-stepping starts from (:func:`bisection_point`).
     """
     hermite_coefficients(y0, f0, y1, f1, h, Q)
-    return first_crossing(kind, y0, Q, h, e0x, e0y, minv, damp, stiff, p, work)
+    return first_crossing(kind, np.int64(0), y0, Q, h, 0.0, 0.0, stick, md, work, F, N)
+
+
+@kernel
+def stick_margin(y, stick, md, F, N):
+    """The stick → slip event μs N − |F_stick| at ``y`` [N] (``stick``: the contact state in stick)."""
+    return event_value(EVENT_STICK, np.int64(0), y, 0.0, 0.0, stick, md, F, N)
 
 
 @kernel
@@ -159,101 +103,23 @@ def bisection_point(a, b, estimate, h):
 
 
 @kernel
-def time_to_zero_of(vx, vy, ax, ay):
-    """Time [s] to the closest approach of v_r = (vx, vy) to zero under constant dv_r/dt = (ax, ay).
-
-    −(v·v)/(v·a); +inf unless v_r heads for zero within 60° of head-on (a turning slip
-    direction is not an approach). Used to home the last step of an approach onto v_r = 0
-    and to scale the steps of the approach.
-    """
-    va = vx * ax + vy * ay
-    if va >= -0.5 * math.sqrt((vx * vx + vy * vy) * (ax * ax + ay * ay)):  # cos 60° = 0.5
-        return math.inf
-    return -(vx * vx + vy * vy) / va
-
-
-@kernel
-def slip_event_possible(g0, dg0, g1, dg1):
-    """Whether the slip event g = v_r·e0 may reach zero inside a step (cheap pre-check).
-
-    ``g0, g1`` are its values at the ends of the step and ``dg0, dg1`` its derivatives with
-    respect to θ ∈ [0, 1] (h × dv_r/dt · e0). The cubic Hermite interpolant of these four
-    numbers is checked at θ = 1/4, 1/2, 3/4 and at the end; a possible crossing is any value
-    at or below half the smaller end value (so a dip towards zero that the cubic only
-    approximates still gets the full check on the step's dense output by
-    :func:`first_crossing`). A monotone approach (g falls from g0 to g1 > 0) needs no check.
-    """
-    if g1 <= 0.0:
-        return True
-    floor = 0.5 * min(g0, g1)
-    for j in range(1, 4):
-        th = 0.25 * j
-        th2 = th * th
-        th3 = th2 * th
-        h00 = 2.0 * th3 - 3.0 * th2 + 1.0
-        h10 = th3 - 2.0 * th2 + th
-        h01 = -2.0 * th3 + 3.0 * th2
-        h11 = th3 - th2
-        if h00 * g0 + h10 * dg0 + h01 * g1 + h11 * dg1 <= floor:
-            return True
-    return False
-
-
-@kernel
-def breakaway_direction(Fx, Fy):
-    """Slip direction at breakaway e = −F_stick/|F_stick| (docs/numerics.md)."""
-    norm = math.sqrt(Fx * Fx + Fy * Fy)
-    if norm == 0.0:
-        return 1.0, 0.0
-    return -Fx / norm, -Fy / norm
-
-
-@kernel
-def arrival_speed(y, rtol, atol):
-    """|v_r| [m/s] at or below which slip has arrived at v_r = 0 for an integration at (rtol, atol).
-
-    The larger of STICK_SPEED_TOL and ten times the velocity resolution of the error control,
-    atol + rtol max|q̇_i|: below that, v_r is integration noise, its direction wanders and no
-    step can home further (seen at rtol 1e-8 with |q̇| ~ 3.5 rad/s: |v_r| hovered at 2e-8).
-    """
-    qd = 0.0
-    for i in range(6, 12):
-        qd = max(qd, abs(y[i]))
-    return max(STICK_SPEED_TOL, 10.0 * (atol + rtol * qd))
-
-
-@kernel
-def try_stick(y, minv, damp, stiff, p, speed_tol):
-    """At a zero of the slip velocity: project and test stick admissibility (Eq. 10).
-
-    If |v_r| > ``speed_tol`` [m/s] nothing happens and ``(False, 0, 0)`` is returned. Otherwise
-    ``y`` is projected onto v_r = 0 in place (the residual ≤ speed_tol removed by an
-    impulsive friction force, booked as friction work) and either ``(True, 0, 0)`` (stick is
-    admissible) or ``(False, ex, ey)`` with the breakaway direction of the inadmissible stick
-    force, along which slip departs again (a velocity reversal through zero).
-    """
-    vx, vy = K.relative_velocity(y, p)
-    if math.sqrt(vx * vx + vy * vy) > speed_tol:
-        return False, 0.0, 0.0
-    K.project_velocity(y, minv, p)
-    Fx, Fy, _ = K.stick_force(y, minv, damp, stiff, p)
-    if math.sqrt(Fx * Fx + Fy * Fy) <= K.static_limit(p):
-        return True, 0.0, 0.0
-    ex, ey = breakaway_direction(Fx, Fy)
-    return False, ex, ey
-
-
-@kernel
-def initial_mode(y, minv, damp, stiff, p):
-    """Mode a state starts in: stick if v_r = 0 (to STICK_SPEED_TOL) and stick is admissible.
-
-    Returns (mode, ex, ey); in slip, (ex, ey) is the direction used while |v_r| is ~0.
-    """
-    stick, ex, ey = try_stick(y, minv, damp, stiff, p, STICK_SPEED_TOL)
-    if stick:
-        return K.MODE_STICK, 0.0, 0.0
-    vx, vy = K.relative_velocity(y, p)
-    speed = math.sqrt(vx * vx + vy * vy)
-    if speed > K.SPEED_FLOOR:
-        return K.MODE_SLIP, vx / speed, vy / speed
-    return K.MODE_SLIP, ex, ey
+def initial_mode(y, cst, stick, md, F, N):
+    """The mode a state starts in, written to ``cst`` (mode, ex, ey, τ): stick if v_r = 0 (to
+    STICK_SPEED_TOL; ``y`` is then projected onto v_r = 0) and stick is admissible (Eq. 10), else
+    slip along v_r/|v_r|, or from v_r = 0 along the breakaway direction of the inadmissible stick
+    force. Returns the mode."""
+    contact = np.int64(0)
+    sticks, ex, ey = try_stick(y, stick, contact, md, STICK_SPEED_TOL, F, N)
+    mode = P.MODE_STICK
+    if not sticks:
+        mode = P.MODE_SLIP
+        vx, vy = P.slip_velocity(y, contact, md)
+        speed = math.sqrt(vx * vx + vy * vy)
+        if speed > P.SPEED_FLOOR:
+            ex = vx / speed
+            ey = vy / speed
+    cst[0] = mode
+    cst[1] = ex
+    cst[2] = ey
+    cst[3] = math.inf
+    return mode

@@ -1,6 +1,6 @@
 """Fixed-step RK4 shared by the paper's two stick solvers, ``aeom`` and ``naeom`` (Sect. 3).
 
-One compiled loop, :func:`integrate_fixed_step`, runs both methods on the model kernels; only
+One compiled loop, :func:`integrate_fixed_step`, runs both methods on the generic physics; only
 the stick step differs:
 
 * slip (both): classic Runge–Kutta 4 (paper ref. [43]) on all twelve states with the slip force,
@@ -16,8 +16,10 @@ the stick step differs:
   grid is kept; uniform samples come from the cubic Hermite interpolant of each step.
 
 The slip direction below the low-speed band is the quasi-static one, with the band widened to
-what the step can resolve (:func:`step_band`). State layout: the plates' 12
-states, then the work of friction and of damping [J].
+what the step can resolve (:func:`step_band`). The physics is the generic one
+(:mod:`stickslip.model.physics`, compiled for the plates' kinematics) on the plates' model data
+``md``; the contact state ``cst`` (mode, slip direction) of the one contact is the loop's.
+State layout: the plates' 12 states, then the work of friction and of damping [J].
 """
 
 from __future__ import annotations
@@ -28,12 +30,16 @@ import time
 
 import numpy as np
 
-from ..model import kernels as K
+from ..model import physics as P
+from ..model.bundle import CST, H_BAND, H_N, ModelData, offsets
 from ..model.jit import kernel, loop
+from ..model.system_model import FrictionModel
 from . import events as E
 from . import rk4
+from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
 from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
+from .step_physics import derivative_and_contact, derivative_under_force, stick_force
 from .status import MAX_STEPS as STATUS_MAX_STEPS
 from .status import NOT_FINITE as STATUS_NOT_FINITE
 from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
@@ -81,7 +87,7 @@ def with_transition_room(run, duration: float, n_state: int = N_STATE):
             return result, tr_t[:n_tr], tr_kind[:n_tr], tr_s[:n_tr]
         capacity = n_tr
 
-__all__ = ["integrate_fixed_step", "run_aeom", "run_naeom", "check_step", "step_band", "kernel_parameters",
+__all__ = ["integrate_fixed_step", "run_aeom", "run_naeom", "check_step", "step_band", "step_data", "plates_model",
            "STABILITY_LIMIT", "METHOD_AEOM", "METHOD_NAEOM"]
 
 #: Stick solver codes of :func:`integrate_fixed_step`.
@@ -102,108 +108,28 @@ STABILITY_LIMIT = 2.0
 #: Δt = 1e-4 s, a band of 1e-2 m/s still changes φ's amplitude by only 9e-5 relative.
 MAX_STEP_BAND = 1e-2
 
-#: Samples within this fraction of a step from its end (either side) are written as the step end
-#: itself (the interpolant there equals y1 up to round-off; sample times and step ends agree to
-#: ~1e-16 t, i.e. ~1e-11 of a step of 1e-3 s at t = 100 s).
-END_SAMPLE_TOL = 1e-9
 
 # --------------------------------------------------------------------------- shared RK4 pieces
 @kernel
-def rk4_slip_step(y, k1, sphi, cphi, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
-    """One classic RK4 step of length ``h`` [s] in slip (Eq. 1 with Eq. 3), k1 = f(y) given.
+def rk4_slip_step(y, K, h, cst, md, ynew, ytmp):
+    """One classic RK4 step of length ``h`` [s] in slip (Eq. 1 with Eq. 3), K[0] = f(y) given.
 
-    ``sphi``, ``cphi``: sin φ, cos φ at ``y``; each stage turns them by its change of φ
-    (``kernels.rotated``: a few multiply-adds for the small angle of a stage instead of a call
-    to sin and cos, equal to round-off). Writes ``ynew``; ``ytmp``, ``k2``…``k4`` are work
-    arrays. Returns the rhs calls made (3).
+    ``cst``: the contact state (mode slip, the stored slip direction). Writes ``ynew`` and the
+    stages K[1:4] (:mod:`.rk4`); ``ytmp`` is a work array. Returns the rhs calls made (3).
 
-    The three stages are one loop around one inlined copy of the right-hand side
-    (``kernels._rhs_body``): inlined, the stages skip a call that passes ~40 words of array
-    descriptors (−6 % per run); one copy instead of three keeps the compile time (+2.3 s per copy).
+    The three stages are one loop around one inlined copy of the generic right-hand side
+    (``physics.rhs_body``): inlined, the stages skip a call that passes the arrays' descriptors;
+    one copy instead of three keeps the compile time (model/jit.py).
     """
     for stage in range(3):
-        c, k_in, k_out = rk4.stage_arrays(stage, h, k1, k2, k3, k4)
-        rk4.stage_state(y, k_in, c, ytmp)
-        cs, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
-        K._rhs_body(ytmp, sn, cs, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, k_out)
-    rk4.combine(y, h, k1, k2, k3, k4, ynew)
+        rk4.stage_state(y, K, stage, h, ytmp)
+        P.rhs_body(ytmp, cst, md, K[stage + 1])
+    rk4.combine(y, h, K, ynew)
     return 3
 
 
 @kernel
-def write_samples(idx, t, h, y0, f0, y1, f1, F1x, F1y, mode, ex, ey, fixed_force, minv, damp, stiff, p,
-                  sample_times, out_s, out_mode, out_F, Q, work):
-    """Write the samples with t < ts ≤ t + h (to END_SAMPLE_TOL) from the Hermite interpolant of
-    the step.
-
-    ``(F1x, F1y)`` is the friction force at the step end y1 [N]. A sample at the step end
-    (θ = 1 to :data:`END_SAMPLE_TOL` on either side; every sample when the sample period is a
-    multiple of Δt) is y1 with that force, and needs neither the interpolant nor a force
-    evaluation. The tolerance also covers the far side: sample times and grid points are
-    rounded separately, and a sample one ulp after the step end would otherwise be interpolated
-    at θ ≈ 0 of the next step, at the full cost of an interpolated sample.
-    Inside the step the force written is (F1x, F1y) if ``fixed_force`` (NAEOM's per-step force
-    in stick), else ``kernels.contact_force`` at the sample. Returns the next sample index.
-    """
-    n_samples = sample_times.shape[0]
-    t_to = t + h
-    t_last = t_to + END_SAMPLE_TOL * h
-    q_ready = False
-    while idx < n_samples and sample_times[idx] <= t_last:
-        theta = (sample_times[idx] - t) / h
-        if theta >= 1.0 - END_SAMPLE_TOL:
-            E.store_sample(idx, y1, mode, F1x, F1y, out_s, out_mode, out_F)
-        else:
-            if not q_ready:
-                E.hermite_coefficients(y0, f0, y1, f1, h, Q)
-                q_ready = True
-            E.dense_state(y0, Q, h, theta, work)
-            _store(idx, work, mode, ex, ey, F1x, F1y, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
-        idx += 1
-    return idx
-
-
-@kernel
-def end_sample_only(idx, t, h, sample_times, y1, mode, Fx, Fy, out_s, out_mode, out_F):
-    """The samples of a step that has none or only one, at its end (the usual cases when the
-    sample period is a multiple of Δt), without the call to :func:`write_samples`.
-
-    Writes that one sample (y1 with the force (Fx, Fy) at y1 [N]) and returns (next index, True);
-    returns (idx, False) and writes nothing when the step needs :func:`write_samples`.
-    """
-    n_samples = sample_times.shape[0]
-    t_last = t + h + END_SAMPLE_TOL * h
-    if idx >= n_samples or sample_times[idx] > t_last:
-        return idx, True  # no sample in this step
-    if (sample_times[idx] - t) / h < 1.0 - END_SAMPLE_TOL:
-        return idx, False  # a sample inside the step: interpolate
-    if idx + 1 < n_samples and sample_times[idx + 1] <= t_last:
-        return idx, False
-    E.store_sample(idx, y1, mode, Fx, Fy, out_s, out_mode, out_F)
-    return idx + 1, True
-
-
-@kernel
-def _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F):
-    """Write sample ``idx``: the given force if ``fixed_force``, else the contact force of ``mode``."""
-    if not fixed_force:
-        Fx, Fy = K.contact_force(y, mode, ex, ey, minv, damp, stiff, p)
-    E.store_sample(idx, y, mode, Fx, Fy, out_s, out_mode, out_F)
-
-
-@kernel
-def write_initial_samples(y, t0, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p,
-                          sample_times, out_s, out_mode, out_F):
-    """Samples at t ≤ t0 (the initial state). Returns the next sample index."""
-    idx = np.int64(0)  # not a literal: one compiled version of _store
-    while idx < sample_times.shape[0] and sample_times[idx] <= t0:
-        _store(idx, y, mode, ex, ey, Fx, Fy, fixed_force, minv, damp, stiff, p, out_s, out_mode, out_F)
-        idx += 1
-    return idx
-
-
-@kernel
-def slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, stats):
+def slip_step_with_event(y, K, h, rx, ry, cst, md, ynew, fnew, ytmp, F, N, v, stats):
     """A slip step with the slip → stick event located by bisection on re-stepping.
 
     The event function is the projection of v_r on the reference direction (rx, ry)
@@ -217,25 +143,21 @@ def slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv, damp, stiff
     re-taken RK4 steps of different lengths do not follow one smooth path). Starting from it
     saved 2 % of the re-steps at Δt = 1e-3 s and 26 % at 1e-4 s (0.2 % of that run): not kept.
 
-    ``(rx, ry)``: unit reference direction, (0, 0) for none (right after breakaway, v_r = 0);
-    ``sphi``, ``cphi``: sin φ, cos φ at ``y``. Returns
-    (h_taken, crossed, v1x, v1y, F1x, F1y, sphi1, cphi1): the step length actually taken [s],
-    whether it ends at a zero of the slip velocity, and v_r [m/s], the friction force [N] and
-    sin φ, cos φ at the step end.
-    ``ynew``, ``fnew`` = f(ynew) hold the step end. ``stats`` is updated (rhs calls at index 2,
-    re-taken steps at 3).
+    ``(rx, ry)``: unit reference direction, (0, 0) for none (right after breakaway, v_r = 0).
+    Returns (h_taken, crossed, v1x, v1y, F1x, F1y): the step length actually taken [s], whether
+    it ends at a zero of the slip velocity, and v_r [m/s] and the friction force [N] at the step
+    end. ``K`` (4, n) is the stage matrix with K[0] = f(y) (:mod:`.rk4`); ``ynew``, ``fnew`` =
+    f(ynew) hold the step end; ``F``, ``N``, ``v`` are work arrays. ``stats`` is updated (rhs
+    calls at index 2, re-taken steps at 3).
     """
-    stats[2] += rk4_slip_step(y, k1, sphi, cphi, h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    sphi1 = math.sin(ynew[4])
-    cphi1 = math.cos(ynew[4])
-    F1x, F1y, v1x, v1y = K.rhs_at(ynew, sphi1, cphi1, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    stats[2] += rk4_slip_step(y, K, h, cst, md, ynew, ytmp)
+    F1x, F1y, v1x, v1y, _ = derivative_and_contact(ynew, cst, md, fnew, F, N, v)
     stats[2] += 1
     if rx == 0.0 and ry == 0.0:  # just after breakaway (v_r = 0) nothing to detect
-        return h, False, v1x, v1y, F1x, F1y, sphi1, cphi1
+        return h, False, v1x, v1y, F1x, F1y
     if v1x * rx + v1y * ry > 0.0:  # the slip event v_r·e0 (events.EVENT_SLIP) stays positive
-        return h, False, v1x, v1y, F1x, F1y, sphi1, cphi1
-    e0x = rx
-    e0y = ry
+        return h, False, v1x, v1y, F1x, F1y
+    contact = np.int64(0)
     a = 0.0
     b = 1.0
     at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
@@ -243,29 +165,28 @@ def slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv, damp, stiff
         c = E.bisection_point(a, b, -1.0, h)
         if c < 0.0:
             break
-        stats[2] += rk4_slip_step(y, k1, sphi, cphi, c * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[2] += rk4_slip_step(y, K, c * h, cst, md, ynew, ytmp)
         stats[3] += 1
-        if E.event_value(E.EVENT_SLIP, ynew, e0x, e0y, minv, damp, stiff, p) > 0.0:
+        vx, vy = P.slip_velocity(ynew, contact, md)
+        if vx * rx + vy * ry > 0.0:
             a = c
             at_b = False
         else:
             b = c
             at_b = True
     if not at_b:
-        stats[2] += rk4_slip_step(y, k1, sphi, cphi, b * h, ex, ey, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
+        stats[2] += rk4_slip_step(y, K, b * h, cst, md, ynew, ytmp)
         stats[3] += 1
-    sphi1 = math.sin(ynew[4])
-    cphi1 = math.cos(ynew[4])
-    F1x, F1y, v1x, v1y = K.rhs_at(ynew, sphi1, cphi1, K.MODE_SLIP, ex, ey, minv, damp, stiff, p, fnew)
+    F1x, F1y, v1x, v1y, _ = derivative_and_contact(ynew, cst, md, fnew, F, N, v)
     stats[2] += 1
-    return b * h, True, v1x, v1y, F1x, F1y, sphi1, cphi1
+    return b * h, True, v1x, v1y, F1x, F1y
 
 
 @kernel
-def event_direction(vx, vy, rx, ry, p):
+def event_direction(vx, vy, rx, ry, band):
     """Reference direction of the slip → stick event for a step that starts with v_r = (vx, vy).
 
-    Above the low-speed band ``p[P_SLIP_BAND]`` it is v_r/|v_r| at the step start; inside the
+    Above the low-speed band ``band`` [m/s] it is v_r/|v_r| at the step start; inside the
     band it stays the direction v_r had when it entered (``(rx, ry)``, the last one returned),
     or v_r/|v_r| at the first step after breakaway ((rx, ry) = (0, 0)). Inside the band the
     slip direction is the quasi-static one, along which v_r changes: a v_r that enters it off
@@ -276,39 +197,40 @@ def event_direction(vx, vy, rx, ry, p):
     arrival (:func:`after_slip_root`). Returns (rx, ry); (0, 0) while v_r = 0.
     """
     speed = math.sqrt(vx * vx + vy * vy)
-    if speed <= K.SPEED_FLOOR:
+    if speed <= P.SPEED_FLOOR:
         return 0.0, 0.0
-    if speed > p[K.P_SLIP_BAND] or (rx == 0.0 and ry == 0.0):
+    if speed > band or (rx == 0.0 and ry == 0.0):
         return vx / speed, vy / speed
     return rx, ry
 
 
 @kernel
-def after_slip_root(ynew, ex, ey, minv, damp, stiff, p):
+def after_slip_root(ynew, cst, stick, md, F, N):
     """At a located zero of the projected slip velocity: arrival at v_r = 0, then
-    ``events.try_stick`` (projection + Eq. 10 test).
+    ``contacts.try_stick`` (projection + Eq. 10 test).
 
     The root of v_r·e0 leaves the component of v_r across e0. A fixed step cannot resolve the
     direction of v_r below |v_r| ~ Δt μ N |G M⁻¹ Gᵀ| (~1e-3 m/s at Δt = 1e-4 s: the direction
     relaxes on the time scale |v_r| / (μ N |G M⁻¹ Gᵀ|)), and inside the low-speed band the slip
     direction is the quasi-static one, which misses the origin by O(band). So a root with
-    |v_r| ≤ the low-speed band ``p[P_SLIP_BAND]`` counts as arrival: the residual is removed by
-    the M-metric projection (an impulsive friction force, booked as friction work) before
-    ``try_stick`` tests admissibility. A larger |v_r| is a mere turn of the slip direction.
+    |v_r| ≤ the low-speed band counts as arrival: the residual is removed by the M-metric
+    projection (an impulsive friction force, booked as friction work) before ``try_stick``
+    tests admissibility. A larger |v_r| is a mere turn of the slip direction.
 
-    Returns (stick, ex, ey): stick True with ``ynew`` projected onto v_r = 0; else the slip
-    direction to continue with (the breakaway direction of an inadmissible stick force, or the
-    current one after a turn).
+    ``cst``: the contact state in slip (its slip direction), ``stick``: in stick. Returns True
+    with ``ynew`` projected onto v_r = 0 when stick begins; else False, with ``cst``'s slip
+    direction the one to continue with (the breakaway direction of an inadmissible stick
+    force, or the current one after a turn).
     """
-    vx, vy = K.relative_velocity(ynew, p)
-    if math.sqrt(vx * vx + vy * vy) <= max(E.STICK_SPEED_TOL, p[K.P_SLIP_BAND]):
-        K.project_velocity(ynew, minv, p)
-    stick, nex, ney = E.try_stick(ynew, minv, damp, stiff, p, E.STICK_SPEED_TOL)
-    if stick:
-        return True, ex, ey
-    if nex != 0.0 or ney != 0.0:
-        return False, nex, ney
-    return False, ex, ey
+    contact = np.int64(0)
+    vx, vy = P.slip_velocity(ynew, contact, md)
+    if math.sqrt(vx * vx + vy * vy) <= max(E.STICK_SPEED_TOL, md.m[H_BAND]):
+        P.project_velocities(ynew, stick, np.int64(-1), md)
+    sticks, nex, ney = E.try_stick(ynew, stick, contact, md, E.STICK_SPEED_TOL, F, N)
+    if not sticks and (nex != 0.0 or ney != 0.0):
+        cst[1] = nex
+        cst[2] = ney
+    return sticks
 
 
 @kernel
@@ -327,9 +249,10 @@ def next_step(t, t0, dt, k_grid, t_end):
 
 
 @loop
-def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_steps, sample_times, out_s, out_mode,
-                         out_F, tr_t, tr_kind, tr_s):
-    """Integrate from ``y0`` (length N_STATE) over [t0, t_end] with the fixed step ``dt`` [s].
+def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, sample_times, out_s, out_mode, out_F, tr_t,
+                         tr_kind, tr_s):
+    """Integrate the model ``md`` (the plates) from ``y0`` (length N_STATE) over [t0, t_end] with
+    the fixed step ``dt`` [s].
 
     ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step). Samples and
     transitions are written as by the event loop (:mod:`.event_loop`).
@@ -354,28 +277,33 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
     ynew = np.empty(n)
     ytmp = np.empty(n)
     work = np.empty(n)
-    k1 = np.empty(n)
+    K = np.empty((4, n))  # RK4 stages (rk4.py); K[0] = k1 = f(y), carried from step to step
+    k1 = K[0]
     fnew = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    s1 = np.empty(n)
+    Kn = np.empty((4, n))  # NAEOM's constant-force steps in stick
     Q = np.empty((n, 3))
     hist = np.zeros(7)  # NAEOM: force history of the stick phase (method_naeom.naeom_stick_branch)
+    cst = np.empty(CST)  # the contact's state (mode, slip direction ex, ey, τ) in its current mode
+    stick = np.empty(CST)  # the same in stick: the stick multiplier, the projection, breakaway
+    stick[0] = P.MODE_STICK
+    stick[1] = 0.0
+    stick[2] = 0.0
+    stick[3] = math.inf
+    F = np.empty(2)
+    N = np.empty(1)
+    v = np.empty(2)
     n_tr = np.int64(0)  # not a literal: one compiled version of the callees
     stats = np.zeros(8, dtype=np.int64)
     force_given = np.bool_(True)  # write_samples' fixed_force; not literals: one compiled version
     force_from_state = np.bool_(False)
+    band = md.m[H_BAND]
 
-    mode, ex, ey = E.initial_mode(y, minv, damp, stiff, p)
-    sphi = math.sin(y[4])  # sin φ, cos φ of the current state, carried from step to step (φ
-    cphi = math.cos(y[4])  # changes only in steps; every step returns them at its end)
-    if method == METHOD_AEOM and mode == K.MODE_STICK:
-        dependent_states(y, sphi, cphi, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, minv, p)
-    _, _, vx, vy = K.rhs_at(y, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, k1)
+    mode = E.initial_mode(y, cst, stick, md, F, N)
+    if method == METHOD_AEOM and mode == P.MODE_STICK:
+        dependent_states(y, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, md)
+    _, _, vx, vy, _ = derivative_and_contact(y, cst, md, k1, F, N, v)
     stats[2] += 1
-    idx = write_initial_samples(y, t0, mode, ex, ey, 0.0, 0.0, force_from_state, minv, damp, stiff, p,
-                                sample_times, out_s, out_mode, out_F)
+    idx = write_initial_samples(y, t0, mode, cst, md, sample_times, out_s, out_mode, out_F, F, N, v)
     rx = 0.0  # reference direction of the slip → stick event (event_direction)
     ry = 0.0
     t = t0
@@ -393,55 +321,53 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
             break
         transition = 0
         crossed = False
-        if mode == K.MODE_SLIP:
-            rx, ry = event_direction(vx, vy, rx, ry, p)
-            h, crossed, vx, vy, Fx, Fy, sphi, cphi = slip_step_with_event(y, k1, sphi, cphi, h, rx, ry, ex, ey, minv,
-                                                                          damp, stiff, p, ynew, fnew, ytmp, k2, k3,
-                                                                          k4, stats)
+        if mode == P.MODE_SLIP:
+            rx, ry = event_direction(vx, vy, rx, ry, band)
+            h, crossed, vx, vy, Fx, Fy = slip_step_with_event(y, K, h, rx, ry, cst, md, ynew, fnew, ytmp, F, N,
+                                                              v, stats)
         elif method == METHOD_AEOM:
-            h, transition, Fx, Fy, sphi, cphi = aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew,
-                                                                  fnew, ytmp, k2, k3, k4, Q, work, stats)
+            h, transition, Fx, Fy = aeom_stick_branch(y, K, h, stick, md, ynew, fnew, ytmp, Q, work, F, N, v,
+                                                      stats)
         else:
-            h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, s1,
-                                                               k2, k3, k4, Q, stats)
+            h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, Kn, Q, F, N,
+                                                               stats)
             if not solved:
                 status = STATUS_SOLVE_FAILED
                 break
-            sphi = math.sin(ynew[4])
-            cphi = math.cos(ynew[4])
-        # samples of the step (Fx, Fy: the friction force at its end), before a transition changes ex, ey
+        # samples of the step (Fx, Fy: the friction force at its end), before a transition changes cst
         idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
         if not done:
             fixed_force = force_from_state
-            if mode == K.MODE_STICK and method == METHOD_NAEOM:
+            if mode == P.MODE_STICK and method == METHOD_NAEOM:
                 # NAEOM's constant force: derivatives at both step ends under it, for the Hermite samples
-                K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
-                K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, fnew)
+                derivative_under_force(y, Fx, Fy, md, k1)
+                derivative_under_force(ynew, Fx, Fy, md, fnew)
                 stats[2] += 2
                 fixed_force = force_given
-            idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, ex, ey, fixed_force, minv, damp, stiff,
-                                p, sample_times, out_s, out_mode, out_F, Q, work)
-        if mode == K.MODE_SLIP:
-            ex, ey = K.slip_direction(ynew, vx, vy, ex, ey, minv, damp, stiff, p)
-            if crossed:
-                stick, ex, ey = after_slip_root(ynew, ex, ey, minv, damp, stiff, p)
-                if stick:
-                    transition = E.TRANSITION_TO_STICK
-                    hist[0] = 0.0
+            idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, fixed_force, cst, md, sample_times,
+                                out_s, out_mode, out_F, Q, work, F, N, v)
+        if mode == P.MODE_SLIP:
+            ex, ey = P.slip_direction(ynew, cst, np.int64(0), md, vx, vy)
+            cst[1] = ex
+            cst[2] = ey
+            if crossed and after_slip_root(ynew, cst, stick, md, F, N):
+                transition = E.TRANSITION_TO_STICK
+                hist[0] = 0.0
         elif transition == E.TRANSITION_TO_SLIP:
-            Fx, Fy, _ = K.stick_force(ynew, minv, damp, stiff, p)
-            ex, ey = E.breakaway_direction(Fx, Fy)
+            Fx, Fy, _ = stick_force(ynew, stick, md, F, N)
+            cst[1], cst[2] = E.breakaway_direction(Fx, Fy, np.int64(2))
         t += h
         stats[0] += 1
         for i in range(n):
             y[i] = ynew[i]
             k1[i] = fnew[i]  # (NAEOM in stick does not use k1)
         if transition != 0:
-            mode = K.MODE_STICK if transition == E.TRANSITION_TO_STICK else K.MODE_SLIP
+            mode = P.MODE_STICK if transition == E.TRANSITION_TO_STICK else P.MODE_SLIP
+            cst[0] = mode
             stats[4 if transition == E.TRANSITION_TO_STICK else 5] += 1
             record_transition(n_tr, t, transition, y, tr_t, tr_kind, tr_s)
             n_tr += 1
-            _, _, vx, vy = K.rhs_at(y, sphi, cphi, mode, ex, ey, minv, damp, stiff, p, k1)  # projected / new mode
+            _, _, vx, vy, _ = derivative_and_contact(y, cst, md, k1, F, N, v)  # projected / new mode
             stats[2] += 1
         if not E.all_finite(y):
             status = STATUS_NOT_FINITE
@@ -451,8 +377,23 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, minv, damp, stiff, p, max_st
 
 
 # --------------------------------------------------------------------------- Python runners
-def check_step(method: str, system, dt) -> float:
-    """Validate the fixed step of ``method`` for ``system``; returns it [s].
+def plates_model(system) -> FrictionModel:
+    """The plates' :class:`~stickslip.model.FrictionModel` of ``system``: the model itself, or the
+    model of an assembled plates :class:`~stickslip.model.System` (what the driver passes)."""
+    if isinstance(system, FrictionModel):
+        return system
+    return system.model()
+
+
+def _diagonal(md: ModelData, block: int) -> np.ndarray:
+    """Diagonal of the n × n block ``block`` of the model data (0: M⁻¹, 3: K; ``bundle.offsets``)."""
+    n = int(md.m[H_N])
+    o = offsets.py_func(n)[block]
+    return md.m[o:o + n * n:n + 1].copy()
+
+
+def check_step(method: str, model: FrictionModel, dt) -> float:
+    """Validate the fixed step of ``method`` for the plates' ``model``; returns it [s].
 
     Raises
     ------
@@ -467,7 +408,7 @@ def check_step(method: str, system, dt) -> float:
             f"method {method!r} is a fixed-step method: give the step dt in seconds, e.g. dt=1e-4 "
             "(the paper's converged step; CLI: --dt 1e-4)"
         )
-    omega = np.sqrt(system.stiff * system.minv)
+    omega = np.sqrt(_diagonal(model.data, 3) * _diagonal(model.data, 0))
     omega_max = float(omega.max())
     if omega_max > 0.0 and dt * omega_max > STABILITY_LIMIT:
         raise SimulationError(
@@ -478,29 +419,32 @@ def check_step(method: str, system, dt) -> float:
     return float(dt)
 
 
-def step_band(system, dt: float) -> float:
+def step_band(model: FrictionModel, dt: float) -> float:
     """Low-speed band [m/s] the fixed step ``dt`` [s] needs: Δt μs N tr(G M⁻¹ Gᵀ).
 
     In slip the direction of v_r relaxes on the time scale |v_r| / (μ N λ), λ an eigenvalue of
-    A = G M⁻¹ Gᵀ (``kernels.DEFAULT_SLIP_BAND``'s note). An explicit step resolves it only when
-    |v_r| ≳ Δt μ N λ; below that speed RK4 makes the direction chatter (measured at Δt = 1e-4 s
-    with a band of 1e-4 m/s: stick entries late by up to 2.5e-4 s and a 1.2 % error of
-    φ's amplitude). There the direction must sit on its slow manifold, which is what the
-    low-speed band does, so the fixed-step methods use max(slip_band, this). λ is bounded by
-    tr(A) taken at R = r (contact at its nominal radius). Table 1: 3.4e-3 m/s at Δt = 1e-4 s.
-    Capped at :data:`MAX_STEP_BAND`.
+    A = G M⁻¹ Gᵀ (``DEFAULT_SLIP_BAND``'s note in :mod:`stickslip.model.system_model`). An
+    explicit step resolves it only when |v_r| ≳ Δt μ N λ; below that speed RK4 makes the
+    direction chatter (measured at Δt = 1e-4 s with a band of 1e-4 m/s: stick entries late by up
+    to 2.5e-4 s and a 1.2 % error of φ's amplitude). There the direction must sit on its slow
+    manifold, which is what the low-speed band does, so the fixed-step methods use
+    max(slip_band, this). λ is bounded by tr(A) taken at R = r (contact at its nominal radius;
+    r from the plates' kinematics, the inverse masses from the model data). Table 1:
+    3.4e-3 m/s at Δt = 1e-4 s. Capped at :data:`MAX_STEP_BAND`.
     """
-    m = system.minv
-    r = system.p[K.P_R]
+    m = _diagonal(model.data, 0)
+    r = model.data.kin.r
     trace = m[0] + m[1] + m[2] + m[3] + (m[4] + m[5]) * r * r
-    return float(min(dt * K.static_limit(system.p) * trace, MAX_STEP_BAND))
+    contact = model.contacts[0]
+    return float(min(dt * contact.friction.mu_s * contact.normal_force * trace, MAX_STEP_BAND))
 
 
-def kernel_parameters(system, dt: float) -> np.ndarray:
-    """``system.p`` with the low-speed band raised to :func:`step_band` where that is larger."""
-    p = system.p.copy()
-    p[K.P_SLIP_BAND] = max(p[K.P_SLIP_BAND], step_band(system, dt))
-    return p
+def step_data(model: FrictionModel, dt: float) -> ModelData:
+    """The model data of ``model`` with the low-speed band raised to :func:`step_band` where that
+    is larger."""
+    m = model.data.m.copy()
+    m[H_BAND] = max(m[H_BAND], step_band(model, dt))
+    return model.data._replace(m=m)
 
 
 def stats_dict(st, compile_time: float) -> dict:
@@ -514,22 +458,23 @@ def stats_dict(st, compile_time: float) -> dict:
     return stats
 
 
-def warm_up(system, t0, dt, method) -> float:
+def warm_up(md: ModelData, t0, dt, method) -> float:
     """Compile (or load from cache) :func:`integrate_fixed_step` on a one-step run; seconds spent,
     0 if compiled already."""
     if integrate_fixed_step.signatures:
         return 0.0
     start = time.perf_counter()
     y = np.zeros(N_STATE)
-    integrate_fixed_step(method, y, t0, t0 + dt, dt, system.minv, system.damp, system.stiff, system.p, 10,
-                         np.array([t0]), np.zeros((1, N_STATE)), np.zeros(1, dtype=np.int8), np.zeros((1, 2)),
-                         np.empty(1), np.empty(1, dtype=np.int8), np.empty((1, N_STATE)))
+    integrate_fixed_step(method, y, t0, t0 + dt, dt, md, 10, np.array([t0]), np.zeros((1, N_STATE)),
+                         np.zeros(1, dtype=np.int8), np.zeros((1, 2)), np.empty(1), np.empty(1, dtype=np.int8),
+                         np.empty((1, N_STATE)))
     return time.perf_counter() - start
 
 
 def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
                    dt: float | None, max_steps: int):
-    """Run ``method`` (``"aeom"`` or ``"naeom"``) for :func:`stickslip.simulate`.
+    """Run ``method`` (``"aeom"`` or ``"naeom"``) on the plates ``system`` (a FrictionModel or an
+    assembled System, :func:`plates_model`) for :func:`stickslip.simulate`.
 
     Returns the tuple of the driver's runners (see ``driver._run_event``).
 
@@ -542,20 +487,21 @@ def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float,
     from .driver import SimulationError
     from .result import Transitions
 
-    dt = check_step(method, system, dt)
+    model = plates_model(system)
+    dt = check_step(method, model, dt)
     code = METHOD_CODES[method]
-    compile_time = warm_up(system, t0, dt, code)
+    md = step_data(model, dt)
+    compile_time = warm_up(md, t0, dt, code)
     n = sample_times.size
     out_s = np.empty((n, N_STATE))  # every kept sample is written
     out_mode = np.empty(n, dtype=np.int8)
     out_F = np.empty((n, 2))
     y = np.zeros(N_STATE)
     y[:12] = y0
-    p = kernel_parameters(system, dt)
 
     def run(tr_t, tr_kind, tr_s):
-        res = integrate_fixed_step(code, y, t0, t_end, dt, system.minv, system.damp, system.stiff, p, max_steps,
-                                   sample_times, out_s, out_mode, out_F, tr_t, tr_kind, tr_s)
+        res = integrate_fixed_step(code, y, t0, t_end, dt, md, max_steps, sample_times, out_s, out_mode, out_F, tr_t,
+                                   tr_kind, tr_s)
         return res, res[3]
 
     (status, t_reached, _, _, st), tr_t, tr_kind, tr_s = with_transition_room(run, t_end - t0)

@@ -9,11 +9,14 @@ The fixed-step loop, the slip steps and the samples are shared with ``naeom``
 * breakaway (Eq. 10) at a step end is located by bisection on re-taken stick steps.
 
 The 4-DOF stick equations, Eq. (13), are Eq. (1) with F eliminated using the acceleration-level
-constraint (Eq. 11, lines 3–4). That elimination is exactly the multiplier solve of
-``kernels.stick_force``, so the stick accelerations of x1, y1, φ, ψ come from
-``kernels.rhs`` in stick mode on the stage state whose x2, y2, ẋ2, ẏ2 are the dependent values
+constraint (Eq. 11, lines 3–4). That elimination is exactly the generic stick multiplier
+(``physics.rhs`` with the contact in stick), so the stick accelerations of x1, y1, φ, ψ come from
+the generic right-hand side on the stage state whose x2, y2, ẋ2, ẏ2 are the dependent values
 above: no second copy of the model. What is specific to AEOM, and kept, is that x2, y2 are *not*
-integrated by RK4 but by the trapezoidal rule (Eqs. 11–12), with its O(Δt²) error.
+integrated by RK4 but by the trapezoidal rule (Eqs. 11–12), with its O(Δt²) error. The plates'
+structure it needs is the plates' model's: q = [x1, y1, x2, y2, φ, ψ], the contact radius r and
+the disc speed Ω from the kinematics data (``md.kin``, ``PlateKinematics``), which of x2, y2 are
+free from the model data (``md.m``).
 
 Model variants. The trick eliminates x2 (y2) through the x (y) component of
 v_r = 0; a locked x2 or y2 (zero inverse mass) cannot absorb its component. Our choice:
@@ -27,7 +30,7 @@ v_r = 0; a locked x2 or y2 (zero inverse mass) cannot absorb its component. Our 
   stick phase is RK4 on the constrained dynamics (rank-1 multiplier, rank-deficient G M⁻¹ Gᵀ).
 
 Whenever a component of v_r = 0 is not enforced by construction (the last two cases), the
-velocities are projected onto v_r = 0 in the M-metric after the step (``kernels.project_velocity``,
+velocities are projected onto v_r = 0 in the M-metric after the step (``physics.project_velocities``,
 the same drift removal as ``event``); no division by a zero mass happens anywhere, so no NaN.
 
 """
@@ -36,50 +39,65 @@ from __future__ import annotations
 
 import math
 
-from ..model import kernels as K
+import numpy as np
+
+from ..model import csmath as csm
+from ..model import physics as P
+from ..model.bundle import offsets
 from ..model.jit import kernel
+from ..model.kinematics import model_sizes
 from . import events as E
 from . import rk4
+from .step_physics import derivative_and_contact
 
 __all__ = ["aeom_stick_branch", "aeom_stick_step", "dependent_states"]
 
 
 # --------------------------------------------------------------------------- AEOM stick step
 @kernel
-def _trapezoid_base(y, sphi, cphi, p):
-    """u = x2 − x1, w = y2 − y1 and their rates from v_r = 0 (Eq. 11) at the step start (sin φ,
-    cos φ of ``y[4]`` given)."""
-    r = p[K.P_R]
-    wt = p[K.P_OMEGA] + y[11]
+def _trapezoid_base(y, md):
+    """u = x2 − x1, w = y2 − y1 and their rates from v_r = 0 (Eq. 11) at the step start."""
+    r = md.kin.r
+    sphi = csm.sin(y[4])
+    cphi = csm.cos(y[4])
+    wt = md.kin.Omega + y[11]
     a0 = -r * y[10] * sphi + wt * (y[1] - y[3] + r * sphi)
     b0 = r * y[10] * cphi - wt * (y[0] - y[2] + r * cphi)
     return y[2] - y[0], y[3] - y[1], a0, b0
 
 
 @kernel
-def dependent_states(s, sphi, cphi, tau, u0, w0, a0, b0, minv, p):
+def _free_lower_plate(md):
+    """Whether x2 and y2 are free DOFs of the model (the variants lock them)."""
+    o_free = offsets(model_sizes(md.kin, md.m)[0])[5]
+    return md.m[o_free + 2] != 0.0, md.m[o_free + 3] != 0.0
+
+
+@kernel
+def dependent_states(s, tau, u0, w0, a0, b0, md):
     """Set x2, y2 by the trapezoidal rule (Eqs. 11–12) and ẋ2, ẏ2 from v_r = 0 (Eq. 11), in place.
 
     Parameters
     ----------
     s : ndarray (≥ 12,)
         State at t_{n−1} + τ whose x1, y1, φ, ψ and rates are given.
-    sphi, cphi : float
-        sin φ, cos φ of ``s[4]``.
     tau : float
         Time since the step start t_{n−1} [s] (Δt of Eq. 12).
     u0, w0, a0, b0 : float
         (x2 − x1), (y2 − y1) [m] at t_{n−1} and their rates from Eq. (11) [m/s].
+    md : ModelData
+        The plates' model (r, Ω from ``md.kin``).
 
     Only free DOFs among x2, y2 are set (see the module docstring for the variants).
     """
-    fx = minv[2] != 0.0
-    fy = minv[3] != 0.0
+    fx, fy = _free_lower_plate(md)
     if not (fx or fy):
         return
-    r = p[K.P_R]
+    r = md.kin.r
+    sphi = csm.sin(s[4])
+    cphi = csm.cos(s[4])
     dphi = s[10]
-    wt = p[K.P_OMEGA] + s[11]
+    wt = md.kin.Omega + s[11]
     half = 0.5 * tau
     # Λ and Π of Eq. (12): trapezoid with the t_n terms that do not involve x2, y2
     lam = u0 + half * (a0 + (-r * dphi * sphi + r * wt * sphi))
@@ -106,51 +124,50 @@ def dependent_states(s, sphi, cphi, tau, u0, w0, a0, b0, minv, p):
 
 
 @kernel
-def aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4):
+def aeom_stick_step(y, K, h, stick, md, ynew, ytmp):
     """One AEOM stick step of length ``h`` [s]: RK4 on x1, y1, φ, ψ (Eq. 13), x2, y2 by Eq. (12).
 
-    ``k1`` = f(y) in stick; ``sphi``, ``cphi``: sin φ, cos φ at ``y``. At every stage the
-    dependent x2, y2, ẋ2, ẏ2 are recomputed with :func:`dependent_states` for the stage time,
-    then the stick accelerations are evaluated (``kernels.rhs`` in stick ≡ Eq. 13; the
-    stage's sin φ, cos φ are those at ``y`` turned by its change of φ, ``kernels.rotated``). The
-    RK4 update of the dependent entries is discarded and replaced by Eq. (12) at the step end.
-    Returns the rhs calls made (3) and sin φ, cos φ at the step end.
+    ``K`` (4, n): the RK4 stages with K[0] = f(y) in stick (:mod:`.rk4`); ``stick`` the contact
+    state in stick. At every stage the dependent
+    x2, y2, ẋ2, ẏ2 are recomputed with :func:`dependent_states` for the stage time, then the
+    stick accelerations are evaluated (``physics.rhs_body`` in stick ≡ Eq. 13). The RK4 update of
+    the dependent entries is discarded and replaced by Eq. (12) at the step end. Returns the rhs
+    calls made (3).
     """
-    u0, w0, a0, b0 = _trapezoid_base(y, sphi, cphi, p)
+    u0, w0, a0, b0 = _trapezoid_base(y, md)
     for stage in range(3):  # one inlined right-hand side for the three stages (integrate/rk4.py)
-        tau, k_in, k_out = rk4.stage_arrays(stage, h, k1, k2, k3, k4)
-        rk4.stage_state(y, k_in, tau, ytmp)
-        cs, sn = K.rotated(cphi, sphi, ytmp[4] - y[4])
-        dependent_states(ytmp, sn, cs, tau, u0, w0, a0, b0, minv, p)
-        K._rhs_body(ytmp, sn, cs, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, k_out)
-    rk4.combine(y, h, k1, k2, k3, k4, ynew)
-    sphi1 = math.sin(ynew[4])
-    cphi1 = math.cos(ynew[4])
-    dependent_states(ynew, sphi1, cphi1, h, u0, w0, a0, b0, minv, p)
-    if minv[2] == 0.0 or minv[3] == 0.0:
-        K.project_velocity(ynew, minv, p)  # the component(s) of v_r = 0 not built in (φ unchanged)
-    return 3, sphi1, cphi1
+        rk4.stage_state(y, K, stage, h, ytmp)
+        dependent_states(ytmp, rk4.stage_time(stage, h), u0, w0, a0, b0, md)
+        P.rhs_body(ytmp, stick, md, K[stage + 1])
+    rk4.combine(y, h, K, ynew)
+    dependent_states(ynew, h, u0, w0, a0, b0, md)
+    fx, fy = _free_lower_plate(md)
+    if not (fx and fy):
+        P.project_velocities(ynew, stick, np.int64(-1), md)  # the component(s) of v_r = 0 not built in
+    return 3
 
 
 @kernel
-def aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, fnew, ytmp, k2, k3, k4, Q, work, stats):
+def aeom_stick_branch(y, K, h, stick, md, ynew, fnew, ytmp, Q, work, F, N, v, stats):
     """An AEOM stick step of length ``h`` [s] with breakaway located by bisection on re-stepping.
 
     If the stick force at the step end violates Eq. (10), θ ∈ (0, 1] is bisected, each trial
     re-taking the stick step with θ h from ``y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step then ends on the slip side of the root.
 
-    ``sphi``, ``cphi``: sin φ, cos φ at ``y``. Returns (h_taken, transition, Fx, Fy, sphi1,
-    cphi1): the step length taken [s], 0 or ``events.TRANSITION_TO_SLIP``, the stick force at
-    the step end [N] and sin φ, cos φ there. ``ynew`` and ``fnew`` = f(ynew) (stick) hold the
-    step end; ``stats`` counts rhs calls (index 2) and re-taken steps (index 3).
+    ``K`` (4, n): the RK4 stages with K[0] = f(y) in stick. Returns (h_taken, transition, Fx, Fy):
+    the step length taken [s], 0 or
+    ``events.TRANSITION_TO_SLIP`` and the stick force at the step end [N]. ``ynew`` and
+    ``fnew`` = f(ynew) (stick) hold the step end; ``stats`` counts rhs calls (index 2) and
+    re-taken steps (index 3). ``Q``, ``work``, ``F``, ``N``, ``v`` are work arrays.
     """
-    calls, sphi1, cphi1 = aeom_stick_step(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, ytmp, k2, k3, k4)
-    Fx, Fy, _, _ = K.rhs_at(ynew, sphi1, cphi1, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
+    calls = aeom_stick_step(y, K, h, stick, md, ynew, ytmp)
+    Fx, Fy, _, _, normal = derivative_and_contact(ynew, stick, md, fnew, F, N, v)
     stats[2] += calls + 1
-    if K.static_limit(p) - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
-        return h, 0, Fx, Fy, sphi1, cphi1
-    estimate = E.interpolated_crossing(E.EVENT_STICK, y, k1, ynew, fnew, h, 0.0, 0.0, minv, damp, stiff, p, Q, work)
+    limit = P.static_limit(md.m, model_sizes(md.kin, md.m)[0], np.int64(0), normal)
+    if limit - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
+        return h, 0, Fx, Fy
+    estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, fnew, h, stick, md, Q, work, F, N)
     a = 0.0
     b = 1.0
     at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
@@ -158,23 +175,17 @@ def aeom_stick_branch(y, k1, sphi, cphi, h, minv, damp, stiff, p, ynew, fnew, yt
         c = E.bisection_point(a, b, estimate, h)
         if c < 0.0:
             break
-        calls, sphi_c, cphi_c = aeom_stick_step(y, k1, sphi, cphi, c * h, minv, damp, stiff, p, ynew, ytmp, k2, k3,
-                                                k4)
-        stats[2] += calls
+        stats[2] += aeom_stick_step(y, K, c * h, stick, md, ynew, ytmp)
         stats[3] += 1
-        if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
+        if E.stick_margin(ynew, stick, md, F, N) > 0.0:
             a = c
             at_b = False
         else:
             b = c
             at_b = True
-            sphi1 = sphi_c
-            cphi1 = cphi_c
     if not at_b:
-        calls, sphi1, cphi1 = aeom_stick_step(y, k1, sphi, cphi, b * h, minv, damp, stiff, p, ynew, ytmp, k2, k3,
-                                              k4)
-        stats[2] += calls
+        stats[2] += aeom_stick_step(y, K, b * h, stick, md, ynew, ytmp)
         stats[3] += 1
-    Fx, Fy, _, _ = K.rhs_at(ynew, sphi1, cphi1, K.MODE_STICK, 0.0, 0.0, minv, damp, stiff, p, fnew)
+    Fx, Fy, _, _, _ = derivative_and_contact(ynew, stick, md, fnew, F, N, v)
     stats[2] += 1
-    return b * h, E.TRANSITION_TO_SLIP, Fx, Fy, sphi1, cphi1
+    return b * h, E.TRANSITION_TO_SLIP, Fx, Fy

@@ -12,9 +12,9 @@ are shared with ``aeom`` (:mod:`~stickslip.integrate.fixed_step`). What is speci
     step start (simplified Newton, no extra integration); if an iteration fails to halve the
     residual, the exact Jacobian is formed by finite differences (two extra RK4 steps) for the
     rest of that solve (full Newton). Rank-1 Jacobians (Model 4) are solved minimal-norm
-    (``kernels.solve_psd_2x2`` on the normal equations);
+    (``physics.solve_psd_2x2`` on the normal equations);
   - start value: linear extrapolation of the last two steps' forces (O(Δt²) accurate), or the
-    exact multiplier ``kernels.stick_force`` at the first step of a stick phase;
+    exact stick multiplier at the first step of a stick phase;
   - stop when |v_r(t_n)| ≤ :data:`VR_TOL`, or when the Newton correction would change v_r(t_n)
     by less than that (the rest of v_r is out of the force's reach, rank-deficient G); after :data:`MAX_NEWTON` iterations the run stops
     with ``STATUS_SOLVE_FAILED`` and the runner raises :class:`~stickslip.SimulationError`.
@@ -30,11 +30,14 @@ from __future__ import annotations
 
 import math
 
-from ..model import kernels as K
+import numpy as np
+
+from ..model import physics as P
 from ..model.jit import kernel
 from . import events as E
 from . import rk4
 from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
+from .step_physics import constraint_metric, contact_limit, derivative_under_force, stick_force
 
 __all__ = ["naeom_stick_branch", "solve_stick_step", "rk4_force_step", "VR_TOL", "MAX_NEWTON", "STATUS_SOLVE_FAILED"]
 
@@ -59,18 +62,18 @@ FD_REL_STEP = 1.5e-8
 
 
 @kernel
-def rk4_force_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4):
-    """RK4 step of Eq. (1) with the friction force (Fx, Fy) [N] held constant; writes ``ynew``."""
-    K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
+def rk4_force_step(y, h, Fx, Fy, md, ynew, ytmp, K):
+    """RK4 step of Eq. (1) with the friction force (Fx, Fy) [N] held constant; writes ``ynew`` and
+    the stages ``K`` (4, n) (:mod:`.rk4`)."""
+    derivative_under_force(y, Fx, Fy, md, K[0])
     for stage in range(3):
-        c, k_in, k_out = rk4.stage_arrays(stage, h, k1, k2, k3, k4)
-        rk4.stage_state(y, k_in, c, ytmp)
-        K.dynamics(ytmp, Fx, Fy, minv, damp, stiff, p, k_out)
-    rk4.combine(y, h, k1, k2, k3, k4, ynew)
+        rk4.stage_state(y, K, stage, h, ytmp)
+        derivative_under_force(ytmp, Fx, Fy, md, K[stage + 1])
+    rk4.combine(y, h, K, ynew)
 
 
 @kernel
-def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4, stats):
+def solve_stick_step(y, h, Fx, Fy, md, ynew, ytmp, K, stats):
     """Find the constant force over a step of length ``h`` [s] that makes v_r(t_n) = 0.
 
     Parameters
@@ -79,6 +82,8 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
         Step start (in stick).
     Fx, Fy : float
         Start value of the iteration [N].
+    md : ModelData
+        The model (one contact).
     stats : ndarray int64
         rhs calls are added at index 2, Newton iterations at index 6, the largest iteration
         count of one solve at index 7.
@@ -88,7 +93,8 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
     (Fx, Fy, iterations) : the solved force [N] and the iterations used, −1 if the solve did not
     reach |v_r(t_n)| ≤ VR_TOL within MAX_NEWTON iterations. ``ynew`` holds the step end.
     """
-    a11, a12, a22 = K.constraint_metric(y, minv, p)
+    a11, a12, a22 = constraint_metric(y, md)
+    contact = np.int64(0)
     j11 = h * a11
     j12 = h * a12
     j21 = h * a12
@@ -96,9 +102,9 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
     exact = False
     res_prev = math.inf
     for it in range(1, MAX_NEWTON + 1):
-        rk4_force_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4)
+        rk4_force_step(y, h, Fx, Fy, md, ynew, ytmp, K)
         stats[2] += 4
-        vx, vy = K.relative_velocity(ynew, p)
+        vx, vy = P.slip_velocity(ynew, contact, md)
         res = math.sqrt(vx * vx + vy * vy)
         if res <= VR_TOL:
             stats[6] += it
@@ -109,11 +115,11 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
             exact = True
         if exact:
             # finite-difference Jacobian of v_r(t_n) with respect to (Fx, Fy)
-            dx = FD_REL_STEP * max(abs(Fx), abs(Fy), K.static_limit(p))
-            rk4_force_step(y, h, Fx + dx, Fy, minv, damp, stiff, p, ytmp, ytmp, k1, k2, k3, k4)
-            ux, uy = K.relative_velocity(ytmp, p)
-            rk4_force_step(y, h, Fx, Fy + dx, minv, damp, stiff, p, ytmp, ytmp, k1, k2, k3, k4)
-            wx, wy = K.relative_velocity(ytmp, p)
+            dx = FD_REL_STEP * max(abs(Fx), abs(Fy), contact_limit(y, md))
+            rk4_force_step(y, h, Fx + dx, Fy, md, ytmp, ytmp, K)
+            ux, uy = P.slip_velocity(ytmp, contact, md)
+            rk4_force_step(y, h, Fx, Fy + dx, md, ytmp, ytmp, K)
+            wx, wy = P.slip_velocity(ytmp, contact, md)
             stats[2] += 8
             j11 = (ux - vx) / dx
             j21 = (uy - vy) / dx
@@ -125,7 +131,7 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
         n22 = j12 * j12 + j22 * j22
         b1 = -(j11 * vx + j21 * vy)
         b2 = -(j12 * vx + j22 * vy)
-        dFx, dFy, _ = K.solve_psd_2x2(n11, n12, n22, b1, b2)
+        dFx, dFy, _ = P.solve_psd_2x2(n11, n12, n22, b1, b2)
         # the part of v_r the force can still change, J ΔF: when it is below VR_TOL the rest of
         # v_r lies outside the range of J (rank-deficient G, e.g. Model 3 at φ ≈ 0, where no
         # friction force acts on v_r·e_x) and the least-squares solve has converged
@@ -144,19 +150,19 @@ def solve_stick_step(y, h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3,
 
 
 @kernel
-def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4, Q, stats):
+def naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, K, Q, F, N, stats):
     """A NAEOM stick step from ``y`` at time ``t`` [s] of length ``h`` [s], breakaway bisected.
 
     ``hist`` (7,) is the force history of the current stick phase, updated here: the number of
     steps so far, then (mid-step time, Fx, Fy) of the last two steps. The start value of the
-    force solve is its linear extrapolation (O(Δt²)), or the exact multiplier
-    ``kernels.stick_force`` at the first step of a stick phase.
+    force solve is its linear extrapolation (O(Δt²)), or the exact stick multiplier at the first
+    step of a stick phase (``stick``: the contact state in stick).
 
     Returns (h_taken, transition, Fx, Fy, solved): the step length taken [s], 0 or
     ``events.TRANSITION_TO_SLIP``, the solved force [N], and False if a solve failed
     (:data:`MAX_NEWTON`). ``ynew`` holds the step end. Breakaway is bisected on re-solved steps,
     the first trials around the root on the step's interpolant (``events.bisection_point``);
-    ``Q`` (n, 3) is a work array.
+    ``K`` (4, n), ``Q`` (n, 3), ``F`` (2,), ``N`` (1,) are work arrays.
     """
     n_hist = hist[0]
     tm = t + 0.5 * h
@@ -167,17 +173,16 @@ def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, 
     elif n_hist == 1:
         gx, gy = hist[2], hist[3]
     else:
-        gx, gy, _ = K.stick_force(y, minv, damp, stiff, p)
-    Fx, Fy, it = solve_stick_step(y, h, gx, gy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4, stats)
+        gx, gy, _ = stick_force(y, stick, md, F, N)
+    Fx, Fy, it = solve_stick_step(y, h, gx, gy, md, ynew, ytmp, K, stats)
     if it < 0:
         return h, 0, Fx, Fy, False
     transition = 0
-    if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) <= 0.0:
+    if E.stick_margin(ynew, stick, md, F, N) <= 0.0:
         # the step's Hermite interpolant under the solved force gives the first trials
-        K.dynamics(y, Fx, Fy, minv, damp, stiff, p, k1)
-        K.dynamics(ynew, Fx, Fy, minv, damp, stiff, p, k2)
-        estimate = E.interpolated_crossing(E.EVENT_STICK, y, k1, ynew, k2, h, 0.0, 0.0, minv, damp, stiff, p, Q,
-                                           ytmp)
+        derivative_under_force(y, Fx, Fy, md, K[0])
+        derivative_under_force(ynew, Fx, Fy, md, K[1])
+        estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, K[1], h, stick, md, Q, ytmp, F, N)
         a = 0.0
         b = 1.0
         at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
@@ -185,20 +190,18 @@ def naeom_stick_branch(y, t, h, hist, minv, damp, stiff, p, ynew, ytmp, k1, k2, 
             c = E.bisection_point(a, b, estimate, h)
             if c < 0.0:
                 break
-            Fx, Fy, it = solve_stick_step(y, c * h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4,
-                                          stats)
+            Fx, Fy, it = solve_stick_step(y, c * h, Fx, Fy, md, ynew, ytmp, K, stats)
             stats[3] += 1
             if it < 0:
                 return h, 0, Fx, Fy, False
-            if E.event_value(E.EVENT_STICK, ynew, 0.0, 0.0, minv, damp, stiff, p) > 0.0:
+            if E.stick_margin(ynew, stick, md, F, N) > 0.0:
                 a = c
                 at_b = False
             else:
                 b = c
                 at_b = True
         if not at_b:
-            Fx, Fy, it = solve_stick_step(y, b * h, Fx, Fy, minv, damp, stiff, p, ynew, ytmp, k1, k2, k3, k4,
-                                          stats)
+            Fx, Fy, it = solve_stick_step(y, b * h, Fx, Fy, md, ynew, ytmp, K, stats)
             stats[3] += 1
             if it < 0:
                 return h, 0, Fx, Fy, False

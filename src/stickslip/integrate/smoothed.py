@@ -5,9 +5,10 @@ The slip law Eq. (3) is regularised as F = −μ(|v_r|) N v_r / √(|v_r|² + ε
 stiff ODE that ``scipy.integrate.solve_ivp`` can integrate. As ε → 0 its solution approaches
 the non-smooth one.
 
-This module deliberately shares **no code** with :mod:`stickslip.model.kernels`: Eq. (1) is
-written here component by component from the paper, with the contact kinematics of Eqs. (2),
-(5)–(9), in plain numpy. Agreement with the ``event`` method is therefore a real cross-check.
+This module deliberately shares **no code** with the compiled physics
+(:mod:`stickslip.model.physics`): Eq. (1) is written here component by component from the paper,
+with the contact kinematics of Eqs. (2), (5)–(9), in plain numpy. Agreement with the ``event``
+method is therefore a real cross-check.
 """
 
 from __future__ import annotations
