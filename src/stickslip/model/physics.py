@@ -209,7 +209,7 @@ def stick_margin(s, cst, c, md):
     h = vec[3]
     F = vec[4]
     f = vec[5]
-    general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)  # a call: events only, not the rhs
     return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
 
 
