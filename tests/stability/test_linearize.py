@@ -1,14 +1,15 @@
 """The plates' linearisation through the generic derivation (complex step of the model's one
-right-hand side) against the paper's own kernels, finite differences and the Appendix matrices."""
+right-hand side) against the paper's equations written out here, finite differences and the
+Appendix matrices."""
 
 import numpy as np
 import pytest
 
 from stickslip import Parameters
-from stickslip.model import MODELS, assemble, kernels
+from stickslip.model import MODELS, assemble
 from stickslip.model.bundle import CST
 from stickslip.model.derivatives import state_jacobian
-from stickslip.model.physics import MODE_SLIP_EXACT, rhs
+from stickslip.model.physics import MODE_SLIP, MODE_SLIP_EXACT, rhs, slip_velocity
 from stickslip.stability import equilibrium, linearization
 from stickslip.stability.equilibrium import plates_model
 
@@ -18,19 +19,52 @@ RNG = np.random.default_rng(7)
 
 
 def slip_state(system, scale=0.05):
-    """A random state with |v_r| well above the low-speed band (so the kernel uses v_r/|v_r|)."""
+    """A random state with |v_r| well above the low-speed band (so slip takes the direction v_r/|v_r|)."""
     while True:
         s = RNG.normal(size=12) * scale
         s[:6] *= system.minv > 0
         s[6:] *= system.minv > 0
-        vx, vy = kernels.relative_velocity(s, system.p)
+        vx, vy = paper_relative_velocity(s, system.params)
         if np.hypot(vx, vy) > 1e-3:
             return s
 
 
-def _slip_modes():
+def paper_basis(q, P):
+    """e_n1 (Eq. 7), e_n2 (Eq. 8) and R (Eq. 2) at the positions q."""
+    X = q[0] - q[2] + P.r * np.cos(q[4])
+    Y = q[1] - q[3] + P.r * np.sin(q[4])
+    R = np.hypot(X, Y)
+    return np.array([-np.sin(q[4]), np.cos(q[4])]), np.array([-Y / R, X / R]), R
+
+
+def paper_relative_velocity(s, P):
+    """v_r = v_c^p − v_c^d, the contact-point velocities of both plates, Eqs. (5)–(9)."""
+    q, qd = s[:6], s[6:12]
+    en1, en2, R = paper_basis(q, P)
+    return tuple(qd[0:2] + qd[4] * P.r * en1 - qd[2:4] - (P.Omega + qd[5]) * R * en2)
+
+
+def paper_rhs(s, system):
+    """Eq. (1) in slip with Eqs. (2)–(4), (7)–(9): [q̇, M⁻¹ (−C q̇ − K q + Q(F))], F = −μ(|v_r|) N v_r/|v_r|."""
+    P = system.params
+    q, qd = s[:6], s[6:12]
+    free = system.minv > 0
+    v = np.array(paper_relative_velocity(s, P))
+    speed = np.hypot(*v)
+    mu = P.mu_k if P.friction_law == "coulomb" else P.mu_k + P.delta_mu * np.exp(-P.alpha * speed)
+    F = -mu * P.N * v / speed
+    en1, en2, R = paper_basis(q, P)
+    Q = np.array([F[0], F[1], -F[0], -F[1], P.r * F @ en1, -R * F @ en2])
+    mass = np.array([P.m_p, P.m_p, P.m_d, P.m_d, P.J_p, P.J_d])
+    c = np.array([P.c_px, P.c_py, P.c_dx, P.c_dy, P.c_pphi, P.c_dpsi])
+    k = np.array([P.k_px, P.k_py, P.k_dx, P.k_dy, P.k_pphi, P.k_dpsi])
+    acc = np.where(free, (Q - c * qd - k * q) / mass, 0.0)
+    return np.concatenate([np.where(free, qd, 0.0), acc])
+
+
+def _slip_modes(mode=MODE_SLIP_EXACT):
     cst = np.zeros(CST)
-    cst[0], cst[3] = MODE_SLIP_EXACT, np.inf
+    cst[0], cst[1], cst[3] = mode, 1.0, np.inf
     return cst
 
 
@@ -47,32 +81,37 @@ def generic_jacobian(s, system):
     return J
 
 
-def kernel_rhs(s, system):
+def simulator_rhs(s, system):
+    """The right-hand side in the simulator's slip mode (v_r/|v_r| above the low-speed band)."""
     ds = np.zeros(12)
-    kernels.rhs(s, kernels.MODE_SLIP, 1.0, 0.0, system.minv, system.damp, system.stiff, system.p, ds)
+    rhs(s, _slip_modes(MODE_SLIP), plates_model(system).data, ds)
     return ds
 
 
 @pytest.mark.parametrize("model", list(MODELS))
 @pytest.mark.parametrize("law", ["exponential", "coulomb"])
-def test_generic_rhs_equals_the_plates_kernel(model, law):
+def test_generic_rhs_equals_the_paper_equations(model, law):
     system = assemble(Parameters(friction_law=law, N=70.0, Omega=3.0), model)
+    md = plates_model(system).data
     for _ in range(20):
         s = slip_state(system)
         ds = generic_rhs(s, system)
-        ref = kernel_rhs(s, system)
-        # the same floating-point operations as the kernel: only round-off (a few ulps) may differ
+        ref = paper_rhs(s, system)
+        # the same equations in another order of operations: only round-off (a few ulps) may differ
         assert np.max(np.abs(ds - ref)) <= 1e-14 * np.max(np.abs(ref))
+        assert np.max(np.abs(simulator_rhs(s, system) - ref)) <= 1e-14 * np.max(np.abs(ref))
+        assert np.allclose(slip_velocity(s, np.int64(0), md), paper_relative_velocity(s, system.params),
+                           rtol=1e-13, atol=1e-15)
 
 
 def central_difference_jacobian(s, system, h=1e-6):
-    """Central differences of the simulator's kernel; h = 1e-6 balances truncation (h² ≈ 1e-12)
+    """Central differences of the simulator's right-hand side; h = 1e-6 balances truncation (h² ≈ 1e-12)
     against round-off (eps/h ≈ 2e-10) for states of size 0.01–1."""
     J = np.zeros((12, 12))
     for j in range(12):
         e = np.zeros(12)
         e[j] = h
-        J[:, j] = (kernel_rhs(s + e, system) - kernel_rhs(s - e, system)) / (2 * h)
+        J[:, j] = (simulator_rhs(s + e, system) - simulator_rhs(s - e, system)) / (2 * h)
     return J
 
 

@@ -10,8 +10,9 @@ loop, since numba reference-counts loop-carried arrays on every iteration
 (``fixed_step.record_transition``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
-kernels on the innermost path (``kernels.dynamics_at``, ``slip_force_at``, ``rotated``) and for
-the right-hand side's body ``kernels._rhs_body`` at exactly one call site per integrator step,
+kernels on the innermost path (``forces.slip_force``, ``forces.add_contact_force``,
+``forces.rotated``) and for the right-hand side's body ``physics.rhs_body`` at exactly one call
+site per integrator step,
 inside the loop over its stages (a call passes each array as 7 words, ~40 per rhs; inlined:
 −1.5…6 % per fixed-step run). Each inlined copy of the rhs costs ~2.3 s of cold compile: three
 copies (one per RK4 stage) took it +5…9 s for about the speed of one copy in a loop. Inlining
