@@ -281,17 +281,13 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
 def _run_fixed_step(method: str, system: FrictionModel, y0: np.ndarray, t0: float, t_end: float,
                     sample_times: np.ndarray, rtol: float, atol: float, dt: float | None, max_steps: int):
     """The paper's fixed-step methods (two plates only)."""
-    from ..model.system import assemble
     from .fixed_step import run_aeom, run_naeom
 
     if system.name != TWO_PLATES:
         raise SimulationError(f"method {method!r} is the paper's fixed-step method for the two plates; "
                               f"model {system.name!r} runs with method='event' (CLI: --method event)")
-    values = dict(system.parameters)
-    variant = values.pop("variant")
-    plates = assemble(Parameters.from_dict(values), variant, system.slip_band)
     runner = run_aeom if method == "aeom" else run_naeom
-    code, t_reached, keep, out_s, out_mode, out_F, transitions, stats = runner(plates, y0, t0, t_end, sample_times,
+    code, t_reached, keep, out_s, out_mode, out_F, transitions, stats = runner(system, y0, t0, t_end, sample_times,
                                                                             rtol, atol, dt, max_steps)
     buffers = _Buffers.__new__(_Buffers)
     buffers.out_s, buffers.out_mode, buffers.out_F = out_s, out_mode, out_F

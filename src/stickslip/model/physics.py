@@ -56,7 +56,7 @@ from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MOD
 from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
-           "rhs", "rhs_body", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
+           "rhs", "rhs_body", "general_rhs", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP",
            # used by the orbits' variational kernels (orbits/var_kernels.py)
@@ -68,7 +68,10 @@ __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC
 @inlined_kernel
 def write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds):
     """ds = [q̇, M⁻¹ f]; with room, the friction power Σ F_c·(G_c q̇) = Σ F_c·(v_c + w_c) and the
-    damping power −q̇ᵀ C q̇ [W] at 2n, 2n + 1 (integrated, they close the energy balance)."""
+    damping power −q̇ᵀ C q̇ [W] at 2n, 2n + 1 (integrated, they close the energy balance).
+
+    Pass ``ds`` as one array variable: inlined into a caller that picks ``ds`` by a branch
+    (``a if c else b``), numba mistook its length and the powers went unwritten."""
     m = md.m
     for i in range(n):
         ds[i] = s[n + i]
