@@ -81,6 +81,7 @@ def test_slip_phases_match_solve_ivp(run):
         assert tr.state[i + 1, 0] == pytest.approx(sol.y_events[0][0][0], rel=1e-8)
 
 
+@pytest.mark.slow  # the complex-step kernels of a new law class: ~30 s of compilation
 def test_jacobian_equals_central_differences():
     """The complex step runs through the user's law: slip (where μ'(|v|) enters) and stick."""
     from test_jacobians import assert_jacobians_agree
