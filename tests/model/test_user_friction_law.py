@@ -100,6 +100,12 @@ def test_a_law_that_cannot_be_used_is_refused():
         FrictionLaw.from_user(Unregistered())
     with pytest.raises(FrictionLawError, match="from_user"):
         FrictionLaw("user", mu_k=0.5)
+    with pytest.raises(FrictionLawError, match="mu_s = -1"):
+        FrictionLaw.from_user(Stribeck(**LAW), mu_s=-1.0)
+    with pytest.raises(FrictionLawError, match="mu_s = nan"):
+        FrictionLaw.from_user(Stribeck(**LAW), mu_s=float("nan"))
+    with pytest.raises(FrictionLawError, match=r"mu\(0\) cannot be evaluated"):
+        FrictionLaw.from_user(Stribeck(**{**LAW, "v_s": 0.0}))
     spec = {"name": "b", "dofs": ["x"], "mass": [[1.0]], "damping": [[0.1]], "stiffness": [[1.0]],
             "contact": [{"tangent": [[1.0]], "drive": [1.5], "normal_force": 1.0,
                          "friction": {"law": "user", "mu_k": 0.5, "delta_mu": 0.5}}]}

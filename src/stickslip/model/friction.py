@@ -162,7 +162,14 @@ class FrictionLaw:
             raise FrictionLawError(f"friction law {law!r}: its class is not registered; call "
                                    "stickslip.model.friction.register_friction_law(cls, mu) first")
         if mu_s is None:
-            mu_s = float(np.real(_USER_LAWS[type(law)].py_func(law, 0.0)))
+            try:
+                mu_s = float(np.real(_USER_LAWS[type(law)].py_func(law, 0.0)))
+            except (ArithmeticError, ValueError, TypeError) as exc:
+                raise FrictionLawError(f"friction law {law!r}: mu(0) cannot be evaluated ({exc}); check its "
+                                       "parameters or give mu_s") from None
+        if isinstance(mu_s, bool) or not isinstance(mu_s, (int, float)) or not math.isfinite(mu_s) or mu_s < 0.0:
+            raise FrictionLawError(f"friction law {law!r}: mu_s = {mu_s!r} must be a finite number >= 0 "
+                                   "(the static coefficient; give it explicitly if mu(0) is not)")
         return cls("user", mu_k=mu_s, delta_mu=0.0, alpha=0.0, mu_v=0.0, user=law)
 
     def __post_init__(self) -> None:
