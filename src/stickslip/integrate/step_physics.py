@@ -6,8 +6,7 @@ in one call, built from the generic kernels' parts for a model with one contact 
 * :func:`derivative_and_contact`: the state derivative in the modes of ``cst`` together with the
   contact's friction force, slip velocity and normal force. Every step end needs the derivative
   (the next step's k1), the slip velocity (the slip → stick event) and the force (the samples,
-  Eq. 10 in stick): the forces of ``physics.contact_forces`` and the derivative under them, so
-  that a stick multiplier is solved once, not again by ``physics.rhs``;
+  Eq. 10 in stick), from one evaluation of the frame and forces (``physics.rhs_and_forces``);
 * :func:`constraint_metric`: A = G M⁻¹ Gᵀ of the contact, NAEOM's Newton Jacobian v_r(t_n; F)
   ≈ Δt A F;
 * :func:`stick_force`: the stick multiplier and the static limit μs N (paper Eq. 10).
@@ -63,8 +62,7 @@ def derivative_and_contact(s, cst, md, ds, F, N, v):
     ``ds`` has room); returns (Fx, Fy, vx, vy, N): the friction force [N], slip velocity [m/s]
     and normal force [N] of the contact at ``s``. ``F`` (2,), ``N`` (1,), ``v`` (2,) are work
     arrays (they receive the same)."""
-    P.contact_forces(s, cst, md, F, N, v)
-    derivative_under_force(s, F[0], F[1], md, ds)
+    P.rhs_and_forces(s, cst, md, ds, F, N, v)
     return F[0], F[1], v[0], v[1], N[0]
 
 

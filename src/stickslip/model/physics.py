@@ -56,7 +56,7 @@ from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MOD
 from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
-           "rhs", "rhs_body", "general_rhs", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
+           "rhs", "rhs_body", "general_rhs", "rhs_and_forces", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP",
            # used by the orbits' variational kernels (orbits/var_kernels.py)
@@ -158,6 +158,30 @@ def contact_forces(s, cst, md, F_out, N_out, v_out):
     f = vec[5]
     if not sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
         general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    for c in range(nc):
+        N_out[c] = N[c]
+        for i in range(2):
+            F_out[2 * c + i] = F[2 * c + i]
+            v_out[2 * c + i] = v[2 * c + i]
+
+
+@kernel
+def rhs_and_forces(s, cst, md, ds, F_out, N_out, v_out):
+    """:func:`rhs` and :func:`contact_forces` from one evaluation of the frames and forces (the
+    fixed-step methods need both at every step end)."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
+    w = vec[0]
+    v = vec[1]
+    N = vec[2]
+    h = vec[3]
+    F = vec[4]
+    f = vec[5]
+    if not sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
+        general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
     for c in range(nc):
         N_out[c] = N[c]
         for i in range(2):
