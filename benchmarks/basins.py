@@ -152,7 +152,7 @@ def main():
         result["plates"] = plates(args.workers, args.plates_grid)
     path = Path(__file__).parent / "results" / "basins.json"
     path.parent.mkdir(exist_ok=True)
-    path.write_text(json.dumps(stickslip.analysis.settle.jsonable(result), indent=1))
+    path.write_text(json.dumps(stickslip.attractors.jsonable(result), indent=1))
     print(f"wrote {path}")
 
 

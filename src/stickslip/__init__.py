@@ -5,7 +5,8 @@
 ``load_model``              a library model by name (``belt``, ``hoffmann``, ...) or a model file (TOML)
 ``Parameters``              the two plates' parameters (paper Table 1), validated, TOML I/O
 ``simulate``                run a simulation, returns a ``Trajectory``
-``attractor``               what a run settles to, honestly (``simulate_until_settled``: run until it does)
+``attractor``               what a run settles to, honestly (``simulate_until_settled``: run until it does;
+                            ``run_summary``: verdict, window and cost as one dict)
 ``basin_stability``         fractions of initial states reaching each attractor, with standard errors
 ``Trajectory``              typed result: samples, modes, forces, transitions, ``.to_xarray()``
 ``load_trajectory``         read a run written with ``Trajectory.to_netcdf``
@@ -35,20 +36,19 @@ import importlib
 import sys
 import types
 
-__version__ = "0.1.0"
-
+from ._version import __version__
 from .analysis import Classification, classify, find_peaks, intensity
-from .errors import StickSlipError
-from .integrate.driver import SimulationError, simulate
-from .integrate.result import FileFormatError, Trajectory, load_trajectory
-from .model.parameters import ParameterError, Parameters
-from .model.variants import DOF_NAMES, MODELS, STATE_NAMES, VariantError
+from .errors import FileFormatError, ParameterError, SimulationError, StickSlipError, VariantError
+from .integrate.driver import simulate
+from .integrate.result import Trajectory, load_trajectory
+from .model.parameters import Parameters
+from .model.variants import DOF_NAMES, MODELS, STATE_NAMES
 
 #: Public names imported on first access, by the module that defines them.
 _LAZY = {
     **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model"], ".model"),
     **dict.fromkeys(["basin_stability", "BasinResult"], ".basins"),
-    **dict.fromkeys(["attractor", "simulate_until_settled", "Attractor"], ".analysis.settle"),
+    **dict.fromkeys(["attractor", "simulate_until_settled", "Attractor", "SettledRun", "run_summary"], ".attractors"),
     **dict.fromkeys(["StabilityMap", "StabilityResult", "load_stability_map", "stability", "stability_map"],
                     ".stability"),
     **dict.fromkeys(["EquilibriumError", "equilibrium"], ".stability.equilibrium"),
@@ -93,7 +93,7 @@ def __dir__():
 __all__ = [
     "__version__", "StickSlipError",
     "FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model",
-    "basin_stability", "BasinResult", "attractor", "simulate_until_settled", "Attractor",
+    "basin_stability", "BasinResult", "attractor", "simulate_until_settled", "Attractor", "SettledRun", "run_summary",
     "Parameters", "ParameterError",
     "simulate", "SimulationError",
     "Trajectory", "load_trajectory", "FileFormatError",

@@ -39,24 +39,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable
 
-from .errors import StickSlipError
+from ._version import __version__
+from .errors import FileFormatError, LockError, StickSlipError, WriteError
 
 __all__ = ["FileFormatError", "LockError", "WriteError", "OutputLock", "lock", "lock_path", "atomic_write",
            "atomic_write_text",
            "temporary_path", "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name",
            "writing_errors"]
-
-
-class FileFormatError(StickSlipError, ValueError):
-    """A file that is not a stickslip result: missing, foreign, truncated or of another version."""
-
-
-class LockError(StickSlipError, RuntimeError):
-    """Another process is writing the same output."""
-
-
-class WriteError(StickSlipError, RuntimeError):
-    """A file could not be written because the disk (or the file size limit) is full."""
 
 
 #: ``errno`` values of a full disk, an exhausted quota and a file over ``RLIMIT_FSIZE``.
@@ -472,8 +461,6 @@ def open_ours(path, kind: str, *, what: str, versions=(1,), noun: str | None = N
         if m.group(1) != kind:
             raise FileFormatError(f"{path} is a stickslip {m.group(1)} file, not a stickslip {noun} file; give {what}")
         if int(m.group(2)) not in versions:
-            from . import __version__
-
             raise FileFormatError(
                 f"{path} is a stickslip {noun} file of format version {m.group(2)}, which stickslip {__version__} "
                 f"does not read (it reads {', '.join(map(str, versions))}); open it with the stickslip version that "

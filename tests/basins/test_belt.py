@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.analysis.settle import attractor
+from stickslip.attractors import attractor
 from stickslip.basins import basin_stability, box
 from stickslip.basins.context import make_context
 from stickslip.basins.early import Options, classify_state

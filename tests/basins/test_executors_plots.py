@@ -54,8 +54,8 @@ def test_label_colours_are_fixed_per_name():
 
 def test_dask_waits_through_poll_timeouts(serial, monkeypatch):
     """Batches that outlast the polling interval (Ctrl-C is checked between polls) are waited for."""
-    from stickslip.basins import engine
+    from stickslip import parallel
 
-    monkeypatch.setattr(engine, "POLL_S", 1e-4)
+    monkeypatch.setattr(parallel, "POLL_S", 1e-4)
     res = basin_stability(BELT, STATES, executor="dask", workers=1, batch_size=20)
     assert np.array_equal(res.labels(), serial.labels())

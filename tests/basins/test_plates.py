@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.analysis.settle import attractor
+from stickslip.attractors import attractor
 from stickslip.basins import basin_stability, grid
 from stickslip.model.library import load_model
 

@@ -138,24 +138,24 @@ def test_an_os_error_while_writing_is_one_line(tmp_path, monkeypatch):
 
 # ----------------------------------------------------------------------------- bugs stay visible
 def test_a_bug_keeps_its_traceback(tmp_path, monkeypatch):
-    import stickslip.integrate.driver as driver
+    import stickslip.cli.simulate as command
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("a bug")
 
-    monkeypatch.setattr(driver, "simulate", broken)
+    monkeypatch.setattr(command, "run_simulation", broken)
     res = invoke("simulate", "--t-end", "1", "--out", str(tmp_path / "x.nc"))
     assert isinstance(res.exception, ZeroDivisionError)
 
 
 # ----------------------------------------------------------------------------- Ctrl-C
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch):
-    import stickslip.integrate.driver as driver
+    import stickslip.cli.simulate as command
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(driver, "simulate", interrupted)
+    monkeypatch.setattr(command, "run_simulation", interrupted)
     res = invoke("simulate", "--t-end", "1", "--out", str(tmp_path / "x.nc"))
     line = one_error_line(res, code=130, prefix="interrupted:")
     assert "nothing was written" in line
@@ -163,13 +163,13 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("target, args, kept", [
-    ("stickslip.orbits.continuation.start_run", ["continue", "--from", "5", "--to", "6", "--out", "b.nc"],
+    ("stickslip.cli.continue_.start_run", ["continue", "--from", "5", "--to", "6", "--out", "b.nc"],
      "finished work is kept in b.nc.journal; run the same command again to resume"),
-    ("stickslip.sweep.sweep", ["sweep", "--grid", "N=30,50", "--out", "s.nc"],
+    ("stickslip.cli.sweep.run_sweep", ["sweep", "--grid", "N=30,50", "--out", "s.nc"],
      "finished work is kept in s.nc.journal; run the same command again to resume"),
-    ("stickslip.studies.reproduce.reproduce", ["reproduce", "--only", "fig3", "--out", "paper"],
+    ("stickslip.cli.reproduce.run_reproduce", ["reproduce", "--only", "fig3", "--out", "paper"],
      "the figures finished so far are listed in paper/report.md"),
-    ("stickslip.orbits.lyapunov_spectrum", ["lyapunov", "--out", "l.nc"], "nothing was written"),
+    ("stickslip.cli.orbit.lyapunov_spectrum", ["lyapunov", "--out", "l.nc"], "nothing was written"),
 ])
 def test_ctrl_c_says_what_each_command_keeps(target, args, kept, tmp_path, monkeypatch):
     module, _, name = target.rpartition(".")

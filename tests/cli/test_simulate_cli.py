@@ -228,9 +228,9 @@ def test_a_run_that_stops_at_its_start_is_said_in_one_line(tmp_path):
 def test_a_run_that_stops_early_is_kept_and_said_in_one_line(tmp_path, monkeypatch):
     import dataclasses
 
-    import stickslip.integrate.driver as driver
+    import stickslip.cli.simulate as command
 
-    library = driver.simulate
+    library = command.run_simulation
 
     def stops_at_half_time(*args, **kwargs):
         traj = library(*args, **kwargs)
@@ -239,7 +239,7 @@ def test_a_run_that_stops_early_is_kept_and_said_in_one_line(tmp_path, monkeypat
                                    friction=traj.friction[keep], work=traj.work[keep], steady_from=0.25,
                                    status="max_steps reached at t = 0.5 s")
 
-    monkeypatch.setattr(driver, "simulate", stops_at_half_time)
+    monkeypatch.setattr(command, "run_simulation", stops_at_half_time)
     out = tmp_path / "x.nc"
     res = run("--t-end", "1", "--out", str(out), "--json")
     assert res.exit_code == 1, res.output
@@ -252,15 +252,15 @@ def test_a_run_that_stops_early_is_kept_and_said_in_one_line(tmp_path, monkeypat
 def test_a_library_warning_is_one_line(tmp_path, monkeypatch):
     import warnings
 
-    import stickslip.integrate.driver as driver
+    import stickslip.cli.simulate as command
 
-    library = driver.simulate
+    library = command.run_simulation
 
     def warns(*args, **kwargs):
         warnings.warn("something to know\nover two lines", RuntimeWarning)
         return library(*args, **kwargs)
 
-    monkeypatch.setattr(driver, "simulate", warns)
+    monkeypatch.setattr(command, "run_simulation", warns)
     res = run("--t-end", "1", "--json")
     assert res.exit_code == 0, res.output
     assert [ln for ln in res.stderr.splitlines() if ln.strip()] == ["warning: something to know over two lines"]

@@ -16,7 +16,8 @@ from reliability.helpers import wait_for  # the fault suite's helpers (tests/rel
 from reliability.test_worker_processes import GRACE_S, _alive, _descendants_once_running
 from stickslip.orbits import arclength, region_edge
 from stickslip.orbits import continuation as C
-from stickslip.sweep.executors import WorkersError, default_workers
+from stickslip.errors import WorkersError
+from stickslip.parallel import default_workers
 
 
 def test_more_workers_than_cpus_is_refused_before_anything_runs(monkeypatch, tmp_path):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stickslip.sweep.executors import default_workers
+from stickslip.parallel import default_workers
 from stickslip.sweep.spec import TIMING_COLUMNS
 
 #: The console script of this environment (a real process that can be killed with SIGKILL).

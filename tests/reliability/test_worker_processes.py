@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from stickslip.cli import app
 from stickslip.sweep import SweepError, sweep
-from stickslip.sweep.executors import default_workers
+from stickslip.parallel import default_workers
 
 from .helpers import STICKSLIP, one_line_error, run, wait_for
 

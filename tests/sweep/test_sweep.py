@@ -67,7 +67,7 @@ def test_local_cluster_workers_start_without_malloc_trim_threshold():
     pytest.importorskip("distributed")
     from distributed import Client
 
-    from stickslip.sweep.executors import local_cluster
+    from stickslip.parallel import local_cluster
 
     with local_cluster(1) as cluster, Client(cluster) as client:
         env = client.run(lambda: {k: os.environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")})

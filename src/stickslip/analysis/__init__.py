@@ -4,11 +4,13 @@ intensity (Eq. 16) and the relative-motion angle (Fig. 11)."""
 from .classify import KINDS, Classification, classify, classify_response, kind_code
 from .intensity import angle_range, intensity, relative_motion_angle, trajectory_intensities
 from .peaks import Peaks, find_peaks, hermite_value, trajectory_peaks
-from .steady import SteadyState, fundamental_frequency, spectrum, stick_time, summarize
 from .period import Periodicity, detect_period
+from .signal import REST_AMPLITUDE, hermite_crossings, spectral_peak, spectrum, stick_time
+from .steady import SteadyState, fundamental_frequency, summarize
 
 __all__ = [
-    "SteadyState", "fundamental_frequency", "spectrum", "stick_time", "summarize", "Periodicity", "detect_period",
+    "SteadyState", "fundamental_frequency", "summarize", "REST_AMPLITUDE", "hermite_crossings", "spectrum",
+    "spectral_peak", "stick_time", "Periodicity", "detect_period",
     "Peaks", "find_peaks", "hermite_value", "trajectory_peaks",
     "KINDS", "Classification", "classify", "classify_response", "kind_code",
     "intensity", "trajectory_intensities", "relative_motion_angle", "angle_range",

@@ -3,7 +3,7 @@ stationary or still drifting.
 
 The decision uses the window t ≥ t_from (the transient before it is discarded):
 
-1. **At rest** – peak-to-peak x below :data:`~stickslip.analysis.steady.REST_AMPLITUDE`:
+1. **At rest** – peak-to-peak x below :data:`~stickslip.analysis.signal.REST_AMPLITUDE`:
    ``equilibrium``, settled.
 2. **Settled period** – :func:`~stickslip.analysis.period.detect_period` (the one period rule,
    shared with ``Trajectory.steady``): the peaks repeat with multiplicity k and the window shows
@@ -13,7 +13,7 @@ The decision uses the window t ≥ t_from (the transient before it is discarded)
    of the window below :data:`DECAY_RATIO` times that of the first quarter, in x and in every
    other given response: ``equilibrium`` (converging to steady sliding). The signal cannot
    tell a decay onto the equilibrium from one onto a small slip limit cycle or a mode growing
-   unseen below it, so this is not settled here: :mod:`stickslip.analysis.settle` confirms it
+   unseen below it, so this is not settled here: :mod:`stickslip.attractors` confirms it
    with the linear stability of the equilibrium. A slip-only response that grows in any
    response is not an equilibrium.
 4. Otherwise ``non-periodic``: **stationary** when the return differences of the best
@@ -21,7 +21,7 @@ The decision uses the window t ≥ t_from (the transient before it is discarded)
    decay (:func:`~stickslip.analysis.period.decay_ratio` at most
    :data:`~stickslip.analysis.period.DECAY_FACTOR`) nor trend (their drift is no larger than
    their spread): no sign of a transient, a candidate for chaos or a torus that only the
-   dynamics can confirm (:mod:`stickslip.analysis.settle`); else **unsettled**. The range of
+   dynamics can confirm (:mod:`stickslip.attractors`); else **unsettled**. The range of
    the peaks is not required to repeat between the window halves: a chaotic attractor's
    100-s windows differ in range by 3–25 % (docs/settling.md).
 
@@ -38,7 +38,7 @@ import numpy as np
 
 from .peaks import Peaks
 from .period import DECAY_FACTOR, MAX_MULTIPLICITY, MIN_PERIODS, SETTLE_RTOL, decay_ratio, detect_period
-from .steady import REST_AMPLITUDE, _spectral_peak, stick_time
+from .signal import REST_AMPLITUDE, spectral_peak, stick_time
 
 __all__ = ["KINDS", "Classification", "classify_response", "classify", "kind_code",
            "SETTLE_RTOL", "MAX_MULTIPLICITY", "MIN_PERIODS"]
@@ -197,7 +197,7 @@ def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | 
     if amp < REST_AMPLITUDE:
         return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, attractor="equilibrium",
                               evidence=evidence, **base)
-    fft_f = _spectral_peak(t, x)
+    fft_f = spectral_peak(t, x)
     if per.periodic:
         kind = "periodic-stick-slip" if stick_fraction > 0.0 else "periodic-slip"
         return Classification(kind, per.multiplicity, per.period_s, 1.0 / per.period_s, fft_f, settled=True,
@@ -225,7 +225,7 @@ def classify(traj, t_from: float | None = None, dof: str | None = None) -> Class
 
     The stick fraction comes from the exact transition instants. ``t_from`` defaults to the
     trajectory's ``steady_from`` (the last half of the run unless set). This is the signal's
-    verdict; :func:`stickslip.analysis.settle.attractor` adds the dynamical confirmations.
+    verdict; :func:`stickslip.attractors.attractor` adds the dynamical confirmations.
     ``dof`` defaults to the model's observed coordinate (the plates' φ).
     """
     system = traj.system

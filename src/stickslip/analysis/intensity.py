@@ -6,6 +6,9 @@ import math
 
 import numpy as np
 
+from ..errors import EquilibriumError
+from ..stability.equilibrium import equilibrium
+
 __all__ = ["ANGLE_SPEED_FRACTION", "intensity", "trajectory_intensities", "relative_motion_angle", "angle_range"]
 
 
@@ -68,8 +71,6 @@ def trajectory_intensities(traj, t_from: float | None = None, equilibrium_q=None
     """
     t_from = traj.steady_from if t_from is None else float(t_from)
     if equilibrium_q is None:
-        from ..stability.equilibrium import EquilibriumError, equilibrium
-
         try:
             equilibrium_q = equilibrium(traj.params, traj.model)
         except EquilibriumError:

@@ -5,7 +5,7 @@ is represented by the cubic Hermite interpolant of (x, ẋ) at its ends, which i
 accurate in the step. A peak is a root of the interpolant's derivative where it changes sign
 from + to − (ẋ = 0 with ẍ < 0); its value is the interpolant there. With the accelerations
 ẍ at the samples as well, the root is located on the Hermite interpolant of (ẋ, ẍ) by
-:func:`stickslip.analysis.steady._hermite_crossings` and the value read off the (x, ẋ) cubic.
+:func:`stickslip.analysis.signal.hermite_crossings` and the value read off the (x, ẋ) cubic.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ import dataclasses
 
 import numpy as np
 
-from .steady import _hermite_crossings
+from ..model.variants import DOF_NAMES
+from .signal import hermite_crossings
 
 __all__ = ["Peaks", "find_peaks", "hermite_value", "trajectory_peaks"]
 
@@ -112,7 +113,7 @@ def find_peaks(t, x, dx, ddx=None) -> Peaks:
         return Peaks(np.empty(0), np.empty(0))
     if ddx is not None:
         # up-crossings of −ẋ through 0 are the instants where ẋ falls through zero
-        times, idx = _hermite_crossings(t, -dx, -np.asarray(ddx, dtype=float), 0.0)
+        times, idx = hermite_crossings(t, -dx, -np.asarray(ddx, dtype=float), 0.0)
         # a crossing that lands exactly on a sample belongs to the interval before it
         return Peaks(times, hermite_value(t, x, dx, idx, times))
     # ẋ ≥ 0 at the left end and ≤ 0 at the right end, not both zero (plateaus are not peaks)
@@ -132,8 +133,6 @@ def trajectory_peaks(traj, t_from: float | None = None, dof: str = "phi") -> Pea
     ``t_from`` defaults to the trajectory's ``steady_from``; ``dof`` is a name of
     :data:`stickslip.DOF_NAMES`.
     """
-    from ..model.variants import DOF_NAMES
-
     if dof not in DOF_NAMES:
         raise ValueError(f"unknown DOF {dof!r}; choose one of {', '.join(DOF_NAMES)}")
     j = DOF_NAMES.index(dof)

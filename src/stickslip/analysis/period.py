@@ -20,9 +20,9 @@ The response is **periodic and settled** with multiplicity k for the smallest k 
 :data:`MAX_MULTIPLICITY` with at least :data:`MIN_PERIODS` periods in the window, spread ≤
 :data:`SETTLE_RTOL`, drift ≤ spread (or ≤ :data:`DRIFT_FLOOR`) and separation ≥
 :data:`SEPARATION_FACTOR` × spread: a period of k ≥ 2 crossings needs distinct branches. Below
-:data:`~stickslip.analysis.steady.REST_AMPLITUDE` the response is at rest and not periodic.
+:data:`~stickslip.analysis.signal.REST_AMPLITUDE` the response is at rest and not periodic.
 
-This is the rule of the signal alone; :mod:`stickslip.analysis.settle` adds what the dynamics
+This is the rule of the signal alone; :mod:`stickslip.attractors` adds what the dynamics
 must confirm (a period-k claim with k ≥ 2 by shooting, chaos by a Lyapunov exponent). Every
 consumer (classification, ``Trajectory.steady``, sweeps) calls :func:`detect_period`.
 """
@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from .peaks import Peaks, find_peaks
-from .steady import REST_AMPLITUDE
+from .signal import REST_AMPLITUDE
 
 __all__ = ["SETTLE_RTOL", "DRIFT_FLOOR", "DECAY_FACTOR", "SEPARATION_FACTOR", "MAX_MULTIPLICITY", "MIN_PERIODS",
            "REST_AMPLITUDE", "ReturnMap", "Periodicity", "return_map", "evidence_at", "decay_ratio", "detect_period"]

@@ -13,11 +13,12 @@ stability, the linear flow), :mod:`.cycles` (phase-independent features and matc
 :mod:`.engine` (batches on an executor). ``docs/basins.md`` describes the method.
 """
 
+from ..errors import BasinError
 from .early import DECIDED, OUTCOMES, Options
 from .engine import basin_stability, load_result
 from .result import BasinResult
 from .spec import parse_param
-from .states import BasinError, StateSpec, box, from_csv, grid, parse_range
+from .states import StateSpec, box, from_csv, grid, parse_range
 from .store import load_basins
 
 __all__ = ["basin_stability", "load_result", "load_basins", "BasinResult", "BasinError", "StateSpec", "box", "grid",

@@ -27,6 +27,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import StickSlipError
+from ..model.library import describe_system, system_from_description
+from ..stability.analysis import stability
 
 __all__ = ["Context", "make_context", "model_of", "model_key", "SAMPLES_PER_PERIOD", "CHUNK_PERIODS",
            "WINDOW_PERIODS", "register_model"]
@@ -97,8 +99,6 @@ class Context:
 
 def model_key(model) -> str:
     """The description of ``model`` as a JSON key (:func:`stickslip.model.library.describe_system`)."""
-    from ..model.library import describe_system
-
     return json.dumps(describe_system(model), sort_keys=True)
 
 
@@ -112,8 +112,6 @@ def register_model(model) -> str:
 
 @lru_cache(maxsize=64)
 def _rebuild(key: str):
-    from ..model.library import system_from_description
-
     return system_from_description(json.loads(key))
 
 
@@ -156,7 +154,6 @@ def make_context(model, *, key: str | None = None) -> Context:
     """The :class:`Context` of ``model`` (steady sliding, its stability, the linear flow)."""
     from scipy.linalg import expm, solve_continuous_lyapunov
 
-    from ..stability.analysis import stability
 
     n = model.n
     free_dofs = np.flatnonzero(model.free)

@@ -23,6 +23,8 @@ import math
 
 import numpy as np
 
+from ..analysis.peaks import find_peaks
+
 __all__ = ["Cycle", "Section", "MATCH_PERIODS", "MATCH_RTOL", "KMAX", "cycles_equal", "run_matches", "find_cycle",
            "section_of", "cycle_from_section"]
 
@@ -121,8 +123,6 @@ class Section:
 
 def section_of(t: np.ndarray, x: np.ndarray, dx: np.ndarray) -> Section:
     """The :class:`Section` of a sampled coordinate x(t) with rate ẋ(t)."""
-    from ..analysis.peaks import find_peaks
-
     top = find_peaks(t, x, dx)
     low = find_peaks(t, -x, -dx)
     m = len(top)

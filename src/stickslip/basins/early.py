@@ -17,9 +17,9 @@ characteristic periods, in this order:
    (:func:`.cycles.run_matches`).
 3. **A new cycle**: the maxima of the last :data:`RULE_PERIODS` T_c repeat by the package's
    period rule (:func:`stickslip.analysis.period.return_map`); the window's verdict
-   (:func:`stickslip.analysis.settle.attractor`, which for k ≥ 2 maxima per period needs the shot
+   (:func:`stickslip.attractors.attractor`, which for k ≥ 2 maxima per period needs the shot
    orbit to confirm it) then decides ``periodic`` and gives the cycle's features.
-4. At ``t_end``: the verdict of :func:`~stickslip.analysis.settle.attractor` on the window
+4. At ``t_end``: the verdict of :func:`~stickslip.attractors.attractor` on the window
    (``equilibrium``, ``periodic``, ``quasiperiodic``, ``chaotic`` or ``unsettled``); a run that
    stops early is ``unbounded`` (non-finite state), ``contact-lost`` (a normal force reached 0)
    or ``failed`` (step size underflow, step cap).
@@ -36,13 +36,21 @@ from collections import deque
 
 import numpy as np
 
+from ..analysis.peaks import Peaks
+from ..analysis.period import MIN_PERIODS, return_map
+from ..attractors import attractor
+from ..integrate import contacts as E
+from ..integrate.event_loop import N_EXTRA, integrate_event
+from ..integrate.result import Stats, Trajectory, Transitions
+from ..integrate.status import CHUNK_END, CONTACT_LOST, NOT_FINITE, SUCCESS
+from ..model.bundle import contact_state
 from .context import Context
 from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
 
 __all__ = ["Options", "Outcome", "classify_state", "OUTCOMES", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
            "RULE_PERIODS", "row_width", "DEFAULT_MAX_STEPS"]
 
-#: Verdicts of one state: the attractor verdicts (:data:`stickslip.analysis.settle.ATTRACTORS`),
+#: Verdicts of one state: the attractor verdicts (:data:`stickslip.attractors.ATTRACTORS`),
 #: then a run that lost a contact, and one the integrator could not finish.
 OUTCOMES = ("equilibrium", "periodic", "quasiperiodic", "chaotic", "unbounded", "unsettled", "contact-lost", "failed")
 
@@ -89,7 +97,7 @@ class Options:
     match_rtol : float
         Tolerance of the cycle matches (:mod:`.cycles`).
     confirm : bool
-        Shoot the orbit of a period claim of k ≥ 2 maxima (:func:`stickslip.analysis.settle.attractor`).
+        Shoot the orbit of a period claim of k ≥ 2 maxima (:func:`stickslip.attractors.attractor`).
     lyapunov : bool
         Compute Lyapunov exponents for a stationary non-periodic window at t_end (chaos or torus).
     max_steps : int
@@ -207,8 +215,6 @@ class _Window:
 
 def _trajectory(model, ctx: Context, opts: Options, window: _Window, t_end: float, steps: int):
     """The window as a :class:`~stickslip.integrate.result.Trajectory` (for the verdict)."""
-    from ..integrate.result import Stats, Trajectory, Transitions
-
     t, states, mode, friction, (tt, kind, contact, ts) = window.arrays()
     return Trajectory(t=t, states=states, mode=mode, friction=friction, work=np.zeros((t.size, 2)),
                       transitions=Transitions(tt, kind, ts, contact), stats=Stats(accepted_steps=steps),
@@ -220,9 +226,7 @@ def _trajectory(model, ctx: Context, opts: Options, window: _Window, t_end: floa
 
 
 def _verdict(model, ctx, opts, window, t_from, t_end, steps, cache):
-    """The verdict of :func:`stickslip.analysis.settle.attractor` on the window from ``t_from``."""
-    from ..analysis.settle import attractor
-
+    """The verdict of :func:`stickslip.attractors.attractor` on the window from ``t_from``."""
     traj = _trajectory(model, ctx, opts, window, t_end, steps)
     return traj, attractor(traj, t_from, confirm=opts.confirm, lyapunov=opts.lyapunov, cache=cache)
 
@@ -260,13 +264,6 @@ def classify_state(ctx: Context, model, s0: np.ndarray, cycles, opts: Options) -
     -------
     Outcome
     """
-    from ..analysis.peaks import Peaks
-    from ..analysis.period import MIN_PERIODS, return_map
-    from ..integrate import contacts as E
-    from ..integrate.event_loop import N_EXTRA, integrate_event
-    from ..integrate.status import CHUNK_END, CONTACT_LOST, NOT_FINITE, SUCCESS
-    from ..model.bundle import contact_state
-
     start = time.perf_counter()
     md = model.data
     n = model.n

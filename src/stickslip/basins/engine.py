@@ -3,7 +3,7 @@
 Per parameter value the model's context (steady sliding, its stability, the linear flow;
 :mod:`.context`) and initial states are made here once. States go to the executor in batches
 (``serial`` in this process, ``processes`` in a pool of worker processes, ``dask`` on a
-LocalCluster or a scheduler, from :mod:`stickslip.sweep.executors`); each batch carries the
+LocalCluster or a scheduler, from :mod:`stickslip.parallel`); each batch carries the
 cycles found so far for its parameter value, so that later states stop as soon as they reach
 one. Outcomes are journaled as batches arrive; the dataset is assembled from the journal
 (:func:`.result.assemble`), so a study killed at any moment and started again computes only the
@@ -14,7 +14,6 @@ journal for the next run.
 
 from __future__ import annotations
 
-import asyncio
 import math
 import tempfile
 import time
@@ -22,20 +21,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import StickSlipError
-from ..files import FileFormatError
+from ..errors import BasinError, FileFormatError, StickSlipError
 from ..integrate.interrupt import interruptible
+from ..model.library import load_model
+from ..parallel import EXECUTORS, check_executor, check_workers, map_unordered
 from .context import Context, make_context, model_of, register_model
 from .cycles import find_cycle
 from .early import Options, Outcome, classify_state
 from .result import BasinResult, assemble
 from .spec import BasinSpec, build_spec
-from .states import BasinError, StateSpec
+from .states import StateSpec
 from .store import Journal, journal_dir, load_basins, write_dataset
 
 __all__ = ["basin_stability", "EXECUTORS", "TARGET_BATCH_S", "evaluate_batch"]
-
-EXECUTORS = ("serial", "processes", "dask")
 
 #: Wall time aimed at per batch [s]: small enough that cycles found by one worker reach the
 #: others soon and that Ctrl-C is answered within about this long, large enough that a task's
@@ -46,9 +44,6 @@ MAX_BATCH_STATES = 4096
 #: States classified in this process after the first (which compiles or loads the kernels) to
 #: time a state for the automatic batch size.
 TIMED_STATES = 8
-
-#: Polling interval of the executors while waiting for batches [s] (Ctrl-C is checked between).
-POLL_S = 0.2
 
 
 def evaluate_batch(task):
@@ -89,71 +84,19 @@ def _contexts(models, keys):
 
 
 def _progress(total, done, label):
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                    TextColumn("{task.fields[rate]}"), TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn())
     bar.start()
     return bar, bar.add_task(label, total=total, completed=done, rate="")
-
-
-def _serial(tasks, stop, info):
-    for task in tasks:
-        if stop.requested:
-            return
-        yield evaluate_batch(task)
-
-
-def _processes(tasks, workers, stop, info):
-    from concurrent.futures import FIRST_COMPLETED, wait
-
-    from ..sweep.executors import worker_pool
-
-    start = time.perf_counter()
-    with worker_pool(workers) as pool:
-        info["pool_start_s"] = time.perf_counter() - start
-        pending = set()
-        for task in tasks:
-            pending.add(pool.submit(evaluate_batch, task))
-            if len(pending) >= 2 * workers:
-                break
-        while pending:
-            done, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
-            for fut in done:
-                yield fut.result()
-                task = None if stop.requested else next(tasks, None)
-                if task is not None:
-                    pending.add(pool.submit(evaluate_batch, task))
-
-
-def _dask(tasks, workers, address, stop, info):
-    from distributed import Client, wait
-
-    from ..sweep.executors import connect, local_cluster
-
-    start = time.perf_counter()
-    cluster = None
-    client = connect(address) if address else Client(cluster := local_cluster(workers))
-    try:
-        info["cluster_start_s"] = time.perf_counter() - start
-        n_workers = max(1, len(client.scheduler_info().get("workers", {})))
-        pending = {client.submit(evaluate_batch, t, pure=False) for _, t in zip(range(2 * n_workers), tasks)}
-        while pending:
-            try:
-                done = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED").done
-            except (TimeoutError, asyncio.TimeoutError):  # dask's wait raises when nothing finished in time
-                continue
-            for fut in done:
-                pending.discard(fut)
-                yield fut.result()
-                fut.release()
-                task = None if stop.requested else next(tasks, None)
-                if task is not None:
-                    pending.add(client.submit(evaluate_batch, task, pure=False))
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def basin_stability(model, states: StateSpec, *, param: str | None = None, values=(), out=None,
@@ -213,12 +156,8 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     stickslip.files.WriteError
         The disk is full (the journal keeps every classified state).
     """
-    from ..model.library import load_model
-    from ..sweep.executors import check_workers
-
     t_start = time.perf_counter()
-    if executor not in EXECUTORS:
-        raise BasinError(f"unknown executor {executor!r}; choose one of {', '.join(EXECUTORS)}")
+    check_executor(executor, BasinError)
     model = load_model(model)
     unknown = set(options) - {"rtol", "atol", "match_rtol", "confirm", "lyapunov", "max_steps"}
     if unknown:
@@ -338,13 +277,8 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
                 size = _batch_size(batch_size, t_state, rest.size, workers, executor)
                 timing.update(batch_size=size, first_state_s=t_state)
                 tasks = (task(b) for b in _batches(rest, size, N))
-                if executor == "serial":
-                    results = _serial(tasks, stop, timing)
-                elif executor == "processes":
-                    results = _processes(tasks, workers, stop, timing)
-                else:
-                    results = _dask(tasks, workers, address, stop, timing)
-                for idx, rws in results:
+                for idx, rws in map_unordered(evaluate_batch, tasks, executor=executor, workers=workers,
+                                              address=address, stop=stop, info=timing):
                     record(idx, rws)
             timing["interrupted"] = bool(stop.requested) and n_new < todo.size
     finally:

@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
+from ..attractors import jsonable
 from .cycles import find_cycle, run_matches
 from .early import DECIDED, OUTCOMES, Outcome
 from .spec import BasinSpec
@@ -289,8 +290,6 @@ class BasinResult:
     def to_json(self) -> dict:
         """``{"n", "fractions", "standard_errors", "attractors"}`` (for a parameter study also
         ``param`` and ``values``, and lists over the values)."""
-        from ..analysis.settle import jsonable
-
         def clean(d):
             return jsonable({k: (v.tolist() if np.ndim(v) else v) for k, v in d.items()})
 

@@ -15,8 +15,10 @@ from typing import Sequence
 
 import numpy as np
 
+from ..errors import BasinError
+from .context import model_key
 from .early import Options, row_width
-from .states import BasinError, StateSpec
+from .states import StateSpec
 
 __all__ = ["BasinSpec", "build_spec", "parse_param"]
 
@@ -124,8 +126,6 @@ def _check_options(options: Options) -> None:
 def build_spec(model, states: StateSpec, *, param: str | None = None, values: Sequence[float] = (),
                options: Options | None = None, key: str | None = None) -> BasinSpec:
     """A checked :class:`BasinSpec` (``values`` empty without ``param``)."""
-    from .context import model_key
-
     options = options or Options()
     _check_options(options)
     values = tuple(float(v) for v in values)

@@ -22,7 +22,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import StickSlipError
+from ..errors import BasinError
 
 __all__ = ["BasinError", "StateSpec", "BASES", "box", "grid", "from_csv", "parse_range"]
 
@@ -31,10 +31,6 @@ BASES = ("equilibrium", "zero")
 
 #: Most states a study may hold (each a row of the journal and of the NetCDF).
 MAX_STATES = 10_000_000
-
-
-class BasinError(StickSlipError, ValueError):
-    """An invalid basin-stability study (states, options), or an output of another study."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -24,11 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import BasinError, SweepError
 from ..files import atomic_write, format_name, open_ours
-from ..sweep.spec import SweepError
 from ..sweep.store import Journal as SweepJournal
 from ..sweep.store import journal_dir
-from .states import BasinError
 
 __all__ = ["Journal", "journal_dir", "write_dataset", "load_basins", "FORMAT"]
 

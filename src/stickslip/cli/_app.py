@@ -24,7 +24,12 @@ from rich.markup import escape
 from rich.text import Text
 from typer.core import TyperGroup
 
+from .._version import __version__
 from ..errors import StickSlipError
+from ..integrate.driver import MAX_SAMPLES
+from ..integrate.interrupt import on_ctrl_c
+from ..model.library import load_model, plates_variant, two_plates
+from ..model.parameters import Parameters
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -139,8 +144,6 @@ class _Application(TyperGroup):
         sys.exit(code)
 
     def invoke(self, ctx):
-        from ..integrate.interrupt import on_ctrl_c
-
         on_interrupt("nothing was written")
         try:
             # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
@@ -203,8 +206,6 @@ PARAMETER_FLAGS = {"N": "--N", "Omega": "--omega", "mu_k": "--mu-k", "delta_mu":
 def config_values(config) -> dict:
     """``{name: value}`` of the parameters a --config TOML file sets (validated; names it does
     not set are left out)."""
-    from ..model.parameters import Parameters
-
     loaded = Parameters.load_toml(config)
     data = tomllib.loads(Path(config).read_text())
     return {name: getattr(loaded, name) for name in data.get("parameters", data)}
@@ -240,8 +241,6 @@ def build_parameters(config, assignments, base=None, swept: dict | None = None, 
         When two options set the same parameter (a named option and ``--set``, or either and
         the option that sweeps it).
     """
-    from ..model.parameters import Parameters
-
     params = Parameters() if base is None else base
     given = []
     if config is not None:
@@ -303,9 +302,6 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
         For an unknown model or parameter, a plates option given for another model, or two
         options that set the same parameter.
     """
-    from ..model.library import load_model, plates_variant, two_plates
-    from ..model.parameters import Parameters
-
     variant = plates_variant(model)
     if base is not None and base.name == "two-plates" and variant is None:
         variant = str(base.parameters.get("variant", "full"))
@@ -421,8 +417,6 @@ def check_samples(duration: float, sample_rate: float, *, time_flag: str = "--t-
     time_flag, rate_flag : str
         The options that set them, named in the message (``rate_flag`` None: not an option).
     """
-    from ..integrate.driver import MAX_SAMPLES
-
     n = duration * sample_rate + 1.0
     limit, what = float(MAX_SAMPLES), f"the {MAX_SAMPLES} samples a run may keep"
     memory = available_memory()
@@ -526,8 +520,6 @@ def given(ctx: typer.Context, name: str) -> bool:
 
 def _version(value: bool) -> None:
     if value:
-        from .. import __version__
-
         console.print(f"stickslip {__version__}")
         raise typer.Exit()
 

@@ -14,7 +14,12 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ._app import MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, err_console, parse_assignments
+from ..basins import basin_stability, from_csv, parse_param, parse_range
+from ..basins import box as random_box
+from ..basins import grid as regular_grid
+from ..plot.basins import save_basins_figure
+from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, err_console,
+                   parse_assignments)
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")
@@ -22,8 +27,6 @@ _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box
 
 def _states(model, box, n, seed, grid, ics, base, state):
     """The initial states from the options (one line naming the fix for a bad combination)."""
-    from ..basins import box as random_box, from_csv, grid as regular_grid, parse_range
-
     if ics is not None:
         if box or grid or state or base is not None:
             raise CLIError("--ics gives every state of every row; drop --box, --grid, --base and --state")
@@ -82,8 +85,6 @@ def basins(
     as_json: bool = typer.Option(False, "--json", help="Print {n, fractions, standard_errors, attractors} as JSON."),
 ) -> None:
     """Basin stability: which attractor each initial state reaches (exact stick), and how often."""
-    from ..basins import basin_stability, parse_param
-
     check_nc_path(out)
     m, _ = build_system(model, None, set_)
     states = _states(m, box, n, seed, grid, ics, base, state)
@@ -98,8 +99,6 @@ def basins(
                              confirm=not no_confirm, lyapunov=lyapunov)
     figure = None
     if not no_plot:
-        from ..plot.basins import save_basins_figure
-
         figure = save_basins_figure(result, out.with_suffix(".png"))
     if as_json:
         print(json.dumps(result.to_json()))

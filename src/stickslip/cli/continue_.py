@@ -14,16 +14,18 @@ import typer
 from rich.table import Table
 
 from ..errors import StickSlipError
-from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one,
-                   check_finite, check_positive, check_resumable_output, check_samples, console, note_line)
+from ..orbits import resolve_section
+from ..orbits.continuation import SPECIAL_KINDS, START_RATE, continue_orbit, start_run
+from ..orbits.models import parameter_value, with_parameter
+from ..plot.continuation import save_branch_figure
+from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_finite,
+                   check_positive, check_resumable_output, check_samples, console, note_line)
 from .orbit import model_system, parse_section, parse_start
 
 
 def _check(start: float, stop: float, max_points: int, step: float, max_step: float, search_time: float,
            rtol: float, tol: float, stop_on: list[str]) -> None:
     """Validate the options before anything is computed (one-line CLIError naming the fix)."""
-    from ..orbits.continuation import SPECIAL_KINDS
-
     check_finite({"--from": start, "--to": stop})
     if start == stop:
         raise CLIError(f"--from and --to are both {start:g}; give the end of the range to continue to")
@@ -82,10 +84,6 @@ def continue_command(
 
     The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused).
     """
-    from ..orbits import resolve_section
-    from ..orbits.continuation import START_RATE, continue_orbit, start_run
-    from ..orbits.models import parameter_value, with_parameter
-
     stop_on = list(stop_on or [])
     _check(start, stop, max_points, step, max_step, search_time, rtol, tol, stop_on)
     ic_start = parse_start(ic)
@@ -110,8 +108,6 @@ def continue_command(
                             on_resume=_note_resume, resume=not overwrite)
     figure = None
     if not no_plot:
-        from ..plot.continuation import save_branch_figure
-
         figure = save_branch_figure(branch, out.with_suffix(".png"))
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "param": param,

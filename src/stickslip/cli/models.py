@@ -9,6 +9,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..model.library import library, load_model, plates_variant, two_plates
 from ._app import app, console
 
 
@@ -19,8 +20,6 @@ def models(
     as_json: bool = typer.Option(False, "--json", help="Print the list, or the model's description, as JSON."),
 ) -> None:
     """The model library, or one model's states, contacts and the parameter paths --set reaches."""
-    from ..model.library import library, load_model, plates_variant, two_plates
-
     if model is None:
         names = library()
         if as_json:

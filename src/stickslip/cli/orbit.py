@@ -18,13 +18,15 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..analysis.signal import stick_time
 from ..files import atomic_write
+from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
+from ..orbits.continuation import START_RATE, start_run
+from ..orbits.start import default_start
+from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
                    check_choice, check_outputs, check_positive, check_samples, console)
 from .simulate import _parse_ic
-
-#: Named starts (:data:`stickslip.sweep.NAMED_ICS`, as ``stickslip continue``); ``far`` is the plates'.
-_ICS = ("far", "near", "zero", "equilibrium")
 
 #: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
 _METHODS = ("saltation", "finite-difference")
@@ -32,19 +34,18 @@ _LYAPUNOV_METHODS = ("variational", "finite-difference")
 
 _N_HELP = "The plates: normal preload N [N] (default 50)."
 _OMEGA_HELP = "The plates: angular velocity Ω of the lower plate [rad/s] (default 5)."
-_IC_HELP = ("Start run: far (the plates) | near | zero | equilibrium (docs/sweeps.md) | NAME=VALUE,... by state "
-            "name, e.g. x=0,dx=1.5.")
+_IC_HELP = ("Start run: zero | near | equilibrium | a start of the model's own (the plates' far; `stickslip models "
+            "NAME` lists them) | NAME=VALUE,... by state name, e.g. x=0,dx=1.5. Default: the model's own first "
+            "start (the plates' far), else zero.")
 _SECTION_HELP = ("Poincaré section: max (maximum of the model's observed coordinate, the plates' φ) | DOF_max | "
                  "DOF=LEVEL (up-crossing of a level), e.g. x2_max.")
 _BAND_HELP = "Low-speed band of the slip direction [m/s] (default: that of stickslip.simulate)."
 
 
-def parse_start(ic: str):
-    """``--ic``: a name of :data:`_ICS` or a state (``NAME=VALUE,...`` or 2n numbers), checked for its form."""
-    start = _parse_ic(ic)
-    if isinstance(start, str):
-        check_choice("--ic", start, _ICS)
-    return start
+def parse_start(ic: str | None):
+    """``--ic``: a start's name or a state (``NAME=VALUE,...`` or 2n numbers), checked for its form
+    (the model checks the name); None when not given."""
+    return None if ic is None else _parse_ic(ic)
 
 
 def model_system(model: str, config, assignments, slip_band, *, swept=None, **named):
@@ -82,7 +83,7 @@ def orbit_command(
     N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
     model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: str = typer.Option("far", "--ic", help=_IC_HELP),
+    ic: Optional[str] = typer.Option(None, "--ic", help=_IC_HELP),
     section: str = typer.Option("max", "--section", help=_SECTION_HELP),
     search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run [s]; the guess is "
                                       "taken from its last section crossings."),
@@ -102,10 +103,6 @@ def orbit_command(
 
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
-    from ..analysis.steady import stick_time
-    from ..orbits import periodic_orbit, resolve_section
-    from ..orbits.continuation import START_RATE, start_run
-
     start = parse_start(ic)
     check_positive({"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
     check_below_one({"--tol": tol})
@@ -129,8 +126,6 @@ def orbit_command(
     atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
     figure = None
     if not no_plot:
-        from ..plot.orbits import save_orbit_figure
-
         figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
     others = np.abs(orbit.nontrivial_multipliers)
     summary = {
@@ -163,7 +158,7 @@ def lyapunov_command(
     N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
     model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: str = typer.Option("far", "--ic", help=_IC_HELP),
+    ic: Optional[str] = typer.Option(None, "--ic", help=_IC_HELP),
     t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first [s]."),
     t_average: float = typer.Option(200.0, "--t-average", help="Averaging time [s]."),
     method: str = typer.Option("variational", "--method", help="variational (saltation matrices) | "
@@ -181,24 +176,19 @@ def lyapunov_command(
 
     Runs --t-transient seconds from --ic, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
     """
-    from ..orbits import lyapunov_spectrum
-    from ..orbits.start import named_start
-
     start = parse_start(ic)
     check_positive({"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol, "--slip-band": slip_band})
     check_choice("--method", method, _LYAPUNOV_METHODS)
     system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
     check_outputs(out, not no_plot, overwrite)
-    start, perturbation = named_start(system, start)
-    spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average,
-                                 perturbation=perturbation, rtol=rtol, method=method)
+    start = default_start(system) if start is None else start
+    spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
+                                 method=method)
     out.parent.mkdir(parents=True, exist_ok=True)
     ds = spectrum.to_xarray()
     atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
     figure = None
     if not no_plot:
-        from ..plot.orbits import save_lyapunov_spectrum_figure
-
         figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import typer
 
+from ..studies.reproduce import recipe_names
+from ..studies.reproduce import reproduce as run_reproduce
 from ._app import OVERWRITE_FOLDER_HELP, CLIError, app, check_output_folder, console, note_line, on_interrupt
 
 
@@ -21,9 +23,6 @@ def reproduce(
 ) -> None:
     """Paper Sects. 4.1–4.2: Figs. 3–16 and Table 2 beside the paper's statements, with a table
     "paper says / we measure / agrees?" (OUT/report.md)."""
-    from ..studies.reproduce import recipe_names
-    from ..studies.reproduce import reproduce as run_reproduce
-
     if only:
         unknown = [n for n in only if n not in recipe_names()]
         if unknown:

@@ -16,8 +16,12 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..attractors import run_summary, simulate_until_settled
+from ..integrate.driver import simulate as run_simulation
 from ..integrate.interrupt import on_ctrl_c
+from ..integrate.result import load_trajectory
 from ..integrate.status import Status
+from ..plot.trajectory import save_trajectory_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
                    check_outputs, check_positive, check_samples, console, err_console, error_line, given, note_line,
                    warning_line)
@@ -68,8 +72,6 @@ def _continuation(ctx: typer.Context, ic: str, settings: dict):
     overridden : list of str
         The options of :data:`_SETTINGS` given on the command line.
     """
-    from ..integrate.result import load_trajectory
-
     saved = load_trajectory(ic)
     stored = dict(saved.options, model=saved.model, method=saved.method)
     overridden = [flag for flag, name in _SETTINGS.items() if given(ctx, name)]
@@ -170,8 +172,6 @@ def simulate(
     as_json: bool = typer.Option(False, "--json", help="Print the steady-state summary as one JSON object."),
 ) -> None:
     """Simulate a model with exact stick-slip (default: the two plates, Table 1, N = 50 N, Ω = 5 rad/s, 100 s)."""
-    from ..integrate.driver import simulate as run_simulation
-
     start = _parse_ic(ic)
     settings = dict(model=model, method=method, rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate)
     run_file = Path(start) if isinstance(start, str) and start.endswith(".nc") else None
@@ -203,12 +203,12 @@ def simulate(
 
     with on_ctrl_c(partial=True):  # Ctrl-C ends the run with the part done, which is written below
         if duration is None:
-            from ..analysis.settle import simulate_until_settled
-
-            traj = simulate_until_settled(system, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
+            settled = simulate_until_settled(system, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
+            traj, verdict = settled.trajectory, settled.attractor
         else:
             traj = run_simulation(system, t0 + duration, t0=t0, ic=start, perturbation=perturb,
                                   steady_from=steady_from, **settings)
+            verdict = None
     # a run that stopped early can be too short for its steady-state window, which the file needs
     keep = write and int(np.count_nonzero(traj.t >= traj.steady_from)) >= 2
     figure = None
@@ -216,8 +216,6 @@ def simulate(
         out.parent.mkdir(parents=True, exist_ok=True)
         traj.to_netcdf(out)
         if not no_plot:
-            from ..plot.trajectory import save_trajectory_figure
-
             figure = save_trajectory_figure(traj, out.with_suffix(".png"))
     kept = f"what it computed is in {out}" if keep else ("it kept too few samples to write" if write else
                                                          "nothing was written (--json without --out)")
@@ -227,7 +225,7 @@ def simulate(
     if traj.status != "success":
         error_line(f"the run stopped early: {traj.status}; {kept}")
         raise typer.Exit(1)
-    summary = traj.summary()
+    summary = run_summary(traj, verdict)
     if as_json:
         print(json.dumps(summary))
     else:

@@ -14,8 +14,13 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..plot.stability import save_stability_map_figure
+from ..stability.analysis import stability as run_stability
+from ..stability.maps import parse_family
+from ..stability.maps import stability_map as run_map
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
                    check_memory, check_outputs, console)
+from .sweep import parse_values
 
 _N_HELP = "Normal preload N [N] (default 50)."
 _OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
@@ -34,8 +39,6 @@ def stability(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
     """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
-    from ..stability.analysis import stability as run_stability
-
     system, _ = build_system(model, config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
     result = run_stability(system)
     if as_json:
@@ -115,9 +118,6 @@ def stability_map(
 ) -> None:
     """Stable/unstable regions of steady sliding over two parameters of any model, with the boundary by
     root finding (plates: (N, Ω), Figs. 3, 4)."""
-    from ..stability.maps import parse_family
-    from ..stability.maps import stability_map as run_map
-
     try:
         members = parse_family(family)
     except ValueError as exc:  # the parser's messages name the fix; here they also name the option
@@ -140,8 +140,6 @@ def stability_map(
     smap.to_netcdf(out)
     figure = None
     if not no_plot:
-        from ..plot.stability import save_stability_map_figure
-
         figure = save_stability_map_figure(smap, out.with_suffix(".png"))
     rows = []
     for f, label in enumerate(smap.family_labels):
@@ -172,8 +170,6 @@ def stability_map(
 
 def _map_axes(axis: list[str] | None, n_range: tuple, omega_range: tuple) -> tuple[tuple[str, str], list]:
     """The map's two parameter names and values: from ``--axis`` (two), else N and Ω of the plates' options."""
-    from .sweep import parse_values
-
     if not axis:
         _check_axis("N", *n_range)
         _check_axis("omega", *omega_range)

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import typer
 
+from ..plot.timestep import save_timestep_figures
+from ..studies.timestep import DT_FULL, DT_QUICK, run_timestep_study
 from ._app import OVERWRITE_FOLDER_HELP, app, check_output_folder, check_positive, console, note_line
 
 study_app = typer.Typer(help="Reproducible studies of the paper (tables, JSON and figures).", no_args_is_help=True)
@@ -21,9 +23,6 @@ def timestep(
 ) -> None:
     """Paper Sect. 4.2.1: AEOM and NAEOM for Δt = 0.1 … 1e-5 s against a converged `event` run
     (Table 2 beside ours, Figs. 5 and 6)."""
-    from ..plot.timestep import save_timestep_figures
-    from ..studies.timestep import DT_FULL, DT_QUICK, run_timestep_study
-
     check_positive({"--t-end": t_end})
     check_output_folder(out, overwrite)
     study = run_timestep_study(DT_QUICK if quick else DT_FULL, t_end=t_end, progress=note_line)

@@ -16,6 +16,15 @@ import numpy as np
 import typer
 from rich.table import Table
 
+from ..analysis.classify import KINDS
+from ..model.library import plates_variant
+from ..model.parameters import Parameters
+from ..plot.regions import save_regions_figure
+from ..plot.sweep import save_bifurcation_figure, save_sweep_figure
+from ..sweep import regions as run_regions
+from ..sweep import sweep as run_sweep
+from ..sweep.bistability import REGION_NAMES
+from ..sweep.spec import COLUMNS, _columns
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
                    check_finite, check_memory, check_positive, check_resumable_output, check_samples, config_values,
                    console, parse_assignments)
@@ -132,8 +141,6 @@ def _settle_options(settle: bool, cap: float | None, t_end: float) -> dict:
 
 def _sweep_target(system) -> tuple:
     """(params, model) for the sweep library: the plates' Parameters and variant, or the model itself."""
-    from ..model.parameters import Parameters
-
     if system.name != "two-plates":
         return system, None
     values = dict(system.parameters)
@@ -143,8 +150,6 @@ def _sweep_target(system) -> tuple:
 
 def _plot_columns(system) -> tuple[str, ...]:
     """The reductions a sweep of ``system`` keeps (those ``--plot`` may draw)."""
-    from ..sweep.spec import COLUMNS, _columns
-
     if system.name == "two-plates":
         return COLUMNS
     return tuple(c[0] for c in _columns(64, system.dofs[system.observed_index]))
@@ -161,8 +166,6 @@ def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_
 
 
 def _kind_counts(ds) -> dict:
-    from ..analysis.classify import KINDS
-
     code = ds["kind"].values
     code = np.where(np.isfinite(code), code, -1).astype(int)
     names = list(KINDS) + ["failed"]
@@ -227,8 +230,6 @@ def sweep_command(
     Grid over any parameters, models and initial conditions; kept per point: peaks of φ, kind,
     frequency, stick fraction, intensity (Eq. 16), relative-motion angle.
     """
-    from ..sweep import sweep as run_sweep
-
     values = parse_grid(grid)
     system, _ = build_system(model, config, set_, swept={k: f"--grid {k}" for k in values})
     target, variant = _sweep_target(system)
@@ -242,8 +243,6 @@ def sweep_command(
     result = run_sweep(values, target, out=out, model=variant, ic=ic, **options)
     figure = None
     if not no_plot:
-        from ..plot.sweep import save_sweep_figure
-
         figure = save_sweep_figure(result, out.with_suffix(".png"), var=plot_var)
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
             result.dataset, as_json)
@@ -284,12 +283,9 @@ def bifurcation(
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
 ) -> None:
     """Bifurcation diagram of φ: steady-state peak values against one parameter (Figs. 12–14)."""
-    from ..sweep import sweep as run_sweep
-
     if param in _CATEGORICAL:
         raise CLIError(f"--param {param}: the control parameter must be numeric; use --model full,x,y,rotation "
                        "for one panel per model")
-    from ..model.library import plates_variant
 
     named = dict(N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
     values = parse_values(param, range_, option="--range")
@@ -313,8 +309,6 @@ def bifurcation(
     result = run_sweep(grid, target, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
     figure = None
     if not no_plot:
-        from ..plot.sweep import save_bifurcation_figure
-
         figure = save_bifurcation_figure(result, out.with_suffix(".png"))
     _report(f"bifurcation diagram of {coordinate} against {param}", out, figure, result.timings, result.dataset, as_json)
 
@@ -374,8 +368,6 @@ def regions_command(
 
     Every (model, N, Ω) is run from the 'far' and the 'near' initial condition (docs/sweeps.md).
     """
-    from ..sweep import regions as run_regions
-
     params, _ = build_parameters(config, set_, swept={"N": "--N", "Omega": "--omega"}, mu_k=mu_k, delta_mu=delta_mu,
                                  alpha=alpha)
     n_values = parse_values("N", N, option="--N")
@@ -389,10 +381,7 @@ def regions_command(
     rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
     figure = None
     if not no_plot:
-        from ..plot.regions import save_regions_figure
-
         figure = save_regions_figure(rmap, out.with_suffix(".png"))
-    from ..sweep.bistability import REGION_NAMES
 
     region = rmap.region
     counts = {REGION_NAMES[c]: int(np.sum(region == c)) for c in sorted(REGION_NAMES) if np.any(region == c)}

@@ -10,19 +10,20 @@ from typing import Mapping
 
 import numpy as np
 
-from ..errors import StickSlipError
+from ..errors import SimulationError
 from ..model.bundle import contact_state
 from ..model.library import resolve_system
 from ..model.library.two_plates import NAME as TWO_PLATES
-from ..model.parameters import Parameters
 from ..model.system_model import FrictionModel
 from . import contacts as E
 from .event_loop import N_EXTRA, integrate_event
-from .result import Stats, Trajectory, Transitions, load_trajectory
+from .fixed_step import run_aeom, run_naeom
+from .initial import initial_state
 from .interrupt import interruptible, partial_on_ctrl_c
+from .result import Stats, Trajectory, Transitions
 from .status import CHUNK_END, Status
 
-__all__ = ["simulate", "initial_state", "SimulationError", "METHODS", "MAX_SAMPLES"]
+__all__ = ["simulate", "METHODS", "MAX_SAMPLES"]
 
 #: Largest number of uniform samples a run may keep (each ~ (2n + 2 + 2 nc) float64 and a flag byte).
 MAX_SAMPLES = 20_000_000
@@ -55,10 +56,6 @@ KEEP_TRANSITION_STATES = 100_000
 NO_STEP_CAP = 2**62
 
 
-class SimulationError(StickSlipError, ValueError):
-    """Invalid simulation options, or a run that could not finish."""
-
-
 def _check_positive(name: str, value, hint: str) -> float:
     try:
         value = float(value)
@@ -67,84 +64,6 @@ def _check_positive(name: str, value, hint: str) -> float:
     if not math.isfinite(value) or value <= 0.0:
         raise SimulationError(f"{name} = {value} must be a finite number > 0; {hint}")
     return value
-
-
-def initial_state(system: FrictionModel, ic="zero", perturbation=None) -> np.ndarray:
-    """The 2n-state initial condition of ``system``.
-
-    Parameters
-    ----------
-    system : FrictionModel
-    ic : {"zero", "equilibrium"}, array-like (2n,), mapping, path of a run's ``.nc`` file, or Trajectory
-        ``zero``: at rest, springs undeformed. ``equilibrium``: steady sliding. A mapping
-        ``{state name: value}`` sets those states (the others 0). A file or Trajectory: its final
-        state (a continuation of that run).
-    perturbation : float or array-like (2n,), optional
-        Added to the state: a float perturbs the observed coordinate (the plates' φ), a vector
-        every state.
-
-    Raises
-    ------
-    SimulationError
-        For an unknown string or state name, a wrong shape, a non-finite value, or a non-zero state
-        of a locked DOF.
-    """
-    if not isinstance(system, FrictionModel):  # the plates' assembled arrays (orbit tools)
-        from ..model.library import two_plates
-
-        system = two_plates(system.params, system.variant)
-    n2 = 2 * system.n
-    names = system.state_names
-    if isinstance(ic, Trajectory):
-        s = ic.final_state
-    elif isinstance(ic, Mapping):
-        s = np.zeros(n2)
-        for name, value in ic.items():
-            if name not in names:
-                raise SimulationError(f"initial state: unknown state {name!r} of model {system.name!r}; "
-                                      f"states are {', '.join(names)}")
-            s[names.index(name)] = float(value)
-    elif isinstance(ic, (str, Path)) and str(ic) in ("zero", "equilibrium"):
-        s = np.zeros(n2)
-        if str(ic) == "equilibrium":
-            from ..stability.equilibrium import EquilibriumError, steady_sliding
-
-            try:
-                s[:system.n] = steady_sliding(system)
-            except EquilibriumError as exc:
-                raise SimulationError(f"ic='equilibrium': {exc}") from exc
-    elif isinstance(ic, Path) or (isinstance(ic, str) and ic.endswith(".nc")):
-        s = load_trajectory(ic).final_state
-    elif isinstance(ic, str):
-        raise SimulationError(
-            f"unknown initial condition {ic!r}; use 'zero', 'equilibrium', a path to a run .nc file, "
-            f"name=value pairs of states ({', '.join(names)}) or {n2} numbers"
-        )
-    else:
-        s = np.asarray(ic, dtype=float).copy()
-        if s.shape != (n2,):
-            raise SimulationError(f"initial state must have {n2} entries ({', '.join(names)}), got shape {s.shape}")
-    if s.shape != (n2,):
-        raise SimulationError(f"initial state from {ic!r} has {s.size} entries, model {system.name!r} has {n2} states")
-    if perturbation is not None:
-        delta = np.asarray(perturbation, dtype=float)
-        if delta.ndim == 0:
-            s[system.observed_index] += float(delta)
-        elif delta.shape == (n2,):
-            s = s + delta
-        else:
-            raise SimulationError(f"perturbation must be a number (added to {system.dofs[system.observed_index]}) "
-                                  f"or {n2} numbers, got shape {delta.shape}")
-    if not np.all(np.isfinite(s)):
-        raise SimulationError("initial state has a non-finite entry; give finite numbers")
-    locked = ~np.concatenate([system.free, system.free])
-    bad = [names[i] for i in np.flatnonzero(locked & (s != 0.0))]
-    if bad:
-        raise SimulationError(
-            f"initial state sets {', '.join(bad)} but those DOFs are locked in this model; "
-            "set them to 0 or choose a model that frees them"
-        )
-    return s
 
 
 class _Buffers:
@@ -281,8 +200,6 @@ def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, s
 def _run_fixed_step(method: str, system: FrictionModel, y0: np.ndarray, t0: float, t_end: float,
                     sample_times: np.ndarray, rtol: float, atol: float, dt: float | None, max_steps: int):
     """The paper's fixed-step methods (two plates only)."""
-    from .fixed_step import run_aeom, run_naeom
-
     if system.name != TWO_PLATES:
         raise SimulationError(f"method {method!r} is the paper's fixed-step method for the two plates; "
                               f"model {system.name!r} runs with method='event' (CLI: --method event)")

@@ -30,6 +30,7 @@ import time
 
 import numpy as np
 
+from ..errors import SimulationError
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, H_N, ModelData, offsets
 from ..model.jit import kernel, loop
@@ -39,13 +40,14 @@ from . import rk4
 from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
 from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
-from .step_physics import derivative_and_contact, derivative_under_force, stick_force
+from .result import Stats, Transitions
 from .status import MAX_STEPS as STATUS_MAX_STEPS
 from .status import NOT_FINITE as STATUS_NOT_FINITE
 from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
 from .status import STEP_UNDERFLOW as STATUS_STEP_UNDERFLOW
 from .status import SUCCESS as STATUS_OK
 from .status import Status
+from .step_physics import derivative_and_contact, derivative_under_force, stick_force
 
 N_STATE = 14  # the plates' 12 states + work of friction + work of damping
 
@@ -401,7 +403,6 @@ def check_step(method: str, model: FrictionModel, dt) -> float:
         If ``dt`` is missing, or larger than ``STABILITY_LIMIT / ω_max`` with ω_max the highest
         natural angular frequency √(k/m) of the free DOFs (RK4 would be unstable or wrong).
     """
-    from .driver import SimulationError
 
     if dt is None:
         raise SimulationError(
@@ -449,8 +450,6 @@ def step_data(model: FrictionModel, dt: float) -> ModelData:
 
 def stats_dict(st, compile_time: float) -> dict:
     """The integrator counters as keyword arguments of ``result.Stats``."""
-    from .result import Stats
-
     stats = dict(accepted_steps=int(st[0]), rejected_steps=int(st[1]), rhs_calls=int(st[2]),
                  retaken_steps=int(st[3]), slip_to_stick=int(st[4]), stick_to_slip=int(st[5]))
     if "compile_time_s" in {f.name for f in dataclasses.fields(Stats)}:
@@ -484,9 +483,6 @@ def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float,
         If ``dt`` is missing or too large (:func:`check_step`), or NAEOM's per-step stick-force
         solve does not converge (``method_naeom.MAX_NEWTON``).
     """
-    from .driver import SimulationError
-    from .result import Transitions
-
     model = plates_model(system)
     dt = check_step(method, model, dt)
     code = METHOD_CODES[method]

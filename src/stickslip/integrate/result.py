@@ -10,14 +10,16 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from .. import __version__
+from .._version import __version__
 from ..analysis.steady import SteadyState, summarize
-from ..files import FileFormatError, atomic_write, format_name, open_ours
+from ..errors import FileFormatError
+from ..files import atomic_write, format_name, open_ours
 from ..model import physics
 from ..model.library import describe_system, system_from_description, two_plates
 from ..model.library.two_plates import NAME as TWO_PLATES
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
+from ..results import Plottable
 from .status import Status
 
 __all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError"]
@@ -108,7 +110,7 @@ def _normal_forces(states, md, nc):
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class Trajectory:
+class Trajectory(Plottable):
     """Result of :func:`stickslip.simulate`.
 
     Attributes
@@ -137,6 +139,8 @@ class Trajectory:
         Start of the steady-state window used by :attr:`steady` [s].
     status_code : Status
     """
+
+    FIGURE = "trajectory"
 
     t: np.ndarray
     states: np.ndarray
@@ -246,42 +250,33 @@ class Trajectory:
         return summarize(self.t, self.states, self.mode, self.transitions.time, self.transitions.kind, t_from,
                          coordinate=i, rate=i + self.system.n)
 
-    @cached_property
-    def attractor(self):
-        """What the steady window settles to, with its evidence
-        (:func:`stickslip.analysis.settle.attractor`: may shoot an orbit or compute a Lyapunov
-        exponent to confirm a claim)."""
-        from ..analysis.settle import attractor
+    # ------------------------------------------------------------- pieces and joins
+    def joined(self, more: "Trajectory") -> "Trajectory":
+        """This run followed by ``more``, a continuation of it that starts at its last sample
+        (dropped from ``more``); statistics add up and the work of ``more`` continues this run's."""
+        a, b = self, more
+        stats = Stats(**{f.name: getattr(a.stats, f.name) + getattr(b.stats, f.name)
+                         for f in dataclasses.fields(Stats)})
+        tr = Transitions(np.concatenate([a.transitions.time, b.transitions.time]),
+                         np.concatenate([a.transitions.kind, b.transitions.kind]),
+                         np.concatenate([a.transitions.state, b.transitions.state]),
+                         np.concatenate([a.transitions.contact, b.transitions.contact]),
+                         a.transitions.dropped + b.transitions.dropped)
+        return dataclasses.replace(
+            b, t=np.concatenate([a.t, b.t[1:]]), states=np.concatenate([a.states, b.states[1:]]),
+            mode=np.concatenate([a.mode, b.mode[1:]]), friction=np.concatenate([a.friction, b.friction[1:]]),
+            work=np.concatenate([a.work, b.work[1:] + a.work[-1]]), transitions=tr, stats=stats,
+            options=dict(a.options, t_end=b.options["t_end"]))
 
-        return attractor(self)
+    def tail(self, t_from: float) -> "Trajectory":
+        """The part of this run from ``t_from`` [s] on (transitions before it counted as dropped)."""
+        sel = self.t >= t_from
+        keep = self.transitions.time > t_from
+        tr = Transitions(self.transitions.time[keep], self.transitions.kind[keep], self.transitions.state[keep],
+                         self.transitions.contact[keep], self.transitions.dropped + int(np.count_nonzero(~keep)))
+        return dataclasses.replace(self, t=self.t[sel], states=self.states[sel], mode=self.mode[sel],
+                                   friction=self.friction[sel], work=self.work[sel], transitions=tr)
 
-    def summary(self) -> dict:
-        """The verdict on the steady window, the steady-state summary and the run's cost, as a
-        JSON-ready dict.
-
-        Keys: ``settled``, ``attractor``, ``period_count``, ``fundamental_frequency_hz`` (None
-        unless settled and periodic), ``dominant_frequency_hz`` (spectral peak), ``settle_time_s``,
-        ``evidence`` (:class:`stickslip.analysis.settle.Attractor`); ``status``, ``model``,
-        ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction``, ``n_transitions``,
-        ``phi_min``, ``phi_max`` [rad] of the window; ``steps``, ``wall_time_s``, ``method``;
-        ``settle`` (the cap and steps of :func:`stickslip.analysis.settle.simulate_until_settled`)
-        when the run was extended until settled.
-        """
-        s = self.steady
-        out = {**self.attractor.to_dict(), "status": self.status, "model": self.model,
-               "parameters": dict(self.system.parameters), "t_end_s": float(self.t[-1]), "steady_from_s": s.t_from,
-               "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "phi_min": s.phi_min,
-               "phi_max": s.phi_max, "steps": self.stats.steps, "wall_time_s": self.stats.wall_time_s,
-               "method": self.method}
-        if "settle" in self.options:
-            out["settle"] = self.options["settle"]
-        return out
-
-    def plot(self, **kwargs):
-        """Overview figure; see :func:`stickslip.plot.plot_trajectory`."""
-        from ..plot.trajectory import plot_trajectory
-
-        return plot_trajectory(self, **kwargs)
 
     # ------------------------------------------------------------- xarray / NetCDF
     def to_xarray(self):

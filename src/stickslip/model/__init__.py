@@ -1,13 +1,14 @@
 """Friction-contact models: the model interface, model files, the library, friction laws,
 contact kinematics and the compiled physics written once for all of them."""
 
+from ..errors import ModelError, ModelFileError, ParameterError
 from .friction import FrictionLaw
 from .kinematics import ConstantKinematics, register_kinematics
 from .library import library, load_model, resolve_system, two_plates
-from .model_file import ModelFileError, load_model_file, model_from_spec
-from .parameters import FRICTION_LAWS, ParameterError, Parameters
+from .model_file import load_model_file, model_from_spec
+from .parameters import FRICTION_LAWS, Parameters
 from .system import System, assemble
-from .system_model import Contact, FrictionModel, ModelError
+from .system_model import Contact, FrictionModel
 from .variants import DOF_NAMES, MODELS, STATE_NAMES, Variant, resolve_variant
 
 __all__ = ["FrictionModel", "Contact", "FrictionLaw", "ModelError", "ModelFileError", "load_model", "load_model_file",

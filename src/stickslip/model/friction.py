@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from ..errors import StickSlipError
+from ..errors import FrictionLawError
 from . import csmath as csm
 from .jit import KERNEL_OPTIONS, inlined_kernel
 
@@ -56,10 +56,6 @@ LAWS = {"exponential": LAW_EXPONENTIAL, "coulomb": LAW_COULOMB}
 L_LAW, L_MU_K, L_DELTA_MU, L_ALPHA, L_MU_V = range(5)
 #: Numbers per law row.
 LAW_WIDTH = 5
-
-
-class FrictionLawError(StickSlipError, ValueError):
-    """A friction law that cannot be used (unknown name, negative coefficient, ...)."""
 
 
 # ----------------------------------------------------------------------------- user laws

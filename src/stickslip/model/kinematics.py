@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from ..errors import StickSlipError
+from ..errors import KinematicsError
 from . import csmath as csm
 from . import stack
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, contact_offsets
@@ -48,10 +48,6 @@ from .jit import KERNEL_OPTIONS, kernel
 
 __all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "registered_frame_bias", "contact_frame",
            "constant_frame", "KinematicsError", "model_sizes", "contact_dim"]
-
-
-class KinematicsError(StickSlipError, TypeError):
-    """A kinematics object whose class was not registered."""
 
 
 #: Registered frame functions by kinematics class.

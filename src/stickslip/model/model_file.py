@@ -36,8 +36,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .friction import FrictionLaw, FrictionLawError
-from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, ModelError
+from ..errors import FrictionLawError, ModelError, ModelFileError
+from .friction import FrictionLaw
+from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -51,10 +52,6 @@ TOP_KEYS = ("name", "description", "dofs", "mass", "damping", "stiffness", "forc
 REQUIRED_TOP = ("dofs", "mass", "damping", "stiffness", "contact")
 CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "friction")
 REQUIRED_CONTACT = ("tangent", "normal_force", "friction")
-
-
-class ModelFileError(ModelError):
-    """A model file that cannot be read as a model (the message names the key and the fix)."""
 
 
 def _number(value, where: str) -> float:

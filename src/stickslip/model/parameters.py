@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..errors import StickSlipError
+from ..errors import ParameterError
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -77,10 +77,6 @@ def parameter_attrs(values: Mapping[str, Any]) -> dict[str, Any]:
         if PARAMETER_UNITS.get(name):
             attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
     return attrs
-
-
-class ParameterError(StickSlipError, ValueError):
-    """A parameter value or file that cannot describe the physical model."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 
+from .library.two_plates import two_plates
 from .parameters import FRICTION_LAWS, Parameters
 from .system_model import DEFAULT_SLIP_BAND
 from .variants import Variant, resolve_variant
@@ -55,8 +56,6 @@ class System:
 
     def model(self):
         """The same plates as a :class:`~stickslip.model.FrictionModel` (what the solvers run)."""
-        from .library.two_plates import two_plates
-
         return two_plates(self.params, self.variant, self.slip_band)
 
     @property

@@ -20,14 +20,14 @@ from typing import Any, Callable, Mapping, NamedTuple
 
 import numpy as np
 
-from ..errors import StickSlipError
+from ..errors import ModelError
 from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
 from .kinematics import ConstantKinematics, registered_kinematics
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
-__all__ = ["FrictionModel", "Contact", "ModelError", "DEFAULT_SLIP_BAND"]
+__all__ = ["FrictionModel", "Contact", "NamedState", "ModelError", "DEFAULT_SLIP_BAND"]
 
 #: Default low-speed band [m/s]: below it the 2-D slip direction is the quasi-static one instead of
 #: v/|v|. Near v = 0 the direction of 2-D friction relaxes on the time scale |v| / (λ μ N) → 0 (a
@@ -37,10 +37,6 @@ __all__ = ["FrictionModel", "Contact", "ModelError", "DEFAULT_SLIP_BAND"]
 #: 1e-5, 1e-4 and 5e-4 give the same errors (≤ 6e-9 in frequency), 1e-3 and above start to show
 #: the band (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
 DEFAULT_SLIP_BAND = 5e-4
-
-
-class ModelError(StickSlipError, ValueError):
-    """A model that cannot be built as stated (the message names the entry and the fix)."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -85,6 +81,13 @@ class Contact:
         return out
 
 
+class NamedState(NamedTuple):
+    """A named initial state of a model (``FrictionModel.starts``): the state (2n,) and one line on it."""
+
+    state: np.ndarray
+    description: str
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class FrictionModel:
     """A friction-contact system (module docstring).
@@ -125,6 +128,9 @@ class FrictionModel:
         dof names as indices and leave out the index of a one-entry vector).
     observed : str, optional
         The dof that summaries follow (frequency, extremes, peaks); default the first free dof.
+    starts : mapping of str to NamedState, optional
+        Named initial states of this model beside the ones every model has (``zero``,
+        ``equilibrium``, ``near``): ``simulate(model, ic=NAME)``, ``--ic NAME``.
     """
 
     name: str
@@ -145,6 +151,7 @@ class FrictionModel:
     spec: Mapping[str, Any] | None = None
     resolver: Callable[[str], str] | None = None
     observed: str | None = None
+    starts: Mapping[str, NamedState] = dataclasses.field(default_factory=dict)
 
     def __post_init__(self) -> None:
         n = len(self.dofs)
@@ -172,6 +179,15 @@ class FrictionModel:
         self._check_contacts()
         if not (math.isfinite(self.slip_band) and self.slip_band > SPEED_FLOOR):
             raise ModelError(f"slip_band = {self.slip_band} must be a finite speed > {SPEED_FLOOR} m/s")
+        self._check_starts()
+
+    def _check_starts(self) -> None:
+        locked = ~np.concatenate([self.free, self.free])
+        for name, start in self.starts.items():
+            state = np.array(start.state, dtype=float)
+            if state.shape != (2 * self.n,) or not np.all(np.isfinite(state)) or np.any(state[locked] != 0.0):
+                raise ModelError(f"model {self.name!r}: start {name!r} must be {2 * self.n} finite numbers, zero on "
+                                 "the locked dofs")
 
     def _check_mass(self) -> None:
         idx = np.flatnonzero(self.free)

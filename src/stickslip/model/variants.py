@@ -12,7 +12,7 @@ from typing import Iterable
 
 import numpy as np
 
-from ..errors import StickSlipError
+from ..errors import VariantError
 
 __all__ = ["DOF_NAMES", "STATE_NAMES", "Variant", "MODELS", "resolve_variant"]
 
@@ -28,10 +28,6 @@ MODELS: dict[str, tuple[str, ...]] = {
     "y": ("y1", "y2", "phi", "psi"),          # Model 3: translation along y only
     "rotation": ("phi", "psi"),              # Model 4: the reduced model, rotation only
 }
-
-
-class VariantError(StickSlipError, ValueError):
-    """An unknown model name or DOF."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -12,11 +12,12 @@
 ==========================  ==============================================================
 """
 
-from .lyapunov import LyapunovResult, LyapunovSpectrum, lyapunov_exponent, lyapunov_spectrum
-from .section import OrbitError, Section, resolve_section
-from .problem import Monodromy, monodromy
-from .shooting import PeriodicOrbit, periodic_orbit
+from ..errors import OrbitError
 from .linear_flow import FlowJacobian, flow_jacobian
+from .lyapunov import LyapunovResult, LyapunovSpectrum, lyapunov_exponent, lyapunov_spectrum
+from .problem import Monodromy, monodromy
+from .section import Section, resolve_section
+from .shooting import PeriodicOrbit, periodic_orbit
 
 __all__ = ["periodic_orbit", "PeriodicOrbit", "Section", "resolve_section", "lyapunov_exponent",
            "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum", "monodromy", "Monodromy",

@@ -26,10 +26,10 @@ import dataclasses
 
 import numpy as np
 
+from ..errors import ContinuationError, OrbitError
 from ..model.system_model import FrictionModel
 from .models import parameter_value, with_parameter
 from .problem import DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, sorted_eigenvalues, stick_count, stick_time
-from .section import OrbitError
 
 __all__ = ["ContinuationError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR", "MIN_TANGENT_COS",
            "MAX_STEPS_PER_SECOND"]
@@ -48,10 +48,6 @@ MIN_TANGENT_COS = 0.9
 #: rtol 1e-10; a stalled integration (approach to stick, docs/orbits.md) fails fast instead of
 #: running 5e7 steps.
 MAX_STEPS_PER_SECOND = 2e5
-
-
-class ContinuationError(OrbitError):
-    """Continuation could not start or go on (the message says why)."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

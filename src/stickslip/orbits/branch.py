@@ -18,20 +18,21 @@ from typing import Sequence
 
 import numpy as np
 
+from ..errors import ContinuationError, ModelError, OrbitError, ParameterError, SimulationError
 from ..files import open_ours
-from ..integrate.driver import SimulationError, simulate
+from ..integrate.driver import simulate
 from ..integrate.result import Trajectory
-from ..model.parameters import ParameterError, Parameters
-from ..model.system_model import FrictionModel, ModelError
+from ..model.parameters import Parameters
+from ..model.system_model import FrictionModel
 from . import branch_store as store
-from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, ContinuationError, Point, Problem,
-                        correct_onto_bound, numeric_parameter, point_at, problem_of, step_from)
-from .problem import unstable_count
-from .section import OrbitError, Section, resolve_section
-from .shooting import PeriodicOrbit
-from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
-                             detect_after_renewal, distance_from_equilibrium)
+from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, Point, Problem, correct_onto_bound,
+                        numeric_parameter, point_at, problem_of, step_from)
 from .models import ModelResult, plates_parameters, resolve, with_parameter
+from .problem import unstable_count
+from .section import Section, resolve_section
+from .shooting import PeriodicOrbit
+from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point, detect_after_renewal,
+                             distance_from_equilibrium)
 from .start import Start, start_orbit
 
 __all__ = ["Branch", "continue_orbit", "load_branch"]

@@ -43,14 +43,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..files import AppendLog, FileFormatError, OutputLock, atomic_write, fsync_dir
+from .._version import __version__
+from ..errors import FileFormatError, OrbitError
+from ..files import AppendLog, OutputLock, atomic_write, fsync_dir
 from ..integrate.result import Trajectory
 from ..model.library import describe_system, system_from_description
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
 from .layout import state_units
 from .models import model_attrs
-from .section import OrbitError, Section
+from .section import Section
 from .shooting import PeriodicOrbit
 
 __all__ = ["Journal", "JournalMismatch", "journal_path", "digest_of", "array_digest", "encode_array",

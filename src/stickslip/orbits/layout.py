@@ -13,6 +13,7 @@ import numpy as np
 from ..integrate.contacts import STICK_SPEED_TOL
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
+from ..stability.equilibrium import steady_sliding
 
 __all__ = ["free_states", "state_units", "equilibrium_state", "stick_projected", "resting_contacts"]
 
@@ -31,8 +32,6 @@ def state_units(system) -> tuple[str, ...]:
 
 def equilibrium_state(system) -> np.ndarray:
     """The steady-sliding state (2n,): q at the equilibrium, q̇ = 0."""
-    from ..stability.equilibrium import steady_sliding
-
     s = np.zeros(2 * system.n)
     s[:system.n] = steady_sliding(system)
     return s

@@ -21,14 +21,15 @@ import types
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
+from ..errors import OrbitError
 from ..integrate import contacts as E
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from . import saltation as S
 from . import var_kernels as V
 from .layout import free_states
-from .section import OrbitError, flow
+from .section import flow
 
 __all__ = ["FlowJacobian", "flow_jacobian", "propagate", "initial_contacts", "ARRIVAL_SPEED"]
 

@@ -25,14 +25,15 @@ import time as _time
 
 import numpy as np
 
-from .. import __version__
-from ..integrate.driver import SimulationError, initial_state, simulate
+from .._version import __version__
+from ..errors import OrbitError, SimulationError
+from ..integrate.driver import simulate
+from ..integrate.initial import initial_state
 from ..model.system_model import FrictionModel
 from .layout import free_states
 from .linear_flow import propagate
 from .models import ModelResult, model_attrs, resolve
 from .problem import ShootingProblem, scales, stick_count
-from .section import OrbitError
 from .shooting import PeriodicOrbit
 
 __all__ = ["LyapunovResult", "lyapunov_exponent", "LyapunovSpectrum", "lyapunov_spectrum"]

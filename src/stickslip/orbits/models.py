@@ -12,10 +12,10 @@ from __future__ import annotations
 import json
 import math
 
+from ..errors import ModelError, OrbitError
 from ..model.library import TWO_PLATES, describe_system, resolve_system
 from ..model.parameters import Parameters, parameter_attrs
-from ..model.system_model import FrictionModel, ModelError
-from .section import OrbitError
+from ..model.system_model import FrictionModel
 
 __all__ = ["resolve", "ModelResult", "parameter_value", "with_parameter", "model_attrs", "is_plates",
            "plates_parameters"]

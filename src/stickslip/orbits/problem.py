@@ -29,15 +29,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import __version__
-from ..integrate.driver import SimulationError
+from .._version import __version__
+from ..errors import OrbitError, SimulationError
 from ..model.bundle import CST
 from ..model.physics import MODE_STICK
 from ..model.system_model import FrictionModel
 from . import linear_flow as _lin
 from .layout import free_states, resting_contacts, stick_projected
 from .models import ModelResult, model_attrs
-from .section import OrbitError, Section, flow, vector_field
+from .section import Section, flow, vector_field
 
 __all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
            "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time",

@@ -12,20 +12,21 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from concurrent.futures import as_completed
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
+from ..errors import ContinuationError, OrbitError, SimulationError
 from ..files import open_ours
-from ..integrate.driver import SimulationError, simulate
+from ..integrate.driver import simulate
 from ..model.parameters import Parameters
+from ..parallel import check_workers, worker_pool
 from . import branch_store as store
-from .arclength import ContinuationError
 from .branch import Branch, continue_orbit
 from .layout import equilibrium_state
 from .models import resolve
-from .section import OrbitError
 from .shooting import PeriodicOrbit, periodic_orbit
 from .start import START_RATE, start_orbit_from_run, start_run
 
@@ -262,7 +263,7 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     model : str
     workers : int
         Processes (one N per task; at most the CPUs this process may run on). They end with this
-        process, also when it is killed (:func:`stickslip.sweep.executors.worker_pool`).
+        process, also when it is killed (:func:`stickslip.parallel.worker_pool`).
     step, max_step, max_points, rtol, tol, **options
         Passed to :func:`continue_orbit` (``rtol``/``tol`` are looser than its defaults: the
         edge needs the branch, not 1e-8 orbits; see :data:`FOLD_RTOL`).
@@ -282,11 +283,9 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     ------
     stickslip.orbits.branch_store.JournalMismatch
         If ``out`` or its journal was written with other settings.
-    stickslip.sweep.executors.WorkersError
+    stickslip.errors.WorkersError
         If ``workers`` is below 1 or above the CPUs available (before anything runs).
     """
-    from ..sweep.executors import check_workers
-
     t0 = time.perf_counter()
     workers = check_workers(workers)
     params = Parameters() if params is None else params
@@ -342,13 +341,9 @@ def _fold_curve_attrs_and_rows(path) -> tuple:
 def _edges(Ns: list, params, omega_start, omega_max, model, options, workers: int, record) -> None:
     """:func:`_edge_at` for each N (in ``workers`` processes), ``record(N, row)`` as each finishes.
 
-    With processes (:func:`stickslip.sweep.executors.worker_pool`), an N whose task raises is
+    With processes (:func:`stickslip.parallel.worker_pool`), an N whose task raises is
     re-raised after every other N is recorded.
     """
-    from concurrent.futures import as_completed
-
-    from ..sweep.executors import worker_pool
-
     if workers <= 1 or len(Ns) <= 1:
         for n in Ns:
             record(n, _edge_at(n, params, omega_start, omega_max, model, options))

@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import OrbitError
 from ..integrate import contacts as E
 from ..model import physics as P
 from ..model.bundle import CST
 from ..model.derivatives import state_jacobian
 from ..model.friction import static_coefficient
-from .section import OrbitError
 from .var_kernels import contact_gradients
 
 __all__ = ["saltation_matrix", "field", "ContactState", "contact_at", "stick_projection", "breakaway_jump",

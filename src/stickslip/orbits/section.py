@@ -18,17 +18,13 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import StickSlipError
-from ..analysis.steady import _hermite_crossings
+from ..analysis.signal import hermite_crossings
+from ..errors import OrbitError
 from ..integrate.driver import simulate
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 
 __all__ = ["Section", "resolve_section", "OrbitError", "flow", "vector_field", "section_crossings"]
-
-
-class OrbitError(StickSlipError, RuntimeError):
-    """A periodic orbit or Lyapunov exponent could not be computed (the message says why)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -162,7 +158,7 @@ def section_crossings(system, section: Section, t, states, mode):
     g = section.direction * (states[:, section.index] - section.value)
     up = np.flatnonzero((g[:-1] < 0.0) & (g[1:] >= 0.0))  # the intervals whose ends need the rate
     dg = section.direction * _state_rates(system, states, mode, section.index, np.union1d(up, up + 1))
-    return _hermite_crossings(np.asarray(t, dtype=float), g, dg, 0.0)
+    return hermite_crossings(np.asarray(t, dtype=float), g, dg, 0.0)
 
 
 #: Newton corrections of the crossing time when landing exactly on the section: the Hermite

@@ -26,15 +26,17 @@ import warnings
 
 import numpy as np
 
-from .. import __version__
-from ..integrate.driver import SimulationError, initial_state, simulate
+from .._version import __version__
+from ..errors import OrbitError, SimulationError
+from ..integrate.driver import simulate
+from ..integrate.initial import initial_state
 from ..integrate.result import Trajectory
 from ..model.system_model import FrictionModel
 from .layout import free_states, state_units
 from .models import ModelResult, model_attrs, resolve
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
                       check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
-from .section import OrbitError, Section, land_on_section, resolve_section, section_crossings
+from .section import Section, land_on_section, resolve_section, section_crossings
 
 __all__ = ["PeriodicOrbit", "periodic_orbit", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_HALVINGS", "SCALE_FLOOR"]
 

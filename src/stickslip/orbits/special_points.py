@@ -27,12 +27,11 @@ import dataclasses
 
 import numpy as np
 
-from ..integrate.driver import SimulationError
+from ..errors import OrbitError, SimulationError
 from . import branch_store as store
 from .arclength import Point, Problem, step_from
 from .layout import equilibrium_state
 from .problem import nontrivial
-from .section import OrbitError
 
 __all__ = ["SpecialPoint", "SPECIAL_KINDS", "HOPF_RATIO", "MIN_STICK_FRACTION", "detect_after_point",
            "detect_after_renewal"]

@@ -13,22 +13,28 @@ import dataclasses
 
 import numpy as np
 
-from ..integrate.driver import SimulationError, simulate
+from ..errors import ContinuationError, OrbitError, SimulationError
+from ..integrate.driver import simulate
 from ..integrate.result import Trajectory
 from ..model.system_model import FrictionModel
-from .arclength import ContinuationError
-from .models import ModelResult, is_plates, parameter_value, plates_parameters, resolve
-from .section import OrbitError, Section, resolve_section, section_crossings
+from .models import ModelResult, parameter_value, resolve
+from .section import Section, resolve_section, section_crossings
 from .shooting import PeriodicOrbit, periodic_orbit
 
-__all__ = ["start_run", "named_start", "crossings_per_stick", "start_orbit_from_run", "Start", "start_orbit", "START_RUN", "START_RATE"]
+__all__ = ["start_run", "default_start", "crossings_per_stick", "start_orbit_from_run", "Start", "start_orbit", "START_RUN", "START_RATE"]
 
 #: Length [s] and sample rate [Hz] of the run from the ``far`` initial condition that gives the
 #: start orbit of each N (the stick-slip oscillation settles within ~20 s at Ω = 5 rad/s).
 START_RUN, START_RATE = 60.0, 2000.0
 
 
-def start_run(system, ic="far", *, model=None, t_end: float = START_RUN, rtol: float = 1e-10,
+def default_start(system: FrictionModel) -> str:
+    """The start of an orbit search when none is given: the model's own first named start (the
+    plates' ``far``), else ``zero``."""
+    return next(iter(system.starts), "zero")
+
+
+def start_run(system, ic=None, *, model=None, t_end: float = START_RUN, rtol: float = 1e-10,
               slip_band: float | None = None) -> Trajectory:
     """A run from a named initial condition, to hand to ``continue_orbit`` as ``start``.
 
@@ -36,9 +42,10 @@ def start_run(system, ic="far", *, model=None, t_end: float = START_RUN, rtol: f
     ----------
     system : FrictionModel, Parameters, str
         The model (as :func:`stickslip.simulate` takes it; ``model``: the plates' variant).
-    ic : str, array-like (2n,) or mapping
-        ``zero``, ``equilibrium``, ``near`` (the equilibrium, the observed dof moved by 1e-3), the
-        plates' ``far`` (:data:`stickslip.sweep.NAMED_ICS`), or a state as ``simulate`` takes it.
+    ic : str, array-like (2n,) or mapping, optional
+        A named start (``zero``, ``equilibrium``, ``near``, the model's own such as the plates'
+        ``far``: :func:`stickslip.integrate.initial.start_names`) or a state as ``simulate``
+        takes it; default :func:`default_start`.
     model : str, optional
     t_end : float
         Run length [s]; the orbit guess is taken from its last section crossings.
@@ -48,36 +55,14 @@ def start_run(system, ic="far", *, model=None, t_end: float = START_RUN, rtol: f
         Low-speed band of the slip direction [m/s] (default: the model's).
     """
     system = resolve(system, model, slip_band)
-    state, pert = named_start(system, ic)
+    ic = default_start(system) if ic is None else ic
     try:
-        run = simulate(system, t_end, ic=state, perturbation=pert, sample_rate=START_RATE, rtol=rtol,
-                       atol=1e-3 * rtol)
+        run = simulate(system, t_end, ic=ic, sample_rate=START_RATE, rtol=rtol, atol=1e-3 * rtol)
     except SimulationError as exc:
         raise ContinuationError(f"the start run from ic {ic!r} failed: {exc}") from exc
     if run.status != "success":
         raise ContinuationError(f"the start run from ic {ic!r} failed: {run.status}")
     return run
-
-
-def named_start(system: FrictionModel, ic):
-    """(ic, perturbation) arguments of :func:`stickslip.simulate` for the start ``ic`` of ``system``:
-    ``zero``, ``equilibrium``, ``near`` (the equilibrium, the observed dof moved by
-    :data:`~stickslip.sweep.spec.NEAR_PERTURBATION`), the plates' ``far``, or a state as ``simulate``
-    takes it (returned as it is).
-
-    Raises
-    ------
-    ContinuationError
-        For ``far`` on a model other than the plates.
-    """
-    from ..sweep.spec import NEAR_PERTURBATION, initial_condition
-
-    if is_plates(system) and isinstance(ic, str):
-        return initial_condition(ic, plates_parameters(system), ModelResult.label(system))
-    if isinstance(ic, str) and ic == "far":
-        raise ContinuationError(f"ic 'far' is the plates' start; for model {system.name!r} use zero, equilibrium, "
-                                "near or a state (NAME=VALUE,...)")
-    return ("equilibrium", NEAR_PERTURBATION) if isinstance(ic, str) and ic == "near" else (ic, None)
 
 
 def crossings_per_stick(run: Trajectory, section="max") -> int:

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ._common import SYMBOLS, param_label, param_text, save_figure
+from .regions import REGION_STYLE, plot_regions
 
 __all__ = ["plot_branch", "save_branch_figure", "plot_region_edge", "SPECIAL_MARKERS"]
 
@@ -162,10 +163,7 @@ def plot_region_edge(curve, rmap=None, ax=None, *, model: str = "full", omega_c=
         _, ax = plt.subplots(figsize=(6.4, 5.0), layout="constrained")
     handles = []
     if rmap is not None:
-        from .regions import plot_regions
-
         plot_regions(rmap, ax, model=model, legend=False)
-        from .regions import REGION_STYLE
         from matplotlib.patches import Patch
 
         handles += [Patch(color=REGION_STYLE[c][0], label=f"brute force: {REGION_STYLE[c][1]}") for c in (1, 2, 3)]

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.steady import spectrum
+from ..analysis.signal import spectrum
 from ._common import param_text, save_figure
 
 __all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals"]

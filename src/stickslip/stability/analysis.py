@@ -8,10 +8,17 @@ import math
 
 import numpy as np
 
+from .._version import __version__
+from ..errors import EquilibriumError
+from ..model.bundle import CST, contact_state
+from ..model.derivatives import state_jacobian
+from ..model.library import resolve_system
+from ..model.library.two_plates import NAME as TWO_PLATES
 from ..model.parameters import Parameters, parameter_attrs
+from ..model.physics import MODE_SLIP_EXACT
 from ..model.system import System
 from ..model.variants import DOF_NAMES
-from .equilibrium import EquilibriumError, point_text, plates_model, solve_steady
+from .equilibrium import plates_model, point_text, solve_steady
 
 __all__ = ["StabilityResult", "stability", "linearization", "model_stability", "jacobian_at"]
 
@@ -118,7 +125,6 @@ class StabilityResult:
         """``xarray.Dataset`` with units, long names and the full parameter set in attrs."""
         import xarray as xr
 
-        from .. import __version__
 
         k = len(self.dofs)
         states = list(self.dofs) + ["d" + d for d in self.dofs]
@@ -183,10 +189,6 @@ def jacobian_at(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     K_L, C_L : ndarray (k, k)
         −M ∂q̈/∂q and −M ∂q̈/∂q̇ on the free DOFs.
     """
-    from ..model.bundle import CST, contact_state
-    from ..model.derivatives import state_jacobian
-    from ..model.physics import MODE_SLIP_EXACT
-
     n = system.n
     s = np.zeros(2 * n)
     s[:n] = q
@@ -230,8 +232,6 @@ def stability(params=None, model="full") -> StabilityResult:
         simulator's low-speed band, where its slip direction is not v/|v|, or a Jacobian that
         overflows (values far outside physical size).
     """
-    from ..model.library import resolve_system
-
     if params is not None and not isinstance(params, (Parameters, str)) and not hasattr(params, "data"):
         raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
     return model_stability(resolve_system(params, model))
@@ -239,8 +239,6 @@ def stability(params=None, model="full") -> StabilityResult:
 
 def model_stability(system) -> StabilityResult:
     """:func:`stability` of a :class:`~stickslip.model.FrictionModel`."""
-    from ..model.library.two_plates import NAME as TWO_PLATES
-
     q, residual, _ = solve_steady(system)
     J, K_L, C_L = jacobian_at(system, q)
     if not np.all(np.isfinite(J)):

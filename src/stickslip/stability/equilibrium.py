@@ -13,8 +13,11 @@ import math
 
 import numpy as np
 
-from ..errors import StickSlipError
+from ..errors import EquilibriumError
+from ..model.bundle import CST
+from ..model.library.two_plates import NAME
 from ..model.parameters import Parameters
+from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 from ..model.system import System, assemble
 from . import steady
 
@@ -38,18 +41,12 @@ _REASONS = {
 }
 
 
-class EquilibriumError(StickSlipError, RuntimeError):
-    """No steady-sliding equilibrium could be found."""
-
-
 def plates_model(system: System):
     """The :class:`~stickslip.model.FrictionModel` of an assembled plates :class:`System`."""
     return system.model()
 
 
 def _is_plates(system) -> bool:
-    from ..model.library.two_plates import NAME
-
     return system.name == NAME
 
 
@@ -63,8 +60,6 @@ def point_text(system) -> str:
 
 def _speeds(system, q: np.ndarray) -> list[float]:
     """Sliding speed of each contact at (q, q̇ = 0) [m/s]."""
-    from ..model.physics import slip_velocity
-
     s = np.zeros(2 * system.n)
     s[:system.n] = q
     return [float(np.hypot(*slip_velocity(s, c, system.data))) for c in range(system.n_contacts)]
@@ -143,9 +138,6 @@ def steady_sliding(system) -> np.ndarray:
 
 def steady_residual(system, q: np.ndarray) -> float:
     """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)."""
-    from ..model.bundle import CST
-    from ..model.physics import MODE_SLIP_EXACT, rhs
-
     n = system.n
     s = np.zeros(2 * n)
     s[:n] = q
@@ -173,9 +165,6 @@ def equilibrium_residual(system: System, q: np.ndarray) -> np.ndarray:
     This is −M q̈ of the slip equations at q̇ = 0, evaluated by the simulator's right-hand side, so
     its zero is exactly the steady sliding state the simulator sees. Locked DOFs give 0.
     """
-    from ..model.bundle import CST
-    from ..model.physics import MODE_SLIP_EXACT, rhs
-
     model = plates_model(system)
     s = np.zeros(12)
     s[:6] = q

@@ -22,10 +22,15 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy import optimize
 
+from .._version import __version__
+from ..errors import ParameterError
 from ..files import atomic_write, format_name, open_ours
-from ..model.parameters import PARAMETER_UNITS, ParameterError, Parameters, parameter_attrs
+from ..model.library import describe_system, resolve_system, system_from_description
+from ..model.library.two_plates import NAME
+from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
 from ..model.system import System
 from ..model.variants import resolve_variant
+from ..results import Plottable
 from . import steady
 from .equilibrium import MAX_ITER, RESIDUAL_TOL, plates_model
 
@@ -78,8 +83,6 @@ def parse_family(text: str | None) -> tuple[str, list] | None:
 
 
 def _is_plates(system) -> bool:
-    from ..model.library.two_plates import NAME
-
     return system.name == NAME
 
 
@@ -275,7 +278,7 @@ def boundary_omegas(grid: MapGrid, i: int, values: np.ndarray):
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class StabilityMap:
+class StabilityMap(Plottable):
     """Stability of steady sliding over a grid of two parameters, for a family of a third.
 
     Attributes
@@ -309,6 +312,8 @@ class StabilityMap:
     system : FrictionModel or None
         The base model.
     """
+
+    FIGURE = "stability_map"
 
     params: Parameters | None
     model: str
@@ -347,8 +352,6 @@ class StabilityMap:
         """``xarray.Dataset`` (family, axis 1, axis 2) with units and the full parameter set in attrs."""
         import xarray as xr
 
-        from .. import __version__
-        from ..model.library import describe_system
 
         a, b = self.axes
         fam = self.family_values if self.family_name else [self.model]
@@ -405,17 +408,10 @@ class StabilityMap:
         ds = self.to_xarray()
         return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 
-    def plot(self, **kwargs):
-        """Figure of the map; see :func:`stickslip.plot.stability.plot_stability_map`."""
-        from ..plot.stability import plot_stability_map
-
-        return plot_stability_map(self, **kwargs)
 
 
 def load_stability_map(path: str | Path) -> StabilityMap:
     """Read a map written by :meth:`StabilityMap.to_netcdf`."""
-    from ..model.library import system_from_description
-
     ds = open_ours(path, "stabilitymap", noun="stability map", what="a .nc file written by `stickslip stability-map`")
     name = ds.attrs["family_name"]
     fam = [str(v) for v in ds["family"].values] if name in ("model", "") else [float(v) for v in ds["family"].values]
@@ -499,8 +495,6 @@ def stability_map(
         For an empty or non-increasing grid, N ≤ 0, Ω = 0 (plates), an unknown parameter, or a
         value that makes the model invalid.
     """
-    from ..model.library import resolve_system
-
     if params is not None and not isinstance(params, (Parameters, str, Path)) and not hasattr(params, "data"):
         raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
     system = resolve_system(params, model)

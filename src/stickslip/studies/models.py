@@ -30,6 +30,8 @@ from ..model.friction import FrictionLaw
 from ..model.kinematics import register_kinematics
 from ..model.library import load_model
 from ..model.system_model import Contact, FrictionModel
+from ..plot.models import save_belt_figure, save_hoffmann_figure, save_popp_stelter_figure
+from ..stability.analysis import stability
 
 __all__ = ["BeltArm", "belt_arm_frame", "belt_arm", "HoffmannSweep", "hoffmann_sweep", "flutter_onset", "OnsetError",
            "BeltAttractors", "belt_attractors", "BSTAB_TEMPLATES", "popp_stelter_orbit", "main"]
@@ -126,8 +128,6 @@ def flutter_onset(damping=(0.0, 0.0), lo=0.0, hi=3.0, threshold=1e-6, tol=1e-10)
     """Smallest μ in [lo, hi] at which steady sliding of ``hoffmann`` has max Re λ > ``threshold``,
     by bisection on :func:`~stickslip.stability.analysis.stability` (undamped, Re λ grows like
     (μ − μc)^½ past the onset, so a threshold above round-off places it to ~threshold²)."""
-    from ..stability.analysis import stability
-
     def unstable(mu):
         return stability(_hoffmann(mu, damping)).max_real_part > threshold
 
@@ -142,8 +142,6 @@ def flutter_onset(damping=(0.0, 0.0), lo=0.0, hi=3.0, threshold=1e-6, tol=1e-10)
 
 def hoffmann_sweep(mu=None, damping=(0.0, 0.0)) -> HoffmannSweep:
     """Eigenvalues of ``hoffmann`` over ``mu`` (default 0 … 2 in steps of 0.01) and its onset."""
-    from ..stability.analysis import stability
-
     mu = np.linspace(0.0, 2.0, 201) if mu is None else np.asarray(mu, dtype=float)
     damping = (float(damping[0]), float(damping[1]))
     lam = np.empty((mu.size, 4), dtype=complex)
@@ -206,8 +204,6 @@ def popp_stelter_orbit(t_end=200.0, sample_rate=200.0):
 # ----------------------------------------------------------------------------- script
 def main(argv=None) -> int:
     """Compute the library figures and write them into the folder given as the argument."""
-    from ..plot.models import save_belt_figure, save_hoffmann_figure, save_popp_stelter_figure
-
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) != 1:
         print("usage: python -m stickslip.studies.models OUTPUT_FOLDER", file=sys.stderr)

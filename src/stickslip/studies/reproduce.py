@@ -13,7 +13,7 @@ printed in the report beside it:
 after each one, so an interrupted run keeps what it has done. A recipe that raises is reported
 as failed (with the error) and the next one runs.
 
-Figs. 10–15 judge what each run settles to (:mod:`stickslip.analysis.settle`): every run is
+Figs. 10–15 judge what each run settles to (:mod:`stickslip.attractors`): every run is
 extended from its final state until it has settled or reaches ``settle_cap``; "periodic" is a
 settled, confirmed period, "non-periodic" a settled chaotic or quasi-periodic attractor, and a
 run still drifting at the cap is "unsettled" and counted as neither.
@@ -45,6 +45,7 @@ import traceback
 from pathlib import Path
 from typing import Callable
 
+from ..attractors import jsonable
 from ..files import atomic_write_text
 from .reproduce_report import NOT_YET, Recipe, RecipeResult, Row, render_report  # noqa: F401  (public here)
 from .reproduce_resolutions import RESOLUTIONS, Resolution
@@ -150,7 +151,6 @@ def reproduce(out_dir, resolution: str | Resolution = "quick", *, only: list[str
     """
     import matplotlib
 
-    from ..analysis.settle import jsonable
 
     matplotlib.use("Agg")
     if isinstance(resolution, str) and resolution not in RESOLUTIONS:

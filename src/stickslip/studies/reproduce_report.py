@@ -14,6 +14,7 @@ import dataclasses
 import math
 from typing import Callable
 
+from .._version import __version__
 from .reproduce_resolutions import Resolution
 
 __all__ = ["Row", "RecipeResult", "Recipe", "NOT_YET", "render_report"]
@@ -68,8 +69,6 @@ def _cell(text: str) -> str:
 def render_report(entries: list, res: Resolution, pending: list, elapsed: float) -> str:
     """Markdown report from the finished recipe entries (dicts written by
     :func:`~stickslip.studies.reproduce.reproduce`)."""
-    from .. import __version__
-
     lines = ["# Reproduction of the paper's Sects. 4.1–4.2", "",
              f"stickslip {__version__}, resolution `{res.name}`, {elapsed:.0f} s so far. "
              "“We measure” is computed by this run; “agrees?” follows the criterion in the last column "

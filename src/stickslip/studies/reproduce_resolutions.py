@@ -42,7 +42,7 @@ class Resolution:
     bif_t_end: float = 200.0
     fig15_t_end: float = 200.0
     # Figs. 10–15: every run is extended from its final state until it has settled, up to this
-    # many seconds (stickslip.analysis.settle; the run lengths above are the first runs)
+    # many seconds (stickslip.attractors; the run lengths above are the first runs)
     settle_cap: float = 2000.0
 
 

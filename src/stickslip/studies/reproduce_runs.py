@@ -3,7 +3,7 @@
 Each of these figures is a handful of runs at fixed operating points, not a grid: the fixed-step
 study of Sect. 4.2.1 (:mod:`stickslip.studies.timestep`), the two initial conditions of Fig. 7,
 and the runs of Figs. 10, 11 and 15, each extended from its final state until it has settled
-(:mod:`stickslip.analysis.settle`, up to ``Resolution.settle_cap``) so that "periodic" and
+(:mod:`stickslip.attractors`, up to ``Resolution.settle_cap``) so that "periodic" and
 "non-periodic" are verdicts on the settled response. Figs. 10 and 11 share their runs through
 the cache of one :func:`~stickslip.studies.reproduce.reproduce` call.
 """
@@ -13,16 +13,23 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from ..analysis.classify import classify
+from ..analysis.intensity import angle_range
+from ..analysis.signal import spectrum
+from ..attractors import simulate_until_settled
+from ..integrate.driver import simulate
+from ..model.parameters import Parameters
 from ..plot._common import save_figure
+from ..plot.timestep import save_timestep_figures
+from ..plot.trajectory import save_trajectory_figure
+from ..sweep.spec import initial_condition
 from .reproduce_report import RecipeResult, Row, _fmt, _yes
 from .reproduce_resolutions import Resolution
+from .timestep import PAPER_TABLE2, run_timestep_study
 
 
 # ----------------------------------------------------------------------------- Table 2, Figs. 5–6
 def _recipe_table2(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..plot.timestep import save_timestep_figures
-    from .timestep import PAPER_TABLE2, run_timestep_study
-
     study = run_timestep_study(res.timestep_dts, t_end=res.timestep_t_end, event_rtols=res.timestep_event_rtols)
     study.save(out / "timestep")
     figs = save_timestep_figures(study, out)
@@ -67,9 +74,6 @@ def _recipe_table2(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 # ----------------------------------------------------------------------------- Fig. 7
 def _simulate_named(params, t_end, ic_name, model="full"):
-    from ..integrate.driver import simulate
-    from ..sweep.spec import initial_condition
-
     ic, pert = initial_condition(ic_name, params, model)
     return simulate(params, t_end, model=model, ic=ic, perturbation=pert, sample_rate=200.0)
 
@@ -77,8 +81,6 @@ def _simulate_named(params, t_end, ic_name, model="full"):
 def _recipe_fig7(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     import matplotlib.pyplot as plt
 
-    from ..analysis.classify import classify
-    from ..model.parameters import Parameters
 
     t_from = res.fig7_t_end * 2.0 / 3.0
     omegas = (5.0, 8.5, 12.0)
@@ -123,27 +125,23 @@ PAPER_FIG11 = {30: (5.0, 15.0), 120: (0.0, 20.0)}
 
 def _settled_run(params, res: Resolution, t_min: float, **options):
     """A run extended until it has settled (or reaches ``res.settle_cap``), window ≤ 100 s."""
-    from ..analysis.settle import simulate_until_settled
-
     window = min(100.0, 0.5 * t_min)
     return simulate_until_settled(params, cap=res.settle_cap, t_min=t_min, window=window, step=window,
                                   sample_rate=200.0, **options)
 
 
-def _verdict_text(tr) -> str:
-    """What a settled run shows, in words, with its frequency."""
-    a = tr.attractor
+def _verdict_text(run) -> str:
+    """What a settled run (:class:`~stickslip.attractors.SettledRun`) shows, in words, with its frequency."""
+    a = run.attractor
     if a.attractor == "periodic":
         return (f"periodic, {a.period_count} peak(s) per period, fundamental {_fmt(a.fundamental_frequency_hz, 4)} Hz "
                 f"(settled by {a.settle_time_s:g} s)")
     if a.settled:
         return f"{a.attractor}, dominant {_fmt(a.dominant_frequency_hz)} Hz (settled by {a.settle_time_s:g} s)"
-    return f"unsettled at {tr.t[-1]:g} s, dominant {_fmt(a.dominant_frequency_hz)} Hz"
+    return f"unsettled at {run.trajectory.t[-1]:g} s, dominant {_fmt(a.dominant_frequency_hz)} Hz"
 
 
 def _fig10_runs(res: Resolution, cache: dict):
-    from ..model.parameters import Parameters
-
     if "fig10_runs" not in cache:
         cache["fig10_runs"] = {int(n): _settled_run(Parameters(N=float(n), Omega=0.5), res, res.fig10_t_end)
                                for n in res.fig10_N}
@@ -153,13 +151,12 @@ def _fig10_runs(res: Resolution, cache: dict):
 def _recipe_fig10(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     import matplotlib.pyplot as plt
 
-    from ..analysis.steady import spectrum
 
     runs = _fig10_runs(res, cache)
     fig, axes = plt.subplots(len(runs), 3, figsize=(12, 2.2 * len(runs)), constrained_layout=True, squeeze=False)
     rows, measured = [], {}
-    for k, (n, tr) in enumerate(runs.items()):
-        a = tr.attractor
+    for k, (n, run) in enumerate(runs.items()):
+        a, tr = run.attractor, run.trajectory
         sel = tr.t >= tr.steady_from
         t, phi, dphi = tr.t[sel], tr.states[sel, 4], tr.states[sel, 10]
         f, amp = spectrum(t, phi)
@@ -170,7 +167,7 @@ def _recipe_fig10(out: Path, res: Resolution, cache: dict) -> RecipeResult:
         axes[k, 2].plot(f, amp, lw=0.6)
         axes[k, 2].set_xlim(0, 8)
         axes[k, 2].set_ylabel("|Φ| [rad]")
-        axes[k, 0].set_title(_verdict_text(tr), fontsize=8)
+        axes[k, 0].set_title(_verdict_text(run), fontsize=8)
         freq = a.fundamental_frequency_hz if a.fundamental_frequency_hz is not None else a.dominant_frequency_hz
         measured[n] = {"attractor": a.attractor, "settled": a.settled, "period_count": a.period_count,
                        "fundamental_frequency_hz": a.fundamental_frequency_hz,
@@ -181,10 +178,10 @@ def _recipe_fig10(out: Path, res: Resolution, cache: dict) -> RecipeResult:
         if pf is not None:
             ok = a.attractor == "periodic" and abs(a.fundamental_frequency_hz - pf) / pf <= 0.1
             ratio = f" ({freq / pf:.2f}× paper)" if freq else ""
-            rows.append(Row(f"Fig. 10, N = {n} N", f"{pk}, fundamental {pf:g} Hz", _verdict_text(tr) + ratio,
+            rows.append(Row(f"Fig. 10, N = {n} N", f"{pk}, fundamental {pf:g} Hz", _verdict_text(run) + ratio,
                             _yes(ok), "settled periodic, fundamental frequency within 10 % of the paper's"))
         elif pk is not None:
-            rows.append(Row(f"Fig. 10, N = {n} N", pk, _verdict_text(tr),
+            rows.append(Row(f"Fig. 10, N = {n} N", pk, _verdict_text(run),
                             _yes(a.attractor in ("chaotic", "quasiperiodic")),
                             "settled non-periodic (chaotic or quasi-periodic, by the largest Lyapunov exponent)"))
     axes[-1, 0].set_xlabel("t [s]")
@@ -203,14 +200,13 @@ def _recipe_fig10(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 def _recipe_fig11(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     import matplotlib.pyplot as plt
 
-    from ..analysis.intensity import angle_range
 
     runs = _fig10_runs(res, cache)
     chosen = [n for n in (30, 120) if n in runs]
     fig, axes = plt.subplots(len(chosen), 1, figsize=(9, 2.6 * len(chosen)), constrained_layout=True, squeeze=False)
     rows, measured = [], {}
     for k, n in enumerate(chosen):
-        tr = runs[n]
+        tr = runs[n].trajectory
         sel = tr.t >= tr.steady_from
         axes[k, 0].plot(tr.t[sel], tr.sliding_angle_deg[sel], lw=0.6, label="Model 1 (slip samples)")
         axes[k, 0].axhline(0.0, color="r", ls="--", lw=1, label="plate centres fixed")
@@ -232,14 +228,11 @@ def _recipe_fig11(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 # ----------------------------------------------------------------------------- Fig. 15
 def _recipe_fig15(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..model.parameters import Parameters
-    from ..plot.trajectory import save_trajectory_figure
-
-    tr = _settled_run(Parameters(N=50.0, Omega=0.5), res, res.fig15_t_end, model="rotation")
-    a = tr.attractor
-    save_trajectory_figure(tr, out / "fig15.png")
+    run = _settled_run(Parameters(N=50.0, Omega=0.5), res, res.fig15_t_end, model="rotation")
+    a = run.attractor
+    save_trajectory_figure(run.trajectory, out / "fig15.png")
     rows = [Row("Fig. 15", "Model 4 (rotation only): periodic stick-slip of φ with one period (Sect. 4.2.3, with Fig. 14(e)(f))",
-                f"N = 50 N, Ω = 0.5 rad/s: {_verdict_text(tr)}, period {_fmt(a.period_s, 4)} s, stick fraction "
+                f"N = 50 N, Ω = 0.5 rad/s: {_verdict_text(run)}, period {_fmt(a.period_s, 4)} s, stick fraction "
                 f"{_fmt(a.classification.stick_fraction if a.classification else math.nan)}",
                 _yes(a.kind == "periodic-stick-slip" and a.period_count == 1),
                 "settled periodic stick-slip with one peak per period (the paper does not print N, Ω of Fig. 15; "

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..plot.stability import save_stability_map_figure
+from ..stability import stability_map
 from .reproduce_report import RecipeResult, Row, _fmt, _yes
 from .reproduce_resolutions import Resolution
 
@@ -45,9 +47,6 @@ def _monotone_family(smap, increasing: bool) -> tuple[bool, int]:
 
 
 def _recipe_fig3(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..plot.stability import save_stability_map_figure
-    from ..stability import stability_map
-
     N, Om = _stab_grids(res)
     ma = stability_map(N=N, Omega=Om, family=("delta_mu", [0.1, 0.2, 0.3]))
     mb = stability_map(N=N, Omega=Om, family=("alpha", [2.0, 5.0, 10.0]))
@@ -85,9 +84,6 @@ def _recipe_fig3(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 
 def _recipe_fig4(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..plot.stability import save_stability_map_figure
-    from ..stability import stability_map
-
     N, Om = _stab_grids(res)
     m = stability_map(N=N, Omega=Om, family=("model", ["full", "rotation"]))
     save_stability_map_figure(m, out / "fig4.png")

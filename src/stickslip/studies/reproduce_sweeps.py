@@ -17,14 +17,20 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.classify import KINDS
+from ..attractors import ATTRACTORS
+from ..model.parameters import Parameters
+from ..plot.intensity import save_intensity_figure
+from ..plot.regions import MODEL_LABELS, save_regions_figure
+from ..plot.sweep import save_bifurcation_figure
+from ..sweep import regions, sweep
+from ..sweep.bistability import REGION_NAMES
 from .reproduce_report import RecipeResult, Row, _fmt, _yes
 from .reproduce_resolutions import Resolution
 
 
 # ----------------------------------------------------------------------------- Fig. 12(a)
 def _recipe_fig12a(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..model.parameters import Parameters
-
     N = np.linspace(10.0, 130.0, res.fig12_N)
     ds = _bifurcation_sweep(out, res, "fig12a", {"N": N}, Parameters(Omega=0.5), t_end=res.fig12_t_end)
     f = ds["dominant_frequency"].values
@@ -66,8 +72,6 @@ DIFFERENT_PERIOD_RTOL = 0.10
 
 def _kind_names(ds) -> np.ndarray:
     """Kind names of a sweep dataset (``failed`` for −1 / missing)."""
-    from ..analysis.classify import KINDS
-
     code = ds["kind"].values
     names = np.array(KINDS + ("failed",), dtype=object)
     return names[np.where(np.isfinite(code), code, -1).astype(int)]
@@ -94,10 +98,8 @@ NON_PERIODIC = ("chaotic", "quasiperiodic")
 
 
 def _attractor_names(ds) -> np.ndarray:
-    """Verdict names of a sweep dataset (:data:`~stickslip.analysis.settle.ATTRACTORS`; ``failed``
+    """Verdict names of a sweep dataset (:data:`~stickslip.attractors.ATTRACTORS`; ``failed``
     for −1 / missing)."""
-    from ..analysis.settle import ATTRACTORS
-
     code = ds["attractor"].values
     names = np.array(ATTRACTORS + ("failed",), dtype=object)
     return names[np.where(np.isfinite(code), code, -1).astype(int)]
@@ -141,9 +143,6 @@ def _bifurcation_sweep(out: Path, res: Resolution, name: str, grid: dict, params
                        t_end: float | None = None):
     """Run one bifurcation sweep with the library, every point extended until settled (up to
     ``res.settle_cap``); save ``name``.nc/.png; return the dataset."""
-    from ..plot.sweep import save_bifurcation_figure
-    from ..sweep import sweep
-
     t_end = res.bif_t_end if t_end is None else t_end
     r = sweep(grid, params, out=out / f"{name}.nc", t_end=t_end, t_from=max(0.5 * t_end, t_end - 100.0), ic=ic,
               executor=res.executor, workers=res.workers, overwrite=True, settle=True,
@@ -158,7 +157,6 @@ def _region_maps(out: Path, res: Resolution, models, cache: dict):
     earlier recipe of this run are reused (Figs. 8, 9 and 16 share one grid)."""
     import xarray as xr
 
-    from ..sweep import regions
 
     have = cache.setdefault("regions", {})
     missing = [m for m in models if m not in have]
@@ -173,9 +171,6 @@ def _region_maps(out: Path, res: Resolution, models, cache: dict):
 
 
 def _recipe_fig8(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..plot.regions import save_regions_figure
-    from ..sweep.bistability import REGION_NAMES
-
     ds = _region_maps(out, res, ["full"], cache)
     save_regions_figure(ds, out / "fig8.png")
     region = ds["region"].sel(model="full").transpose("N", "Omega").values
@@ -215,8 +210,6 @@ def _recipe_fig8(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 
 def _recipe_fig9(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..plot.regions import MODEL_LABELS, save_regions_figure
-
     models = ["full", "x", "y", "rotation"]
     ds = _region_maps(out, res, models, cache)
     save_regions_figure(ds, out / "fig9.png")
@@ -247,8 +240,6 @@ def _recipe_fig9(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 
 def _recipe_fig16(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..plot.intensity import save_intensity_figure
-
     ds = _region_maps(out, res, ["full", "rotation"], cache)
     save_intensity_figure(ds, out / "fig16.png", ic="far")
     far = ds.sel(ic="far").transpose("model", "N", "Omega", ...)
@@ -279,8 +270,6 @@ def _recipe_fig16(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 # ----------------------------------------------------------------------------- Figs. 12(b), 13
 def _recipe_fig12b(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..model.parameters import Parameters
-
     Om = np.linspace(*FIG12B_OMEGA_RANGE, res.bif_points)
     ds = _bifurcation_sweep(out, res, "fig12b", {"Omega": Om}, Parameters(N=50.0), ic="far")
     labels = _attractor_names(ds)
@@ -306,8 +295,6 @@ def _recipe_fig12b(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 
 def _recipe_fig13(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..model.parameters import Parameters
-
     base = Parameters(N=50.0, Omega=0.5)
     dmu = np.linspace(*FIG13_DELTA_MU_RANGE, res.bif_points)
     alpha = np.linspace(*FIG13_ALPHA_RANGE, res.bif_points)
@@ -352,9 +339,6 @@ def _period_summary(ds, model: str) -> dict:
 
 
 def _recipe_fig14(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    from ..model.parameters import Parameters
-    from ..plot.regions import MODEL_LABELS
-
     models = ["x", "y", "rotation"]
     N = np.linspace(10.0, 130.0, res.fig14_N)
     Om = np.linspace(*FIG12B_OMEGA_RANGE, res.fig14_N)

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..files import atomic_write_text
 from ..integrate.driver import simulate
 from ..model.parameters import Parameters

@@ -2,10 +2,11 @@
 of reductions (peaks, classification, frequency, intensity, stick fraction), streamed to disk,
 resumable, on serial, process-pool or dask executors; bistability regions (Figs. 8, 9)."""
 
+from ..errors import SweepError
+from ..parallel import EXECUTORS
 from .bistability import RegionMap, load_region_map, regions
 from .engine import SweepResult, sweep
-from .executors import EXECUTORS
-from .spec import NAMED_ICS, SweepError, SweepSpec
+from .spec import NAMED_ICS, SweepSpec
 from .store import load_sweep
 
 __all__ = ["sweep", "SweepResult", "SweepSpec", "SweepError", "load_sweep", "EXECUTORS", "NAMED_ICS",

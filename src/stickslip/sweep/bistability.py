@@ -32,11 +32,13 @@ from typing import Sequence
 
 import numpy as np
 
+from ..errors import SweepError
 from ..files import atomic_write, lock
 from ..model.parameters import Parameters
+from ..parallel import check_workers
+from ..results import Plottable
 from .engine import SweepResult, sweep
-from .executors import check_workers
-from .spec import SweepError, SweepSpec
+from .spec import SweepSpec
 from .store import load_sweep
 
 __all__ = ["RegionMap", "regions", "load_region_map", "REGION_NAMES", "classify_regions"]
@@ -62,7 +64,7 @@ def classify_regions(kind: np.ndarray, stick_fraction: np.ndarray) -> np.ndarray
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class RegionMap:
+class RegionMap(Plottable):
     """Regions I/II/III over (model, N, Ω) and the stick-slip boundary.
 
     Attributes
@@ -73,6 +75,8 @@ class RegionMap:
     path : Path or None
     timings : dict
     """
+
+    FIGURE = "regions"
 
     dataset: object
     path: Path | None
@@ -89,10 +93,6 @@ class RegionMap:
     def to_xarray(self):
         return self.dataset
 
-    def plot(self, **kwargs):
-        from ..plot.regions import plot_regions
-
-        return plot_regions(self, **kwargs)
 
 
 def _with_regions(ds):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import tempfile
 import time
@@ -11,10 +12,10 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from ..model.parameters import Parameters
-from ..files import FileFormatError
-from .executors import check_workers, run_batches
-from .spec import SweepError, SweepSpec, evaluate_batch
+from ..analysis.classify import KINDS
+from ..errors import FileFormatError, SweepError
+from ..parallel import check_executor, check_workers, map_unordered
+from .spec import SweepSpec, evaluate_batch, warm_up
 from .store import Journal, assemble, journal_dir, load_sweep
 
 __all__ = ["SweepResult", "sweep", "TARGET_BATCH_S"]
@@ -59,8 +60,6 @@ class SweepResult:
 
     def kinds(self) -> np.ndarray:
         """Steady-state kind names over the grid (``failed`` for −1)."""
-        from ..analysis.classify import KINDS
-
         code = self.dataset["kind"].values
         names = np.array(KINDS + ("failed",), dtype=object)
         return names[np.where(np.isfinite(code), code, -1).astype(int)]
@@ -90,8 +89,15 @@ def _settle_attrs(spec: SweepSpec) -> dict:
 
 
 def _progress_bar():
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskProgressColumn, TextColumn,
-                               TimeElapsedColumn, TimeRemainingColumn)
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     return Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TaskProgressColumn(),
                     TextColumn("{task.fields[rate]}"), TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
@@ -161,8 +167,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     """
     t_start = time.perf_counter()
     spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
-    if executor not in TARGET_BATCH_S:
-        raise SweepError(f"unknown executor {executor!r}; choose serial, processes or dask")
+    check_executor(executor)
     workers = check_workers(workers, address=address)
     tmpdir = None
     if out is None:
@@ -221,7 +226,8 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
             batches = [rest[i : i + size] for i in range(0, rest.size, size)]
             info.update(batch_size=size, batches=len(batches), first_point_s=t_point)
             if batches:
-                for idx, rows in run_batches(spec, batches, executor=executor, workers=workers, address=address, info=info):
+                for idx, rows in map_unordered(functools.partial(evaluate_batch, spec), batches, executor=executor,
+                                               workers=workers, address=address, warm=warm_up, info=info):
                     record(idx, rows)
         info["compute_s"] = time.perf_counter() - compute_start
         if bar is not None:

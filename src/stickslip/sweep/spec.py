@@ -18,28 +18,25 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..analysis.settle import ATTRACTORS, DEFAULT_CAP_S
-from ..errors import StickSlipError
+from ..analysis.classify import kind_code
+from ..analysis.intensity import angle_range, intensity, trajectory_intensities
+from ..attractors import ATTRACTORS, DEFAULT_CAP_S, attractor, simulate_until_settled
+from ..errors import EquilibriumError, SimulationError, SweepError
+from ..integrate.driver import simulate
+from ..integrate.initial import NAMED_STARTS, NEAR_PERTURBATION
+from ..integrate.status import Status
+from ..model.library import describe_system, plates_variant, resolve_system, system_from_description, two_plates
+from ..model.library.two_plates import NAME as TWO_PLATES
 from ..model.parameters import Parameters
-from ..model.variants import DOF_NAMES, STATE_NAMES, resolve_variant
+from ..model.system_model import FrictionModel
+from ..model.variants import STATE_NAMES, resolve_variant
+from ..stability.equilibrium import steady_sliding
 
 __all__ = ["SweepSpec", "SweepError", "NAMED_ICS", "initial_condition", "COLUMNS", "evaluate", "evaluate_batch",
            "NEAR_PERTURBATION", "spec_system"]
 
-#: Perturbation of φ added to the equilibrium by the ``near`` initial condition [rad]:
-#: 5 % of φ_e ≈ 0.0197 rad at N = 50 N (Eq. 14), small enough to stay in the basin of a stable
-#: equilibrium and large enough that an unstable one departs within a few seconds.
-NEAR_PERTURBATION = 1e-3
-
-#: Named initial conditions (Sect. 4.2.2 uses one far from and one near the equilibrium).
-NAMED_ICS = {
-    "zero": "plates at rest, springs undeformed (q = 0, q̇ = 0)",
-    "far": "q = 0 with the upper plate carried along by the lower plate's surface (v_r = 0 at "
-           "t = 0): ẏ1 = Ω r when y1 is free, else φ̇ = Ω",
-    "near": f"the equilibrium of Eq. (14) with φ raised by {NEAR_PERTURBATION:g} rad (other models: their "
-            "observed coordinate)",
-    "equilibrium": "the equilibrium of Eq. (14) exactly (other models: their steady sliding)",
-}
+#: Named initial conditions: those of every model, then the plates' own (``far``).
+NAMED_ICS = {**NAMED_STARTS, **{k: v.description for k, v in two_plates().starts.items()}}
 
 #: Named initial conditions that only the plates have.
 PLATES_ONLY_ICS = ("far",)
@@ -47,30 +44,18 @@ PLATES_ONLY_ICS = ("far",)
 _SPECIAL_DIMS = ("model", "ic")
 
 
-class SweepError(StickSlipError, ValueError):
-    """An invalid sweep definition, or an output that belongs to another sweep."""
-
-
 def initial_condition(name: str, params: Parameters, model) -> tuple[Any, float | None]:
-    """(ic, perturbation) arguments of :func:`stickslip.simulate` for a named initial condition."""
-    if name == "zero":
-        return "zero", None
-    if params is None and name in PLATES_ONLY_ICS:
-        raise SweepError(f"initial condition {name!r} is defined for the plates only")
-    if name == "equilibrium":
-        return "equilibrium", None
+    """(ic, perturbation) arguments of :func:`stickslip.simulate` for a named initial condition
+    (``params`` and ``model``: the plates' parameters and variant, for their own starts)."""
+    if name not in NAMED_ICS:
+        raise SweepError(f"unknown initial condition {name!r}; choose one of {', '.join(NAMED_ICS)}")
     if name == "near":
         return "equilibrium", NEAR_PERTURBATION
-    if name == "far":
-        free = resolve_variant(model).free
-        s = np.zeros(12)
-        if "y1" in free:
-            # q = 0: X = r, Y = 0 and v_r = (ẋ1 − ẋ2, ẏ1 − ẏ2 + r φ̇ − Ω r) (Eq. 9) vanishes for ẏ1 = Ω r
-            s[6 + DOF_NAMES.index("y1")] = params.Omega * params.r
-        else:
-            s[6 + DOF_NAMES.index("phi")] = params.Omega
-        return s, None
-    raise SweepError(f"unknown initial condition {name!r}; choose one of {', '.join(NAMED_ICS)}")
+    if name in NAMED_STARTS:
+        return name, None
+    if params is None:
+        raise SweepError(f"initial condition {name!r} is defined for the plates only")
+    return two_plates(params, model).starts[name].state.copy(), None
 
 
 # ----------------------------------------------------------------------------- the row schema
@@ -164,12 +149,12 @@ class SweepSpec:
         and the start of its window; the window length t_end − t_from is also the step.
     settle : bool
         Extend each run from its final state until it has settled or reaches ``cap``
-        (:func:`stickslip.analysis.settle.simulate_until_settled`).
+        (:func:`stickslip.attractors.simulate_until_settled`).
     cap : float
         Longest run when settling [s].
     confirm : bool
         Confirm a period of more than one peak by shooting and chaos or a torus by the largest
-        Lyapunov exponent (:func:`stickslip.analysis.settle.attractor`); without it no such
+        Lyapunov exponent (:func:`stickslip.attractors.attractor`); without it no such
         claim is made.
     sample_rate : float
         Output samples per second of each run [Hz].
@@ -269,8 +254,6 @@ class SweepSpec:
             resolve_variant(model)
             base = dict(params=params.to_dict(), model=model)
         else:
-            from ..model.library import describe_system
-
             options.pop("model", None)
             base = dict(params=dict(system.parameters), model=system.name, system=describe_system(system))
         spec = cls(dims=tuple(dims), ic=ic, t_end=t_end, t_from=t_from, **base, **options)
@@ -332,10 +315,6 @@ class SweepSpec:
 
 def _resolve_model(params, options: dict):
     """The model of a sweep other than the plates, or None for the plates (variants, Parameters)."""
-    from ..model.library import resolve_system
-    from ..model.library.two_plates import NAME as TWO_PLATES
-    from ..model.system_model import FrictionModel
-
     model = options.get("model")
     if params is not None and not isinstance(params, (Parameters, FrictionModel, str, Path)):
         raise SweepError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
@@ -352,9 +331,8 @@ def _resolve_model(params, options: dict):
 
 
 def _is_model_name(text: str) -> bool:
-    from ..model.library import _is_model_name as is_model
-
-    return is_model(text)
+    """Whether ``text`` names a model other than a variant of the plates (a library name or file)."""
+    return plates_variant(text) is None
 
 
 def _canonical(system, name: str) -> str:
@@ -375,8 +353,6 @@ def _check_ic(ic: str, system) -> None:
 
 @functools.lru_cache(maxsize=8)
 def _system_from_json(text: str):
-    from ..model.library import system_from_description
-
     return system_from_description(json.loads(text))
 
 
@@ -388,12 +364,6 @@ def spec_system(spec: "SweepSpec"):
 # ----------------------------------------------------------------------------- one point
 def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     """Simulate one grid point and reduce it to a row of :attr:`SweepSpec.row_width` numbers."""
-    from ..analysis.classify import kind_code
-    from ..analysis.intensity import angle_range, trajectory_intensities
-    from ..analysis.settle import attractor, simulate_until_settled
-    from ..integrate.driver import SimulationError, simulate
-    from ..integrate.status import Status
-
     start = time.perf_counter()
     values = spec.point(flat_index)
     changes = {k: v for k, v in values.items() if k not in _SPECIAL_DIMS and not k.startswith("perturb_")}
@@ -423,12 +393,14 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     try:
         if spec.settle:
             window = spec.t_end - spec.t_from
-            traj = simulate_until_settled(params, cap=spec.cap, t_min=spec.t_end, window=window, step=window,
-                                          keep="window", confirm=spec.confirm, lyapunov=spec.confirm, **run)
+            settled = simulate_until_settled(params, cap=spec.cap, t_min=spec.t_end, window=window, step=window,
+                                             keep="window", confirm=spec.confirm, lyapunov=spec.confirm, **run)
+            traj, verdict = settled.trajectory, settled.attractor
         else:
             traj = simulate(params, spec.t_end, steady_from=spec.t_from, **run)
+            verdict = None
     except SimulationError:
-        traj = None
+        traj = verdict = None
     if traj is not None and traj.status_code == Status.INTERRUPTED:
         raise KeyboardInterrupt  # Ctrl-C: the point is not done (the journal keeps the others; resume redoes it)
     if traj is not None:
@@ -436,10 +408,11 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         out["steps"] = float(traj.stats.steps)
     if traj is None or traj.status != "success":
         out["kind"] = -1.0
-        unbounded = traj is not None and traj.attractor.attractor == "unbounded"
-        out["attractor"] = float(traj.attractor.code) if unbounded else -1.0
+        verdict = None if traj is None else verdict or attractor(traj, confirm=spec.confirm, lyapunov=spec.confirm)
+        unbounded = verdict is not None and verdict.attractor == "unbounded"
+        out["attractor"] = float(verdict.code) if unbounded else -1.0
     else:
-        verdict = traj.attractor if spec.settle else attractor(traj, confirm=spec.confirm, lyapunov=spec.confirm)
+        verdict = verdict or attractor(traj, confirm=spec.confirm, lyapunov=spec.confirm)
         c = verdict.classification
         t_from = traj.steady_from
         sel = traj.t >= t_from
@@ -473,9 +446,6 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
 
 def _observed_intensity(traj, system, observed: int, t_from: float) -> float:
     """Eq. (16) of the observed coordinate about its steady-sliding value (NaN without one)."""
-    from ..analysis.intensity import intensity
-    from ..stability.equilibrium import EquilibriumError, steady_sliding
-
     try:
         q_e = steady_sliding(system)[observed]
     except EquilibriumError:
@@ -497,13 +467,8 @@ def evaluate_batch(spec: SweepSpec, indices) -> tuple[np.ndarray, np.ndarray]:
 
 
 def warm_up(spec: SweepSpec | None = None) -> float:
-    """Prepare a worker process: compile or load the numba kernels (a 10 ms run) and import the
-    analysis that :func:`evaluate` uses (~0.5 s of imports that would otherwise land on the
-    first point of every worker). Returns the seconds taken."""
-    from ..analysis import classify, intensity  # noqa: F401
-    from ..integrate.driver import simulate
-    from ..stability import equilibrium  # noqa: F401  (imported by the intensity of each point)
-
+    """Prepare a worker process: compile or load the numba kernels (a 10 ms run), which would
+    otherwise land on the first point of every worker. Returns the seconds taken."""
     start = time.perf_counter()
     simulate(None, 0.01, sample_rate=1000.0)
     return time.perf_counter() - start

@@ -35,10 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
+from ..errors import SweepError
 from ..files import AppendLog, OutputLock, atomic_write, format_name, fsync_dir, open_ours
 from ..model.parameters import PARAMETER_UNITS, parameter_attrs
-from .spec import NAMED_ICS, SweepError, SweepSpec
+from .spec import NAMED_ICS, SweepSpec, spec_system
 
 __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir", "flat_hyperslabs", "LOAD_LIMIT_POINTS"]
 
@@ -271,8 +272,6 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
     }
     attrs.update(parameter_attrs(spec.params))
     if spec.system is not None:
-        from .spec import spec_system
-
         system = spec_system(spec)
         attrs["system"] = json.dumps(spec.system)
         attrs["observed"] = system.dofs[system.observed_index]

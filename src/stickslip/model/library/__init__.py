@@ -15,9 +15,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...errors import ModelError
 from ..model_file import load_model_file, model_from_spec
 from ..parameters import Parameters
-from ..system_model import DEFAULT_SLIP_BAND, FrictionModel, ModelError
+from ..system_model import DEFAULT_SLIP_BAND, FrictionModel
 from ..variants import MODELS
 from .two_plates import NAME as TWO_PLATES
 from .two_plates import two_plates

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..friction import FrictionLaw
 from ..parameters import PARAMETER_UNITS, Parameters
-from ..system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel
+from ..system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, NamedState
 from ..variants import DOF_NAMES, resolve_variant
 from .plate_kinematics import PlateKinematics
 
@@ -37,6 +37,15 @@ def two_plates(params: Parameters | None = None, variant="full", slip_band: floa
     law = FrictionLaw(P.friction_law, P.mu_k, P.delta_mu, P.alpha)
     contact = Contact(dim=2, friction=law, normal_force=P.N, name="plates")
 
+    far = np.zeros(12)
+    if v.mask[DOF_NAMES.index("y1")]:
+        # q = 0: X = r, Y = 0 and v_r = (ẋ1 − ẋ2, ẏ1 − ẏ2 + r φ̇ − Ω r) (Eq. 9) vanishes for ẏ1 = Ω r
+        far[6 + DOF_NAMES.index("y1")] = P.Omega * P.r
+    else:
+        far[6 + DOF_NAMES.index("phi")] = P.Omega
+    starts = {"far": NamedState(far, "q = 0 with the upper plate carried along by the lower plate's surface "
+                                     "(v_r = 0 at t = 0): ẏ1 = Ω r when y1 is free, else φ̇ = Ω")}
+
     def builder(values: Mapping[str, Any]) -> FrictionModel:
         values = dict(values)
         var = values.pop("variant", v.name)
@@ -46,6 +55,6 @@ def two_plates(params: Parameters | None = None, variant="full", slip_band: floa
         name=NAME, dofs=DOF_NAMES, mass=mass, damping=damping * v.mask, stiffness=stiffness * v.mask,
         force=np.zeros(6), contacts=(contact,), kinematics=PlateKinematics(P.r, P.Omega), free=v.mask,
         parameters={**P.to_dict(), "variant": v.name}, builder=builder, source=f"library:{NAME}",
-        units=_UNITS, slip_band=slip_band, observed="phi",
+        units=_UNITS, slip_band=slip_band, observed="phi", starts=starts,
         description="two rigid plates in point contact, 2-D friction (Liu & Ouyang; the paper)",
     )

@@ -7,7 +7,7 @@ that), tried on the analysed coordinate first and then on the other free ones: i
 minima, or crossings of a level of it (:data:`LEVELS`), with the number of crossings per period
 counted in the window. The claim stands when Newton converges, every non-trivial Floquet
 multiplier lies inside the unit circle, and a run of :data:`ORBIT_PERIODS` periods started on
-the orbit shows, by the same period rule as the signal (:func:`~.period.detect_period`), the
+the orbit shows, by the same period rule as the signal (:func:`~stickslip.analysis.period.detect_period`), the
 same k and the same period to :data:`PERIOD_RTOL`: a transient near a period-1 orbit shot with
 multiplicity 2 converges onto that orbit, whose own run then shows k = 1.
 
@@ -25,9 +25,12 @@ import math
 
 import numpy as np
 
+from ..analysis.classify import dof_index, range_change
+from ..analysis.peaks import find_peaks
+from ..analysis.period import detect_period, evidence_at, return_map
 from ..errors import StickSlipError
-from .classify import dof_index
-from .period import detect_period
+from ..orbits import lyapunov_exponent, periodic_orbit
+from ..orbits.section import Section, section_crossings
 
 __all__ = ["ORBIT_PERIODS", "PERIOD_RTOL", "LAMBDA_ZERO", "SEPARATIONS", "QUASI_SPAN_S", "QUASI_RATE",
            "LYAPUNOV_TIME_S", "confirm_period", "lyapunov_sign", "span_change"]
@@ -37,7 +40,7 @@ __all__ = ["ORBIT_PERIODS", "PERIOD_RTOL", "LAMBDA_ZERO", "SEPARATIONS", "QUASI_
 ORBIT_PERIODS = 30
 
 #: Agreement of the shot orbit's period with the run's [-]; the run's period has settled to
-#: 1e-5 (:data:`~.period.SETTLE_RTOL`).
+#: 1e-5 (:data:`~stickslip.analysis.period.SETTLE_RTOL`).
 PERIOD_RTOL = 1e-4
 
 #: A positive largest Lyapunov exponent must exceed this [1/s] (and 3 standard errors). Benettin
@@ -51,7 +54,7 @@ SEPARATIONS = (1e-7, 1e-6)
 
 #: A torus claim needs the crossings unchanged over this span [s]: the spreads of its first and
 #: last windows may differ by a contraction rate of at most QUASI_RATE [1/s], and their peak
-#: ranges by :data:`~.classify.STATIONARY_RTOL` of A. A λ ≈ 0 alone does not tell a torus from
+#: ranges by :data:`~stickslip.analysis.classify.STATIONARY_RTOL` of A. A λ ≈ 0 alone does not tell a torus from
 #: a periodic orbit approached slowly (Model 1, N = 50 N, Ω = 0.5, Δμ = 0.0661: λ = −0.0004 …
 #: 0.005 1/s, no visible decay in 330 s, but the spreads fall ×2.7 per 500 s, 0.5 → 5e-4 over
 #: 4000 s).
@@ -70,8 +73,6 @@ def _sections_in_slip(traj, dof: str, t_from: float, period: float):
     """Sections crossed only in slip in the window, with their crossings per period: on ``dof``
     first, then on the model's other free coordinates; on each, its maxima, its minima, then
     up- and down-crossings of :data:`LEVELS` of its range in the window."""
-    from ..orbits.section import Section, section_crossings
-
     system = traj.system
     n = system.n
     sel = traj.t >= t_from
@@ -115,8 +116,6 @@ def confirm_period(traj, k: int, period: float, *, dof: str | None = None, t_fro
         in the orbit's own run), ``stable``, ``stick_phases`` (per period), ``max_multiplier``
         (largest non-trivial modulus), ``residual``; ``reason`` when not confirmed.
     """
-    from ..orbits import periodic_orbit
-
     dof = traj.system.dofs[dof_index(traj, dof)]
     t_from = traj.steady_from if t_from is None else float(t_from)
     reasons = []
@@ -164,8 +163,6 @@ def lyapunov_sign(traj, *, averaging: float = LYAPUNOV_TIME_S) -> dict:
         None otherwise: the estimates disagree), ``exponents`` [1/s],
         ``standard_errors`` [1/s], ``separations``, ``averaging_s``; ``reason`` when None.
     """
-    from ..orbits import lyapunov_exponent
-
     lams, ses = [], []
     for d0 in SEPARATIONS:
         try:
@@ -195,12 +192,8 @@ def span_change(traj, window: float, *, dof: str | None = None, span: float = QU
     dict or None
         ``span_s``, ``multiplicity`` (the last window's best), ``rate`` (|ln| of the ratio of the
         two windows' spreads at that multiplicity over the time between them [1/s]) and
-        ``range_change`` (:func:`~.classify.range_change`).
+        ``range_change`` (:func:`~stickslip.analysis.classify.range_change`).
     """
-    from .classify import range_change
-    from .peaks import find_peaks
-    from .period import evidence_at, return_map
-
     end = float(traj.t[-1])
     if end - float(traj.t[0]) < span - 1e-9:
         return None

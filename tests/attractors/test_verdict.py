@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.analysis.confirm import QUASI_SPAN_S, lyapunov_sign
-from stickslip.analysis.settle import attractor, simulate_until_settled
+from stickslip.attractors.confirm import QUASI_SPAN_S, lyapunov_sign
+from stickslip.attractors import attractor, run_summary, simulate_until_settled
 from stickslip.stability import stability
 
 #: Detuned stiffnesses (docs/orbits.md, "A chaotic case") with Table 1 damping: the period-1
@@ -26,7 +26,7 @@ def _shot(params, run, k=1):
 def test_converging_transient_is_unsettled_when_short_and_period_one_when_long():
     p = stickslip.Parameters(N=50.0, Omega=0.5)
     short = stickslip.simulate(p, 200.0, sample_rate=200.0)
-    s = short.summary()
+    s = run_summary(short)
     # a 1e-3 return-map rule called this window period 2 at 0.769 Hz
     assert (s["attractor"], s["settled"], s["period_count"], s["fundamental_frequency_hz"]) == (
         "unsettled", False, None, None)
@@ -37,26 +37,26 @@ def test_converging_transient_is_unsettled_when_short_and_period_one_when_long()
     a = long.summary()
     assert (a["attractor"], a["settled"], a["period_count"]) == ("periodic", True, 1)
     assert a["fundamental_frequency_hz"] == pytest.approx(1.0 / period, rel=1e-6)
-    assert 200.0 < a["settle_time_s"] == long.t[-1] <= 2000.0
+    assert 200.0 < a["settle_time_s"] == long.trajectory.t[-1] <= 2000.0
     assert a["settle"]["settled"] and a["settle"]["cap_s"] == 2000.0
 
 
 @pytest.mark.parametrize("N", [50.0, 70.0, 110.0])
 def test_default_summary_never_calls_a_converging_transient_period_k(N):
     # the runs: 200 s at Ω = 0.5 rad/s were reported as period 2, 5 and 6
-    s = stickslip.simulate(stickslip.Parameters(N=N, Omega=0.5), 200.0, sample_rate=200.0).summary()
+    s = run_summary(stickslip.simulate(stickslip.Parameters(N=N, Omega=0.5), 200.0, sample_rate=200.0))
     assert s["attractor"] == "unsettled" and s["period_count"] is None and s["fundamental_frequency_hz"] is None
 
 
 def test_paper_defaults():
     p = stickslip.Parameters()                                    # N = 50 N, Ω = 5 rad/s
-    s = stickslip.simulate(p, 100.0).summary()                   # what `stickslip simulate` runs
+    s = run_summary(stickslip.simulate(p, 100.0))                # what `stickslip simulate` runs
     assert s["attractor"] == "unsettled" and s["fundamental_frequency_hz"] is None
     assert {"status", "model", "parameters"} <= set(s) and s["parameters"]["Omega"] == 5.0
     run = simulate_until_settled(p, sample_rate=500.0)
     a = run.attractor
     assert (a.attractor, a.period_count) == ("periodic", 1)
-    period, orbit = _shot(p, run)
+    period, orbit = _shot(p, run.trajectory)
     assert orbit.stable
     assert a.fundamental_frequency_hz == pytest.approx(1.0 / period, rel=1e-6)   # 2.7035 Hz
 
@@ -84,20 +84,21 @@ def test_at_rest_on_an_unstable_equilibrium_is_not_settled():
     p = stickslip.Parameters(N=50.0, Omega=5.5)
     assert not stability(p).stable
     run = stickslip.simulate(p, 20.0, ic="equilibrium", sample_rate=100.0)
-    a = run.attractor
+    a = attractor(run)
     assert a.classification.attractor == "equilibrium"            # the signal is at rest
     assert a.attractor == "unsettled" and "unstable" in a.evidence["reason"]
 
 
 def test_period_two_past_a_period_doubling_is_confirmed():
-    from stickslip.analysis.confirm import _sections_in_slip
+    from stickslip.attractors.confirm import _sections_in_slip
 
     # the period-1 orbit at Ω = 1.08 rad/s, continued down in Ω: a real multiplier crosses −1
     p = stickslip.Parameters(Omega=1.08, **DETUNED)
     run1 = simulate_until_settled(p, ic="equilibrium", perturbation=1e-3, sample_rate=500.0)
     assert (run1.attractor.attractor, run1.attractor.period_count) == ("periodic", 1)
-    section, mult = next(_sections_in_slip(run1, "phi", run1.steady_from, run1.attractor.period_s))
-    orbit1 = stickslip.periodic_orbit(p, run1, section=section, period_multiplicity=mult)
+    section, mult = next(_sections_in_slip(run1.trajectory, "phi", run1.trajectory.steady_from,
+                                           run1.attractor.period_s))
+    orbit1 = stickslip.periodic_orbit(p, run1.trajectory, section=section, period_multiplicity=mult)
     branch = stickslip.continue_orbit(p, "Omega", start=orbit1, direction=-1, bounds=(1.0, 1.08), step=0.01,
                                       section=section)
     pd = [sp for sp in branch.special if sp.kind == "period-doubling"]
@@ -127,7 +128,7 @@ def test_two_maxima_per_period_are_confirmed_by_shooting():
     from stickslip.orbits.section import Section
 
     level = float(shot["section"].split("=")[1].split()[0])
-    orbit = stickslip.periodic_orbit(p, run, section=Section(4, level, -1 if "down" in shot["section"] else 1, "x"),
+    orbit = stickslip.periodic_orbit(p, run.trajectory, section=Section(4, level, -1 if "down" in shot["section"] else 1, "x"),
                                      period_multiplicity=1)
     dense = orbit.trajectory(periods=1.0, sample_rate=20000.0).states[:, 4]
     inner = (dense[1:-1] > dense[:-2]) & (dense[1:-1] >= dense[2:])
@@ -138,7 +139,7 @@ def test_two_maxima_per_period_are_confirmed_by_shooting():
 def test_no_period_k_claim_without_confirmation():
     p = stickslip.Parameters(N=110.0, Omega=0.5)
     run = simulate_until_settled(p, sample_rate=200.0)
-    a = attractor(run, confirm=False)
+    a = attractor(run.trajectory, confirm=False)
     assert a.classification.attractor == "periodic" and a.classification.multiplicity == 2
     assert a.attractor == "unsettled" and a.period_count is None and "confirm" in a.evidence["reason"]
 
@@ -151,7 +152,7 @@ def test_a_run_that_blew_up_is_unbounded():
 
 
 def test_lyapunov_sign_needs_both_separations_to_agree(monkeypatch):
-    import stickslip.orbits as orbits
+    import stickslip.attractors.confirm as confirm
 
     run = stickslip.simulate(stickslip.Parameters(), 1.0, sample_rate=100.0)
 
@@ -162,7 +163,7 @@ def test_lyapunov_sign_needs_both_separations_to_agree(monkeypatch):
                           ({1e-7: (0.345, 0.029), 1e-6: (-0.001, 0.022)}, None),   # Model 3, Ω = 0.677 rad/s
                           ({1e-7: (0.006, 0.02), 1e-6: (0.006, 0.02)}, "zero"),
                           ({1e-7: (-0.3, 0.01), 1e-6: (-0.3, 0.01)}, None)]:
-        monkeypatch.setattr(orbits, "lyapunov_exponent", fake(by_d0))
+        monkeypatch.setattr(confirm, "lyapunov_exponent", fake(by_d0))
         out = lyapunov_sign(run)
         assert out["sign"] == expect, by_d0
         assert out["exponents"] == [by_d0[1e-7][0], by_d0[1e-6][0]] and (expect is not None or "reason" in out)
@@ -211,8 +212,9 @@ def test_chaotic_case_is_chaotic():
 
 def test_extended_run_is_one_uniform_record():
     p = stickslip.Parameters(N=50.0, Omega=0.5)
-    run = simulate_until_settled(p, sample_rate=100.0, cap=400.0, t_min=200.0)
-    assert run.t[0] == 0.0 and run.t[-1] == 400.0 and not run.attractor.settled
+    settled = simulate_until_settled(p, sample_rate=100.0, cap=400.0, t_min=200.0)
+    run = settled.trajectory
+    assert run.t[0] == 0.0 and run.t[-1] == 400.0 and not settled.attractor.settled
     assert np.allclose(np.diff(run.t), 0.01) and run.states.shape == (40001, 12)
     assert np.all(np.diff(run.transitions.time) > 0)
     assert np.all(np.diff(run.work[:, 1]) <= 1e-12)               # damper work keeps falling across joins
@@ -224,8 +226,8 @@ def test_window_mode_keeps_the_last_span_and_reaches_the_same_verdict():
     p = stickslip.Parameters(N=41.0, Omega=0.5)
     full = simulate_until_settled(p, model="y", sample_rate=100.0, cap=1300.0)
     window = simulate_until_settled(p, model="y", sample_rate=100.0, cap=1300.0, keep="window")
-    assert full.t[0] == 0.0 and window.t[0] == pytest.approx(1300.0 - QUASI_SPAN_S, abs=0.01)
-    assert window.t[-1] == full.t[-1] == 1300.0 and not full.attractor.settled
+    assert full.trajectory.t[0] == 0.0 and window.trajectory.t[0] == pytest.approx(1300.0 - QUASI_SPAN_S, abs=0.01)
+    assert window.trajectory.t[-1] == full.trajectory.t[-1] == 1300.0 and not full.attractor.settled
     assert window.attractor.evidence == full.attractor.evidence
 
 

@@ -6,6 +6,7 @@ import pytest
 from typer.testing import CliRunner
 
 from stickslip import load_trajectory
+from stickslip.attractors import run_summary
 from stickslip.cli import app
 
 runner = CliRunner()
@@ -22,7 +23,7 @@ def test_auto_run_length_reports_the_settled_orbit(tmp_path):
     assert s["settle"]["cap_s"] == 2000.0 and s["settle_time_s"] == s["t_end_s"]
     traj = load_trajectory(out)
     assert traj.t[0] == 0.0 and traj.t[-1] == s["settle_time_s"]                # the whole run is kept
-    assert traj.options["settle"]["settled"] and traj.summary()["attractor"] == "periodic"
+    assert traj.options["settle"]["settled"] and run_summary(traj)["attractor"] == "periodic"
 
 
 def test_cap_stops_an_unsettled_run(tmp_path):

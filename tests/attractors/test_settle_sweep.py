@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.analysis.settle import ATTRACTORS, simulate_until_settled
+from stickslip.attractors import ATTRACTORS, simulate_until_settled
 from stickslip.sweep import load_sweep, sweep
 
 

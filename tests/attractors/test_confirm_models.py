@@ -1,9 +1,9 @@
-"""Period and chaos confirmations (analysis/confirm.py) on a model file: the belt's stick-slip cycle."""
+"""Period and chaos confirmations (attractors/confirm.py) on a model file: the belt's stick-slip cycle."""
 
 import pytest
 
 from stickslip import simulate
-from stickslip.analysis.confirm import confirm_period, lyapunov_sign
+from stickslip.attractors.confirm import confirm_period, lyapunov_sign
 
 #: The belt's stick-slip cycle [s] (tests/orbits/test_generic_models.py: closed-form stick phase and a
 #: DOP853 slip phase, to 3e-12).

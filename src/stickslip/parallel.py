@@ -1,17 +1,21 @@
-"""Executors: run batches of grid points and yield ``(indices, rows)`` as they finish.
+"""One worker pool for every campaign: tasks mapped over this process, a process pool or dask.
+
+Sweeps, basin-stability studies and the Region II edge over N all hand independent tasks to
+:func:`map_unordered`, which yields each task's result as it finishes:
 
 ``serial``     in this process.
-``processes``  a :class:`concurrent.futures.ProcessPoolExecutor` (``fork`` where available, so
-               the workers inherit the kernels this process has already compiled).
+``processes``  a :class:`concurrent.futures.ProcessPoolExecutor` (:func:`worker_pool`; ``fork``
+               where available, so the workers inherit the kernels this process has already
+               compiled).
 ``dask``       a ``dask.distributed`` client to a scheduler address, or to a LocalCluster with
-               one single-threaded worker process per core when no address is given; each worker
-               loads the numba kernels from the on-disk cache (``cache=True``) once, before the
-               first batch (:func:`~stickslip.sweep.spec.warm_up`). The LocalCluster's workers
-               are forked where available and start without the ``MALLOC_TRIM_THRESHOLD_`` that
-               dask's nanny sets by default (:func:`local_cluster`).
+               one single-threaded worker process per core when no address is given
+               (:func:`local_cluster`); each worker runs the caller's warm-up once, before its
+               first task.
 
-At most ``2 × workers`` batches are in flight, so the pending work held in memory does not grow
-with the grid. ``workers`` may not exceed the CPUs this process may run on
+At most ``2 × workers`` tasks are in flight, and the next task is drawn from the caller's
+iterator only after a result has been handed back, so tasks may depend on the results seen so
+far (basin studies pass the cycles found) and the pending work held in memory does not grow
+with the campaign. ``workers`` may not exceed the CPUs this process may run on
 (:func:`check_workers`): more would only time-share the cores and multiply memory. Pool workers
 end within a second of their parent, also when it is killed with ``kill -9``
 (:func:`watch_parent`); dask's LocalCluster workers already do (each watches a pipe to the
@@ -20,22 +24,27 @@ process that started it).
 
 from __future__ import annotations
 
+import asyncio
 import multiprocessing
 import os
 import signal
 import sys
 import threading
 import time
-from typing import Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor
+from concurrent.futures import wait as wait_futures
+from typing import Callable, Iterable, Iterator
 
-import numpy as np
+from .errors import SchedulerError, SweepError, WorkersError
 
-from .spec import SweepError, SweepSpec, evaluate_batch, warm_up
-
-__all__ = ["EXECUTORS", "default_workers", "check_workers", "watch_parent", "worker_pool", "connect", "local_cluster",
-           "run_batches", "WorkersError", "SchedulerError"]
+__all__ = ["EXECUTORS", "default_workers", "check_workers", "check_executor", "watch_parent", "worker_pool",
+           "connect", "local_cluster", "map_unordered", "POLL_S"]
 
 EXECUTORS = ("serial", "processes", "dask")
+
+#: How often the pool and dask loops look at the caller's stop flag while tasks run [s] (Ctrl-C
+#: is answered between).
+POLL_S = 0.2
 
 
 def default_workers() -> int:
@@ -44,10 +53,6 @@ def default_workers() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - macOS/Windows
         return os.cpu_count() or 1
-
-
-class WorkersError(SweepError):
-    """More worker processes than CPUs, or fewer than one."""
 
 
 def check_workers(workers: int | None, *, address: str | None = None, option: str = "workers") -> int:
@@ -79,6 +84,13 @@ def check_workers(workers: int | None, *, address: str | None = None, option: st
     return workers
 
 
+def check_executor(executor: str, error: type[Exception] = SweepError) -> str:
+    """``executor`` if it is one of :data:`EXECUTORS`, else ``error`` naming the choices."""
+    if executor not in EXECUTORS:
+        raise error(f"unknown executor {executor!r}; choose one of {', '.join(EXECUTORS)}")
+    return executor
+
+
 #: How often a pool worker checks that its parent is alive [s] (where the platform cannot tell it).
 PARENT_POLL_S = 0.5
 
@@ -96,7 +108,7 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
     parent = os.getppid() if parent is None else parent
     if sys.platform.startswith("linux"):
         try:
-            import ctypes
+            import ctypes  # only where prctl exists
 
             libc = ctypes.CDLL(None, use_errno=True)
             PR_SET_PDEATHSIG = 1
@@ -115,51 +127,23 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
     threading.Thread(target=poll, name="stickslip-watch-parent", daemon=True).start()
 
 
-def _init_worker(parent: int, warm: bool) -> None:
+def _init_worker(parent: int, warm: Callable[[], object] | None) -> None:
     watch_parent(parent)
-    if warm:
-        warm_up()
+    if warm is not None:
+        warm()
 
 
-def worker_pool(workers: int):
+def worker_pool(workers: int, warm: Callable[[], object] | None = None) -> ProcessPoolExecutor:
     """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes that end with this one.
 
     Forked where the platform can (the workers inherit the kernels this process has already
-    compiled), else spawned and warmed up (:func:`~stickslip.sweep.spec.warm_up`) as they start.
-    Each worker runs :func:`watch_parent`.
+    compiled), else spawned, and then each runs ``warm()`` (a module-level function: compile or
+    load the kernels its tasks need) as it starts. Each worker runs :func:`watch_parent`.
     """
-    from concurrent.futures import ProcessPoolExecutor
-
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                               initargs=(os.getpid(), ctx.get_start_method() != "fork"))
-
-
-def _serial(spec, batches, info) -> Iterator:
-    for b in batches:
-        yield evaluate_batch(spec, b)
-
-
-def _processes(spec, batches, workers, info) -> Iterator:
-    from concurrent.futures import FIRST_COMPLETED, wait
-
-    start = time.perf_counter()
-    with worker_pool(workers) as pool:
-        info["pool_start_s"] = time.perf_counter() - start
-        it = iter(batches)
-        pending = set()
-        for b in it:
-            pending.add(pool.submit(evaluate_batch, spec, b))
-            if len(pending) >= 2 * workers:
-                break
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in done:
-                yield fut.result()
-                nxt = next(it, None)
-                if nxt is not None:
-                    pending.add(pool.submit(evaluate_batch, spec, nxt))
+                               initargs=(os.getpid(), None if ctx.get_start_method() == "fork" else warm))
 
 
 #: Environment variables of dask's nanny (``distributed.nanny.pre-spawn-environ``) that the
@@ -180,7 +164,7 @@ def local_cluster(workers: int):
     worker warm-up 0.44 s forked, 0.87 s and 0.7–1.1 s spawned (dask's default), which on the
     10 s Fig. 12(a) benchmark is the difference between 1.35× and ≥ 1.6× the serial speed.
     """
-    import dask
+    import dask  # dask is imported only by campaigns that use it (~1 s of imports)
     from distributed import LocalCluster
 
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {})
@@ -194,10 +178,6 @@ def local_cluster(workers: int):
                             dashboard_address=None, silence_logs=40)
 
 
-class SchedulerError(SweepError):
-    """The dask scheduler address is malformed or cannot be reached."""
-
-
 def connect(address: str):
     """A ``distributed.Client`` of the scheduler at ``address``.
 
@@ -208,7 +188,7 @@ def connect(address: str):
     SchedulerError
         One line, if the address is malformed or nothing answers there.
     """
-    from distributed import Client
+    from distributed import Client  # dask is imported only by campaigns that use it
 
     try:
         return Client(address)
@@ -218,52 +198,101 @@ def connect(address: str):
                              "reachable from here, or leave out --scheduler to use this machine's cores") from None
 
 
-def _dask(spec, batches, workers, address, info) -> Iterator:
-    try:
-        from distributed import Client, as_completed
-    except ImportError as exc:  # pragma: no cover - dask is a dependency
-        raise SweepError("the dask executor needs `pip install 'dask[distributed]'`") from exc
+class _NoStop:
+    requested = False
+
+
+def _serial(fn, tasks, stop) -> Iterator:
+    for task in tasks:
+        if stop.requested:
+            return
+        yield fn(task)
+
+
+def _processes(fn, tasks, workers, stop, warm, info) -> Iterator:
+    start = time.perf_counter()
+    with worker_pool(workers, warm) as pool:
+        info["pool_start_s"] = time.perf_counter() - start
+        pending = set()
+        for task in tasks:
+            pending.add(pool.submit(fn, task))
+            if len(pending) >= 2 * workers:
+                break
+        while pending:
+            done, pending = wait_futures(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
+            for fut in done:
+                yield fut.result()
+                task = None if stop.requested else next(tasks, None)
+                if task is not None:
+                    pending.add(pool.submit(fn, task))
+
+
+def _dask(fn, tasks, workers, address, stop, warm, info) -> Iterator:
+    from distributed import Client, wait  # dask is imported only by campaigns that use it
+
     start = time.perf_counter()
     cluster = None
-    if address:
-        client = connect(address)
-    else:
-        cluster = local_cluster(workers)
-        client = Client(cluster)
+    client = connect(address) if address else Client(cluster := local_cluster(workers))
     try:
         info["cluster_start_s"] = time.perf_counter() - start
-        t = time.perf_counter()
-        client.run(warm_up)
-        info["worker_warm_s"] = time.perf_counter() - t
+        if warm is not None:
+            t = time.perf_counter()
+            client.run(warm)
+            info["worker_warm_s"] = time.perf_counter() - t
         n_workers = max(1, len(client.scheduler_info().get("workers", {})))
-        it = iter(batches)
-        futures = [client.submit(evaluate_batch, spec, b, pure=False) for _, b in zip(range(2 * n_workers), it)]
-        ac = as_completed(futures)
-        for fut in ac:
-            result = fut.result()
-            fut.release()
-            yield result
-            nxt = next(it, None)
-            if nxt is not None:
-                ac.add(client.submit(evaluate_batch, spec, nxt, pure=False))
+        pending = {client.submit(fn, t, pure=False) for _, t in zip(range(2 * n_workers), tasks)}
+        while pending:
+            try:
+                done = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED").done
+            except (TimeoutError, asyncio.TimeoutError):  # dask's wait raises when nothing finished in time
+                continue
+            for fut in done:
+                pending.discard(fut)
+                result = fut.result()
+                fut.release()
+                yield result
+                task = None if stop.requested else next(tasks, None)
+                if task is not None:
+                    pending.add(client.submit(fn, task, pure=False))
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
 
 
-def run_batches(spec: SweepSpec, batches: Sequence[np.ndarray], *, executor: str = "processes",
-                workers: int | None = None, address: str | None = None, info: dict | None = None) -> Iterator:
-    """Yield ``(indices, rows)`` for each batch as it finishes (order not guaranteed).
+def map_unordered(fn: Callable, tasks: Iterable, *, executor: str = "processes", workers: int | None = None,
+                  address: str | None = None, stop=None, warm: Callable[[], object] | None = None,
+                  info: dict | None = None) -> Iterator:
+    """Yield ``fn(task)`` for each task as it finishes (order not guaranteed).
 
-    ``info`` receives start-up timings (``pool_start_s``, ``cluster_start_s``, ``worker_warm_s``).
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (or ``functools.partial`` of one) of one task, so that worker
+        processes can unpickle it.
+    tasks : iterable
+        Drawn lazily: the next task is taken after a result has been yielded.
+    executor : {"serial", "processes", "dask"}
+    workers : int, optional
+        Worker processes (default all CPUs available; :func:`check_workers`); with ``dask`` and
+        no ``address``, the LocalCluster's size.
+    address : str, optional
+        A dask scheduler address (``tcp://host:8786``).
+    stop : object with a ``requested`` attribute, optional
+        When it turns true no further task is handed out; the tasks running finish and are yielded.
+    warm : callable, optional
+        Run once in each worker before its first task where the worker does not inherit this
+        process's compiled kernels (spawned pool workers, dask workers).
+    info : dict, optional
+        Receives start-up timings (``pool_start_s``, ``cluster_start_s``, ``worker_warm_s``).
     """
     info = {} if info is None else info
+    stop = _NoStop() if stop is None else stop
+    tasks = iter(tasks)
+    check_executor(executor)
     workers = check_workers(workers, address=address)
     if executor == "serial":
-        return _serial(spec, batches, info)
+        return _serial(fn, tasks, stop)
     if executor == "processes":
-        return _processes(spec, batches, workers, info)
-    if executor == "dask":
-        return _dask(spec, batches, workers, address, info)
-    raise SweepError(f"unknown executor {executor!r}; choose one of {', '.join(EXECUTORS)}")
+        return _processes(fn, tasks, workers, stop, warm, info)
+    return _dask(fn, tasks, workers, address, stop, warm, info)

@@ -1,0 +1,18 @@
+"""Attractors: what a run settles to, from the evidence, and the claims the dynamics must confirm.
+
+=========================  ==================================================================
+``attractor``              the verdict on a trajectory's window (:mod:`.verdict`)
+``simulate_until_settled`` a run extended until its verdict is settled (:mod:`.settle`)
+``run_summary``            a run's verdict, steady window and cost as one dict (:mod:`.summary`)
+``confirm_period``, ...    shooting and Lyapunov confirmations of claims (:mod:`.confirm`)
+=========================  ==================================================================
+"""
+
+from .confirm import confirm_period, lyapunov_sign, span_change
+from .settle import DEFAULT_CAP_S, DEFAULT_STEP_S, DEFAULT_T_MIN_S, DEFAULT_WINDOW_S, SettledRun, simulate_until_settled
+from .summary import run_summary
+from .verdict import ATTRACTORS, Attractor, attractor, attractor_code, jsonable, undersampled
+
+__all__ = ["ATTRACTORS", "Attractor", "attractor", "attractor_code", "jsonable", "undersampled", "SettledRun",
+           "simulate_until_settled", "run_summary", "confirm_period", "lyapunov_sign", "span_change",
+           "DEFAULT_CAP_S", "DEFAULT_STEP_S", "DEFAULT_T_MIN_S", "DEFAULT_WINDOW_S"]

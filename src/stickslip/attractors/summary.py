@@ -1,0 +1,42 @@
+"""The summary of a run: its verdict, its steady window and its cost, as one JSON-ready dict."""
+
+from __future__ import annotations
+
+from ..integrate.result import Trajectory
+from .verdict import Attractor, attractor
+
+__all__ = ["run_summary"]
+
+
+def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
+    """The verdict on the steady window, the steady-state summary and the run's cost.
+
+    Parameters
+    ----------
+    traj : Trajectory
+    verdict : Attractor, optional
+        The verdict already reached for ``traj``'s steady window (default:
+        :func:`~.verdict.attractor` of it, which may shoot an orbit or compute a Lyapunov
+        exponent to confirm a claim).
+
+    Returns
+    -------
+    dict
+        Keys: ``settled``, ``attractor``, ``period_count``, ``fundamental_frequency_hz`` (None
+        unless settled and periodic), ``dominant_frequency_hz`` (spectral peak),
+        ``settle_time_s``, ``evidence`` (:class:`~.verdict.Attractor`); ``status``, ``model``,
+        ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction``, ``n_transitions``,
+        ``phi_min``, ``phi_max`` of the window; ``steps``, ``wall_time_s``, ``method``; ``settle``
+        (the cap and steps of :func:`~.settle.simulate_until_settled`) when the run was extended
+        until settled.
+    """
+    verdict = attractor(traj) if verdict is None else verdict
+    s = traj.steady
+    out = {**verdict.to_dict(), "status": traj.status, "model": traj.model,
+           "parameters": dict(traj.system.parameters), "t_end_s": float(traj.t[-1]), "steady_from_s": s.t_from,
+           "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "phi_min": s.phi_min,
+           "phi_max": s.phi_max, "steps": traj.stats.steps, "wall_time_s": traj.stats.wall_time_s,
+           "method": traj.method}
+    if "settle" in traj.options:
+        out["settle"] = traj.options["settle"]
+    return out
