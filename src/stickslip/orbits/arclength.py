@@ -31,7 +31,7 @@ from .models import parameter_value, with_parameter
 from .problem import DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, sorted_eigenvalues, stick_count, stick_time
 from .section import OrbitError
 
-__all__ = ["ContinuationError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR", "MIN_TANGENT_COS",
+__all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR", "MIN_TANGENT_COS",
            "MAX_STEPS_PER_SECOND"]
 
 #: Corrector iterations before a step counts as failed (then halved). Broyden from the previous
@@ -52,6 +52,19 @@ MAX_STEPS_PER_SECOND = 2e5
 
 class ContinuationError(OrbitError):
     """Continuation could not start or go on (the message says why)."""
+
+
+class SteadySlidingError(ContinuationError):
+    """The start orbit is steady sliding (the equilibrium solves the shooting equations for any
+    period), not a cycle. ``param`` and ``value``: where."""
+
+    def __init__(self, param: str, value: float):
+        self.param, self.value = param, float(value)
+        super().__init__(f"converged to steady sliding at {param} = {value:.6g}: the start is the equilibrium, "
+                         "not a cycle; start from a state on the cycle (or a run that ends on it)")
+
+    def __reduce__(self):
+        return type(self), (self.param, self.value)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -25,12 +25,12 @@ from ..model.parameters import ParameterError, Parameters
 from ..model.system_model import FrictionModel, ModelError
 from . import branch_store as store
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, ContinuationError, Point, Problem,
-                        correct_onto_bound, numeric_parameter, point_at, problem_of, step_from)
+                        SteadySlidingError, correct_onto_bound, numeric_parameter, point_at, problem_of, step_from)
 from .problem import unstable_count
 from .section import OrbitError, Section, resolve_section
 from .shooting import PeriodicOrbit
 from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
-                             detect_after_renewal, distance_from_equilibrium)
+                             detect_after_renewal, distance_from_equilibrium, is_orbit)
 from .models import ModelResult, plates_parameters, resolve, with_parameter
 from .start import Start, start_orbit
 
@@ -332,6 +332,11 @@ def continue_orbit(
     else:
         begin = Start(**store.start_fields(start_rec))
     problem = problem_of(begin, param, fd_step, param_scale)
+    lam0 = numeric_parameter(begin.system, param)
+    if not is_orbit(problem, begin.state, lam0, begin.stick_phases):
+        if journal is not None:
+            journal.remove()  # it holds no work: nothing to resume
+        raise SteadySlidingError(param, lam0)
     measure = (lambda p: _amplitude(problem, *problem.unpack(p.v))) if amplitude else (lambda p: float("nan"))
     walk = _walk_from_records(records)
     resumed = 0 if walk is None else len(walk.points)
@@ -377,10 +382,14 @@ def continue_orbit(
                 break
             stop = "bounds"
         walk.points.append(new)
-        walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
-        walk.amplitudes.append(measure(new))
-        found, stop, quiet = detect_after_point(problem, walk, last, new, stop, tol, locate, jacobian_every,
-                                                min_stick_fraction, size0, stop_on)
+        found, stop, quiet, drop = detect_after_point(problem, walk, last, new, stop, tol, locate, min_stick_fraction,
+                                                      size0, stop_on)
+        if drop:  # steady sliding, not an orbit: the branch ends at the point before
+            walk.points.pop()
+        else:
+            new = walk.points[-1]  # its Jacobian may have been renewed to classify a turn
+            walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
+            walk.amplitudes.append(measure(new))
         walk.special.extend(found)
         walk.stop = stop
         if stop is None:
