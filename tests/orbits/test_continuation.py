@@ -9,82 +9,19 @@ import subprocess
 import sys
 import textwrap
 import time
-import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from stickslip import Parameters, simulate
-from stickslip.model.library import two_plates
-from stickslip.orbits import PeriodicOrbit, periodic_orbit, resolve_section
-from stickslip.orbits import arclength, region_edge
+from stickslip.orbits import periodic_orbit
+from stickslip.orbits import region_edge
 from stickslip.orbits import continuation as C
 from stickslip.orbits.continuation import ContinuationError, continue_orbit, load_branch, start_run
 
 
-# --------------------------------------------------------------------------- constructed problem
-ROTATION = two_plates(Parameters(alpha=5.0), "rotation", 1e-12)
-
-
-def _constructed_orbit():
-    """A PeriodicOrbit of model ``rotation`` whose shooting map is replaced by an algebraic one.
-
-    Free states (phi, psi, phi_dot, psi_dot); the section fixes phi_dot, so the scaled unknowns are
-    v = (phi/σ0, psi/σ1, psi_dot/σ3, T/T0, alpha/alpha0). With alpha0 = 5 the start is v = (1, 0.1, 0, 1, 1).
-    """
-    sigma = np.array([0.01, 0.02, 0.3, 0.4])
-    state = np.zeros(12)
-    state[4], state[5] = sigma[0] * 1.0, sigma[1] * 0.1
-    return PeriodicOrbit(state=state, period=0.5, multiplicity=1, stick_phases=1, residual=0.0, iterations=0,
-                         residual_history=np.zeros(1), multipliers=np.ones(4, complex), monodromy=np.eye(4),
-                         free_states=("phi", "psi", "phi_dot", "psi_dot"), scale=sigma,
-                         system=ROTATION, section=resolve_section("phi_max", ROTATION),
-                         options=dict(rtol=1e-10, atol=1e-13, slip_band=1e-12, tol=1e-8, fd_step=1e-5, max_iter=20))
-
-
-def _algebraic(v):
-    """F(v): v0² + v4 − 2 (a fold at v4 = 2, i.e. alpha = 10), v1 = 0.1 v4, v2 = 0, v3 = 1."""
-    return np.array([v[0] ** 2 + v[4] - 2.0, v[1] - 0.1 * v[4], v[2], v[3] - 1.0])
-
-
-def _fold_multiplier(v):
-    """1 − v0/2: a real multiplier that crosses +1 at the fold (v0 = 0), inside the circle before it."""
-    return 1.0 - 0.5 * v[0]
-
-
-def _monodromy(v):
-    """diag(1, m, 1 − v0/2, 0.2), m = −0.5 − 0.75 (1 − v0): m = −1 at v0 = 1/3 (alpha = 5 (2 − 1/9)),
-    and a real multiplier through +1 at the fold (alpha = 10)."""
-    return np.diag([1.0, -0.5 - 0.75 * (1.0 - v[0]), _fold_multiplier(v), 0.2])
-
-
-@pytest.fixture
-def constructed_with(monkeypatch):
-    """``make(monodromy)``: the constructed start orbit, its shooting map the algebraic one with the
-    monodromy matrix ``monodromy(v)`` (4 × 4, the trivial multiplier 1 included)."""
-    stick = types.SimpleNamespace(kind=np.array([1, -1], dtype=np.int8), time=np.array([0.1, 0.2]))
-
-    def make(monodromy=_monodromy):
-        def residual(problem, v):
-            return _algebraic(v), np.zeros(12), stick
-
-        def jacobian(problem, v, end):
-            J = np.array([[2 * v[0], 0, 0, 0, 1.0], [0, 1.0, 0, 0, -0.1], [0, 0, 1.0, 0, 0], [0, 0, 0, 1.0, 0]])
-            return J, monodromy(v)
-
-        monkeypatch.setattr(arclength, "_residual", residual)
-        monkeypatch.setattr(arclength, "_jacobian", jacobian)
-        return _constructed_orbit()
-
-    return make
-
-
-@pytest.fixture
-def constructed(constructed_with):
-    return constructed_with()
-
-
+# --------------------------------------------------------------------------- constructed problem (conftest.py)
 def test_constructed_fold_and_period_doubling_are_found_where_they_are(constructed):
     b = continue_orbit(start=constructed, param="alpha", step=0.05, max_step=0.2, max_points=200,
                        bounds=(4.0, 20.0), amplitude=False)
@@ -112,74 +49,6 @@ def test_constructed_fold_and_period_doubling_are_found_where_they_are(construct
     real_before = fold.multipliers_before[np.abs(fold.multipliers_before - 1.0) > 1e-12].real
     real_after = fold.multipliers_after[np.abs(fold.multipliers_after - 1.0) > 1e-12].real
     assert np.any((real_before > 0.9) & (real_before < 1.0)) and np.any((real_after > 1.0) & (real_after < 1.1))
-
-
-#: α where the constructed branch (v0 = √(2 − α/5) before the fold) has v0 = 1/2: r(v0) = 1 below.
-ALPHA_HALF = 5.0 * (2.0 - 0.25)
-
-
-def _rotation_block(r, theta=1.0):
-    """r (cos θ, −sin θ; sin θ, cos θ): the complex pair r e^{±iθ}."""
-    return r * np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
-
-
-def _torus_birth(v):
-    """1 ⊕ r R(1 rad) ⊕ (1 − v0/2), r = 0.8 + 0.4 (1 − v0): the pair r e^{±i} leaves the unit circle
-    at v0 = 1/2 (alpha = 8.75), a torus birth; the last multiplier crosses +1 at the fold."""
-    M = np.zeros((4, 4))
-    M[0, 0], M[3, 3] = 1.0, _fold_multiplier(v)
-    M[1:3, 1:3] = _rotation_block(0.8 + 0.4 * (1.0 - v[0]))
-    return M
-
-
-def _collision(v):
-    """1 ⊕ (−1.5, 1; c, −1.5) ⊕ (1 − v0/2), c = 0.4 (v0 − 1/2): multipliers −1.5 ± √c, two reals
-    (−1.95, −1.05 at the start) that meet at −1.5 (alpha = 8.75) and leave the real axis as a pair of
-    modulus √(2.25 − c) > 1.5: all the time outside the unit circle, nothing crosses it."""
-    M = np.zeros((4, 4))
-    M[0, 0], M[3, 3] = 1.0, _fold_multiplier(v)
-    M[1:3, 1:3] = [[-1.5, 1.0], [0.4 * (v[0] - 0.5), -1.5]]
-    return M
-
-
-def _complex_outside(multipliers):
-    return np.sum((np.abs(multipliers.imag) > 1e-9) & (np.abs(multipliers) > 1.0), axis=-1)
-
-
-def test_constructed_torus_birth_is_a_neimark_sacker_point(constructed_with):
-    """A complex pair that crosses |μ| = 1 is found and located where it crosses (r = 1)."""
-    b = continue_orbit(start=constructed_with(_torus_birth), param="alpha", step=0.05, max_step=0.2, max_points=200,
-                       bounds=(4.0, 20.0), amplitude=False)
-    assert [p.kind for p in b.special] == ["neimark-sacker", "fold"]
-    ns = b.special[0]
-    # bisection to 1e-3 of a step ≤ 0.2 in arclength, λ = 5 v4 with |dv4/ds| ≤ 1: 1e-3 in alpha
-    assert ns.located and ns.bracket <= 1e-3 and ns.value == pytest.approx(ALPHA_HALF, abs=1e-3)
-    pair_before = ns.multipliers_before[np.abs(ns.multipliers_before.imag) > 0.1]
-    pair_after = ns.multipliers_after[np.abs(ns.multipliers_after.imag) > 0.1]
-    assert pair_before.size == pair_after.size == 2
-    assert np.all(np.abs(pair_before) < 1.0) and np.all(np.abs(pair_after) > 1.0)
-    assert np.all(b.n_unstable[: ns.index + 1] == 0) and b.n_unstable[ns.index + 1] == 2
-
-
-def test_constructed_collision_on_the_real_axis_outside_the_circle_is_no_bifurcation(constructed_with):
-    """Two real multipliers outside the unit circle meet on the negative real axis and leave it as a
-    complex pair: the number of complex multipliers outside the circle changes (0 → 2), but nothing
-    crosses |μ| = 1: no Neimark–Sacker point, no period doubling; the fold is still found."""
-    b = continue_orbit(start=constructed_with(_collision), param="alpha", step=0.05, max_step=0.2, max_points=200,
-                       bounds=(4.0, 20.0), amplitude=False)
-    outside = _complex_outside(b.multipliers)
-    assert outside[0] == 0 and outside.max() == 2  # the collision happened on this branch
-    assert [p.kind for p in b.special] == ["fold"] and b.special[0].value == pytest.approx(10.0, abs=1e-6)
-    assert np.all(b.n_unstable[: b.special[0].index + 1] == 2)  # the pair stays outside until the fold
-
-
-def test_constructed_turn_without_a_multiplier_through_plus_one_is_no_fold(constructed_with):
-    """The branch turns at alpha = 10, but no multiplier crosses +1 there (diag(1, m, 0.5, 0.2)): it
-    is no fold of cycles and not reported; the period doubling is."""
-    b = continue_orbit(start=constructed_with(lambda v: np.diag([1.0, -0.5 - 0.75 * (1.0 - v[0]), 0.5, 0.2])),
-                       param="alpha", step=0.05, max_step=0.2, max_points=200, bounds=(4.0, 20.0), amplitude=False)
-    assert 9.5 < np.max(b.values) <= 10.0 + 1e-9 and b.values[-1] < 5.0  # it turned at alpha = 10
-    assert [p.kind for p in b.special] == ["period-doubling"]
 
 
 @pytest.mark.parametrize("jacobian_every", [2, 3, 4])
