@@ -201,3 +201,33 @@ def test_two_mass_belt_collision_is_no_neimark_sacker_and_the_period_doubling_is
     assert np.sum(np.abs(pd.multipliers_before.imag) > 0) == 2
     after = pd.multipliers_after[np.abs(pd.multipliers_after) > 1e-3].real
     assert np.sum(after < -1.0) == 1 and np.sum((after > -1.0) & (after < -0.9)) == 1
+
+
+def test_model1_slip_cycle_torus_birth_is_found_where_a_complex_pair_leaves_the_circle():
+    """Model 1, N = 50 N: the unstable pure-slip cycle between the basins (edge tracking at
+    Ω ≈ 10 rad/s), continued up in Ω, has a complex pair (arg ≈ 66°) that leaves the unit circle
+    near 13.45 rad/s: a Neimark–Sacker point, found there; the saltation multipliers (variational
+    equations) of the cycles shot at 13.40 and 13.50 rad/s have the pair inside, then outside."""
+    from stickslip import Parameters
+    from stickslip.orbits.continuation import unstable_cycle
+
+    p = Parameters(N=50.0, Omega=8.0)
+    b = continue_orbit(start=periodic_orbit(p, start_run(p, "far", t_end=60.0)), param="Omega", step=0.05,
+                       max_step=1.0, max_points=400, bounds=(8.0, 30.0), amplitude=False)
+    i = int(np.argmin(np.abs(b.values - 10.0)))
+    up = continue_orbit(start=unstable_cycle(b.orbit_params(i), b.states[i]), param="Omega", step=0.05,
+                        max_step=1.0, max_points=60, bounds=(b.values[i], 13.6), amplitude=False)
+    assert [q.kind for q in up.special] == ["neimark-sacker"]
+    ns = up.special[0]
+
+    def pair(mu):
+        return mu[(mu.imag > 0.5)][0]  # the pair near e^{±1.15i}
+
+    assert abs(pair(ns.multipliers_before)) < 1.0 < abs(pair(ns.multipliers_after))
+    radius = {}
+    for omega in (13.40, 13.50):
+        j = int(np.argmin(np.abs(up.values - omega)))
+        cycle = periodic_orbit(Parameters(N=50.0, Omega=omega), up.states[j], search_time=1.0)
+        assert cycle.stick_phases == 0 and cycle.options["monodromy"] == "saltation"
+        radius[omega] = abs(pair(cycle.multipliers))
+    assert radius[13.40] < 1.0 < radius[13.50] and 13.40 < ns.value < 13.50
