@@ -31,8 +31,8 @@ from .models import parameter_value, with_parameter
 from .problem import DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, sorted_eigenvalues, stick_count, stick_time
 from .section import OrbitError
 
-__all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR", "MIN_TANGENT_COS",
-           "MAX_STEPS_PER_SECOND"]
+__all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR",
+           "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND"]
 
 #: Corrector iterations before a step counts as failed (then halved). Broyden from the previous
 #: point's Jacobian reduces the residual ~5× per iteration (measured on Model 1, N = 50 N: the

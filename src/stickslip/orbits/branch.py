@@ -82,7 +82,9 @@ class Branch(ModelResult):
         Corrector iterations of each point (0 for the start).
     special : list of SpecialPoint
     stop_reason : str
-        Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``, ...).
+        Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``,
+        ``steady sliding at <param> = <value>`` where the corrector converged onto the equilibrium
+        (that point is not in the branch), ...).
     system : FrictionModel
         The model at the start (the continuation parameter at its start value); ``params`` and
         ``model``: the plates' Parameters and variant, or None and the model's name.
@@ -291,6 +293,9 @@ def continue_orbit(
     ------
     ContinuationError
         If ``param`` is not numeric, the start orbit cannot be found, or the first Jacobian fails.
+    SteadySlidingError
+        If the start orbit is steady sliding, not a cycle (a ContinuationError; nothing is left
+        at ``out``).
     stickslip.orbits.branch_store.JournalMismatch
         If ``out`` or its journal was written with another start or other settings (an
         :class:`~stickslip.orbits.OrbitError`, like ContinuationError).
