@@ -17,7 +17,8 @@ them without importing the module that raises it.
 ``EquilibriumError``     no steady sliding found
 ``SimulationError``      invalid simulation options, or a run that could not finish
 ``OrbitError``           a periodic orbit or Lyapunov exponent that could not be computed
-                         (``ContinuationError``: a branch that could not start or go on)
+                         (``ContinuationError``: a branch that could not start or go on;
+                         ``SteadySlidingError``: one whose start is steady sliding)
 ``SweepError``           an invalid sweep, or an output of another sweep
 ``WorkersError``         a worker count outside 1 … the CPUs available
 ``SchedulerError``       a dask scheduler that is malformed or unreachable
@@ -31,7 +32,7 @@ them without importing the module that raises it.
 from __future__ import annotations
 
 __all__ = ["StickSlipError", "ModelError", "ModelFileError", "ParameterError", "FrictionLawError", "VariantError",
-           "KinematicsError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SweepError",
+           "KinematicsError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
            "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError"]
 
 
@@ -77,6 +78,19 @@ class OrbitError(StickSlipError, RuntimeError):
 
 class ContinuationError(OrbitError):
     """Continuation could not start or go on (the message says why)."""
+
+
+class SteadySlidingError(ContinuationError):
+    """The start orbit of a continuation is steady sliding (the equilibrium solves the shooting
+    equations for any period), not a cycle. ``param`` and ``value``: where."""
+
+    def __init__(self, param: str, value: float):
+        self.param, self.value = param, float(value)
+        super().__init__(f"converged to steady sliding at {param} = {value:.6g}: the start is the equilibrium, "
+                         "not a cycle; start from a state on the cycle (or a run that ends on it)")
+
+    def __reduce__(self):
+        return type(self), (self.param, self.value)
 
 
 class SweepError(StickSlipError, ValueError):

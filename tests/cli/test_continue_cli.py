@@ -1,7 +1,9 @@
-"""`stickslip continue`: one-line errors for bad input (exit 2, nothing computed) and a small
-branch written to NetCDF and PNG that matches the library's result."""
+"""`stickslip continue`: one-line errors for bad input (exit 2, nothing computed), a small branch
+written to NetCDF and PNG that matches the library's result, and the two-mass belt a user
+continued: a start on steady sliding, a collision of multipliers that is no Neimark–Sacker point."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -144,3 +146,63 @@ def test_continue_a_model_file_over_a_set_path(tmp_path):
     bad = runner.invoke(app, ["continue", "--model", "belt", "--param", "Omega", "--from", "1", "--to", "2",
                               "--out", str(tmp_path / "b.nc")])
     assert bad.exit_code == 2 and "unknown parameter 'Omega' of model 'belt'" in bad.output
+
+
+#: The two-mass belt model file a user continued in its first drive (tests/orbits/two_mass_belt.toml).
+TWO_MASS = str(Path(__file__).parents[1] / "orbits" / "two_mass_belt.toml")
+_TWO_MASS_ARGS = ["continue", "--model", TWO_MASS, "--param", "contact.0.drive", "--from", "0.2", "--to", "1.2",
+                  "--ic", "zero", "--max-points", "30", "--no-plot"]
+
+
+def test_start_on_steady_sliding_is_one_error_line_and_nothing_is_written(tmp_path):
+    """The user's first command: the 60 s start run from rest shoots onto steady sliding. It is
+    said so in one line naming what to change (exit 2), not continued as a branch with a fold."""
+    out = tmp_path / "b.nc"
+    res = runner.invoke(app, _TWO_MASS_ARGS + ["--out", str(out)])
+    assert res.exit_code == 2, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: converged to steady sliding at contact.0.drive=0.2:")
+    assert "--ic x1=" in lines[0] and "--search-time" in lines[0] and "fold" not in lines[0]
+    assert not out.exists() and not Path(str(out) + ".journal").exists()
+
+
+def test_collision_of_multipliers_is_no_neimark_sacker_and_special_points_carry_their_multipliers(tmp_path):
+    """The user's second command (--search-time 30): no Neimark–Sacker point at 0.5557 (a complex pair
+    meets the real axis outside the unit circle there, tests/orbits/test_special_points.py), the period
+    doubling between 0.5858 and 0.5958; the JSON and the file carry the multipliers on either side."""
+    out = tmp_path / "b.nc"
+    res = runner.invoke(app, _TWO_MASS_ARGS + ["--search-time", "30", "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.stdout.strip().splitlines()[-1])
+    kinds = [q["kind"] for q in s["special"]]
+    assert "neimark-sacker" not in kinds and kinds[0] == "period-doubling"
+    pd = s["special"][0]
+    assert 0.5858 < pd["value"] < 0.5958
+    before = np.array([complex(*z) for z in pd["multipliers_before"]])
+    after = np.array([complex(*z) for z in pd["multipliers_after"]])
+    assert np.sum(np.abs(before.imag) > 0) == 2 and np.all(np.abs(before[np.abs(before.imag) > 0]) > 1.0)
+    assert np.sum(after.real < -1.0) == 1 and np.sum((after.real > -1.0) & (after.real < -0.9)) == 1
+    ds = load_branch(out)
+    assert list(ds["special_kind"].values) == kinds
+    for side, mult in (("before", before), ("after", after)):
+        stored = ds[f"special_multiplier_{side}_real"].values[0] + 1j * ds[f"special_multiplier_{side}_imag"].values[0]
+        assert np.array_equal(stored, mult)
+    table = runner.invoke(app, _TWO_MASS_ARGS + ["--search-time", "30", "--out", str(out), "--no-progress"])
+    assert table.exit_code == 0 and "multipliers" in table.stdout and "neimark-sacker" not in table.stdout
+
+
+def test_continuation_that_converges_onto_steady_sliding_writes_its_orbits_and_exits_1(tmp_path, monkeypatch):
+    """Every new point taken for steady sliding (the test made so): the branch ends after its start
+    orbit, the file holds that orbit, the JSON summary is printed and one error line says where it
+    converged (exit 1, a run that stopped early)."""
+    from stickslip.orbits import special_points
+
+    monkeypatch.setattr(special_points, "is_orbit", lambda *a: False)
+    out = tmp_path / "b.nc"
+    res = runner.invoke(app, _TWO_MASS_ARGS + ["--search-time", "30", "--out", str(out), "--json"])
+    assert res.exit_code == 1, res.output
+    s = json.loads(res.stdout.strip().splitlines()[-1])
+    assert s["points"] == 1 and s["special"] == [] and s["stop_reason"].startswith("steady sliding at contact.0.drive")
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: the continuation converged to steady sliding at")
+    assert load_branch(out)["value"].size == 1

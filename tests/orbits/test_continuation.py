@@ -9,66 +9,19 @@ import subprocess
 import sys
 import textwrap
 import time
-import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from stickslip import Parameters, simulate
-from stickslip.model.library import two_plates
-from stickslip.orbits import PeriodicOrbit, periodic_orbit, resolve_section
-from stickslip.orbits import arclength, region_edge
+from stickslip.orbits import periodic_orbit
+from stickslip.orbits import region_edge
 from stickslip.orbits import continuation as C
 from stickslip.orbits.continuation import ContinuationError, continue_orbit, load_branch, start_run
 
 
-# --------------------------------------------------------------------------- constructed problem
-ROTATION = two_plates(Parameters(alpha=5.0), "rotation", 1e-12)
-
-
-def _constructed_orbit():
-    """A PeriodicOrbit of model ``rotation`` whose shooting map is replaced by an algebraic one.
-
-    Free states (phi, psi, phi_dot, psi_dot); the section fixes phi_dot, so the scaled unknowns are
-    v = (phi/σ0, psi/σ1, psi_dot/σ3, T/T0, alpha/alpha0). With alpha0 = 5 the start is v = (1, 0.1, 0, 1, 1).
-    """
-    sigma = np.array([0.01, 0.02, 0.3, 0.4])
-    state = np.zeros(12)
-    state[4], state[5] = sigma[0] * 1.0, sigma[1] * 0.1
-    return PeriodicOrbit(state=state, period=0.5, multiplicity=1, stick_phases=1, residual=0.0, iterations=0,
-                         residual_history=np.zeros(1), multipliers=np.ones(4, complex), monodromy=np.eye(4),
-                         free_states=("phi", "psi", "phi_dot", "psi_dot"), scale=sigma,
-                         system=ROTATION, section=resolve_section("phi_max", ROTATION),
-                         options=dict(rtol=1e-10, atol=1e-13, slip_band=1e-12, tol=1e-8, fd_step=1e-5, max_iter=20))
-
-
-def _algebraic(v):
-    """F(v): v0² + v4 − 2 (a fold at v4 = 2, i.e. alpha = 10), v1 = 0.1 v4, v2 = 0, v3 = 1."""
-    return np.array([v[0] ** 2 + v[4] - 2.0, v[1] - 0.1 * v[4], v[2], v[3] - 1.0])
-
-
-def _monodromy(v):
-    """diag(1, m, 0.5, 0.2), m = −0.5 − 0.75 (1 − v0): m = −1 at v0 = 1/3 (alpha = 5 (2 − 1/9))."""
-    return np.diag([1.0, -0.5 - 0.75 * (1.0 - v[0]), 0.5, 0.2])
-
-
-@pytest.fixture
-def constructed(monkeypatch):
-    stick = types.SimpleNamespace(kind=np.array([1, -1], dtype=np.int8), time=np.array([0.1, 0.2]))
-
-    def residual(problem, v):
-        return _algebraic(v), np.zeros(12), stick
-
-    def jacobian(problem, v, end):
-        J = np.array([[2 * v[0], 0, 0, 0, 1.0], [0, 1.0, 0, 0, -0.1], [0, 0, 1.0, 0, 0], [0, 0, 0, 1.0, 0]])
-        return J, _monodromy(v)
-
-    monkeypatch.setattr(arclength, "_residual", residual)
-    monkeypatch.setattr(arclength, "_jacobian", jacobian)
-    return _constructed_orbit()
-
-
+# --------------------------------------------------------------------------- constructed problem (conftest.py)
 def test_constructed_fold_and_period_doubling_are_found_where_they_are(constructed):
     b = continue_orbit(start=constructed, param="alpha", step=0.05, max_step=0.2, max_points=200,
                        bounds=(4.0, 20.0), amplitude=False)
@@ -90,6 +43,12 @@ def test_constructed_fold_and_period_doubling_are_found_where_they_are(construct
     assert b.values[-1] == pytest.approx(4.0, abs=1e-12)
     assert b.states[-1][4] / 0.01 == pytest.approx(-math.sqrt(2.0 - 4.0 / 5.0), abs=1e-8)
     assert np.max(b.values) <= 10.0 + 1e-6
+    # each carries the multipliers of the points it lies between: the one that crossed is on either side
+    assert np.min(np.abs(pd.multipliers_before + 1.0)) < 0.1 and np.all(np.abs(pd.multipliers_before) <= 1.0)
+    assert np.sum(np.abs(pd.multipliers_after) > 1.0) == 1
+    real_before = fold.multipliers_before[np.abs(fold.multipliers_before - 1.0) > 1e-12].real
+    real_after = fold.multipliers_after[np.abs(fold.multipliers_after - 1.0) > 1e-12].real
+    assert np.any((real_before > 0.9) & (real_before < 1.0)) and np.any((real_after > 1.0) & (real_after < 1.1))
 
 
 @pytest.mark.parametrize("jacobian_every", [2, 3, 4])

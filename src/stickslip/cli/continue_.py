@@ -7,6 +7,7 @@ figure; no physics here.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import List, Optional
 
@@ -14,13 +15,14 @@ import typer
 from rich.table import Table
 
 from ..errors import StickSlipError
+from ..errors import SteadySlidingError
 from ..orbits import resolve_section
 from ..orbits.continuation import SPECIAL_KINDS, START_RATE, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_finite,
-                   check_positive, check_resumable_output, check_samples, console, note_line)
-from .orbit import model_system, parse_section, parse_start
+                   check_positive, check_resumable_output, check_samples, console, error_line, note_line)
+from .orbit import IC_HELP, model_system, parse_section, parse_start
 
 
 def _check(start: float, stop: float, max_points: int, step: float, max_step: float, search_time: float,
@@ -46,6 +48,26 @@ def _note_resume(k: int) -> None:
     note_line(f"resuming from {k} points")
 
 
+def _steady_start(exc, system) -> CLIError:
+    """The one-line error of a start that converged onto steady sliding, naming the options to change."""
+    x = system.dofs[system.observed_index]
+    return CLIError(f"converged to steady sliding at {exc.param}={exc.value:g}: the start orbit is the equilibrium, "
+                    f"not a cycle; start from a state on the cycle, e.g. --ic {x}=...,d{x}=..., or a longer "
+                    "--search-time")
+
+
+def _multipliers_text(mu) -> str:
+    """Floquet multipliers as text, a conjugate pair once as a ± bi (NaN: none)."""
+    if not all(map(math.isfinite, (abs(m) for m in mu))):
+        return "none"
+    return ", ".join(f"{m.real:.4g}±{m.imag:.3g}i" if m.imag > 0 else f"{m.real:.4g}" for m in mu if m.imag >= 0)
+
+
+def _pairs(mu) -> list:
+    """Complex numbers as JSON-ready [real, imag] pairs (NaN as null)."""
+    return [[None if math.isnan(m.real) else float(m.real), None if math.isnan(m.imag) else float(m.imag)] for m in mu]
+
+
 @app.command("continue")
 def continue_command(
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: any numeric parameter of the model, the "
@@ -58,8 +80,7 @@ def continue_command(
     N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
     omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
     model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: str = typer.Option("far", "--ic", help="Start run: far (the plates) | near | zero | equilibrium "
-                           "(docs/sweeps.md) | NAME=VALUE,... by state name."),
+    ic: Optional[str] = typer.Option(None, "--ic", help=IC_HELP),
     section: str = typer.Option("max", "--section", help="Poincaré section: max | DOF_max | DOF=LEVEL."),
     search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run [s]."),
     max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
@@ -82,7 +103,7 @@ def continue_command(
 ) -> None:
     """Continue a periodic orbit in one parameter, with stability, folds and stick-phase changes.
 
-    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused).
+    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused). Folds, period doublings and Neimark-Sacker points are told apart by what crosses the unit circle (a real multiplier at +1, at -1, a complex pair), with the multipliers on either side. A start orbit that is steady sliding (the equilibrium, no cycle) is an error (exit 2, nothing written); a continuation that converges onto steady sliding writes the orbits before it and exits 1.
     """
     stop_on = list(stop_on or [])
     _check(start, stop, max_points, step, max_step, search_time, rtol, tol, stop_on)
@@ -102,10 +123,13 @@ def continue_command(
                                           f"{'stable' if st else 'unstable'}"))
     run = start_run(system, ic_start, t_end=search_time, rtol=rtol)
     out.parent.mkdir(parents=True, exist_ok=True)
-    branch = continue_orbit(system, param, start=run, direction=1 if stop > start else -1, step=step,
-                            max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
-                            stop_on=tuple(stop_on), section=sec, rtol=rtol, tol=tol, callback=progress, out=out,
-                            on_resume=_note_resume, resume=not overwrite)
+    try:
+        branch = continue_orbit(system, param, start=run, direction=1 if stop > start else -1, step=step,
+                                max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
+                                stop_on=tuple(stop_on), section=sec, rtol=rtol, tol=tol, callback=progress, out=out,
+                                on_resume=_note_resume, resume=not overwrite)
+    except SteadySlidingError as exc:
+        raise _steady_start(exc, system) from None
     figure = None
     if not no_plot:
         figure = save_branch_figure(branch, out.with_suffix(".png"))
@@ -113,13 +137,25 @@ def continue_command(
         "out": str(out), "figure": None if figure is None else str(figure), "param": param,
         "points": len(branch), "from": float(branch.values[0]), "to": float(branch.values[-1]),
         "stable_points": int(branch.stable.sum()), "stop_reason": branch.stop_reason,
-        "special": [{"kind": p.kind, "value": p.value, "located": p.located} for p in branch.special],
+        "special": [{"kind": p.kind, "value": p.value, "located": p.located, "multipliers": _pairs(p.multipliers),
+                     "multipliers_before": _pairs(p.multipliers_before),
+                     "multipliers_after": _pairs(p.multipliers_after)} for p in branch.special],
         "total_s": branch.timings["total_s"], "simulations": branch.timings["simulations"],
         "points_resumed": branch.timings.get("points_resumed", 0),
     }
+    steady = branch.stop_reason.startswith("steady sliding")
     if as_json:
         print(json.dumps(summary))
-        return
+    else:
+        _print_summary(branch, summary, param, out)
+    if steady:  # the orbits before it are a result, but the branch did not end where it should
+        error_line(f"the continuation converged to {branch.stop_reason} after {len(branch)} orbits (they are in "
+                   f"{out}); the step left the cycle or the cycle ends there: try a smaller --max-step")
+        raise typer.Exit(1)
+
+
+def _print_summary(branch, summary: dict, param: str, out: Path) -> None:
+    """The summary table: range, stop reason, special points with the multipliers on either side."""
     table = Table(title=f"stickslip continue ({branch.model}, in {param})", show_header=False)
     table.add_row("orbits", f"{summary['points']} ({summary['stable_points']} stable)")
     table.add_row(f"{param} range", f"{summary['from']:.6g} → {summary['to']:.6g}")
@@ -127,8 +163,11 @@ def continue_command(
     table.add_row("stopped", summary["stop_reason"])
     for p in branch.special:
         table.add_row(p.label, f"{param} = {p.value:.6g}" + ("" if p.located else " (not located to tolerance)"))
+        if p.kind in ("fold", "period-doubling", "neimark-sacker"):
+            table.add_row("  multipliers", f"{_multipliers_text(p.multipliers_before)} → "
+                                           f"{_multipliers_text(p.multipliers_after)}")
     table.add_row("wall time", f"{summary['total_s']:.2f} s ({summary['simulations']} simulations)")
     if summary["points_resumed"]:
         table.add_row("resumed", f"{summary['points_resumed']} orbits read back from {out} or its journal")
-    table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
+    table.add_row("wrote", str(out) + ("" if summary["figure"] is None else f", {summary['figure']}"))
     console.print(table)

@@ -34,7 +34,7 @@ _LYAPUNOV_METHODS = ("variational", "finite-difference")
 
 _N_HELP = "The plates: normal preload N [N] (default 50)."
 _OMEGA_HELP = "The plates: angular velocity Ω of the lower plate [rad/s] (default 5)."
-_IC_HELP = ("Start run: zero | near | equilibrium | a start of the model's own (the plates' far; `stickslip models "
+IC_HELP = ("Start run: zero | near | equilibrium | a start of the model's own (the plates' far; `stickslip models "
             "NAME` lists them) | NAME=VALUE,... by state name, e.g. x=0,dx=1.5. Default: the model's own first "
             "start (the plates' far), else zero.")
 _SECTION_HELP = ("Poincaré section: max (maximum of the model's observed coordinate, the plates' φ) | DOF_max | "
@@ -83,7 +83,7 @@ def orbit_command(
     N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
     model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: Optional[str] = typer.Option(None, "--ic", help=_IC_HELP),
+    ic: Optional[str] = typer.Option(None, "--ic", help=IC_HELP),
     section: str = typer.Option("max", "--section", help=_SECTION_HELP),
     search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run [s]; the guess is "
                                       "taken from its last section crossings."),
@@ -158,7 +158,7 @@ def lyapunov_command(
     N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
     omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
     model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: Optional[str] = typer.Option(None, "--ic", help=_IC_HELP),
+    ic: Optional[str] = typer.Option(None, "--ic", help=IC_HELP),
     t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first [s]."),
     t_average: float = typer.Option(200.0, "--t-average", help="Averaging time [s]."),
     method: str = typer.Option("variational", "--method", help="variational (saltation matrices) | "

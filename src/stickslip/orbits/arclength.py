@@ -26,13 +26,13 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import ContinuationError, OrbitError
+from ..errors import ContinuationError, OrbitError, SteadySlidingError
 from ..model.system_model import FrictionModel
 from .models import parameter_value, with_parameter
 from .problem import DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, sorted_eigenvalues, stick_count, stick_time
 
-__all__ = ["ContinuationError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR", "MIN_TANGENT_COS",
-           "MAX_STEPS_PER_SECOND"]
+__all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR",
+           "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND"]
 
 #: Corrector iterations before a step counts as failed (then halved). Broyden from the previous
 #: point's Jacobian reduces the residual ~5× per iteration (measured on Model 1, N = 50 N: the

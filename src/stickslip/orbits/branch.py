@@ -18,7 +18,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import ContinuationError, ModelError, OrbitError, ParameterError, SimulationError
+from ..errors import (ContinuationError, ModelError, OrbitError, ParameterError, SimulationError,
+                      SteadySlidingError)
 from ..files import open_ours
 from ..integrate.driver import simulate
 from ..integrate.result import Trajectory
@@ -32,7 +33,7 @@ from .problem import unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
 from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point, detect_after_renewal,
-                             distance_from_equilibrium)
+                             distance_from_equilibrium, is_orbit)
 from .start import Start, start_orbit
 
 __all__ = ["Branch", "continue_orbit", "load_branch"]
@@ -83,7 +84,9 @@ class Branch(ModelResult):
         Corrector iterations of each point (0 for the start).
     special : list of SpecialPoint
     stop_reason : str
-        Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``, ...).
+        Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``,
+        ``steady sliding at <param> = <value>`` where the corrector converged onto the equilibrium
+        (that point is not in the branch), ...).
     system : FrictionModel
         The model at the start (the continuation parameter at its start value); ``params`` and
         ``model``: the plates' Parameters and variant, or None and the model's name.
@@ -292,6 +295,9 @@ def continue_orbit(
     ------
     ContinuationError
         If ``param`` is not numeric, the start orbit cannot be found, or the first Jacobian fails.
+    SteadySlidingError
+        If the start orbit is steady sliding, not a cycle (a ContinuationError; nothing is left
+        at ``out``).
     stickslip.orbits.branch_store.JournalMismatch
         If ``out`` or its journal was written with another start or other settings (an
         :class:`~stickslip.orbits.OrbitError`, like ContinuationError).
@@ -333,6 +339,11 @@ def continue_orbit(
     else:
         begin = Start(**store.start_fields(start_rec))
     problem = problem_of(begin, param, fd_step, param_scale)
+    lam0 = numeric_parameter(begin.system, param)
+    if not is_orbit(problem, begin.state, lam0, begin.stick_phases):
+        if journal is not None:
+            journal.remove()  # it holds no work: nothing to resume
+        raise SteadySlidingError(param, lam0)
     measure = (lambda p: _amplitude(problem, *problem.unpack(p.v))) if amplitude else (lambda p: float("nan"))
     walk = _walk_from_records(records)
     resumed = 0 if walk is None else len(walk.points)
@@ -378,10 +389,14 @@ def continue_orbit(
                 break
             stop = "bounds"
         walk.points.append(new)
-        walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
-        walk.amplitudes.append(measure(new))
-        found, stop, quiet = detect_after_point(problem, walk, last, new, stop, tol, locate, jacobian_every,
-                                                min_stick_fraction, size0, stop_on)
+        found, stop, quiet, drop = detect_after_point(problem, walk, last, new, stop, tol, locate, min_stick_fraction,
+                                                      size0, stop_on)
+        if drop:  # steady sliding, not an orbit: the branch ends at the point before
+            walk.points.pop()
+        else:
+            new = walk.points[-1]  # its Jacobian may have been renewed to classify a turn
+            walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
+            walk.amplitudes.append(measure(new))
         walk.special.extend(found)
         walk.stop = stop
         if stop is None:

@@ -369,6 +369,13 @@ def branch_dataset(branch):
                                     .reshape(len(sp), branch.multipliers.shape[1]),
                                     {"long_name": "Floquet multiplier at the special point, imaginary part", "units": "1"}),
     }
+    for side in ("before", "after"):  # the multipliers of the two points a special point was found between
+        mult = np.array([getattr(p, f"multipliers_{side}") for p in sp], dtype=complex) \
+            .reshape(len(sp), branch.multipliers.shape[1])
+        for part, values in (("real", mult.real), ("imag", mult.imag)):
+            data[f"special_multiplier_{side}_{part}"] = (("special", "multiplier"), values, {
+                "long_name": f"Floquet multiplier of the branch point {side} the special point, "
+                             f"{'real' if part == 'real' else 'imaginary'} part", "units": "1"})
     coords = {"point": np.arange(len(branch)), "state": list(branch.system.state_names),
               "multiplier": np.arange(branch.multipliers.shape[1]), "special": np.arange(len(sp))}
     attrs = {
@@ -393,11 +400,14 @@ def branch_fields(ds) -> dict:
     the fields of each special point."""
     mult = ds["multiplier_real"].values + 1j * ds["multiplier_imag"].values
     smult = ds["special_multiplier_real"].values + 1j * ds["special_multiplier_imag"].values
+    side = {k: (ds[f"special_{k}_real"].values + 1j * ds[f"special_{k}_imag"].values) if f"special_{k}_real" in ds
+            else np.full(smult.shape, np.nan + 0j) for k in ("multiplier_before", "multiplier_after")}
     special = [dict(kind=str(ds["special_kind"].values[k]), index=int(ds["special_index"].values[k]),
                     value=float(ds["special_value"].values[k]), period=float(ds["special_period"].values[k]),
                     state=ds["special_state"].values[k], multipliers=smult[k],
                     before=float(ds["special_before"].values[k]), after=float(ds["special_after"].values[k]),
-                    bracket=float(ds["special_bracket"].values[k]), located=bool(ds["special_located"].values[k]))
+                    bracket=float(ds["special_bracket"].values[k]), located=bool(ds["special_located"].values[k]),
+                    multipliers_before=side["multiplier_before"][k], multipliers_after=side["multiplier_after"][k])
                for k in range(ds.sizes.get("special", 0))]
     return dict(param=ds.attrs["param"], values=ds["value"].values, periods=ds["period"].values,
                 states=ds["state_on_section"].values, multipliers=mult, stable=ds["stable"].values.astype(bool),

@@ -10,8 +10,9 @@ are located. The work is split by responsibility:
                                ``periodic_orbit`` and the Lyapunov tools
 :mod:`.arclength`              the corrector: λ as an unknown, Jacobian, tangent, Newton–Broyden
 :mod:`.branch`                 :func:`continue_orbit` (steps, step control, stops) and :class:`Branch`
-:mod:`.special_points`         folds, period doubling, Neimark–Sacker, stick phases appearing or
-                               vanishing, Hopf points: detection and location
+:mod:`.special_points`         folds, period doubling, Neimark–Sacker (by what crosses the unit
+                               circle), stick phases appearing or vanishing, Hopf points, steady
+                               sliding: detection and location
 :mod:`.start`                  the first orbit: :func:`start_run`, :func:`start_orbit_from_run`
 :mod:`.branch_store`           journals (resume), JSON records, NetCDF of branches and fold curves
 :mod:`.region_edge`            the Region II edge over N (:func:`fold_curve`), :func:`unstable_cycle`
@@ -27,7 +28,7 @@ from __future__ import annotations
 
 
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_CORRECTOR, MAX_STEPS_PER_SECOND, MIN_TANGENT_COS,
-                        ContinuationError, _jacobian, _residual)
+                        ContinuationError, SteadySlidingError, _jacobian, _residual)
 from .branch import (AMPLITUDE_SAMPLES, EASY_ITERATIONS, GROW, HARD_ITERATIONS, SHRINK, Branch, continue_orbit,
                      load_branch)
 from .problem import nontrivial, unstable_count
@@ -35,10 +36,11 @@ from .region_edge import (EDGE_BISECTIONS, EDGE_PROBE, EDGE_SEPARATION, EDGE_WIN
                           FOLD_TOL, START_FALLBACK, FoldCurve, _edge_at, branch_edge, fold_curve, load_fold_curve,
                           unstable_cycle)
 from .section import OrbitError
-from .special_points import (HOPF_RATIO, LOCATE_RTOL, MAX_LOCATE, MIN_STICK_FRACTION, SPECIAL_KINDS, VANISH_FIT_POINTS,
-                             VANISH_FIT_RTOL, SpecialPoint)
+from .special_points import (HOPF_RATIO, LOCATE_RTOL, MAX_LOCATE, MIN_STICK_FRACTION, ORBIT_MIN_SIZE, REAL_RTOL,
+                             SPECIAL_KINDS, VANISH_FIT_POINTS, VANISH_FIT_RTOL, SpecialPoint, circle_crossings,
+                             is_orbit)
 from .start import START_RATE, START_RUN, crossings_per_stick, start_orbit_from_run, start_run
 
 __all__ = ["Branch", "SpecialPoint", "FoldCurve", "continue_orbit", "fold_curve", "branch_edge", "start_run",
            "crossings_per_stick", "start_orbit_from_run", "unstable_cycle", "load_branch", "load_fold_curve",
-           "ContinuationError", "SPECIAL_KINDS"]
+           "ContinuationError", "SteadySlidingError", "SPECIAL_KINDS", "circle_crossings"]

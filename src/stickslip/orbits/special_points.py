@@ -1,40 +1,55 @@
-"""Special points of a branch: detection between consecutive points and location on the arclength.
+"""Special points of a branch: what crosses the unit circle between two points, and where.
 
-Test functions are evaluated at every branch point; a sign change (or a change of count)
-between two consecutive points is a special point, located by the Illinois (modified regula
-falsi) method on the arclength for continuous tests and by bisection for discrete ones, each
-evaluation a corrector step from the left point (:func:`.arclength.step_from`):
+A branch point is an orbit only if it has a stick phase or lies away from the steady-sliding
+state (:func:`is_orbit`): a corrector that converges onto steady sliding (the equilibrium solves
+the shooting equations for every period) ends the branch there, with no special point on it.
 
-``fold``              τ_λ (the parameter component of the tangent) changes sign: a fold (saddle-node)
-                      of cycles, where two orbits meet and disappear (the edge of bistability).
-``period-doubling``   det(M + I) changes sign: a real multiplier crosses −1.
-``neimark-sacker``    the number of complex multipliers outside the unit circle changes
-                      (located by bisection).
+Multiplier tests use the non-trivial Floquet multipliers of the finite-difference monodromy (the
+one closest to 1, the shift along the orbit of the autonomous flow, is left out) at two
+consecutive points that have multipliers, and classify a change by what crossed the unit circle:
+
+``fold``              the branch turns (τ_λ, the parameter component of the tangent, changes
+                      sign) and a real multiplier crosses +1 (the sign of ∏(μ − 1) changes: a
+                      complex pair contributes |μ − 1|² > 0, so only a real multiplier passing +1
+                      changes it). A fold (saddle-node) of cycles, where two orbits meet and
+                      disappear (the edge of bistability). Located on τ_λ.
+``period-doubling``   a real multiplier crosses −1 (∏(μ + 1) changes sign).
+``neimark-sacker``    a complex-conjugate pair crosses |μ| = 1: the number of complex multipliers
+                      outside the unit circle changes while the number of complex multipliers
+                      does not. A pair that meets on the real axis and splits into two real
+                      multipliers changes the number of complex multipliers and crosses nothing:
+                      it is no bifurcation (located by bisection).
 ``stick-phases``      the number of stick phases per period changes (grazing/sliding: a stick
                       phase appears or disappears; located by bisection).
-``hopf``              a fold of a pure-slip branch where the cycle has shrunk onto the equilibrium
+``hopf``              the branch turns where a pure-slip cycle has shrunk onto the equilibrium
                       (distance from it < :data:`HOPF_RATIO` of the start's): the Hopf point of
                       the linearisation (paper Eq. 15, Appendix); the branch ends.
 ``stick-vanishing``   the total stick time per period falls towards 0 and the branch ends: the
                       stick-slip orbit loses its stick phase (it meets the unstable pure-slip
                       cycle, a non-smooth fold). Located by extrapolating τ_stick² linearly in λ
                       to 0 over the last points (τ_stick ∝ √(λ* − λ) measured).
+
+A change is located between the two points by the Illinois (modified regula falsi) method on the
+arclength for continuous tests and by bisection for discrete ones, each evaluation a corrector
+step from the left point (:func:`.arclength.step_from`). Each special point keeps the multipliers
+of the two points it was found between.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import OrbitError, SimulationError
+from ..errors import EquilibriumError, OrbitError, SimulationError
 from . import branch_store as store
-from .arclength import Point, Problem, step_from
+from .arclength import Point, Problem, point_at, step_from
 from .layout import equilibrium_state
 from .problem import nontrivial
 
-__all__ = ["SpecialPoint", "SPECIAL_KINDS", "HOPF_RATIO", "MIN_STICK_FRACTION", "detect_after_point",
-           "detect_after_renewal"]
+__all__ = ["SpecialPoint", "SPECIAL_KINDS", "HOPF_RATIO", "MIN_STICK_FRACTION", "ORBIT_MIN_SIZE", "REAL_RTOL",
+           "Detection", "circle_crossings", "is_orbit", "steady_stop", "detect_after_point", "detect_after_renewal"]
 
 #: Kinds of special points, in the order they are reported.
 SPECIAL_KINDS = ("fold", "period-doubling", "neimark-sacker", "stick-phases", "stick-vanishing", "hopf")
@@ -46,6 +61,18 @@ SPECIAL_KINDS = ("fold", "period-doubling", "neimark-sacker", "stick-phases", "s
 #: of the start at the located turning point, against ≥ 0.3 on the rest of those branches.
 HOPF_RATIO = 0.1
 
+#: A point without stick phases whose state on the section lies closer than this to the
+#: steady-sliding state (‖(s − s_eq)/σ‖ over the free states, σ the start orbit's scales) is the
+#: equilibrium, not an orbit: the finite differences of its Jacobian (steps of DEFAULT_FD_STEP =
+#: 1e-5 σ) would straddle such a cycle, so nothing the shooting computes can tell it from steady
+#: sliding. Measured: 1e-12 on the steady sliding the two-mass belt's start converged onto, against
+#: ≥ 2.8e-3 on the Model 4 slip cycle down to its Hopf point (0.69 at its start).
+ORBIT_MIN_SIZE = 1e-5
+
+#: A multiplier is real when |Im μ| ≤ REAL_RTOL |μ|: LAPACK returns the real eigenvalues of a real
+#: matrix with Im = 0 exactly and the others in conjugate pairs, so this only absorbs round-off.
+REAL_RTOL = 1e-9
+
 #: A branch stops when the stick time per period falls below this fraction of the period: the
 #: stick phase is vanishing (measured at N = 50 N: τ_stick² falls linearly to 0 with Ω, so the
 #: orbit ends where its stick phase shrinks to an instant; the finite-difference Jacobian is
@@ -56,13 +83,18 @@ MIN_STICK_FRACTION = 1e-3
 #: relative to the largest τ_stick² (measured at N = 50 N: slopes of consecutive pairs agree to 3 %).
 VANISH_FIT_POINTS, VANISH_FIT_RTOL = 4, 0.05
 
-
 #: Location of a special point stops when the bracket in arclength is below this fraction of
 #: the step it was found in, or after :data:`MAX_LOCATE` evaluations.
 LOCATE_RTOL, MAX_LOCATE = 1e-3, 12
 
 #: Stop reason of a branch that ends at a Hopf point.
 HOPF_STOP = "hopf (the cycle shrinks onto the equilibrium)"
+
+#: Tests located by the Illinois method (sign changes of a continuous function).
+_CONTINUOUS = ("fold", "period-doubling")
+
+#: Tests between two points with multipliers, besides the turn.
+_MULTIPLIER_KINDS = ("period-doubling", "neimark-sacker")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -74,22 +106,26 @@ class SpecialPoint:
     kind : str
         One of :data:`SPECIAL_KINDS`.
     index : int
-        The special point lies between branch points ``index`` and ``index + 1``.
+        The special point lies between branch points ``index`` and ``index + 1`` (after the last
+        point for a ``hopf`` whose next point was the equilibrium).
     value : float
         Parameter value at the special point [unit of the parameter].
     period : float
         Period there [s].
     state : ndarray (2n,)
         State on the section there.
-    multipliers : ndarray complex
+    multipliers : ndarray (2 n_free,) complex
         Floquet multipliers there (at the nearest evaluated point for discrete tests) [-].
     before, after : float
         Test function on either side (τ_λ; det(M + I); complex multipliers outside the unit
-        circle; stick phases per period).
+        circle; stick phases per period; stick time [s]).
     bracket : float
         Width of the final bracket in λ [unit of the parameter] (0 if found exactly).
     located : bool
         False if the location stopped before the bracket tolerance was met.
+    multipliers_before, multipliers_after : ndarray (2 n_free,) complex
+        Floquet multipliers of the points it was found between (those that classify it; NaN
+        where a point has none: a Broyden point, or the equilibrium after a Hopf point) [-].
     """
 
     kind: str
@@ -102,10 +138,12 @@ class SpecialPoint:
     after: float
     bracket: float
     located: bool
+    multipliers_before: np.ndarray
+    multipliers_after: np.ndarray
 
     @property
     def label(self) -> str:
-        """Short description, e.g. ``fold at Omega = 8.73``."""
+        """Short description, e.g. ``stick-phases (1 → 2)``."""
         extra = f" ({self.before:g} → {self.after:g})" if self.kind in ("stick-phases", "neimark-sacker") else ""
         return f"{self.kind}{extra}"
 
@@ -114,41 +152,120 @@ class SpecialPoint:
         return {"kind": self.kind, "index": int(self.index), "value": float(self.value), "period": float(self.period),
                 "state": store.encode_array(self.state), "multipliers": store.encode_array(self.multipliers),
                 "before": float(self.before), "after": float(self.after), "bracket": float(self.bracket),
-                "located": bool(self.located)}
+                "located": bool(self.located), "multipliers_before": store.encode_array(self.multipliers_before),
+                "multipliers_after": store.encode_array(self.multipliers_after)}
 
     @classmethod
     def from_record(cls, rec: dict) -> "SpecialPoint":
         """Inverse of :meth:`to_record`."""
+        mult = store.decode_array(rec["multipliers"]).astype(complex)
+        side = {k: store.decode_array(rec[k]).astype(complex) if k in rec else np.full(mult.shape, np.nan + 0j)
+                for k in ("multipliers_before", "multipliers_after")}
         return cls(kind=rec["kind"], index=int(rec["index"]), value=float(rec["value"]), period=float(rec["period"]),
-                   state=store.decode_array(rec["state"]), multipliers=store.decode_array(rec["multipliers"]).astype(complex),
-                   before=float(rec["before"]), after=float(rec["after"]), bracket=float(rec["bracket"]),
-                   located=bool(rec["located"]))
+                   state=store.decode_array(rec["state"]), multipliers=mult, before=float(rec["before"]),
+                   after=float(rec["after"]), bracket=float(rec["bracket"]), located=bool(rec["located"]), **side)
+
+
+class Detection(NamedTuple):
+    """What :func:`detect_after_point` found after a new branch point."""
+
+    found: list  # special points, along the branch
+    stop: str | None  # why the branch ends here (None: it goes on)
+    quiet: bool  # the new point is left out of the progress callback (the branch ended before it)
+    drop: bool  # the new point is not an orbit (steady sliding): it is removed from the branch
+
+
+# --------------------------------------------------------------------------- multiplier tests
+def _multiplier_tests(multipliers: np.ndarray) -> dict:
+    """The multiplier tests of one point (None for each when it has no multipliers).
+
+    ``plus-one`` and ``period-doubling`` are ∏(μ − 1) and ∏(μ + 1) over the non-trivial
+    multipliers (real: conjugate pairs give |μ ∓ 1|²); ``neimark-sacker`` counts the complex ones
+    outside the unit circle, ``complex`` all complex ones.
+    """
+    if not np.all(np.isfinite(multipliers)):
+        return dict.fromkeys(("plus-one", "period-doubling", "neimark-sacker", "complex"))
+    mu = nontrivial(multipliers)
+    cplx = np.abs(mu.imag) > REAL_RTOL * np.abs(mu)
+    return {"plus-one": float(np.real(np.prod(mu - 1.0))), "period-doubling": float(np.real(np.prod(mu + 1.0))),
+            "neimark-sacker": int(np.sum(cplx & (np.abs(mu) > 1.0))), "complex": int(np.sum(cplx))}
 
 
 def _test_values(point: Point) -> dict:
-    """Test functions of the special points at one point (continuous ones are floats; None where
-    the point has no multipliers, see ``jacobian_every``)."""
-    fresh = point.fresh
-    mu = nontrivial(point.multipliers) if fresh else None
-    return {
-        "fold": float(point.tangent[-1]),
-        "period-doubling": float(np.real(np.prod(mu + 1.0))) if fresh else None,
-        "neimark-sacker": int(np.sum((np.abs(mu) > 1.0) & (np.abs(mu.imag) > 1e-9 * np.abs(mu)))) if fresh else None,
-        "stick-phases": int(point.stick_phases),
-    }
+    """Test functions of the special points at one point (multiplier tests None where the point
+    has no multipliers, see ``jacobian_every``)."""
+    return {"fold": float(point.tangent[-1]), "stick-phases": int(point.stick_phases),
+            **_multiplier_tests(point.multipliers)}
 
 
-def _locate(problem: Problem, left: Point, right_test, kind: str, h: float, tol: float, index: int) -> SpecialPoint:
-    """Locate a sign change (or count change) of test ``kind`` between ``left`` and arclength ``h``.
+def _changed(kind: str, a: dict, b: dict) -> bool:
+    """Whether test ``kind`` changes between the test values ``a`` and ``b``."""
+    if a[kind] is None or b[kind] is None:
+        return False
+    if kind in _CONTINUOUS or kind == "plus-one":
+        return bool(np.sign(a[kind]) != np.sign(b[kind]))
+    if kind == "neimark-sacker":  # a pair crossed |μ| = 1, not one that met on (or left) the real axis
+        return a[kind] != b[kind] and a["complex"] == b["complex"]
+    return a[kind] != b[kind]
+
+
+def circle_crossings(before: np.ndarray, after: np.ndarray) -> set:
+    """What crossed the unit circle between two sets of Floquet multipliers (trivial one included).
+
+    Returns
+    -------
+    set of str
+        ``"+1"`` (a real multiplier crossed +1), ``"-1"`` (a real multiplier crossed −1),
+        ``"pair"`` (a complex-conjugate pair crossed |μ| = 1); empty if nothing crossed, e.g. a
+        complex pair that met on the real axis and split into two real multipliers.
+    """
+    a, b = _multiplier_tests(np.asarray(before)), _multiplier_tests(np.asarray(after))
+    names = {"plus-one": "+1", "period-doubling": "-1", "neimark-sacker": "pair"}
+    return {name for kind, name in names.items() if _changed(kind, a, b)}
+
+
+# --------------------------------------------------------------------------- orbit or steady sliding
+def distance_from_equilibrium(problem: Problem, state: np.ndarray, lam: float) -> float:
+    """‖(s − s_eq)/σ‖ on the free states: the size of a slip cycle about the equilibrium of Eq. (14)."""
+    sp = problem.shooting
+    s_eq = equilibrium_state(problem.system_at(lam))
+    return float(np.linalg.norm((state - s_eq)[sp.free] / sp.sigma))
+
+
+def is_orbit(problem: Problem, state: np.ndarray, lam: float, stick_phases: int) -> bool:
+    """Whether a solution of the shooting equations is an orbit: it has a stick phase, or its state
+    on the section lies at least :data:`ORBIT_MIN_SIZE` from the steady-sliding state (a model
+    without steady sliding at ``lam`` has no such solution)."""
+    if stick_phases > 0:
+        return True
+    try:
+        return distance_from_equilibrium(problem, state, lam) >= ORBIT_MIN_SIZE
+    except EquilibriumError:
+        return True
+
+
+def steady_stop(param: str, value: float) -> str:
+    """Stop reason of a branch whose corrector converged onto steady sliding at ``param`` = ``value``."""
+    return f"steady sliding at {param} = {value:.6g}"
+
+
+# --------------------------------------------------------------------------- location
+def _nan_like(point: Point) -> np.ndarray:
+    return np.full(point.multipliers.shape, np.nan + 0j)
+
+
+def _locate(problem: Problem, left: Point, right: Point, kind: str, h: float, tol: float, index: int) -> SpecialPoint:
+    """Locate a sign change (or count change) of test ``kind`` between ``left`` and arclength ``h``
+    (``right`` the point there).
 
     Continuous tests (fold, period-doubling): Illinois regula falsi on the arclength s ∈ (0, h).
     Discrete tests (neimark-sacker, stick-phases): bisection. Every evaluation is a corrector
     from ``left`` along its tangent (and a Jacobian when the test needs multipliers).
     """
-    continuous = kind in ("fold", "period-doubling")
+    continuous = kind in _CONTINUOUS
     need_jac = kind != "stick-phases"
     f_left = _test_values(left)[kind]
-    f_right = right_test
+    f_right = _test_values(right)[kind]
     a, b, fa, fb = 0.0, h, f_left, f_right
     side = 0
     best = left
@@ -186,60 +303,97 @@ def _locate(problem: Problem, left: Point, right_test, kind: str, h: float, tol:
     lb = problem.unpack(left.v + b * left.tangent)[2]
     return SpecialPoint(kind=kind, index=index, value=lam_best, period=T_best, state=s_best,
                         multipliers=best.multipliers, before=float(f_left), after=float(f_right),
-                        bracket=float(abs(lb - la)), located=bool(abs(b - a) <= LOCATE_RTOL * abs(h)))
+                        bracket=float(abs(lb - la)), located=bool(abs(b - a) <= LOCATE_RTOL * abs(h)),
+                        multipliers_before=left.multipliers, multipliers_after=right.multipliers)
 
 
-def _detect(problem: Problem, last: Point, new: Point, tol: float, index: int, locate: bool, kinds) -> list:
+def _detect(problem: Problem, left: Point, right: Point, tol: float, index: int, locate: bool, kinds) -> list:
     """Special points of ``kinds`` between two branch points (located when ``locate``)."""
-    a, b = _test_values(last), _test_values(new)
+    a, b = _test_values(left), _test_values(right)
     found = []
-    h_actual = float(last.tangent @ (new.v - last.v))  # arclength of ``new`` along the last tangent
+    h_actual = float(left.tangent @ (right.v - left.v))  # arclength of ``right`` along the left tangent
     for kind in kinds:
-        if a[kind] is None or b[kind] is None:
-            continue
-        changed = (np.sign(a[kind]) != np.sign(b[kind])) if kind in ("fold", "period-doubling") else a[kind] != b[kind]
-        if not changed:
+        if not _changed(kind, a, b):
             continue
         if locate:
-            found.append(_locate(problem, last, b[kind], kind, h_actual, tol, index))
+            found.append(_locate(problem, left, right, kind, h_actual, tol, index))
         else:
-            s, T, lam = problem.unpack(new.v)
-            found.append(SpecialPoint(kind, index, lam, T, s, new.multipliers, float(a[kind]), float(b[kind]),
-                                      float(abs(lam - problem.unpack(last.v)[2])), False))
+            s, T, lam = problem.unpack(right.v)
+            found.append(SpecialPoint(kind=kind, index=index, value=lam, period=T, state=s,
+                                      multipliers=right.multipliers, before=float(a[kind]), after=float(b[kind]),
+                                      bracket=float(abs(lam - problem.unpack(left.v)[2])), located=False,
+                                      multipliers_before=left.multipliers, multipliers_after=right.multipliers))
     return found
 
 
+def _turns(problem: Problem, left: Point, right: Point, before: Point, tol: float, index: int, locate: bool,
+           size0) -> list:
+    """The turn of the branch between ``left`` and ``right`` (τ_λ changes sign) as a special point:
+    ``hopf`` where a slip cycle has shrunk onto the equilibrium (``size0``: the start's distance
+    from it, None for a stick-slip branch), ``fold`` where a real multiplier crossed +1 between
+    ``before`` (the last point with multipliers up to ``left``) and ``right``; otherwise none (a
+    turn without a multiplier crossing +1 is no fold of cycles)."""
+    found = _detect(problem, left, right, tol, index, locate, ("fold",))
+    if not found:
+        return []
+    turn = found[0]
+    if size0 is not None and right.stick_phases == 0 and size0 > 0.0 \
+            and distance_from_equilibrium(problem, turn.state, turn.value) < HOPF_RATIO * size0:
+        return [dataclasses.replace(turn, kind="hopf", multipliers_before=before.multipliers)]
+    if "+1" in circle_crossings(before.multipliers, right.multipliers):
+        return [dataclasses.replace(turn, multipliers_before=before.multipliers)]
+    return []
+
+
+def _sorted(found: list) -> list:
+    return sorted(found, key=lambda q: (q.index, SPECIAL_KINDS.index(q.kind)))
+
+
+# --------------------------------------------------------------------------- after each point
 def detect_after_point(problem: Problem, walk, last: Point, new: Point, stop: str | None, tol: float,
-                       locate: bool, jacobian_every: int, min_stick_fraction: float, size0, stop_on) -> tuple:
+                       locate: bool, min_stick_fraction: float, size0, stop_on) -> Detection:
     """Special points between ``last`` and the new last point of ``walk``, and whether to stop.
+
+    A new point that is not an orbit (:func:`is_orbit`) ends the branch: at a ``hopf`` point if
+    the slip cycle shrank onto the equilibrium there, else as steady sliding (:func:`steady_stop`)
+    with no special point; it is dropped. A turn seen by a point without multipliers (a Broyden
+    point) renews that point's Jacobian first, so that the turn is classified. Updates
+    ``walk.fresh_index`` (and ``walk.points[-1]`` when renewed).
 
     Returns
     -------
-    (found, stop, quiet)
-        The special points (along the branch; at one index in :data:`SPECIAL_KINDS` order), the stop reason (None: go on; the
-        ``stop`` passed in is kept unless the branch ends here for another reason), and whether
-        the point is left out of the progress callback (the branch ended before it: stick phase
-        vanishing, Hopf point). Updates ``walk.fresh_index``.
+    Detection
+        The special points (along the branch; at one index in :data:`SPECIAL_KINDS` order), the
+        stop reason (the ``stop`` passed in is kept unless the branch ends here for another
+        reason), whether the point is left out of the progress callback (stick phase vanishing,
+        Hopf point) and whether it is dropped.
     """
     points = walk.points
-    if last.stick_time > 0.0 and new.stick_time < min_stick_fraction * problem.unpack(new.v)[1]:
+    k = len(points) - 1
+    s_new, T_new, lam_new = problem.unpack(new.v)
+    before = points[walk.fresh_index]
+    if not is_orbit(problem, s_new, lam_new, new.stick_phases):
+        found = _turns(problem, last, new, before, tol, k - 1, locate, size0) if last.stick_phases == 0 else []
+        hopf = [dataclasses.replace(q, multipliers_after=_nan_like(new)) for q in found if q.kind == "hopf"]
+        return Detection(hopf, HOPF_STOP if hopf else steady_stop(problem.param, lam_new), True, True)
+    if last.stick_time > 0.0 and new.stick_time < min_stick_fraction * T_new:
         # its multipliers are not trusted: the differences cross the edge of the stick phase
-        return [_stick_vanishing(problem, points, len(points) - 2)], "stick phase vanishing", True
-    found = _detect(problem, last, new, tol, len(points) - 2, locate, ("fold", "stick-phases"))
-    if new.fresh and jacobian_every > 1:
-        found += _detect(problem, points[walk.fresh_index], new, tol, walk.fresh_index, locate,
-                         ("period-doubling", "neimark-sacker"))
-    elif new.fresh:
-        found += _detect(problem, last, new, tol, len(points) - 2, locate, ("period-doubling", "neimark-sacker"))
+        return Detection([_stick_vanishing(problem, points, k - 1)], "stick phase vanishing", True, False)
+    if not new.fresh and _changed("fold", _test_values(last), _test_values(new)):
+        try:
+            new = points[-1] = point_at(problem, new.v, new.iterations, last.tangent)
+        except (OrbitError, SimulationError):
+            pass  # the turn stays unclassified (no multipliers): it is not reported
+    found = _detect(problem, last, new, tol, k - 1, locate, ("stick-phases",))
     if new.fresh:
-        walk.fresh_index = len(points) - 1
-    found = [_as_hopf(problem, q, size0) if q.kind == "fold" and size0 is not None
-             and new.stick_phases == 0 else q for q in found]
-    found = sorted(found, key=lambda q: (q.index, SPECIAL_KINDS.index(q.kind)))
+        found += _turns(problem, last, new, before, tol, k - 1, locate, size0)
+        found += _detect(problem, before, new, tol, walk.fresh_index, locate, _MULTIPLIER_KINDS)
+        walk.fresh_index = k
+    found = _sorted(found)
     reason = _stop_reason(found, stop_on)
     if reason == HOPF_STOP:
-        return found, reason, True
-    return found, reason if stop is None else stop, False
+        return Detection(found, reason, True, False)
+    return Detection(found, reason if stop is None else stop, False, False)
 
 
 def detect_after_renewal(problem: Problem, walk, tol: float, locate: bool, size0, stop_on) -> tuple:
@@ -248,24 +402,22 @@ def detect_after_renewal(problem: Problem, walk, tol: float, locate: bool, size0
     Broyden's updates lie along the corrector steps, nearly orthogonal to the tangent, so a point
     without finite differences keeps its predecessor's tangent; τ_λ then changes sign only when
     the Jacobian of the last point is renewed (after a failed step), and the renewed point has
-    multipliers. Test ``fold`` between the previous point and the renewed one, and the multiplier
+    multipliers. Test the turn between the previous point and the renewed one, and the multiplier
     tests between the last point with multipliers (``walk.fresh_index``, not yet moved) and it.
 
     Returns
     -------
     (found, stop)
-        Special points (along the branch, as in :func:`detect_after_point`; ``hopf`` for a fold of a slip branch on
-        the equilibrium) and the stop reason (or None).
+        Special points (along the branch, as in :func:`detect_after_point`) and the stop reason
+        (or None).
     """
     if len(walk.points) < 2:
         return [], None
     k = len(walk.points) - 1
-    found = _detect(problem, walk.points[k - 1], walk.points[k], tol, k - 1, locate, ("fold",))
-    found += _detect(problem, walk.points[walk.fresh_index], walk.points[k], tol, walk.fresh_index, locate,
-                     ("period-doubling", "neimark-sacker"))
-    found = sorted(found, key=lambda q: (q.index, SPECIAL_KINDS.index(q.kind)))
-    found = [_as_hopf(problem, q, size0) if size0 is not None and walk.points[-1].stick_phases == 0 else q
-             for q in found]
+    before, renewed = walk.points[walk.fresh_index], walk.points[k]
+    found = _turns(problem, walk.points[k - 1], renewed, before, tol, k - 1, locate, size0)
+    found += _detect(problem, before, renewed, tol, walk.fresh_index, locate, _MULTIPLIER_KINDS)
+    found = _sorted(found)
     return found, _stop_reason(found, stop_on)
 
 
@@ -276,20 +428,6 @@ def _stop_reason(found: list, stop_on) -> str | None:
     if any(q.kind in stop_on for q in found):
         return "stop_on " + ",".join(sorted({q.kind for q in found if q.kind in stop_on}))
     return None
-
-
-def distance_from_equilibrium(problem: Problem, state: np.ndarray, lam: float) -> float:
-    """‖(s − s_eq)/σ‖ on the free states: the size of a slip cycle about the equilibrium of Eq. (14)."""
-    sp = problem.shooting
-    s_eq = equilibrium_state(problem.system_at(lam))
-    return float(np.linalg.norm((state - s_eq)[sp.free] / sp.sigma))
-
-
-def _as_hopf(problem: Problem, fold: SpecialPoint, size0: float) -> SpecialPoint:
-    """A fold of a slip branch that sits on the equilibrium is its Hopf point (:data:`HOPF_RATIO`)."""
-    if size0 > 0.0 and distance_from_equilibrium(problem, fold.state, fold.value) < HOPF_RATIO * size0:
-        return dataclasses.replace(fold, kind="hopf")
-    return fold
 
 
 def _stick_vanishing(problem: Problem, points: list, index: int) -> SpecialPoint:
@@ -315,5 +453,5 @@ def _stick_vanishing(problem: Problem, points: list, index: int) -> SpecialPoint
                 value, located = float(root), True
     return SpecialPoint(kind="stick-vanishing", index=index, value=value, period=T, state=s,
                         multipliers=last.multipliers, before=float(points[-2].stick_time),
-                        after=float(last.stick_time), bracket=float(abs(value - lam_last)), located=located)
-
+                        after=float(last.stick_time), bracket=float(abs(value - lam_last)), located=located,
+                        multipliers_before=points[-2].multipliers, multipliers_after=last.multipliers)
