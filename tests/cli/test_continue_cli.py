@@ -26,7 +26,7 @@ BAND = 1e-5
     (["--from", "nan", "--to", "3"], "--from must be a finite number"),
     (["--from", "3", "--to", "inf"], "--to must be a finite number"),
     (["--from", "3", "--to", "4", "--out", "b.txt"], "give a path ending in .nc"),
-    (["--from", "3", "--to", "4", "--ic", "hot"], "--ic hot: choose one of far, near, zero, equilibrium"),
+    (["--from", "3", "--to", "4", "--ic", "hot"], "unknown initial condition 'hot'; use 'zero', 'near', 'equilibrium', 'far'"),
     (["--from", "3", "--to", "4", "--max-points", "1"], "--max-points must be >= 2"),
     (["--from", "3", "--to", "4", "--step", "0"], "--step must be a finite number > 0"),
     (["--from", "3", "--to", "4", "--step", "0.5", "--max-step", "0.1"], "--step 0.5 is larger than --max-step 0.1"),
