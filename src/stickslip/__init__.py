@@ -36,14 +36,6 @@ import importlib
 import sys
 import types
 
-from ._version import __version__
-from .analysis import Classification, classify, find_peaks, intensity
-from .errors import FileFormatError, ParameterError, SimulationError, StickSlipError, VariantError
-from .integrate.driver import simulate
-from .integrate.result import Trajectory, load_trajectory
-from .model.parameters import Parameters
-from .model.variants import DOF_NAMES, MODELS, STATE_NAMES
-
 #: Public names imported on first access, by the module that defines them.
 _LAZY = {
     **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model"], ".model"),
@@ -75,7 +67,15 @@ class _Package(types.ModuleType):
         super().__setattr__(name, value)
 
 
-sys.modules[__name__].__class__ = _Package
+sys.modules[__name__].__class__ = _Package  # before the imports below, which import stickslip.stability
+
+from ._version import __version__  # noqa: E402
+from .analysis import Classification, classify, find_peaks, intensity  # noqa: E402
+from .errors import FileFormatError, ParameterError, SimulationError, StickSlipError, VariantError  # noqa: E402
+from .integrate.driver import simulate  # noqa: E402
+from .integrate.result import Trajectory, load_trajectory  # noqa: E402
+from .model.parameters import Parameters  # noqa: E402
+from .model.variants import DOF_NAMES, MODELS, STATE_NAMES  # noqa: E402
 
 
 def __getattr__(name):

@@ -34,11 +34,11 @@ def test_a_run_starting_at_t0_1e4_equals_the_same_run_from_0():
 
 
 def test_chunked_run_takes_the_same_steps_as_one_call(monkeypatch):
-    from stickslip.integrate import driver
+    from stickslip.integrate import runner
 
     one = stickslip.simulate(t_end=40.0, sample_rate=10.0)
-    monkeypatch.setattr(driver, "FIRST_CHUNK", 0.7)
-    monkeypatch.setattr(driver, "CHUNK_STEPS", 50)  # many short chunks
+    monkeypatch.setattr(runner, "FIRST_CHUNK", 0.7)
+    monkeypatch.setattr(runner, "CHUNK_STEPS", 50)  # many short chunks
     many = stickslip.simulate(t_end=40.0, sample_rate=10.0)
     assert many.stats.accepted_steps == one.stats.accepted_steps
     assert many.stats.rejected_steps == one.stats.rejected_steps

@@ -1,9 +1,9 @@
 """The early-stopping classifier: one initial state, integrated in chunks until its attractor is known.
 
-Each state runs with the exact ``event`` integrator (:func:`stickslip.integrate.event_loop.integrate_event`,
-called chunk by chunk with the contacts' state carried over, so the run takes the same steps as
-one long call) for at most ``t_end``. After each chunk of :data:`~.context.CHUNK_PERIODS`
-characteristic periods, in this order:
+Each state runs with the exact ``event`` integrator, chunk by chunk
+(:func:`stickslip.integrate.runner.run_chunks` with the stop condition :class:`EarlyStop`, so the
+run takes the same steps as one long call) for at most ``t_end``. After each chunk of
+:data:`~.context.CHUNK_PERIODS` characteristic periods, in this order:
 
 1. **Steady sliding reached** (only where it is linearly stable). The deviation δ = s − s_e of
    the chunk's end is compared with the linear flow from its start, Φ δ0. In the norm of the
@@ -32,22 +32,19 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections import deque
 
 import numpy as np
 
 from ..analysis.peaks import Peaks
 from ..analysis.period import MIN_PERIODS, return_map
 from ..attractors import attractor
-from ..integrate import contacts as E
-from ..integrate.event_loop import N_EXTRA, integrate_event
 from ..integrate.result import Stats, Trajectory, Transitions
+from ..integrate.runner import Chunk, EventStepper, Record, StopCondition, run_chunks
 from ..integrate.status import CHUNK_END, CONTACT_LOST, NOT_FINITE, SUCCESS
-from ..model.bundle import contact_state
 from .context import Context
 from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
 
-__all__ = ["Options", "Outcome", "classify_state", "OUTCOMES", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
+__all__ = ["Options", "Outcome", "classify_state", "EarlyStop", "OUTCOMES", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
            "RULE_PERIODS", "row_width", "DEFAULT_MAX_STEPS"]
 
 #: Verdicts of one state: the attractor verdicts (:data:`stickslip.attractors.ATTRACTORS`),
@@ -184,51 +181,36 @@ class Outcome:
                    float(wall))
 
 
-class _Window:
-    """The run's last samples (on the global sample grid t_i = i dt) and transitions, kept in
-    chunks and trimmed to the context's window."""
-
-    def __init__(self, limit: int):
-        self.limit = limit
-        self.chunks: deque = deque()
-        self.size = 0
-        self.first = 0  # global index of the first sample kept
-        self._joined = None
-
-    def add(self, t, states, mode, friction, transitions) -> None:
-        self.chunks.append((t, states, mode, friction, transitions))
-        self.size += t.size
-        while self.size - self.chunks[0][0].size >= self.limit:
-            dropped = self.chunks.popleft()[0].size
-            self.size -= dropped
-            self.first += dropped
-        self._joined = None
-
-    def arrays(self):
-        """(t, states, mode, friction, [transition times, kinds, contacts, states]) of the window."""
-        if self._joined is None:
-            t, s, mode, friction, tr = zip(*self.chunks)
-            self._joined = (np.concatenate(t), np.concatenate(s), np.concatenate(mode), np.concatenate(friction),
-                            [np.concatenate([x[i] for x in tr]) for i in range(4)])
-        return self._joined
+def _window_start(record: Record, limit: int) -> int:
+    """Index in ``record.chunks`` of the first chunk of the window: the chunks with samples from the
+    latest one on whose later chunks hold fewer than ``limit`` samples (the window holds at least
+    ``limit`` samples, whole chunks, once the run has that many)."""
+    later, start = 0, 0
+    for k in range(len(record.chunks) - 1, -1, -1):
+        size = record.chunks[k][2]
+        if size and later < limit:
+            start = k
+        later += size
+    return start
 
 
-def _trajectory(model, ctx: Context, opts: Options, window: _Window, t_end: float, steps: int):
-    """The window as a :class:`~stickslip.integrate.result.Trajectory` (for the verdict)."""
-    t, states, mode, friction, (tt, kind, contact, ts) = window.arrays()
-    return Trajectory(t=t, states=states, mode=mode, friction=friction, work=np.zeros((t.size, 2)),
-                      transitions=Transitions(tt, kind, ts, contact), stats=Stats(accepted_steps=steps),
-                      status="success", system=model, method="event",
-                      options={"rtol": opts.rtol, "atol": opts.atol, "dt": None, "sample_rate": 1.0 / ctx.dt,
+def _trajectory(model, opts: Options, record: Record, first_chunk: int, t_end: float, steps: int) -> Trajectory:
+    """The window (the samples and transitions of ``record`` from chunk ``first_chunk`` on, without
+    a last chunk that wrote no samples) as a :class:`~stickslip.integrate.result.Trajectory`, for the verdict."""
+    n2 = 2 * model.n
+    first_sample, first_tr, _ = record.chunks[first_chunk]
+    last_tr = record.chunks[-1][1] if record.chunks[-1][2] == 0 else record.transition_count
+    t, states, mode, friction = record.samples(first_sample)
+    tr = record.transitions(first_tr, last_tr)
+    return Trajectory(t=t.copy(), states=np.ascontiguousarray(states[:, :n2]), mode=mode.copy(),
+                      friction=friction.copy(), work=np.zeros((t.size, 2)),
+                      transitions=Transitions(tr.time, tr.kind, np.ascontiguousarray(tr.state[:, :n2]), tr.contact),
+                      stats=Stats(accepted_steps=steps), status="success", system=model, method="event",
+                      options={"rtol": opts.rtol, "atol": opts.atol, "dt": None,
+                               "sample_rate": 1.0 / (record.sample_times[1] - record.sample_times[0]),
                                "ic": "explicit", "perturbation": None, "t0": float(t[0]), "t_end": t_end,
                                "slip_band": model.slip_band},
                       steady_from=float(t[0]))
-
-
-def _verdict(model, ctx, opts, window, t_from, t_end, steps, cache):
-    """The verdict of :func:`stickslip.attractors.attractor` on the window from ``t_from``."""
-    traj = _trajectory(model, ctx, opts, window, t_end, steps)
-    return traj, attractor(traj, t_from, confirm=opts.confirm, lyapunov=opts.lyapunov, cache=cache)
 
 
 def _linear(ctx: Context, d0: np.ndarray, d1: np.ndarray) -> tuple[bool, bool]:
@@ -244,6 +226,102 @@ def _linear(ctx: Context, d0: np.ndarray, d1: np.ndarray) -> tuple[bool, bool]:
     lin = ctx.flow @ d0
     contraction = norm(d0) - norm(lin)
     return False, contraction > 0.0 and norm(d1 - lin) <= LINEAR_MARGIN * contraction
+
+
+class EarlyStop(StopCondition):
+    """The stop condition of one state (module docstring): chunks of ``ctx.chunk`` samples, each
+    followed by the tests that may decide the state's :class:`Outcome` (in :attr:`outcome`).
+
+    Parameters
+    ----------
+    ctx : Context
+    model : FrictionModel
+    cycles : sequence of Cycle
+        Cycles already found for this model.
+    opts : Options
+    record : Record
+        The run's record (its samples before the window are dropped as the run goes on).
+    start : float
+        ``time.perf_counter()`` when the state was taken up (for the outcome's wall time).
+    """
+
+    def __init__(self, ctx: Context, model, cycles, opts: Options, record: Record, start: float):
+        self.ctx, self.model, self.cycles, self.opts, self.record, self.start = ctx, model, cycles, opts, record, start
+        self.target = 0
+        self.linear_run = 0
+        self.cache: dict = {}
+        self.outcome: Outcome | None = None
+
+    def chunk_length(self, stepper) -> float:
+        m, record = self.ctx.chunk, self.record
+        if record.room < 2 * m + 2 and record.chunks:  # drop the samples before the window
+            record.keep_from(record.chunks[_window_start(record, self.ctx.window)][0])
+        self.target = max(record.n + m - 1, m)  # the chunk ends at this sample
+        return self.target * self.ctx.dt - stepper.t
+
+    def stop(self, stepper, record: Record, chunk: Chunk) -> bool:
+        self.outcome = self._decide(stepper, record, chunk)
+        return self.outcome is not None
+
+    def _decide(self, stepper, record: Record, chunk: Chunk) -> Outcome | None:
+        ctx, model, opts = self.ctx, self.model, self.opts
+        n, n2, j, m = model.n, 2 * model.n, model.observed_index, ctx.chunk
+        t, steps, target = stepper.t, int(stepper.stats[0] + stepper.stats[1]), self.target
+        first = _window_start(record, ctx.window)
+        window_first = record.chunks[first][0]
+        tw, sw, mw, _ = record.samples(window_first)
+        sw = sw[:, :n2]
+
+        def outcome(verdict, decided, cycle=None, state=None, section=None):
+            last = sw[-1].copy() if record.chunks[-1][2] else stepper.y[:n2].copy()
+            return Outcome(verdict, decided, t, cycle, last if state is None else state, section, steps,
+                           time.perf_counter() - self.start)
+
+        if chunk.status not in (CHUNK_END, SUCCESS):
+            return outcome({NOT_FINITE: "unbounded", CONTACT_LOST: "contact-lost"}.get(chunk.status, "failed"),
+                           "stopped")
+        # 1. steady sliding reached: the last m samples against the linear flow
+        a, b = target - m - window_first, target - window_first
+        if ctx.stable and a >= 0 and b < tw.size:
+            trw = record.transitions(record.chunks[first][1]).time
+            stuck = bool(np.any(mw[a:b + 1])) or bool(np.any((trw > tw[a]) & (trw <= tw[b])))
+            rest, linear = _linear(ctx, sw[a, ctx.free] - ctx.equilibrium[ctx.free],
+                                   sw[b, ctx.free] - ctx.equilibrium[ctx.free])
+            if rest:
+                return outcome("equilibrium", "at-rest")
+            self.linear_run = self.linear_run + 1 if linear and not stuck else 0
+            if self.linear_run >= LINEAR_CHUNKS:
+                return outcome("equilibrium", "linear")
+        section = section_of(tw, sw[:, j], sw[:, n + j])
+        # 2. a known cycle reached
+        for cycle in self.cycles:
+            if run_matches(cycle, section, opts.match_rtol):
+                return outcome("periodic", "matched", cycle, cycle.state)
+        # 4. the verdict at t_end
+        if chunk.status == SUCCESS:
+            traj, v = self._verdict(record, first, float(tw[0]), steps)
+            if v.attractor == "periodic":
+                cyc = _cycle(section, traj, v)
+                return outcome("periodic", "period-rule", cyc, cyc.state)
+            return outcome(v.attractor, "end-verdict", section=section)
+        # 3. a new cycle: the period rule on the last RULE_PERIODS T_c, then the window's verdict
+        t_from = t - RULE_PERIODS * ctx.period
+        recent = section.times >= t_from
+        if np.count_nonzero(recent) > MIN_PERIODS and tw[0] <= t_from:
+            x = sw[tw >= t_from, j]
+            settled, _ = return_map(Peaks(section.times[recent], section.maxima[recent]), float(np.ptp(x)))
+            if settled is not None:
+                traj, v = self._verdict(record, first, t_from, steps)
+                if v.attractor == "periodic":
+                    cyc = _cycle(section, traj, v)
+                    return outcome("periodic", "period-rule", cyc, cyc.state)
+        return None
+
+    def _verdict(self, record: Record, first_chunk: int, t_from: float, steps: int):
+        """The verdict of :func:`stickslip.attractors.attractor` on the window from ``t_from``."""
+        traj = _trajectory(self.model, self.opts, record, first_chunk, float(self.opts.t_end), steps)
+        return traj, attractor(traj, t_from, confirm=self.opts.confirm, lyapunov=self.opts.lyapunov,
+                               cache=self.cache)
 
 
 def classify_state(ctx: Context, model, s0: np.ndarray, cycles, opts: Options) -> Outcome:
@@ -265,91 +343,20 @@ def classify_state(ctx: Context, model, s0: np.ndarray, cycles, opts: Options) -
     Outcome
     """
     start = time.perf_counter()
-    md = model.data
-    n = model.n
-    n2 = 2 * n
-    nc = model.n_contacts
-    y = np.zeros(n2 + N_EXTRA)
-    y[:n2] = s0
-    if E.contact_lost(y, md) >= 0:
+    m, dt, t_end = ctx.chunk, ctx.dt, float(opts.t_end)
+    # a step never passes more than one chunk of samples
+    stepper = EventStepper(model, s0, 0.0, t_end, rtol=opts.rtol, atol=opts.atol, h_max=m * dt,
+                           max_steps=opts.max_steps)
+    if stepper.open_contact >= 0:
         return Outcome("contact-lost", "stopped", 0.0, None, np.array(s0, dtype=float),
                        wall_time=time.perf_counter() - start)
-    F = np.empty(2 * nc)
-    N = np.empty(nc)
-    cst = contact_state(md.m)
-    E.initial_modes(y, cst, md, opts.rtol, opts.atol, F, N)
-    m, dt, t_end = ctx.chunk, ctx.dt, float(opts.t_end)
-    h_max = m * dt  # a step never passes more than one chunk of samples
-    out_s = np.empty((2 * m + 2, n2 + N_EXTRA))
-    out_mode = np.empty(2 * m + 2, dtype=np.int8)
-    out_F = np.empty((2 * m + 2, 2 * nc))
-    window = _Window(ctx.window)
-    free, se, j = ctx.free, ctx.equilibrium, model.observed_index
-    t, h, steps, linear_run, next_sample, room = 0.0, min(1e-3, h_max), 0, 0, 0, 64
-    cache: dict = {}
-    while True:
-        target = max(next_sample + m - 1, m)  # the chunk ends at this sample
-        times = np.arange(next_sample, target + m + 2) * dt
-        saved = (y.copy(), cst.copy(), h)
-        while True:  # again from the chunk's start with room for every transition, if needed
-            tr = (np.empty(room), np.empty(room, np.int8), np.empty(room, np.int8), np.empty((room, n2 + N_EXTRA)))
-            status, tau, y, h, idx, n_tr, st, _ = integrate_event(
-                y, cst, t, target * dt - t, t_end - t, md, opts.rtol, opts.atol, h, h_max, opts.max_steps - steps,
-                times, 0, out_s, out_mode, out_F, tr[0], tr[1], tr[2], tr[3], 0)
-            if n_tr <= room:
-                break
-            room = 2 * n_tr
-            y, cst, h = saved[0].copy(), saved[1].copy(), saved[2]
-        t += tau
-        steps += int(st[0] + st[1])
-        next_sample += idx
-        if idx:
-            window.add(times[:idx].copy(), out_s[:idx, :n2].copy(), out_mode[:idx].copy(), out_F[:idx].copy(),
-                       (tr[0][:n_tr].copy(), tr[1][:n_tr].copy(), tr[2][:n_tr].copy(), tr[3][:n_tr, :n2].copy()))
-        tw, sw, mw, _, trw = window.arrays()
-
-        def outcome(verdict, decided, cycle=None, state=None, section=None):
-            last = sw[-1].copy() if idx else y[:n2].copy()
-            return Outcome(verdict, decided, t, cycle, last if state is None else state, section, steps,
-                           time.perf_counter() - start)
-
-        if status not in (CHUNK_END, SUCCESS):
-            return outcome({NOT_FINITE: "unbounded", CONTACT_LOST: "contact-lost"}.get(status, "failed"), "stopped")
-        # 1. steady sliding reached: the last m samples against the linear flow
-        a, b = target - m - window.first, target - window.first
-        if ctx.stable and a >= 0 and b < tw.size:
-            stuck = bool(np.any(mw[a:b + 1])) or bool(np.any((trw[0] > tw[a]) & (trw[0] <= tw[b])))
-            rest, linear = _linear(ctx, sw[a, free] - se[free], sw[b, free] - se[free])
-            if rest:
-                return outcome("equilibrium", "at-rest")
-            linear_run = linear_run + 1 if linear and not stuck else 0
-            if linear_run >= LINEAR_CHUNKS:
-                return outcome("equilibrium", "linear")
-        section = section_of(tw, sw[:, j], sw[:, n + j])
-        # 2. a known cycle reached
-        for cycle in cycles:
-            if run_matches(cycle, section, opts.match_rtol):
-                return outcome("periodic", "matched", cycle, cycle.state)
-        # 4. the verdict at t_end
-        if status == SUCCESS:
-            traj, v = _verdict(model, ctx, opts, window, float(tw[0]), t_end, steps, cache)
-            if v.attractor == "periodic":
-                cyc = _cycle(section, traj, v)
-                return outcome("periodic", "period-rule", cyc, cyc.state)
-            return outcome(v.attractor, "end-verdict", section=section)
-        # 3. a new cycle: the period rule on the last RULE_PERIODS T_c, then the window's verdict
-        t_from = t - RULE_PERIODS * ctx.period
-        recent = section.times >= t_from
-        if np.count_nonzero(recent) > MIN_PERIODS and tw[0] <= t_from:
-            x = sw[tw >= t_from, j]
-            settled, _ = return_map(Peaks(section.times[recent], section.maxima[recent]), float(np.ptp(x)))
-            if settled is not None:
-                traj, v = _verdict(model, ctx, opts, window, t_from, t_end, steps, cache)
-                if v.attractor == "periodic":
-                    cyc = _cycle(section, traj, v)
-                    return outcome("periodic", "period-rule", cyc, cyc.state)
-
-
+    # samples t_i = i dt up to t_end; the record holds the window and room for two chunks (a chunk
+    # writes at most 2m + 2 samples: it ends within one step of h_max = m dt past its target)
+    times = np.arange(int(math.floor(t_end / dt)) + 2) * dt
+    record = Record(model, times, capacity=ctx.window + 3 * (2 * m + 2))
+    stop = EarlyStop(ctx, model, cycles, opts, record, start)
+    run_chunks(stepper, record, stop, interrupt=False)
+    return stop.outcome
 def _cycle(section: Section, traj, verdict) -> Cycle:
     """The features of the window's settled periodic verdict."""
     return cycle_from_section(section, traj.t, traj.states, verdict.period_count, verdict.period_s,

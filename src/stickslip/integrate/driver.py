@@ -3,6 +3,7 @@ method in chunks, wrap the result."""
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from pathlib import Path
@@ -11,17 +12,13 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import SimulationError
-from ..model.bundle import contact_state
 from ..model.library import resolve_system
 from ..model.library.two_plates import NAME as TWO_PLATES
-from ..model.system_model import FrictionModel
-from . import contacts as E
-from .event_loop import N_EXTRA, integrate_event
-from .fixed_step import run_aeom, run_naeom
+from .fixed_step import run_fixed_step
 from .initial import initial_state
-from .interrupt import interruptible, partial_on_ctrl_c
+from .interrupt import partial_on_ctrl_c
 from .result import Stats, Trajectory, Transitions
-from .status import CHUNK_END, Status
+from .runner import NO_STEP_CAP, run_event
 
 __all__ = ["simulate", "METHODS", "MAX_SAMPLES"]
 
@@ -31,29 +28,6 @@ MAX_SAMPLES = 20_000_000
 #: Integration methods by name; ``aeom`` and ``naeom`` are the paper's fixed-step methods for the
 #: two plates only.
 METHODS = ("event", "aeom", "naeom")
-
-#: Steps (accepted and rejected) a chunk of the compiled loop aims at: Ctrl-C is answered between
-#: chunks, after about 0.1 s (the plates take ~1 µs a step). Chunk lengths follow from step
-#: counts, not from wall time, so a run's chunks, and with them the round-off of its local
-#: times, are the same however loaded the machine is: the same inputs give the same result.
-CHUNK_STEPS = 100_000
-#: Simulated time [s] of the first chunk, before its speed is known.
-FIRST_CHUNK = 20.0
-
-#: Initial room for transitions per simulated second of a chunk (stick-slip cycles have 2 per
-#: period); a chunk with more is run again from its start with room for all (same result).
-TRANSITIONS_PER_SECOND = 64
-MIN_TRANSITION_ROOM = 1024
-
-#: Transitions a run keeps: the most recent ones (earlier ones are counted in
-#: ``Transitions.dropped``), so that memory stays bounded however long the run: 10^6 transitions
-#: × (instant, kind, contact) plus the states of the last :data:`KEEP_TRANSITION_STATES`.
-KEEP_TRANSITIONS = 1_000_000
-KEEP_TRANSITION_STATES = 100_000
-
-
-#: "No cap" on the steps of a run (int64 for the compiled loop).
-NO_STEP_CAP = 2**62
 
 
 def _check_positive(name: str, value, hint: str) -> float:
@@ -66,154 +40,9 @@ def _check_positive(name: str, value, hint: str) -> float:
     return value
 
 
-class _Buffers:
-    """Output arrays of a run: samples (allocated once) and per-chunk transition buffers."""
-
-    def __init__(self, system: FrictionModel, sample_times: np.ndarray):
-        n = sample_times.size
-        ns = 2 * system.n + N_EXTRA
-        self.out_s = np.empty((n, ns))
-        self.out_mode = np.empty(n, dtype=np.int8)
-        self.out_F = np.empty((n, 2 * system.n_contacts))
-        self.tr_t: list[np.ndarray] = []
-        self.tr_kind: list[np.ndarray] = []
-        self.tr_contact: list[np.ndarray] = []
-        self.tr_s: list[np.ndarray] = []
-        self.kept = 0
-        self.dropped = 0
-
-    def add_transitions(self, tr, n_tr: int) -> None:
-        """Keep the first ``n_tr`` transitions of a chunk's buffers, dropping the oldest beyond the caps."""
-        for store, buf in zip((self.tr_t, self.tr_kind, self.tr_contact, self.tr_s), tr):
-            store.append(buf[:n_tr].copy())
-        self.kept += n_tr
-        if self.kept > 2 * KEEP_TRANSITIONS or sum(len(s) for s in self.tr_s) > 2 * KEEP_TRANSITION_STATES:
-            drop = max(self.kept - KEEP_TRANSITIONS, 0)
-            for store in (self.tr_t, self.tr_kind, self.tr_contact):
-                joined = np.concatenate(store)[drop:]
-                store[:] = [joined]
-            states = np.concatenate(self.tr_s)
-            self.tr_s[:] = [states[max(len(states) - KEEP_TRANSITION_STATES, 0):]]
-            self.kept -= drop
-            self.dropped += drop
-
-    def transitions(self, ns: int) -> Transitions:
-        """The kept transitions; states of the earliest kept ones beyond the state cap are NaN."""
-        if not self.tr_t:
-            return Transitions(np.empty(0), np.empty(0, np.int8), np.empty((0, ns)), np.empty(0, np.int8))
-        time_, kind, contact = (np.concatenate(s) for s in (self.tr_t, self.tr_kind, self.tr_contact))
-        states = np.concatenate(self.tr_s)
-        if len(states) < len(time_):
-            states = np.concatenate([np.full((len(time_) - len(states), ns), np.nan), states])
-        return Transitions(time_, kind, states, contact, dropped=self.dropped)
-
-    @staticmethod
-    def transition_room(duration: float, ns: int, capacity: int | None = None):
-        cap = capacity or MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * max(duration, 0.0))
-        return np.empty(cap), np.empty(cap, dtype=np.int8), np.empty(cap, dtype=np.int8), np.empty((cap, ns))
-
-
-def _warm_up(system: FrictionModel, y: np.ndarray, rtol, atol) -> None:
-    """Compile (or load from cache) the event loop for this kinematics class on a 1 µs run."""
-    ns = y.size
-    cst = contact_state(system.data.m)
-    st = np.array([0.0])
-    tr = _Buffers.transition_room(0.0, ns, 1)
-    integrate_event(y.copy(), cst, 0.0, 1e-6, 1e-6, system.data, rtol, atol, 1e-7, 1e-6, 10, st, 0,
-                    np.empty((1, ns)), np.empty(1, dtype=np.int8), np.empty((1, 2 * system.n_contacts)),
-                    tr[0], tr[1], tr[2], tr[3], 0)
-
-
-def _run_event(system: FrictionModel, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
-               rtol: float, atol: float, dt: float | None, max_steps: int):
-    """The ``event`` method, in chunks of about :data:`CHUNK_STEPS` steps.
-
-    Each chunk integrates in its own local time from the previous chunk's end (absolute time
-    never enters a step or an event tolerance, so runs of any length keep their resolution) and
-    ends at the first accepted step past its planned end that is not inside an approach to stick,
-    so the chunks take the same steps as one long call. A KeyboardInterrupt between chunks ends
-    the run with what is done (status INTERRUPTED).
-    """
-    prepared = time.perf_counter()
-    md = system.data
-    ns = 2 * system.n + N_EXTRA
-    y = np.zeros(ns)
-    y[:2 * system.n] = y0
-    F = np.empty(2 * system.n_contacts)
-    N = np.empty(system.n_contacts)
-    cst = contact_state(md.m)
-    lost = E.contact_lost(y, md)
-    if lost >= 0:
-        raise SimulationError(f"the normal force of contact {lost} is ≤ 0 at the initial state: the contact is open; "
-                              "start from a state where every contact is pressed")
-    _warm_up(system, y, rtol, atol)
-    E.initial_modes(y, cst, md, rtol, atol, F, N)
-    # everything before the loop (packing the model, compiling or loading the kernels) when it is
-    # the first run of a process (seconds; numba's own start is ~0.4 s of it), else microseconds
-    compile_time = time.perf_counter() - prepared
-    compile_time = compile_time if compile_time > 0.05 else 0.0
-    h_max = dt if dt is not None else (t_end - t0)
-    h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
-    buffers = _Buffers(system, sample_times)
-    stats = np.zeros(6, dtype=np.int64)
-    t = t0
-    idx = 0
-    chunk = min(FIRST_CHUNK, t_end - t0)
-    status = CHUNK_END
-    lost = -1
-    steps_left = max_steps
-    interrupted = False
-    with interruptible() as stop:
-        while status == CHUNK_END and not stop.requested:
-            tau_end = t_end - t
-            tau_stop = min(chunk, tau_end)
-            start_state = (y.copy(), cst.copy(), h, idx)
-            capacity = None
-            while True:
-                tr = _Buffers.transition_room(tau_stop, ns, capacity)
-                res = integrate_event(y, cst, t, tau_stop, tau_end, md, rtol, atol, h, h_max, steps_left, sample_times,
-                                      idx, buffers.out_s, buffers.out_mode, buffers.out_F, tr[0], tr[1], tr[2], tr[3], 0)
-                n_tr = res[5]
-                if n_tr <= tr[0].size:
-                    break
-                capacity = n_tr  # rerun this chunk from its start with room for all its transitions
-                y, cst, h, idx = start_state[0].copy(), start_state[1].copy(), start_state[2], start_state[3]
-            status, tau, y, h, idx, _, st, lost = res
-            buffers.add_transitions(tr, n_tr)
-            stats += st
-            steps_left = max_steps - int(stats[0] + stats[1])
-            t = t + tau
-            taken = int(st[0] + st[1])
-            if tau > 0.0 and taken > 0:  # aim the next chunk at CHUNK_STEPS steps
-                chunk = min(max(tau * CHUNK_STEPS / taken, 1e-3), 10.0 * max(tau, 1e-3))
-        interrupted = stop.requested and status == CHUNK_END
-    if stop.requested and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
-        raise KeyboardInterrupt
-    code = Status.INTERRUPTED if interrupted else Status(status)
-    transitions = buffers.transitions(ns)
-    stats_out = dict(accepted_steps=int(stats[0]), rejected_steps=int(stats[1]), rhs_calls=int(stats[2]),
-                     retaken_steps=int(stats[3]), slip_to_stick=int(stats[4]), stick_to_slip=int(stats[5]),
-                     compile_time_s=compile_time)
-    return code, t, lost, idx, buffers, transitions, stats_out
-
-
-def _run_fixed_step(method: str, system: FrictionModel, y0: np.ndarray, t0: float, t_end: float,
-                    sample_times: np.ndarray, rtol: float, atol: float, dt: float | None, max_steps: int):
-    """The paper's fixed-step methods (two plates only)."""
-    if system.name != TWO_PLATES:
-        raise SimulationError(f"method {method!r} is the paper's fixed-step method for the two plates; "
-                              f"model {system.name!r} runs with method='event' (CLI: --method event)")
-    runner = run_aeom if method == "aeom" else run_naeom
-    code, t_reached, keep, out_s, out_mode, out_F, transitions, stats = runner(system, y0, t0, t_end, sample_times,
-                                                                            rtol, atol, dt, max_steps)
-    buffers = _Buffers.__new__(_Buffers)
-    buffers.out_s, buffers.out_mode, buffers.out_F = out_s, out_mode, out_F
-    n_kept = int(np.count_nonzero(keep))
-    ns = out_s.shape[1]
-    transitions = Transitions(transitions.time, transitions.kind,
-                              np.concatenate([transitions.state, np.zeros((len(transitions), ns - 12))], axis=1),
-                              np.zeros(len(transitions), dtype=np.int8))
-    return code, t_reached, -1, n_kept, buffers, transitions, stats
+#: The runner of each method (:class:`.runner.RunOutput` from the same arguments).
+RUNNERS = {"event": run_event, "aeom": functools.partial(run_fixed_step, "aeom"),
+           "naeom": functools.partial(run_fixed_step, "naeom")}
 
 
 def simulate(
@@ -302,13 +131,19 @@ def simulate(
     y0 = initial_state(system, ic, perturbation)
     sample_times = t0 + np.arange(n_samples) / sample_rate
 
+    if method != "event" and system.name != TWO_PLATES:
+        raise SimulationError(f"method {method!r} is the paper's fixed-step method for the two plates; "
+                              f"model {system.name!r} runs with method='event' (CLI: --method event)")
+
     start = time.perf_counter()
-    runner = _run_event if method == "event" else (lambda *a: _run_fixed_step(method, *a))
-    code, t_reached, lost, n_kept, buffers, transitions, stats = runner(
-        system, y0, t0, t_end, sample_times, rtol, atol, dt, NO_STEP_CAP if max_steps is None else int(max_steps))
-    wall = time.perf_counter() - start - stats.get("compile_time_s", 0.0)  # integration only
+    out = RUNNERS[method](system, y0, t0, t_end, sample_times, rtol=rtol, atol=atol, dt=dt,
+                          max_steps=NO_STEP_CAP if max_steps is None else int(max_steps))
+    wall = time.perf_counter() - start - out.stats["compile_time_s"]  # integration only
+    if out.interrupted and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
+        raise KeyboardInterrupt
+    code, record, n_kept = out.status, out.record, out.record.n
     if n_kept == 0:
-        raise SimulationError(f"the run ended before its first sample ({code.message(t_reached, lost)})")
+        raise SimulationError(f"the run ended before its first sample ({code.message(out.t_reached, out.lost)})")
 
     ic_text = ic if isinstance(ic, str) else ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path)
                                               else "states" if isinstance(ic, Mapping) else "explicit")
@@ -319,16 +154,18 @@ def simulate(
     if steady_from is None:
         steady_from = t0 + 0.5 * (t_samples[-1] - t0)
     n2 = 2 * system.n
+    transitions = record.transitions()
+    _, states, mode, friction = record.samples()
     return Trajectory(
         t=t_samples,
-        states=buffers.out_s[:n_kept, :n2],
-        mode=buffers.out_mode[:n_kept],
-        friction=buffers.out_F[:n_kept],
-        work=buffers.out_s[:n_kept, n2:n2 + 2],
+        states=states[:, :n2],
+        mode=mode,
+        friction=friction,
+        work=states[:, n2:n2 + 2],
         transitions=Transitions(transitions.time, transitions.kind, transitions.state[:, :n2], transitions.contact,
                                 transitions.dropped),
-        stats=Stats(**stats, wall_time_s=wall),
-        status=code.message(t_reached, lost),
+        stats=Stats(**out.stats, wall_time_s=wall),
+        status=code.message(out.t_reached, out.lost),
         system=system,
         method=method,
         options=options,

@@ -19,12 +19,11 @@ The slip direction below the low-speed band is the quasi-static one, with the ba
 what the step can resolve (:func:`step_band`). The physics is the generic one
 (:mod:`stickslip.model.physics`, compiled for the plates' kinematics) on the plates' model data
 ``md``; the contact state ``cst`` (mode, slip direction) of the one contact is the loop's.
-State layout: the plates' 12 states, then the work of friction and of damping [J].
+State layout: the plates' 2n states, then the work of friction and of damping [J].
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 
@@ -40,7 +39,8 @@ from . import rk4
 from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
 from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
-from .result import Stats, Transitions
+from .event_loop import N_EXTRA
+from .runner import Chunk, Record, RunOutput, ToTheEnd, run_chunks, stats_dict, transition_room
 from .status import MAX_STEPS as STATUS_MAX_STEPS
 from .status import NOT_FINITE as STATUS_NOT_FINITE
 from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
@@ -49,21 +49,15 @@ from .status import SUCCESS as STATUS_OK
 from .status import Status
 from .step_physics import derivative_and_contact, derivative_under_force, stick_force
 
-N_STATE = 14  # the plates' 12 states + work of friction + work of damping
-
-#: Initial room for transitions per simulated second (stick-slip cycles have 2 per period); a run
-#: with more is run again with room for all (deterministic, same result).
-TRANSITIONS_PER_SECOND = 64
-MIN_TRANSITION_ROOM = 1024
 
 
 @kernel
 def record_transition(n, t, kind, y, tr_t, tr_kind, tr_s):
     """Write transition ``n`` (time [s], kind, state) into the buffers if they have room.
 
-    The loop counts on past the capacity and :func:`with_transition_room` runs again with room for
-    all: buffers that grew inside the loop would be loop-carried arrays, which numba
-    reference-counts on every iteration.
+    The loop counts on past the capacity and :meth:`FixedStepper.advance` runs again with room for
+    all (:func:`.runner.transition_room`): buffers that grew inside the loop would be loop-carried
+    arrays, which numba reference-counts on every iteration.
     """
     if n < tr_t.shape[0]:
         tr_t[n] = t
@@ -72,24 +66,7 @@ def record_transition(n, t, kind, y, tr_t, tr_kind, tr_s):
             tr_s[n, i] = y[i]
 
 
-def with_transition_room(run, duration: float, n_state: int = N_STATE):
-    """Call ``run(tr_t, tr_kind, tr_s)`` with transition buffers for a run of ``duration`` [s],
-    again with bigger ones if the transitions it found exceeded their room.
-
-    ``run`` returns ``(result, n_transitions)``. Returns ``(result, tr_t, tr_kind, tr_s)`` trimmed
-    to the transitions recorded.
-    """
-    capacity = MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * duration)
-    while True:
-        tr_t = np.empty(capacity)
-        tr_kind = np.empty(capacity, dtype=np.int8)
-        tr_s = np.empty((capacity, n_state))
-        result, n_tr = run(tr_t, tr_kind, tr_s)
-        if n_tr <= capacity:
-            return result, tr_t[:n_tr], tr_kind[:n_tr], tr_s[:n_tr]
-        capacity = n_tr
-
-__all__ = ["integrate_fixed_step", "run_aeom", "run_naeom", "check_step", "step_band", "step_data", "plates_model",
+__all__ = ["integrate_fixed_step", "run_fixed_step", "FixedStepper", "check_step", "step_band", "step_data",
            "STABILITY_LIMIT", "METHOD_AEOM", "METHOD_NAEOM"]
 
 #: Stick solver codes of :func:`integrate_fixed_step`.
@@ -253,7 +230,7 @@ def next_step(t, t0, dt, k_grid, t_end):
 @loop
 def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, sample_times, out_s, out_mode, out_F, tr_t,
                          tr_kind, tr_s):
-    """Integrate the model ``md`` (the plates) from ``y0`` (length N_STATE) over [t0, t_end] with
+    """Integrate the model ``md`` (the plates) from ``y0`` (2n + 2 entries) over [t0, t_end] with
     the fixed step ``dt`` [s].
 
     ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step). Samples and
@@ -265,7 +242,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, sample_times,
         A :mod:`.status` code.
     t : float
         Time reached [s].
-    y : ndarray (N_STATE,)
+    y : ndarray (2n + 2,)
         Final state.
     n_transitions : int
         Transitions found (in the buffers up to their room).
@@ -379,14 +356,6 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, sample_times,
 
 
 # --------------------------------------------------------------------------- Python runners
-def plates_model(system) -> FrictionModel:
-    """The plates' :class:`~stickslip.model.FrictionModel` of ``system``: the model itself, or the
-    model of an assembled plates :class:`~stickslip.model.System` (what the driver passes)."""
-    if isinstance(system, FrictionModel):
-        return system
-    return system.model()
-
-
 def _diagonal(md: ModelData, block: int) -> np.ndarray:
     """Diagonal of the n × n block ``block`` of the model data (0: M⁻¹, 3: K; ``bundle.offsets``)."""
     n = int(md.m[H_N])
@@ -448,34 +417,71 @@ def step_data(model: FrictionModel, dt: float) -> ModelData:
     return model.data._replace(m=m)
 
 
-def stats_dict(st, compile_time: float) -> dict:
-    """The integrator counters as keyword arguments of ``result.Stats``."""
-    stats = dict(accepted_steps=int(st[0]), rejected_steps=int(st[1]), rhs_calls=int(st[2]),
-                 retaken_steps=int(st[3]), slip_to_stick=int(st[4]), stick_to_slip=int(st[5]))
-    if "compile_time_s" in {f.name for f in dataclasses.fields(Stats)}:
-        stats["compile_time_s"] = compile_time
-    return stats
-
-
-def warm_up(md: ModelData, t0, dt, method) -> float:
-    """Compile (or load from cache) :func:`integrate_fixed_step` on a one-step run; seconds spent,
-    0 if compiled already."""
+def warm_up(md: ModelData, ns: int, t0, dt, method) -> float:
+    """Compile (or load from cache) :func:`integrate_fixed_step` on a one-step run of a state of
+    ``ns`` entries; seconds spent, 0 if compiled already."""
     if integrate_fixed_step.signatures:
         return 0.0
     start = time.perf_counter()
-    y = np.zeros(N_STATE)
-    integrate_fixed_step(method, y, t0, t0 + dt, dt, md, 10, np.array([t0]), np.zeros((1, N_STATE)),
+    y = np.zeros(ns)
+    integrate_fixed_step(method, y, t0, t0 + dt, dt, md, 10, np.array([t0]), np.zeros((1, ns)),
                          np.zeros(1, dtype=np.int8), np.zeros((1, 2)), np.empty(1), np.empty(1, dtype=np.int8),
-                         np.empty((1, N_STATE)))
+                         np.empty((1, ns)))
     return time.perf_counter() - start
 
 
-def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
-                   dt: float | None, max_steps: int):
-    """Run ``method`` (``"aeom"`` or ``"naeom"``) on the plates ``system`` (a FrictionModel or an
-    assembled System, :func:`plates_model`) for :func:`stickslip.simulate`.
+class FixedStepper:
+    """A fixed-step method (``aeom`` or ``naeom``) of the plates' ``model`` from ``s0`` at ``t0``:
+    one chunk to ``t_end`` (the stepper of :func:`.runner.run_chunks`; its loop keeps the time
+    grid t0 + k Δt of the whole run, so it is not cut into chunks).
 
-    Returns the tuple of the driver's runners (see ``driver._run_event``).
+    Raises
+    ------
+    SimulationError
+        If ``dt`` is missing or too large (:func:`check_step`).
+    """
+
+    def __init__(self, method: str, model: FrictionModel, s0: np.ndarray, t0: float, t_end: float, dt,
+                 max_steps: int):
+        self.dt = check_step(method, model, dt)
+        self.code = METHOD_CODES[method]
+        self.md = step_data(model, self.dt)
+        self.ns = 2 * model.n + N_EXTRA
+        self.prepare_s = warm_up(self.md, self.ns, t0, self.dt, self.code)
+        self.y = np.zeros(self.ns)
+        self.y[:2 * model.n] = s0
+        self.t, self.t_end = float(t0), float(t_end)
+        self.max_steps = int(max_steps)
+        self.stats = np.zeros(6, dtype=np.int64)
+
+    def advance(self, tau_stop: float, record: Record) -> Chunk:
+        """The whole run (``tau_stop`` is not used), samples written into ``record``."""
+        capacity = None
+        while True:
+            tr = transition_room(self.t_end - self.t, self.ns, capacity)
+            times, row, out_s, out_mode, out_F = record.loop_arrays()
+            status, t_reached, _, n_tr, st = integrate_fixed_step(
+                self.code, self.y, self.t, self.t_end, self.dt, self.md, self.max_steps, times, out_s, out_mode,
+                out_F, tr[0], tr[1], tr[3])
+            if n_tr <= tr[0].size:
+                break
+            capacity = n_tr  # again with room for every transition (same result)
+        if status == STATUS_SOLVE_FAILED:
+            raise SimulationError(
+                f"naeom: the stick-force solve did not reach |v_r| ≤ {VR_TOL:g} m/s in {MAX_NEWTON} Newton "
+                f"iterations at t = {t_reached:.6g} s (dt = {self.dt:g} s); give a smaller dt"
+            )
+        tr[2][:n_tr] = 0  # the plates' one contact
+        tau = t_reached - self.t
+        self.t = t_reached
+        self.stats += st[:6]
+        kept = int(np.count_nonzero(record.sample_times <= t_reached))
+        return Chunk(int(status), float(tau), kept, st[:6], -1, tuple(a[:n_tr] for a in tr))
+
+
+def run_fixed_step(method: str, system: FrictionModel, s0: np.ndarray, t0: float, t_end: float,
+                   sample_times: np.ndarray, *, dt: float | None, max_steps: int, **_) -> RunOutput:
+    """Run ``method`` (``"aeom"`` or ``"naeom"``) on the plates' ``system`` for :func:`stickslip.simulate`.
 
     Raises
     ------
@@ -483,41 +489,7 @@ def run_fixed_step(method: str, system, y0: np.ndarray, t0: float, t_end: float,
         If ``dt`` is missing or too large (:func:`check_step`), or NAEOM's per-step stick-force
         solve does not converge (``method_naeom.MAX_NEWTON``).
     """
-    model = plates_model(system)
-    dt = check_step(method, model, dt)
-    code = METHOD_CODES[method]
-    md = step_data(model, dt)
-    compile_time = warm_up(md, t0, dt, code)
-    n = sample_times.size
-    out_s = np.empty((n, N_STATE))  # every kept sample is written
-    out_mode = np.empty(n, dtype=np.int8)
-    out_F = np.empty((n, 2))
-    y = np.zeros(N_STATE)
-    y[:12] = y0
-
-    def run(tr_t, tr_kind, tr_s):
-        res = integrate_fixed_step(code, y, t0, t_end, dt, md, max_steps, sample_times, out_s, out_mode, out_F, tr_t,
-                                   tr_kind, tr_s)
-        return res, res[3]
-
-    (status, t_reached, _, _, st), tr_t, tr_kind, tr_s = with_transition_room(run, t_end - t0)
-    if status == STATUS_SOLVE_FAILED:
-        raise SimulationError(
-            f"naeom: the stick-force solve did not reach |v_r| ≤ {VR_TOL:g} m/s in {MAX_NEWTON} Newton "
-            f"iterations at t = {t_reached:.6g} s (dt = {dt:g} s); give a smaller dt"
-        )
-    keep = sample_times <= t_reached
-    return (Status(status), t_reached, keep, out_s, out_mode, out_F,
-            Transitions(tr_t, tr_kind, tr_s[:, :12]), stats_dict(st, compile_time))
-
-
-def run_aeom(system, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
-             rtol: float, atol: float, dt: float | None, max_steps: int):
-    """Runner of ``method="aeom"`` (signature of ``driver._run_event``; ``rtol``/``atol`` unused)."""
-    return run_fixed_step("aeom", system, y0, t0, t_end, sample_times, dt, max_steps)
-
-
-def run_naeom(system, y0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray,
-              rtol: float, atol: float, dt: float | None, max_steps: int):
-    """Runner of ``method="naeom"`` (signature of ``driver._run_event``; ``rtol``/``atol`` unused)."""
-    return run_fixed_step("naeom", system, y0, t0, t_end, sample_times, dt, max_steps)
+    stepper = FixedStepper(method, system, s0, t0, t_end, dt, max_steps)
+    record = Record(system, sample_times)
+    status, interrupted, _ = run_chunks(stepper, record, ToTheEnd())
+    return RunOutput(Status(status), stepper.t, -1, record, stats_dict(stepper.stats, stepper.prepare_s), interrupted)
