@@ -36,10 +36,10 @@ from ..model.jit import kernel, loop
 from ..model.system_model import FrictionModel
 from . import events as E
 from . import rk4
+from .event_loop import N_EXTRA
 from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
 from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
-from .event_loop import N_EXTRA
 from .runner import Chunk, Record, RunOutput, ToTheEnd, run_chunks, stats_dict, transition_room
 from .status import MAX_STEPS as STATUS_MAX_STEPS
 from .status import NOT_FINITE as STATUS_NOT_FINITE
@@ -48,7 +48,6 @@ from .status import STEP_UNDERFLOW as STATUS_STEP_UNDERFLOW
 from .status import SUCCESS as STATUS_OK
 from .status import Status
 from .step_physics import derivative_and_contact, derivative_under_force, stick_force
-
 
 
 @kernel
