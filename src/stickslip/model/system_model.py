@@ -91,7 +91,7 @@ def check_name(name: str, what: str) -> None:
     """
     if not isinstance(name, str) or not _NAME.match(name):
         shown = repr(name) if len(repr(name)) <= 40 else repr(name)[:37] + "..."
-        raise ModelError(f"{what} = {shown} is not a valid name; use {NAME_RULE}")
+        raise ModelError(f"{what} = {shown} is not a valid name; give a name of {NAME_RULE}")
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -213,7 +213,7 @@ class FrictionModel:
         for dof in self.dofs:
             if "d" + dof in self.dofs:
                 raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
-                                 f"states are the dofs, then d + each dof); rename one of them")
+                                 f"states are the dofs, then d + each dof); give one of them another name")
         for key in ("mass", "damping", "stiffness"):
             value = np.array(getattr(self, key), dtype=float)
             if value.shape != (n, n):
