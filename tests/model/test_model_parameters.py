@@ -219,3 +219,16 @@ def test_set_a_named_parameter_from_the_command_line(tmp_path):
     res = runner.invoke(app, ["stability", "--model", str(path), "--set", "contact.0.drive=0.7"])
     assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1, res.output
     assert 'is the expression "V" of [parameters]' in res.output
+
+
+def test_stability_map_over_a_named_parameter_finds_the_closed_form_boundary():
+    """Equal masses, dampings c and normal forces: the linearised damping is (c − e^{−2V}) I for
+    every kc (μ' = −Δμ α e^{−αV}), so steady sliding turns stable at V = ln(1/c)/2 for any kc."""
+    from stickslip.stability.maps import stability_map
+
+    spec = copy.deepcopy(PARAMETRIC)
+    spec["mass"] = [[1.0, 0.0], [0.0, 1.0]]
+    spec["contact"][1]["normal_force"] = 1.0
+    spec["contact"][1]["friction"]["alpha"] = 2.0
+    smap = stability_map(model_from_spec(spec), np.linspace(0.5, 2.0, 4), np.linspace(0.5, 3.0, 11), axes=("kc", "V"))
+    assert smap.boundary[0][:, 0] == pytest.approx(np.full(4, np.log(1.0 / 0.05) / 2.0), rel=1e-9)
