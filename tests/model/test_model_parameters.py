@@ -171,7 +171,7 @@ def test_normal_force_from_an_expression_must_be_positive():
 @pytest.mark.parametrize("changes, words", [
     ({"V": "fast"}, 'parameter V = "fast" is not a number'),
     ({"V": float("inf")}, "parameters.V = inf is not finite"),
-    ({"W": 1.0}, "no parameter or key 'W'; named parameters: V, k1, k2, kc, m; keys: name, dofs"),
+    ({"W": 1.0}, "no key 'W' under the model and no parameter of that name; named parameters: V, k1, k2, kc, m; keys there: name, dofs"),
     ({"kc": 0.0}, "contact.1.normal_force = 0 must be > 0"),
     ({"m": 1e-320}, "mass is singular or not positive definite to working precision"),
 ])

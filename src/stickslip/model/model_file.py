@@ -485,8 +485,8 @@ def resolve_path(spec: Mapping[str, Any], path: str) -> str:
                 if not canonical:
                     named = ", ".join(spec.get("parameters", {})) or "none (name one in a [parameters] table)"
                     keys = ", ".join(str(k) for k in node if k != "parameters")
-                    raise ModelFileError(f"--set {path}: no parameter or key {part!r}; named parameters: {named}; "
-                                         f"keys: {keys}")
+                    raise ModelFileError(f"--set {path}: no key {part!r} under the model and no parameter of that "
+                                         f"name; named parameters: {named}; keys there: {keys}")
                 raise ModelFileError(f"--set {path}: no key {part!r} under {'.'.join(canonical)}; "
                                      f"keys there: {', '.join(str(k) for k in node)}")
             node = node[part]
