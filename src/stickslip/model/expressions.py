@@ -25,7 +25,7 @@ from typing import Callable, Collection, Mapping
 from ..errors import StickSlipError
 
 __all__ = ["Expression", "ExpressionError", "FUNCTIONS", "CONSTANTS", "RESERVED", "MAX_LENGTH", "MAX_DEPTH",
-           "parse_expression", "grammar"]
+           "parse_expression", "grammar", "finite_number"]
 
 #: Functions an expression may call (one argument each).
 FUNCTIONS: dict[str, Callable[[float], float]] = {"sqrt": math.sqrt, "exp": math.exp, "sin": math.sin, "cos": math.cos}
@@ -51,6 +51,25 @@ _UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos}
 
 class ExpressionError(StickSlipError, ValueError):
     """An expression that cannot be parsed or evaluated (the message says why, without the key)."""
+
+
+def finite_number(value) -> float:
+    """``value`` (an int or float, not a bool) as a finite float.
+
+    Raises
+    ------
+    ExpressionError
+        Saying what ``value`` is instead: not a number, too large for a float, or not finite.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ExpressionError("is not a number")
+    try:
+        number = float(value)
+    except OverflowError:
+        raise ExpressionError("is too large for a float (above 1e308)") from None
+    if not math.isfinite(number):
+        raise ExpressionError("is not finite")
+    return number
 
 
 def grammar(names: Collection[str]) -> str:
@@ -123,15 +142,10 @@ def _compile(node: ast.AST, names: frozenset, used: set, depth: int) -> Callable
     if depth > MAX_DEPTH:
         raise ExpressionError(f"it is nested more than {MAX_DEPTH} levels deep")
     if isinstance(node, ast.Constant):
-        value = node.value
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ExpressionError(f"{value!r} is not a number")
         try:
-            number = float(value)
-        except OverflowError:
-            raise ExpressionError(f"the number {value} is too large for a float") from None
-        if not math.isfinite(number):
-            raise ExpressionError(f"the number {ast.unparse(node)} is not finite")
+            number = finite_number(node.value)
+        except ExpressionError as exc:
+            raise ExpressionError(f"{_describe(node)} {exc}") from None
         return lambda values: number
     if isinstance(node, ast.Name):
         if node.id in CONSTANTS:

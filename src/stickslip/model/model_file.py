@@ -41,7 +41,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import keyword
-import math
 import reprlib
 import sys
 from pathlib import Path
@@ -49,7 +48,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .expressions import RESERVED, Expression, ExpressionError, grammar, parse_expression
+from .expressions import RESERVED, Expression, ExpressionError, finite_number, grammar, parse_expression
 from .friction import FrictionLaw, FrictionLawError
 from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, ModelError, check_name, check_text
 
@@ -101,26 +100,24 @@ def _label(path: str) -> str:
     return ".".join(parts[:k]) + "".join(f"[{p}]" for p in parts[k:])
 
 
-def _number(value, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ModelFileError(f"{where} = {_show(value)} is not a number; give a number")
+def _number(value, where: str, hint: str = "") -> float:
     try:
-        number = float(value)
-    except OverflowError:
-        raise ModelFileError(f"{where} = {value} is too large for a float; give a number below 1e308") from None
-    if not math.isfinite(number):
-        raise ModelFileError(f"{where} = {value} is not finite; give a finite number")
-    return number
+        return finite_number(value)
+    except ExpressionError as exc:
+        raise ModelFileError(f"{where} = {_show(value)} {exc}; give a finite number{hint}") from None
+
+
+def _check_keys(table: Mapping, known: tuple, where: str) -> None:
+    unknown = sorted(map(str, set(table) - set(known)))
+    if unknown:
+        raise ModelFileError(f"{where}unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(known)}")
 
 
 def _entry(value, path: str, names) -> float | Expression:
     """A number of the file: a float, or an expression of the parameters ``names`` (a string)."""
     label = _label(path)
     if not isinstance(value, str):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ModelFileError(f"{label} = {_show(value)} is not a number; give a number or an expression "
-                                 "of [parameters] (a string)")
-        return _number(value, label)
+        return _number(value, label, " or an expression of [parameters] (a string)")
     try:
         check_text(value, label)
     except ModelError as exc:
@@ -311,9 +308,7 @@ class _Parser:
         where = f"contact.{c}"
         if not isinstance(table, Mapping):
             raise ModelFileError(f"{where} must be a table ([[contact]])")
-        unknown = sorted(map(str, set(table) - set(CONTACT_KEYS)))
-        if unknown:
-            raise ModelFileError(f"{where}: unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(CONTACT_KEYS)}")
+        _check_keys(table, CONTACT_KEYS, f"{where}: ")
         for key in REQUIRED_CONTACT:
             if key not in table:
                 hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]", "normal_force": "N0 > 0 [N]",
@@ -342,9 +337,7 @@ class _Parser:
         where = f"contact.{c}.friction"
         if not isinstance(table, Mapping):
             raise ModelFileError(f"{where} must be a table ([contact.friction])")
-        unknown = sorted(map(str, set(table) - set(FRICTION_KEYS)))
-        if unknown:
-            raise ModelFileError(f"{where}: unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(FRICTION_KEYS)}")
+        _check_keys(table, FRICTION_KEYS, f"{where}: ")
         self.shapes[f"{c}.friction"] = None
         for key, value in table.items():
             if key != "law":
@@ -360,9 +353,7 @@ def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Templ
     """Check a model file's content (keys, shapes, names, expressions) once."""
     if not isinstance(spec, Mapping):
         raise ModelFileError("a model file holds a table of keys (name, dofs, mass, ...)")
-    unknown = sorted(map(str, set(spec) - set(TOP_KEYS)))
-    if unknown:
-        raise ModelFileError(f"unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(TOP_KEYS)}")
+    _check_keys(spec, TOP_KEYS, "")
     for key in REQUIRED_TOP:
         if key not in spec:
             hint = {"contact": "add at least one [[contact]] table", "dofs": 'e.g. dofs = ["x"]'}.get(
