@@ -9,11 +9,14 @@ import pytest
 import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from typer.testing import CliRunner
 
+from stickslip.cli import app
 from stickslip.errors import StickSlipError
+from stickslip.model.friction import FrictionLaw
 from stickslip.model.library import load_model
 from stickslip.model.model_file import (CONTACT_KEYS, TOP_KEYS, ModelFileError, load_model_file, model_from_spec)
-from stickslip.model.system_model import ModelError
+from stickslip.model.system_model import Contact, FrictionModel, ModelError
 
 #: Words of the fix that every message gives.
 FIX_WORDS = ("give", "choose", "add", "must", "fix", "valid keys", "e.g.", "needs")
@@ -192,7 +195,8 @@ def cannot_be_an_expression(text):
 
 #: Values that are not a finite number (those a TOML file can hold); strings that could be an
 #: expression are left out.
-NOT_A_NUMBER = st.one_of(st.text(max_size=5).filter(cannot_be_an_expression), st.booleans(), st.lists(st.floats(allow_nan=False), max_size=2),
+NOT_A_NUMBER = st.one_of(st.text(max_size=5).filter(cannot_be_an_expression), st.booleans(),
+                         st.lists(st.floats(allow_nan=False), max_size=2),
                          st.dictionaries(st.text("abc", min_size=1, max_size=3), st.integers(-5, 5), max_size=2),
                          st.sampled_from([math.nan, math.inf, -math.inf]))
 
@@ -291,8 +295,6 @@ def test_errors_are_stickslip_errors():
 
 # --------------------------------------------------------------------------- input defects
 def test_replace_on_a_model_without_parameters_says_how_to_give_it_some():
-    from stickslip.model.friction import FrictionLaw
-    from stickslip.model.system_model import Contact, FrictionModel
 
     model = FrictionModel(name="hand", dofs=("x",), mass=[[1.0]], damping=[[0.1]], stiffness=[[1.0]], force=[0.0],
                           contacts=(Contact(dim=1, friction=FrictionLaw("coulomb", 0.3, 0.1), normal_force=1.0,
@@ -320,7 +322,6 @@ def test_dof_names_that_collide_or_cannot_be_reached_are_refused(tmp_path, dofs,
 
 
 def test_python_models_refuse_colliding_state_names():
-    from stickslip.model.system_model import FrictionModel
 
     base = load_model("popp-stelter")
     with pytest.raises(ModelError, match="dofs x and dx both have the state name dx"):
@@ -348,10 +349,6 @@ def test_tiny_mass_of_a_file_is_refused_and_a_well_conditioned_one_is_not(tmp_pa
 
 
 def test_set_a_subnormal_mass_on_the_command_line_is_one_line():
-    from typer.testing import CliRunner
-
-    from stickslip.cli import app
-
     res = CliRunner().invoke(app, ["stability", "--model", "popp-stelter", "--set", "mass.0.0=1e-320"])
     assert res.exit_code == 2 and "Traceback" not in res.output, res.output
     assert len(res.output.strip().splitlines()) == 1 and "working precision" in res.output
@@ -397,7 +394,6 @@ def test_control_characters_in_names_and_descriptions_are_refused(tmp_path, wher
 
 
 def test_python_models_refuse_control_characters():
-    from stickslip.model.system_model import Contact, FrictionModel
 
     base = load_model("belt")
     for changes in ({"name": "a\x1bb"}, {"description": "x\r\ny"},
@@ -410,10 +406,6 @@ def test_python_models_refuse_control_characters():
 
 
 def test_the_cli_prints_no_escape_sequence_from_a_model_file(tmp_path):
-    from typer.testing import CliRunner
-
-    from stickslip.cli import app
-
     spec = copy.deepcopy(BASES[0])
     spec["description"] = "\x1b[31mred\x1b[0m"
     res = CliRunner().invoke(app, ["models", str(write(tmp_path, spec))])

@@ -11,8 +11,9 @@ from typer.testing import CliRunner
 
 from stickslip.cli import app
 from stickslip.model.library import describe_system, load_model, system_from_description
-from stickslip.model.model_file import ModelFileError, load_model_file, model_from_spec
+from stickslip.model.model_file import ModelFileError, model_from_spec
 from stickslip.model.system_model import ModelError
+from stickslip.stability.maps import stability_map
 
 #: Two masses on one belt (the library's popp-stelter structure) with named parameters.
 PARAMETRIC = {
@@ -145,7 +146,8 @@ def test_a_bad_expression_names_the_key_and_the_grammar():
     (lambda s: s["parameters"].update(ic=1.0), "'ic' is reserved"),
     (lambda s: s["parameters"].update(perturb_x1=1.0), "'perturb_x1' is reserved"),
     (lambda s: s["parameters"].update({"lambda": 1.0}), "'lambda' is reserved"),
-    (lambda s: s["parameters"].update({"a b": 1.0}), "'a b' is not a valid name; give a name of ASCII letters, digits and _"),
+    (lambda s: s["parameters"].update({"a b": 1.0}),
+     "'a b' is not a valid name; give a name of ASCII letters, digits and _"),
     (lambda s: s["parameters"].update({"k.1": 1.0}), "'k.1' is not a valid name"),
     (lambda s: s["parameters"].update({"1k": 1.0}), "not starting with a digit"),
     (lambda s: s["contact"][0].update(drive=["1 / (V - 0.3)"]),
@@ -171,7 +173,8 @@ def test_normal_force_from_an_expression_must_be_positive():
 @pytest.mark.parametrize("changes, words", [
     ({"V": "fast"}, 'parameter V = "fast" is not a number'),
     ({"V": float("inf")}, "parameters.V = inf is not finite"),
-    ({"W": 1.0}, "no key 'W' under the model and no parameter of that name; named parameters: V, k1, k2, kc, m; keys there: name, dofs"),
+    ({"W": 1.0}, "no key 'W' under the model and no parameter of that name; named parameters: V, k1, k2, kc, m; "
+                 "keys there: name, dofs"),
     ({"kc": 0.0}, "contact.1.normal_force = 0 must be > 0"),
     ({"m": 1e-320}, "mass is singular or not positive definite to working precision"),
 ])
@@ -224,8 +227,6 @@ def test_set_a_named_parameter_from_the_command_line(tmp_path):
 def test_stability_map_over_a_named_parameter_finds_the_closed_form_boundary():
     """Equal masses, dampings c and normal forces: the linearised damping is (c − e^{−2V}) I for
     every kc (μ' = −Δμ α e^{−αV}), so steady sliding turns stable at V = ln(1/c)/2 for any kc."""
-    from stickslip.stability.maps import stability_map
-
     spec = copy.deepcopy(PARAMETRIC)
     spec["mass"] = [[1.0, 0.0], [0.0, 1.0]]
     spec["contact"][1]["normal_force"] = 1.0

@@ -19,6 +19,7 @@ from __future__ import annotations
 import ast
 import dataclasses
 import math
+import numbers
 import operator
 from typing import Callable, Collection, Mapping
 
@@ -54,14 +55,14 @@ class ExpressionError(StickSlipError, ValueError):
 
 
 def finite_number(value) -> float:
-    """``value`` (an int or float, not a bool) as a finite float.
+    """``value`` (a real number such as an int, float or numpy scalar; not a bool) as a finite float.
 
     Raises
     ------
     ExpressionError
         Saying what ``value`` is instead: not a number, too large for a float, or not finite.
     """
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ExpressionError("is not a number")
     try:
         number = float(value)

@@ -5,7 +5,7 @@ name = "belt"
 dofs = ["x"]              # names of q, in order; states are the dofs, then "d" + each dof
 mass = [[1.0]]            # M, n×n
 damping = [[0.1]]         # C, n×n
-stiffness = ["k"]         # K, n×n, may be non-symmetric; here an expression of [parameters]
+stiffness = [["k"]]       # K, n×n, may be non-symmetric; here an expression of [parameters]
 force = [0.0]             # f0 (optional, default 0)
 
 [parameters]              # optional: named numbers that entries use in expressions
@@ -206,9 +206,10 @@ class _Template:
                 continue
             current = self.slots[path]
             if isinstance(current, Expression):
+                uses = ", ".join(sorted(current.names)) or "none"
                 raise ModelFileError(f"--set {path}: {_label(path)} is the expression {_quote(current.text)} of "
-                                     f"[parameters]; set the parameters it uses ({', '.join(sorted(current.names)) or 'none'}) "
-                                     "instead, or write a number in the file")
+                                     f"[parameters]; set the parameters it uses ({uses}) instead, or write a number "
+                                     "in the file")
             slots = dict(slots) if slots is self.slots else slots
             if self.targets[path][1] == "law":
                 slots[path] = new
@@ -224,8 +225,6 @@ class _Template:
 def _parameter_value(value, name: str) -> float:
     if isinstance(value, str):
         raise ModelFileError(f"parameter {name} = {_quote(value)} is not a number; give a number")
-    if isinstance(value, np.generic):
-        value = value.item()
     return _number(value, f"parameters.{name}")
 
 

@@ -73,7 +73,7 @@ def check_text(text: str, what: str) -> None:
         Naming ``what`` and the first such character.
     """
     text = str(text)
-    if text.isprintable():  # no character of _CONTROL (nor any space but " ")
+    if text.isprintable():  # False for every character of _CONTROL (and for spaces other than " ")
         return
     for ch in text:
         if unicodedata.category(ch) in _CONTROL:
@@ -365,9 +365,9 @@ class FrictionModel:
         if not changes:
             return self
         if self.builder is None or not self.parameters:
-            raise ModelError(f"model {self.name!r} has no named parameters to change ({', '.join(changes)}): it was "
-                             "built directly; give FrictionModel a builder= and parameters= (a function that builds "
-                             "the model from its parameters, docs/models.md) or state it as a model file")
+            raise ModelError(f"model {self.name!r} has no named parameters to change ({', '.join(changes)}); give "
+                             "FrictionModel a builder= and parameters= (a function that builds the model from its "
+                             "parameters, docs/models.md) or state it as a model file")
         if self.resolver is not None:
             changes = {self.resolver(k): v for k, v in changes.items()}
         unknown = [k for k in changes if k not in self.parameters]
