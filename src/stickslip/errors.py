@@ -10,6 +10,7 @@ them without importing the module that raises it.
 
 =======================  ======================================================================
 ``ModelError``           a model that cannot be built as stated (``ModelFileError``: a model file)
+``ExpressionError``      an expression of named parameters that cannot be parsed or evaluated
 ``ParameterError``       a parameter of the two plates that cannot describe them
 ``FrictionLawError``     an unknown or invalid friction law
 ``VariantError``         an unknown variant (set of free DOFs) of the two plates
@@ -32,7 +33,7 @@ them without importing the module that raises it.
 from __future__ import annotations
 
 __all__ = ["StickSlipError", "ModelError", "ModelFileError", "ParameterError", "FrictionLawError", "VariantError",
-           "KinematicsError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
+           "KinematicsError", "ExpressionError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
            "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError"]
 
 
@@ -46,6 +47,11 @@ class ModelError(StickSlipError, ValueError):
 
 class ModelFileError(ModelError):
     """A model file that cannot be read as a model (the message names the key and the fix)."""
+
+
+class ExpressionError(StickSlipError, ValueError):
+    """An expression of a model file that cannot be parsed or evaluated (the message says why,
+    without the key: the model file adds it)."""
 
 
 class ParameterError(StickSlipError, ValueError):

@@ -2,17 +2,21 @@
 
 import copy
 import math
+import unicodedata
 
 import numpy as np
 import pytest
 import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from typer.testing import CliRunner
 
+from stickslip.cli import app
 from stickslip.errors import StickSlipError
+from stickslip.model.friction import FrictionLaw
 from stickslip.model.library import load_model
 from stickslip.model.model_file import (CONTACT_KEYS, TOP_KEYS, ModelFileError, load_model_file, model_from_spec)
-from stickslip.model.system_model import ModelError
+from stickslip.model.system_model import Contact, FrictionModel, ModelError
 
 #: Words of the fix that every message gives.
 FIX_WORDS = ("give", "choose", "add", "must", "fix", "valid keys", "e.g.", "needs")
@@ -145,8 +149,9 @@ def test_missing_key(tmp_path, where, key):
     assert "missing" in message
 
 
-@pytest.mark.parametrize("value", ["1.0", True, [1.0], {"a": 1.0}, math.nan, math.inf])
+@pytest.mark.parametrize("value", ["one", "1.0 +", True, [1.0], {"a": 1.0}, math.nan, math.inf])
 def test_non_number(tmp_path, value):
+    """Strings are expressions of [parameters]: one that is not valid is refused like a non-number."""
     spec = copy.deepcopy(BASES[0])
     spec["stiffness"][0][0] = value
     refused(write(tmp_path, spec), "stiffness[0][0]")
@@ -181,8 +186,17 @@ def test_set_paths_are_checked():
 
 
 # --------------------------------------------------------------------------- properties
-#: Values that are not a finite number (those a TOML file can hold).
-NOT_A_NUMBER = st.one_of(st.text(max_size=5), st.booleans(), st.lists(st.floats(allow_nan=False), max_size=2),
+def cannot_be_an_expression(text):
+    """Whether ``text`` has no number, ``pi`` or name a valid expression needs (these files have no
+    [parameters]): no digit and no letter after Unicode normalisation, which Python applies to names."""
+    text = unicodedata.normalize("NFKC", text)
+    return not any(ch.isdigit() or ch.isalpha() or ch == "_" for ch in text)
+
+
+#: Values that are not a finite number (those a TOML file can hold); strings that could be an
+#: expression are left out.
+NOT_A_NUMBER = st.one_of(st.text(max_size=5).filter(cannot_be_an_expression), st.booleans(),
+                         st.lists(st.floats(allow_nan=False), max_size=2),
                          st.dictionaries(st.text("abc", min_size=1, max_size=3), st.integers(-5, 5), max_size=2),
                          st.sampled_from([math.nan, math.inf, -math.inf]))
 
@@ -277,3 +291,122 @@ def test_errors_are_stickslip_errors():
     assert issubclass(ModelFileError, StickSlipError) and issubclass(ModelFileError, ValueError)
     with pytest.raises(StickSlipError):
         model_from_spec({"dofs": ["x"]})
+
+
+# --------------------------------------------------------------------------- input defects
+def test_replace_on_a_model_without_parameters_says_how_to_give_it_some():
+
+    model = FrictionModel(name="hand", dofs=("x",), mass=[[1.0]], damping=[[0.1]], stiffness=[[1.0]], force=[0.0],
+                          contacts=(Contact(dim=1, friction=FrictionLaw("coulomb", 0.3, 0.1), normal_force=1.0,
+                                            tangent=[[1.0]], drive=[0.5]),))
+    with pytest.raises(ModelError) as info:
+        model.replace(**{"contact.0.drive": 0.3})
+    message = str(info.value)
+    assert "valid names" not in message and "no named parameters" in message
+    assert "builder=" in message and "parameters=" in message and "model file" in message
+
+
+@pytest.mark.parametrize("dofs, words", [
+    (["x", "dx"], "dofs x and dx both have the state name dx"),
+    (["x=1"], "dofs[0] = 'x=1' is not a valid name"), (["a,b"], "is not a valid name"), (["x y"], "not a valid name"),
+    (["x.y"], "not a valid name"), (["x\t"], "not a valid name"), (["1x"], "not starting with a digit"),
+    (["φ"], "ASCII letters, digits and _"), (["x", "x-1"], "dofs[1] = 'x-1'"),
+])
+def test_dof_names_that_collide_or_cannot_be_reached_are_refused(tmp_path, dofs, words):
+    spec = copy.deepcopy(BASES[0]) if len(dofs) == 1 else copy.deepcopy(BASES[1])
+    spec["dofs"] = dofs
+    spec.pop("units", None)
+    spec.pop("observe", None)
+    message = refused(write(tmp_path, spec), "dof")
+    assert words in message and ("ASCII letters, digits and _" in message or "state name" in message), message
+
+
+def test_python_models_refuse_colliding_state_names():
+
+    base = load_model("popp-stelter")
+    with pytest.raises(ModelError, match="dofs x and dx both have the state name dx"):
+        FrictionModel(name="m", dofs=("x", "dx"), mass=base.mass, damping=base.damping, stiffness=base.stiffness,
+                      force=base.force, contacts=base.contacts)
+
+
+@pytest.mark.parametrize("path, value", [("mass.0.0", 1e-320), ("mass.1.1", 5e-324), ("mass.0.0", 1e-14)])
+def test_mass_singular_to_working_precision_is_refused_in_one_line(path, value):
+    with pytest.raises(ModelError) as info:
+        load_model("popp-stelter").replace(**{path: value})
+    message = str(info.value)
+    assert "\n" not in message and "singular or not positive definite to working precision" in message
+
+
+def test_tiny_mass_of_a_file_is_refused_and_a_well_conditioned_one_is_not(tmp_path):
+    spec = copy.deepcopy(BASES[0])
+    spec["mass"] = [[5e-324]]
+    refused(write(tmp_path, spec), "mass", "working precision")
+    spec = copy.deepcopy(BASES[1])
+    spec["mass"] = [[1.0, 0.0], [0.0, 1e-12]]    # condition number 1e12: below the limit
+    assert load_model_file(write(tmp_path, spec)).mass[1, 1] == 1e-12
+    spec["mass"] = [[1.0, 0.0], [0.0, 1e-14]]    # 1e14: above it
+    refused(write(tmp_path, spec), "mass", "working precision")
+
+
+def test_set_a_subnormal_mass_on_the_command_line_is_one_line():
+    res = CliRunner().invoke(app, ["stability", "--model", "popp-stelter", "--set", "mass.0.0=1e-320"])
+    assert res.exit_code == 2 and "Traceback" not in res.output, res.output
+    assert len(res.output.strip().splitlines()) == 1 and "working precision" in res.output
+
+
+def nested(depth, leaf=1.0):
+    value = leaf
+    for _ in range(depth):
+        value = [value]
+    return value
+
+
+def test_deeply_nested_value_is_one_line(tmp_path):
+    path = tmp_path / "deep.toml"
+    path.write_text("mass = " + "[" * 1000 + "1.0" + "]" * 1000 + "\n")  # TOML's reader recurses per level
+    message = refused(path, "deep.toml", "nested too deeply")
+    assert len(message) < 300
+    for depth in (300, 1000, 3000):
+        spec = copy.deepcopy(BASES[0])
+        spec["mass"] = nested(depth)
+        with pytest.raises(ModelFileError) as info:
+            model_from_spec(spec)
+        assert len(str(info.value)) < 300 and "mass[0][0]" in str(info.value)
+
+
+@pytest.mark.parametrize("where, text", [
+    ("name", "\x1b[31mred"), ("description", "one\ntwo"), ("description", "tab\there"),
+    ("description", "right-to-left \u202e override"), ("contact.0.name", "\x1b[2J"), ("units", None),
+])
+def test_control_characters_in_names_and_descriptions_are_refused(tmp_path, where, text):
+    spec = copy.deepcopy(BASES[0])
+    if where == "contact.0.name":
+        spec["contact"][0]["name"] = text
+    elif where == "units":
+        spec["dofs"] = ["x\x1b"]
+        spec.pop("units", None)
+        spec.pop("observe", None)
+        where = "dofs[0]"
+    else:
+        spec[where] = text
+    message = refused(write(tmp_path, spec), where)
+    assert "\x1b" not in message and "\t" not in message and "\u202e" not in message
+
+
+def test_python_models_refuse_control_characters():
+
+    base = load_model("belt")
+    for changes in ({"name": "a\x1bb"}, {"description": "x\r\ny"},
+                    {"contacts": (Contact(dim=1, friction=base.contacts[0].friction, normal_force=1.0,
+                                          tangent=[[1.0]], drive=[1.0], name="c\n"),)}):
+        fields = dict(name="m", dofs=("x",), mass=base.mass, damping=base.damping, stiffness=base.stiffness,
+                      force=base.force, contacts=base.contacts) | changes
+        with pytest.raises(ModelError, match="control character"):
+            FrictionModel(**fields)
+
+
+def test_the_cli_prints_no_escape_sequence_from_a_model_file(tmp_path):
+    spec = copy.deepcopy(BASES[0])
+    spec["description"] = "\x1b[31mred\x1b[0m"
+    res = CliRunner().invoke(app, ["models", str(write(tmp_path, spec))])
+    assert res.exit_code == 2 and "\x1b" not in res.output and len(res.output.strip().splitlines()) == 1

@@ -25,22 +25,10 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.jit import kernel
-
 # the event codes, tolerances and transition steps are those of the generic event integrator
-from .contacts import (  # noqa: F401
-    EVENT_SLIP,
-    EVENT_STICK,
-    EVENT_TIME_TOL,
-    STICK_SPEED_TOL,
-    TRANSITION_TO_SLIP,
-    TRANSITION_TO_STICK,
-    all_finite,
-    breakaway_direction,
-    dense_state,
-    event_value,
-    first_crossing,
-    try_stick,
-)
+from .contacts import (EVENT_SLIP, EVENT_STICK, EVENT_TIME_TOL, STICK_SPEED_TOL, TRANSITION_TO_SLIP,  # noqa: F401
+                       TRANSITION_TO_STICK, all_finite, breakaway_direction, dense_state, event_value, first_crossing,
+                       try_stick)
 
 #: Largest number of bisections of one transition bracket (fixed-step methods): the bracket
 #: halves each time, so 200 is far more than the ~40 needed to go from Δt = 0.1 s to

@@ -5,8 +5,11 @@ name = "belt"
 dofs = ["x"]              # names of q, in order; states are the dofs, then "d" + each dof
 mass = [[1.0]]            # M, n×n
 damping = [[0.1]]         # C, n×n
-stiffness = [[1.0]]       # K, n×n, may be non-symmetric
+stiffness = [["k"]]       # K, n×n, may be non-symmetric; here an expression of [parameters]
 force = [0.0]             # f0 (optional, default 0)
+
+[parameters]              # optional: named numbers that entries use in expressions
+k = 1.0
 
 [[contact]]               # one table per contact
 tangent = [[1.0]]         # G: 1 row (1-D friction) or 2 rows (2-D), n columns
@@ -20,73 +23,421 @@ delta_mu = 0.5
 alpha = 2.0
 ```
 
-Every key is documented in ``docs/models.md``. Every number of a file is a parameter that
-``--set`` reaches by its path: ``mass.0.0``, ``stiffness.x.y`` (indices or dof names),
-``force.1``, ``contact.0.drive`` (a one-entry vector needs no index), ``contact.0.normal_force``,
-``contact.1.friction.mu_k``, ``slip_band``. Errors name the key and the fix in one line.
+Every key is documented in ``docs/models.md``. A string where a number goes is an expression of
+the ``[parameters]`` (:mod:`stickslip.model.expressions`). Every parameter is reached by
+``--set`` and ``FrictionModel.replace``: a named parameter by its name (``k``), every entry by
+its path: ``mass.0.0``, ``stiffness.x.y`` (indices or dof names), ``force.1``,
+``contact.0.drive`` (a one-entry vector needs no index), ``contact.0.normal_force``,
+``contact.1.friction.mu_k``, ``slip_band``. An entry written as an expression is set through its
+parameters (a path into it is refused). Errors name the key and the fix in one line.
+
+The file is checked once, when it is read (keys, shapes, names, expressions), into a
+:class:`_Template`; each model — the file's, and each ``replace`` of it — is the template's
+entries evaluated at its parameter values, validated once by :class:`FrictionModel`.
 """
 
 from __future__ import annotations
 
-import copy
-import math
+import dataclasses
+import json
+import keyword
+import reprlib
 import sys
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import FrictionLawError, ModelError, ModelFileError
+from ..errors import ExpressionError, FrictionLawError, ModelError, ModelFileError
+from .expressions import RESERVED, Expression, finite_number, grammar, parse_expression
 from .friction import FrictionLaw
-from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel
+from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, check_name, check_text
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["load_model_file", "model_from_spec", "parameter_paths", "ModelFileError", "TOP_KEYS", "CONTACT_KEYS"]
+__all__ = ["load_model_file", "model_from_spec", "resolve_path", "ModelFileError", "TOP_KEYS", "CONTACT_KEYS",
+           "FRICTION_KEYS", "RESERVED_NAMES"]
 
-TOP_KEYS = ("name", "description", "dofs", "mass", "damping", "stiffness", "force", "units", "slip_band", "observe",
-            "contact")
+TOP_KEYS = ("name", "description", "parameters", "dofs", "mass", "damping", "stiffness", "force", "units",
+            "slip_band", "observe", "contact")
 REQUIRED_TOP = ("dofs", "mass", "damping", "stiffness", "contact")
 CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "friction")
 REQUIRED_CONTACT = ("tangent", "normal_force", "friction")
+FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v")
+
+#: Names a parameter cannot take: the model file's keys (``--set mass=2`` is the path of a 1×1
+#: mass), the functions and constant of expressions, and the names a sweep's grid gives other
+#: meanings (``model``, ``ic``; ``perturb_<state>`` is refused as a prefix).
+RESERVED_NAMES = frozenset(TOP_KEYS) | RESERVED | {"model", "ic"}
+
+#: Short reprs for messages: a value shown in an error stays on one short line, however deeply
+#: nested or long (levels, list items and characters shown).
+_SHORT = reprlib.Repr()
+_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxstring, _SHORT.maxother = 3, 6, 40, 40
 
 
-def _number(value, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ModelFileError(f"{where} = {value!r} is not a number; give a number")
+def _show(value) -> str:
+    return _SHORT.repr(value)
+
+
+def _quote(text: str) -> str:
+    """An expression as the file writes it, on one line (control characters escaped)."""
+    return json.dumps(text if len(text) <= 60 else text[:57] + "...", ensure_ascii=False)
+
+
+def _label(path: str) -> str:
+    """How errors name an entry: ``mass.0.1`` → ``mass[0][1]``, ``contact.0.drive.0`` → ``contact.0.drive[0]``."""
+    parts = path.split(".")
+    k = len(parts)
+    while k > 1 and parts[k - 1].isdigit():
+        k -= 1
+    return ".".join(parts[:k]) + "".join(f"[{p}]" for p in parts[k:])
+
+
+def _number(value, where: str, hint: str = "") -> float:
     try:
-        number = float(value)
-    except OverflowError:
-        raise ModelFileError(f"{where} = {value} is too large for a float; give a number below 1e308") from None
-    if not math.isfinite(number):
-        raise ModelFileError(f"{where} = {value} is not finite; give a finite number")
-    return number
+        return finite_number(value)
+    except ExpressionError as exc:
+        raise ModelFileError(f"{where} = {_show(value)} {exc}; give a finite number{hint}") from None
 
 
-def _vector(value, n: int, where: str) -> np.ndarray:
-    if not isinstance(value, list):
-        value = [value] if n == 1 else value
-    if not isinstance(value, list) or len(value) != n:
-        raise ModelFileError(f"{where} must be a list of {n} number(s), got {value!r}")
-    return np.array([_number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+def _check_keys(table: Mapping, known: tuple, where: str) -> None:
+    unknown = sorted(map(str, set(table) - set(known)))
+    if unknown:
+        raise ModelFileError(f"{where}unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(known)}")
 
 
-def _matrix(value, rows: int | None, n: int, where: str) -> np.ndarray:
-    if not isinstance(value, list) or not value or not all(isinstance(row, list) for row in value):
-        raise ModelFileError(f"{where} must be a list of rows, each a list of {n} numbers, e.g. "
-                             f"{where.split('.')[-1]} = [[{', '.join(['1.0'] * n)}]]")
-    if rows is not None and len(value) != rows:
-        raise ModelFileError(f"{where} must have {rows} row(s) (one per dof), got {len(value)}")
-    out = np.empty((len(value), n))
-    for i, row in enumerate(value):
-        if len(row) != n:
-            raise ModelFileError(f"{where} row {i} must have {n} number(s) (one per dof), got {len(row)}")
-        for j, v in enumerate(row):
-            out[i, j] = _number(v, f"{where}[{i}][{j}]")
+def _entry(value, path: str, names) -> float | Expression:
+    """A number of the file: a float, or an expression of the parameters ``names`` (a string)."""
+    label = _label(path)
+    if not isinstance(value, str):
+        return _number(value, label, " or an expression of [parameters] (a string)")
+    try:
+        check_text(value, label)
+    except ModelError as exc:
+        raise ModelFileError(str(exc)) from None
+    try:
+        return parse_expression(value, names)
+    except ExpressionError as exc:
+        raise ModelFileError(f"{label} = {_quote(value)} is not a valid expression: {exc}; {grammar(names)}") from None
+
+
+def _parameters(table) -> dict[str, float]:
+    """The ``[parameters]`` table: valid names, finite numbers."""
+    if not isinstance(table, Mapping):
+        raise ModelFileError(f"parameters = {_show(table)} must be a table of name = number, e.g. [parameters] V = 0.2")
+    out = {}
+    for name, value in table.items():
+        try:
+            check_name(name, "parameters: name")
+        except ModelError as exc:
+            raise ModelFileError(str(exc)) from None
+        if keyword.iskeyword(name) or name in RESERVED_NAMES or name.startswith("perturb_"):
+            raise ModelFileError(f"parameters: the name {name!r} is reserved (a key of model files, a function or "
+                                 "constant of expressions, or a sweep's model, ic, perturb_*); choose another name")
+        if isinstance(value, str):
+            raise ModelFileError(f"parameters.{name} = {_quote(value)} is not a number; give a number (expressions "
+                                 "go in the model's entries, not in [parameters])")
+        out[name] = _number(value, f"parameters.{name}")
     return out
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Template:
+    """A model file checked once: what every model built from it shares, and its entries.
+
+    ``slots`` maps each entry's path (file order) to its float, :class:`Expression` or law name;
+    ``targets`` maps the path to (container, index) where its value goes; ``shapes`` gives each
+    container's array shape (None: a table of values, such as a contact's friction).
+    """
+
+    spec: dict
+    name: str
+    description: str
+    dofs: tuple
+    units: dict
+    observe: str
+    source: str
+    contact_names: tuple
+    shapes: dict
+    targets: dict
+    named: dict
+    slots: dict
+    parameters: dict = dataclasses.field(init=False)
+
+    def __post_init__(self) -> None:
+        raw = {p: v.text if isinstance(v, Expression) else v for p, v in self.slots.items()}
+        object.__setattr__(self, "parameters", {**self.named, **raw})
+
+    def resolve(self, path: str) -> str:
+        """The parameter name of ``path``: a named parameter, or the canonical path of an entry."""
+        if path in self.named:
+            return path
+        head, _, rest = path.partition(".")
+        if head == "parameters" and rest in self.named:
+            return rest
+        return resolve_path(self.spec, path)
+
+    def with_values(self, values: Mapping[str, Any]) -> FrictionModel:
+        """The model at parameter values ``values`` (names and canonical paths, as in :attr:`parameters`).
+
+        Entries whose value differs from the template's are replaced (a number, or a string: an
+        expression); a named parameter moves every expression that uses it. Only the changed
+        entries are checked here; the model is validated once when it is built.
+        """
+        named, slots, edits = self.named, self.slots, {}
+        for name, old in self.named.items():
+            new = values.get(name, old)
+            if new is not old and new != old:
+                named = dict(named) if named is self.named else named
+                named[name] = _parameter_value(new, name)
+                edits[f"parameters.{name}"] = named[name]
+        for path, old in self.parameters.items():
+            if path in self.named:
+                continue
+            new = values.get(path, old)
+            if new is old or (type(new) is type(old) and new == old):
+                continue
+            current = self.slots[path]
+            if isinstance(current, Expression):
+                uses = ", ".join(sorted(current.names)) or "none"
+                raise ModelFileError(f"--set {path}: {_label(path)} is the expression {_quote(current.text)} of "
+                                     f"[parameters]; set the parameters it uses ({uses}) instead, or write a number "
+                                     "in the file")
+            slots = dict(slots) if slots is self.slots else slots
+            if self.targets[path][1] == "law":
+                slots[path] = new
+            else:
+                slots[path] = _entry(new, path, self.named)
+                new = new if isinstance(new, str) else slots[path]
+            edits[path] = new
+        if not edits:
+            return _build(self)
+        return _build(dataclasses.replace(self, spec=_edited(self.spec, edits), named=named, slots=slots))
+
+
+def _parameter_value(value, name: str) -> float:
+    if isinstance(value, str):
+        raise ModelFileError(f"parameter {name} = {_quote(value)} is not a number; give a number")
+    return _number(value, f"parameters.{name}")
+
+
+def _edited(spec: dict, edits: Mapping[str, Any]) -> dict:
+    """A copy of ``spec`` with the values at the canonical paths ``edits`` replaced; only the
+    tables and lists on the way to an edit are copied (``spec`` itself is never changed)."""
+    out = dict(spec)
+    copied = {id(out)}
+    for path, value in edits.items():
+        parts = path.split(".")
+        node = out
+        for part in parts[:-1]:
+            key = int(part) if isinstance(node, list) else part
+            child = node[key]
+            if id(child) not in copied:
+                child = list(child) if isinstance(child, list) else dict(child)
+                copied.add(id(child))
+                node[key] = child
+            node = child
+        node[int(parts[-1]) if isinstance(node, list) else parts[-1]] = value
+    return out
+
+
+def _plain_copy(value):
+    """A copy of the checked tables and lists of a file (no shared containers with the caller's)."""
+    if isinstance(value, Mapping):
+        return {k: _plain_copy(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain_copy(v) for v in value]
+    return value
+
+
+class _Parser:
+    """Checks the entries of a file and collects them as slots of a :class:`_Template`."""
+
+    def __init__(self, n: int, names) -> None:
+        self.n, self.names = n, names
+        self.slots: dict = {}
+        self.targets: dict = {}
+        self.shapes: dict = {"scalars": None}
+
+    def number(self, value, path: str, container: str, index) -> None:
+        self.slots[path] = _entry(value, path, self.names)
+        self.targets[path] = (container, index)
+
+    def vector(self, value, n: int, key: str, container: str) -> None:
+        """n entries (a one-entry vector may be written as a number)."""
+        if not isinstance(value, list):
+            if n == 1 and (isinstance(value, (int, float, str)) and not isinstance(value, bool)):
+                self.shapes[container] = (1,)
+                return self.number(value, key, container, 0)
+            raise ModelFileError(f"{key} must be a list of {n} number(s), got {_show(value)}")
+        if len(value) != n:
+            raise ModelFileError(f"{key} must be a list of {n} number(s), got {_show(value)}")
+        self.shapes[container] = (n,)
+        for i, v in enumerate(value):
+            self.number(v, f"{key}.{i}", container, i)
+
+    def matrix(self, value, rows: int | None, key: str, container: str, flat: bool = False) -> int:
+        """A matrix of ``rows`` (None: any number of) rows of n entries; returns the number of rows."""
+        n = self.n
+        if flat:  # a single row written flat
+            value = [value]
+        if not isinstance(value, list) or not value or not all(isinstance(row, list) for row in value):
+            raise ModelFileError(f"{key} must be a list of rows, each a list of {n} numbers, e.g. "
+                                 f"{key.split('.')[-1]} = [[{', '.join(['1.0'] * n)}]]")
+        if rows is not None and len(value) != rows:
+            raise ModelFileError(f"{key} must have {rows} row(s) (one per dof), got {len(value)}")
+        for i, row in enumerate(value):
+            if len(row) != n:
+                raise ModelFileError(f"{key} row {i} must have {n} number(s) (one per dof), got {len(row)}")
+        self.shapes[container] = (len(value), n)
+        for i, row in enumerate(value):
+            for j, v in enumerate(row):
+                self.number(v, f"{key}.{j}" if flat else f"{key}.{i}.{j}", container, (i, j))
+        return len(value)
+
+    def contact(self, c: int, table) -> str:
+        """Contact ``c``'s entries; returns its name."""
+        where = f"contact.{c}"
+        if not isinstance(table, Mapping):
+            raise ModelFileError(f"{where} must be a table ([[contact]])")
+        _check_keys(table, CONTACT_KEYS, f"{where}: ")
+        for key in REQUIRED_CONTACT:
+            if key not in table:
+                hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]", "normal_force": "N0 > 0 [N]",
+                        "friction": "add a [contact.friction] table with law, mu_k, delta_mu"}[key]
+                raise ModelFileError(f"{where}.{key} is missing; give {hint}")
+        tangent = table["tangent"]
+        flat = isinstance(tangent, list) and bool(tangent) and not isinstance(tangent[0], list)
+        dim = self.matrix(tangent, None, f"{where}.tangent", f"{c}.tangent", flat=flat)
+        if dim not in (1, 2):
+            raise ModelFileError(f"{where}.tangent must have 1 row (1-D friction) or 2 rows (2-D), got {dim}")
+        self.shapes[f"{c}.drive"] = (dim,)
+        for key, value in table.items():
+            if key in ("drive", "normal_gradient", "normal_rate_gradient"):
+                self.vector(value, dim if key == "drive" else self.n, f"{where}.{key}", f"{c}.{key}")
+            elif key == "normal_force":
+                self.number(value, f"{where}.normal_force", "scalars", f"{c}.normal_force")
+            elif key == "friction":
+                self.friction(c, value)
+        name = table.get("name", f"contact{c}")
+        if not isinstance(name, str):
+            raise ModelFileError(f"{where}.name = {_show(name)} must be a string")
+        check_text(name, f"{where}.name")
+        return name
+
+    def friction(self, c: int, table) -> None:
+        where = f"contact.{c}.friction"
+        if not isinstance(table, Mapping):
+            raise ModelFileError(f"{where} must be a table ([contact.friction])")
+        _check_keys(table, FRICTION_KEYS, f"{where}: ")
+        self.shapes[f"{c}.friction"] = None
+        for key, value in table.items():
+            if key != "law":
+                self.number(value, f"{where}.{key}", f"{c}.friction", key)
+            elif isinstance(value, str):
+                self.slots[f"{where}.law"] = value
+                self.targets[f"{where}.law"] = (f"{c}.friction", "law")
+            else:
+                raise ModelFileError(f"{where}.law = {_show(value)} is not a law name; choose coulomb or exponential")
+
+
+def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Template:
+    """Check a model file's content (keys, shapes, names, expressions) once."""
+    if not isinstance(spec, Mapping):
+        raise ModelFileError("a model file holds a table of keys (name, dofs, mass, ...)")
+    _check_keys(spec, TOP_KEYS, "")
+    for key in REQUIRED_TOP:
+        if key not in spec:
+            hint = {"contact": "add at least one [[contact]] table", "dofs": 'e.g. dofs = ["x"]'}.get(
+                key, f"give the {key} matrix, one row per dof")
+            raise ModelFileError(f"key {key!r} is missing; {hint}")
+    dofs = spec["dofs"]
+    if not isinstance(dofs, list) or not dofs or not all(isinstance(d, str) and d for d in dofs):
+        raise ModelFileError(f"dofs must be a non-empty list of names, e.g. dofs = [\"x\", \"y\"], got {_show(dofs)}")
+    for i, dof in enumerate(dofs):
+        check_name(dof, f"dofs[{i}]")
+    texts = {key: spec.get(key, default) for key, default in (("name", default_name), ("description", ""))}
+    for key, text in texts.items():
+        if not isinstance(text, str):
+            raise ModelFileError(f"{key} must be a string, got {_show(text)}")
+        check_text(text, key)
+    observe = spec.get("observe", dofs[0])
+    if not isinstance(observe, str) or observe not in dofs:
+        raise ModelFileError(f"observe = {_show(observe)} is not a dof; give one of {', '.join(dofs)}")
+    units = spec.get("units", {})
+    if not isinstance(units, Mapping) or not all(isinstance(v, str) for v in units.values()):
+        raise ModelFileError('units must be a table of dof = "unit", e.g. units = { x = "m" }')
+    named = _parameters(spec.get("parameters", {}))
+    tables = spec["contact"]
+    if isinstance(tables, Mapping):
+        tables = [tables]
+    if not isinstance(tables, list) or not tables:
+        raise ModelFileError("contact must be one or more [[contact]] tables")
+    n = len(dofs)
+    parser = _Parser(n, tuple(named))
+    contact_names = []
+    for key, value in spec.items():  # file order: the order of the parameters
+        if key in ("mass", "damping", "stiffness"):
+            parser.matrix(value, n, key, key)
+        elif key == "force":
+            parser.vector(value, n, key, key)
+        elif key == "slip_band":
+            parser.number(value, key, "scalars", key)
+        elif key == "contact":
+            contact_names = [parser.contact(c, table) for c, table in enumerate(tables)]
+    parser.shapes.setdefault("force", (n,))
+    frozen = _plain_copy({**spec, "contact": tables})
+    if "slip_band" not in frozen:  # a parameter of every model file
+        frozen["slip_band"] = DEFAULT_SLIP_BAND
+        parser.number(DEFAULT_SLIP_BAND, "slip_band", "scalars", "slip_band")
+    return _Template(spec=frozen, name=texts["name"], description=texts["description"], dofs=tuple(dofs),
+                     units=dict(units), observe=observe, source=source, contact_names=tuple(contact_names),
+                     shapes=parser.shapes, targets=parser.targets, named=named, slots=parser.slots)
+
+
+def _value(raw, path: str, named: Mapping[str, float]):
+    """An entry's value at the parameters ``named``: its float, its expression's value, or its law name."""
+    if not isinstance(raw, Expression):
+        return raw
+    try:
+        return raw(named)
+    except ExpressionError as exc:
+        used = ", ".join(f"{k} = {named[k]:g}" for k in sorted(raw.names))
+        raise ModelFileError(f"{_label(path)} = {_quote(raw.text)} cannot be evaluated"
+                             f"{' with ' + used if used else ''}: {exc}; fix the expression or give other parameter "
+                             "values") from None
+
+
+def _build(t: _Template) -> FrictionModel:
+    """The model of template ``t`` at its parameter values (validated once, by FrictionModel)."""
+    out = {key: {} if shape is None else np.zeros(shape) for key, shape in t.shapes.items()}
+    for path, raw in t.slots.items():
+        container, index = t.targets[path]
+        out[container][index] = _value(raw, path, t.named)
+    scalars = out["scalars"]
+    contacts = []
+    for c, name in enumerate(t.contact_names):
+        N0 = scalars[f"{c}.normal_force"]
+        if N0 <= 0.0:
+            raise ModelFileError(f"contact.{c}.normal_force = {N0:g} must be > 0 (the contact must be pressed)")
+        try:
+            law = FrictionLaw.from_mapping(out[f"{c}.friction"], where=f"contact.{c}.friction")
+        except FrictionLawError as exc:
+            raise ModelFileError(str(exc)) from None
+        G = out[f"{c}.tangent"]
+        contacts.append(Contact(dim=G.shape[0], friction=law, normal_force=N0, tangent=G, drive=out[f"{c}.drive"],
+                                normal_gradient=out.get(f"{c}.normal_gradient"),
+                                normal_rate_gradient=out.get(f"{c}.normal_rate_gradient"), name=name))
+    return FrictionModel(
+        name=t.name, dofs=t.dofs, mass=out["mass"], damping=out["damping"], stiffness=out["stiffness"],
+        force=out["force"], contacts=tuple(contacts), parameters=t.parameters, builder=t.with_values,
+        source=t.source, units=dict(t.units), slip_band=scalars["slip_band"], description=t.description,
+        spec=t.spec, resolver=t.resolve, observed=t.observe,
+    )
 
 
 def model_from_spec(spec: Mapping[str, Any], *, source: str = "python", name: str = "model") -> FrictionModel:
@@ -96,110 +447,10 @@ def model_from_spec(spec: Mapping[str, Any], *, source: str = "python", name: st
     ------
     ModelFileError
         Naming the key and the fix, for a missing key, an unknown key, a wrong shape, a
-        non-number, a mass that is not symmetric positive definite, an unknown law or N0 ≤ 0.
+        non-number, a bad expression or parameter, a mass that is not symmetric positive
+        definite, an unknown law or N0 ≤ 0.
     """
-    if not isinstance(spec, Mapping):
-        raise ModelFileError("a model file holds a table of keys (name, dofs, mass, ...)")
-    unknown = sorted(set(spec) - set(TOP_KEYS))
-    if unknown:
-        raise ModelFileError(f"unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(TOP_KEYS)}")
-    for key in REQUIRED_TOP:
-        if key not in spec:
-            hint = {"contact": "add at least one [[contact]] table", "dofs": 'e.g. dofs = ["x"]'}.get(
-                key, f"give the {key} matrix, one row per dof")
-            raise ModelFileError(f"key {key!r} is missing; {hint}")
-    dofs = spec["dofs"]
-    if not isinstance(dofs, list) or not dofs or not all(isinstance(d, str) and d for d in dofs):
-        raise ModelFileError(f"dofs must be a non-empty list of names, e.g. dofs = [\"x\", \"y\"], got {dofs!r}")
-    n = len(dofs)
-    model_name = spec.get("name", name)
-    if not isinstance(model_name, str):
-        raise ModelFileError(f"name must be a string, got {model_name!r}")
-    mats = {key: _matrix(spec[key], n, n, key) for key in ("mass", "damping", "stiffness")}
-    force = _vector(spec["force"], n, "force") if "force" in spec else np.zeros(n)
-    slip_band = _number(spec["slip_band"], "slip_band") if "slip_band" in spec else DEFAULT_SLIP_BAND
-    observe = spec.get("observe", dofs[0])
-    if observe not in dofs:
-        raise ModelFileError(f"observe = {observe!r} is not a dof; give one of {', '.join(dofs)}")
-    units = spec.get("units", {})
-    if not isinstance(units, Mapping) or not all(isinstance(v, str) for v in units.values()):
-        raise ModelFileError('units must be a table of dof = "unit", e.g. units = { x = "m" }')
-    tables = spec["contact"]
-    if isinstance(tables, Mapping):
-        tables = [tables]
-    if not isinstance(tables, list) or not tables:
-        raise ModelFileError("contact must be one or more [[contact]] tables")
-    contacts = []
-    for c, table in enumerate(tables):
-        where = f"contact.{c}"
-        if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([[contact]])")
-        unknown = sorted(set(table) - set(CONTACT_KEYS))
-        if unknown:
-            raise ModelFileError(f"{where}: unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(CONTACT_KEYS)}")
-        for key in REQUIRED_CONTACT:
-            if key not in table:
-                hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]", "normal_force": "N0 > 0 [N]",
-                        "friction": "add a [contact.friction] table with law, mu_k, delta_mu"}[key]
-                raise ModelFileError(f"{where}.{key} is missing; give {hint}")
-        tangent = table["tangent"]
-        if isinstance(tangent, list) and tangent and not isinstance(tangent[0], list):
-            tangent = [tangent]
-        G = _matrix(tangent, None, n, f"{where}.tangent")
-        if G.shape[0] not in (1, 2):
-            raise ModelFileError(f"{where}.tangent must have 1 row (1-D friction) or 2 rows (2-D), got {G.shape[0]}")
-        dim = G.shape[0]
-        w = _vector(table["drive"], dim, f"{where}.drive") if "drive" in table else np.zeros(dim)
-        N0 = _number(table["normal_force"], f"{where}.normal_force")
-        if N0 <= 0.0:
-            raise ModelFileError(f"{where}.normal_force = {N0:g} must be > 0 (the contact must be pressed)")
-        grad = _vector(table["normal_gradient"], n, f"{where}.normal_gradient") if "normal_gradient" in table else None
-        rate = (_vector(table["normal_rate_gradient"], n, f"{where}.normal_rate_gradient")
-                if "normal_rate_gradient" in table else None)
-        friction = table["friction"]
-        if not isinstance(friction, Mapping):
-            raise ModelFileError(f"{where}.friction must be a table ([contact.friction])")
-        try:
-            law = FrictionLaw.from_mapping(friction, where=f"{where}.friction")
-        except FrictionLawError as exc:
-            raise ModelFileError(str(exc)) from None
-        contacts.append(Contact(dim=dim, friction=law, normal_force=N0, tangent=G, drive=w, normal_gradient=grad,
-                                normal_rate_gradient=rate, name=str(table.get("name", f"contact{c}"))))
-    frozen = copy.deepcopy(dict(spec))
-    frozen["contact"] = [dict(t) for t in tables]
-    frozen.setdefault("slip_band", slip_band)  # a parameter of every model file
-    parameters = parameter_paths(frozen)
-    return FrictionModel(
-        name=model_name, dofs=tuple(dofs), mass=mats["mass"], damping=mats["damping"],
-        stiffness=mats["stiffness"], force=force, contacts=tuple(contacts), parameters=parameters,
-        builder=lambda values: model_from_spec(_with_values(frozen, values), source=source, name=model_name),
-        source=source, units=dict(units), slip_band=slip_band, description=str(spec.get("description", "")),
-        spec=frozen, resolver=lambda path: resolve_path(frozen, path), observed=observe,
-    )
-
-
-def parameter_paths(spec: Mapping[str, Any]) -> dict[str, Any]:
-    """Every number (and law name) of a model file by its path, in file order."""
-    out: dict[str, Any] = {}
-
-    def walk(prefix: str, value) -> None:
-        if isinstance(value, bool):
-            return
-        if isinstance(value, (int, float)):
-            out[prefix] = float(value)
-        elif isinstance(value, list):
-            for i, item in enumerate(value):
-                walk(f"{prefix}.{i}", item)
-        elif isinstance(value, Mapping):
-            for key, item in value.items():
-                if key in ("name", "description", "dofs", "units", "observe"):
-                    continue
-                walk(f"{prefix}.{key}" if prefix else key, item)
-        elif prefix.endswith("friction.law"):
-            out[prefix] = value
-
-    walk("", spec)
-    return out
+    return _build(_template(spec, source, name))
 
 
 def resolve_path(spec: Mapping[str, Any], path: str) -> str:
@@ -217,8 +468,13 @@ def resolve_path(spec: Mapping[str, Any], path: str) -> str:
                 raise ModelFileError(f"--set {path}: {'.'.join(canonical) or 'root'} has no entry {part!r}")
             node = node[int(part)]
         elif isinstance(node, Mapping):
-            if part not in node:
-                raise ModelFileError(f"--set {path}: no key {part!r} under {'.'.join(canonical) or 'the model'}; "
+            if part not in node or (not canonical and part == "parameters"):
+                if not canonical:
+                    named = ", ".join(spec.get("parameters", {})) or "none (name one in a [parameters] table)"
+                    keys = ", ".join(str(k) for k in node if k != "parameters")
+                    raise ModelFileError(f"--set {path}: no key {part!r} under the model and no parameter of that "
+                                         f"name; named parameters: {named}; keys there: {keys}")
+                raise ModelFileError(f"--set {path}: no key {part!r} under {'.'.join(canonical)}; "
                                      f"keys there: {', '.join(str(k) for k in node)}")
             node = node[part]
         else:
@@ -230,22 +486,6 @@ def resolve_path(spec: Mapping[str, Any], path: str) -> str:
     if isinstance(node, (list, Mapping)):
         raise ModelFileError(f"--set {path}: that is a table or list, not one number; give an entry such as {path}.0")
     return ".".join(canonical)
-
-
-def _with_values(spec: Mapping[str, Any], values: Mapping[str, Any]) -> dict:
-    """A copy of ``spec`` with the numbers at the given (canonical or alias) paths replaced."""
-    out = copy.deepcopy(dict(spec))
-    for path, value in values.items():
-        canonical = resolve_path(out, path).split(".")
-        node = out
-        for part in canonical[:-1]:
-            node = node[int(part)] if isinstance(node, list) else node[part]
-        last = canonical[-1]
-        if isinstance(node, list):
-            node[int(last)] = value
-        else:
-            node[last] = value
-    return out
 
 
 def load_model_file(path: str | Path, source: str | None = None) -> FrictionModel:
@@ -260,6 +500,9 @@ def load_model_file(path: str | Path, source: str | None = None) -> FrictionMode
         spec = tomllib.loads(path.read_text())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ModelFileError(f"{path} is not valid TOML ({exc}); fix the syntax") from None
+    except RecursionError:
+        raise ModelFileError(f"{path}: a value is nested too deeply to read; a model file holds numbers, lists "
+                             "and matrices (lists of lists): fix the brackets") from None
     try:
         return model_from_spec(spec, source=source or f"file:{path}", name=path.stem)
     except ModelError as exc:

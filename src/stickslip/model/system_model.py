@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
+import unicodedata
 from functools import cached_property
 from typing import Any, Callable, Mapping, NamedTuple
 
@@ -27,7 +29,8 @@ from .kinematics import ConstantKinematics, registered_kinematics
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
-__all__ = ["FrictionModel", "Contact", "NamedState", "ModelError", "DEFAULT_SLIP_BAND"]
+__all__ = ["FrictionModel", "Contact", "NamedState", "ModelError", "DEFAULT_SLIP_BAND", "MAX_MASS_CONDITION",
+           "NAME_RULE", "check_text", "check_name"]
 
 #: Default low-speed band [m/s]: below it the 2-D slip direction is the quasi-static one instead of
 #: v/|v|. Near v = 0 the direction of 2-D friction relaxes on the time scale |v| / (λ μ N) → 0 (a
@@ -37,6 +40,54 @@ __all__ = ["FrictionModel", "Contact", "NamedState", "ModelError", "DEFAULT_SLIP
 #: 1e-5, 1e-4 and 5e-4 give the same errors (≤ 6e-9 in frequency), 1e-3 and above start to show
 #: the band (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
 DEFAULT_SLIP_BAND = 5e-4
+
+#: Largest condition number λmax/λmin of the mass matrix (on the free dofs) accepted. eigvalsh
+#: finds the eigenvalues of M to an absolute error of about n·ε·λmax (ε = 2.2e-16), at most
+#: 64·ε ≈ 1.4e-14·λmax for the kernels' MAX_DOFS = 64; an eigenvalue below 1e-13·λmax is within
+#: ten times that of zero, so M is singular to working precision, and M⁻¹, formed once for the
+#: kernels, would carry relative errors of cond(M)·ε ≈ 2e-3 or more.
+MAX_MASS_CONDITION = 1e13
+
+#: What a dof name may hold: ``--ic x=1,dx=0`` splits at ``,`` and ``=``, ``--set stiffness.x.y``
+#: at ``.``, the shell at whitespace, and a leading digit would read as an index in a path.
+NAME_RULE = "ASCII letters, digits and _, not starting with a digit"
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+
+#: Unicode categories refused in names and descriptions: control (Cc: newline, tab, escape, so
+#: ANSI colour codes), format (Cf: bidirectional overrides that reorder a printed line),
+#: surrogates and private use (Cs, Co), unassigned (Cn) and line/paragraph separators (Zl, Zp).
+_CONTROL = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})
+
+
+def check_text(text: str, what: str) -> None:
+    """Refuse a name or description that holds control or format characters (printed raw by the
+    command line, they would move the cursor, colour the terminal or break the line).
+
+    Raises
+    ------
+    ModelError
+        Naming ``what`` and the first such character.
+    """
+    text = str(text)
+    if text.isprintable():  # False for every character of _CONTROL (and for spaces other than " ")
+        return
+    for ch in text:
+        if unicodedata.category(ch) in _CONTROL:
+            raise ModelError(f"{what} contains the control character U+{ord(ch):04X}; give printable text on "
+                             "one line (no newlines, tabs or escape sequences)")
+
+
+def check_name(name: str, what: str) -> None:
+    """Refuse a dof name that ``--ic NAME=VALUE,...`` or a ``--set`` path cannot reach (:data:`NAME_RULE`).
+
+    Raises
+    ------
+    ModelError
+        Naming ``what`` and the characters allowed.
+    """
+    if not isinstance(name, str) or not _NAME.match(name):
+        shown = repr(name) if len(repr(name)) <= 40 else repr(name)[:37] + "..."
+        raise ModelError(f"{what} = {shown} is not a valid name; give a name of {NAME_RULE}")
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -109,9 +160,12 @@ class FrictionModel:
     free : ndarray (n,) of bool
         Free DOFs; locked ones never move (zero inverse mass).
     parameters : mapping
-        Named parameter values (what ``--set`` changes), in the order they are listed.
+        Named parameter values (what ``--set`` changes), in the order they are listed. Model files:
+        the ``[parameters]`` first, then every entry by its path (a number, the text of an
+        expression, or a law name).
     builder : callable
-        ``builder(parameters) -> FrictionModel``: the model with other parameter values.
+        ``builder(parameters) -> FrictionModel``: the model with other parameter values (it gets
+        every parameter, the changed ones included).
     source : str
         Where the model came from: ``library:NAME``, ``file:PATH`` or ``python``.
     units : mapping
@@ -157,18 +211,26 @@ class FrictionModel:
         n = len(self.dofs)
         if n == 0:
             raise ModelError(f"model {self.name!r} has no degrees of freedom; list them in dofs")
+        check_text(self.name, "the model's name")
+        check_text(self.description, f"model {self.name!r}: description")
+        for i, dof in enumerate(self.dofs):
+            check_name(dof, f"model {self.name!r}: dof {i}")
         if len(set(self.dofs)) != n:
             raise ModelError(f"model {self.name!r}: dof names must be unique, got {list(self.dofs)}")
+        for dof in self.dofs:
+            if "d" + dof in self.dofs:
+                raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
+                                 f"states are the dofs, then d + each dof); give one of them another name")
         for key in ("mass", "damping", "stiffness"):
             value = np.array(getattr(self, key), dtype=float)
             if value.shape != (n, n):
                 raise ModelError(f"model {self.name!r}: {key} must be {n}×{n} (one row and column per dof), "
                                  f"got shape {value.shape}")
-            if not np.all(np.isfinite(value)):
+            if not np.isfinite(value).all():
                 raise ModelError(f"model {self.name!r}: {key} has a non-finite entry; give finite numbers")
             object.__setattr__(self, key, value)
         force = np.zeros(n) if self.force is None else np.array(self.force, dtype=float).reshape(-1)
-        if force.shape != (n,) or not np.all(np.isfinite(force)):
+        if force.shape != (n,) or not np.isfinite(force).all():
             raise ModelError(f"model {self.name!r}: force must be {n} finite numbers, got {force.tolist()}")
         object.__setattr__(self, "force", force)
         free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
@@ -192,12 +254,17 @@ class FrictionModel:
     def _check_mass(self) -> None:
         idx = np.flatnonzero(self.free)
         M = self.mass[np.ix_(idx, idx)]
-        if not np.allclose(M, M.T, rtol=1e-12, atol=0.0):
+        if not (np.abs(M - M.T) <= 1e-12 * np.abs(M.T)).all():  # M = Mᵀ to 1e-12 relative
             raise ModelError(f"model {self.name!r}: mass must be symmetric; give M with M[i][j] = M[j][i]")
         lam = np.linalg.eigvalsh(0.5 * (M + M.T)) if M.size else np.ones(1)
-        if lam.min() <= 0.0:
+        low, high = lam.min(), lam.max()
+        if not low > 0.0:
             raise ModelError(f"model {self.name!r}: mass is not positive definite (smallest eigenvalue "
-                             f"{lam.min():.3g}); masses and inertias must be > 0")
+                             f"{low:.3g}); masses and inertias must be > 0")
+        if low < np.finfo(float).tiny or not np.isfinite(high) or high > low * MAX_MASS_CONDITION:
+            raise ModelError(f"model {self.name!r}: mass is singular or not positive definite to working precision "
+                             f"(eigenvalues from {low:.3g} to {high:.3g}); masses and inertias must be normal floats "
+                             f"(>= {np.finfo(float).tiny:.3g}) within a factor {MAX_MASS_CONDITION:.0e} of each other")
 
     def _check_contacts(self) -> None:
         n = self.n
@@ -217,6 +284,7 @@ class FrictionModel:
             raise ModelError(f"model {self.name!r} has no contact; add a [[contact]] table")
         for c, contact in enumerate(self.contacts):
             where = f"model {self.name!r}: contact {c}"
+            check_text(contact.name, f"{where}: name")
             if contact.dim not in (1, 2):
                 raise ModelError(f"{where}: the slip velocity has 1 or 2 components (tangent rows), got {contact.dim}")
             if not (math.isfinite(contact.normal_force) and contact.normal_force > 0.0):
@@ -225,7 +293,7 @@ class FrictionModel:
                 value = getattr(contact, key)
                 if value is not None:
                     value = np.array(value, dtype=float).reshape(-1)
-                    if value.shape != (n,) or not np.all(np.isfinite(value)):
+                    if value.shape != (n,) or not np.isfinite(value).all():
                         raise ModelError(f"{where}: {key} must be {n} finite numbers")
                     object.__setattr__(contact, key, value)
             if constant:
@@ -239,7 +307,7 @@ class FrictionModel:
                     raise ModelError(f"{where}: tangent must have {contact.dim} row(s) of {n} numbers, got shape {G.shape}")
                 if w.shape != (contact.dim,):
                     raise ModelError(f"{where}: drive must have {contact.dim} number(s), one per tangent row")
-                if not (np.all(np.isfinite(G)) and np.all(np.isfinite(w))):
+                if not (np.isfinite(G).all() and np.isfinite(w).all()):
                     raise ModelError(f"{where}: tangent and drive must be finite")
                 if not np.any(G[:, self.free]):
                     raise ModelError(f"{where}: tangent is zero on every free dof; the contact cannot slip")
@@ -300,17 +368,28 @@ class FrictionModel:
 
     # ------------------------------------------------------------------ parameters
     def replace(self, **changes: Any) -> "FrictionModel":
-        """The model with some parameters changed (names as in :attr:`parameters`)."""
+        """The model with some parameters changed (names as in :attr:`parameters`, or their aliases).
+
+        The builder gets every parameter value, the changed ones included, and builds the new
+        model once (one validation, in ``__post_init__``).
+
+        Raises
+        ------
+        ModelError
+            For a model without named parameters, an unknown name or a value that makes the model invalid.
+        """
         if not changes:
             return self
+        if self.builder is None or not self.parameters:
+            raise ModelError(f"model {self.name!r} has no named parameters to change ({', '.join(changes)}); give "
+                             "FrictionModel a builder= and parameters= (a function that builds the model from its "
+                             "parameters, docs/models.md) or state it as a model file")
         if self.resolver is not None:
             changes = {self.resolver(k): v for k, v in changes.items()}
         unknown = [k for k in changes if k not in self.parameters]
         if unknown:
             raise ModelError(f"unknown parameter(s) {', '.join(unknown)} of model {self.name!r}; "
                              f"valid names: {', '.join(self.parameters)}")
-        if self.builder is None:
-            raise ModelError(f"model {self.name!r} was built directly and has no parameters to change")
         values = dict(self.parameters)
         values.update(changes)
         return self.builder(values)
