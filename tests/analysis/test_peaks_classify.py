@@ -92,10 +92,11 @@ def test_intensity_of_an_analytic_signal():
 
 # ------------------------------------------------------------------ the paper's known cases
 def _run(omega, ic, t_end=60.0):
+    from stickslip.model.library import two_plates
     from stickslip.sweep.spec import initial_condition
 
     p = stickslip.Parameters(N=50.0, Omega=omega)
-    s0, pert = initial_condition(ic, p, "full")
+    s0, pert = initial_condition(ic, two_plates(p, "full"))
     traj = stickslip.simulate(p, t_end, ic=s0, perturbation=pert, sample_rate=200.0)
     assert traj.status == "success", traj.status
     return classify(traj, 0.5 * t_end)

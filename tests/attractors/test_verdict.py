@@ -62,10 +62,11 @@ def test_paper_defaults():
 
 
 def test_stable_steady_sliding_is_an_equilibrium():
+    from stickslip.model.library import two_plates
     from stickslip.sweep.spec import initial_condition
 
     p = stickslip.Parameters(N=50.0, Omega=12.0)                 # Fig. 7(e)
-    ic, pert = initial_condition("near", p, "full")
+    ic, pert = initial_condition("near", two_plates(p, "full"))
     run = simulate_until_settled(p, ic=ic, perturbation=pert, sample_rate=200.0)
     a = run.summary()
     assert (a["attractor"], a["settled"], a["period_count"]) == ("equilibrium", True, None)

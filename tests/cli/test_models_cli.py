@@ -62,7 +62,7 @@ def test_belt_file_from_x1_dx1_settles_to_the_closed_form_steady_sliding(belt_fi
     # steady sliding of x'' + 0.1 x' + x = μ(1.5): x_e = 0.5 + 0.5 exp(-3); linearised damping
     # 0.1 + μ'(1.5) = 0.1 − 2·0.5·exp(−3), so the decay rate is half of it
     x_e = 0.5 + 0.5 * math.exp(-3.0)
-    assert s["phi_min"] < x_e < s["phi_max"] and s["phi_max"] - s["phi_min"] < 0.01
+    assert s["coordinate"] == "x" and s["x_min"] < x_e < s["x_max"] and s["x_max"] - s["x_min"] < 0.01
     assert s["evidence"]["stability"]["max_real_part"] == pytest.approx(-(0.1 - math.exp(-3.0)) / 2, rel=1e-6)
     assert not list(belt_file.parent.glob("*.nc"))  # --json alone writes nothing
 

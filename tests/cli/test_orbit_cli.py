@@ -12,6 +12,7 @@ from stickslip import Parameters
 from stickslip.cli import app
 from stickslip.orbits import lyapunov_spectrum, periodic_orbit
 from stickslip.orbits.continuation import start_run
+from stickslip.model.library import two_plates
 from stickslip.sweep.spec import initial_condition
 
 runner = CliRunner()
@@ -120,7 +121,7 @@ def test_lyapunov_writes_the_library_spectrum_and_a_figure(method, tmp_path):
     assert out.with_suffix(".png").stat().st_size > 10_000
 
     p = Parameters(N=50.0, Omega=5.0)
-    state, pert = initial_condition("far", p, "full")
+    state, pert = initial_condition("far", two_plates(p, "full"))
     S = lyapunov_spectrum(p, state, model="full", t_transient=5.0, t_average=10.0, perturbation=pert, method=method)
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert np.array_equal(ds["exponent"].values, S.exponents)

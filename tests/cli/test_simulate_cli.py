@@ -13,7 +13,7 @@ runner = CliRunner()
 
 JSON_KEYS = {"settled", "attractor", "period_count", "fundamental_frequency_hz", "dominant_frequency_hz",
              "settle_time_s", "evidence", "status", "model", "parameters", "t_end_s", "steady_from_s",
-             "stick_fraction", "n_transitions", "phi_min", "phi_max", "steps", "wall_time_s", "method"}
+             "stick_fraction", "n_transitions", "coordinate", "phi_min", "phi_max", "steps", "wall_time_s", "method"}
 
 
 def run(*args):
@@ -31,7 +31,7 @@ def test_json_summary_and_netcdf_round_trip(tmp_path):
     traj = load_trajectory(out)
     assert traj.params.N == 50.0 and traj.params.Omega == 5.0
     assert traj.steady.n_transitions == summary["n_transitions"]
-    assert np.isclose(traj.steady.phi_max, summary["phi_max"])
+    assert np.isclose(traj.steady.maximum, summary["phi_max"])
 
 
 def test_human_summary_and_options(tmp_path):

@@ -13,6 +13,7 @@ from stickslip.analysis import classify, kind_code
 from stickslip.cli import app
 from stickslip.sweep import load_region_map, load_sweep
 from stickslip.sweep.bistability import classify_regions
+from stickslip.model.library import two_plates
 from stickslip.sweep.spec import initial_condition
 
 runner = CliRunner()
@@ -35,7 +36,7 @@ def summary(res) -> dict:
 
 def direct(params, model="full", ic="zero"):
     """The sweep point recomputed by `stickslip.simulate` + `classify` (what the sweep must store)."""
-    ic_arg, pert = initial_condition(ic, params, model)
+    ic_arg, pert = initial_condition(ic, two_plates(params, model))
     traj = stickslip.simulate(params, T_END, model=model, ic=ic_arg, perturbation=pert, **SIM)
     return traj, classify(traj, T_FROM)
 

@@ -11,7 +11,7 @@ from stickslip.integrate.smoothed import simulate_smoothed
 @pytest.mark.parametrize("N", [30.0, 50.0, 70.0])
 def test_frequency_converges_with_tolerance(N):
     P = Parameters(Omega=0.5, N=N)
-    f = [simulate(P, 100.0, rtol=rtol, atol=rtol * 1e-2, sample_rate=500).steady.fundamental_frequency_hz
+    f = [simulate(P, 100.0, rtol=rtol, atol=rtol * 1e-2, sample_rate=500).steady.frequency_hz
          for rtol in (1e-6, 1e-8)]
     assert np.isfinite(f).all()
     assert abs(f[0] - f[1]) < 1e-3 * abs(f[1])
@@ -20,7 +20,7 @@ def test_frequency_converges_with_tolerance(N):
 def test_smoothed_friction_approaches_event_solution():
     P = Parameters(Omega=0.5, N=30.0)
     t_end, t_from = 40.0, 20.0
-    ref = simulate(P, t_end, rtol=1e-10, atol=1e-12).steady_state(t_from).fundamental_frequency_hz
+    ref = simulate(P, t_end, rtol=1e-10, atol=1e-12).steady_state(t_from).frequency_hz
     errors = []
     for eps in (1e-2, 1e-3, 1e-4):
         t, y, info = simulate_smoothed(P, t_end, eps=eps)
@@ -47,6 +47,6 @@ def test_tight_tolerances_finish_and_agree():
     P = Parameters()
     runs = [simulate(P, 100.0, rtol=rtol, atol=rtol * 1e-2, sample_rate=200) for rtol in (1e-10, 1e-11)]
     assert all(r.status == "success" for r in runs)
-    f = [r.steady.fundamental_frequency_hz for r in runs]
+    f = [r.steady.frequency_hz for r in runs]
     assert abs(f[0] - f[1]) < 1e-8 * f[1]
     assert len(runs[0].transitions) == len(runs[1].transitions)

@@ -79,8 +79,8 @@ def test_agrees_with_aeom_where_both_stick(dt):
     a = stickslip.simulate(method="aeom", **kw).steady
     n = stickslip.simulate(method="naeom", **kw).steady
     assert a.stick_fraction > 0.1 and n.stick_fraction > 0.1
-    df = abs(a.fundamental_frequency_hz / n.fundamental_frequency_hz - 1)
-    dpp = abs((a.phi_max - a.phi_min) / (n.phi_max - n.phi_min) - 1)
+    df = abs(a.frequency_hz / n.frequency_hz - 1)
+    dpp = abs((a.maximum - a.minimum) / (n.maximum - n.minimum) - 1)
     tol = 2e-2 if dt == 1e-3 else 5e-4
     assert df < tol and dpp < tol
 

@@ -4,16 +4,15 @@ Appendix matrices."""
 
 import numpy as np
 import pytest
+from appendix import appendix_matrices
+from plates import plate_arrays
 
 from stickslip import Parameters
-from stickslip.model import MODELS, assemble
+from stickslip.model import MODELS
 from stickslip.model.bundle import CST
 from stickslip.model.derivatives import state_jacobian
 from stickslip.model.physics import MODE_SLIP, MODE_SLIP_EXACT, rhs, slip_velocity
 from stickslip.stability import equilibrium, linearization
-from stickslip.stability.equilibrium import plates_model
-
-from appendix import appendix_matrices
 
 RNG = np.random.default_rng(7)
 
@@ -71,28 +70,28 @@ def _slip_modes(mode=MODE_SLIP_EXACT):
 def generic_rhs(s, system):
     """The model's right-hand side (the seam's physics) in exact slip."""
     ds = np.zeros(12)
-    rhs(s, _slip_modes(), plates_model(system).data, ds)
+    rhs(s, _slip_modes(), system.model.data, ds)
     return ds
 
 
 def generic_jacobian(s, system):
     J = np.empty((12, 12))
-    state_jacobian(s, _slip_modes(), plates_model(system).data, J, np.zeros(12, complex), np.zeros(12, complex))
+    state_jacobian(s, _slip_modes(), system.model.data, J, np.zeros(12, complex), np.zeros(12, complex))
     return J
 
 
 def simulator_rhs(s, system):
     """The right-hand side in the simulator's slip mode (v_r/|v_r| above the low-speed band)."""
     ds = np.zeros(12)
-    rhs(s, _slip_modes(MODE_SLIP), plates_model(system).data, ds)
+    rhs(s, _slip_modes(MODE_SLIP), system.model.data, ds)
     return ds
 
 
 @pytest.mark.parametrize("model", list(MODELS))
 @pytest.mark.parametrize("law", ["exponential", "coulomb"])
 def test_generic_rhs_equals_the_paper_equations(model, law):
-    system = assemble(Parameters(friction_law=law, N=70.0, Omega=3.0), model)
-    md = plates_model(system).data
+    system = plate_arrays(Parameters(friction_law=law, N=70.0, Omega=3.0), model)
+    md = system.model.data
     for _ in range(20):
         s = slip_state(system)
         ds = generic_rhs(s, system)
@@ -117,7 +116,7 @@ def central_difference_jacobian(s, system, h=1e-6):
 
 @pytest.mark.parametrize("model", list(MODELS))
 def test_jacobian_matches_central_differences(model):
-    system = assemble(Parameters(N=60.0, Omega=2.5), model)
+    system = plate_arrays(Parameters(N=60.0, Omega=2.5), model)
     q = equilibrium(system.params, model)
     states = [np.concatenate([q, np.zeros(6)])] + [slip_state(system) for _ in range(5)]
     for s in states:
@@ -133,12 +132,12 @@ def test_jacobian_matches_central_differences(model):
 
 
 def test_reduced_jacobian_is_the_free_block_of_the_full_one():
-    system = assemble(Parameters(), "x")
+    system = plate_arrays(Parameters(), "x")
     q = equilibrium(system.params, "x")
     free = system.variant.free_indices
     idx = np.concatenate([free, 6 + free])
     full = generic_jacobian(np.concatenate([q, np.zeros(6)]), system)
-    J, K_L, C_L = linearization(system, q)
+    J, K_L, C_L = linearization(system.model, q)
     np.testing.assert_array_equal(J, full[np.ix_(idx, idx)])
     M = system.mass[free]
     # J = [[0, I], [-M⁻¹ K_L, -M⁻¹ C_L]] (Eq. 15); the same numbers, so exact up to one division
@@ -156,9 +155,9 @@ WRONG_K = {(4, 4)}
 @pytest.mark.parametrize("N, Omega", [(80.0, 3.0), (30.0, 7.0), (150.0, 1.5), (50.0, 12.0)])
 def test_appendix_matrices(N, Omega):
     P = Parameters(N=N, Omega=Omega)
-    system = assemble(P, "full")
+    system = plate_arrays(P, "full")
     q = equilibrium(P)
-    _, K_L, C_L = linearization(system, q)
+    _, K_L, C_L = linearization(system.model, q)
     C_p, K_p = appendix_matrices(q, P)
     C_c, K_c = appendix_matrices(q, P, corrected=True)
     # the Appendix's closed forms and complex-step derivatives agree to round-off of O(1e3) entries

@@ -35,7 +35,7 @@ def test_belt_sweep_equals_single_runs(belt_sweep):
         sel = traj.t >= RUN["t_from"]
         x = traj.states[sel, 0]
         point = ds.isel({"contact.0.drive.0": i})
-        assert float(point["phi_min"]) == x.min() and float(point["phi_max"]) == x.max()
+        assert float(point["x_min"]) == x.min() and float(point["x_max"]) == x.max()  # the model's own coordinate
         assert float(point["stick_fraction"]) == pytest.approx(traj.steady.stick_fraction, abs=0)
         assert float(point["t_reached"]) == traj.t[-1] and float(point["steps"]) == traj.stats.steps
         ref = intensity(traj.t, traj.states[:, 0], steady_sliding(model)[0], t_from=RUN["t_from"])
@@ -73,7 +73,7 @@ def test_plates_specs_read_as_before():
 
 
 @pytest.mark.parametrize("grid, options, message", [
-    ({"contact.0.drive": [1.0, 2.0]}, {"ic": "far"}, "plates only"),
+    ({"contact.0.drive": [1.0, 2.0]}, {"ic": "far"}, "unknown initial condition 'far' of model 'belt'"),
     ({"model": ["full"]}, {}, "cannot sweep 'model'"),
     ({"contact.0.nonsense": [1.0]}, {}, "cannot sweep 'contact.0.nonsense': give a parameter"),
     ({"contact.0.normal_force": [1.0, -1.0]}, {}, "must be > 0"),

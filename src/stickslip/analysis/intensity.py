@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..errors import EquilibriumError
-from ..stability.equilibrium import equilibrium
+from ..stability.equilibrium import equilibrium, sliding_speeds
 
 __all__ = ["ANGLE_SPEED_FRACTION", "intensity", "trajectory_intensities", "relative_motion_angle", "angle_range"]
 
@@ -52,14 +52,15 @@ def intensity(t, x, x_e=0.0, *, t_from: float | None = None) -> float:
 
 
 def trajectory_intensities(traj, t_from: float | None = None, equilibrium_q=None) -> dict:
-    """Eq. (16) for the responses of Fig. 16 over t ≥ ``t_from`` [s].
+    """Eq. (16) for the responses of Fig. 16 over t ≥ ``t_from`` [s] (a run of the two plates: its
+    coordinates are found by their names, phi, x1, y1, and r among its parameters).
 
     Parameters
     ----------
     traj : Trajectory
     t_from : float, optional
         Default the trajectory's ``steady_from``.
-    equilibrium_q : ndarray (6,), optional
+    equilibrium_q : ndarray (n,), optional
         The equilibrium q_e (Eq. 14); computed with :func:`stickslip.equilibrium` when omitted.
         NaNs are returned when it cannot be found.
 
@@ -70,19 +71,21 @@ def trajectory_intensities(traj, t_from: float | None = None, equilibrium_q=None
         (‖(x1, y1) − (x1e, y1e)‖, Fig. 16(c)) [m s^-1/2].
     """
     t_from = traj.steady_from if t_from is None else float(t_from)
+    system = traj.system
     if equilibrium_q is None:
         try:
-            equilibrium_q = equilibrium(traj.params, traj.model)
+            equilibrium_q = equilibrium(system)
         except EquilibriumError:
-            equilibrium_q = np.full(6, np.nan)
+            equilibrium_q = np.full(system.n, np.nan)
     qe = np.asarray(equilibrium_q, dtype=float)
-    r = traj.params.r
+    r = system.parameters["r"]
     s = traj.states
+    phi, x1, y1 = (system.dofs.index(name) for name in ("phi", "x1", "y1"))
     return {
-        "r_phi": intensity(traj.t, r * s[:, 4], r * qe[4], t_from=t_from),
-        "x1": intensity(traj.t, s[:, 0], qe[0], t_from=t_from),
-        "y1": intensity(traj.t, s[:, 1], qe[1], t_from=t_from),
-        "translation": intensity(traj.t, s[:, :2], qe[:2], t_from=t_from),
+        "r_phi": intensity(traj.t, r * s[:, phi], r * qe[phi], t_from=t_from),
+        "x1": intensity(traj.t, s[:, x1], qe[x1], t_from=t_from),
+        "y1": intensity(traj.t, s[:, y1], qe[y1], t_from=t_from),
+        "translation": intensity(traj.t, s[:, [x1, y1]], qe[[x1, y1]], t_from=t_from),
     }
 
 
@@ -102,7 +105,8 @@ def relative_motion_angle(traj, t_from: float | None = None):
     return traj.t[sel], traj.sliding_angle_deg[sel]
 
 
-#: Default speed floor of :func:`angle_range` as a fraction of the steady sliding speed Ω r:
+#: Default speed floor of :func:`angle_range` as a fraction of the contact's sliding speed at rest
+#: (for the plates Ω r):
 #: within 1 % of v_r = 0 the direction of v_r turns through all angles on the approach to and
 #: departure from stick (it is the direction of a vanishing vector), which would swamp the
 #: variation of the sliding direction that Fig. 11 shows.
@@ -112,12 +116,12 @@ ANGLE_SPEED_FRACTION = 0.01
 def angle_range(traj, t_from: float | None = None, min_speed: float | None = None) -> tuple[float, float]:
     """(min, max) of the relative-motion angle in slip [deg] over samples with |v_r| ≥ ``min_speed``.
 
-    ``min_speed`` [m/s] defaults to :data:`ANGLE_SPEED_FRACTION` · |Ω| r. NaNs when no sample
-    qualifies (all stick).
+    ``min_speed`` [m/s] defaults to :data:`ANGLE_SPEED_FRACTION` × the first contact's sliding
+    speed at rest at q = 0 (for the plates |Ω| r). NaNs when no sample qualifies (all stick).
     """
     t_from = traj.steady_from if t_from is None else float(t_from)
     if min_speed is None:
-        min_speed = ANGLE_SPEED_FRACTION * abs(traj.params.Omega) * traj.params.r
+        min_speed = ANGLE_SPEED_FRACTION * sliding_speeds(traj.system, np.zeros(traj.system.n))[0]
     _, ang = relative_motion_angle(traj, t_from)
     vr = traj.relative_velocity[traj.t >= t_from]
     ang = ang[np.isfinite(ang) & (np.hypot(vr[:, 0], vr[:, 1]) >= min_speed)]

@@ -14,7 +14,6 @@ import dataclasses
 
 import numpy as np
 
-from ..model.variants import DOF_NAMES
 from .signal import hermite_crossings
 
 __all__ = ["Peaks", "find_peaks", "hermite_value", "trajectory_peaks"]
@@ -127,15 +126,17 @@ def find_peaks(t, x, dx, ddx=None) -> Peaks:
     return Peaks(times, hermite_value(t, x, dx, i, times))
 
 
-def trajectory_peaks(traj, t_from: float | None = None, dof: str = "phi") -> Peaks:
+def trajectory_peaks(traj, t_from: float | None = None, dof: str | None = None) -> Peaks:
     """Peaks of one DOF of a :class:`~stickslip.Trajectory` for t ≥ ``t_from`` [s].
 
-    ``t_from`` defaults to the trajectory's ``steady_from``; ``dof`` is a name of
-    :data:`stickslip.DOF_NAMES`.
+    ``t_from`` defaults to the trajectory's ``steady_from``; ``dof`` is a name of the model's
+    dofs, default its observed one (the plates' φ).
     """
-    if dof not in DOF_NAMES:
-        raise ValueError(f"unknown DOF {dof!r}; choose one of {', '.join(DOF_NAMES)}")
-    j = DOF_NAMES.index(dof)
+    system = traj.system
+    dof = system.dofs[system.observed_index] if dof is None else dof
+    if dof not in system.dofs:
+        raise ValueError(f"unknown DOF {dof!r}; choose one of {', '.join(system.dofs)}")
+    j = system.dofs.index(dof)
     t_from = traj.steady_from if t_from is None else float(t_from)
     sel = traj.t >= t_from
-    return find_peaks(traj.t[sel], traj.states[sel, j], traj.states[sel, 6 + j])
+    return find_peaks(traj.t[sel], traj.states[sel, j], traj.states[sel, system.n + j])

@@ -15,44 +15,58 @@ __all__ = ["SteadyState", "fundamental_frequency", "summarize"]
 
 @dataclasses.dataclass(frozen=True)
 class SteadyState:
-    """Summary of the steady part of a run (t ≥ ``t_from``).
+    """Summary of the steady part of a run (t ≥ ``t_from``), following one coordinate.
 
     Attributes
     ----------
     t_from, t_to : float
         Window analysed [s].
     fundamental_frequency_hz : float
-        1 / (smallest period) of φ [Hz] when periodic and settled (return map on the peak
-        section, :func:`stickslip.analysis.period.detect_period`); otherwise the highest peak
-        of the spectrum (dominant frequency); NaN at rest. ``Trajectory.summary()`` keeps the
-        two apart and confirms periods of more than one peak.
+        1 / (smallest period) of the coordinate [Hz] when it repeats on its peak section and has
+        settled (:func:`stickslip.analysis.period.detect_period`); NaN otherwise. This is the
+        signal's rule alone: :func:`stickslip.attractors.attractor` confirms periods of more than
+        one peak by shooting before it reports them.
+    dominant_frequency_hz : float
+        Highest peak of the coordinate's amplitude spectrum in the window [Hz]; NaN at rest.
     periodic : bool
-        Whether φ repeats on the section and has settled (the signal rule of
-        :mod:`stickslip.analysis.period`); the same decision as
-        :func:`stickslip.analysis.classify.classify`.
+        Whether the coordinate repeats on the section and has settled (the same decision as
+        :func:`stickslip.analysis.classify.classify`).
     period_multiplicity : int
-        Section crossings (peaks of φ) per period (0 when not periodic).
+        Section crossings (peaks) per period (0 when not periodic).
     stick_fraction : float
         Fraction of the window spent in stick [-].
     n_transitions : int
         Stick↔slip transitions inside the window.
-    phi_min, phi_max : float
-        Extremes of φ in the window [rad] (from the uniform samples).
+    coordinate : str
+        The dof followed (the model's observed one: the plates' φ).
+    minimum, maximum : float
+        Extremes of the coordinate in the window [its unit] (from the uniform samples).
     """
 
     t_from: float
     t_to: float
     fundamental_frequency_hz: float
+    dominant_frequency_hz: float
     periodic: bool
     period_multiplicity: int
     stick_fraction: float
     n_transitions: int
-    phi_min: float
-    phi_max: float
+    coordinate: str
+    minimum: float
+    maximum: float
+
+    @property
+    def frequency_hz(self) -> float:
+        """The fundamental frequency when periodic, else the dominant one [Hz] (NaN at rest)."""
+        return self.fundamental_frequency_hz if self.periodic else self.dominant_frequency_hz
 
     def to_dict(self) -> dict:
-        """Plain dict (NaN kept as float NaN)."""
-        return dataclasses.asdict(self)
+        """Plain dict (NaN kept as float NaN), the extremes named after the coordinate
+        (``phi_min``, ``phi_max`` for the plates, ``x_min``, ``x_max`` for the belt)."""
+        d = dataclasses.asdict(self)
+        d[f"{self.coordinate}_min"] = d.pop("minimum")
+        d[f"{self.coordinate}_max"] = d.pop("maximum")
+        return d
 
 
 def fundamental_frequency(t, phi, dphi):
@@ -83,9 +97,10 @@ def fundamental_frequency(t, phi, dphi):
     return spectral_peak(t, phi), False, 0
 
 
-def summarize(t, states, mode, transition_times, transition_kinds, t_from, coordinate=4, rate=10):
+def summarize(t, states, mode, transition_times, transition_kinds, t_from, coordinate: int, rate: int,
+              name: str) -> SteadyState:
     """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
-    state column ``coordinate`` (its rate in column ``rate``; default the plates' φ)."""
+    state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
@@ -99,16 +114,20 @@ def summarize(t, states, mode, transition_times, transition_kinds, t_from, coord
     tt = np.asarray(transition_times)
     kinds = np.asarray(transition_kinds)
     window = (tt > t0) & (tt <= t1)
-    freq, periodic, mult = fundamental_frequency(ts, phi, dphi)
+    per = detect_period(ts, phi, dphi)
+    at_rest = per.amplitude < REST_AMPLITUDE
+    periodic = per.periodic and not at_rest
     stick = stick_time(t0, t1, mode0, tt, kinds)
     return SteadyState(
         t_from=t0,
         t_to=t1,
-        fundamental_frequency_hz=float(freq),
+        fundamental_frequency_hz=1.0 / per.period_s if periodic else math.nan,
+        dominant_frequency_hz=math.nan if at_rest else spectral_peak(ts, phi),
         periodic=bool(periodic),
-        period_multiplicity=int(mult),
+        period_multiplicity=int(per.multiplicity) if periodic else 0,
         stick_fraction=stick / (t1 - t0),
         n_transitions=int(window.sum()),
-        phi_min=float(phi.min()),
-        phi_max=float(phi.max()),
+        coordinate=name,
+        minimum=float(phi.min()),
+        maximum=float(phi.max()),
     )

@@ -26,7 +26,8 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
         unless settled and periodic), ``dominant_frequency_hz`` (spectral peak),
         ``settle_time_s``, ``evidence`` (:class:`~.verdict.Attractor`); ``status``, ``model``,
         ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction``, ``n_transitions``,
-        ``phi_min``, ``phi_max`` of the window; ``steps``, ``wall_time_s``, ``method``; ``settle``
+        ``coordinate`` (the model's observed dof) and its extremes ``<coordinate>_min``,
+        ``<coordinate>_max`` in the window (the plates: ``phi_min``, ``phi_max``); ``steps``, ``wall_time_s``, ``method``; ``settle``
         (the cap and steps of :func:`~.settle.simulate_until_settled`) when the run was extended
         until settled.
     """
@@ -34,9 +35,9 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
     s = traj.steady
     out = {**verdict.to_dict(), "status": traj.status, "model": traj.model,
            "parameters": dict(traj.system.parameters), "t_end_s": float(traj.t[-1]), "steady_from_s": s.t_from,
-           "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "phi_min": s.phi_min,
-           "phi_max": s.phi_max, "steps": traj.stats.steps, "wall_time_s": traj.stats.wall_time_s,
-           "method": traj.method}
+           "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "coordinate": s.coordinate,
+           f"{s.coordinate}_min": s.minimum, f"{s.coordinate}_max": s.maximum, "steps": traj.stats.steps,
+           "wall_time_s": traj.stats.wall_time_s, "method": traj.method}
     if "settle" in traj.options:
         out["settle"] = traj.options["settle"]
     return out

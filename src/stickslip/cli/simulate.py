@@ -256,8 +256,7 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
         (f"dominant frequency of {symbol}", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         ("transitions in window", str(s.n_transitions)),
-        (f"{symbol} min / max", f"{s.phi_min:.6g} / {s.phi_max:.6g}" + (" rad" if p is not None else
-                                                                        f" {system.units.get(observed, '')}".rstrip(" -"))),
+        (f"{symbol} min / max", f"{s.minimum:.6g} / {s.maximum:.6g}" + f" {system.units.get(observed, '')}".rstrip(" -")),
         ("steps (accepted + rejected)", f"{traj.stats.steps} ({traj.method})"),
         ("wall time", f"{traj.stats.wall_time_s:.3f} s"),
         ("wrote", wrote),

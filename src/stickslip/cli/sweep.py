@@ -24,7 +24,7 @@ from ..plot.sweep import save_bifurcation_figure, save_sweep_figure
 from ..sweep import regions as run_regions
 from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
-from ..sweep.spec import COLUMNS, _columns
+from ..sweep.spec import columns_of
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
                    check_finite, check_memory, check_positive, check_resumable_output, check_samples, config_values,
                    console, parse_assignments)
@@ -150,9 +150,7 @@ def _sweep_target(system) -> tuple:
 
 def _plot_columns(system) -> tuple[str, ...]:
     """The reductions a sweep of ``system`` keeps (those ``--plot`` may draw)."""
-    if system.name == "two-plates":
-        return COLUMNS
-    return tuple(c[0] for c in _columns(64, system.dofs[system.observed_index]))
+    return tuple(c[0] for c in columns_of(system))
 
 
 def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..model.library import resolve_system
-from ..model.library.two_plates import NAME as TWO_PLATES
+from ..model.library.two_plates import is_plates
 from .fixed_step import run_fixed_step
 from .initial import initial_state
 from .interrupt import partial_on_ctrl_c
@@ -131,7 +131,7 @@ def simulate(
     y0 = initial_state(system, ic, perturbation)
     sample_times = t0 + np.arange(n_samples) / sample_rate
 
-    if method != "event" and system.name != TWO_PLATES:
+    if method != "event" and not is_plates(system):
         raise SimulationError(f"method {method!r} is the paper's fixed-step method for the two plates; "
                               f"model {system.name!r} runs with method='event' (CLI: --method event)")
 

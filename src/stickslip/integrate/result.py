@@ -16,7 +16,7 @@ from ..errors import FileFormatError
 from ..files import atomic_write, format_name, open_ours
 from ..model import physics
 from ..model.library import describe_system, system_from_description, two_plates
-from ..model.library.two_plates import NAME as TWO_PLATES
+from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
 from ..results import Plottable
@@ -160,23 +160,17 @@ class Trajectory(Plottable):
     @property
     def is_plates(self) -> bool:
         """Whether the model is the paper's two plates."""
-        return self.system.name == TWO_PLATES
+        return is_plates(self.system)
 
     @property
     def params(self) -> Parameters | None:
         """The plates' :class:`Parameters` (None for other models: see ``system.parameters``)."""
-        if not self.is_plates:
-            return None
-        values = dict(self.system.parameters)
-        values.pop("variant", None)
-        return Parameters.from_dict(values)
+        return plates_parameters(self.system)
 
     @property
     def model(self) -> str:
-        """The plates' variant (``full``, ``rotation``, ...) or the model's name."""
-        if self.is_plates:
-            return str(self.system.parameters["variant"])
-        return self.system.name
+        """How results name the model: the plates' variant (``full``, ``rotation``, ...) or the model's name."""
+        return self.system.label or self.system.name
 
     @property
     def state_names(self) -> tuple[str, ...]:
@@ -198,23 +192,30 @@ class Trajectory(Plottable):
         """The plates' v_r (k, 2), Eq. (9) [m/s] (the first contact's slip velocity)."""
         return self.slip_velocity[:, :2]
 
+    @cached_property
+    def sliding_angle(self) -> np.ndarray:
+        """Angle of each contact's slip velocity v against its steady-sliding direction [deg] (k, nc),
+        NaN in stick.
+
+        The steady-sliding direction is that of the slip velocity the contact would have at rest in
+        the same position, v0 = −w(q) (q̇ = 0), so the angle is 0 in steady sliding and measures how
+        far the motion of the bodies turns the slip. For the plates v0 = Ω R (−e_n2), the direction
+        of motion of the lower plate's surface against the upper plate (Eq. 8): the angle of Fig. 11.
+        """
+        n, nc = self.system.n, self.system.n_contacts
+        at_rest = np.ascontiguousarray(self.states).copy()
+        at_rest[:, n:] = 0.0
+        v0 = _slip_velocities(at_rest, self.system.data, nc).reshape(-1, nc, 2)
+        v = self.slip_velocity.reshape(-1, nc, 2)
+        cross = v0[..., 0] * v[..., 1] - v0[..., 1] * v[..., 0]
+        dot = v0[..., 0] * v[..., 0] + v0[..., 1] * v[..., 1]
+        angle = np.degrees(np.arctan2(cross, dot))
+        return np.where((v[..., 0] == 0.0) & (v[..., 1] == 0.0), np.nan, angle)
+
     @property
     def sliding_angle_deg(self) -> np.ndarray:
-        """The plates: angle of v_r against the circumferential direction −e_n2 [deg], NaN in stick.
-
-        e_n2 = (−Y, X)/R is the direction of motion of the lower plate's surface at the contact
-        (Eq. 8); in steady sliding v_r = −Ω R e_n2, so the angle is 0 there (Fig. 11).
-        """
-        if not self.is_plates:
-            raise AttributeError("sliding_angle_deg is defined for the two plates only")
-        r = self.system.kinematics.r
-        s = self.states
-        X = s[:, 0] - s[:, 2] + r * np.cos(s[:, 4])
-        Y = s[:, 1] - s[:, 3] + r * np.sin(s[:, 4])
-        vx, vy = self.relative_velocity.T
-        with np.errstate(invalid="ignore"):
-            angle = np.degrees(np.arctan2(Y * vy + X * vx, vx * Y - vy * X))
-        return np.where((vx == 0.0) & (vy == 0.0), np.nan, angle)
+        """:attr:`sliding_angle` of the first contact (k,) [deg] (for the plates, Fig. 11)."""
+        return self.sliding_angle[:, 0]
 
     @cached_property
     def normal_force(self) -> np.ndarray:
@@ -248,7 +249,7 @@ class Trajectory(Plottable):
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
         return summarize(self.t, self.states, self.mode, self.transitions.time, self.transitions.kind, t_from,
-                         coordinate=i, rate=i + self.system.n)
+                         coordinate=i, rate=i + self.system.n, name=self.system.dofs[i])
 
     # ------------------------------------------------------------- pieces and joins
     def joined(self, more: "Trajectory") -> "Trajectory":
@@ -302,9 +303,9 @@ class Trajectory(Plottable):
                             {"units": "N", "long_name": "friction force of each contact along its tangent rows"})
         data["slip_velocity"] = (("time", "contact", "component"), self.slip_velocity.reshape(-1, nc, 2),
                                  {"units": "m/s", "long_name": "slip velocity v = G q̇ − w of each contact"})
-        if self.is_plates:
-            data["sliding_angle"] = ("time", self.sliding_angle_deg,
-                                     {"units": "degree", "long_name": "angle of v_r against the circumferential direction"})
+        angle_attrs = {"units": "degree", "long_name": "angle of the slip velocity against the steady-sliding direction"}
+        data["sliding_angle"] = (("time",), self.sliding_angle_deg, angle_attrs) if nc == 1 else \
+            (("time", "contact"), self.sliding_angle, angle_attrs)
         data["work_friction"] = ("time", self.work[:, 0], {"units": "J", "long_name": "work of friction since t0"})
         data["work_damping"] = ("time", self.work[:, 1], {"units": "J", "long_name": "work of the dampers since t0"})
         data["transition_time"] = ("transition", self.transitions.time, {"units": "s"})

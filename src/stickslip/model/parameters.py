@@ -69,13 +69,15 @@ _NON_NEGATIVE = (
 )
 
 
-def parameter_attrs(values: Mapping[str, Any]) -> dict[str, Any]:
-    """NetCDF attributes ``param_<name>`` (and ``param_<name>_units``) for a parameter mapping."""
+def parameter_attrs(values: Mapping[str, Any], units: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """NetCDF attributes ``param_<name>`` (and ``param_<name>_units``) for a parameter mapping;
+    ``units`` default the plates' (:data:`PARAMETER_UNITS`)."""
+    units = PARAMETER_UNITS if units is None else units
     attrs: dict[str, Any] = {}
     for name, value in values.items():
         attrs[f"param_{name}"] = value
-        if PARAMETER_UNITS.get(name):
-            attrs[f"param_{name}_units"] = PARAMETER_UNITS[name]
+        if units.get(name):
+            attrs[f"param_{name}_units"] = units[name]
     return attrs
 
 

@@ -185,6 +185,14 @@ class FrictionModel:
     starts : mapping of str to NamedState, optional
         Named initial states of this model beside the ones every model has (``zero``,
         ``equilibrium``, ``near``): ``simulate(model, ic=NAME)``, ``--ic NAME``.
+    label : str, optional
+        How results name the model (default :attr:`name`; the plates: their variant, ``full``).
+    headline : tuple of str, optional
+        Parameters that messages show to say which point of the model they mean (the plates:
+        ``N`` and ``Omega``).
+    steady_hint : callable, optional
+        ``steady_hint(model, q) -> str``: why steady sliding may not exist near the coordinates
+        ``q`` where the search failed, in the model's own terms ("" for no hint).
     """
 
     name: str
@@ -206,6 +214,9 @@ class FrictionModel:
     resolver: Callable[[str], str] | None = None
     observed: str | None = None
     starts: Mapping[str, NamedState] = dataclasses.field(default_factory=dict)
+    label: str = ""
+    headline: tuple[str, ...] = ()
+    steady_hint: Callable[["FrictionModel", np.ndarray], str] | None = None
 
     def __post_init__(self) -> None:
         n = len(self.dofs)
@@ -393,6 +404,15 @@ class FrictionModel:
         values = dict(self.parameters)
         values.update(changes)
         return self.builder(values)
+
+    def point_text(self) -> str:
+        """Which model and point, in words for messages: its :attr:`headline` parameters and label
+        (``N = 50 N, Omega = 5 rad/s, model 'full'``), or ``model 'belt'``."""
+        shown = []
+        for key in self.headline:
+            unit = self.units.get(key, "")
+            shown.append(f"{key} = {self.parameters[key]:g}" + (f" {unit}" if unit and unit != "-" else ""))
+        return ", ".join(shown + [f"model {self.label or self.name!r}"])
 
     def with_slip_band(self, slip_band: float) -> "FrictionModel":
         """The same model with another low-speed band [m/s]."""

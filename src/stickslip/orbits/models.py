@@ -13,7 +13,8 @@ import json
 import math
 
 from ..errors import ModelError, OrbitError
-from ..model.library import TWO_PLATES, describe_system, resolve_system
+from ..model.library import describe_system, resolve_system
+from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
 
@@ -33,20 +34,6 @@ def resolve(system=None, model=None, slip_band: float | None = None) -> Friction
         return resolve_system(system, model, slip_band)
     except ModelError as exc:
         raise OrbitError(str(exc)) from exc
-
-
-def is_plates(system: FrictionModel) -> bool:
-    """Whether ``system`` is the paper's two plates."""
-    return system.name == TWO_PLATES
-
-
-def plates_parameters(system: FrictionModel) -> Parameters | None:
-    """The plates' :class:`Parameters` of ``system`` (None for other models)."""
-    if not is_plates(system):
-        return None
-    values = dict(system.parameters)
-    values.pop("variant", None)
-    return Parameters.from_dict(values)
 
 
 def parameter_value(system: FrictionModel, name: str) -> float:
@@ -96,8 +83,8 @@ class ModelResult:
 
     @staticmethod
     def label(system: FrictionModel) -> str:
-        """The plates' variant (``full``, ``rotation``, ...) or the model's name."""
-        return str(system.parameters["variant"]) if is_plates(system) else system.name
+        """How results name the model: the plates' variant (``full``, ``rotation``, ...) or the model's name."""
+        return system.label or system.name
 
     @property
     def params(self) -> Parameters | None:

@@ -237,8 +237,8 @@ def periodic_orbit(
     """
     if isinstance(guess, Trajectory) and system is None and model is None:
         system = guess.system.with_slip_band(guess.system.slip_band if slip_band is None else slip_band)
-    elif isinstance(guess, Trajectory) and guess.is_plates and model is None:
-        system = resolve(system, guess.model, slip_band)  # the plates' parameters given: the run's variant
+    elif isinstance(guess, Trajectory) and model is None and "variant" in guess.system.parameters:
+        system = resolve(system, guess.system.parameters["variant"], slip_band)  # new parameters, the run's variant
     else:
         system = resolve(system, model, slip_band)
     k = int(period_multiplicity)

@@ -13,6 +13,14 @@ from ..model.parameters import PARAMETER_UNITS
 #: Symbols of the parameters that name axes and titles.
 SYMBOLS = {"N": "N", "Omega": "Ω", "mu_k": "μk", "delta_mu": "Δμ", "alpha": "α"}
 
+#: Greek names of coordinates written as their letters (any model's dofs).
+GREEK = {"phi": "φ", "psi": "ψ", "theta": "θ", "alpha": "α", "beta": "β", "gamma": "γ", "omega": "ω"}
+
+
+def symbol(name: str) -> str:
+    """How a figure writes a parameter or coordinate: ``Omega`` → Ω, ``phi`` → φ, others as named."""
+    return SYMBOLS.get(name) or GREEK.get(name, name)
+
 #: The paper's names of the model variants (Sect. 4.2.3).
 MODEL_LABELS = {"full": "Model 1 (full)", "x": "Model 2 (x translation)", "y": "Model 3 (y translation)",
                 "rotation": "Model 4 (rotation only)"}

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..model.parameters import PARAMETER_UNITS
 from ._common import (MODEL_LABELS, SYMBOLS, agg_figure, cell_edges, grid_axis, is_geometric, param_text, save_figure,
-                      unit_text)
+                      symbol, unit_text)
 
 __all__ = ["plot_reduction", "save_sweep_figure", "plot_bifurcation", "save_bifurcation_figure", "KIND_STYLE",
            "kind_styles", "axis_label"]
@@ -24,6 +24,13 @@ __all__ = ["plot_reduction", "save_sweep_figure", "plot_bifurcation", "save_bifu
 #: Colour and label of each steady-state kind code (:data:`stickslip.analysis.classify.KINDS`,
 #: −1 = the run failed). A sweep file names its codes in the ``flag_values`` / ``flag_meanings``
 #: attributes of ``kind``; :func:`kind_styles` reads them and keeps these colours for known kinds.
+def _observed(ds) -> tuple[str, str, str]:
+    """(name, symbol, unit) of the coordinate a sweep's peaks follow (the plates' φ [rad])."""
+    name = ds.attrs.get("observed", "phi")
+    unit = ds["peaks"].attrs.get("units", "") if "peaks" in ds.variables else ""
+    return name, symbol(name), unit
+
+
 KIND_STYLE = {
     -1: ("#d62728", "failed"),
     0: ("#7f7f7f", "equilibrium"),
@@ -405,18 +412,19 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
             ax.scatter(xx[ok], yy[ok], s=marker_size, color=colour, linewidths=0, rasterized=True)
             handles.append(Line2D([], [], ls="", marker="o", ms=5, color=colour, label=label))
     codes = {label: code for code, (_, label) in styles.items()}
+    coordinate, symbol, unit = _observed(ds)
     eq = kind == codes.get("equilibrium", 0)
     if np.any(eq):
         colour = styles.get(codes.get("equilibrium", 0), KIND_STYLE[0])[0]
-        ax.plot(xs[eq], ds["phi_mean"].values[eq], "x", color=colour, ms=5)
-        handles.append(Line2D([], [], ls="", marker="x", ms=5, color=colour, label="equilibrium (φ at rest)"))
+        ax.plot(xs[eq], ds[f"{coordinate}_mean"].values[eq], "x", color=colour, ms=5)
+        handles.append(Line2D([], [], ls="", marker="x", ms=5, color=colour, label=f"equilibrium ({symbol} at rest)"))
     for where, colour, label in ((kind == codes.get("failed", -1), KIND_STYLE[-1][0], "run failed"),
                                  (pending, "#b0b0b0", "not computed")):
-        if np.any(where):  # ticks on the lower edge: these points have no φ to show
+        if np.any(where):  # ticks on the lower edge: these points have no value to show
             ax.plot(xs[where], np.zeros(where.sum()), "|", color=colour, ms=10, transform=ax.get_xaxis_transform())
             handles.append(Line2D([], [], ls="", marker="|", ms=5, mew=1.5, color=colour, label=label))
     ax.set_xlabel(axis_label(ds, x))
-    ax.set_ylabel("peak values of φ [rad]")
+    ax.set_ylabel(f"peak values of {symbol}" + (f" [{unit}]" if unit else ""))
     if is_geometric(xs):
         ax.set_xscale("log")
     elif xs.size > 1:

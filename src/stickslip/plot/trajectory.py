@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.signal import spectrum
-from ._common import param_text, save_figure
+from ._common import param_text, save_figure, symbol
 
 __all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals"]
 
@@ -70,10 +70,10 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
     system = traj.system
     shown, unit = _shown_coordinates(system)
     for j in shown:
-        ax_phi.plot(t[show], traj.states[show, j], lw=1.0, label=_SYMBOL.get(system.dofs[j], system.dofs[j]))
+        ax_phi.plot(t[show], traj.states[show, j], lw=1.0, label=symbol(system.dofs[j]))
     _shade_stick(ax_phi, intervals, t_lo, t_hi, label="stick" if system.n_contacts == 1 else "a contact sticks")
     ax_phi.set_xlim(t_lo, t_hi)
-    ax_phi.set_ylabel(("angle" if traj.is_plates else "coordinate") + (f" [{unit}]" if unit else ""))
+    ax_phi.set_ylabel(("angle" if unit == "rad" else "coordinate") + (f" [{unit}]" if unit else ""))
     whole = t_lo <= t_first
     span = f"{_g(t_lo)}–{_g(t_hi)} s"
     ax_phi.set_title(f"the whole run, {span}" if whole else f"last {_g(t_hi - t_lo)} s of the run ({span} of "
@@ -94,27 +94,26 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
 
     steady_span = f"steady window {_g(t_steady)}–{_g(t_hi)} s"
     k = traj.observed
-    symbol = _SYMBOL.get(system.dofs[k], system.dofs[k])
+    sym = symbol(system.dofs[k])
     unit = system.units.get(system.dofs[k], "").strip("-")
     phi, dphi = traj.states[steady, k], traj.states[steady, system.n + k]
     ax_phase.plot(phi, dphi, lw=0.6)
-    ax_phase.set_xlabel(symbol + (f" [{unit}]" if unit else ""))
-    ax_phase.set_ylabel(f"d{symbol}/dt" + (f" [{unit}/s]" if unit else ""))
+    ax_phase.set_xlabel(sym + (f" [{unit}]" if unit else ""))
+    ax_phase.set_ylabel(f"d{sym}/dt" + (f" [{unit}/s]" if unit else ""))
     ax_phase.set_title(f"phase plot ({steady_span})", fontsize=10)
 
     f, a = spectrum(t[steady], phi)
     ax_spec.semilogy(f, np.maximum(a, 1e-12), lw=0.8)
     s = traj.steady
-    if np.isfinite(s.fundamental_frequency_hz):
-        # the summary's frequency is the fundamental only when φ repeats; otherwise the highest peak
-        name = "fundamental" if getattr(s, "periodic", False) else "dominant (not periodic)"
-        ax_spec.axvline(s.fundamental_frequency_hz, color="tab:red", ls=":", lw=1,
-                        label=f"{name} {s.fundamental_frequency_hz:.4g} Hz")
+    if np.isfinite(s.frequency_hz):
+        # the fundamental only when the coordinate repeats; otherwise the highest peak
+        name = "fundamental" if s.periodic else "dominant (not periodic)"
+        ax_spec.axvline(s.frequency_hz, color="tab:red", ls=":", lw=1, label=f"{name} {s.frequency_hz:.4g} Hz")
         ax_spec.legend(loc="best")
-        ax_spec.set_xlim(0, min(f[-1], 10 * s.fundamental_frequency_hz + 1))
+        ax_spec.set_xlim(0, min(f[-1], 10 * s.frequency_hz + 1))
     ax_spec.set_xlabel("frequency [Hz]")
-    ax_spec.set_ylabel(f"amplitude of {symbol}" + (f" [{unit}]" if unit else ""))
-    ax_spec.set_title(f"spectrum of {symbol} ({steady_span})", fontsize=10)
+    ax_spec.set_ylabel(f"amplitude of {sym}" + (f" [{unit}]" if unit else ""))
+    ax_spec.set_title(f"spectrum of {sym} ({steady_span})", fontsize=10)
     p = traj.params
     if p is not None:
         fig.suptitle(f"model {traj.model}: " + ", ".join(param_text(k, getattr(p, k)) for k in
@@ -125,7 +124,6 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
 
 
 #: Symbols of the plates' coordinates in labels.
-_SYMBOL = {"phi": "φ", "psi": "ψ"}
 
 #: Most coordinates drawn in the time history of a model other than the plates.
 MAX_SHOWN = 4

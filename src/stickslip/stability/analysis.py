@@ -12,15 +12,14 @@ from .._version import __version__
 from ..errors import EquilibriumError
 from ..model.bundle import CST, contact_state
 from ..model.derivatives import state_jacobian
-from ..model.library import resolve_system
-from ..model.library.two_plates import NAME as TWO_PLATES
+from ..model.library.two_plates import plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.physics import MODE_SLIP_EXACT
-from ..model.system import System
 from ..model.variants import DOF_NAMES
-from .equilibrium import plates_model, point_text, solve_steady
+from .equilibrium import model_of, point_text, solve_steady
 
-__all__ = ["StabilityResult", "stability", "linearization", "model_stability", "jacobian_at"]
+__all__ = ["StabilityResult", "stability", "linearization", "model_stability"]
+
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class StabilityResult:
@@ -164,23 +163,11 @@ class StabilityResult:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def linearization(system: System, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Reduced Jacobian, K_L and C_L (Eq. 15) of the plates' slip equations about (q, q̇ = 0).
+def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Jacobian of the slip equations of any model at (q, q̇ = 0), reduced to the free DOFs (for
+    the plates: Eq. 15 with K_L and C_L of the Appendix).
 
-    The complex-step Jacobian of the simulator's right-hand side (:func:`jacobian_at`) on the
-    plates' model of the assembled ``system``.
-
-    Returns
-    -------
-    jacobian : ndarray (2k, 2k)
-    K_L, C_L : ndarray (k, k)
-        −∂Q/∂q and −∂Q/∂q̇ on the free DOFs (Q = Gᵀ F − C q̇ − K q).
-    """
-    return jacobian_at(plates_model(system), q)
-
-
-def jacobian_at(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Jacobian of the slip equations of any model at (q, q̇ = 0), reduced to the free DOFs.
+    The complex-step Jacobian of the simulator's own right-hand side.
 
     Returns
     -------
@@ -232,15 +219,13 @@ def stability(params=None, model="full") -> StabilityResult:
         simulator's low-speed band, where its slip direction is not v/|v|, or a Jacobian that
         overflows (values far outside physical size).
     """
-    if params is not None and not isinstance(params, (Parameters, str)) and not hasattr(params, "data"):
-        raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
-    return model_stability(resolve_system(params, model))
+    return model_stability(model_of(params, model))
 
 
 def model_stability(system) -> StabilityResult:
     """:func:`stability` of a :class:`~stickslip.model.FrictionModel`."""
     q, residual, _ = solve_steady(system)
-    J, K_L, C_L = jacobian_at(system, q)
+    J, K_L, C_L = linearization(system, q)
     if not np.all(np.isfinite(J)):
         raise EquilibriumError(f"the linearisation at steady sliding is not finite ({point_text(system)}: overflow); "
                                "give values of physical size")
@@ -257,12 +242,8 @@ def model_stability(system) -> StabilityResult:
             shapes[j] /= shapes[j, m]
     M = system.mass[np.ix_(free, free)]
     diagonal = np.count_nonzero(M - np.diag(np.diag(M))) == 0
-    plates = system.name == TWO_PLATES
-    params = None
-    if plates:
-        params = Parameters.from_dict({key: v for key, v in system.parameters.items() if key != "variant"})
     return StabilityResult(
-        params=params, model=system.parameters["variant"] if plates else system.name,
+        params=plates_parameters(system), model=system.label or system.name,
         dofs=tuple(system.dofs[i] for i in free), equilibrium=q, residual=residual, jacobian=J,
         stiffness=K_L, damping=C_L, mass=np.diag(M).copy() if diagonal else M, eigenvalues=lam,
         mode_shapes=shapes, system=system, all_dofs=tuple(system.dofs),

@@ -3,26 +3,26 @@
 q̇ = 0 and f0 − K q + Σ_c G_cᵀ F_c(q, 0) = 0 with every contact slipping, solved by damped Newton
 from q = 0 with the exact Jacobian of the simulator's own right-hand side (complex step), with a
 continuation in the normal load as a fallback near the fold where steady sliding ceases to exist
-(:mod:`stickslip.stability.steady`, compiled). The plates' functions (:func:`equilibrium`,
-:func:`solve_equilibrium`, :func:`equilibrium_residual`) are this on the plates' model.
+(:mod:`stickslip.stability.steady`, compiled).
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import EquilibriumError
 from ..model.bundle import CST
-from ..model.library.two_plates import NAME
+from ..model.library import resolve_system
 from ..model.parameters import Parameters
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
-from ..model.system import System, assemble
+from ..model.system_model import FrictionModel
 from . import steady
 
-__all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "solve_equilibrium", "RESIDUAL_TOL",
-           "steady_sliding", "steady_residual", "solve_steady", "plates_model", "point_text"]
+__all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "RESIDUAL_TOL", "steady_sliding",
+           "steady_residual", "solve_steady", "point_text", "sliding_speeds", "model_of"]
 
 #: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved. Newton reaches ~1e-16
 #: (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while still
@@ -41,24 +41,12 @@ _REASONS = {
 }
 
 
-def plates_model(system: System):
-    """The :class:`~stickslip.model.FrictionModel` of an assembled plates :class:`System`."""
-    return system.model()
-
-
-def _is_plates(system) -> bool:
-    return system.name == NAME
-
-
 def point_text(system) -> str:
-    """The point in words for messages: the plates' N, Ω and variant, else the model's name."""
-    if _is_plates(system):
-        p = system.parameters
-        return f"N = {p['N']:g} N, Omega = {p['Omega']:g} rad/s, model {p['variant']!r}"
-    return f"model {system.name!r}"
+    """The point in words for messages (:meth:`~stickslip.model.FrictionModel.point_text`)."""
+    return system.point_text()
 
 
-def _speeds(system, q: np.ndarray) -> list[float]:
+def sliding_speeds(system, q: np.ndarray) -> list[float]:
     """Sliding speed of each contact at (q, q̇ = 0) [m/s]."""
     s = np.zeros(2 * system.n)
     s[:system.n] = q
@@ -66,36 +54,23 @@ def _speeds(system, q: np.ndarray) -> list[float]:
 
 
 def _not_sliding_message(system, q: np.ndarray) -> str:
-    plates = _is_plates(system)
-    for c, (speed, contact) in enumerate(zip(_speeds(system, q), system.contacts)):
+    for c, (speed, contact) in enumerate(zip(sliding_speeds(system, q), system.contacts)):
         if speed == 0.0:
-            if plates:
-                return ("no steady sliding at Omega = 0: the relative velocity vanishes at rest and the friction "
-                        "direction is undefined; choose Omega != 0")
-            return (f"no steady sliding: contact {c} does not slide at rest (its drive is 0); "
-                    "give the contact a non-zero drive")
+            return (f"no steady sliding at {system.point_text()}: contact {c} does not slide at rest (its drive is "
+                    "0: the slip velocity vanishes and the friction direction is undefined); give the contact a "
+                    "non-zero drive")
         if contact.dim == 2 and speed <= system.slip_band:
-            fix = "increase |Omega|" if plates else "increase the drive"
-            name = "|Omega| R" if plates else f"of contact {c}"
-            return (f"sliding speed at equilibrium {name} = {speed:.3g} m/s is inside the simulator's low-speed band "
-                    f"({system.slip_band:g} m/s), where its slip direction is not v/|v| and steady sliding is not an "
-                    f"equilibrium of the simulated equations; {fix}")
+            return (f"the sliding speed of contact {c} at equilibrium, {speed:.3g} m/s, is inside the simulator's "
+                    f"low-speed band ({system.slip_band:g} m/s), where its slip direction is not v/|v| and steady "
+                    "sliding is not an equilibrium of the simulated equations; increase the drive")
     return "steady sliding is not an equilibrium of the simulated equations"
 
 
 def _failure_message(system, q: np.ndarray, status: int, rel: float) -> str:
     reason = _REASONS.get(int(status), "the residual check failed")
-    hint = ""
-    if _is_plates(system) and np.all(np.isfinite(q)):
-        r = system.parameters["r"]
-        R = math.hypot(q[0] - q[2] + r * math.cos(q[4]), q[1] - q[3] + r * math.sin(q[4]))
-        if R < 0.5 * r:
-            hint = (f"; the iterate has the contact point at R = {R:.3g} m from the centre O2 (r = {r:g} m): the "
-                    "friction load mu N drags the contact point onto the centre of the lower plate and steady "
-                    "sliding does not exist beyond that load (a fold of Eq. 14); reduce N or mu")
-    elif not _is_plates(system):
-        hint = ("; steady sliding may not exist at these parameters (e.g. a friction load that drags the "
-                "contact into a fold)")
+    hint = system.steady_hint(system, q) if system.steady_hint is not None else (
+        "steady sliding may not exist at these parameters (e.g. a friction load that drags the contact into a fold)")
+    hint = f"; {hint}" if hint else ""
     return (f"no steady-sliding equilibrium found for {point_text(system)}: {reason} (relative residual "
             f"{rel:.2e} > {RESIDUAL_TOL:g}){hint}")
 
@@ -118,14 +93,14 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         0) or, for a 2-D contact, slides inside the low-speed band (the simulator's slip direction
         there is not v/|v|, so steady sliding is not an equilibrium of the simulated equations).
     """
-    if _is_plates(system) and system.parameters["Omega"] == 0.0:
+    if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:  # a contact at rest does not slide (e.g. Ω = 0)
         raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
     free = np.flatnonzero(system.free).astype(np.int64)
     q, status, rel, iterations = steady.steady_sliding_point(system.data, free, MAX_ITER)
     if status == steady.NEWTON_NOT_SLIDING:
         raise EquilibriumError(_not_sliding_message(system, q))
     if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
-        if np.all(np.isfinite(q)) and min(_speeds(system, q)) == 0.0:
+        if np.all(np.isfinite(q)) and min(sliding_speeds(system, q)) == 0.0:
             raise EquilibriumError(_not_sliding_message(system, q))
         raise EquilibriumError(_failure_message(system, q, status, rel))
     return q, float(rel), int(iterations)
@@ -158,73 +133,58 @@ def steady_residual(system, q: np.ndarray) -> float:
     return num / scale if scale > 0.0 and np.isfinite(num) else math.inf
 
 
-# --------------------------------------------------------------------------- the plates' API
-def equilibrium_residual(system: System, q: np.ndarray) -> np.ndarray:
-    """Force residual K q − Gᵀ F(v_r = Ω(Y, −X)) at rest (q̇ = 0) of the plates, shape (6,) [N or N m].
+def equilibrium_residual(system, q: np.ndarray) -> np.ndarray:
+    """Force residual −M q̈ of the slip equations at (q, q̇ = 0), shape (n,) [N or N m per dof].
 
-    This is −M q̈ of the slip equations at q̇ = 0, evaluated by the simulator's right-hand side, so
-    its zero is exactly the steady sliding state the simulator sees. Locked DOFs give 0.
+    Evaluated by the simulator's right-hand side, so its zero is exactly the steady sliding state
+    the simulator sees (for the plates: K q − Gᵀ F(v_r = Ω(Y, −X)), paper Eq. 14). Locked DOFs give 0.
     """
-    model = plates_model(system)
-    s = np.zeros(12)
-    s[:6] = q
-    ds = np.zeros(12)
-    cst = np.zeros(CST)
-    cst[0] = MODE_SLIP_EXACT
-    cst[3] = np.inf
-    rhs(s, cst, model.data, ds)
-    return np.where(system.minv > 0, -(model.mass @ ds[6:]), 0.0)
+    n = system.n
+    s = np.zeros(2 * n)
+    s[:n] = q
+    ds = np.zeros(2 * n)
+    cst = np.zeros(CST * system.n_contacts)
+    cst[0::CST] = MODE_SLIP_EXACT
+    cst[3::CST] = np.inf
+    rhs(s, cst, system.data, ds)
+    return np.where(system.free, -(system.mass @ ds[n:]), 0.0)
 
 
-def solve_equilibrium(system: System) -> tuple[np.ndarray, float, int]:
-    """Steady sliding (Eq. 14) of an assembled plates :class:`System`: :func:`solve_steady` on its model.
+def equilibrium(system=None, model=None) -> np.ndarray:
+    """Steady-sliding equilibrium q_e (n,) of a model, locked DOFs 0 [units of the dofs].
 
-    Returns
-    -------
-    q : ndarray (6,)
-        Equilibrium [m, m, m, m, rad, rad]; locked DOFs are 0.
-    relative_residual : float
-        max|K x − b| / max(|K x|, |b|), evaluated with the simulator's right-hand side.
-    iterations : int
-
-    Raises
-    ------
-    EquilibriumError
-        See :func:`equilibrium`.
-    """
-    return solve_steady(plates_model(system))
-
-
-def equilibrium(params: Parameters, model="full") -> np.ndarray:
-    """Steady-sliding equilibrium q_e of the free DOFs (locked DOFs are 0), shape (6,).
-
-    Solves K x = b(x) (paper Eq. 14, b from Appendix A.1) by damped Newton from x = 0 with the
-    exact Jacobian (falling back to continuation in N from a fraction of the load when Newton
-    from 0 stalls) and checks the residual with the simulator's kernel.
+    Solves the force balance at rest (for the plates K x = b(x), paper Eq. 14, b from Appendix
+    A.1) by damped Newton from x = 0 with the exact Jacobian (falling back to continuation in the
+    load from a fraction of it when Newton from 0 stalls) and checks the residual with the
+    simulator's kernel (:func:`solve_steady`).
 
     Parameters
     ----------
-    params : Parameters
-    model : str, iterable of DOF names or Variant
-        ``full`` (Model 1), ``x``, ``y``, ``rotation`` (Model 4), or the DOFs to free.
-
-    Returns
-    -------
-    ndarray, shape (6,)
-        [x1, y1, x2, y2, φ, ψ] at equilibrium [m, m, m, m, rad, rad].
+    system : Parameters, FrictionModel or str, optional
+        The plates' parameters (default Table 1), or any model (as :func:`stickslip.simulate` takes it).
+    model : str, iterable of DOF names or Variant, optional
+        The plates' variant: ``full`` (Model 1), ``x``, ``y``, ``rotation`` (Model 4), or the DOFs to free.
 
     Raises
     ------
     EquilibriumError
-        When Ω = 0 (v_r vanishes at rest, the friction direction is undefined: no steady
-        sliding), or when Newton does not reach a relative residual of :data:`RESIDUAL_TOL`
-        (e.g. at large N and small Ω, where the contact point is dragged to the centre of the
-        lower plate and steady sliding ceases to exist), or when the sliding speed |Ω| R at
-        equilibrium is inside the simulator's low-speed band (``model.system_model.DEFAULT_SLIP_BAND``).
+        When a contact does not slide at rest (the plates at Ω = 0: v_r vanishes, the friction
+        direction is undefined), when Newton does not reach a relative residual of
+        :data:`RESIDUAL_TOL` (e.g. the plates at large N and small Ω, where the contact point is
+        dragged to the centre of the lower plate and steady sliding ceases to exist), or when the
+        sliding speed at equilibrium is inside the simulator's low-speed band.
     """
-    if not isinstance(params, Parameters):
-        raise TypeError(f"params must be a stickslip.Parameters, got {type(params).__name__}")
-    q, _, _ = solve_equilibrium(assemble(params, model))
-    return q
+    return steady_sliding(model_of(system, model))
 
 
+def model_of(params, model) -> FrictionModel:
+    """The model that ``params`` and ``model`` name (as :func:`stickslip.simulate` takes them).
+
+    Raises
+    ------
+    TypeError
+        For ``params`` that is not the plates' Parameters, a model, a library name or a model file.
+    """
+    if params is not None and not isinstance(params, (Parameters, FrictionModel, str, Path)):
+        raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
+    return resolve_system(params, model)

@@ -23,16 +23,15 @@ import numpy as np
 from scipy import optimize
 
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..files import atomic_write, format_name, open_ours
-from ..model.library import describe_system, resolve_system, system_from_description
-from ..model.library.two_plates import NAME
+from ..model.library import describe_system, system_from_description
+from ..model.library.two_plates import plates_parameters
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
-from ..model.system import System
 from ..model.variants import resolve_variant
 from ..results import Plottable
 from . import steady
-from .equilibrium import MAX_ITER, RESIDUAL_TOL, plates_model
+from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds
 
 __all__ = ["StabilityMap", "stability_map", "max_real_part", "boundary_omegas", "load_stability_map",
            "parse_family", "MapGrid"]
@@ -82,8 +81,18 @@ def parse_family(text: str | None) -> tuple[str, list] | None:
         raise ValueError(f"family {text!r}: the values of {name} must be numbers") from None
 
 
-def _is_plates(system) -> bool:
-    return system.name == NAME
+def _numeric_parameters(system) -> list[str]:
+    return [k for k, v in system.parameters.items() if not isinstance(v, (str, bool))]
+
+
+def _check_axis_values(system, name: str, values: np.ndarray) -> None:
+    """Refuse axis values that make the model invalid or leave a contact at rest without slip
+    (no steady sliding: the friction direction is undefined), before any grid point is computed."""
+    for v in np.unique(values):
+        member = system.replace(**{name: float(v)})
+        if min(sliding_speeds(member, np.zeros(member.n))) == 0.0:
+            raise ValueError(f"{name} = {v:g} has no steady sliding (a contact does not slide at rest: the friction "
+                             "direction is undefined); leave it out of the grid")
 
 
 def _row(system) -> np.ndarray:
@@ -238,9 +247,7 @@ def _jacobian_of(system) -> np.ndarray:
 
 def max_real_part(system, N: float, Omega: float, names: tuple[str, str] = ("N", "Omega")) -> float:
     """Largest real part of the eigenvalues at steady sliding with the parameters ``names`` set to
-    (N, Ω) [1/s]; NaN without steady sliding. ``system``: a plates :class:`System` or any model."""
-    if isinstance(system, System):
-        system = plates_model(system)
+    (N, Ω) [1/s]; NaN without steady sliding."""
     J = _jacobian_of(system.replace(**{names[0]: float(N), names[1]: float(Omega)}))
     return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
 
@@ -442,14 +449,21 @@ def _members(system, family) -> tuple[str, list, list]:
     values = list(values)
     if not values:
         raise ValueError(f"family {name!r} has no values")
-    if name == "model":
-        if not _is_plates(system):
-            raise ValueError("a family of models needs the plates (variants full, x, y, rotation); "
+    if name == "model":  # the variants (sets of free DOFs) of a model that has them: the plates' Models 1-4
+        if "variant" not in system.parameters:
+            raise ValueError(f"a family of models needs a model with variants (the plates: full, x, y, rotation); "
                              f"model {system.name!r} has none: vary one of its parameters instead")
         names = [resolve_variant(v).name for v in values]
         return name, names, [system.replace(variant=v) for v in names]
-    if _is_plates(system) and name not in Parameters.names():
-        raise ParameterError(f"unknown family parameter {name!r}; use 'model' or one of {', '.join(Parameters.names())}")
+    known = _numeric_parameters(system)
+    try:
+        key = system.resolver(name) if system.resolver is not None else name
+    except ModelError:
+        key = None
+    if key not in known:
+        shown = ", ".join(known) if len(known) <= 30 else ", ".join(known[:30]) + ", ..."
+        raise ParameterError(f"unknown family parameter {name!r} of model {system.name!r}; use "
+                             + ("'model' or " if "variant" in system.parameters else "") + f"one of {shown}")
     return name, values, [system.replace(**{name: float(v)}) for v in values]
 
 
@@ -495,19 +509,12 @@ def stability_map(
         For an empty or non-increasing grid, N ≤ 0, Ω = 0 (plates), an unknown parameter, or a
         value that makes the model invalid.
     """
-    if params is not None and not isinstance(params, (Parameters, str, Path)) and not hasattr(params, "data"):
-        raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
-    system = resolve_system(params, model)
+    system = model_of(params, model)
     axes = tuple(axes)
     N = _as_float_array(axes[0], N)
     Omega = _as_float_array(axes[1], Omega)
-    if _is_plates(system):
-        for name, values in zip(axes, (N, Omega)):
-            if name == "N" and np.any(values <= 0):
-                raise ValueError("N must be > 0 (the plates must be pressed together)")
-            if name == "Omega" and np.any(values == 0):
-                raise ValueError("Omega = 0 has no steady sliding (the friction direction is undefined); "
-                                 "leave it out of the grid")
+    for name, values in zip(axes, (N, Omega)):
+        _check_axis_values(system, name, values)
     fam = family if not isinstance(family, str) else parse_family(family)
     fam_name = (next(iter(fam)) if isinstance(fam, Mapping) else fam[0]) if fam is not None else ""
     if fam_name in axes:
@@ -533,12 +540,8 @@ def stability_map(
             bnd[f, a, :len(roots)] = roots
             bdir[f, a, :len(dirs)] = dirs
             bjump[f, a, :len(jumps)] = jumps
-    plates = _is_plates(system)
-    base_params = None
-    if plates:
-        base_params = Parameters.from_dict({k: v for k, v in system.parameters.items() if k != "variant"})
     return StabilityMap(
-        params=base_params, model=system.parameters["variant"] if plates else system.name, N=N, Omega=Omega,
+        params=plates_parameters(system), model=system.label or system.name, N=N, Omega=Omega,
         family_name=name, family_values=values if name else [],
         max_real_part=mrp, boundary=bnd, boundary_direction=bdir, boundary_jump=bjump,
         timings={"grid_s": t1 - t0, "boundary_s": t2 - t1, "points": int(mrp.size)}, axes=axes, system=system,

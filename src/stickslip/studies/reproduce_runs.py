@@ -22,6 +22,7 @@ from ..model.parameters import Parameters
 from ..plot._common import save_figure
 from ..plot.timestep import save_timestep_figures
 from ..plot.trajectory import save_trajectory_figure
+from ..model.library import two_plates
 from ..sweep.spec import initial_condition
 from .reproduce_report import RecipeResult, Row, _fmt, _yes
 from .reproduce_resolutions import Resolution
@@ -74,7 +75,7 @@ def _recipe_table2(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 # ----------------------------------------------------------------------------- Fig. 7
 def _simulate_named(params, t_end, ic_name, model="full"):
-    ic, pert = initial_condition(ic_name, params, model)
+    ic, pert = initial_condition(ic_name, two_plates(params, model))
     return simulate(params, t_end, model=model, ic=ic, perturbation=pert, sample_rate=200.0)
 
 

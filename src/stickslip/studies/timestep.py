@@ -95,11 +95,11 @@ def steady_errors(traj, ref) -> dict:
     s, r = traj.steady, ref.steady
     sel = traj.t >= s.t_from
     rsel = ref.t >= r.t_from
-    phi_pp = s.phi_max - s.phi_min
-    ref_pp = r.phi_max - r.phi_min
-    level = 0.5 * (r.phi_min + r.phi_max)
-    f = s.fundamental_frequency_hz
-    fr = r.fundamental_frequency_hz
+    phi_pp = s.maximum - s.minimum
+    ref_pp = r.maximum - r.minimum
+    level = 0.5 * (r.minimum + r.maximum)
+    f = s.frequency_hz
+    fr = r.frequency_hz
     freq_error = 1.0 if not math.isfinite(f) else abs(f - fr) / fr
     static = (traj.params.mu_k + traj.params.delta_mu) * traj.params.N
     ref_phi = period_waveform(ref.t[rsel], ref.states[rsel, 4], ref.states[rsel, 4], level, 1.0 / fr)
@@ -248,14 +248,14 @@ def _run(params, t_end, method, *, dt=None, rtol=None):
 def _summarise(traj, ref, method, dt, rtol, paper) -> TimestepRun:
     s = traj.steady
     sel = traj.t >= traj.t[-1] - FIGURE_WINDOW
-    f = s.fundamental_frequency_hz
+    f = s.frequency_hz
     initial_stick = int(traj.mode[0] == 1)
     return TimestepRun(
         method=method, dt=dt, rtol=rtol,
         wall_time_s=float(traj.stats.wall_time_s), steps=int(traj.stats.steps), rhs_calls=int(traj.stats.rhs_calls),
         stick_phases=int(traj.stats.slip_to_stick) + initial_stick,
         frequency_hz=None if not math.isfinite(f) else float(f),
-        phi_min=float(s.phi_min), phi_max=float(s.phi_max),
+        phi_min=float(s.minimum), phi_max=float(s.maximum),
         F_max=float(traj.friction_magnitude[traj.t >= s.t_from].max()),
         stick_fraction=float(s.stick_fraction),
         errors=steady_errors(traj, ref) if ref is not None else {
@@ -302,7 +302,7 @@ def run_timestep_study(dts=DT_FULL, *, methods=("aeom", "naeom"), event_rtols=EV
     say = progress or (lambda msg: None)
     _warm_up(params)
     ref_traj = _run(params, t_end, "event", rtol=reference_rtol)
-    if ref_traj.status != "success" or not math.isfinite(ref_traj.steady.fundamental_frequency_hz):
+    if ref_traj.status != "success" or not math.isfinite(ref_traj.steady.frequency_hz):
         raise RuntimeError(f"the reference event run did not give a steady oscillation ({ref_traj.status})")
     reference = _summarise(ref_traj, None, "event", None, reference_rtol, None)
     say(f"reference event rtol={reference_rtol:g}: {reference.wall_time_s:.3f} s")

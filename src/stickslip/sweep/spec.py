@@ -23,49 +23,48 @@ from ..analysis.intensity import angle_range, intensity, trajectory_intensities
 from ..attractors import ATTRACTORS, DEFAULT_CAP_S, attractor, simulate_until_settled
 from ..errors import EquilibriumError, SimulationError, SweepError
 from ..integrate.driver import simulate
-from ..integrate.initial import NAMED_STARTS, NEAR_PERTURBATION
+from ..integrate.initial import NAMED_STARTS, NEAR_PERTURBATION, start_names
 from ..integrate.status import Status
-from ..model.library import describe_system, plates_variant, resolve_system, system_from_description, two_plates
-from ..model.library.two_plates import NAME as TWO_PLATES
+from ..model.library import describe_system, resolve_system, system_from_description, two_plates
+from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters
-from ..model.system_model import FrictionModel
-from ..model.variants import STATE_NAMES, resolve_variant
+from ..model.system_model import DEFAULT_SLIP_BAND, FrictionModel
+from ..model.variants import resolve_variant
 from ..stability.equilibrium import steady_sliding
 
 __all__ = ["SweepSpec", "SweepError", "NAMED_ICS", "initial_condition", "COLUMNS", "evaluate", "evaluate_batch",
-           "NEAR_PERTURBATION", "spec_system"]
+           "NEAR_PERTURBATION", "spec_system", "observed_columns", "columns_of"]
 
-#: Named initial conditions: those of every model, then the plates' own (``far``).
+#: Named initial conditions: those of every model, then the plates' own (``far``; a model's own
+#: starts are in ``FrictionModel.starts``).
 NAMED_ICS = {**NAMED_STARTS, **{k: v.description for k, v in two_plates().starts.items()}}
 
-#: Named initial conditions that only the plates have.
-PLATES_ONLY_ICS = ("far",)
-
+#: Dimensions that are not numeric parameters: ``model`` (the variants of a model that has them,
+#: the plates' Models 1-4) and ``ic`` (named initial conditions).
 _SPECIAL_DIMS = ("model", "ic")
 
 
-def initial_condition(name: str, params: Parameters, model) -> tuple[Any, float | None]:
-    """(ic, perturbation) arguments of :func:`stickslip.simulate` for a named initial condition
-    (``params`` and ``model``: the plates' parameters and variant, for their own starts)."""
-    if name not in NAMED_ICS:
-        raise SweepError(f"unknown initial condition {name!r}; choose one of {', '.join(NAMED_ICS)}")
+def initial_condition(name: str, system: FrictionModel) -> tuple[Any, float | None]:
+    """(ic, perturbation) arguments of :func:`stickslip.simulate` for the named initial condition
+    ``name`` of ``system`` (:func:`stickslip.integrate.initial.start_names`)."""
+    if name not in start_names(system):
+        raise SweepError(f"unknown initial condition {name!r} of model {system.name!r}; choose one of "
+                         f"{', '.join(start_names(system))}")
     if name == "near":
         return "equilibrium", NEAR_PERTURBATION
     if name in NAMED_STARTS:
         return name, None
-    if params is None:
-        raise SweepError(f"initial condition {name!r} is defined for the plates only")
-    return two_plates(params, model).starts[name].state.copy(), None
+    return system.starts[name].state.copy(), None
 
 
 # ----------------------------------------------------------------------------- the row schema
-def _columns(n_peaks: int, observed: str | None = None):
+def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str = "rad"):
     """(name, width, attrs) of each reduced quantity, in row order.
 
-    ``observed``: None for the plates (the response is φ; the intensities and angles of Eq. 16 and
-    Fig. 11); for any other model the name of its observed coordinate, which the ``phi_*``,
-    ``amplitude`` and ``peaks`` columns then follow, with one ``intensity`` of it instead of the
-    plates' intensities and angles.
+    ``observed``: the model's observed coordinate (the plates' φ), which the ``<observed>_min``,
+    ``_max``, ``_mean``, ``amplitude`` and ``peaks`` columns follow, in ``unit``. ``plates``: the
+    plates' own reductions (the intensities of Eq. 16 and the sliding angles of Fig. 11); other
+    models get one ``intensity`` of the observed coordinate instead.
     """
     cols = [
         ("kind", 1, {"long_name": "steady-state kind", "flag_values": "-1 0 1 2 3",
@@ -102,25 +101,39 @@ def _columns(n_peaks: int, observed: str | None = None):
         ("wall_time", 1, {"units": "s", "long_name": "wall time of the point (simulation and reduction)"}),
         ("peaks", n_peaks, {"units": "rad", "long_name": "last peak values of phi in the steady window (events dphi = 0)"}),
     ]
-    if observed is None:
+    if plates and observed == "phi":
         return cols
     plates_only = ("intensity_r_phi", "intensity_x1", "intensity_y1", "intensity_translation", "angle_min", "angle_max")
     out = []
     for name, width, attrs in cols:
-        if name in plates_only:
+        if name in plates_only and not plates:
             if name == "intensity_r_phi":
                 out.append(("intensity", 1, {"long_name": f"intensity index I of {observed} about steady sliding, "
                                                           "Eq. (16)", "comment": "unit of the coordinate times s-1/2"}))
             continue
         attrs = dict(attrs)
         for key in ("long_name", "comment"):
-            if key in attrs:
+            if key in attrs and name not in plates_only:
                 attrs[key] = attrs[key].replace("phi", observed)
         if name in ("amplitude", "phi_min", "phi_max", "phi_mean", "peaks"):
             attrs.pop("units", None)
+            if unit:
+                attrs["units"] = unit
             attrs["coordinate"] = observed
+            name = name.replace("phi", observed) if name.startswith("phi_") else name
         out.append((name, width, attrs))
     return out
+
+
+def columns_of(system: FrictionModel, n_peaks: int = 64):
+    """(name, width, attrs) of each reduced quantity of a sweep of ``system``, in row order."""
+    observed = system.dofs[system.observed_index]
+    return _columns(n_peaks, observed, is_plates(system), system.units.get(observed, ""))
+
+
+def observed_columns(observed: str) -> tuple[str, str, str]:
+    """The names of the minimum, maximum and mean columns of the observed coordinate."""
+    return f"{observed}_min", f"{observed}_max", f"{observed}_mean"
 
 
 #: Columns of the default schema (64 peaks), for reference.
@@ -137,13 +150,17 @@ class SweepSpec:
     Attributes
     ----------
     dims : tuple of (name, tuple of values)
-        Swept dimensions in order. A name is a :class:`~stickslip.Parameters` field, ``model``
-        (values: model names), ``ic`` (values: :data:`NAMED_ICS`), or ``perturb_<state>`` (added
-        to that state of the initial condition, e.g. ``perturb_phi`` [rad]).
+        Swept dimensions in order. A name is a numeric parameter of the model (the plates'
+        ``N``, a model file's ``contact.0.drive``), ``model`` (values: variants of a model that
+        has them, the plates' ``full`` … ``rotation``), ``ic`` (values: named starts of the model,
+        :func:`stickslip.integrate.initial.start_names`), or ``perturb_<state>`` (added to that
+        state of the initial condition, e.g. ``perturb_phi`` [rad]).
     params : dict
-        Base parameters (:meth:`Parameters.to_dict`).
-    model, ic : str
-        Defaults when not swept.
+        Base parameters of the model (``FrictionModel.parameters``).
+    model : str
+        How results name the model (the plates' variant, else the model's name).
+    ic : str
+        Initial condition when not swept.
     t_end, t_from : float
         Run length and start of the steady window [s]. When settling: the first run's length
         and the start of its window; the window length t_end − t_from is also the step.
@@ -167,9 +184,9 @@ class SweepSpec:
     method : str
         Integration method.
     system : dict or None
-        A model other than the plates, as :func:`~stickslip.model.library.describe_system` writes
-        it (then ``params`` are its parameters, ``model`` its name, and a dimension name is one of
-        its parameter paths, e.g. ``contact.0.drive``); None for the plates.
+        The model, as :func:`~stickslip.model.library.describe_system` writes it (every worker
+        rebuilds it: :func:`spec_system`); None for the plates, which ``params`` and ``model``
+        (their variant) describe.
     """
 
     dims: tuple
@@ -198,13 +215,8 @@ class SweepSpec:
         FrictionModel, library name or model file; also accepted as the ``model`` option).
         """
         system = _resolve_model(params, options)
-        if system is None:
-            params = Parameters() if params is None else params
-            fields = {f.name for f in dataclasses.fields(Parameters)} - {"friction_law"}
-            states = STATE_NAMES
-        else:
-            fields = {k for k, v in system.parameters.items() if not isinstance(v, str)}
-            states = tuple(system.dofs) + tuple("d" + d for d in system.dofs)
+        fields = {k for k, v in system.parameters.items() if not isinstance(v, (str, bool))}
+        states = system.state_names
         if not grid:
             raise SweepError("the grid is empty; give at least one dimension, e.g. {'N': [30, 50, 70]}")
         dims = []
@@ -212,17 +224,17 @@ class SweepSpec:
             values = list(np.atleast_1d(np.asarray(values, dtype=object)))
             if not values:
                 raise SweepError(f"dimension {name!r} has no values")
-            if system is not None and name not in _SPECIAL_DIMS and not name.startswith("perturb_"):
+            if name not in _SPECIAL_DIMS and not name.startswith("perturb_"):
                 name = _canonical(system, name)
             if name in _SPECIAL_DIMS:
                 values = [str(v) for v in values]
                 for v in values:
                     if name == "ic":
-                        _check_ic(v, system)
+                        initial_condition(v, system)
                     if name == "model":
-                        if system is not None:
-                            raise SweepError(f"cannot sweep 'model' with model {system.name!r}: the variants "
-                                             "belong to the plates; run one sweep per model")
+                        if "variant" not in system.parameters:
+                            raise SweepError(f"cannot sweep 'model' with model {system.name!r}: it has no variants "
+                                             "(the plates' full, x, y, rotation); run one sweep per model")
                         resolve_variant(v)
             elif name in fields or (name.startswith("perturb_") and name[8:] in states):
                 try:
@@ -233,9 +245,9 @@ class SweepSpec:
                     raise SweepError(f"dimension {name!r} has non-finite values")
                 if name in fields:  # validates (e.g. N > 0) before any run
                     for v in (values[0], values[-1]):
-                        (params if system is None else system).replace(**{name: v})
+                        system.replace(**{name: v})
             else:
-                special = "'ic'" if system is not None else "'model', 'ic'"
+                special = "'model', 'ic'" if "variant" in system.parameters else "'ic'"
                 raise SweepError(
                     f"cannot sweep {name!r}: give a parameter ({', '.join(sorted(fields))}), {special} "
                     f"or perturb_<state> with state one of {', '.join(states)}"
@@ -248,15 +260,9 @@ class SweepSpec:
         if not 0.0 <= t_from < t_end:
             raise SweepError(f"t_from = {t_from} s must lie in [0, t_end = {t_end} s)")
         ic = str(options.pop("ic", "zero"))
-        _check_ic(ic, system)
-        if system is None:
-            model = str(options.pop("model", "full"))
-            resolve_variant(model)
-            base = dict(params=params.to_dict(), model=model)
-        else:
-            options.pop("model", None)
-            base = dict(params=dict(system.parameters), model=system.name, system=describe_system(system))
-        spec = cls(dims=tuple(dims), ic=ic, t_end=t_end, t_from=t_from, **base, **options)
+        initial_condition(ic, system)
+        options.pop("model", None)
+        spec = cls(dims=tuple(dims), ic=ic, t_end=t_end, t_from=t_from, **_described(system), **options)
         if spec.n_peaks < 1:
             raise SweepError("n_peaks must be >= 1")
         if spec.sample_rate * (t_end - t_from) < 8:
@@ -280,10 +286,7 @@ class SweepSpec:
 
     @property
     def columns(self):
-        if self.system is None:
-            return _columns(self.n_peaks)
-        system = spec_system(self)
-        return _columns(self.n_peaks, system.dofs[system.observed_index])
+        return columns_of(spec_system(self), self.n_peaks)
 
     @property
     def row_width(self) -> int:
@@ -297,7 +300,7 @@ class SweepSpec:
     def to_json(self) -> str:
         d = dataclasses.asdict(self)
         d["dims"] = [[n, list(v)] for n, v in self.dims]
-        if d["system"] is None:  # the plates' specs (and digests) read as before models were added
+        if d["system"] is None:  # the plates (:func:`_described`): the spec and digest of earlier versions
             del d["system"]
         return json.dumps(d, sort_keys=True)
 
@@ -313,26 +316,26 @@ class SweepSpec:
         return hashlib.sha256(self.to_json().encode()).hexdigest()[:16]
 
 
-def _resolve_model(params, options: dict):
-    """The model of a sweep other than the plates, or None for the plates (variants, Parameters)."""
-    model = options.get("model")
+def _described(system: FrictionModel) -> dict:
+    """``params``, ``model`` and ``system`` of a spec of ``system``. The plates with their default
+    slip band are described by their Parameters and variant alone (``system`` None), as before
+    models were data: their specs, digests and files stay the same, and journals of earlier
+    sweeps resume."""
+    if is_plates(system) and system.slip_band == DEFAULT_SLIP_BAND:
+        return dict(params=plates_parameters(system).to_dict(), model=system.label, system=None)
+    return dict(params=dict(system.parameters), model=system.label or system.name, system=describe_system(system))
+
+
+def _resolve_model(params, options: dict) -> FrictionModel:
+    """The model of a sweep: the plates' Parameters with ``options["model"]`` their variant, or any
+    model (a FrictionModel, a library name or a model file, also as ``options["model"]``)."""
     if params is not None and not isinstance(params, (Parameters, FrictionModel, str, Path)):
         raise SweepError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
-    if isinstance(params, Parameters) or (params is None and (model is None or isinstance(model, str)
-                                                              and not _is_model_name(model))):
-        return None
-    system = resolve_system(params, model)
-    if system.name == TWO_PLATES:
-        raise SweepError("give the plates as Parameters with model= one of full, x, y, rotation")
-    if system.builder is None or system.spec is None:
+    system = resolve_system(params, options.get("model"))
+    if system.builder is None or (system.spec is None and system.source == "python"):
         raise SweepError(f"model {system.name!r} was defined in Python and cannot be rebuilt by the sweep's workers; "
                          "state it as a model file (.toml)")
     return system
-
-
-def _is_model_name(text: str) -> bool:
-    """Whether ``text`` names a model other than a variant of the plates (a library name or file)."""
-    return plates_variant(text) is None
 
 
 def _canonical(system, name: str) -> str:
@@ -343,22 +346,21 @@ def _canonical(system, name: str) -> str:
         return name
 
 
-def _check_ic(ic: str, system) -> None:
-    if ic not in NAMED_ICS:
-        raise SweepError(f"ic {ic!r} unknown; choose from {', '.join(NAMED_ICS)}")
-    if system is not None and ic in PLATES_ONLY_ICS:
-        raise SweepError(f"ic {ic!r} is defined for the plates only; for model {system.name!r} choose from "
-                         f"{', '.join(k for k in NAMED_ICS if k not in PLATES_ONLY_ICS)}")
-
-
 @functools.lru_cache(maxsize=8)
 def _system_from_json(text: str):
     return system_from_description(json.loads(text))
 
 
-def spec_system(spec: "SweepSpec"):
-    """The model of a sweep other than the plates (rebuilt once per process), or None."""
-    return None if spec.system is None else _system_from_json(json.dumps(spec.system, sort_keys=True))
+def spec_system(spec: "SweepSpec") -> FrictionModel:
+    """The model of a sweep (rebuilt once per process)."""
+    if spec.system is None:  # the plates (:func:`_described`)
+        return _plates_from_json(json.dumps(spec.params, sort_keys=True), spec.model)
+    return _system_from_json(json.dumps(spec.system, sort_keys=True))
+
+
+@functools.lru_cache(maxsize=8)
+def _plates_from_json(params: str, variant: str):
+    return two_plates(Parameters.from_dict(json.loads(params)), variant)
 
 
 # ----------------------------------------------------------------------------- one point
@@ -367,17 +369,12 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     start = time.perf_counter()
     values = spec.point(flat_index)
     changes = {k: v for k, v in values.items() if k not in _SPECIAL_DIMS and not k.startswith("perturb_")}
-    system = spec_system(spec)
-    if system is None:
-        params = Parameters.from_dict(spec.params).replace(**changes) if changes else Parameters.from_dict(spec.params)
-        model = values.get("model", spec.model)
-        ic, pert = initial_condition(values.get("ic", spec.ic), params, model)
-        n, observed, state_names = 6, 4, STATE_NAMES
-    else:
-        params = system.replace(**changes) if changes else system
-        model = None
-        ic, pert = initial_condition(values.get("ic", spec.ic), None, None)
-        n, observed, state_names = params.n, params.observed_index, tuple(params.dofs) + tuple("d" + d for d in params.dofs)
+    if "model" in values:
+        changes["variant"] = values["model"]
+    base = spec_system(spec)
+    system = base.replace(**changes) if changes else base
+    ic, pert = initial_condition(values.get("ic", spec.ic), system)
+    n, observed, state_names = system.n, system.observed_index, system.state_names
     deltas = {k[8:]: v for k, v in values.items() if k.startswith("perturb_")}
     if deltas:
         vec = np.zeros(2 * n)
@@ -388,16 +385,16 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         pert = vec
     out = {name: math.nan for name, _, _ in spec.columns}
     peaks = np.full(spec.n_peaks, math.nan)
-    run = dict(model=model, method=spec.method, ic=ic, perturbation=pert, rtol=spec.rtol, atol=spec.atol,
+    run = dict(method=spec.method, ic=ic, perturbation=pert, rtol=spec.rtol, atol=spec.atol,
                sample_rate=spec.sample_rate, max_steps=spec.max_steps)
     try:
         if spec.settle:
             window = spec.t_end - spec.t_from
-            settled = simulate_until_settled(params, cap=spec.cap, t_min=spec.t_end, window=window, step=window,
+            settled = simulate_until_settled(system, cap=spec.cap, t_min=spec.t_end, window=window, step=window,
                                              keep="window", confirm=spec.confirm, lyapunov=spec.confirm, **run)
             traj, verdict = settled.trajectory, settled.attractor
         else:
-            traj = simulate(params, spec.t_end, steady_from=spec.t_from, **run)
+            traj = simulate(system, spec.t_end, steady_from=spec.t_from, **run)
             verdict = None
     except SimulationError:
         traj = verdict = None
@@ -416,23 +413,24 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         c = verdict.classification
         t_from = traj.steady_from
         sel = traj.t >= t_from
-        phi = traj.states[sel, observed]
+        x = traj.states[sel, observed]
+        x_min, x_max, x_mean = observed_columns(system.dofs[observed])
         out.update(kind=float(kind_code(verdict.kind)), attractor=float(verdict.code), settled=float(verdict.settled),
                    period_count=float(verdict.period_count or 0), period=verdict.period_s,
                    fundamental_frequency=_nan(verdict.fundamental_frequency_hz), frequency=c.frequency_hz,
                    dominant_frequency=_nan(verdict.dominant_frequency_hz),
                    settle_time=_nan(verdict.settle_time_s), stick_fraction=c.stick_fraction, amplitude=c.amplitude,
-                   phi_min=float(phi.min()), phi_max=float(phi.max()),
-                   phi_mean=float(np.sum(0.5 * (phi[1:] + phi[:-1]) * np.diff(traj.t[sel])) / (traj.t[sel][-1] - traj.t[sel][0])),
                    n_peaks=float(len(c.peaks)))
+        out[x_min], out[x_max] = float(x.min()), float(x.max())
+        out[x_mean] = float(np.sum(0.5 * (x[1:] + x[:-1]) * np.diff(traj.t[sel])) / (traj.t[sel][-1] - traj.t[sel][0]))
         tt = traj.transitions.time
         out["n_transitions"] = float(np.sum((tt > t_from) & (tt <= traj.t[-1])))
-        if system is None:
+        if is_plates(system):  # the plates' own reductions (Eq. 16, Fig. 11)
             for key, val in trajectory_intensities(traj, t_from).items():
                 out[f"intensity_{key}"] = val
             out["angle_min"], out["angle_max"] = angle_range(traj, t_from)
         else:
-            out["intensity"] = _observed_intensity(traj, params, observed, t_from)
+            out["intensity"] = _observed_intensity(traj, system, observed, t_from)
         last = c.peaks.value[-spec.n_peaks:]
         peaks[: last.size] = last
     out["wall_time"] = time.perf_counter() - start

@@ -38,8 +38,10 @@ import numpy as np
 from .._version import __version__
 from ..errors import SweepError
 from ..files import AppendLog, OutputLock, atomic_write, format_name, fsync_dir, open_ours
-from ..model.parameters import PARAMETER_UNITS, parameter_attrs
-from .spec import NAMED_ICS, SweepSpec, spec_system
+from ..integrate.initial import start_description
+from ..model.library import describe_system
+from ..model.parameters import parameter_attrs
+from .spec import SweepSpec, spec_system
 
 __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir", "flat_hyperslabs", "LOAD_LIMIT_POINTS"]
 
@@ -226,20 +228,25 @@ def flat_hyperslabs(shape, start: int, stop: int) -> list:
     return out
 
 
+def _state_unit(system, state: str) -> str:
+    """Unit of a state of ``system`` (a dof's, or per second for a rate ``d<dof>``)."""
+    if state in system.dofs:
+        return system.units.get(state, "")
+    unit = system.units.get(state[1:], "")
+    return f"{unit}/s" if unit and unit != "-" else unit
+
+
 def _coords(spec: SweepSpec):
+    system = spec_system(spec)
     coords = {}
     for name, values in spec.dims:
         if name in ("model", "ic"):
             attrs = {"long_name": "model variant" if name == "model" else "initial condition"}
             if name == "ic":
-                attrs["description"] = json.dumps({v: NAMED_ICS[v] for v in values})
+                attrs["description"] = json.dumps({v: start_description(system, v) for v in values})
             coords[name] = (name, np.array(values, dtype=object), attrs)
         else:
-            unit = PARAMETER_UNITS.get(name, "")
-            if name.startswith("perturb_"):
-                state = name[8:]
-                unit = "rad" if state in ("phi", "psi") else "rad/s" if state in ("dphi", "dpsi") else \
-                    "m/s" if state.startswith("d") else "m"
+            unit = _state_unit(system, name[8:]) if name.startswith("perturb_") else system.units.get(name, "")
             coords[name] = (name, np.array(values, dtype=float), {"units": unit, "long_name": name})
     return coords
 
@@ -259,8 +266,7 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
     attrs = {
         "format": FORMAT,
         "stickslip_version": __version__,
-        "title": f"stickslip parameter sweep of the {'two-plate' if spec.system is None else spec.model} friction "
-                 "model (reductions per point)",
+        "title": f"stickslip parameter sweep of model {spec.model} (reductions per point)",
         "spec": spec.to_json(),
         "digest": spec.digest,
         "parameters": json.dumps(spec.params),
@@ -270,11 +276,10 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
         "points": spec.size, "points_done": int(done.sum()),
         "complete": int(done.all()),
     }
-    attrs.update(parameter_attrs(spec.params))
-    if spec.system is not None:
-        system = spec_system(spec)
-        attrs["system"] = json.dumps(spec.system)
-        attrs["observed"] = system.dofs[system.observed_index]
+    system = spec_system(spec)
+    attrs.update(parameter_attrs(spec.params, system.units))
+    attrs["system"] = json.dumps(describe_system(system))
+    attrs["observed"] = system.dofs[system.observed_index]
     attrs.update(extra_attrs or {})
     base = xr.Dataset({"done": (spec.names, done.reshape(spec.shape).astype(np.int8),
                                 {"long_name": "point computed (1) or pending (0)"})},

@@ -9,6 +9,7 @@ DOFs (:mod:`stickslip.model.variants`): a locked DOF gets zero inverse mass and 
 
 from __future__ import annotations
 
+import math
 from typing import Any, Mapping
 
 import numpy as np
@@ -19,7 +20,7 @@ from ..system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, NamedState
 from ..variants import DOF_NAMES, resolve_variant
 from .plate_kinematics import PlateKinematics
 
-__all__ = ["two_plates", "NAME"]
+__all__ = ["two_plates", "NAME", "is_plates", "plates_parameters"]
 
 NAME = "two-plates"
 
@@ -55,6 +56,34 @@ def two_plates(params: Parameters | None = None, variant="full", slip_band: floa
         name=NAME, dofs=DOF_NAMES, mass=mass, damping=damping * v.mask, stiffness=stiffness * v.mask,
         force=np.zeros(6), contacts=(contact,), kinematics=PlateKinematics(P.r, P.Omega), free=v.mask,
         parameters={**P.to_dict(), "variant": v.name}, builder=builder, source=f"library:{NAME}",
-        units=_UNITS, slip_band=slip_band, observed="phi", starts=starts,
-        description="two rigid plates in point contact, 2-D friction (Liu & Ouyang; the paper)",
+        units=_UNITS, slip_band=slip_band, observed="phi", starts=starts, label=v.name, headline=("N", "Omega"),
+        steady_hint=_steady_hint, description="two rigid plates in point contact, 2-D friction (Liu & Ouyang; the paper)",
     )
+
+
+def is_plates(model: FrictionModel) -> bool:
+    """Whether ``model`` is the two plates (any variant, any parameters)."""
+    return model.name == NAME
+
+
+def plates_parameters(model: FrictionModel) -> Parameters | None:
+    """The plates' :class:`~stickslip.model.parameters.Parameters` of ``model`` (None for other models)."""
+    if not is_plates(model):
+        return None
+    values = dict(model.parameters)
+    values.pop("variant", None)
+    return Parameters.from_dict(values)
+
+
+def _steady_hint(model: FrictionModel, q) -> str:
+    """Why steady sliding may not exist near ``q`` (Eq. 14): the friction load drags the contact
+    point onto the centre of the lower plate, where the branch of equilibria folds."""
+    r = model.parameters["r"]
+    if not all(math.isfinite(x) for x in q):
+        return ""
+    R = math.hypot(q[0] - q[2] + r * math.cos(q[4]), q[1] - q[3] + r * math.sin(q[4]))
+    if R >= 0.5 * r:
+        return ""
+    return (f"the iterate has the contact point at R = {R:.3g} m from the centre O2 (r = {r:g} m): the friction "
+            "load mu N drags the contact point onto the centre of the lower plate and steady sliding does not exist "
+            "beyond that load (a fold of Eq. 14); reduce N or mu")
