@@ -35,7 +35,7 @@ import importlib
 import sys
 import types
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 from .analysis import Classification, classify, find_peaks, intensity
 from .errors import StickSlipError
