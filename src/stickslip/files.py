@@ -99,17 +99,19 @@ HDF5_SUFFIXES = frozenset({".nc", ".nc4", ".h5", ".hdf5"})
 
 
 # --------------------------------------------------------------------------- errors of writing
-def _is_full(exc: BaseException) -> bool:
-    """Whether ``exc`` (or an exception it was raised from) reports a full disk or size limit."""
+def _full_reason(exc: BaseException) -> str | None:
+    """The system's words for a full disk or size limit if ``exc`` (or an exception it was
+    raised from) reports one ("No space left on device"), else None."""
     seen = set()
     while exc is not None and id(exc) not in seen:
         seen.add(id(exc))
         if isinstance(exc, OSError) and exc.errno in FULL_ERRNOS:
-            return True
-        if any(text in str(exc) for text in _FULL_TEXTS):
-            return True
+            return os.strerror(exc.errno)
+        found = [text for text in _FULL_TEXTS if text in str(exc)]
+        if found:
+            return found[0]
         exc = exc.__cause__ or exc.__context__
-    return False
+    return None
 
 
 @contextmanager
@@ -126,11 +128,13 @@ def writing_errors(path, kept: str | None = None):
     try:
         yield
     except Exception as exc:  # a full disk met by a nested write (a temporary of this one) is named here too
-        if not isinstance(exc, DiskFullError) and (isinstance(exc, StickSlipError) or not _is_full(exc)):
+        reason = _full_reason(exc)
+        if not isinstance(exc, DiskFullError) and (isinstance(exc, StickSlipError) or reason is None):
             raise
+        why = f" ({reason})" if reason else ""
         note = f"; {kept}" if kept else ""
-        raise DiskFullError(f"cannot write {path}: the disk or the file size limit is full; free space and run the "
-                            f"command again{note}") from exc
+        raise DiskFullError(f"cannot write {path}: the disk or the file size limit is full{why}; free space and run "
+                            f"the command again{note}") from exc
 
 
 # --------------------------------------------------------------------------- atomic replacement
@@ -360,8 +364,7 @@ class OutputLock:
                          f"command again, or choose another output (--out)")
 
     def _cannot(self, exc: OSError, what: str) -> WriteError:
-        return WriteError(f"cannot write {self.output}: {what} in {self.path.parent} fails ({exc.strerror or exc}); "
-                          f"choose another path")
+        return WriteError(f"cannot write {self.output}: {what} fails ({exc.strerror or exc}); choose another path")
 
     def _try_take(self) -> int | None:
         """The descriptor of the locked lock file, or None while another holds it."""
@@ -370,12 +373,12 @@ class OutputLock:
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
-            raise self._cannot(exc, "creating a folder") from None
+            raise self._cannot(exc, f"creating the folder {self.path.parent}") from None
         while True:
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
             except OSError as exc:
-                raise self._cannot(exc, "creating a file") from None
+                raise self._cannot(exc, f"creating a file in {self.path.parent}") from None
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
@@ -383,7 +386,7 @@ class OutputLock:
                 return None
             except OSError as exc:
                 os.close(fd)
-                raise self._cannot(exc, "locking a file") from None
+                raise self._cannot(exc, f"locking a file in {self.path.parent}") from None
             try:  # the file locked must still be the one at the name (not deleted by a holder that just left)
                 if os.path.samestat(os.fstat(fd), os.stat(self.path)):
                     return fd
@@ -499,7 +502,7 @@ def same_file(a, b) -> bool:
         return False
 
 
-def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out") -> None:
+def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out", what: str | None = None) -> None:
     """Refuse to write ``path`` onto an input, a folder, or (without ``overwrite``) an existing file.
 
     Parameters
@@ -511,18 +514,21 @@ def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out") ->
         Files the command reads (None entries skipped); never written, not even with ``overwrite``.
     flag : str
         The option that names ``path``, for the messages.
+    what : str, optional
+        How the messages name ``path`` (default ``"{flag} {path}"``; e.g. a figure beside the output).
 
     Raises
     ------
     OutputError
     """
     path = Path(path)
+    what = what or f"{flag} {path}"
     for in_flag, in_path in (inputs or {}).items():
         if in_path is not None and same_file(path, in_path):
-            raise OutputError(f"{flag} {path} is the file given to {in_flag}; an input is never overwritten, "
+            raise OutputError(f"{what} is the file given to {in_flag}; an input is never overwritten, "
                               f"give another {flag}")
     if path.is_dir():
-        raise OutputError(f"{flag} {path} is a directory; give a file name")
+        raise OutputError(f"{what} is a directory; give a file name")
     if (path.exists() or path.is_symlink()) and not overwrite:
         raise OutputError(f"{path} exists; pass --overwrite to replace it, or give another {flag}")
 

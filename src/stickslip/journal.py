@@ -96,7 +96,7 @@ class Journal:
     inputs : dict of option → path, optional
         Files the run reads: ``out`` must not be one of them (:func:`stickslip.files.refuse_output`).
     saved : str
-        What the records are, for the messages of a full disk ("finished points").
+        What the records hold, plural, for the messages of a full disk ("the finished points").
     restart : str
         How to start over, for the messages.
 
@@ -115,7 +115,7 @@ class Journal:
 
     def __init__(self, out, *, kind: str, digest: str, settings, noun: str, differs: str, error=JournalError,
                  overwrite: bool = False, lock: OutputLock | None = None, inputs: dict | None = None,
-                 saved: str = "finished work", restart: str = "pass overwrite=True (--overwrite)"):
+                 saved: str = "the finished records", restart: str = "pass overwrite=True (--overwrite)"):
         self.out = Path(out)
         self.location = journal_path(self.out)
         self.kind, self.digest, self.settings = kind, digest, settings
@@ -133,7 +133,7 @@ class Journal:
             else:
                 self._check(header)
             self._open()
-            self._log = AppendLog(self.path, kept=f"{saved} is kept in {self.location}")
+            self._log = AppendLog(self.path, kept=f"{saved} are kept in {self.location}")
 
     # ------------------------------------------------------------------ header
     def _header(self) -> dict:
@@ -192,7 +192,7 @@ class Journal:
         """
         path = self.out if path is None else Path(path)
         return write_output(path, write, overwrite=True, inputs=self.inputs,
-                            kept=f"{path} is left as it was and {self.saved} is kept in {self.location}")
+                            kept=f"{path} is left as it was and {self.saved} are kept in {self.location}")
 
     def close(self) -> None:
         """Close the journal (it stays on disk, to resume from) and release the output's lock."""

@@ -57,7 +57,7 @@ class Journal(RowJournal):
         super().__init__(out, width=spec.row_width, size=spec.size, kind="basins", digest=spec.digest,
                          settings=json.loads(spec.to_json()), noun="basin study",
                          differs="model, states or options differ", error=BasinError, overwrite=overwrite,
-                         inputs={"--ics": spec.states.source or None}, saved="every classified state")
+                         inputs={"--ics": spec.states.source or None}, saved="the classified states")
 
     def read(self) -> tuple[np.ndarray, np.ndarray]:
         """(flat indices (m,), rows (m, row width)) of every record, the last record of an index kept."""

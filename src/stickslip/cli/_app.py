@@ -471,7 +471,8 @@ def _check_folder(path: Path, flag: str) -> None:
         raise CLIError(f"{flag} {path}: the folder {existing} is not writable; choose another {flag}")
 
 
-def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: dict | None = None) -> None:
+def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: dict | None = None,
+                 what: str | None = None) -> None:
     """Refuse, before anything is computed, an output file that must not or cannot be written.
 
     Parameters
@@ -484,11 +485,19 @@ def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: di
         The option that names it.
     inputs : dict of option → Path, optional
         Files the command reads; never overwritten, not even with ``--overwrite``.
+    what : str, optional
+        How the messages name the file (default ``"{flag} {path}"``).
     """
     from ..files import refuse_output
 
-    refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag)
+    refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag, what=what)
     _check_folder(path, flag)
+
+
+def _figure_of(out: Path, flag: str = "--out") -> dict:
+    """The figure beside NetCDF output ``out`` and how messages name it."""
+    png = out.with_suffix(".png")
+    return {"path": png, "what": f"the figure {png} of {flag} {out}"}
 
 
 def check_outputs(out: Path, figure: bool, overwrite: bool, **kwargs) -> None:
@@ -497,7 +506,8 @@ def check_outputs(out: Path, figure: bool, overwrite: bool, **kwargs) -> None:
     check_nc_path(out, kwargs.get("flag", "--out"))
     check_output(out, overwrite, **kwargs)
     if figure:
-        check_output(out.with_suffix(".png"), overwrite, **kwargs)
+        fig = _figure_of(out, kwargs.get("flag", "--out"))
+        check_output(fig["path"], overwrite, what=fig["what"], **kwargs)
     hold_output(out)
 
 
@@ -525,7 +535,8 @@ def check_resumable_output(out: Path, figure: bool, overwrite: bool, inputs: dic
     _check_folder(out, "--out")
     fresh = not out.exists() and not journal_of(out).exists()
     if figure:
-        check_output(out.with_suffix(".png"), overwrite or not fresh, inputs=inputs)
+        fig = _figure_of(out)
+        check_output(fig["path"], overwrite or not fresh, inputs=inputs, what=fig["what"])
     hold_output(out)
     on_interrupt(f"finished work is kept in {journal_of(out)}; run the same command again to resume")
     return overwrite or not fresh

@@ -135,7 +135,8 @@ class Journal(LineJournal):
                  overwrite: bool = False):
         super().__init__(out, kind=kind, digest=digest, settings=settings, noun=f"{kind} run",
                          differs="settings or start differ", error=JournalMismatch, overwrite=overwrite, lock=lock,
-                         saved=f"the {kind} computed so far", restart="pass resume=False (--overwrite)")
+                         saved="the finished orbits" if kind == "branch" else "the finished N values",
+                         restart="pass resume=False (--overwrite)")
 
 
 def check_output(out, kind: str, digest: str, attrs: dict) -> None:
@@ -265,8 +266,11 @@ def branch_settings(system, param, start, section, rtol, atol, numerics: dict) -
 # ----------------------------------------------------------------------- NetCDF
 def write_dataset(ds, path) -> Path:
     """Write ``ds`` to ``path`` (NetCDF4 via h5netcdf) under the output's lock, atomically
-    (:func:`stickslip.files.write_output`)."""
-    return write_output(Path(path), lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=True)
+    (:func:`stickslip.files.write_output`); a full disk names the journal that keeps the run."""
+    path = Path(path)
+    journal = journal_path(path)
+    kept = f"{path} is left as it was" + (f" and the finished work is kept in {journal}" if journal.exists() else "")
+    return write_output(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=True, kept=kept)
 
 
 def branch_dataset(branch):

@@ -82,7 +82,7 @@ class Journal(RowJournal):
         self.spec = spec
         super().__init__(out, width=spec.row_width, size=spec.size, kind="sweep", digest=spec.digest,
                          settings=json.loads(spec.to_json()), noun="sweep", differs="grid or options differ",
-                         error=SweepError, overwrite=overwrite, saved="every finished point")
+                         error=SweepError, overwrite=overwrite, saved="the finished points")
 
     def done_mask(self) -> np.ndarray:
         """Boolean (size,) of the points already in the journal."""
