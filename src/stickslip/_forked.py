@@ -93,6 +93,7 @@ def _child_writes(write, tmp: Path, fd: int) -> None:
 def write_in_child(write, tmp: Path) -> None:
     """Call ``write(tmp)`` in a forked child process and raise its first error here (module
     docstring); the child's warnings are issued here. Ctrl-C kills the child and raises here.
+    Where no child can be started (fork fails), ``write`` runs in this process.
 
     Raises
     ------
@@ -101,9 +102,15 @@ def write_in_child(write, tmp: Path) -> None:
         RuntimeError if the child died without reporting one.
     """
     read_fd, write_fd = os.pipe()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)  # Python >= 3.12 on fork with threads running
-        pid = os.fork()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)  # Python >= 3.12 on fork with threads running
+            pid = os.fork()
+    except OSError:  # no memory or processes left for a child: write here, as without fork
+        os.close(read_fd)
+        os.close(write_fd)
+        write(tmp)
+        return
     if pid == 0:  # pragma: no cover - the child; reported through the pipe
         os.close(read_fd)
         _child_writes(write, tmp, write_fd)

@@ -135,8 +135,8 @@ def test_a_netcdf_output_cut_by_a_full_disk_is_one_line_and_the_command_resumes(
 
 def test_a_full_disk_keeps_the_previous_netcdf_output(tmp_path):
     out = tmp_path / "o.nc"
-    assert run(_belt("simulate", out)).returncode == 0
+    assert run(_belt("simulate", "o.nc"), cwd=tmp_path).returncode == 0
     before = out.read_bytes()
-    res = run(_belt("simulate", out, "--overwrite", "--t-end", "120"), preexec_fn=limited(65_536))
-    one_line_error(res, "o.nc is left as it was")
+    res = run(_belt("simulate", "o.nc", "--overwrite", "--t-end", "120"), cwd=tmp_path, preexec_fn=limited(65_536))
+    one_line_error(res, "o.nc is left as it was")  # before: that line, then exit 139
     assert out.read_bytes() == before and leftovers(out) == []
