@@ -55,9 +55,10 @@ try:
 except ImportError:  # pragma: no cover - Windows: no flock, the lock is refused in one line
     fcntl = None
 
-__all__ = ["FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError", "OutputLock", "lock", "lock_path",
-           "atomic_write", "atomic_write_text", "write_output", "refuse_output", "same_file", "temporary_path",
-           "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name", "writing_errors"]
+__all__ = ["FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError", "OutputLock", "lock",
+           "lock_path", "atomic_write", "atomic_write_text", "write_output", "refuse_output", "same_file",
+           "temporary_path", "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name",
+           "writing_errors"]
 
 
 class LockError(StickSlipError, RuntimeError):
@@ -197,9 +198,9 @@ def atomic_write(path, write: Callable[[Path], object], *, kept: str | None = No
 
     ``write`` is called with a unique temporary path in the same directory
     (:func:`temporary_path`), in a forked child process for HDF5 files (:data:`HDF5_SUFFIXES`;
-    :func:`stickslip._forked.write_in_child`); the temporary is then ``fsync``-ed, renamed onto ``path`` and the
-    directory ``fsync``-ed. On any error the temporary is removed and ``path`` is left as it was.
-    This does not take the output's lock: outputs go through :func:`write_output`.
+    :func:`stickslip._forked.write_in_child`); the temporary is then ``fsync``-ed, renamed onto
+    ``path`` and the directory ``fsync``-ed. On any error the temporary is removed and ``path`` is
+    left as it was. This does not take the output's lock: outputs go through :func:`write_output`.
 
     Parameters
     ----------

@@ -25,6 +25,7 @@ from rich.text import Text
 from typer.core import TyperGroup
 
 from ..errors import StickSlipError
+from ..files import lock, refuse_output
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -448,8 +449,6 @@ _held_outputs: list = []
 def hold_output(out: Path) -> None:
     """Take the lock of output ``out`` for the rest of the command: a second writer of it is
     refused now, before anything is computed, not after (:class:`stickslip.files.OutputLock`)."""
-    from ..files import lock
-
     _held_outputs.append(lock(out))
 
 
@@ -488,16 +487,14 @@ def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: di
     what : str, optional
         How the messages name the file (default ``"{flag} {path}"``).
     """
-    from ..files import refuse_output
-
     refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag, what=what)
     _check_folder(path, flag)
 
 
-def _figure_of(out: Path, flag: str = "--out") -> dict:
-    """The figure beside NetCDF output ``out`` and how messages name it."""
+def _check_figure(out: Path, overwrite: bool, flag: str = "--out", inputs: dict | None = None) -> None:
+    """:func:`check_output` for the figure beside NetCDF output ``out`` (``OUT.png``)."""
     png = out.with_suffix(".png")
-    return {"path": png, "what": f"the figure {png} of {flag} {out}"}
+    check_output(png, overwrite, flag=flag, inputs=inputs, what=f"the figure {png} of {flag} {out}")
 
 
 def check_outputs(out: Path, figure: bool, overwrite: bool, **kwargs) -> None:
@@ -506,8 +503,7 @@ def check_outputs(out: Path, figure: bool, overwrite: bool, **kwargs) -> None:
     check_nc_path(out, kwargs.get("flag", "--out"))
     check_output(out, overwrite, **kwargs)
     if figure:
-        fig = _figure_of(out, kwargs.get("flag", "--out"))
-        check_output(fig["path"], overwrite, what=fig["what"], **kwargs)
+        _check_figure(out, overwrite, **kwargs)
     hold_output(out)
 
 
@@ -528,15 +524,12 @@ def check_resumable_output(out: Path, figure: bool, overwrite: bool, inputs: dic
         Whether the figure may replace an existing file: with ``overwrite``, or when the run
         resumes (its figure is the command's own).
     """
-    from ..files import refuse_output
-
     check_nc_path(out)
     refuse_output(out, overwrite=True, inputs=inputs)
     _check_folder(out, "--out")
     fresh = not out.exists() and not journal_of(out).exists()
     if figure:
-        fig = _figure_of(out)
-        check_output(fig["path"], overwrite or not fresh, inputs=inputs, what=fig["what"])
+        _check_figure(out, overwrite or not fresh, inputs=inputs)
     hold_output(out)
     on_interrupt(f"finished work is kept in {journal_of(out)}; run the same command again to resume")
     return overwrite or not fresh
