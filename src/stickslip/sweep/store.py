@@ -37,6 +37,7 @@ import numpy as np
 
 from .._version import __version__
 from ..files import format_name, open_ours
+from ..journal import READ_ROWS as JOURNAL_READ_ROWS
 from ..journal import RowJournal, journal_path
 from ..model.parameters import PARAMETER_UNITS, parameter_attrs
 from .spec import NAMED_ICS, SweepError, SweepSpec
@@ -45,9 +46,9 @@ __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir", "flat_h
 
 FORMAT = format_name("sweep", 1)
 
-#: Journal records read at once: 4096 records of ~88 float64 = 2.9 MB, whatever the journal length
-#: (16384 measured 20 MB more peak at 10^5 points: two blocks and their sorted copies in flight).
-READ_ROWS = 4096
+#: Journal records read at once (:data:`stickslip.journal.READ_ROWS`, 2.9 MB of ~88 float64 rows;
+#: 16384 measured 20 MB more peak at 10^5 points: two blocks and their sorted copies in flight).
+READ_ROWS = JOURNAL_READ_ROWS
 
 #: Consecutive grid points written to the NetCDF variables at once: the largest array of the
 #: assembly holds SLAB_POINTS × row width float64 (4096 × 86 × 8 B = 2.8 MB with 64 peaks), and
