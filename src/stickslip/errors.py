@@ -26,7 +26,9 @@ them without importing the module that raises it.
 ``BasinError``           an invalid basin-stability study
 ``FileFormatError``      a file that is not a stickslip result of a readable format
 ``LockError``            another process writes the same output
-``WriteError``           a full disk or file size limit
+``WriteError``           a file that could not be written (``DiskFullError``: a full disk or file size limit)
+``OutputError``          an output that must not be written (exists, a folder, an input)
+``JournalError``         a journal of other settings, corrupt, or of an earlier format
 =======================  ======================================================================
 """
 
@@ -34,7 +36,8 @@ from __future__ import annotations
 
 __all__ = ["StickSlipError", "ModelError", "ModelFileError", "ParameterError", "FrictionLawError", "VariantError",
            "KinematicsError", "ExpressionError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
-           "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError"]
+           "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError",
+           "JournalError"]
 
 
 class StickSlipError(Exception):
@@ -124,4 +127,16 @@ class LockError(StickSlipError, RuntimeError):
 
 
 class WriteError(StickSlipError, RuntimeError):
-    """A file could not be written because the disk (or the file size limit) is full."""
+    """A file could not be written: the disk or the file size limit is full, or its folder takes no files."""
+
+
+class DiskFullError(WriteError):
+    """The disk, a quota or the file size limit is full."""
+
+
+class OutputError(StickSlipError, ValueError):
+    """An output that must not be written: an existing file without overwrite, a folder, or an input."""
+
+
+class JournalError(StickSlipError, ValueError):
+    """A journal that cannot be resumed: of other settings or kind, of an earlier format, or corrupt."""

@@ -3,19 +3,25 @@
 Every stickslip command that writes a file goes through these helpers, so that nothing the user
 made is lost and no reader ever sees half a file:
 
-:func:`lock`
-    One writer per output. A resumable command holds ``OUT.lock`` (a :mod:`filelock` lock on a
-    file beside the output, with the holder's pid, host, start time and command line written
-    into it) for as long as it writes ``OUT`` or its journal. A second writer is refused with one
-    line naming the holder. The lock is a kernel lock (``flock``), so a process that dies, even by
-    ``kill -9``, drops it with its last open descriptor and the next writer takes it over; the
-    file itself stays (deleting a lock file while others wait on it would split them across two
-    files) and is empty whenever nobody holds it.
+:func:`write_output`
+    The one way an output is written: take its lock, refuse an existing file without
+    ``overwrite`` and any file the command reads, replace the file atomically, release the lock.
+:class:`OutputLock`
+    One writer per output: ``OUT.lock`` beside the output, locked with :mod:`filelock` (``flock``)
+    and holding the holder's pid, host, start time and command line. A second writer is refused with one line
+    naming the holder. The kernel drops the lock with the holder's last descriptor, so a process
+    that dies, even by ``kill -9``, never blocks the next writer. The last release deletes the
+    file while still holding it, and a taker keeps a lock only if the file it locked is still the
+    one at that name (a waiter that locked a deleted file tries again): no two writers can hold
+    two different files, and no ``.lock`` file stays beside a finished output.
 :func:`atomic_write`
     Replace a file all at once: write a temporary file with a unique name in the same directory,
     ``fsync`` it, rename it onto the target and ``fsync`` the directory. A crash leaves the old
     file or the new one, never a mixture; a full disk leaves the old one and raises
-    :class:`WriteError`.
+    :class:`WriteError`. HDF5 files (NetCDF-4) are written by a forked child process
+    (:mod:`stickslip._forked`): HDF5 does not survive a failed write (it reports errors from its
+    finalisers and then crashes the process), so the crash is contained in the child and the
+    command reports one line.
 :class:`AppendLog`
     A journal file that grows by records, each written whole and ``fsync``-ed before the call
     returns; a record torn by a full disk is cut off again at once.
@@ -34,21 +40,26 @@ import re
 import secrets
 import socket
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable
 
-from ._version import __version__
-from .errors import FileFormatError, LockError, StickSlipError, WriteError
+from filelock import FileLock, Timeout
 
-__all__ = ["FileFormatError", "LockError", "WriteError", "OutputLock", "lock", "lock_path", "atomic_write",
-           "atomic_write_text",
+from . import _forked
+from ._loader import format_name, open_ours
+from .errors import DiskFullError, FileFormatError, LockError, OutputError, StickSlipError, WriteError
+
+__all__ = ["FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError", "OutputLock", "lock",
+           "lock_path", "atomic_write", "atomic_write_text", "write_output", "refuse_output", "same_file",
            "temporary_path", "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name",
            "writing_errors"]
 
 
-#: ``errno`` values of a full disk, an exhausted quota and a file over ``RLIMIT_FSIZE``.
+#: ``errno`` values of a full disk, an exhausted quota and a file over ``RLIMIT_FSIZE`` (Python
+#: ignores SIGXFSZ, so a write over the size limit fails with EFBIG instead of killing the process).
 FULL_ERRNOS = frozenset(e for e in (errno.ENOSPC, getattr(errno, "EDQUOT", None), errno.EFBIG) if e is not None)
 
 #: Texts by which HDF5 reports the same conditions inside its own error messages (h5py does not
@@ -58,24 +69,32 @@ _FULL_TEXTS = tuple(os.strerror(e) for e in FULL_ERRNOS)
 #: Seconds a refused writer waits for the holder's details to appear in a freshly taken lock.
 _HOLDER_READ_S = 0.5
 
+#: Seconds between two tries of a writer that waits for a lock (``timeout`` > 0).
+_LOCK_POLL_S = 0.05
+
+#: Suffixes of the files HDF5 writes: these are written by a forked child (:mod:`stickslip._forked`).
+HDF5_SUFFIXES = frozenset({".nc", ".nc4", ".h5", ".hdf5"})
+
 
 # --------------------------------------------------------------------------- errors of writing
-def _is_full(exc: BaseException) -> bool:
-    """Whether ``exc`` (or an exception it was raised from) reports a full disk or size limit."""
+def _full_reason(exc: BaseException) -> str | None:
+    """The system's words for a full disk or size limit if ``exc`` (or an exception it was
+    raised from) reports one ("No space left on device"), else None."""
     seen = set()
     while exc is not None and id(exc) not in seen:
         seen.add(id(exc))
         if isinstance(exc, OSError) and exc.errno in FULL_ERRNOS:
-            return True
-        if any(text in str(exc) for text in _FULL_TEXTS):
-            return True
+            return os.strerror(exc.errno)
+        found = [text for text in _FULL_TEXTS if text in str(exc)]
+        if found:
+            return found[0]
         exc = exc.__cause__ or exc.__context__
-    return False
+    return None
 
 
 @contextmanager
 def writing_errors(path, kept: str | None = None):
-    """Turn a full disk, quota or file size limit while writing ``path`` into one :class:`WriteError` line.
+    """Turn a full disk, quota or file size limit while writing ``path`` into one :class:`DiskFullError` line.
 
     Parameters
     ----------
@@ -86,23 +105,23 @@ def writing_errors(path, kept: str | None = None):
     """
     try:
         yield
-    except Exception as exc:
-        if isinstance(exc, StickSlipError) or not _is_full(exc):
+    except Exception as exc:  # a full disk met by a nested write (a temporary of this one) is named here too
+        reason = _full_reason(exc)
+        if not isinstance(exc, DiskFullError) and (isinstance(exc, StickSlipError) or reason is None):
             raise
+        why = f" ({reason})" if reason else ""
         note = f"; {kept}" if kept else ""
-        raise WriteError(f"cannot write {path}: the disk or the file size limit is full; free space and run the "
-                         f"command again{note}") from exc
+        raise DiskFullError(f"cannot write {path}: the disk or the file size limit is full{why}; free space and run "
+                            f"the command again{note}") from exc
 
 
 # --------------------------------------------------------------------------- atomic replacement
 def temporary_path(path) -> Path:
-    """A unique temporary name beside ``path``: ``NAME.<pid>-<random>.tmp`` in the same directory
-    (same file system, so the final rename is atomic)."""
+    """A unique temporary name beside ``path``, with its suffix: ``STEM.<pid>-<random>.tmp.SUFFIX``
+    (same file system, so the final rename is atomic; same suffix, so writers that choose the
+    format by it, such as figures, write the right one)."""
     path = Path(path)
-    return path.with_name(f"{path.name}.{os.getpid()}-{secrets.token_hex(4)}.tmp")
-
-
-_TEMPORARY = re.compile(r"\.(\d+)-[0-9a-f]{8}\.tmp$")
+    return path.with_name(f"{path.stem}.{os.getpid()}-{secrets.token_hex(4)}.tmp{path.suffix}")
 
 
 def _alive(pid: int) -> bool:
@@ -126,9 +145,10 @@ def clean_temporaries(path) -> list[Path]:
     removed = []
     if not path.parent.is_dir():
         return removed
-    for other in path.parent.glob(f"{path.name}.*.tmp"):
-        m = _TEMPORARY.search(other.name)
-        if m and other.name == f"{path.name}{m.group(0)}" and not _alive(int(m.group(1))):
+    pattern = re.compile(rf"^{re.escape(path.stem)}\.(\d+)-[0-9a-f]{{8}}\.tmp{re.escape(path.suffix)}$")
+    for other in path.parent.glob(f"{path.stem}.*.tmp{path.suffix}"):
+        m = pattern.match(other.name)
+        if m and not _alive(int(m.group(1))):
             other.unlink(missing_ok=True)
             removed.append(other)
     return removed
@@ -154,31 +174,14 @@ def _fsync_file(path: Path) -> None:
         os.fsync(fh.fileno())
 
 
-def _abandon_netcdf(path: Path) -> None:
-    """Mark every ``h5netcdf.File`` still open on ``path`` closed, so that nothing writes to it again.
-
-    After a failed HDF5 write (a full disk) the writer may be left open (xarray keeps it in its
-    file cache when closing it fails); its next ``close``, from the cache or from ``__del__``, would
-    flush the NetCDF metadata into the broken file and h5py then crashes the process. ``path``
-    is a temporary that is deleted anyway.
-    """
-    h5netcdf = sys.modules.get("h5netcdf")
-    if h5netcdf is None:
-        return
-    import gc
-
-    for obj in gc.get_objects():
-        if isinstance(obj, h5netcdf.File) and not getattr(obj, "_closed", True) \
-                and str(getattr(obj, "_filename", "")) == str(path):  # no HDF5 call: any may crash now
-            obj._closed = True  # its close() (also from __del__) must not flush again
-
-
 def atomic_write(path, write: Callable[[Path], object], *, kept: str | None = None) -> Path:
     """Replace ``path`` by the file that ``write(tmp)`` creates, all at once.
 
     ``write`` is called with a unique temporary path in the same directory
-    (:func:`temporary_path`); the temporary is then ``fsync``-ed, renamed onto ``path`` and the
-    directory ``fsync``-ed. On any error the temporary is removed and ``path`` is left as it was.
+    (:func:`temporary_path`), in a forked child process for HDF5 files (:data:`HDF5_SUFFIXES`;
+    :func:`stickslip._forked.write_in_child`); the temporary is then ``fsync``-ed, renamed onto
+    ``path`` and the directory ``fsync``-ed. On any error the temporary is removed and ``path`` is
+    left as it was. This does not take the output's lock: outputs go through :func:`write_output`.
 
     Parameters
     ----------
@@ -201,18 +204,24 @@ def atomic_write(path, write: Callable[[Path], object], *, kept: str | None = No
     """
     path = Path(path)
     tmp = temporary_path(path)
+    isolate = path.suffix.lower() in HDF5_SUFFIXES and hasattr(os, "fork") and not _forked.in_child()
     try:
         with writing_errors(path, kept or f"{path} is left as it was"):
-            write(tmp)
+            if isolate:
+                _forked.write_in_child(write, tmp)
+            else:
+                write(tmp)
             _fsync_file(tmp)
             os.replace(tmp, path)
-    except BaseException:
-        _abandon_netcdf(tmp)
-        raise
     finally:
         tmp.unlink(missing_ok=True)
     fsync_dir(path.parent)
     return path
+
+
+def atomic_write_text(path, text: str) -> Path:
+    """Replace the text file ``path`` by ``text`` (UTF-8) all at once (:func:`atomic_write`)."""
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 # --------------------------------------------------------------------------- durable appends
@@ -222,7 +231,7 @@ class AppendLog:
     Each record is written whole (``os.write`` until done), then ``fsync``-ed. If the write fails
     (a full disk) the file is cut back to its length before the record, so it never ends in half
     a record written by this process, and :class:`WriteError` is raised. Records torn by a kill
-    inside a write are for the reader to drop (each journal format marks complete records).
+    inside a write are for the reader to drop (:mod:`stickslip.journal` checksums every record).
 
     Parameters
     ----------
@@ -264,21 +273,17 @@ class AppendLog:
         self.close()
 
 
-def atomic_write_text(path, text: str) -> Path:
-    """Replace the text file ``path`` by ``text`` (UTF-8) all at once (:func:`atomic_write`)."""
-    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-
-
 # --------------------------------------------------------------------------- one writer per output
 def lock_path(path) -> Path:
     """The lock file of output ``path``: ``OUT.lock`` beside it."""
     return Path(str(path) + ".lock")
 
 
-def _holder_text() -> str:
-    return json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
-                       "since": datetime.datetime.now().isoformat(timespec="seconds"),
-                       "command": " ".join([Path(sys.argv[0]).name] + sys.argv[1:]) if sys.argv else ""})
+def _holder_text() -> bytes:
+    return (json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
+                        "since": datetime.datetime.now().isoformat(timespec="seconds"),
+                        "command": " ".join([Path(sys.argv[0]).name] + sys.argv[1:]) if sys.argv else ""})
+            + "\n").encode()
 
 
 def _read_holder(path: Path) -> dict:
@@ -286,12 +291,47 @@ def _read_holder(path: Path) -> dict:
     deadline = time.monotonic() + _HOLDER_READ_S
     while True:
         try:
-            text = path.read_text()
-            return json.loads(text)
+            return json.loads(path.read_text())
         except (OSError, ValueError):
             if time.monotonic() > deadline:
                 return {}
             time.sleep(0.02)
+
+
+class _Stale(Exception):
+    """The lock file just locked is no longer the one at its name (a holder deleted it on release)."""
+
+
+def _take_current(path: Path):
+    """``on_acquired`` callback of :class:`filelock.FileLock`: keep the lock only when the file it
+    locked is still the one at ``path`` (else roll the acquisition back), then record the holder."""
+
+    def on_acquired(fd: int) -> None:
+        try:
+            current = os.path.samestat(os.fstat(fd), os.stat(path))
+        except FileNotFoundError:
+            current = False
+        if not current:
+            raise _Stale
+        try:  # who holds it, for a refused writer's message (best effort: a full disk leaves it empty)
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, _holder_text(), 0)
+        except OSError:
+            pass
+
+    return on_acquired
+
+
+class _Hold:
+    """A lock this process holds: the file lock, the thread that holds it and how often."""
+
+    def __init__(self, file_lock: FileLock):
+        self.file_lock, self.thread, self.count, self.pid = file_lock, threading.get_ident(), 1, os.getpid()
+
+
+#: Locks held by this process, by the real path of the lock file.
+_HOLDS: dict[str, _Hold] = {}
+_HOLDS_GUARD = threading.Lock()
 
 
 class OutputLock:
@@ -300,6 +340,9 @@ class OutputLock:
     Re-entrant within a thread (a command that holds it may call another that takes it again,
     e.g. ``regions`` around ``sweep``); exclusive between threads and processes. Use as a
     context manager, or :meth:`acquire` / :meth:`release` (idempotent: one release per object).
+    The locking is :mod:`filelock`'s (``flock``); the last release in the process deletes the
+    lock file while holding it, and a lock taken on a file no longer at its name is given back and
+    taken again (module docstring).
 
     Parameters
     ----------
@@ -310,49 +353,95 @@ class OutputLock:
     """
 
     def __init__(self, path, *, timeout: float = 0.0):
-        from filelock import FileLock
-
         self.output = Path(path)
         self.path = lock_path(self.output)
         self.timeout = float(timeout)
-        self._lock = FileLock(str(self.path), is_singleton=True)
+        self._key = os.path.realpath(self.path)
         self._held = False
         self._pid = os.getpid()
 
-    def acquire(self) -> "OutputLock":
-        """Take the lock, or raise :class:`LockError` naming the holder and what to do."""
-        from filelock import Timeout
+    def _refuse(self) -> LockError:
+        holder = _read_holder(self.path)
+        who = (f"process {holder.get('pid')} on {holder.get('host')} (since {holder.get('since')}: "
+               f"{holder.get('command')})") if holder else "another process"
+        return LockError(f"{self.output} is being written by {who}; wait for it to finish (or stop it) and run the "
+                         f"command again, or choose another output (--out)")
 
+    def _cannot(self, exc: OSError, what: str) -> WriteError:
+        return WriteError(f"cannot write {self.output}: {what} fails ({exc.strerror or exc}); choose another path")
+
+    def _try_take(self) -> FileLock | None:
+        """The lock of the file at the lock's name, or None while another holds it."""
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise self._cannot(exc, f"creating the folder {self.path.parent}") from None
+        while True:
+            file_lock = FileLock(self.path, timeout=0, thread_local=False, on_acquired=_take_current(self.path))
+            try:
+                file_lock.acquire()
+            except Timeout:
+                return None
+            except _Stale:
+                continue  # locked a file its holder had just deleted: the name holds a new one
+            except OSError as exc:
+                raise self._cannot(exc, f"locking a file in {self.path.parent}") from None
+            return file_lock
+
+    def acquire(self) -> "OutputLock":
+        """Take the lock, or raise :class:`LockError` naming the holder and what to do.
+
+        Raises
+        ------
+        LockError
+            Another process or thread holds it (after ``timeout`` seconds).
+        WriteError
+            The lock file cannot be created or locked there (e.g. ``/proc``, a read-only folder).
+        """
         if self._held:
             return self
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            self._lock.acquire(timeout=self.timeout)
-        except Timeout:
-            holder = _read_holder(self.path)
-            who = (f"process {holder.get('pid')} on {holder.get('host')} (since {holder.get('since')}: "
-                   f"{holder.get('command')})") if holder else "another process"
-            raise LockError(f"{self.output} is being written by {who}; wait for it to finish (or stop it) and run "
-                            f"the command again, or choose another output (--out)") from None
+        deadline = time.monotonic() + self.timeout
+        while True:
+            with _HOLDS_GUARD:
+                hold = _HOLDS.get(self._key)
+                if hold is not None and hold.pid != os.getpid():  # a forked child: the parent's, not ours
+                    hold = None
+                if hold is not None and hold.thread == threading.get_ident():
+                    hold.count += 1
+                    self._held = True
+                    return self
+                file_lock = None
+                if hold is None:
+                    file_lock = self._try_take()
+                    if file_lock is not None:
+                        _HOLDS[self._key] = _Hold(file_lock)
+            if file_lock is not None:
+                break
+            if 0 <= self.timeout and time.monotonic() >= deadline:
+                raise self._refuse()
+            time.sleep(_LOCK_POLL_S)
         self._held = True
-        if self._lock.lock_counter == 1:  # first hold in this process: record us, drop dead writers' leftovers
-            with open(self.path, "w") as fh:
-                fh.write(_holder_text() + "\n")
-            clean_temporaries(self.output)
+        clean_temporaries(self.output)
         return self
 
     def release(self) -> None:
-        """Give the lock back (the file stays, emptied when the last hold in this process ends)."""
+        """Give the lock back; the last release in this process deletes the lock file, then unlocks it."""
         if not self._held or os.getpid() != self._pid:  # a forked child shares the parent's lock: never release it
             return
         self._held = False
-        if self._lock.lock_counter == 1:
+        with _HOLDS_GUARD:
+            hold = _HOLDS.get(self._key)
+            if hold is None:  # pragma: no cover - released twice through another object
+                return
+            hold.count -= 1
+            if hold.count > 0:
+                return
+            del _HOLDS[self._key]
             try:
-                with open(self.path, "w"):
-                    pass
+                os.unlink(self.path)  # while locked: a waiter that locks the deleted file takes the new one
             except OSError:  # pragma: no cover - the next holder overwrites it anyway
                 pass
-        self._lock.release()
+            hold.file_lock.release()
 
     @property
     def held(self) -> bool:
@@ -391,90 +480,80 @@ def lock(path, *, timeout: float = 0.0) -> OutputLock:
     return OutputLock(path, timeout=timeout).acquire()
 
 
-# --------------------------------------------------------------------------- one loader
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
-_FORMAT = re.compile(r"^stickslip-([a-z]+)-(\d+)$")
+# --------------------------------------------------------------------------- the one writer path
+def same_file(a, b) -> bool:
+    """Whether paths ``a`` and ``b`` name the same file (also through links)."""
+    a, b = Path(a), Path(b)
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
 
 
-def format_name(kind: str, version: int = 1) -> str:
-    """The ``format`` attribute of a stickslip file: ``stickslip-<kind>-<version>``."""
-    return f"stickslip-{kind}-{version}"
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()
-    return f"{type(exc).__name__}: {text[0] if text else ''}".rstrip(": ")
-
-
-def open_ours(path, kind: str, *, what: str, versions=(1,), noun: str | None = None,
-              load: bool | Callable[[object], bool] = True):
-    """Open a NetCDF file written by stickslip and check that it is a ``kind`` file we can read.
+def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out", what: str | None = None) -> None:
+    """Refuse to write ``path`` onto an input, a folder, or (without ``overwrite``) an existing file.
 
     Parameters
     ----------
     path : path
-    kind : str
-        The expected kind, the middle of the ``format`` attribute (``sweep``, ``trajectory``,
-        ``branch``, ...; see :func:`format_name`).
-    what : str
-        What the user should give instead, for the messages (e.g. "a .nc file written by
-        `stickslip sweep`").
-    versions : sequence of int
-        Format versions this code reads.
-    noun : str, optional
-        How the messages name the kind (default ``kind``).
-    load : bool or callable
-        Read every variable into memory and close the file, or keep the dataset lazily backed by
-        the open file; a callable decides from the opened dataset.
-
-    Returns
-    -------
-    xarray.Dataset
+    overwrite : bool
+        Replace an existing file.
+    inputs : dict of option → path, optional
+        Files the command reads (None entries skipped); never written, not even with ``overwrite``.
+    flag : str
+        The option that names ``path``, for the messages.
+    what : str, optional
+        How the messages name ``path`` (default ``"{flag} {path}"``; e.g. a figure beside the output).
 
     Raises
     ------
-    FileFormatError
-        One line: the file is missing, not NetCDF-4/HDF5, truncated or corrupt, not written by
-        stickslip, of another kind, or of a format version this code does not read.
+    OutputError
     """
-    import xarray as xr
-
     path = Path(path)
-    noun = noun or kind
-    if not path.is_file():
-        raise FileFormatError(f"{path} does not exist; give {what}")
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(len(_HDF5_SIGNATURE))
-    except OSError as exc:
-        raise FileFormatError(f"{path} cannot be read ({_first_line(exc)}); give {what}") from exc
-    if head != _HDF5_SIGNATURE:
-        raise FileFormatError(f"{path} is not a stickslip NetCDF file (not NetCDF-4/HDF5: "
-                              f"{'empty' if not head else 'wrong signature'}); give {what}")
-    ds = None
-    try:
-        ds = xr.open_dataset(path, engine="h5netcdf")
-        fmt = ds.attrs.get("format")
-        m = _FORMAT.match(fmt) if isinstance(fmt, str) else None
-        if m is None:
-            raise FileFormatError(f"{path} is not a stickslip {noun} file (format attribute {fmt!r}); give {what}")
-        if m.group(1) != kind:
-            raise FileFormatError(f"{path} is a stickslip {m.group(1)} file, not a stickslip {noun} file; give {what}")
-        if int(m.group(2)) not in versions:
-            raise FileFormatError(
-                f"{path} is a stickslip {noun} file of format version {m.group(2)}, which stickslip {__version__} "
-                f"does not read (it reads {', '.join(map(str, versions))}); open it with the stickslip version that "
-                f"wrote it, or run the command that made it again")
-        if load is True or (callable(load) and load(ds)):
-            ds.load()
-            ds.close()
-    except FileFormatError:
-        if ds is not None:
-            ds.close()
-        raise
-    except Exception as exc:  # h5py/xarray raise many types for damaged files
-        if ds is not None:
-            ds.close()
-        raise FileFormatError(f"{path} is truncated or corrupt ({_first_line(exc)}); give {what}, or run the "
-                              f"command that wrote it again") from exc
-    return ds
+    what = what or f"{flag} {path}"
+    for in_flag, in_path in (inputs or {}).items():
+        if in_path is not None and same_file(path, in_path):
+            raise OutputError(f"{what} is the file given to {in_flag}; an input is never overwritten, "
+                              f"give another {flag}")
+    if path.is_dir():
+        raise OutputError(f"{what} is a directory; give a file name")
+    if (path.exists() or path.is_symlink()) and not overwrite:
+        raise OutputError(f"{path} exists; pass --overwrite to replace it, or give another {flag}")
+
+
+def write_output(path, write: Callable[[Path], object], *, overwrite: bool = False, inputs=None,
+                 flag: str = "--out", kept: str | None = None) -> Path:
+    """Write the output file ``path``: the one path every command's outputs take.
+
+    Takes ``path``'s lock (re-entrant: a command that holds it already keeps it), refuses an
+    existing file without ``overwrite`` and any of ``inputs`` (:func:`refuse_output`), replaces
+    the file atomically (:func:`atomic_write`) and releases the lock.
+
+    Parameters
+    ----------
+    path : path
+    write : callable
+        ``write(tmp: Path)`` writes the whole file to ``tmp``.
+    overwrite : bool
+        Replace an existing file.
+    inputs : dict of option → path, optional
+        Files the command reads: never written.
+    flag : str
+        The option that names ``path`` (messages).
+    kept : str, optional
+        What a full disk leaves, for the :class:`WriteError` message.
+
+    Raises
+    ------
+    LockError
+        Another process writes ``path``.
+    OutputError
+        ``path`` exists (without ``overwrite``), is a folder or an input.
+    WriteError
+        The disk is full or the folder takes no files (``path`` unchanged).
+    """
+    path = Path(path)
+    with OutputLock(path):
+        refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return atomic_write(path, write, kept=kept)

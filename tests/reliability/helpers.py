@@ -43,9 +43,10 @@ def command(name: str, out: Path, *extra: str) -> list[str]:
     return [STICKSLIP] + [str(out) if a == "OUT" else a for a in COMMANDS[name]] + list(extra)
 
 
-def run(argv, *, env=None, preexec_fn=None, timeout=600) -> subprocess.CompletedProcess:
+def run(argv, *, env=None, preexec_fn=None, cwd=None, timeout=600) -> subprocess.CompletedProcess:
     """Run ``argv`` to completion (text output captured)."""
-    return subprocess.run(argv, capture_output=True, text=True, env=env, preexec_fn=preexec_fn, timeout=timeout)
+    return subprocess.run(argv, capture_output=True, text=True, env=env, preexec_fn=preexec_fn, cwd=cwd,
+                          timeout=timeout)
 
 
 def start(argv, **kwargs) -> subprocess.Popen:
@@ -86,8 +87,8 @@ def assert_same_results(name: str, a, b) -> None:
 
 
 def leftovers(out: Path) -> list[Path]:
-    """Files beside ``out`` other than the output, its figure and its (empty) lock file."""
-    keep = {out.name, out.with_suffix(".png").name, out.name + ".lock"}
+    """Files beside ``out`` other than the output and its figure (a lock file is a leftover too)."""
+    keep = {out.name, out.with_suffix(".png").name}
     return sorted(p for p in out.parent.iterdir() if p.name not in keep)
 
 

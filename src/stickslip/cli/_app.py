@@ -26,6 +26,7 @@ from typer.core import TyperGroup
 
 from .._version import __version__
 from ..errors import StickSlipError
+from ..files import lock, refuse_output
 from ..integrate.driver import MAX_SAMPLES
 from ..integrate.interrupt import on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
@@ -160,6 +161,8 @@ class _Application(TyperGroup):
         except KeyboardInterrupt:
             err_console.print(Text(f"interrupted: {_interrupt_note['text']}"))
             raise typer.Exit(130) from None
+        finally:
+            release_outputs()
         raise typer.Exit(2)
 
 
@@ -432,11 +435,21 @@ def check_samples(duration: float, sample_rate: float, *, time_flag: str = "--t-
 
 
 # ----------------------------------------------------------------------------- outputs
-def _same_file(a: Path, b: Path) -> bool:
-    try:
-        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
-    except OSError:
-        return False
+#: Locks of the outputs of the running command, taken by the checks below and released when the
+#: command ends (:meth:`_Application.invoke`).
+_held_outputs: list = []
+
+
+def hold_output(out: Path) -> None:
+    """Take the lock of output ``out`` for the rest of the command: a second writer of it is
+    refused now, before anything is computed, not after (:class:`stickslip.files.OutputLock`)."""
+    _held_outputs.append(lock(out))
+
+
+def release_outputs() -> None:
+    """Release the locks :func:`hold_output` took (the last release deletes each lock file)."""
+    while _held_outputs:
+        _held_outputs.pop().release()
 
 
 def _check_folder(path: Path, flag: str) -> None:
@@ -451,7 +464,8 @@ def _check_folder(path: Path, flag: str) -> None:
         raise CLIError(f"{flag} {path}: the folder {existing} is not writable; choose another {flag}")
 
 
-def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: dict | None = None) -> None:
+def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: dict | None = None,
+                 what: str | None = None) -> None:
     """Refuse, before anything is computed, an output file that must not or cannot be written.
 
     Parameters
@@ -464,24 +478,27 @@ def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: di
         The option that names it.
     inputs : dict of option → Path, optional
         Files the command reads; never overwritten, not even with ``--overwrite``.
+    what : str, optional
+        How the messages name the file (default ``"{flag} {path}"``).
     """
-    for in_flag, in_path in (inputs or {}).items():
-        if in_path is not None and _same_file(path, Path(in_path)):
-            raise CLIError(f"{flag} {path} is the file given to {in_flag}; an input is never overwritten, "
-                           f"give another {flag}")
-    if path.is_dir():
-        raise CLIError(f"{flag} {path} is a directory; give a file name")
-    if (path.exists() or path.is_symlink()) and not overwrite:
-        raise CLIError(f"{path} exists; pass --overwrite to replace it, or give another {flag}")
+    refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag, what=what)
     _check_folder(path, flag)
 
 
+def _check_figure(out: Path, overwrite: bool, flag: str = "--out", inputs: dict | None = None) -> None:
+    """:func:`check_output` for the figure beside NetCDF output ``out`` (``OUT.png``)."""
+    png = out.with_suffix(".png")
+    check_output(png, overwrite, flag=flag, inputs=inputs, what=f"the figure {png} of {flag} {out}")
+
+
 def check_outputs(out: Path, figure: bool, overwrite: bool, **kwargs) -> None:
-    """:func:`check_output` for a NetCDF output and, with ``figure``, the .png beside it."""
+    """:func:`check_output` for a NetCDF output and, with ``figure``, the .png beside it; then
+    hold the output's lock until the command ends (:func:`hold_output`)."""
     check_nc_path(out, kwargs.get("flag", "--out"))
     check_output(out, overwrite, **kwargs)
     if figure:
-        check_output(out.with_suffix(".png"), overwrite, **kwargs)
+        _check_figure(out, overwrite, **kwargs)
+    hold_output(out)
 
 
 def journal_of(out: Path) -> Path:
@@ -489,18 +506,27 @@ def journal_of(out: Path) -> Path:
     return out.with_name(out.name + ".journal")
 
 
-def check_resumable_output(out: Path, figure: bool, overwrite: bool) -> None:
+def check_resumable_output(out: Path, figure: bool, overwrite: bool, inputs: dict | None = None) -> bool:
     """Outputs of a resumable command: the NetCDF file and its journal are the command's own
     (the library resumes them or refuses another run's); a figure is refused only when a
-    fresh run would replace a file that is not the command's."""
+    fresh run would replace a file that is not the command's. No output may be an input. Holds
+    the output's lock until the command ends (:func:`hold_output`).
+
+    Returns
+    -------
+    bool
+        Whether the figure may replace an existing file: with ``overwrite``, or when the run
+        resumes (its figure is the command's own).
+    """
     check_nc_path(out)
-    if out.is_dir():
-        raise CLIError(f"--out {out} is a directory; give a file name")
+    refuse_output(out, overwrite=True, inputs=inputs)
     _check_folder(out, "--out")
     fresh = not out.exists() and not journal_of(out).exists()
-    if figure and fresh:
-        check_output(out.with_suffix(".png"), overwrite)
+    if figure:
+        _check_figure(out, overwrite or not fresh, inputs=inputs)
+    hold_output(out)
     on_interrupt(f"finished work is kept in {journal_of(out)}; run the same command again to resume")
+    return overwrite or not fresh
 
 
 def check_output_folder(out: Path, overwrite: bool) -> None:

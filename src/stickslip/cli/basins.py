@@ -17,8 +17,9 @@ from rich.table import Table
 from ..basins import basin_stability, from_csv, parse_param, parse_range
 from ..basins import box as random_box
 from ..basins import grid as regular_grid
+from ..files import write_output
 from ..plot.basins import save_basins_figure
-from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, err_console,
+from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_resumable_output, console, err_console,
                    parse_assignments)
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
@@ -79,13 +80,15 @@ def basins(
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="dask.distributed scheduler address, e.g. "
                                             "tcp://head:8786 (implies --executor dask)."),
     out: Path = typer.Option(Path("basins.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an output (or journal) of a different study."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an output (or journal) of a different study, "
+                                   "and an existing figure; never the --ics file."),
     no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
     no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print {n, fractions, standard_errors, attractors} as JSON."),
 ) -> None:
     """Basin stability: which attractor each initial state reaches (exact stick), and how often."""
-    check_nc_path(out)
+    inputs = {"--ics": ics}
+    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
     m, _ = build_system(model, None, set_)
     states = _states(m, box, n, seed, grid, ics, base, state)
     path, values = parse_param(param) if param is not None else (None, ())
@@ -99,7 +102,8 @@ def basins(
                              confirm=not no_confirm, lyapunov=lyapunov)
     figure = None
     if not no_plot:
-        figure = save_basins_figure(result, out.with_suffix(".png"))
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_basins_figure(result, tmp),
+                              overwrite=replace_figure, inputs=inputs)
     if as_json:
         print(json.dumps(result.to_json()))
     else:

@@ -19,7 +19,7 @@ from rich.table import Table
 from rich.text import Text
 
 from ..analysis.signal import stick_time
-from ..files import atomic_write
+from ..files import write_output
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import START_RATE, start_run
 from ..orbits.start import default_start
@@ -112,7 +112,8 @@ def orbit_command(
         raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
     system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
     sec = resolve_section(parse_section(section), system)
-    check_outputs(out, not no_plot, overwrite)
+    inputs = {"--config": config}
+    check_outputs(out, not no_plot, overwrite, inputs=inputs)
     t0 = time.perf_counter()
     run = start_run(system, start, t_end=search_time, rtol=rtol)
     orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
@@ -121,12 +122,12 @@ def orbit_command(
     one_period = orbit.trajectory(1.0)
     stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
                        one_period.transitions.kind)
-    out.parent.mkdir(parents=True, exist_ok=True)
     ds = orbit.to_xarray()
-    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
-        figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_orbit_figure(orbit, one_period, tmp),
+                              overwrite=overwrite, inputs=inputs)
     others = np.abs(orbit.nontrivial_multipliers)
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": orbit.model,
@@ -180,16 +181,17 @@ def lyapunov_command(
     check_positive({"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol, "--slip-band": slip_band})
     check_choice("--method", method, _LYAPUNOV_METHODS)
     system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
-    check_outputs(out, not no_plot, overwrite)
+    inputs = {"--config": config}
+    check_outputs(out, not no_plot, overwrite, inputs=inputs)
     start = default_start(system) if start is None else start
     spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
                                  method=method)
-    out.parent.mkdir(parents=True, exist_ok=True)
     ds = spectrum.to_xarray()
-    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
-        figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_lyapunov_spectrum_figure(spectrum, tmp),
+                              overwrite=overwrite, inputs=inputs)
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,

@@ -18,6 +18,7 @@ from rich.text import Text
 
 from ..attractors import run_summary, simulate_until_settled
 from ..integrate.driver import simulate as run_simulation
+from ..files import write_output
 from ..integrate.interrupt import on_ctrl_c
 from ..integrate.result import load_trajectory
 from ..integrate.status import Status
@@ -193,8 +194,9 @@ def simulate(
     _check_steps(longest, settings["dt"], time_flag)
     write = out is not None or not as_json
     out = Path("run.nc") if out is None else out
+    inputs = {"--ic": run_file, "--config": config}
     if write:
-        check_outputs(out, not no_plot, overwrite, inputs={"--ic": run_file, "--config": config})
+        check_outputs(out, not no_plot, overwrite, inputs=inputs)
     if run_file is not None:
         overridden = set_by + overridden
         note_line(f"continuing {run_file} from t = {t0:g} s with its model, parameters and settings"
@@ -213,10 +215,10 @@ def simulate(
     keep = write and int(np.count_nonzero(traj.t >= traj.steady_from)) >= 2
     figure = None
     if keep:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        traj.to_netcdf(out)
+        write_output(out, traj.to_netcdf, overwrite=overwrite, inputs=inputs)
         if not no_plot:
-            figure = save_trajectory_figure(traj, out.with_suffix(".png"))
+            figure = write_output(out.with_suffix(".png"), lambda tmp: save_trajectory_figure(traj, tmp),
+                                  overwrite=overwrite, inputs=inputs)
     kept = f"what it computed is in {out}" if keep else ("it kept too few samples to write" if write else
                                                          "nothing was written (--json without --out)")
     if traj.status_code == Status.INTERRUPTED:

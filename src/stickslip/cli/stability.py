@@ -18,6 +18,7 @@ from ..plot.stability import save_stability_map_figure
 from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
+from ..files import write_output
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
                    check_memory, check_outputs, console)
 from .sweep import parse_values
@@ -134,13 +135,14 @@ def stability_map(
         raise CLIError(f"model {system.name!r} has no N and Ω: give its two axes, e.g. "
                        "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
     _check_grid_memory(values[0].size, values[1].size, 1 if members is None else len(members[1]))
-    check_outputs(out, not no_plot, overwrite)
+    inputs = {"--config": config}
+    check_outputs(out, not no_plot, overwrite, inputs=inputs)
     smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    smap.to_netcdf(out)
+    write_output(out, smap.to_netcdf, overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
-        figure = save_stability_map_figure(smap, out.with_suffix(".png"))
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_stability_map_figure(smap, tmp),
+                              overwrite=overwrite, inputs=inputs)
     rows = []
     for f, label in enumerate(smap.family_labels):
         mrp = smap.max_real_part[f]

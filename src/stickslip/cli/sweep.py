@@ -25,6 +25,7 @@ from ..sweep import regions as run_regions
 from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import columns_of
+from ..files import write_output
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
                    check_finite, check_memory, check_positive, check_resumable_output, check_samples, config_values,
                    console, parse_assignments)
@@ -237,11 +238,13 @@ def sweep_command(
     _check_grid(values)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     options.update(_settle_options(settle, cap, t_end))
-    check_resumable_output(out, not no_plot, overwrite)
+    inputs = {"--config": config}
+    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
     result = run_sweep(values, target, out=out, model=variant, ic=ic, **options)
     figure = None
     if not no_plot:
-        figure = save_sweep_figure(result, out.with_suffix(".png"), var=plot_var)
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_sweep_figure(result, tmp, var=plot_var),
+                              overwrite=replace_figure, inputs=inputs)
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
             result.dataset, as_json)
 
@@ -303,11 +306,13 @@ def bifurcation(
     _check_grid(grid, n_peaks)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     options.update(_settle_options(settle, cap, t_end))
-    check_resumable_output(out, not no_plot, overwrite)
+    inputs = {"--config": config}
+    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
     result = run_sweep(grid, target, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
     figure = None
     if not no_plot:
-        figure = save_bifurcation_figure(result, out.with_suffix(".png"))
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_bifurcation_figure(result, tmp),
+                              overwrite=replace_figure, inputs=inputs)
     _report(f"bifurcation diagram of {coordinate} against {param}", out, figure, result.timings, result.dataset, as_json)
 
 
@@ -375,11 +380,13 @@ def regions_command(
     if t_from is None and math.isfinite(t_end):
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-    check_resumable_output(out, not no_plot, overwrite)
+    inputs = {"--config": config}
+    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
     rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
     figure = None
     if not no_plot:
-        figure = save_regions_figure(rmap, out.with_suffix(".png"))
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_regions_figure(rmap, tmp),
+                              overwrite=replace_figure, inputs=inputs)
 
     region = rmap.region
     counts = {REGION_NAMES[c]: int(np.sum(region == c)) for c in sorted(REGION_NAMES) if np.any(region == c)}

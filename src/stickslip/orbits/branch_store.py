@@ -2,26 +2,24 @@
 
 Journals
 --------
-Append-only journals make long continuation runs resumable.
+Append-only journals make long continuation runs resumable (the resumable store of
+:mod:`stickslip.journal`, :class:`~stickslip.journal.LineJournal`).
 
-A run that writes to ``OUT.nc`` holds the output's lock ``OUT.nc.lock`` (:func:`stickslip.files.lock`:
-a second run on the same output is refused with one line naming the holder) and keeps, while it
-works, a journal ``OUT.nc.journal`` beside it (as :mod:`stickslip.sweep.store` does for sweeps):
-a text file of JSON lines,
+A run that writes to ``OUT.nc`` holds the output's lock ``OUT.nc.lock`` (a second run on the same
+output is refused with one line naming the holder) and keeps, while it works, a journal
+``OUT.nc.journal`` beside it: a text file whose line 1 is the header (format, kind, digest,
+settings, package version), written atomically when the journal is created, followed by one
+checksummed JSON record per finished unit of work (a branch point of
+:func:`~stickslip.orbits.branch.continue_orbit`, one N of
+:func:`~stickslip.orbits.region_edge.fold_curve`), each written with one ``write`` and
+``fsync``-ed, so a killed process or a power cut loses only the unit it was working on, and a
+full disk loses nothing written before.
 
-* line 1, the header: ``{"format", "kind", "digest", "settings", "stickslip_version"}``,
-  written atomically (:func:`stickslip.files.atomic_write`) when the journal is created;
-* then one record per finished unit of work (a branch point of
-  :func:`~stickslip.orbits.branch.continue_orbit`, one N of
-  :func:`~stickslip.orbits.region_edge.fold_curve`), each written with one ``write`` ending in a
-  newline and ``fsync``-ed (:class:`stickslip.files.AppendLog`), so a killed process or a power
-  cut loses only the unit it was working on, and a full disk loses nothing written before.
-
-On reopening, a torn last line (a kill inside a write: no final newline, or not valid JSON) is cut
-off. The digest covers everything that determines the results; a journal or an output file with
-another digest is refused (:class:`JournalMismatch`), never mixed in. When the run ends, the
-caller writes ``OUT.nc`` atomically (:func:`write_atomically`) and removes the journal, which
-releases the lock.
+On reopening, the journal is cut at its first torn or corrupt record. The digest covers
+everything that determines the results; a journal or an output file with another digest is
+refused (:class:`JournalMismatch`), never mixed in, and so is a journal whose header cannot be
+read. When the run ends, the caller writes ``OUT.nc`` atomically (:func:`write_dataset`) and
+removes the journal, which releases the lock.
 
 Floats go through JSON as ``repr`` text, which round-trips float64 exactly (NaN as ``NaN``), so a
 resumed run restarts from bit-identical numbers.
@@ -45,8 +43,10 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import FileFormatError, OrbitError
-from ..files import AppendLog, OutputLock, atomic_write, fsync_dir
+from ..files import OutputLock, atomic_write, write_output
 from ..integrate.result import Trajectory
+from ..journal import FORMAT as JOURNAL_FORMAT
+from ..journal import LineJournal, journal_path
 from ..model.library import describe_system, system_from_description
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
 from .layout import state_units
@@ -60,16 +60,9 @@ __all__ = ["Journal", "JournalMismatch", "journal_path", "digest_of", "array_dig
            "branch_settings", "branch_dataset", "branch_fields", "fold_curve_dataset", "fold_curve_fields",
            "plain_row", "write_dataset"]
 
-JOURNAL_FORMAT = "stickslip-continuation-journal-1"
-
 
 class JournalMismatch(OrbitError):
-    """A journal or output file at the requested path belongs to a run with other settings."""
-
-
-def journal_path(out) -> Path:
-    """The journal beside the output ``out`` (``OUT.nc.journal``)."""
-    return Path(str(out) + ".journal")
+    """A journal or output file at the requested path belongs to a run with other settings, or is corrupt."""
 
 
 def digest_of(settings: dict) -> str:
@@ -111,21 +104,8 @@ def write_atomically(path: Path, write) -> Path:
     return atomic_write(path, write)
 
 
-def _read_lines(path: Path) -> tuple[list, int]:
-    """Complete JSON lines of ``path`` and the byte length they span (a torn tail excluded)."""
-    data = path.read_bytes()
-    records, good = [], 0
-    for line in data.split(b"\n")[:-1]:  # the piece after the last newline is torn or empty
-        try:
-            records.append(json.loads(line))
-        except ValueError:
-            break
-        good += len(line) + 1
-    return records, good
-
-
-class Journal:
-    """The append-only journal of one resumable run.
+class Journal(LineJournal):
+    """The append-only journal of one resumable run (:class:`stickslip.journal.LineJournal`).
 
     Parameters
     ----------
@@ -136,64 +116,28 @@ class Journal:
     digest : str
         :func:`digest_of` the settings that determine the results.
     settings : dict
-        Stored in the header (JSON), for the record and for :meth:`header`.
+        Stored in the header (JSON), for the record.
     lock : OutputLock, optional
         The output's lock, already held by the caller (default: taken here). Held until
         :meth:`close` or :meth:`remove`.
+    overwrite : bool
+        Discard an existing journal (start over).
 
     Raises
     ------
     JournalMismatch
-        If a journal with another kind or digest exists at that path.
+        If a journal with another kind or digest, of an earlier format or with a corrupt header
+        exists at that path.
     stickslip.files.LockError
         If another process is writing ``out``.
     """
 
-    def __init__(self, out, kind: str, digest: str, settings: dict, lock: OutputLock | None = None):
-        self.path = journal_path(out)
-        self.kind, self.digest = kind, digest
-        self.lock = (lock or OutputLock(out)).acquire()
-        with self.lock.released_on_error():
-            self._open(settings)
-
-    def _open(self, settings: dict) -> None:
-        kind, digest = self.kind, self.digest
-        if self.path.exists():
-            lines, good = _read_lines(self.path)
-            head = lines[0] if lines else {}
-            if head.get("format") != JOURNAL_FORMAT or head.get("kind") != kind or head.get("digest") != digest:
-                raise JournalMismatch(
-                    f"{self.path} is the journal of a different {kind} run (settings or start differ: digest "
-                    f"{head.get('digest')} vs {digest}); run again with the same arguments to resume, choose "
-                    f"another output (--out) or delete {self.path}")
-            if good < self.path.stat().st_size:
-                with open(self.path, "r+b") as fh:
-                    fh.truncate(good)  # drop the torn last record
-            self.records = lines[1:]
-        else:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            header = {"format": JOURNAL_FORMAT, "kind": kind, "digest": digest, "settings": settings,
-                      "stickslip_version": __version__}
-            write_atomically(self.path, lambda tmp: tmp.write_text(json.dumps(header, default=str) + "\n"))
-            self.records = []
-        self._log = AppendLog(self.path, kept=f"the {kind} computed so far is kept in {self.path}")
-
-    def append(self, record: dict) -> None:
-        """Write one record (one line, one ``write``, ``fsync``-ed)."""
-        self._log.append((json.dumps(record) + "\n").encode())
-        self.records.append(record)
-
-    def close(self) -> None:
-        """Close the file (the journal stays on disk) and release the output's lock."""
-        self._log.close()
-        self.lock.release()
-
-    def remove(self) -> None:
-        """Close and delete the journal (after the output is written), then release the lock."""
-        self._log.close()
-        self.path.unlink(missing_ok=True)
-        fsync_dir(self.path.parent)
-        self.lock.release()
+    def __init__(self, out, kind: str, digest: str, settings: dict, lock: OutputLock | None = None,
+                 overwrite: bool = False):
+        super().__init__(out, kind=kind, digest=digest, settings=settings, noun=f"{kind} run",
+                         differs="settings or start differ", error=JournalMismatch, overwrite=overwrite, lock=lock,
+                         saved="the finished orbits" if kind == "branch" else "the finished N values",
+                         restart="pass resume=False (--overwrite)")
 
 
 def check_output(out, kind: str, digest: str, attrs: dict) -> None:
@@ -218,7 +162,8 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
     kind, digest, settings
         As :class:`Journal`.
     resume : bool
-        False: delete an existing output and journal first (start over).
+        False: discard an existing journal and start over (a finished output is replaced when
+        the new run ends, not before).
     read : callable
         ``read(out)`` → (attrs dict, finished result) of an existing output file.
 
@@ -231,18 +176,15 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
     Raises
     ------
     JournalMismatch
-        If the journal or the output file belongs to a run with other settings, or the output
-        is not a stickslip file of this kind.
+        If the journal or the output file belongs to a run with other settings, the output is
+        not a stickslip file of this kind, or the journal is corrupt.
     stickslip.files.LockError
         If another process is writing ``out``.
     """
-    out, jp = Path(out), journal_path(out)
-    lock = OutputLock(out).acquire()  # before anything is deleted or read: one writer at a time
+    out = Path(out)
+    lock = OutputLock(out).acquire()  # before anything is read: one writer at a time
     with lock.released_on_error():
-        if not resume:
-            jp.unlink(missing_ok=True)
-            out.unlink(missing_ok=True)
-        if out.exists() and not jp.exists():
+        if resume and out.exists() and not journal_path(out).exists():
             try:
                 attrs, result = read(out)
             except FileFormatError as exc:
@@ -251,7 +193,7 @@ def open_output(out, kind: str, digest: str, settings: dict, resume: bool, read)
             check_output(out, kind, digest, attrs)
             lock.release()
             return None, result
-        return Journal(out, kind, digest, settings, lock=lock), None
+        return Journal(out, kind, digest, settings, lock=lock, overwrite=not resume), None
 
 
 # ----------------------------------------------------------------------- records of a branch
@@ -324,8 +266,12 @@ def branch_settings(system, param, start, section, rtol, atol, numerics: dict) -
 
 # ----------------------------------------------------------------------- NetCDF
 def write_dataset(ds, path) -> Path:
-    """Write ``ds`` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
-    return write_atomically(Path(path), lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    """Write ``ds`` to ``path`` (NetCDF4 via h5netcdf) under the output's lock, atomically
+    (:func:`stickslip.files.write_output`); a full disk names the journal that keeps the run."""
+    path = Path(path)
+    journal = journal_path(path)
+    kept = f"{path} is left as it was" + (f" and the finished work is kept in {journal}" if journal.exists() else "")
+    return write_output(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=True, kept=kept)
 
 
 def branch_dataset(branch):

@@ -1,22 +1,23 @@
 """Durable, resumable storage of sweep results.
 
-Layout beside the NetCDF output ``OUT.nc``:
+Layout beside the NetCDF output ``OUT.nc`` (the resumable store of :mod:`stickslip.journal`):
 
 ``OUT.nc.lock``
-    Held by the one process writing ``OUT.nc`` and its journal (:func:`stickslip.files.lock`):
+    Held by the one process writing ``OUT.nc`` and its journal (:class:`stickslip.files.OutputLock`):
     a second sweep on the same output is refused with one line naming the holder.
 ``OUT.nc.journal/manifest.json``
-    The :class:`~stickslip.sweep.spec.SweepSpec` (as JSON, with its digest) and the row layout.
+    The journal's header: format, the :class:`~stickslip.sweep.spec.SweepSpec` (as JSON) with its
+    digest, the row width and the package version.
 ``OUT.nc.journal/rows.f64``
-    Append-only float64 records ``[flat index, row..., SENTINEL]``, one per finished point,
-    appended by the driver as each batch arrives (one ``write`` per batch, ``fsync``-ed before
-    the next batch is taken, so neither a killed process nor a power cut loses a batch it had
-    received). On reopening, a torn last record (a kill inside a write) and any record without
-    the sentinel are dropped and recomputed.
+    Append-only checksummed records ``[flat index, row..., check]``
+    (:class:`stickslip.journal.RowJournal`), one per finished point, appended by the driver as each
+    batch arrives (one ``write`` per batch, ``fsync``-ed before the next batch is taken, so neither
+    a killed process nor a power cut loses a batch it had received). On reopening, a torn record,
+    one whose checksum fails and one whose index is out of range are dropped and recomputed.
 
 ``OUT.nc`` is assembled from the journal into a temporary file that replaces the output
-atomically (:func:`stickslip.files.atomic_write`), at intervals while the sweep runs and at the
-end; the journal is then removed. A killed sweep therefore always leaves either a complete
+atomically (:meth:`stickslip.journal.Journal.snapshot`), at intervals while the sweep runs and at
+the end; the journal is then removed. A killed sweep therefore always leaves either a complete
 earlier snapshot or none, and a full disk leaves the journal and the previous ``OUT.nc``.
 
 Memory of the assembly does not grow with the grid (beyond one byte per point for the ``done``
@@ -30,15 +31,16 @@ hyperslabs (:func:`flat_hyperslabs`).
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
 
 from .._version import __version__
 from ..errors import SweepError
-from ..files import AppendLog, OutputLock, atomic_write, format_name, fsync_dir, open_ours
+from ..files import format_name, open_ours
 from ..integrate.initial import start_description
+from ..journal import READ_ROWS as JOURNAL_READ_ROWS
+from ..journal import RowJournal, journal_path
 from ..model.library import describe_system
 from ..model.parameters import parameter_attrs
 from .spec import SweepSpec, spec_system
@@ -46,13 +48,10 @@ from .spec import SweepSpec, spec_system
 __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir", "flat_hyperslabs", "LOAD_LIMIT_POINTS"]
 
 FORMAT = format_name("sweep", 1)
-JOURNAL_FORMAT = "stickslip-sweep-journal-1"
-#: Last value of every journal record: a record without it was torn by a kill mid-write.
-SENTINEL = 8.0e300
 
-#: Journal records read at once: 4096 records of ~88 float64 = 2.9 MB, whatever the journal length
-#: (16384 measured 20 MB more peak at 10^5 points: two blocks and their sorted copies in flight).
-READ_ROWS = 4096
+#: Journal records read at once (:data:`stickslip.journal.READ_ROWS`, 2.9 MB of ~88 float64 rows;
+#: 16384 measured 20 MB more peak at 10^5 points: two blocks and their sorted copies in flight).
+READ_ROWS = JOURNAL_READ_ROWS
 
 #: Consecutive grid points written to the NetCDF variables at once: the largest array of the
 #: assembly holds SLAB_POINTS × row width float64 (4096 × 86 × 8 B = 2.8 MB with 64 peaks), and
@@ -64,12 +63,11 @@ SLAB_POINTS = 4096
 #: hold the whole grid in memory: 65536 points × ~88 float64 = 46 MB at most.
 LOAD_LIMIT_POINTS = 65536
 
+#: The journal beside an output (``OUT.nc.journal``).
+journal_dir = journal_path
 
-def journal_dir(out: Path) -> Path:
-    return Path(str(out) + ".journal")
 
-
-class Journal:
+class Journal(RowJournal):
     """The append-only record of finished points of one sweep, and the lock of its output.
 
     Opening it takes the output's lock (:class:`~stickslip.files.OutputLock`) and keeps it until
@@ -80,116 +78,41 @@ class Journal:
     stickslip.files.LockError
         If another process is writing the same output.
     SweepError
-        If the journal beside ``out`` belongs to a different sweep (and not ``overwrite``).
+        If the journal beside ``out`` belongs to a different sweep, is of an earlier format or is
+        corrupt (and not ``overwrite``).
     """
 
     def __init__(self, out: Path, spec: SweepSpec, *, overwrite: bool = False):
-        self.out = Path(out)
-        self.dir = journal_dir(self.out)
         self.spec = spec
-        self.width = spec.row_width + 2
-        self.lock = OutputLock(self.out).acquire()
-        with self.lock.released_on_error():
-            self._open(overwrite)
-
-    def _open(self, overwrite: bool) -> None:
-        manifest = self.dir / "manifest.json"
-        if overwrite and self.dir.exists():
-            shutil.rmtree(self.dir)
-        if manifest.exists():
-            old = json.loads(manifest.read_text())
-            if old.get("format") != JOURNAL_FORMAT or old.get("digest") != self.spec.digest:
-                raise SweepError(
-                    f"{self.dir} holds the journal of a different sweep (grid or options differ); "
-                    "resume with the same arguments, pass overwrite=True (--overwrite), or choose another output"
-                )
-        else:
-            self.dir.mkdir(parents=True, exist_ok=True)
-            fsync_dir(self.dir.parent)
-            text = json.dumps({"format": JOURNAL_FORMAT, "digest": self.spec.digest, "spec": self.spec.to_json(),
-                               "row_width": self.spec.row_width, "stickslip_version": __version__})
-            atomic_write(manifest, lambda tmp: tmp.write_text(text))
-        self.path = self.dir / "rows.f64"
-        self._repair()
-        self._log = AppendLog(self.path, kept=f"finished points are kept in {self.dir}")
-
-    def _repair(self) -> None:
-        """Drop a torn tail and records without the sentinel (streamed: bounded memory)."""
-        if not self.path.exists():
-            self.path.touch()
-            return
-        rec = self.width * 8
-        size = self.path.stat().st_size
-        if size % rec:
-            with open(self.path, "r+b") as fh:
-                fh.truncate(size - size % rec)
-        if all(np.all(block[:, -1] == SENTINEL) for block in self.blocks()):
-            return
-
-        def keep_complete(tmp):
-            with open(tmp, "wb") as fh:
-                for block in self.blocks():
-                    fh.write(block[block[:, -1] == SENTINEL].tobytes())
-
-        atomic_write(self.path, keep_complete)
-
-    def n_records(self) -> int:
-        """Complete records in the journal file."""
-        return self.path.stat().st_size // (self.width * 8)
-
-    def blocks(self, rows: int = READ_ROWS):
-        """Yield the journal as float64 arrays of at most ``rows`` records × (row width + 2)."""
-        n = self.n_records()
-        with open(self.path, "rb") as fh:
-            for start in range(0, n, rows):
-                count = min(rows, n - start)
-                yield np.fromfile(fh, dtype=np.float64, count=count * self.width).reshape(count, self.width)
+        super().__init__(out, width=spec.row_width, size=spec.size, kind="sweep", digest=spec.digest,
+                         settings=json.loads(spec.to_json()), noun="sweep", differs="grid or options differ",
+                         error=SweepError, overwrite=overwrite, saved="the finished points")
 
     def done_mask(self) -> np.ndarray:
         """Boolean (size,) of the points already in the journal."""
         mask = np.zeros(self.spec.size, dtype=bool)
-        for block in self.blocks():
-            mask[block[:, 0].astype(np.int64)] = True
+        for idx, _ in self.blocks(READ_ROWS):
+            mask[idx] = True
         return mask
-
-    def append(self, indices: np.ndarray, rows: np.ndarray) -> None:
-        """Record finished points (one write, ``fsync``-ed before returning)."""
-        rec = np.empty((len(indices), self.width))
-        rec[:, 0] = indices
-        rec[:, 1:-1] = rows
-        rec[:, -1] = SENTINEL
-        self._log.append(rec.tobytes())
-
-    def close(self) -> None:
-        """Close the journal (it stays on disk) and release the output's lock."""
-        self._log.close()
-        self.lock.release()
-
-    def remove(self) -> None:
-        """Delete the journal (after the output is written) and release the output's lock."""
-        self._log.close()
-        shutil.rmtree(self.dir, ignore_errors=True)
-        fsync_dir(self.dir.parent)
-        self.lock.release()
 
     def write_ordered(self, path: Path) -> None:
         """Scatter the journal rows into ``path`` as (size, row width) float64 in grid order.
 
         Rows of points not in the journal are left as zeros (a sparse file); the reader masks
         them with :meth:`done_mask`. Each journal block is sorted by index and written as runs
-        of consecutive points, so a journal that arrived in order is copied with few writes.
+        of consecutive points, so a journal that arrived in order is copied with few writes; a
+        point recorded twice keeps its last record.
         """
         row_bytes = self.spec.row_width * 8
         with open(path, "wb") as fh:
             fh.truncate(self.spec.size * row_bytes)
-            for block in self.blocks():
-                idx = block[:, 0].astype(np.int64)
+            for idx, rows in self.blocks(READ_ROWS):
                 order = np.argsort(idx, kind="stable")
-                idx, rows = idx[order], block[order, 1:-1]
+                idx, rows = idx[order], rows[order]
                 breaks = np.flatnonzero(np.diff(idx) != 1) + 1
                 for lo, hi in zip(np.concatenate([[0], breaks]), np.concatenate([breaks, [idx.size]])):
                     fh.seek(int(idx[lo]) * row_bytes)
-                    fh.write(np.ascontiguousarray(rows[lo:hi]).tobytes())
+                    fh.write(np.ascontiguousarray(rows[lo:hi], dtype=np.float64).tobytes())
 
 
 def flat_hyperslabs(shape, start: int, stop: int) -> list:
@@ -294,7 +217,7 @@ def assemble(journal: Journal, path: Path, *, extra_attrs: dict | None = None) -
         finally:
             ordered.unlink(missing_ok=True)
 
-    return atomic_write(path, write, kept=f"{path} is left as it was and finished points are kept in {journal.dir}")
+    return journal.snapshot(write, path)
 
 
 def _write_columns(nc_path: Path, ordered: Path, spec: SweepSpec, done: np.ndarray) -> None:
