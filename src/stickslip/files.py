@@ -376,6 +376,10 @@ class OutputLock:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise self._cannot(exc, f"creating the folder {self.path.parent}") from None
+        try:  # a folder that takes no files (/proc, read-only) is said as such, not as a busy lock
+            os.close(os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644))
+        except OSError as exc:
+            raise self._cannot(exc, f"creating a file in {self.path.parent}") from None
         while True:
             file_lock = FileLock(self.path, timeout=0, thread_local=False, on_acquired=_take_current(self.path))
             try:

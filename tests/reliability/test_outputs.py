@@ -5,6 +5,7 @@ lock file beside a finished output."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -93,28 +94,40 @@ def test_no_lock_file_is_left_beside_a_finished_output(args, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["o.nc"]  # before: o.nc.lock too (resumable commands)
 
 
-def test_a_writer_waiting_on_a_lock_takes_the_file_at_its_name(tmp_path, monkeypatch):
-    """A holder deletes its lock file while it still holds it, then unlocks (another process, here
-    a bare descriptor). A writer that had opened that file just before gets its lock, but must let
-    go and lock the file now at the name, or two writers could hold two different files."""
+def test_a_lock_on_a_file_no_longer_at_its_name_is_not_kept(tmp_path):
+    """A holder deletes its lock file while it still holds it, then unlocks. A writer that had
+    opened that file just before gets its flock, but must let go and lock the file now at the
+    name, or two writers could hold two different files: the check run on every acquisition."""
     out = tmp_path / "o.nc"
     path = lock_path(out)
-    other = os.open(path, os.O_RDWR | os.O_CREAT)
-    files.fcntl.flock(other, files.fcntl.LOCK_EX)
-    real_flock, calls = files.fcntl.flock, []
+    stale = os.open(path, os.O_RDWR | os.O_CREAT)
+    os.unlink(path)
+    current = os.open(path, os.O_RDWR | os.O_CREAT)
+    try:
+        with pytest.raises(files._Stale):
+            files._take_current(path)(stale)
+        files._take_current(path)(current)  # the file at the name: kept, the holder recorded
+        assert json.loads(path.read_text())["pid"] == os.getpid()
+    finally:
+        os.close(stale)
+        os.close(current)
 
-    def holder_leaves_first(fd, op):  # between the writer's open and its flock
-        calls.append(fd)
-        if len(calls) == 1:
-            os.unlink(path)
-            os.close(other)
-        return real_flock(fd, op)
 
-    monkeypatch.setattr(files.fcntl, "flock", holder_leaves_first)
+def test_a_stale_acquisition_is_taken_again(tmp_path, monkeypatch):
+    out = tmp_path / "o.nc"
+    real, made = files.FileLock, []
+
+    class FirstStale(real):
+        def acquire(self, *args, **kwargs):
+            made.append(self)
+            if len(made) == 1:
+                raise files._Stale
+            return super().acquire(*args, **kwargs)
+
+    monkeypatch.setattr(files, "FileLock", FirstStale)
     with OutputLock(out, timeout=10) as taken:
-        fd = files._HOLDS[taken._key].fd
-        assert os.path.samestat(os.fstat(fd), os.stat(path))  # the file at the name, not the deleted one
-    assert len(calls) == 2 and not path.exists()
+        assert taken.held and len(made) == 2 and lock_path(out).exists()
+    assert not lock_path(out).exists()  # the last release deletes it
 
 
 # ----------------------------------------------------------------------------- inputs and existing files
