@@ -16,9 +16,10 @@ The decision uses the window t ≥ t_from (the transient before it is discarded)
    unseen below it, so this is not settled here: :mod:`stickslip.attractors` confirms it
    with the linear stability of the equilibrium. A slip-only response that grows in any
    response is not an equilibrium.
-4. Otherwise ``non-periodic``: **stationary** when the return differences of the best
-   multiplicity seen are far from a match (spread ≥ :data:`STATIONARY_MIN_SPREAD`), neither
-   decay (:func:`~stickslip.analysis.period.decay_ratio` at most
+4. Otherwise ``non-periodic``: **stationary** when the window holds enough peaks for every
+   multiplicity to have been tried (:data:`STATIONARY_MIN_PEAKS`), the return differences of
+   the best multiplicity seen are far from a match (spread ≥ :data:`STATIONARY_MIN_SPREAD`),
+   and they show neither decay (:func:`~stickslip.analysis.period.decay_ratio` at most
    :data:`~stickslip.analysis.period.DECAY_FACTOR`) nor trend (their drift is no larger than
    their spread): no sign of a transient, a candidate for chaos or a torus that only the
    dynamics can confirm (:mod:`stickslip.attractors`); else **unsettled**. The range of
@@ -41,7 +42,7 @@ from .period import DECAY_FACTOR, MAX_MULTIPLICITY, MIN_PERIODS, SETTLE_RTOL, de
 from .signal import REST_AMPLITUDE, spectral_peak, stick_time
 
 __all__ = ["KINDS", "Classification", "classify_response", "classify", "kind_code",
-           "SETTLE_RTOL", "MAX_MULTIPLICITY", "MIN_PERIODS"]
+           "SETTLE_RTOL", "MAX_MULTIPLICITY", "MIN_PERIODS", "STATIONARY_MIN_PEAKS"]
 
 #: Steady-state kinds; their index is the integer code stored in sweeps (−1: the run failed).
 KINDS = ("equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic")
@@ -60,6 +61,12 @@ STATIONARY_MIN_SPREAD = 1e-3
 #: Agreement of the peak ranges of two windows of a stationary response, relative to A (the
 #: range change of a torus's windows; :func:`range_change`).
 STATIONARY_RTOL = 1e-2
+
+#: Peaks a window needs before "no period" is a finding rather than a lack of data: every
+#: multiplicity up to :data:`~stickslip.analysis.period.MAX_MULTIPLICITY` then fits
+#: :data:`~stickslip.analysis.period.MIN_PERIODS` periods plus one (a 2.5 s window with 9 peaks
+#: was called stationary, and then chaotic, because only k = 1 could be tried in it).
+STATIONARY_MIN_PEAKS = (MIN_PERIODS + 1) * MAX_MULTIPLICITY
 
 
 def kind_code(kind: str) -> int:
@@ -80,7 +87,8 @@ class Classification:
     period_s : float
         Period from the return map [s]; NaN unless periodic.
     frequency_hz : float
-        1/period when periodic; otherwise the mean rate of peaks [Hz]; NaN without peaks.
+        1/period when periodic [Hz]; NaN otherwise (a run without a period has no frequency of its
+        own: see ``fft_frequency_hz`` and ``peak_rate_hz``).
     fft_frequency_hz : float
         Highest peak of the Hann-windowed amplitude spectrum of x [Hz]; NaN at rest.
     stick_fraction : float
@@ -91,6 +99,8 @@ class Classification:
         Peak-to-peak x in the window [unit of x].
     peaks : Peaks
         Event-located peaks of x in the window.
+    peak_rate_hz : float
+        Mean rate of the peaks in the window [Hz]; NaN with fewer than two.
     t_from, t_to : float
         The window [s].
     attractor : str
@@ -114,11 +124,12 @@ class Classification:
     stick_fraction: float
     settled: bool
     amplitude: float
-    peaks: Peaks
+    peaks: Peaks = dataclasses.field(repr=False)
     t_from: float
     t_to: float
     attractor: str = "unsettled"
-    evidence: dict = dataclasses.field(default_factory=dict)
+    evidence: dict = dataclasses.field(default_factory=dict, repr=False)
+    peak_rate_hz: float = math.nan
 
     @property
     def code(self) -> int:
@@ -192,30 +203,32 @@ def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | 
     t0, t1 = float(t[0]), float(t[-1])
     per = detect_period(t, x, dx)
     amp, pk = per.amplitude, per.peaks
-    base = dict(stick_fraction=float(stick_fraction), amplitude=amp, peaks=pk, t_from=t0, t_to=t1)
+    rate = (len(pk) - 1) / (pk.time[-1] - pk.time[0]) if len(pk) >= 2 and pk.time[-1] > pk.time[0] else math.nan
+    base = dict(stick_fraction=float(stick_fraction), amplitude=amp, peaks=pk, t_from=t0, t_to=t1,
+                peak_rate_hz=float(rate))
     evidence = per.evidence.to_dict()
-    if amp < REST_AMPLITUDE:
+    if amp < REST_AMPLITUDE:  # at rest: no rate of peaks either
         return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, attractor="equilibrium",
-                              evidence=evidence, **base)
+                              evidence=evidence, **{**base, "peak_rate_hz": math.nan})
     fft_f = spectral_peak(t, x)
     if per.periodic:
         kind = "periodic-stick-slip" if stick_fraction > 0.0 else "periodic-slip"
         return Classification(kind, per.multiplicity, per.period_s, 1.0 / per.period_s, fft_f, settled=True,
                               attractor="periodic", evidence=evidence, **base)
-    rate = (len(pk) - 1) / (pk.time[-1] - pk.time[0]) if len(pk) >= 2 else math.nan
     quarters = [_quarters(t, x, t0, t1)] + ([] if others is None else [_quarters(t, y, t0, t1) for y in others.T])
     evidence["amplitude_ratio"] = float(quarters[0][-1] / quarters[0][0]) if quarters[0][0] > 0 else math.nan
     if stick_fraction == 0.0 and all(_decaying(q) for q in quarters):
-        return Classification("equilibrium", 0, math.nan, float(rate), fft_f, settled=False, attractor="decaying",
+        return Classification("equilibrium", 0, math.nan, math.nan, fft_f, settled=False, attractor="decaying",
                               evidence=evidence, **base)
     mid = 0.5 * (t0 + t1)
     evidence["range_change"] = range_change(pk.value[pk.time < mid], pk.value[pk.time >= mid], amp)
     k = max(per.evidence.multiplicity, 1)
     evidence["return_decay"] = decay_ratio(pk.value[k:] - pk.value[:-k])
     best = per.evidence
+    evidence["peaks"] = len(pk)
     stationary = (best.spread >= STATIONARY_MIN_SPREAD and evidence["return_decay"] <= DECAY_FACTOR
-                  and not best.drift > best.spread)
-    return Classification("non-periodic", 0, math.nan, float(rate), fft_f, settled=False,
+                  and not best.drift > best.spread and len(pk) >= STATIONARY_MIN_PEAKS)
+    return Classification("non-periodic", 0, math.nan, math.nan, fft_f, settled=False,
                           attractor="stationary" if stationary else "unsettled", evidence=evidence, **base)
 
 

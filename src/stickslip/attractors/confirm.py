@@ -33,7 +33,7 @@ from ..orbits import lyapunov_exponent, periodic_orbit
 from ..orbits.section import Section, section_crossings
 
 __all__ = ["ORBIT_PERIODS", "PERIOD_RTOL", "LAMBDA_ZERO", "SEPARATIONS", "QUASI_SPAN_S", "QUASI_RATE",
-           "LYAPUNOV_TIME_S", "confirm_period", "lyapunov_sign", "span_change"]
+           "LYAPUNOV_TIME_S", "LYAPUNOV_START_S", "confirm_period", "lyapunov_sign", "span_change"]
 
 #: Periods of the run from the shot orbit on which its own multiplicity is measured (the period
 #: rule needs nine; thirty average the noise of its drift test).
@@ -61,8 +61,10 @@ SEPARATIONS = (1e-7, 1e-6)
 QUASI_SPAN_S = 1000.0
 QUASI_RATE = 1e-4
 
-#: Averaging time of the Lyapunov exponent [s] (after a 20 s start that sets the norm's scales).
+#: Averaging time of the Lyapunov exponent [s], after a start of LYAPUNOV_START_S that sets the
+#: norm's scales.
 LYAPUNOV_TIME_S = 500.0
+LYAPUNOV_START_S = 20.0
 
 #: Levels of the coordinate, as fractions of its range in the window, whose up- and
 #: down-crossings are tried as sections after its maxima and minima.
@@ -166,7 +168,7 @@ def lyapunov_sign(traj, *, averaging: float = LYAPUNOV_TIME_S) -> dict:
     lams, ses = [], []
     for d0 in SEPARATIONS:
         try:
-            res = lyapunov_exponent(traj.system, traj.final_state, t_transient=20.0,
+            res = lyapunov_exponent(traj.system, traj.final_state, t_transient=LYAPUNOV_START_S,
                                     t_average=averaging, d0=d0)
         except (StickSlipError, ArithmeticError) as exc:
             return {"sign": None, "reason": f"Lyapunov exponent failed: {exc}"}

@@ -29,10 +29,11 @@ import math
 
 import numpy as np
 
-from ..analysis.classify import STATIONARY_RTOL, Classification, classify
+from ..analysis.classify import STATIONARY_MIN_PEAKS, STATIONARY_RTOL, Classification, classify
 from ..errors import StickSlipError
 from ..stability import stability
-from .confirm import QUASI_RATE, QUASI_SPAN_S, confirm_period, lyapunov_sign, span_change
+from .confirm import (LYAPUNOV_START_S, ORBIT_PERIODS, QUASI_RATE, QUASI_SPAN_S, confirm_period, lyapunov_sign,
+                      span_change)
 
 __all__ = ["ATTRACTORS", "Attractor", "attractor", "attractor_code", "jsonable", "undersampled"]
 
@@ -71,6 +72,10 @@ class Attractor:
     evidence : dict
         What was measured (the classification's evidence, plus ``shooting`` or ``lyapunov``
         results and a ``reason`` when a claim was not made).
+    confirmed_by : str or None
+        The computation past the window that confirmed the verdict, in words (a shot orbit and
+        its own run, or Lyapunov runs continued from the run's end, with their simulated time);
+        None when the window alone decided.
     """
 
     attractor: str
@@ -82,6 +87,7 @@ class Attractor:
     settle_time_s: float | None
     classification: Classification | None
     evidence: dict
+    confirmed_by: str | None = None
 
     @property
     def code(self) -> int:
@@ -102,7 +108,7 @@ class Attractor:
         return {"settled": self.settled, "attractor": self.attractor, "period_count": self.period_count,
                 "fundamental_frequency_hz": self.fundamental_frequency_hz,
                 "dominant_frequency_hz": self.dominant_frequency_hz, "settle_time_s": self.settle_time_s,
-                "evidence": jsonable(self.evidence)}
+                "confirmed_by": self.confirmed_by, "evidence": jsonable(self.evidence)}
 
 
 def jsonable(x):
@@ -159,11 +165,11 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
     dominant = _finite(c.fft_frequency_hz)
     sparse = undersampled(traj)
 
-    def verdict(name, k=None, period=math.nan, **more):
+    def verdict(name, k=None, period=math.nan, confirmed_by=None, **more):
         evidence.update(more)
         settled = name != "unsettled"
         return Attractor(name, settled, k, period, 1.0 / period if settled and k else None, dominant,
-                         end if settled else None, c, evidence)
+                         end if settled else None, c, evidence, confirmed_by if settled else None)
 
     if sparse:
         return verdict("unsettled", reason=sparse)
@@ -187,7 +193,9 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
             cache[key] = confirm_period(traj, k, period, dof=dof, t_from=t_from)
         shot = cache[key]
         if shot["confirmed"]:
-            return verdict("periodic", k, period, shooting=shot)
+            return verdict("periodic", k, period, shooting=shot,
+                           confirmed_by=f"the shot orbit and its own run of {ORBIT_PERIODS} periods "
+                                        f"({ORBIT_PERIODS * shot['period_s']:.4g} s) past the run")
         return verdict("unsettled", shooting=shot, reason=f"period of {k} maxima not confirmed: {shot['reason']}")
     if c.attractor == "stationary":
         if not lyapunov:
@@ -195,19 +203,26 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
         if "lyapunov" not in cache:
             cache["lyapunov"] = lyapunov_sign(traj)
         lyap = cache["lyapunov"]
+        past = (f"largest Lyapunov exponents over {len(lyap.get('exponents', []))} runs of "
+                f"{LYAPUNOV_START_S + lyap.get('averaging_s', 0.0):g} s continued from the run's end")
         if lyap["sign"] == "positive":
-            return verdict("chaotic", lyapunov=lyap)
+            return verdict("chaotic", lyapunov=lyap, confirmed_by=past)
         if lyap["sign"] is None:
             return verdict("unsettled", lyapunov=lyap, reason=lyap["reason"])
         span = span_change(traj, end - max(t_from, float(traj.t[0])), dof=dof)
         if span is not None and span["rate"] <= QUASI_RATE and span["range_change"] <= STATIONARY_RTOL:
-            return verdict("quasiperiodic", lyapunov=lyap, span=span)
+            return verdict("quasiperiodic", lyapunov=lyap, span=span, confirmed_by=past)
         why = (f"the run is shorter than {QUASI_SPAN_S:g} s" if span is None else
                f"its crossings changed over {QUASI_SPAN_S:g} s (rate {span['rate']:.2g} 1/s, range "
                f"{span['range_change']:.2g} A)")
         return verdict("unsettled", lyapunov=lyap, span=span,
                        reason=f"largest Lyapunov exponent ≈ 0, but a torus is claimed only when the crossings stay "
                               f"unchanged over {QUASI_SPAN_S:g} s and {why}")
+    peaks = c.evidence.get("peaks", STATIONARY_MIN_PEAKS)
+    if peaks < STATIONARY_MIN_PEAKS:
+        return verdict("unsettled", reason=f"the window holds {peaks} peaks of the coordinate; a claim that it has no "
+                                           f"period needs at least {STATIONARY_MIN_PEAKS} (every multiplicity up to "
+                                           "16 over 9 periods): run longer")
     return verdict("unsettled", reason="the window still drifts")
 
 

@@ -246,7 +246,8 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     table = Table(title=Text(title), show_header=False)
     freq, dominant = summary["fundamental_frequency_hz"], summary["dominant_frequency_hz"]
     kind = summary["attractor"] + (f", {summary['period_count']} peak(s) of {symbol} per period" if summary["period_count"] else "")
-    kind += (f" (settled by {summary['settle_time_s']:g} s)" if summary["settled"]
+    confirmed = f"; confirmed by {summary['confirmed_by']}" if summary.get("confirmed_by") else ""
+    kind += (f" (settled by {summary['settle_time_s']:g} s{confirmed})" if summary["settled"]
              else f" ({summary['evidence'].get('reason', 'no verdict')})")
     wrote = "nothing" if out is None else str(out) + ("" if figure is None else f", {figure}")
     rows = [

@@ -417,7 +417,7 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         x_min, x_max, x_mean = observed_columns(system.dofs[observed])
         out.update(kind=float(kind_code(verdict.kind)), attractor=float(verdict.code), settled=float(verdict.settled),
                    period_count=float(verdict.period_count or 0), period=verdict.period_s,
-                   fundamental_frequency=_nan(verdict.fundamental_frequency_hz), frequency=c.frequency_hz,
+                   fundamental_frequency=_nan(verdict.fundamental_frequency_hz), frequency=c.frequency_hz if c.kind.startswith("periodic") else c.peak_rate_hz,
                    dominant_frequency=_nan(verdict.dominant_frequency_hz),
                    settle_time=_nan(verdict.settle_time_s), stick_fraction=c.stick_fraction, amplitude=c.amplitude,
                    n_peaks=float(len(c.peaks)))
