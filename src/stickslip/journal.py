@@ -35,16 +35,17 @@ from __future__ import annotations
 
 import json
 import shutil
+import tempfile
 import zlib
 from pathlib import Path
 
 import numpy as np
 
 from ._version import __version__
-from .errors import JournalError, StickSlipError
+from .errors import FileFormatError, JournalError, StickSlipError
 from .files import AppendLog, OutputLock, atomic_write, fsync_dir, refuse_output, write_output
 
-__all__ = ["Journal", "RowJournal", "LineJournal", "JournalError", "journal_path", "FORMAT", "EARLIER_FORMATS",
+__all__ = ["Journal", "RowJournal", "LineJournal", "JournalError", "journal_path", "output_path", "finished_output", "FORMAT", "EARLIER_FORMATS",
            "ROW_MAGIC", "READ_ROWS"]
 
 #: Format of every journal's header.
@@ -59,6 +60,53 @@ ROW_MAGIC = 0x534C4A32
 
 #: Row records read at once: 4096 records of ~88 float64 = 2.9 MB, whatever the journal length.
 READ_ROWS = 4096
+
+
+def output_path(out, default: str, error: type[Exception]):
+    """The output of a resumable run and the temporary folder that holds it when none is given:
+    ``(path, tmpdir or None)``; ``default`` names the temporary file (``sweep.nc``).
+
+    Raises
+    ------
+    error
+        For a path that does not end in ``.nc``.
+    """
+    tmpdir = None
+    if out is None:
+        tmpdir = tempfile.TemporaryDirectory(prefix=f"stickslip-{Path(default).stem}-")
+        out = Path(tmpdir.name) / default
+    out = Path(out)
+    if out.suffix != ".nc":
+        raise error(f"output {out}: give a path ending in .nc")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return out, tmpdir
+
+
+def finished_output(out: Path, digest: str, load, *, what: str, error: type[Exception], overwrite: bool):
+    """The result already at ``out`` of the run with ``digest`` (complete or not), or None when
+    there is none to take (no file, a journal beside it to resume, or ``overwrite``).
+
+    Parameters
+    ----------
+    load : callable
+        ``load(path) -> xarray.Dataset``: the command's loader (it checks the file is ours).
+    what : str
+        The run in words for messages ("sweep", "basin study").
+
+    Raises
+    ------
+    error
+        The file is not ours, or holds another run (the message names ``--overwrite``).
+    """
+    if overwrite or not out.exists() or journal_path(out).exists():
+        return None
+    try:
+        ds = load(out)
+    except FileFormatError as exc:
+        raise error(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
+    if ds.attrs.get("digest") != digest:
+        raise error(f"{out} holds a different {what}; pass overwrite=True (--overwrite) or choose another output")
+    return ds
 
 
 def journal_path(out) -> Path:

@@ -31,7 +31,6 @@ DEFAULT_STEP_S = 100.0
 DEFAULT_T_MIN_S = 200.0
 
 
-
 @dataclasses.dataclass(frozen=True)
 class SettledRun:
     """A run extended until settled (:func:`simulate_until_settled`), with the verdict it reached.

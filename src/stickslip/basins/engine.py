@@ -15,14 +15,14 @@ journal for the next run.
 from __future__ import annotations
 
 import math
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import BasinError, FileFormatError, StickSlipError
+from ..errors import BasinError, StickSlipError
 from ..integrate.interrupt import interruptible
+from ..journal import finished_output, output_path
 from ..model.library import load_model
 from ..parallel import EXECUTORS, check_executor, check_workers, map_unordered
 from .context import Context, make_context, model_of, register_model
@@ -31,7 +31,7 @@ from .early import Options, Outcome, classify_state
 from .result import BasinResult, assemble
 from .spec import BasinSpec, build_spec
 from .states import StateSpec
-from .store import Journal, journal_dir, load_basins, write_dataset
+from .store import Journal, load_basins, write_dataset
 
 __all__ = ["basin_stability", "EXECUTORS", "TARGET_BATCH_S", "evaluate_batch"]
 
@@ -175,26 +175,12 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
                          f"{model.name!r} (its slowest oscillation); give several periods, e.g. --t-end {100 * period:.3g}")
     initial = np.stack([states.states(m, None if c.equilibrium is None else c.equilibrium[:m.n])
                         for m, c in zip(models, ctxs)])
-    tmpdir = None
-    if out is None:
-        tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-basins-")
-        out = Path(tmpdir.name) / "basins.nc"
-    out = Path(out)
-    if out.suffix != ".nc":
-        raise BasinError(f"output {out}: give a path ending in .nc")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    if out.exists() and not journal_dir(out).exists() and not overwrite:
-        try:
-            ds = load_basins(out)
-        except FileFormatError as exc:
-            raise BasinError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
-        if ds.attrs.get("digest") != spec.digest:
-            raise BasinError(f"{out} holds a different basin study; pass overwrite=True (--overwrite) or choose another "
-                             "output")
-        if int(ds.attrs.get("complete", 0)):
-            return BasinResult(out, ds, {"total_s": time.perf_counter() - t_start, "states_computed": 0,
-                                         "states_resumed": spec.size, "executor": executor, "workers": workers,
-                                         "interrupted": False})
+    out, tmpdir = output_path(out, "basins.nc", BasinError)
+    ds = finished_output(out, spec.digest, load_basins, what="basin study", error=BasinError, overwrite=overwrite)
+    if ds is not None and int(ds.attrs.get("complete", 0)):
+        return BasinResult(out, ds, {"total_s": time.perf_counter() - t_start, "states_computed": 0,
+                                     "states_resumed": spec.size, "executor": executor, "workers": workers,
+                                     "interrupted": False})
     journal = Journal(out, spec, overwrite=overwrite)
     timing = {"executor": executor, "workers": workers, "interrupted": False}
     try:

@@ -332,14 +332,8 @@ def lyapunov_spectrum(
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str, optional
-        The model as :func:`stickslip.simulate` takes it (default: the orbit's, else the plates, Table 1).
-    ic : "equilibrium", "zero", array-like (2n,), Trajectory or PeriodicOrbit
-        Start of the transient run (a PeriodicOrbit: its section state and model).
-    model : str, optional
-        The plates' variant, or a library name / model file as ``system``.
-    t_transient : float
-        Transient simulated and discarded first [s] (> 0: it sets the norm's scales).
+    system, ic, model, t_transient
+        As :func:`lyapunov_exponent`.
     t_average : float
         Averaging time [s].
     record : float

@@ -111,28 +111,6 @@ def steady_sliding(system) -> np.ndarray:
     return solve_steady(system)[0]
 
 
-def steady_residual(system, q: np.ndarray) -> float:
-    """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)."""
-    n = system.n
-    s = np.zeros(2 * n)
-    s[:n] = q
-    ds = np.zeros(2 * n)
-    cst = np.zeros(CST * system.n_contacts)
-    cst[0::CST] = MODE_SLIP_EXACT
-    cst[3::CST] = np.inf
-    rhs(s, cst, system.data, ds)
-    free = np.flatnonzero(system.free)
-    Q = (system.mass @ ds[n:])[free]
-    Kq = (system.stiffness @ np.asarray(q, float))[free]
-    f0 = system.force[free]
-    num = float(np.max(np.abs(Q), initial=0.0))
-    scale = max(float(np.max(np.abs(Kq), initial=0.0)), float(np.max(np.abs(f0), initial=0.0)),
-                float(np.max(np.abs(Q + Kq - f0), initial=0.0)))
-    if num == 0.0:
-        return 0.0
-    return num / scale if scale > 0.0 and np.isfinite(num) else math.inf
-
-
 def equilibrium_residual(system, q: np.ndarray) -> np.ndarray:
     """Force residual −M q̈ of the slip equations at (q, q̇ = 0), shape (n,) [N or N m per dof].
 
@@ -148,6 +126,20 @@ def equilibrium_residual(system, q: np.ndarray) -> np.ndarray:
     cst[3::CST] = np.inf
     rhs(s, cst, system.data, ds)
     return np.where(system.free, -(system.mass @ ds[n:]), 0.0)
+
+
+def steady_residual(system, q: np.ndarray) -> float:
+    """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)."""
+    free = np.flatnonzero(system.free)
+    Q = -equilibrium_residual(system, q)[free]
+    Kq = (system.stiffness @ np.asarray(q, float))[free]
+    f0 = system.force[free]
+    num = float(np.max(np.abs(Q), initial=0.0))
+    scale = max(float(np.max(np.abs(Kq), initial=0.0)), float(np.max(np.abs(f0), initial=0.0)),
+                float(np.max(np.abs(Q + Kq - f0), initial=0.0)))
+    if num == 0.0:
+        return 0.0
+    return num / scale if scale > 0.0 and np.isfinite(num) else math.inf
 
 
 def equilibrium(system=None, model=None) -> np.ndarray:

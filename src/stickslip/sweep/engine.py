@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import tempfile
 import time
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -13,10 +12,11 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..analysis.classify import KINDS
-from ..errors import FileFormatError, SweepError
+from ..errors import SweepError
+from ..journal import finished_output, output_path
 from ..parallel import check_executor, check_workers, map_unordered
 from .spec import SweepSpec, evaluate_batch, warm_up
-from .store import Journal, assemble, journal_dir, load_sweep
+from .store import Journal, assemble, load_sweep
 
 __all__ = ["SweepResult", "sweep", "TARGET_BATCH_S"]
 
@@ -169,24 +169,12 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
     check_executor(executor)
     workers = check_workers(workers, address=address)
-    tmpdir = None
-    if out is None:
-        tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-sweep-")
-        out = Path(tmpdir.name) / "sweep.nc"
-    out = Path(out)
-    if out.suffix != ".nc":
-        raise SweepError(f"output {out}: give a path ending in .nc")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    if out.exists() and not journal_dir(out).exists() and not overwrite:
-        try:
-            ds = load_sweep(out, load="auto")
-        except FileFormatError as exc:
-            raise SweepError(f"{exc}; refusing to overwrite it (pass overwrite=True / --overwrite)") from None
-        if ds.attrs.get("digest") == spec.digest and int(ds.attrs.get("complete", 0)):
-            return SweepResult(out, spec, ds, {"total_s": time.perf_counter() - t_start, "points_computed": 0,
-                                               "points_resumed": spec.size, "executor": executor, "workers": workers})
-        if ds.attrs.get("digest") != spec.digest:
-            raise SweepError(f"{out} holds a different sweep; pass overwrite=True (--overwrite) or choose another output")
+    out, tmpdir = output_path(out, "sweep.nc", SweepError)
+    ds = finished_output(out, spec.digest, lambda path: load_sweep(path, load="auto"), what="sweep", error=SweepError,
+                         overwrite=overwrite)
+    if ds is not None and int(ds.attrs.get("complete", 0)):
+        return SweepResult(out, spec, ds, {"total_s": time.perf_counter() - t_start, "points_computed": 0,
+                                           "points_resumed": spec.size, "executor": executor, "workers": workers})
     journal = Journal(out, spec, overwrite=overwrite)
     info: dict = {"executor": executor, "workers": workers}
     try:
