@@ -8,6 +8,7 @@ import pytest
 
 import stickslip
 from stickslip.analysis import classify, classify_response, detect_period, fundamental_frequency
+from stickslip.analysis.classify import STATIONARY_MIN_PEAKS
 from stickslip.analysis.period import MIN_PERIODS, SETTLE_RTOL
 
 W = 2 * np.pi * 0.5  # 0.5 Hz fundamental: period 2 s
@@ -49,7 +50,8 @@ def _modulated(t, c, gamma, theta):
 
 @pytest.mark.parametrize("kind, periodic, k", [("sine", True, 1), ("two_humps", True, 2), ("quasi", False, 0)])
 def test_constructed_signals_agree(kind, periodic, k):
-    t, x, dx = _signal(kind)
+    # 300 s: the quasi-periodic signal's 212 peaks let every multiplicity up to 16 be tried
+    t, x, dx = _signal(kind, t_end=300.0)
     c = classify_response(t, x, dx)
     f, is_periodic, mult = fundamental_frequency(t, x, dx)
     per = detect_period(t, x, dx)
@@ -62,6 +64,13 @@ def test_constructed_signals_agree(kind, periodic, k):
         assert f == 1.0 / c.period_s == pytest.approx(0.5, rel=1e-6)
     else:
         assert not c.settled and c.attractor == "stationary"     # stationary, not periodic
+        assert c.evidence["peaks"] >= STATIONARY_MIN_PEAKS
+
+
+def test_no_period_is_claimed_from_too_few_peaks():
+    t, x, dx = _signal("quasi", t_end=100.0)                     # 70 peaks: k up to 16 cannot all be tried
+    c = classify_response(t, x, dx)
+    assert c.evidence["peaks"] < STATIONARY_MIN_PEAKS and c.attractor == "unsettled"
 
 
 def test_too_few_periods_is_not_periodic():
