@@ -21,7 +21,7 @@ runner = CliRunner()
 #: stick-slip orbit (T ≈ 0.37 s) closely enough for Newton (5 iterations, ~0.3 s).
 SEARCH = 10.0
 
-ORBIT_KEYS = {"out", "figure", "model", "period_s", "frequency_hz", "stick_phases", "stick_fraction",
+ORBIT_KEYS = {"out", "figure", "model", "period_s", "frequency_hz", "stick_phases", "stick_fraction", "contacts",
               "max_nontrivial_multiplier_abs", "trivial_multiplier_error", "stable", "monodromy", "iterations",
               "residual", "wall_time_s"}
 LYAPUNOV_KEYS = {"out", "figure", "model", "method", "t_transient_s", "t_average_s", "exponents", "largest",

@@ -13,7 +13,8 @@ runner = CliRunner()
 
 JSON_KEYS = {"settled", "attractor", "period_count", "fundamental_frequency_hz", "dominant_frequency_hz",
              "settle_time_s", "evidence", "status", "model", "parameters", "t_end_s", "steady_from_s",
-             "stick_fraction", "n_transitions", "coordinate", "phi_min", "phi_max", "steps", "wall_time_s", "method"}
+             "stick_fraction", "n_transitions", "contacts", "coordinate", "phi_min", "phi_max", "steps", "wall_time_s",
+             "method", "confirmed_by"}
 
 
 def run(*args):

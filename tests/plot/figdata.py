@@ -79,7 +79,8 @@ def make_trajectory(t_end=100.0, steady_from=50.0, *, periodic=True, frequency=2
     mode = (states[:, 4] > 0.009).astype(np.int8)
     steady = SteadyState(t_from=steady_from, t_to=t_end, fundamental_frequency_hz=frequency if periodic else np.nan,
                          dominant_frequency_hz=frequency, periodic=periodic, period_multiplicity=1 if periodic else 0,
-                         stick_fraction=float(mode.mean()), n_transitions=0, coordinate="phi", minimum=-0.01,
+                         stick_fraction=float(mode.mean()), contact_stick_fractions=(float(mode.mean()),),
+                         n_transitions=0, coordinate="phi", minimum=-0.01,
                          maximum=0.01)
     from stickslip.model.library import two_plates
 

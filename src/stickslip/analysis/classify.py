@@ -249,7 +249,9 @@ def classify(traj, t_from: float | None = None, dof: str | None = None) -> Class
     ts = traj.t[sel]
     if ts.size < 8:
         raise ValueError(f"t_from = {t_from} s leaves fewer than 8 samples; choose an earlier time")
-    stick = stick_time(float(ts[0]), float(ts[-1]), int(traj.mode[sel][0]), traj.transitions.time, traj.transitions.kind)
+    tr = traj.transitions
+    stick, _ = stick_time(float(ts[0]), float(ts[-1]), int(traj.mode[sel][0]), tr.time, tr.kind, tr.contact,
+                          system.n_contacts)
     frac = stick / float(ts[-1] - ts[0])
     free = [int(i) for i in np.flatnonzero(system.free) if i != j]
     return classify_response(ts, traj.states[sel, j], traj.states[sel, n + j], stick_fraction=frac,

@@ -73,24 +73,52 @@ def spectral_peak(t, x):
     return float(f[k])
 
 
-def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds):
-    """Total time spent in stick within [t_from, t_to] [s], from exact transition instants.
+def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, transition_contacts=None,
+               n_contacts: int = 1):
+    """Time spent in stick within [t_from, t_to] [s], from exact transition instants: by any
+    contact (the union of their stick intervals), and by each.
 
-    ``mode_at_start`` is the mode (1 = stick) just after ``t_from``; kinds are +1 for
-    slip → stick and −1 for stick → slip.
+    Parameters
+    ----------
+    t_from, t_to : float
+        The window [s].
+    mode_at_start : int
+        The mode just after ``t_from``: bit c set when contact c sticks (one contact: 1 in stick).
+    transition_times, transition_kinds : array-like (k,)
+        Transition instants [s] and kinds (+1 slip → stick, −1 stick → slip).
+    transition_contacts : array-like (k,), optional
+        The contact of each transition (default all contact 0).
+    n_contacts : int
+
+    Returns
+    -------
+    float, or (float, ndarray (n_contacts,)) when ``transition_contacts`` is given
+        Time with some contact stuck [s] (and each contact's own).
     """
-    stick = bool(mode_at_start)
+    contacts = np.zeros(len(transition_times), dtype=np.int64) if transition_contacts is None else transition_contacts
+    stuck = [bool(int(mode_at_start) >> c & 1) for c in range(n_contacts)]
+    since = [t_from] * n_contacts
+    each = np.zeros(n_contacts)
     start = t_from
     total = 0.0
-    for tt, kind in zip(transition_times, transition_kinds):
+    for tt, kind, c in zip(transition_times, transition_kinds, contacts):
         if tt <= t_from or tt > t_to:
             continue
-        if stick and kind < 0:
+        c = int(c)
+        was = any(stuck)
+        if stuck[c] and kind < 0:
+            each[c] += tt - since[c]
+            stuck[c] = False
+        elif not stuck[c] and kind > 0:
+            since[c] = tt
+            stuck[c] = True
+        if was and not any(stuck):
             total += tt - start
-            stick = False
-        elif not stick and kind > 0:
+        elif not was and any(stuck):
             start = tt
-            stick = True
-    if stick:
+    for c in range(n_contacts):
+        if stuck[c]:
+            each[c] += t_to - since[c]
+    if any(stuck):
         total += t_to - start
-    return total
+    return total if transition_contacts is None else (total, each)

@@ -34,7 +34,9 @@ class SteadyState:
     period_multiplicity : int
         Section crossings (peaks) per period (0 when not periodic).
     stick_fraction : float
-        Fraction of the window spent in stick [-].
+        Fraction of the window in which some contact sticks [-].
+    contact_stick_fractions : tuple of float
+        Fraction of the window in which each contact sticks [-], in the model's contact order.
     n_transitions : int
         Stick↔slip transitions inside the window.
     coordinate : str
@@ -50,6 +52,7 @@ class SteadyState:
     periodic: bool
     period_multiplicity: int
     stick_fraction: float
+    contact_stick_fractions: tuple
     n_transitions: int
     coordinate: str
     minimum: float
@@ -97,10 +100,11 @@ def fundamental_frequency(t, phi, dphi):
     return spectral_peak(t, phi), False, 0
 
 
-def summarize(t, states, mode, transition_times, transition_kinds, t_from, coordinate: int, rate: int,
-              name: str) -> SteadyState:
+def summarize(t, states, mode, transition_times, transition_kinds, transition_contacts, n_contacts: int,
+              t_from, coordinate: int, rate: int, name: str) -> SteadyState:
     """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
-    state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``."""
+    state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``, of a model
+    with ``n_contacts`` contacts."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
@@ -117,7 +121,7 @@ def summarize(t, states, mode, transition_times, transition_kinds, t_from, coord
     per = detect_period(ts, phi, dphi)
     at_rest = per.amplitude < REST_AMPLITUDE
     periodic = per.periodic and not at_rest
-    stick = stick_time(t0, t1, mode0, tt, kinds)
+    stick, each = stick_time(t0, t1, mode0, tt, kinds, np.asarray(transition_contacts), n_contacts)
     return SteadyState(
         t_from=t0,
         t_to=t1,
@@ -126,6 +130,7 @@ def summarize(t, states, mode, transition_times, transition_kinds, t_from, coord
         periodic=bool(periodic),
         period_multiplicity=int(per.multiplicity) if periodic else 0,
         stick_fraction=stick / (t1 - t0),
+        contact_stick_fractions=tuple(float(x) / (t1 - t0) for x in each),
         n_transitions=int(window.sum()),
         coordinate=name,
         minimum=float(phi.min()),

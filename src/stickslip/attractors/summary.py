@@ -25,7 +25,9 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
         Keys: ``settled``, ``attractor``, ``period_count``, ``fundamental_frequency_hz`` (None
         unless settled and periodic), ``dominant_frequency_hz`` (spectral peak),
         ``settle_time_s``, ``evidence`` (:class:`~.verdict.Attractor`); ``status``, ``model``,
-        ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction``, ``n_transitions``,
+        ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction`` (some contact stuck),
+        ``n_transitions``, ``contacts`` (by name: each contact's ``stick_fraction`` and
+        ``n_transitions`` in the window),
         ``coordinate`` (the model's observed dof) and its extremes ``<coordinate>_min``,
         ``<coordinate>_max`` in the window (the plates: ``phi_min``, ``phi_max``); ``steps``, ``wall_time_s``, ``method``; ``settle``
         (the cap and steps of :func:`~.settle.simulate_until_settled`) when the run was extended
@@ -35,9 +37,19 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
     s = traj.steady
     out = {**verdict.to_dict(), "status": traj.status, "model": traj.model,
            "parameters": dict(traj.system.parameters), "t_end_s": float(traj.t[-1]), "steady_from_s": s.t_from,
-           "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions, "coordinate": s.coordinate,
+           "stick_fraction": s.stick_fraction, "n_transitions": s.n_transitions,
+           "contacts": _contacts(traj, s), "coordinate": s.coordinate,
            f"{s.coordinate}_min": s.minimum, f"{s.coordinate}_max": s.maximum, "steps": traj.stats.steps,
            "wall_time_s": traj.stats.wall_time_s, "method": traj.method}
     if "settle" in traj.options:
         out["settle"] = traj.options["settle"]
     return out
+
+
+def _contacts(traj: Trajectory, steady) -> dict:
+    """Each contact's stick fraction and transitions in the steady window, by name."""
+    tr = traj.transitions
+    window = (tr.time > steady.t_from) & (tr.time <= steady.t_to)
+    return {name: {"stick_fraction": steady.contact_stick_fractions[c],
+                   "n_transitions": int(((tr.contact == c) & window).sum())}
+            for c, name in enumerate(traj.system.contact_names)}

@@ -18,10 +18,10 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..analysis.signal import stick_time
 from ..files import write_output
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import START_RATE, start_run
+from ..orbits.problem import stick_summary
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
@@ -120,8 +120,7 @@ def orbit_command(
                            monodromy=monodromy)
     wall = time.perf_counter() - t0
     one_period = orbit.trajectory(1.0)
-    stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
-                       one_period.transitions.kind)
+    stick = stick_summary(one_period, orbit.period)
     ds = orbit.to_xarray()
     write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
     figure = None
@@ -132,7 +131,7 @@ def orbit_command(
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": orbit.model,
         "period_s": float(orbit.period), "frequency_hz": float(orbit.frequency),
-        "stick_phases": int(orbit.stick_phases), "stick_fraction": float(stick / orbit.period),
+        "stick_phases": int(orbit.stick_phases), **stick,
         "max_nontrivial_multiplier_abs": float(others.max()) if others.size else None,
         "trivial_multiplier_error": float(abs(orbit.trivial_multiplier - 1.0)),
         "stable": bool(orbit.stable), "monodromy": orbit.options.get("monodromy", monodromy),
@@ -143,7 +142,9 @@ def orbit_command(
         return
     table = Table(title=f"stickslip orbit ({model_label(orbit)})", show_header=False)
     table.add_row("period", f"{summary['period_s']:.10g} s ({summary['frequency_hz']:.8g} Hz)")
-    table.add_row("stick", f"{summary['stick_phases']} phase(s), {summary['stick_fraction']:.4f} of the period")
+    for name, c in stick["contacts"].items():
+        table.add_row("stick" if len(stick["contacts"]) == 1 else f"stick of {name}",
+                      f"{c['stick_phases']} phase(s), {c['stick_fraction']:.4f} of the period")
     if summary["max_nontrivial_multiplier_abs"] is not None:
         table.add_row("largest |μ| (non-trivial)", f"{summary['max_nontrivial_multiplier_abs']:.8g}")
     table.add_row("|μ_trivial − 1|", f"{summary['trivial_multiplier_error']:.2e} ({summary['monodromy']})")

@@ -22,7 +22,7 @@ from ..model.system_model import FrictionModel
 from ..results import Plottable
 from .status import Status
 
-__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError"]
+__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -85,6 +85,12 @@ class Transitions:
         return int(self.time.size)
 
 
+def mode_dtype(n_contacts: int):
+    """Integer type of the sampled mode (bit c set: contact c sticks): int8 up to 8 contacts,
+    int16 up to 16 (the most a model may have)."""
+    return np.int8 if n_contacts <= 8 else np.int16
+
+
 @njit(cache=True)
 def _slip_velocities(states, md, nc):
     """Slip velocity of every contact (k, 2 nc) at each sample [m/s]."""
@@ -119,7 +125,7 @@ class Trajectory(Plottable):
         Uniform sample times [s].
     states : ndarray (k, 2n)
         s = [q, q̇] in the order of ``system.state_names``.
-    mode : ndarray (k,) int8
+    mode : ndarray (k,) int8 (int16 beyond 8 contacts)
         Bit c set when contact c sticks (a one-contact model: 1 in stick, 0 in slip).
     friction : ndarray (k, 2 nc)
         Friction force of contact c at columns 2c, 2c+1 [N] (for the plates: (Fx, Fy) on the
@@ -248,7 +254,8 @@ class Trajectory(Plottable):
     def steady_state(self, t_from: float) -> SteadyState:
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
-        return summarize(self.t, self.states, self.mode, self.transitions.time, self.transitions.kind, t_from,
+        tr = self.transitions
+        return summarize(self.t, self.states, self.mode, tr.time, tr.kind, tr.contact, self.system.n_contacts, t_from,
                          coordinate=i, rate=i + self.system.n, name=self.system.dofs[i])
 
     # ------------------------------------------------------------- pieces and joins
@@ -287,7 +294,7 @@ class Trajectory(Plottable):
         system = self.system
         coords = {"time": ("time", self.t, {"units": "s", "long_name": "time"}),
                   "state": ("state", list(system.state_names)),
-                  "contact": ("contact", [c.name or f"contact{i}" for i, c in enumerate(system.contacts)]),
+                  "contact": ("contact", list(system.contact_names)),
                   "component": ("component", ["t1", "t2"])}
         data = {}
         for j, name in enumerate(system.state_names):
@@ -296,9 +303,12 @@ class Trajectory(Plottable):
             unit = unit if j < system.n else (f"{unit}/s" if unit and unit != "-" else unit)
             data[name] = ("time", self.states[:, j], {"units": unit, "long_name": ("" if j < system.n else "rate of ") + dof})
         nc = system.n_contacts
-        data["mode"] = ("time", self.mode.astype(np.int8), {
+        data["mode"] = ("time", self.mode, {
             "long_name": "sticking contacts (bit c set: contact c sticks)",
             **({"flag_values": "0 1", "flag_meanings": "slip stick"} if nc == 1 else {"flag_masks": " ".join(str(1 << c) for c in range(nc))})})
+        data["stick"] = (("time", "contact"), ((self.mode[:, None].astype(np.int64) >> np.arange(nc)) & 1).astype(np.int8),
+                         {"long_name": "each contact sticks (1) or slips (0)", "flag_values": "0 1",
+                          "flag_meanings": "slip stick"})
         data["friction"] = (("time", "contact", "component"), self.friction.reshape(-1, nc, 2),
                             {"units": "N", "long_name": "friction force of each contact along its tangent rows"})
         data["slip_velocity"] = (("time", "contact", "component"), self.slip_velocity.reshape(-1, nc, 2),
@@ -333,7 +343,8 @@ class Trajectory(Plottable):
         if self.is_plates:
             attrs.update(parameter_attrs(self.params.to_dict()))
         for key, value in self.steady.to_dict().items():
-            attrs[f"steady_{key}"] = int(value) if isinstance(value, bool) else value
+            attrs[f"steady_{key}"] = int(value) if isinstance(value, bool) else \
+                np.asarray(value, dtype=float) if isinstance(value, tuple) else value
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def to_netcdf(self, path: str | Path) -> Path:
@@ -358,7 +369,7 @@ class Trajectory(Plottable):
         nc = system.n_contacts
         code = Status(int(ds.attrs.get("status_code", 0)))
         return cls(
-            t=ds["time"].values, states=states, mode=ds["mode"].values.astype(np.int8),
+            t=ds["time"].values, states=states, mode=ds["mode"].values.astype(mode_dtype(nc)),
             friction=ds["friction"].values.reshape(-1, 2 * nc),
             work=np.stack([ds["work_friction"].values, ds["work_damping"].values], axis=1),
             transitions=Transitions(ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),

@@ -35,7 +35,7 @@ from ..model.system_model import FrictionModel
 from . import contacts as E
 from .event_loop import N_EXTRA, integrate_event
 from .interrupt import interruptible
-from .result import Transitions
+from .result import Transitions, mode_dtype
 from .status import CHUNK_END, Status
 
 __all__ = ["EventStepper", "Record", "Chunk", "RunOutput", "StopCondition", "ToTheEnd", "run_chunks",
@@ -140,7 +140,7 @@ class Record:
         self.ns = 2 * system.n + N_EXTRA
         self.capacity = k
         self._states = np.empty((k, self.ns))
-        self._mode = np.empty(k, dtype=np.int8)
+        self._mode = np.empty(k, dtype=mode_dtype(system.n_contacts))
         self._friction = np.empty((k, 2 * system.n_contacts))
         self.base = 0
         self.n = 0

@@ -341,6 +341,11 @@ class FrictionModel:
         return self.dofs + tuple("d" + d for d in self.dofs)
 
     @property
+    def contact_names(self) -> tuple[str, ...]:
+        """Each contact's name, ``contact<c>`` where it has none."""
+        return tuple(c.name or f"contact{i}" for i, c in enumerate(self.contacts))
+
+    @property
     def observed_index(self) -> int:
         """Index of :attr:`observed` in q (default: the first free dof)."""
         if self.observed is not None:

@@ -30,6 +30,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._version import __version__
+from ..analysis.signal import stick_time as signal_stick_time
 from ..errors import OrbitError, SimulationError
 from ..model.bundle import CST
 from ..model.physics import MODE_STICK
@@ -40,7 +41,7 @@ from .models import ModelResult, model_attrs
 from .section import Section, flow, vector_field
 
 __all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
-           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time",
+           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time", "stick_summary",
            "check_method", "check_section", "METHODS", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
 
 #: Ways of computing ∂Φ/∂s0: variational equations with saltation matrices, or central differences.
@@ -142,6 +143,19 @@ def unstable_count(multipliers: np.ndarray) -> int:
 def stick_count(transitions) -> int:
     """Slip → stick transitions of a run (its stick phases)."""
     return int(np.sum(transitions.kind == 1))
+
+
+def stick_summary(traj, period: float) -> dict:
+    """The stick of one period of an orbit's run (``PeriodicOrbit.trajectory(1.0)``):
+    ``stick_fraction`` (some contact stuck) and, by contact name, ``contacts`` with each one's
+    ``stick_phases`` and ``stick_fraction`` of the period."""
+    tr = traj.transitions
+    nc = traj.system.n_contacts
+    total, each = signal_stick_time(0.0, period, int(traj.mode[0]), tr.time, tr.kind, tr.contact, nc)
+    contacts = {name: {"stick_phases": int(np.sum((tr.kind == 1) & (tr.contact == c))),
+                       "stick_fraction": float(each[c] / period)}
+                for c, name in enumerate(traj.system.contact_names)}
+    return {"stick_fraction": float(total / period), "contacts": contacts}
 
 
 def stick_time(transitions) -> float:

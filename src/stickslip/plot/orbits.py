@@ -6,8 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import save_figure
-from .trajectory import _shade_stick, stick_intervals
+from ..orbits.problem import stick_summary
+from ._common import save_figure, symbol
+from .trajectory import shade_contacts, shown_coordinates
 
 #: Exponents at or below this [1/s] are left out of :func:`plot_lyapunov_spectrum` by default:
 #: the directions a stick phase collapses, −∞ in exact arithmetic.
@@ -119,15 +120,18 @@ def plot_orbit(orbit, traj, ax=None):
     matplotlib.figure.Figure
     """
     fig, ax = _figure_axes(ax, (6.4, 3.6))
-    _shade_stick(ax, stick_intervals(traj.t, traj.mode), traj.t[0], traj.t[-1])
-    j = orbit.system.observed_index
-    name = orbit.system.dofs[j]
-    ax.plot(traj.t, traj.states[:, j], color="tab:blue", lw=1.2, label="φ" if name == "phi" else name)
+    system = orbit.system
+    shade_contacts(ax, traj.t, traj.mode, system, traj.t[0], traj.t[-1])
+    shown, unit = shown_coordinates(system)
+    for j in shown:
+        ax.plot(traj.t, traj.states[:, j], lw=1.2, label=symbol(system.dofs[j]))
     ax.set_xlim(0.0, orbit.period)
     ax.set_xlabel("time from the section [s]")
-    ax.set_ylabel(f"{'φ' if name == 'phi' else name} [{orbit.system.units.get(name, '-')}]")
-    ax.set_title(f"T = {orbit.period:.6g} s ({orbit.frequency:.6g} Hz), {orbit.stick_phases} stick phase(s)",
-                 fontsize=9)
+    ax.set_ylabel(("coordinates" if len(shown) > 1 else symbol(system.dofs[shown[0]])) + (f" [{unit}]" if unit else ""))
+    contacts = stick_summary(traj, orbit.period)["contacts"]
+    phases = ", ".join(f"{c['stick_phases']} of {name}" for name, c in contacts.items()) if len(contacts) > 1 else \
+        str(orbit.stick_phases)
+    ax.set_title(f"T = {orbit.period:.6g} s ({orbit.frequency:.6g} Hz), stick phases: {phases}", fontsize=9)
     ax.legend(fontsize=7, loc="best")
     ax.grid(alpha=0.3)
     return fig

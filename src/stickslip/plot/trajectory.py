@@ -10,7 +10,7 @@ import numpy as np
 from ..analysis.signal import spectrum
 from ._common import param_text, save_figure, symbol
 
-__all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals"]
+__all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals", "shade_contacts", "shown_coordinates"]
 
 
 def stick_intervals(t: np.ndarray, mode: np.ndarray) -> list[tuple[float, float]]:
@@ -22,13 +22,28 @@ def stick_intervals(t: np.ndarray, mode: np.ndarray) -> list[tuple[float, float]
     return [(float(t[a]), float(t[b])) for a, b in zip(starts, ends)]
 
 
-def _shade_stick(ax, intervals, t_lo, t_hi, label="stick"):
+def _shade_stick(ax, intervals, t_lo, t_hi, label="stick", color="tab:orange"):
     first = True
     for a, b in intervals:
         if b < t_lo or a > t_hi:
             continue
-        ax.axvspan(a, b, color="tab:orange", alpha=0.25, lw=0, label=label if first and label else None)
+        ax.axvspan(a, b, color=color, alpha=0.25, lw=0, label=label if first and label else None)
         first = False
+
+
+#: Shading colours of the contacts' stick phases, by contact (cycled).
+STICK_COLORS = ("tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
+
+
+def shade_contacts(ax, t, mode, system, t_lo, t_hi, labels: bool = True) -> None:
+    """Shade the stick phases of each contact of ``system`` in the sampled ``mode`` (bit c: contact c),
+    one colour per contact, labelled ``stick`` (one contact) or ``<contact name> sticks``."""
+    mode = np.asarray(mode).astype(np.int64)
+    names = system.contact_names
+    for c, name in enumerate(names):
+        label = ("stick" if len(names) == 1 else f"{name} sticks") if labels else None
+        _shade_stick(ax, stick_intervals(t, (mode >> c) & 1), t_lo, t_hi, label=label,
+                     color=STICK_COLORS[c % len(STICK_COLORS)])
 
 
 def plot_trajectory(traj, *, window: float | None = None, fig=None):
@@ -57,7 +72,6 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
         window = min(10.0, t_hi - traj.steady_from) if steady.sum() > 1 else t_hi - t_first
     t_lo = max(t_first, t_hi - window)
     show = t >= t_lo
-    intervals = stick_intervals(t, traj.mode)
     if fig is None:
         fig = plt.figure(figsize=(11, 8.4), constrained_layout=True)
     gs = fig.add_gridspec(3, 2)
@@ -68,10 +82,10 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
     above = {"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "frameon": False, "fontsize": 9}  # hides no data
 
     system = traj.system
-    shown, unit = _shown_coordinates(system)
+    shown, unit = shown_coordinates(system)
     for j in shown:
         ax_phi.plot(t[show], traj.states[show, j], lw=1.0, label=symbol(system.dofs[j]))
-    _shade_stick(ax_phi, intervals, t_lo, t_hi, label="stick" if system.n_contacts == 1 else "a contact sticks")
+    shade_contacts(ax_phi, t, traj.mode, system, t_lo, t_hi)
     ax_phi.set_xlim(t_lo, t_hi)
     ax_phi.set_ylabel(("angle" if unit == "rad" else "coordinate") + (f" [{unit}]" if unit else ""))
     whole = t_lo <= t_first
@@ -87,7 +101,7 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
         line, = ax_F.plot(t[show], F[show], lw=1.0, color="tab:green" if nc == 1 else None, label=f"|F|{tag}")
         ax_F.plot(t[show], contact.friction.mu_s * traj.normal_force[show, c], color="k" if nc == 1 else line.get_color(),
                   ls="--", lw=0.8, label=f"μs N{tag}")
-    _shade_stick(ax_F, intervals, t_lo, t_hi, label=None)
+    shade_contacts(ax_F, t, traj.mode, system, t_lo, t_hi, labels=False)
     ax_F.set_xlabel("t [s]")
     ax_F.set_ylabel("friction force [N]")
     ax_F.legend(ncol=2 * nc, **above)
@@ -123,22 +137,18 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
     return fig
 
 
-#: Symbols of the plates' coordinates in labels.
-
-#: Most coordinates drawn in the time history of a model other than the plates.
+#: Most coordinates drawn in a time history.
 MAX_SHOWN = 4
 
 
-def _shown_coordinates(system) -> tuple[list[int], str]:
-    """Indices of the coordinates of the time history and their common unit ("" if they differ):
-    the plates' rotations φ, ψ; else the free DOFs, at most :data:`MAX_SHOWN`, the observed first."""
-    if system.name == "two-plates":
-        shown = [system.dofs.index("phi"), system.dofs.index("psi")]
-    else:
-        free = [j for j in range(system.n) if system.free[j]]
-        shown = ([system.observed_index] + [j for j in free if j != system.observed_index])[:MAX_SHOWN]
-    units = {system.units.get(system.dofs[j], "").strip("-") for j in shown}
-    return shown, units.pop() if len(units) == 1 else ""
+def shown_coordinates(system) -> tuple[list[int], str]:
+    """Indices of the coordinates a time history shows and their common unit: the observed one
+    and the other free DOFs in its unit (the plates' φ and ψ), at most :data:`MAX_SHOWN`."""
+    j0 = system.observed_index
+    unit = system.units.get(system.dofs[j0], "").strip("-")
+    same = [j for j in range(system.n) if system.free[j] and j != j0
+            and system.units.get(system.dofs[j], "").strip("-") == unit]
+    return ([j0] + same)[:MAX_SHOWN], unit
 
 
 def _g(value: float) -> str:
