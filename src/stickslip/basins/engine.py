@@ -14,6 +14,7 @@ journal for the next run.
 
 from __future__ import annotations
 
+import json
 import math
 import time
 from pathlib import Path
@@ -62,6 +63,11 @@ def evaluate_batch(task):
             cycles.append(o.cycle)
         rows.append(o.to_row())
     return indices, np.array(rows)
+
+
+def _state_units(model) -> dict:
+    """The unit of each state and parameter of ``model`` (where it says), for the figures' axes."""
+    return {**model.units, **dict(zip(model.state_names, model.state_units))}
 
 
 def _models(model, param, values):
@@ -184,7 +190,8 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     journal = Journal(out, spec, overwrite=overwrite)
     timing = {"executor": executor, "workers": workers, "interrupted": False}
     try:
-        result = _run(spec, ctxs, info_models, initial, journal, out, timing, executor=executor, workers=workers,
+        result = _run(spec, ctxs, info_models, initial, journal, out, timing, _state_units(model), executor=executor,
+                      workers=workers,
                       address=address, batch_size=batch_size, progress=progress,
                       snapshot_interval=snapshot_interval)
         if timing["interrupted"] or keep_journal:
@@ -201,7 +208,7 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     return result
 
 
-def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Journal, out: Path, timing: dict, *,
+def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Journal, out: Path, timing: dict, units, *,
          executor, workers, address, batch_size, progress, snapshot_interval) -> BasinResult:
     """Classify the states the journal lacks, journaling each batch, and write the result."""
     N, n = spec.n_states, spec.n_dofs
@@ -226,7 +233,8 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
     def dataset(extra=None):
         idx = np.concatenate(store["idx"])
         rws = np.concatenate(store["rows"]) if idx.size else np.empty((0, spec.row_width))
-        return assemble(spec, info_models, initial, idx, rws, attrs={"executor": timing["executor"], **(extra or {})})
+        return assemble(spec, info_models, initial, idx, rws,
+                        attrs={"executor": timing["executor"], "state_units": json.dumps(units), **(extra or {})})
 
     bar = task_id = None
     if progress:

@@ -297,10 +297,8 @@ class Trajectory(Plottable):
                   "contact": ("contact", list(system.contact_names)),
                   "component": ("component", ["t1", "t2"])}
         data = {}
-        for j, name in enumerate(system.state_names):
+        for j, (name, unit) in enumerate(zip(system.state_names, system.state_units)):
             dof = system.dofs[j % system.n]
-            unit = system.units.get(dof, "")
-            unit = unit if j < system.n else (f"{unit}/s" if unit and unit != "-" else unit)
             data[name] = ("time", self.states[:, j], {"units": unit, "long_name": ("" if j < system.n else "rate of ") + dof})
         nc = system.n_contacts
         data["mode"] = ("time", self.mode, {

@@ -341,6 +341,12 @@ class FrictionModel:
         return self.dofs + tuple("d" + d for d in self.dofs)
 
     @property
+    def state_units(self) -> tuple[str, ...]:
+        """Units of the 2n states ("" where the model does not say): a dof's unit, then its unit per second."""
+        units = tuple(self.units.get(d, "") for d in self.dofs)
+        return units + tuple(f"{u}/s" if u and u != "-" else u for u in units)
+
+    @property
     def contact_names(self) -> tuple[str, ...]:
         """Each contact's name, ``contact<c>`` where it has none."""
         return tuple(c.name or f"contact{i}" for i, c in enumerate(self.contacts))

@@ -49,7 +49,6 @@ from ..journal import FORMAT as JOURNAL_FORMAT
 from ..journal import LineJournal, journal_path
 from ..model.library import describe_system, system_from_description
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
-from .layout import state_units
 from .models import model_attrs
 from .section import Section
 from .shooting import PeriodicOrbit
@@ -285,7 +284,7 @@ def branch_dataset(branch):
         "value": ("point", branch.values, {"long_name": f"continuation parameter {branch.param}", "units": unit}),
         "period": ("point", branch.periods, {"long_name": "period", "units": "s"}),
         "state_on_section": (("point", "state"), branch.states, {"long_name": "state on the Poincaré section",
-                                                                 "units": " ".join(state_units(branch.system))}),
+                                                                 "units": " ".join(branch.system.state_units)}),
         "multiplier_real": (("point", "multiplier"), branch.multipliers.real, {"long_name": "Floquet multiplier, real part", "units": "1"}),
         "multiplier_imag": (("point", "multiplier"), branch.multipliers.imag, {"long_name": "Floquet multiplier, imaginary part", "units": "1"}),
         "stable": ("point", branch.stable.astype(np.int8), {"long_name": "1 if every non-trivial multiplier is inside the unit circle"}),
@@ -293,7 +292,8 @@ def branch_dataset(branch):
         "stick_phases": ("point", branch.stick_phases.astype(np.int16), {"long_name": "stick phases per period"}),
         "stick_time": ("point", branch.stick_time, {"long_name": "time in stick per period", "units": "s"}),
         "amplitude": ("point", branch.amplitude, {"long_name": f"peak-to-peak range of {observed} over one period",
-                                                  "units": branch.system.units.get(observed, "")}),
+                                                  "units": branch.system.units.get(observed, ""),
+                                                  "coordinate": observed}),
         "arclength": ("point", branch.arclength, {"long_name": "scaled pseudo-arclength", "units": "1"}),
         "residual": ("point", branch.residuals, {"long_name": "scaled shooting residual", "units": "1"}),
         "iterations": ("point", branch.iterations.astype(np.int16), {"long_name": "corrector iterations"}),

@@ -15,19 +15,13 @@ from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from ..stability.equilibrium import steady_sliding
 
-__all__ = ["free_states", "state_units", "equilibrium_state", "stick_projected", "resting_contacts"]
+__all__ = ["free_states", "equilibrium_state", "stick_projected", "resting_contacts"]
 
 
 def free_states(system) -> np.ndarray:
     """Indices (2 n_free,) of the free states of ``system``: positions, then velocities."""
     dofs = np.flatnonzero(system.free)
     return np.concatenate([dofs, dofs + system.n])
-
-
-def state_units(system) -> tuple[str, ...]:
-    """Units of the 2n states ("" where the model does not say): a dof's unit, then its unit per second."""
-    units = tuple(system.units.get(d, "") for d in system.dofs)
-    return units + tuple(f"{u}/s" if u and u != "-" else u for u in units)
 
 
 def equilibrium_state(system) -> np.ndarray:

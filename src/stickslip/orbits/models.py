@@ -68,10 +68,12 @@ def with_parameter(system: FrictionModel, name: str, value: float) -> FrictionMo
 
 def model_attrs(system: FrictionModel) -> dict:
     """NetCDF attributes naming the model: ``model`` (the plates' variant or the model's name), its
-    description (rebuilds it: :func:`stickslip.model.library.system_from_description`), its parameters."""
+    description (rebuilds it: :func:`stickslip.model.library.system_from_description`), its
+    parameters, the ones that name a point (``headline``) and its ``observed`` coordinate."""
     values = {k: v for k, v in system.parameters.items() if isinstance(v, (int, float, str))}
     attrs = {"model": ModelResult.label(system), "system": json.dumps(describe_system(system), default=str),
-             "parameters": json.dumps(values)}
+             "parameters": json.dumps(values), "headline": json.dumps(list(system.headline)),
+             "observed": system.dofs[system.observed_index]}
     attrs.update(parameter_attrs({k: v for k, v in values.items() if not isinstance(v, bool)}))
     return attrs
 

@@ -32,7 +32,7 @@ from ..integrate.driver import simulate
 from ..integrate.initial import initial_state
 from ..integrate.result import Trajectory
 from ..model.system_model import FrictionModel
-from .layout import free_states, state_units
+from .layout import free_states
 from .models import ModelResult, model_attrs, resolve
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
                       check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
@@ -114,7 +114,7 @@ class PeriodicOrbit(ModelResult, Multipliers):
 
         data = {
             "state_on_section": ("state", self.state, {"long_name": "state on the Poincaré section",
-                                                       "units": " ".join(state_units(self.system))}),
+                                                       "units": " ".join(self.system.state_units)}),
             **multiplier_variables(self.multipliers, "multiplier"),
             "monodromy": (("free_state", "free_state_0"), self.monodromy,
                           {"long_name": f"monodromy matrix d s(T) / d s(0) on the free states ({self.options.get('monodromy', 'finite-difference')})",

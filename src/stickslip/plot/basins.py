@@ -34,6 +34,12 @@ def _one(result, ax, param_index: int, figsize):
     return ds, (agg_figure(figsize).add_subplot() if ax is None else ax)
 
 
+def _with_unit(name: str, units: dict) -> str:
+    """An axis label: the name with its unit from ``units`` (the model's), else the plates' parameter units."""
+    unit = units.get(name, "").strip("-")
+    return f"{name} [{unit}]" if unit else param_label(name)
+
+
 def label_colors(names) -> list[str]:
     """One colour per attractor label, the same label always the same colour."""
     out = []
@@ -98,8 +104,9 @@ def plot_basins(result, ax=None, *, param_index: int = 0, legend: bool = True):
         for code, (name, color) in enumerate(zip(names, colors)):
             sel = label == code
             ax.scatter(xs[sel], ys[sel], s=size, c=color, lw=0, label=name)
-    ax.set_xlabel(axes[0])
-    ax.set_ylabel(axes[1] if len(axes) > 1 else "")
+    units = json.loads(ds.attrs.get("state_units", "{}"))
+    ax.set_xlabel(_with_unit(axes[0], units))
+    ax.set_ylabel(_with_unit(axes[1], units) if len(axes) > 1 else "")
     if legend and names:
         present = [i for i in range(len(names)) if np.any(label == i)]
         ax.legend(handles=[Patch(color=colors[i], label=names[i]) for i in present], fontsize="small", loc="best")
@@ -137,7 +144,7 @@ def plot_parameter_study(result, ax=None):
         ax.plot(x, p, "o-", color=color, label=name, ms=4)
         ax.fill_between(x, p - se, p + se, color=color, alpha=0.25, lw=0)
     path = ds.attrs.get("param", "")
-    ax.set_xlabel(param_label(path))
+    ax.set_xlabel(_with_unit(path, json.loads(ds.attrs.get("state_units", "{}"))))
     ax.set_ylabel("basin stability (fraction of states)")
     ax.set_ylim(-0.02, 1.02)
     ax.legend(fontsize="small")

@@ -7,11 +7,12 @@ read back by :func:`~stickslip.orbits.continuation.load_branch`) or a
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 
-from ._common import SYMBOLS, param_label, param_text, save_figure
+from ._common import param_label, param_text, save_figure, symbol
 from .regions import REGION_STYLE, plot_regions
 
 __all__ = ["plot_branch", "save_branch_figure", "plot_region_edge", "SPECIAL_MARKERS"]
@@ -27,26 +28,31 @@ SPECIAL_MARKERS = {
 }
 
 
-_YLABELS = {"period": "period T [s]", "amplitude": "peak-to-peak φ [rad]", "stick_time": "time in stick per period [s]"}
+_YLABELS = {"period": "period T [s]", "amplitude": "peak-to-peak {coordinate}{unit}",
+            "stick_time": "time in stick per period [s]"}
 
 
 def _branch_data(branch) -> dict:
     """Arrays of a Branch or of its dataset, in one form."""
     if hasattr(branch, "to_xarray") and hasattr(branch, "values"):
+        system = branch.system
+        observed = system.dofs[system.observed_index]
         sp = branch.special
         return {"param": branch.param, "value": branch.values, "period": branch.periods,
                 "amplitude": branch.amplitude, "stick_time": branch.stick_time, "stable": branch.stable.astype(bool),
                 "special": [(p.kind, p.index, p.value) for p in sp], "model": branch.model,
-                "N": getattr(branch.params, "N", None), "Omega": getattr(branch.params, "Omega", None),
-                "stop_reason": branch.stop_reason}
+                "fixed": [(k, system.parameters[k]) for k in system.headline], "coordinate": observed,
+                "unit": system.units.get(observed, ""), "stop_reason": branch.stop_reason}
     ds = branch
+    headline = json.loads(ds.attrs["headline"]) if "headline" in ds.attrs else ["N", "Omega"]
     return {"param": ds.attrs["param"], "value": ds["value"].values, "period": ds["period"].values,
             "amplitude": ds["amplitude"].values, "stick_time": ds["stick_time"].values,
             "stable": ds["stable"].values.astype(bool),
             "special": [(str(k), int(i), float(v)) for k, i, v in zip(ds["special_kind"].values, ds["special_index"].values,
                                                                        ds["special_value"].values)],
-            "model": ds.attrs["model"], "N": ds.attrs.get("param_N"), "Omega": ds.attrs.get("param_Omega"),
-            "stop_reason": ds.attrs.get("stop_reason")}
+            "model": ds.attrs["model"], "fixed": [(k, ds.attrs.get(f"param_{k}")) for k in headline],
+            "coordinate": ds["amplitude"].attrs.get("coordinate", ds.attrs.get("observed", "phi")),
+            "unit": ds["amplitude"].attrs.get("units", ""), "stop_reason": ds.attrs.get("stop_reason")}
 
 
 def _stability_segments(x, y, stable):
@@ -72,7 +78,8 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True, colo
     branch : Branch or xarray.Dataset
     ax : matplotlib Axes, optional
     y : {"period", "amplitude", "stick_time"}
-        Period [s], peak-to-peak φ [rad] or time in stick per period [s].
+        Period [s], peak-to-peak of the model's observed coordinate (the plates' φ [rad]) or
+        time in stick per period [s].
     legend : bool
     color : str
         Colour of the branch.
@@ -108,7 +115,8 @@ def plot_branch(branch, ax=None, *, y: str = "period", legend: bool = True, colo
             handles.append(Line2D([], [], marker=marker, color=colour, ls="", mfc="none", mew=1.8, label=kind))
             seen.add(kind)
     ax.set_xlabel(param_label(d["param"]))
-    ax.set_ylabel(_YLABELS[y])
+    unit = d["unit"].strip("-")
+    ax.set_ylabel(_YLABELS[y].format(coordinate=symbol(d["coordinate"]), unit=f" [{unit}]" if unit else ""))
     ax.grid(alpha=0.3)
     if legend:
         ax.legend(handles=handles, fontsize=7, loc="best")
@@ -124,11 +132,10 @@ def save_branch_figure(branch, path, *, dpi: int = 110) -> Path:
     plot_branch(branch, axes[0], y="period")
     plot_branch(branch, axes[1], y="amplitude", legend=False)
     plot_branch(branch, axes[2], y="stick_time", legend=False)
-    fixed = ", ".join(param_text(k, v) for k, v in (("N", d["N"]), ("Omega", d["Omega"]))
-                      if k != d["param"] and v is not None)
-    ends = f"; stopped: {d['stop_reason']}" if d.get("stop_reason") else ""
-    fig.suptitle(f"Branch of periodic orbits in {SYMBOLS.get(d['param'], d['param'])} (model {d['model']}; {fixed}"
-                 f"{ends})", fontsize=10)
+    fixed = ", ".join(param_text(k, v) for k, v in d["fixed"] if k != d["param"] and v is not None)
+    about = "; ".join(part for part in (f"model {d['model']}", fixed,
+                                        f"stopped: {d['stop_reason']}" if d.get("stop_reason") else "") if part)
+    fig.suptitle(f"Branch of periodic orbits in {symbol(d['param'])} ({about})", fontsize=10)
     path = Path(path)
     save_figure(fig, path, dpi=dpi)
     plt.close(fig)

@@ -151,14 +151,6 @@ def flat_hyperslabs(shape, start: int, stop: int) -> list:
     return out
 
 
-def _state_unit(system, state: str) -> str:
-    """Unit of a state of ``system`` (a dof's, or per second for a rate ``d<dof>``)."""
-    if state in system.dofs:
-        return system.units.get(state, "")
-    unit = system.units.get(state[1:], "")
-    return f"{unit}/s" if unit and unit != "-" else unit
-
-
 def _coords(spec: SweepSpec):
     system = spec_system(spec)
     coords = {}
@@ -169,7 +161,8 @@ def _coords(spec: SweepSpec):
                 attrs["description"] = json.dumps({v: start_description(system, v) for v in values})
             coords[name] = (name, np.array(values, dtype=object), attrs)
         else:
-            unit = _state_unit(system, name[8:]) if name.startswith("perturb_") else system.units.get(name, "")
+            unit = dict(zip(system.state_names, system.state_units))[name[8:]] if name.startswith("perturb_") \
+                else system.units.get(name, "")
             coords[name] = (name, np.array(values, dtype=float), {"units": unit, "long_name": name})
     return coords
 
