@@ -27,6 +27,7 @@ them without importing the module that raises it.
 ``FileFormatError``      a file that is not a stickslip result of a readable format
 ``LockError``            another process writes the same output
 ``WriteError``           a full disk or file size limit
+``MemoryLimitError``     work whose estimated memory exceeds what is available (``stickslip.memory``)
 =======================  ======================================================================
 """
 
@@ -34,7 +35,8 @@ from __future__ import annotations
 
 __all__ = ["StickSlipError", "ModelError", "ModelFileError", "ParameterError", "FrictionLawError", "VariantError",
            "KinematicsError", "ExpressionError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
-           "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError"]
+           "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError",
+           "MemoryLimitError"]
 
 
 class StickSlipError(Exception):
@@ -125,3 +127,8 @@ class LockError(StickSlipError, RuntimeError):
 
 class WriteError(StickSlipError, RuntimeError):
     """A file could not be written because the disk (or the file size limit) is full."""
+
+
+class MemoryLimitError(StickSlipError, MemoryError):
+    """Work refused before it allocates: its estimated memory exceeds what is available (the
+    message gives the estimate and a setting that fits)."""

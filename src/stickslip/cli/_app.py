@@ -4,9 +4,17 @@ Every command runs inside :class:`_Application`, which turns what the user can f
 on stderr and exit code 2: option values the parser refuses, any
 :class:`~stickslip.errors.StickSlipError` (the library's and this package's :class:`CLIError`),
 and operating-system errors with a path (read-only, missing or wrong kind of file or folder, full
-disk). Ctrl-C prints one line saying what was kept and exits with 130. Anything else is a bug
-and keeps its traceback. Text is printed as written: the consoles read no rich markup or emoji
-codes, and help texts are escaped from markup once, here.
+disk). Anything else is a bug and keeps its traceback. Text is printed as written: the consoles
+read no rich markup or emoji codes, and help texts are escaped from markup once, here; a console
+that cannot encode a character (``PYTHONIOENCODING=ascii``) prints ``?`` for it.
+
+Ctrl-C has one path too: whenever it lands (start-up, compilation, a run, a write, a figure),
+the command ends with exit code 130 and one line saying what is on disk at that moment. A
+command registers each file it writes (:func:`keeps`, with what the file holds); the line names
+those that were written (replaced or created) since, else the command's note
+(:func:`on_interrupt`, for work kept in a journal), else ``nothing was written``. A Ctrl-C while
+the package and the commands are imported and the command line is parsed is held
+(:mod:`stickslip._startup`) and reported the same way.
 """
 
 from __future__ import annotations
@@ -14,9 +22,11 @@ from __future__ import annotations
 import errno
 import math
 import os
+import re
 import sys
 import warnings
 from pathlib import Path
+from typing import Callable
 
 import typer
 from rich.console import Console
@@ -24,10 +34,10 @@ from rich.markup import escape
 from rich.text import Text
 from typer.core import TyperGroup
 
+from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
-from ..integrate.driver import MAX_SAMPLES
-from ..integrate.interrupt import on_ctrl_c
+from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.parameters import Parameters
 
@@ -52,10 +62,6 @@ OVERWRITE_FOLDER_HELP = "Write into a folder that is not empty, replacing files 
 RESTART_HELP = ("Start over: replace the output, its journal and its figure (of this or another run) instead of "
                 "resuming or refusing.")
 
-#: Peak memory of `stickslip simulate` per kept sample [bytes]: the run's arrays, the steady-state
-#: analysis, the NetCDF dataset and the figure (measured: about 290 B, from 1e5 to 5e6 samples).
-SAMPLE_BYTES = 300
-
 #: The click base class of usage errors (typer re-exports only its subclass BadParameter; recent
 #: typer versions carry their own copy of click).
 _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
@@ -71,9 +77,30 @@ class CLIError(StickSlipError, ValueError):
     must not be replaced. The message names the option and the fix."""
 
 
+#: A run of this many digits or more in a message is a number typed or computed beyond any
+#: meaning (a 300-digit --n); it is shown with 3 significant digits. Paths keep theirs.
+_LONG_DIGITS = 16
+_LONG_NUMBER = re.compile(r"(?<![\w/.\\])(\d{%d,})(?![\w/\\]|\.\w)" % _LONG_DIGITS)
+
+
+def _short_number(match: re.Match) -> str:
+    """``1.23e+299`` for a long run of digits (not through float, which ends at 1e308)."""
+    digits = match.group(1).lstrip("0") or "0"
+    exponent = len(digits) - 1
+    mantissa = round(int(digits[:4]) / 10 ** (min(len(digits), 4) - 1), 2)
+    if mantissa >= 10:  # 9.999… rounds up to the next power of ten
+        mantissa, exponent = mantissa / 10, exponent + 1
+    return f"{mantissa:g}e+{exponent}"
+
+
+def shorten_numbers(text: str) -> str:
+    """``text`` with every number of :data:`_LONG_DIGITS` digits or more shown as ``1.23e+299``."""
+    return _LONG_NUMBER.sub(_short_number, text)
+
+
 def error_line(message: str) -> None:
-    """Print ``error: message`` as one line on stderr, exactly as written."""
-    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(str(message).split())))
+    """Print ``error: message`` as one line on stderr, exactly as written (long numbers shortened)."""
+    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(shorten_numbers(str(message)).split())))
 
 
 def warning_line(message: str) -> None:
@@ -86,13 +113,85 @@ def note_line(message: str) -> None:
     err_console.print(Text(" ".join(str(message).split()), style="dim"))
 
 
-#: What a Ctrl-C leaves behind, as set by the running command (:func:`on_interrupt`).
-_interrupt_note = {"text": "nothing was written"}
+#: What the running command has on disk for the line a Ctrl-C prints: the files it registered
+#: (path, its state when registered, what it holds) and its note.
+_kept: dict = {"files": [], "note": None, "reported": False}
 
 
-def on_interrupt(text: str) -> None:
-    """Say what an interruption from now on keeps (printed after ``interrupted:``)."""
-    _interrupt_note["text"] = text
+def _file_state(path: Path):
+    """What tells a file written since apart: (inode, size, modification time), None if absent."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
+def keeps(path, holds: str | Callable[[Path], str]) -> None:
+    """Register a file the command writes: if a Ctrl-C ends the command after the file was written
+    (created or replaced since this call), the interruption line says what it ``holds`` (a text
+    such as ``"the orbit is in orbit.nc"``, or a function of the path that reads it from the file)."""
+    path = Path(path)
+    _kept["files"].append((path, _file_state(path), holds))
+
+
+def resumable_holds(what: str) -> Callable[[Path], str]:
+    """What a resumable command's output holds, read from its ``complete`` attribute when it was
+    written: the finished ``what``, or part of it with the journal that keeps the rest."""
+    def holds(path: Path) -> str:
+        import h5py  # the attributes alone, without opening the dataset (h5py is already loaded by then)
+
+        with h5py.File(path, "r") as fh:
+            complete = int(fh.attrs.get("complete", 1))
+        if complete:
+            return f"the finished {what} is in {path}"
+        return (f"{path} holds part of the {what} and {journal_of(path)} the finished work; run the same command "
+                "again to resume")
+    return holds
+
+
+def on_interrupt(text: str, path=None) -> None:
+    """Say what an interruption keeps when no registered file was written (printed after
+    ``interrupted:``); with ``path``, only if that file or folder exists then (a journal)."""
+    _kept["note"] = (text, None if path is None else Path(path))
+
+
+def _reset_kept() -> None:
+    _kept.update(files=[], note=None, reported=False)
+
+
+def _on_disk() -> str:
+    """What the command has on disk now (see :func:`keeps`, :func:`on_interrupt`)."""
+    written = []
+    for path, before, holds in _kept["files"]:
+        now = _file_state(path)
+        if now is not None and now != before:
+            try:
+                written.append(holds(path) if callable(holds) else holds)
+            except Exception:  # the file is there but cannot be read: say only that  # noqa: BLE001
+                written.append(f"{path} was written")
+    if written:
+        return "; ".join(written)
+    note = _kept["note"]
+    if note is not None and (note[1] is None or note[1].exists()):
+        return note[0]
+    return "nothing was written"
+
+
+def report_interrupt() -> None:
+    """Print the one ``interrupted: ...`` line (once per command), from what is on disk now."""
+    if not _kept["reported"]:
+        _kept["reported"] = True
+        err_console.print(Text(f"interrupted: {_on_disk()}"))
+
+
+def _interrupted_by_ctrl_c(exc: BaseException) -> bool:
+    """A SystemError that a Ctrl-C caused: raised while a compiled kernel returned its result."""
+    while exc is not None:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _path_error_message(exc: OSError) -> str:
@@ -127,9 +226,15 @@ class _Application(TyperGroup):
         _escape_help(self)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        _reset_kept()
+        _use_replacement_characters()
         try:
+            if _startup.release(raise_pending=False):  # a Ctrl-C held since the imports
+                raise KeyboardInterrupt
             code = super().main(args=args, prog_name=prog_name, complete_var=complete_var, standalone_mode=False,
                                 **extra)
+        except KeyboardInterrupt:  # before the command ran (the parser's own turns into exit code 130)
+            code = 130
         except _ClickException as exc:  # the parser's: unknown, missing or mistyped options
             code = exc.exit_code
             if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help
@@ -139,13 +244,16 @@ class _Application(TyperGroup):
             error_line("aborted")
             code = 1
         code = code if isinstance(code, int) else 0
+        if code == 130:
+            report_interrupt()  # unless the command has
         if not standalone_mode:
             return code
         sys.exit(code)
 
     def invoke(self, ctx):
-        on_interrupt("nothing was written")
+        forget_ctrl_c()
         try:
+            _check_environment()
             # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
             # `simulate` keeps its one interrupted run instead
             with warnings.catch_warnings(), on_ctrl_c(partial=False):
@@ -158,12 +266,53 @@ class _Application(TyperGroup):
                 raise
             error_line(_path_error_message(exc))
         except KeyboardInterrupt:
-            err_console.print(Text(f"interrupted: {_interrupt_note['text']}"))
+            report_interrupt()
+            raise typer.Exit(130) from None
+        except SystemError as exc:
+            if not _interrupted_by_ctrl_c(exc):
+                raise
+            report_interrupt()
             raise typer.Exit(130) from None
         raise typer.Exit(2)
 
 
-app = typer.Typer(
+class _Typer(typer.Typer):
+    """The typer application whose start-up (building the command tree, until
+    :meth:`_Application.main` runs) holds Ctrl-C as the imports before it did (:mod:`stickslip._startup`)."""
+
+    def __call__(self, *args, **kwargs):
+        _startup.hold()
+        try:
+            return super().__call__(*args, **kwargs)
+        finally:
+            _startup.release(raise_pending=False)  # main has released it, unless it never ran
+
+
+def _use_replacement_characters() -> None:
+    """Let stdout and stderr print ``?`` for characters their encoding lacks (``PYTHONIOENCODING=ascii``,
+    a C locale) instead of failing on the first ``–`` or ``φ``."""
+    for stream in (sys.stdout, sys.stderr):
+        encoding = getattr(stream, "encoding", None) or "utf-8"
+        try:
+            "–≈φ│".encode(encoding)
+        except (UnicodeEncodeError, LookupError):
+            try:
+                stream.reconfigure(errors="replace")
+            except (AttributeError, ValueError):  # not a text stream of the interpreter's (tests capture it)
+                pass
+
+
+def _check_environment() -> None:
+    """Refuse an environment the kernels cannot run in; say what :mod:`stickslip._startup` changed."""
+    if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
+        raise CLIError(f"NUMBA_DISABLE_JIT={os.environ['NUMBA_DISABLE_JIT']}: stickslip's kernels must be compiled "
+                       "(interpreted, a run would take hours and some kernels cannot run at all); unset "
+                       "NUMBA_DISABLE_JIT or set it to 0")
+    for note in _startup.notes:
+        warning_line(note)
+
+
+app = _Typer(
     name="stickslip",
     cls=_Application,
     help="Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact.",
@@ -366,69 +515,6 @@ def check_finite(flags: dict) -> None:
     for flag, value in flags.items():
         if value is not None and not math.isfinite(value):
             raise CLIError(f"{flag} must be a finite number, got {value}")
-
-
-# ----------------------------------------------------------------------------- memory
-def available_memory() -> float | None:
-    """Memory the system can give this process now [bytes] (``MemAvailable``), else the
-    physical memory, else None when neither can be read."""
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
-    try:
-        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
-def check_memory(need: float, what: str, fix: str) -> None:
-    """Refuse work that needs ``need`` bytes when less memory is available.
-
-    Parameters
-    ----------
-    need : float
-        Estimated peak memory [bytes] (may be inf).
-    what : str
-        What needs it, for the message (``"a 1000 × 1000 map"``).
-    fix : str
-        The options that lower it (``"lower --N-points"``).
-    """
-    memory = available_memory()
-    if memory is not None and not need <= memory:
-        raise CLIError(f"{what} needs ≈ {need / 1e9:.3g} GB, more than the {memory / 1e9:.3g} GB of memory "
-                       f"available; {fix}")
-
-
-def check_samples(duration: float, sample_rate: float, *, time_flag: str = "--t-end",
-                  rate_flag: str | None = "--sample-rate") -> None:
-    """Refuse a run whose samples would not fit: more than the library keeps per run
-    (``MAX_SAMPLES``) or more memory than is available (:data:`SAMPLE_BYTES` each).
-
-    Parameters
-    ----------
-    duration : float
-        Simulated time [s] (finite, > 0).
-    sample_rate : float
-        Samples per second [Hz] (finite, > 0).
-    time_flag, rate_flag : str
-        The options that set them, named in the message (``rate_flag`` None: not an option).
-    """
-    n = duration * sample_rate + 1.0
-    limit, what = float(MAX_SAMPLES), f"the {MAX_SAMPLES} samples a run may keep"
-    memory = available_memory()
-    if memory is not None and memory / SAMPLE_BYTES < limit:
-        limit, what = memory / SAMPLE_BYTES, f"the {memory / 1e9:.3g} GB of memory available"
-    if n <= limit:
-        return
-    fix = f"shorten {time_flag}"
-    if rate_flag is not None:
-        fix = f"lower {rate_flag} to at most {(limit - 1.0) / duration:.3g} Hz or " + fix
-    raise CLIError(f"{time_flag} {duration:g} s at {sample_rate:g} Hz keeps {n:.3g} samples "
-                   f"(≈ {n * SAMPLE_BYTES / 1e9:.3g} GB), more than {what}; {fix}")
 
 
 # ----------------------------------------------------------------------------- outputs

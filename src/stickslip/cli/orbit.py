@@ -20,12 +20,13 @@ from rich.text import Text
 
 from ..analysis.signal import stick_time
 from ..files import atomic_write
+from ..integrate.interrupt import finish_first
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
-from ..orbits.continuation import START_RATE, start_run
+from ..orbits.continuation import start_run
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
-                   check_choice, check_outputs, check_positive, check_samples, console)
+                   check_choice, check_outputs, check_positive, console, keeps)
 from .simulate import _parse_ic
 
 #: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
@@ -72,6 +73,15 @@ def parse_section(text: str):
     return text
 
 
+def _write(*, ds_of, out: Path, holds: str) -> None:
+    """Write the dataset ``ds_of()`` to ``out`` whole; a Ctrl-C meanwhile lets it finish, then stops."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    keeps(out, holds)
+    with finish_first():
+        ds = ds_of()
+        atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+
 def _finite_or_none(x: float):
     """A float for JSON, ``None`` where it is not finite (JSON has no ±inf or NaN)."""
     x = float(x)
@@ -106,7 +116,6 @@ def orbit_command(
     start = parse_start(ic)
     check_positive({"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
     check_below_one({"--tol": tol})
-    check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
     check_choice("--monodromy", monodromy, _METHODS)
     if period_multiplicity < 1:
         raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
@@ -121,11 +130,10 @@ def orbit_command(
     one_period = orbit.trajectory(1.0)
     stick = stick_time(0.0, orbit.period, int(one_period.mode[0]), one_period.transitions.time,
                        one_period.transitions.kind)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    ds = orbit.to_xarray()
-    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    _write(ds_of=orbit.to_xarray, out=out, holds=f"the orbit is in {out}")
     figure = None
     if not no_plot:
+        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
         figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
     others = np.abs(orbit.nontrivial_multipliers)
     summary = {
@@ -184,11 +192,10 @@ def lyapunov_command(
     start = default_start(system) if start is None else start
     spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
                                  method=method)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    ds = spectrum.to_xarray()
-    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    _write(ds_of=spectrum.to_xarray, out=out, holds=f"the spectrum is in {out}")
     figure = None
     if not no_plot:
+        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
         figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {

@@ -25,6 +25,7 @@ from scipy import optimize
 from .._version import __version__
 from ..errors import ParameterError
 from ..files import atomic_write, format_name, open_ours
+from ..memory import check_memory, largest_count, map_point_bytes
 from ..model.library import describe_system, resolve_system, system_from_description
 from ..model.library.two_plates import NAME
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
@@ -80,6 +81,21 @@ def parse_family(text: str | None) -> tuple[str, list] | None:
         return name, [float(v) for v in items]
     except ValueError:
         raise ValueError(f"family {text!r}: the values of {name} must be numbers") from None
+
+
+def _check_memory(system, na: int, nb: int, members: int, every_point: bool = False) -> None:
+    """Refuse a map whose grid would not fit in memory, before it is built: per point and member
+    :func:`stickslip.memory.map_point_bytes`, per axis value (every point when the axes are not
+    separable) a row of the model's data, and the Jacobians of one compiled call with their
+    eigenvalue copy."""
+    row = 8.0 * _row(system).size
+    k = 2 * system.n
+    per = map_point_bytes(members) + (members * row if every_point else 0.0)
+    fixed = members * (na + nb) * row + 2.0 * CHUNK_POINTS * 8 * k * k
+    side = lambda memory: math.isqrt(largest_count(per, memory, fixed))  # noqa: E731 - a square grid that fits
+    check_memory(float(na) * nb * per + fixed,
+                 f"a stability map of {na:.3g} × {nb:.3g} points and {members} member(s) of model {system.name!r}",
+                 lambda memory: f"give at most {side(memory) ** 2:.3g} points, e.g. {side(memory)} values per axis")
 
 
 def _is_plates(system) -> bool:
@@ -185,6 +201,7 @@ class MapGrid:
             separable = np.array_equal(np.abs(corner - full) <= 1e-13 * np.maximum(np.abs(full), 1e-300),
                                        np.ones_like(full, dtype=bool))
         if not separable:
+            _check_memory(system, a.size, b.size, 1, every_point=True)
             rows_a = np.array([_row(system.replace(**{names[0]: float(x), names[1]: float(y)}))
                                for x in a for y in b])
             mask_b = np.zeros_like(mask_b)
@@ -513,6 +530,7 @@ def stability_map(
     if fam_name in axes:
         raise ValueError(f"family parameter {fam_name!r} is already an axis of the map; choose another parameter")
     name, values, systems = _members(system, fam)
+    _check_memory(system, N.size, Omega.size, len(systems))
     t0 = time.perf_counter()
     grids = [MapGrid.build(sy, axes, N, Omega) for sy in systems]
     mrp = np.stack([g.max_real_part() for g in grids])

@@ -14,8 +14,12 @@ import numpy as np
 
 from ..analysis.classify import KINDS
 from ..errors import FileFormatError, SweepError
+from ..integrate.driver import check_samples
+from ..memory import check_memory, format_bytes, grid_point_bytes, largest_count, sample_bytes
+from ..model.library import two_plates
+from ..model.parameters import Parameters
 from ..parallel import check_executor, check_workers, map_unordered
-from .spec import SweepSpec, evaluate_batch, warm_up
+from .spec import SweepSpec, evaluate_batch, spec_system, warm_up
 from .store import Journal, assemble, journal_dir, load_sweep
 
 __all__ = ["SweepResult", "sweep", "TARGET_BATCH_S"]
@@ -86,6 +90,21 @@ def _settle_attrs(spec: SweepSpec) -> dict:
                      settle_comment="each run extended from its final state in steps of t_end - t_from until "
                                     "settled or cap; settle_time per point, window t_end - t_from at its end")
     return attrs
+
+
+def _check_memory(spec: SweepSpec, runs: int) -> None:
+    """Refuse, before anything runs, a sweep whose runs or grid would not fit in memory: one run
+    (:func:`~stickslip.integrate.driver.check_samples`), then the grid's rows beside ``runs`` runs
+    held at once in this machine's workers."""
+    system = spec_system(spec)
+    if system is None:  # the plates: every variant has their six coordinates and one contact
+        system = two_plates(Parameters.from_dict(spec.params), spec.model)
+    run = check_samples(system, spec.t_end, spec.sample_rate) * sample_bytes(system.n, system.n_contacts)
+    points = math.prod(spec.shape)  # a Python int: no overflow for a huge grid
+    per = grid_point_bytes(spec.row_width)
+    check_memory(points * per + runs * run, f"a sweep of {points:.3g} points ({format_bytes(per)} each, beside {runs} "
+                 f"run(s) of {format_bytes(run)} at a time)",
+                 lambda memory: f"give at most {largest_count(per, memory, runs * run):.3g} points (fewer values)")
 
 
 def _progress_bar():
@@ -169,6 +188,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
     check_executor(executor)
     workers = check_workers(workers, address=address)
+    _check_memory(spec, 0 if address else 1 if executor == "serial" else workers)
     tmpdir = None
     if out is None:
         tmpdir = tempfile.TemporaryDirectory(prefix="stickslip-sweep-")
