@@ -114,6 +114,8 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
         raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
                        f"give a time in that range")
     start = t0 + 0.5 * (t_end - t0) if steady_from is None else steady_from
+    if not math.isfinite((t_end - t0) * sample_rate):  # samples beyond counting: the run refuses them itself
+        return
     first = math.ceil((start - t0) * sample_rate - 1e-9)
     n = math.floor((t_end - t0) * sample_rate + 1e-9) - first + 1
     if n < WINDOW_SAMPLES:

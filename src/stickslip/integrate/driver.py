@@ -55,7 +55,8 @@ def check_samples(system, duration: float, sample_rate: float, *, run: str = "th
     SimulationError, MemoryLimitError
         With the sample rate and the run length that fit (each on its own).
     """
-    count = math.floor(duration * sample_rate + 1e-9) + 1.0  # a float: a huge request stays a number
+    raw = duration * sample_rate
+    count = math.floor(raw + 1e-9) + 1.0 if math.isfinite(raw) else math.inf  # a float: a huge request stays a number
 
     def fits(limit: float) -> str:
         length = f"shorten {run} to at most {round_down((limit - 1.0) / sample_rate):.3g} s"
@@ -64,8 +65,9 @@ def check_samples(system, duration: float, sample_rate: float, *, run: str = "th
         return f"lower the sample rate to at most {round_down((limit - 1.0) / duration):.3g} Hz or {length}"
 
     if count > MAX_SAMPLES:
-        raise SimulationError(f"{run} of {duration:.6g} s at {sample_rate:.6g} Hz keeps {count:.3g} samples, more "
-                              f"than the {MAX_SAMPLES:.3g} a run may keep; {fits(MAX_SAMPLES)}")
+        raise SimulationError(f"{run} of {duration:.6g} s at {sample_rate:.6g} Hz keeps "
+                              f"{f'{count:.3g}' if math.isfinite(count) else 'more than 1e+308'} samples, more than the "
+                              f"{MAX_SAMPLES:.3g} a run may keep; {fits(MAX_SAMPLES)}")
     per = sample_bytes(system.n, system.n_contacts)
     check_memory(count * per, f"{run} ({count:.3g} samples of model {system.name!r}, {format_bytes(per)} each)",
                  lambda memory: fits(min(largest_count(per, memory), MAX_SAMPLES)))

@@ -102,9 +102,20 @@ def _check_memory(spec: SweepSpec, runs: int) -> None:
     run = check_samples(system, spec.t_end, spec.sample_rate) * sample_bytes(system.n, system.n_contacts)
     points = math.prod(spec.shape)  # a Python int: no overflow for a huge grid
     per = grid_point_bytes(spec.row_width)
+
+    def fits(memory: float) -> str:
+        fixes = []
+        if largest_count(per, memory, runs * run) >= 1:
+            fixes.append(f"give at most {largest_count(per, memory, runs * run):.3g} points (fewer values)")
+        others = spec.row_width - spec.n_peaks  # the numbers of a point besides its peaks
+        per_peak = grid_point_bytes(1) - grid_point_bytes(0)
+        peaks = largest_count(per_peak, (memory - runs * run) / points, grid_point_bytes(others))
+        if peaks < spec.n_peaks:
+            fixes.append(f"keep at most {peaks} peaks a point (n_peaks, --peaks)")
+        return " or ".join(fixes)
+
     check_memory(points * per + runs * run, f"a sweep of {points:.3g} points ({format_bytes(per)} each, beside {runs} "
-                 f"run(s) of {format_bytes(run)} at a time)",
-                 lambda memory: f"give at most {largest_count(per, memory, runs * run):.3g} points (fewer values)")
+                 f"run(s) of {format_bytes(run)} at a time)", fits)
 
 
 def _progress_bar():
