@@ -95,7 +95,8 @@ def _check_memory(system, na: int, nb: int, members: int, every_point: bool = Fa
     side = lambda memory: math.isqrt(largest_count(per, memory, fixed))  # noqa: E731 - a square grid that fits
     check_memory(float(na) * nb * per + fixed,
                  f"a stability map of {na:.3g} × {nb:.3g} points and {members} member(s) of model {system.name!r}",
-                 lambda memory: f"give at most {side(memory) ** 2:.3g} points, e.g. {side(memory)} values per axis")
+                 lambda memory: f"give at most {side(memory) ** 2:.3g} points, e.g. {side(memory)} values per axis"
+                 if side(memory) >= 2 else f"free memory: its fixed arrays alone take {fixed / 1e6:.3g} MB")
 
 
 def _is_plates(system) -> bool:
