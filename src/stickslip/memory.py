@@ -7,10 +7,11 @@ a setting that fits, computed from them. The library functions check (``simulate
 ``basin_stability`` and the states of a study, ``sweep``, ``stability_map``, the Lyapunov
 functions), so a caller, the command line included, checks nothing again.
 
-The estimates are per item (a kept sample of a run, a state of a basin study, a grid point of a
-sweep or a stability map, a running estimate of a Lyapunov spectrum) and were measured as the
-growth of the peak resident memory between two sizes of the same computation (the numbers are
-beside each constant). They are upper bounds of the arrays that grow; the process's fixed
+The estimates are per item: a kept sample of a run, a state and a parameter value of a basin
+study (these three measured as the growth of the peak resident memory between two sizes of the
+same computation; the numbers are beside each constant), a grid point of a sweep or a stability
+map and a running estimate of a Lyapunov average (counted from the arrays that hold them, with
+the copies the measured ones showed). They cover the arrays that grow; the process's fixed
 memory (libraries, compiled kernels) is already resident when the check runs and so is not
 counted in what is available.
 
@@ -29,7 +30,7 @@ from typing import Callable
 from .errors import MemoryLimitError
 
 __all__ = ["available_memory", "check_memory", "largest_count", "sample_bytes", "state_bytes", "param_bytes",
-           "grid_point_bytes", "map_point_bytes", "estimate_bytes", "format_bytes"]
+           "grid_point_bytes", "map_point_bytes", "average_bytes", "format_bytes"]
 
 #: Control-group memory limits (v2, then v1) that cap what the kernel gives this process.
 _CGROUP_LIMITS = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
@@ -116,11 +117,6 @@ def largest_count(per_item: float, memory: float, fixed: float = 0.0) -> int:
     return max(int((memory - fixed) // per_item), 0)
 
 
-def estimate_bytes(count: float, per_item: float, fixed: float = 0.0) -> float:
-    """``count`` items of ``per_item`` bytes and ``fixed`` bytes, as a float (counts may be huge)."""
-    return float(count) * float(per_item) + float(fixed)
-
-
 # ----------------------------------------------------------------------------- per item
 #: Bytes per kept sample of a run beyond its recorded arrays: the contiguous copy of the states
 #: taken by the derived series, the sample times and a dozen float series of the analysis and
@@ -188,3 +184,14 @@ _MAP_POINT = 24
 def map_point_bytes(members: int) -> float:
     """Peak bytes per (first, second) grid point of a stability map of ``members`` family members."""
     return float(_MAP_POINT * max(int(members), 1))
+
+
+#: Bytes per running estimate of a Lyapunov average, fixed and per exponent: its time (a Python
+#: float in a list) and its sums (an array in a list, the stacked copy, the estimate and its
+#: ordered copy).
+_AVERAGE_FIXED, _AVERAGE_PER_EXPONENT = 160, 32
+
+
+def average_bytes(exponents: int) -> float:
+    """Peak bytes per running estimate of a Lyapunov average of ``exponents`` exponents."""
+    return float(_AVERAGE_FIXED + _AVERAGE_PER_EXPONENT * int(exponents))

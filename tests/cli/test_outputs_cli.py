@@ -81,7 +81,8 @@ def test_an_output_folder_with_files_is_refused(args, tmp_path):
     (["stability-map", "--N-min", "nan"], "--N-min must be a finite number"),
     (["stability-map", "--family", "N=1,2"], "N is an axis of the map"),
     (["stability-map", "--family", "delta_mu"], "--family"),
-    (["stability-map", "--N-points", "1000000000", "--omega-points", "1000000000"], "--N-points 1000000000 needs ≈ 64 GB"),
+    (["stability-map", "--N-points", "1000000000", "--omega-points", "1000000000"],
+     "--N-points 1000000000 needs ≈ 64 GB"),
     (["stability", "--omega", "5", "--set", "Omega=3"], "--set Omega=3 and --omega 5 both set Omega"),
     (["stability", "--omega", "-2.1199605744342958e+229"], "not finite"),  # found by the property tests
     (["orbit", "--N", "50", "--set", "N=30"], "--set N=30 and --N 50 both set N"),

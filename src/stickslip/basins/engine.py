@@ -11,7 +11,8 @@ missing states and gives the same labels. Ctrl-C stops handing out batches, wait
 running (each about :data:`TARGET_BATCH_S` of work), writes the partial result and keeps the
 journal for the next run; a Ctrl-C while the result is written lets the write finish (the file
 is then whole, complete or not). Either way the result says it was interrupted
-(``timings["interrupted"]``) and the caller learns it from :func:`~stickslip.integrate.interrupt.ctrl_c_taken`.
+(``timings["interrupted"]``), and a caller learns it from
+:func:`~stickslip.integrate.interrupt.ctrl_c_taken`.
 """
 
 from __future__ import annotations

@@ -135,6 +135,11 @@ def keeps(path, holds: str | Callable[[Path], str]) -> None:
     _kept["files"].append((path, _file_state(path), holds))
 
 
+def keeps_figure(out: Path) -> None:
+    """:func:`keeps` for the figure a command draws beside its output ``out`` (``OUT.png``)."""
+    keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+
+
 def resumable_holds(what: str) -> Callable[[Path], str]:
     """What a resumable command's output holds, read from its ``complete`` attribute when it was
     written: the finished ``what``, or part of it with the journal that keeps the rest."""

@@ -22,7 +22,7 @@ from ..basins.engine import load_result
 from ..integrate.interrupt import stop_if_interrupted
 from ..plot.basins import save_basins_figure
 from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, journal_of, keeps,
-                   on_interrupt, parse_assignments)
+                   keeps_figure, on_interrupt, parse_assignments)
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")
@@ -106,7 +106,7 @@ def basins(
     stop_if_interrupted()  # the study took a Ctrl-C: it wrote what it had
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_basins_figure(result, out.with_suffix(".png"))
     if as_json:
         print(json.dumps(result.to_json()))

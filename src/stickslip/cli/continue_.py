@@ -20,7 +20,8 @@ from ..orbits.continuation import SPECIAL_KINDS, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_finite,
-                   check_positive, check_resumable_output, console, error_line, keeps, note_line, resumable_holds)
+                   check_positive, check_resumable_output, console, error_line, keeps, keeps_figure, note_line,
+                   resumable_holds)
 from .orbit import IC_HELP, model_system, parse_section, parse_start
 
 
@@ -131,7 +132,7 @@ def continue_command(
         raise _steady_start(exc, system) from None
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_branch_figure(branch, out.with_suffix(".png"))
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "param": param,

@@ -26,7 +26,7 @@ from ..orbits.continuation import start_run
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
-                   check_choice, check_outputs, check_positive, console, keeps)
+                   check_choice, check_outputs, check_positive, console, keeps, keeps_figure)
 from .simulate import _parse_ic
 
 #: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
@@ -133,7 +133,7 @@ def orbit_command(
     _write(ds_of=orbit.to_xarray, out=out, holds=f"the orbit is in {out}")
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_orbit_figure(orbit, one_period, out.with_suffix(".png"))
     others = np.abs(orbit.nontrivial_multipliers)
     summary = {
@@ -195,7 +195,7 @@ def lyapunov_command(
     _write(ds_of=spectrum.to_xarray, out=out, holds=f"the spectrum is in {out}")
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_lyapunov_spectrum_figure(spectrum, out.with_suffix(".png"))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {

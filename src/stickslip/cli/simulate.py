@@ -29,8 +29,8 @@ from ..integrate.status import Status
 from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, check_positive, console, error_line, given, keeps, note_line, on_interrupt,
-                   warning_line)
+                   check_outputs, check_positive, console, error_line, given, keeps, keeps_figure, note_line,
+                   on_interrupt, warning_line)
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
@@ -94,13 +94,11 @@ def _continuation(ctx: typer.Context, ic: str, settings: dict):
 def _check_same_model(model: str, saved, ic: str) -> None:
     """``--model`` with ``--ic RUN.nc`` must name the run's own model (the plates: its variant)."""
     system = saved.system
-    plates = system.name == "two-plates"
-    if plates and plates_variant(model) is not None:
-        asked = plates_variant(model)
-        same = asked == plates_variant(str(system.parameters.get("variant", "full")))
+    variant = plates_variant(model)
+    if system.name == "two-plates":
+        same = variant is not None and variant == plates_variant(str(system.parameters.get("variant", "full")))
     else:
-        asked = model if plates_variant(model) is not None else load_model(model).name
-        same = not plates and asked == system.name
+        same = variant is None and load_model(model).name == system.name
     if not same:
         raise CLIError(f"--model {model}: {ic} is a run of model {_model_label(system)}, and a run continues its own "
                        f"model; drop --model to continue it, or start a run of {model} from a state "
@@ -240,7 +238,8 @@ def simulate(
     interrupted = traj.status_code == Status.INTERRUPTED
     if keep:
         out.parent.mkdir(parents=True, exist_ok=True)
-        keeps(out, f"the run up to t = {traj.t[-1]:g} s is in {out}" if interrupted else f"the finished run is in {out}")
+        keeps(out, f"the run up to t = {traj.t[-1]:g} s is in {out}" if interrupted else
+              f"the finished run is in {out}")
         with finish_first():  # what is done is kept: a Ctrl-C now waits for the file
             traj.to_netcdf(out)
     if interrupted and not keep:
@@ -249,7 +248,7 @@ def simulate(
     stop_if_interrupted()  # a Ctrl-C during the run (its part is written) or as it finished
     figure = None
     if keep and not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_trajectory_figure(traj, out.with_suffix(".png"))
     if traj.status != "success":
         error_line(f"the run stopped early: {traj.status}; " + (f"what it computed is in {out}" if keep else

@@ -21,7 +21,7 @@ from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, console, keeps)
+                   check_outputs, console, keeps, keeps_figure)
 from .sweep import _VALUE_BYTES, parse_values
 
 _N_HELP = "Normal preload N [N] (default 50)."
@@ -135,7 +135,7 @@ def stability_map(
         smap.to_netcdf(out)
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_stability_map_figure(smap, out.with_suffix(".png"))
     rows = []
     for f, label in enumerate(smap.family_labels):

@@ -27,7 +27,7 @@ from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import COLUMNS, _columns
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
-                   check_finite, check_positive, check_resumable_output, config_values, console, keeps,
+                   check_finite, check_positive, check_resumable_output, config_values, console, keeps, keeps_figure,
                    parse_assignments, resumable_holds)
 
 _CATEGORICAL = ("model", "ic")
@@ -234,7 +234,7 @@ def sweep_command(
     result = run_sweep(values, target, out=out, model=variant, ic=ic, **options)
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_sweep_figure(result, out.with_suffix(".png"), var=plot_var)
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
             result.dataset, as_json)
@@ -301,7 +301,7 @@ def bifurcation(
     result = run_sweep(grid, target, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_bifurcation_figure(result, out.with_suffix(".png"))
     _report(f"bifurcation diagram of {coordinate} against {param}", out, figure, result.timings, result.dataset, as_json)
 
@@ -374,7 +374,7 @@ def regions_command(
     rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
     figure = None
     if not no_plot:
-        keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
+        keeps_figure(out)
         figure = save_regions_figure(rmap, out.with_suffix(".png"))
 
     region = rmap.region

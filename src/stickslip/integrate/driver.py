@@ -26,12 +26,13 @@ __all__ = ["simulate", "METHODS", "MAX_SAMPLES", "check_samples", "round_down"]
 #: Largest number of uniform samples a run may keep (each ~ (2n + 2 + 2 nc) float64 and a flag byte).
 MAX_SAMPLES = 20_000_000
 
+
 def round_down(x: float) -> float:
     """``x`` (> 0) rounded down to 3 significant digits: a setting quoted in a message that fits."""
     if not x > 0 or not math.isfinite(x):
         return 0.0
     step = 10.0 ** (math.floor(math.log10(x)) - 2)
-    return math.floor(x / step * (1 + 1e-12)) * step
+    return math.floor(x / step * (1 + 1e-12)) * step  # 1e-12: 582 computed as 581.999… stays 582
 
 
 def check_samples(system, duration: float, sample_rate: float, *, run: str = "the run",
@@ -65,8 +66,8 @@ def check_samples(system, duration: float, sample_rate: float, *, run: str = "th
         return f"lower the sample rate to at most {round_down((limit - 1.0) / duration):.3g} Hz or {length}"
 
     if count > MAX_SAMPLES:
-        raise SimulationError(f"{run} of {duration:.6g} s at {sample_rate:.6g} Hz keeps "
-                              f"{f'{count:.3g}' if math.isfinite(count) else 'more than 1e+308'} samples, more than the "
+        shown = f"{count:.3g}" if math.isfinite(count) else "more than 1e+308"
+        raise SimulationError(f"{run} of {duration:.6g} s at {sample_rate:.6g} Hz keeps {shown} samples, more than the "
                               f"{MAX_SAMPLES:.3g} a run may keep; {fits(MAX_SAMPLES)}")
     per = sample_bytes(system.n, system.n_contacts)
     check_memory(count * per, f"{run} ({count:.3g} samples of model {system.name!r}, {format_bytes(per)} each)",

@@ -30,7 +30,7 @@ from .._version import __version__
 from ..errors import OrbitError, SimulationError
 from ..integrate.driver import check_samples, round_down, simulate
 from ..integrate.initial import initial_state
-from ..memory import check_memory, format_bytes, largest_count
+from ..memory import average_bytes, check_memory, format_bytes, largest_count
 from ..model.system_model import FrictionModel
 from .layout import free_states
 from .linear_flow import propagate
@@ -46,10 +46,6 @@ DEFAULT_D0 = 1e-7
 
 #: Samples per second of the transient run [Hz], whose second half sets the scales of the norm.
 TRANSIENT_RATE = 200.0
-
-#: Bytes per running estimate of an average, per exponent and fixed: its time (a Python float in
-#: a list) and its sums (an array in a list, the stacked copy, the estimate and its ordered copy).
-_ESTIMATE_FIXED, _ESTIMATE_PER_EXPONENT = 160.0, 32.0
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -128,7 +124,7 @@ def _check_memory(system, t_transient: float, t_average: float, interval: float,
     if not (math.isfinite(interval) and interval > 0):
         return
     count = t_average / interval
-    per = _ESTIMATE_FIXED + _ESTIMATE_PER_EXPONENT * 2 * system.n
+    per = average_bytes(2 * system.n)  # at most 2n exponents
     check_memory(count * per, f"an average over {t_average:.3g} s ({count:.3g} running estimates, one per "
                  f"{interval:g} s of {option}, {format_bytes(per)} each)",
                  lambda memory: f"shorten t_average (--t-average) to at most "
