@@ -92,11 +92,16 @@ def _check_memory(system, na: int, nb: int, members: int, every_point: bool = Fa
     k = 2 * system.n
     per = map_point_bytes(members) + (members * row if every_point else 0.0)
     fixed = members * (na + nb) * row + 2.0 * CHUNK_POINTS * 8 * k * k
-    side = lambda memory: math.isqrt(largest_count(per, memory, fixed))  # noqa: E731 - a square grid that fits
+
+    def fits(memory: float) -> str:
+        side = math.isqrt(largest_count(per, memory, fixed))  # of a square grid that fits
+        if side < 2:
+            return f"free memory: its fixed arrays alone take {fixed / 1e6:.3g} MB"
+        return f"give at most {side ** 2:.3g} points, e.g. {side} values per axis"
+
     check_memory(float(na) * nb * per + fixed,
                  f"a stability map of {na:.3g} × {nb:.3g} points and {members} member(s) of model {system.name!r}",
-                 lambda memory: f"give at most {side(memory) ** 2:.3g} points, e.g. {side(memory)} values per axis"
-                 if side(memory) >= 2 else f"free memory: its fixed arrays alone take {fixed / 1e6:.3g} MB")
+                 fits)
 
 
 def _is_plates(system) -> bool:
