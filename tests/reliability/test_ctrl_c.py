@@ -21,6 +21,7 @@ from typer.testing import CliRunner
 import stickslip.cli.basins as basins_cli
 import stickslip.cli.orbit as orbit_cli
 import stickslip.cli.simulate as simulate_cli
+import stickslip.cli.sweep as sweep_cli
 from stickslip import load_trajectory
 from stickslip.basins import basin_stability, box, engine
 from stickslip.basins.store import load_basins
@@ -231,6 +232,15 @@ def test_orbit_and_lyapunov_interrupted_while_writing_keep_their_file(command, h
     out = tmp_path / "o.nc"
     assert interrupted(runner.invoke(app, [*command, "--out", str(out)])) == f"{holds} is in {out}"
     assert files(tmp_path) == ["o.nc"] and out.stat().st_size > 1000
+
+
+def test_a_sweep_interrupted_while_drawing_says_its_file_is_finished(tmp_path, monkeypatch):
+    """A resumable command's line reads its output: finished (its journal gone), or part of it."""
+    monkeypatch.setattr(sweep_cli, "save_sweep_figure", sends_ctrl_c(sweep_cli.save_sweep_figure))
+    out = tmp_path / "s.nc"
+    line = interrupted(runner.invoke(app, ["sweep", "--grid", "N=30,50", "--grid", "Omega=0.5", "--t-end", "2",
+                                           "--executor", "serial", "--no-progress", "--out", str(out)]))
+    assert line == f"the finished sweep is in {out}"
 
 
 # ----------------------------------------------------------------------------- start-up, compilation

@@ -28,6 +28,7 @@ import warnings
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
@@ -147,7 +148,7 @@ def resumable_holds(what: str) -> Callable[[Path], str]:
         import h5py  # the attributes alone, without opening the dataset (h5py is already loaded by then)
 
         with h5py.File(path, "r") as fh:
-            complete = int(fh.attrs.get("complete", 1))
+            complete = int(np.ravel(fh.attrs.get("complete", 1))[0])  # netCDF attributes are arrays
         if complete:
             return f"the finished {what} is in {path}"
         return (f"{path} holds part of the {what} and {journal_of(path)} the finished work; run the same command "
