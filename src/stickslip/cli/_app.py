@@ -9,12 +9,10 @@ read no rich markup or emoji codes, and help texts are escaped from markup once,
 that cannot encode a character (``PYTHONIOENCODING=ascii``) prints ``?`` for it.
 
 Ctrl-C has one path too: whenever it lands (start-up, compilation, a run, a write, a figure),
-the command ends with exit code 130 and one line saying what is on disk at that moment. A
-command registers each file it writes (:func:`keeps`, with what the file holds); the line names
-those that were written (replaced or created) since, else the command's note
-(:func:`on_interrupt`, for work kept in a journal), else ``nothing was written``. A Ctrl-C while
-the package and the commands are imported and the command line is parsed is held
-(:mod:`stickslip._startup`) and reported the same way.
+the command ends with exit code 130 and one line saying what is on disk at that moment, from the
+files the command registered as it wrote them (:mod:`._kept`). A Ctrl-C while the package and
+the commands are imported and the command line is parsed is held (:mod:`stickslip._startup`)
+and reported the same way.
 """
 
 from __future__ import annotations
@@ -41,6 +39,7 @@ from ..errors import StickSlipError
 from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.parameters import Parameters
+from ._kept import forget_outputs, on_disk, on_interrupt
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -114,33 +113,6 @@ def note_line(message: str) -> None:
     err_console.print(Text(" ".join(str(message).split()), style="dim"))
 
 
-#: What the running command has on disk for the line a Ctrl-C prints: the files it registered
-#: (path, its state when registered, what it holds) and its note.
-_kept: dict = {"files": [], "note": None, "reported": False}
-
-
-def _file_state(path: Path):
-    """What tells a file written since apart: (inode, size, modification time), None if absent."""
-    try:
-        st = path.stat()
-    except OSError:
-        return None
-    return st.st_ino, st.st_size, st.st_mtime_ns
-
-
-def keeps(path, holds: str | Callable[[Path], str]) -> None:
-    """Register a file the command writes: if a Ctrl-C ends the command after the file was written
-    (created or replaced since this call), the interruption line says what it ``holds`` (a text
-    such as ``"the orbit is in orbit.nc"``, or a function of the path that reads it from the file)."""
-    path = Path(path)
-    _kept["files"].append((path, _file_state(path), holds))
-
-
-def keeps_figure(out: Path) -> None:
-    """:func:`keeps` for the figure a command draws beside its output ``out`` (``OUT.png``)."""
-    keeps(out.with_suffix(".png"), f"its figure is in {out.with_suffix('.png')}")
-
-
 def resumable_holds(what: str) -> Callable[[Path], str]:
     """What a resumable command's output holds, read from its ``complete`` attribute when it was
     written: the finished ``what``, or part of it with the journal that keeps the rest."""
@@ -156,39 +128,15 @@ def resumable_holds(what: str) -> Callable[[Path], str]:
     return holds
 
 
-def on_interrupt(text: str, path=None) -> None:
-    """Say what an interruption keeps when no registered file was written (printed after
-    ``interrupted:``); with ``path``, only if that file or folder exists then (a journal)."""
-    _kept["note"] = (text, None if path is None else Path(path))
-
-
-def _reset_kept() -> None:
-    _kept.update(files=[], note=None, reported=False)
-
-
-def _on_disk() -> str:
-    """What the command has on disk now (see :func:`keeps`, :func:`on_interrupt`)."""
-    written = []
-    for path, before, holds in _kept["files"]:
-        now = _file_state(path)
-        if now is not None and now != before:
-            try:
-                written.append(holds(path) if callable(holds) else holds)
-            except Exception:  # the file is there but cannot be read: say only that  # noqa: BLE001
-                written.append(f"{path} was written")
-    if written:
-        return "; ".join(written)
-    note = _kept["note"]
-    if note is not None and (note[1] is None or note[1].exists()):
-        return note[0]
-    return "nothing was written"
+#: Whether the running command has printed its ``interrupted:`` line.
+_reported = [False]
 
 
 def report_interrupt() -> None:
     """Print the one ``interrupted: ...`` line (once per command), from what is on disk now."""
-    if not _kept["reported"]:
-        _kept["reported"] = True
-        err_console.print(Text(f"interrupted: {_on_disk()}"))
+    if not _reported[0]:
+        _reported[0] = True
+        err_console.print(Text(f"interrupted: {on_disk()}"))
 
 
 def _interrupted_by_ctrl_c(exc: BaseException) -> bool:
@@ -232,7 +180,8 @@ class _Application(TyperGroup):
         _escape_help(self)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
-        _reset_kept()
+        forget_outputs()
+        _reported[0] = False
         _use_replacement_characters()
         try:
             if _startup.release(raise_pending=False):  # a Ctrl-C held since the imports

@@ -21,8 +21,9 @@ from ..basins import grid as regular_grid
 from ..basins.engine import load_result
 from ..integrate.interrupt import stop_if_interrupted
 from ..plot.basins import save_basins_figure
-from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, journal_of, keeps,
-                   keeps_figure, on_interrupt, parse_assignments)
+from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_nc_path, console, journal_of,
+                   parse_assignments)
+from ._kept import keeps, keeps_figure, on_interrupt
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")

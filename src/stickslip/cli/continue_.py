@@ -20,8 +20,8 @@ from ..orbits.continuation import SPECIAL_KINDS, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_finite,
-                   check_positive, check_resumable_output, console, error_line, keeps, keeps_figure, note_line,
-                   resumable_holds)
+                   check_positive, check_resumable_output, console, error_line, note_line, resumable_holds)
+from ._kept import keeps, keeps_figure
 from .orbit import IC_HELP, model_system, parse_section, parse_start
 
 

@@ -26,7 +26,8 @@ from ..orbits.continuation import start_run
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
-                   check_choice, check_outputs, check_positive, console, keeps, keeps_figure)
+                   check_choice, check_outputs, check_positive, console)
+from ._kept import keeps, keeps_figure
 from .simulate import _parse_ic
 
 #: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).

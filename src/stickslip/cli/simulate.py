@@ -29,8 +29,8 @@ from ..integrate.status import Status
 from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, check_positive, console, error_line, given, keeps, keeps_figure, note_line,
-                   on_interrupt, warning_line)
+                   check_outputs, check_positive, console, error_line, given, note_line, warning_line)
+from ._kept import keeps, keeps_figure, on_interrupt
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that

@@ -21,7 +21,8 @@ from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, console, keeps, keeps_figure)
+                   check_outputs, console)
+from ._kept import keeps, keeps_figure
 from .sweep import _VALUE_BYTES, parse_values
 
 _N_HELP = "Normal preload N [N] (default 50)."

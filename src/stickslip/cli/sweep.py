@@ -27,8 +27,9 @@ from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import COLUMNS, _columns
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
-                   check_finite, check_positive, check_resumable_output, config_values, console, keeps, keeps_figure,
-                   parse_assignments, resumable_holds)
+                   check_finite, check_positive, check_resumable_output, config_values, console, parse_assignments,
+                   resumable_holds)
+from ._kept import keeps, keeps_figure
 
 _CATEGORICAL = ("model", "ic")
 
