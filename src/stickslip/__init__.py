@@ -36,6 +36,10 @@ import importlib
 import sys
 import types
 
+from . import _startup  # first: Ctrl-C held during the import; NUMBA_NUM_THREADS made valid before numba loads
+
+_startup.hold()
+
 #: Public names imported on first access, by the module that defines them.
 _LAZY = {
     **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model"], ".model"),
@@ -76,6 +80,8 @@ from .integrate.driver import simulate  # noqa: E402
 from .integrate.result import Trajectory, load_trajectory  # noqa: E402
 from .model.parameters import Parameters  # noqa: E402
 from .model.variants import DOF_NAMES, MODELS, STATE_NAMES  # noqa: E402
+
+_startup.release()  # a Ctrl-C held during the import is raised here
 
 
 def __getattr__(name):

@@ -29,6 +29,7 @@ them without importing the module that raises it.
 ``WriteError``           a file that could not be written (``DiskFullError``: a full disk or file size limit)
 ``OutputError``          an output that must not be written (exists, a folder, an input)
 ``JournalError``         a journal of other settings, corrupt, or of an earlier format
+``MemoryLimitError``     work whose estimated memory exceeds what is available (``stickslip.memory``)
 =======================  ======================================================================
 """
 
@@ -36,8 +37,8 @@ from __future__ import annotations
 
 __all__ = ["StickSlipError", "ModelError", "ModelFileError", "ParameterError", "FrictionLawError", "VariantError",
            "KinematicsError", "ExpressionError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
-           "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError",
-           "JournalError"]
+           "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError", "DiskFullError",
+           "OutputError", "JournalError", "MemoryLimitError"]
 
 
 class StickSlipError(Exception):
@@ -140,3 +141,8 @@ class OutputError(StickSlipError, ValueError):
 
 class JournalError(StickSlipError, ValueError):
     """A journal that cannot be resumed: of other settings or kind, of an earlier format, or corrupt."""
+
+
+class MemoryLimitError(StickSlipError, MemoryError):
+    """Work refused before it allocates: its estimated memory exceeds what is available (the
+    message gives the estimate and a setting that fits)."""

@@ -255,6 +255,7 @@ def test_ctrl_c_keeps_the_part_of_a_run_done(tmp_path):
     started = time.monotonic()
     code, _, lines = _interrupt_when(proc, lambda: time.monotonic() - started > 8)
     assert code == 130, lines
-    assert len(lines) == 1 and lines[0].startswith("interrupted: interrupted at t = ") and str(out) in lines[0], lines
+    assert len(lines) == 1 and lines[0].startswith("interrupted: the run up to t = ") and str(out) in lines[0], lines
     kept = load_trajectory(out)
     assert 0 < kept.t[-1] < 100000 and kept.status.startswith("interrupted at t = ")
+    assert f"t = {kept.t[-1]:g} s" in lines[0]  # the line says what the file holds

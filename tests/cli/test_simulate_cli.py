@@ -179,8 +179,9 @@ def test_json_alone_writes_nothing(tmp_path, monkeypatch):
 
 # ----------------------------------------------------------------------------- option checks
 @pytest.mark.parametrize("args, words", [
-    (["--t-end", "1e9", "--sample-rate", "1e6"], "lower --sample-rate to at most"),
-    (["--t-end", "1e300", "--sample-rate", "1e300"], "lower --sample-rate to at most"),
+    (["--t-end", "1e9", "--sample-rate", "1e6"], "lower the sample rate to at most 0.0199 Hz or shorten the run to "
+                                                 "at most 19.9 s"),
+    (["--t-end", "1e300", "--sample-rate", "1e300"], "keeps more than 1e+308 samples"),
     (["--N", "30", "--set", "N=40"], "--set N=40 and --N 30 both set N"),
     (["--set", "N=30", "--set", "N=40"], "--set N is given twice"),
     (["--steady-from", "-1"], "--steady-from -1 s is outside the run, which goes from 0 to 1 s"),

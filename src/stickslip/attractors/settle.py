@@ -12,7 +12,7 @@ import dataclasses
 import math
 
 from ..errors import SimulationError
-from ..integrate.driver import simulate
+from ..integrate.driver import check_samples, simulate
 from ..integrate.result import Trajectory
 from .confirm import QUASI_SPAN_S
 from .summary import run_summary
@@ -107,6 +107,8 @@ def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: fl
     t0 = float(t0)
     end = t0 + min(t_min, cap)
     traj = simulate(params, end, t0=t0, **simulate_options)
+    if keep == "all":  # the extensions keep every sample up to the cap: refused now if they would not fit
+        check_samples(traj.system, cap, traj.options["sample_rate"], run="the run up to the cap (cap, --cap)")
     simulate_options.pop("ic", None)
     simulate_options.pop("perturbation", None)
     cache: dict = {}

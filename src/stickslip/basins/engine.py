@@ -9,7 +9,10 @@ one. Outcomes are journaled as batches arrive; the dataset is assembled from the
 (:func:`.result.assemble`), so a study killed at any moment and started again computes only the
 missing states and gives the same labels. Ctrl-C stops handing out batches, waits for those
 running (each about :data:`TARGET_BATCH_S` of work), writes the partial result and keeps the
-journal for the next run.
+journal for the next run; a Ctrl-C while the result is written lets the write finish (the file
+is then whole, complete or not). Either way the result says it was interrupted
+(``timings["interrupted"]``), and a caller learns it from
+:func:`~stickslip.integrate.interrupt.ctrl_c_taken`.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ import numpy as np
 from ..errors import BasinError, StickSlipError
 from ..integrate.interrupt import interruptible
 from ..journal import finished_output, output_path
+from ..memory import check_memory, format_bytes, largest_count, param_bytes, state_bytes
 from ..model.library import load_model
 from ..parallel import EXECUTORS, check_executor, check_workers, map_unordered
 from .context import Context, make_context, model_of, register_model
@@ -80,6 +84,33 @@ def _models(model, param, values):
         text = str(exc)
         raise BasinError("--param " + text[len("--set "):] if text.startswith("--set ") else f"--param {param}: {text}") \
             from None
+
+
+#: How each kind of states names its count, for the setting that fits.
+_STATE_COUNT = {"box": "--n {k}", "grid": "a --grid of at most {k} points", "ics": "at most {k} rows in --ics"}
+
+
+def _check_memory(model, spec: BasinSpec) -> None:
+    """Refuse, before a model is rebuilt or a state drawn, a study whose states and models would
+    not fit in memory (:func:`stickslip.memory.state_bytes`, :func:`~stickslip.memory.param_bytes`)."""
+    P, N = spec.n_params, spec.n_states
+    per_state, per_param = state_bytes(model.n, spec.row_width), param_bytes(model.n)
+
+    def fits(memory: float) -> str:
+        fixes = []
+        k = largest_count(P * per_state, memory, P * per_param)  # states per value, the values kept
+        if k >= 1:
+            fixes.append("give " + _STATE_COUNT[spec.states.kind].format(k=k))
+        p = largest_count(N * per_state + per_param, memory)  # values, the states kept
+        if spec.param is not None and p >= 2:
+            fixes.append(f"give at most {p} parameter values (--param PATH=LO:HI:K)")
+        return " or ".join(fixes) or (f"give fewer states and parameter values ({format_bytes(per_state)} a state "
+                                      f"and {format_bytes(per_param)} a parameter value)")
+
+    values = f" × {P:.3g} parameter values" if spec.param is not None else ""
+    check_memory(float(P) * N * per_state + float(P) * per_param,
+                 f"a basin study of {N:.3g} states{values} of model {model.name!r} ({format_bytes(per_state)} a state)",
+                 fits)
 
 
 def _contexts(models, keys):
@@ -151,7 +182,8 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     Returns
     -------
     BasinResult
-        ``complete`` is False when the study was interrupted (Ctrl-C); the journal is then kept.
+        ``complete`` is False when the study was interrupted (Ctrl-C) before every state was
+        classified; the journal is then kept. ``timings["interrupted"]``: whether Ctrl-C was pressed.
 
     Raises
     ------
@@ -172,6 +204,7 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     key = register_model(model)
     spec = build_spec(model, states, param=param, values=values, options=opts, key=key)
     workers = check_workers(workers, address=address)
+    _check_memory(model, spec)
     models = _models(model, param, spec.values)
     keys = [register_model(m) for m in models]
     ctxs, info_models = _contexts(models, keys)
@@ -194,7 +227,7 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
                       workers=workers,
                       address=address, batch_size=batch_size, progress=progress,
                       snapshot_interval=snapshot_interval)
-        if timing["interrupted"] or keep_journal:
+        if not result.complete or keep_journal:
             journal.close()
         else:
             journal.remove()
@@ -260,7 +293,7 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
         return (ctxs[p], flat, initial[p, flat % N], tuple(registry[p]), spec.options)
 
     try:
-        with interruptible() as stop:
+        with interruptible() as stop:  # also while the result is written: a Ctrl-C then lets the write finish
             if todo.size:
                 record(*evaluate_batch(task(todo[:1])))  # compiles or loads the kernels
                 timed, rest = todo[1:1 + TIMED_STATES], todo[1 + TIMED_STATES:]
@@ -274,13 +307,17 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
                 for idx, rws in map_unordered(evaluate_batch, tasks, executor=executor, workers=workers,
                                               address=address, stop=stop, info=timing):
                     record(idx, rws)
-            timing["interrupted"] = bool(stop.requested) and n_new < todo.size
+            if bar is not None:
+                bar.stop()
+                bar = None
+            timing["compute_s"] = time.perf_counter() - compute_start
+            timing["states_computed"] = n_new
+            ds = dataset({"compute_s": timing["compute_s"]})
+            write_dataset(ds, out, journal)
+            timing["interrupted"] = bool(stop.requested)
     finally:
         if bar is not None:
             bar.stop()
-    timing["compute_s"] = time.perf_counter() - compute_start
-    ds = dataset({"compute_s": timing["compute_s"]})
-    write_dataset(ds, out, journal)
     return BasinResult(out, ds, timing)
 
 

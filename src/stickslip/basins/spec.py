@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import BasinError
 from .context import model_key
 from .early import Options, row_width
-from .states import StateSpec
+from .states import MAX_STATES, StateSpec
 
 __all__ = ["BasinSpec", "build_spec", "parse_param"]
 
@@ -105,8 +105,8 @@ def parse_param(text: str) -> tuple[str, list[float]]:
         raise BasinError(f"--param {text}: LO and HI must be finite numbers")
     if lo >= hi:
         raise BasinError(f"--param {text}: LO must be < HI")
-    if k < 2:
-        raise BasinError(f"--param {text}: K must be >= 2 values")
+    if not 2 <= k <= MAX_STATES:
+        raise BasinError(f"--param {text}: K must be 2 … {MAX_STATES} values")
     return name, np.linspace(lo, hi, k).tolist()
 
 

@@ -23,6 +23,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..errors import BasinError
+from ..memory import check_memory, format_bytes, largest_count
 
 __all__ = ["BasinError", "StateSpec", "BASES", "box", "grid", "from_csv", "parse_range"]
 
@@ -31,6 +32,9 @@ BASES = ("equilibrium", "zero")
 
 #: Most states a study may hold (each a row of the journal and of the NetCDF).
 MAX_STATES = 10_000_000
+
+#: Seeds of the random draws: what numpy's generator takes and the result's int64 attribute holds.
+MAX_SEED = 2**63 - 1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -120,6 +124,9 @@ class StateSpec:
         names = model.state_names
         if self.kind == "ics":
             return np.array(self.table, dtype=float)
+        per = 8.0 * (2 * len(names) + 2 * len(self.names))  # the states and the unit draws with their scaled copy
+        check_memory(self.n * per, f"{self.n:.3g} initial states of model {model.name!r} ({format_bytes(per)} each)",
+                     lambda memory: f"give at most {largest_count(per, memory)} states")
         base = np.zeros(len(names))
         if self.base == "equilibrium":
             if equilibrium is None:
@@ -213,6 +220,18 @@ def _fixed(model, fixed: Mapping[str, float] | None, box_names) -> tuple:
     return tuple(out)
 
 
+def _check_seed(seed) -> int:
+    """The seed as an int of 0 … :data:`MAX_SEED` (numpy refuses negative seeds; the result's
+    attributes hold it as int64)."""
+    try:
+        value = int(seed)
+    except (TypeError, ValueError):
+        raise BasinError(f"--seed {seed!r}: give an integer 0 … 2^63 − 1") from None
+    if (isinstance(seed, float) and value != seed) or not 0 <= value <= MAX_SEED:
+        raise BasinError(f"--seed {seed}: give an integer 0 … 2^63 − 1")
+    return value
+
+
 def _check_base(base: str) -> str:
     if base not in BASES:
         raise BasinError(f"--base {base}: choose one of {', '.join(BASES)}")
@@ -231,7 +250,7 @@ def box(model, ranges, n: int, *, seed: int = 0, base: str = "equilibrium",
     n : int
         Number of draws, ≥ 1.
     seed : int
-        Seed of numpy's default generator.
+        Seed of numpy's default generator, 0 … 2^63 − 1.
     base : {"equilibrium", "zero"}
         State of the entries outside the box.
     fixed : mapping name → value, optional
@@ -240,7 +259,8 @@ def box(model, ranges, n: int, *, seed: int = 0, base: str = "equilibrium",
     Raises
     ------
     BasinError
-        Unknown or locked state, LO ≥ HI, non-finite bounds, n ≤ 0.
+        Unknown or locked state, LO ≥ HI, non-finite bounds, n ≤ 0 or above :data:`MAX_STATES`, a
+        seed outside 0 … 2^63 − 1.
     """
     names, lows, highs = _box(model, ranges)
     try:
@@ -249,7 +269,7 @@ def box(model, ranges, n: int, *, seed: int = 0, base: str = "equilibrium",
         raise BasinError(f"--n {n!r}: give the number of random states, an integer >= 1") from None
     if n <= 0 or n > MAX_STATES:
         raise BasinError(f"--n {n}: give the number of random states, 1 … {MAX_STATES}")
-    return StateSpec("box", names, lows, highs, n=n, seed=int(seed), base=_check_base(base),
+    return StateSpec("box", names, lows, highs, n=n, seed=_check_seed(seed), base=_check_base(base),
                      fixed=_fixed(model, fixed, names))
 
 
@@ -292,7 +312,7 @@ def from_csv(model, path) -> StateSpec:
         raise BasinError(f"--ics {path}: no such file; give a CSV file whose header names the states "
                          f"{','.join(names)}")
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark (spreadsheets) is skipped
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise BasinError(f"--ics {path}: cannot be read as CSV ({exc})") from None

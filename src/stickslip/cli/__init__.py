@@ -1,9 +1,15 @@
 """Command line: ``stickslip <command>``. Parse → library call → write; no physics here.
 
-Each command lives in its own module and registers itself on :data:`app` when imported.
+Each command lives in its own module and registers itself on :data:`app` when imported. Ctrl-C
+is held while they are imported (:mod:`stickslip._startup`): one pressed then ends the process
+with one line, as one pressed while ``stickslip`` itself is imported.
 """
 
-from ._app import app
+from .. import _startup
+
+_startup.hold()
+
+from ._app import app  # noqa: E402
 
 from . import simulate  # noqa: E402,F401  (registers `stickslip simulate`)
 from . import stability  # noqa: E402,F401
@@ -14,5 +20,7 @@ from . import continue_  # noqa: E402,F401  (registers `stickslip continue`)
 from . import orbit  # noqa: E402,F401  (registers `stickslip orbit`, `lyapunov`)
 from . import basins  # noqa: E402,F401  (registers `stickslip basins`)
 from . import models  # noqa: E402,F401  (registers `stickslip models`)
+
+_startup.release()  # a Ctrl-C held during these imports is raised here, reported in one line
 
 __all__ = ["app"]

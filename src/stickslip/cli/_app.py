@@ -4,9 +4,15 @@ Every command runs inside :class:`_Application`, which turns what the user can f
 on stderr and exit code 2: option values the parser refuses, any
 :class:`~stickslip.errors.StickSlipError` (the library's and this package's :class:`CLIError`),
 and operating-system errors with a path (read-only, missing or wrong kind of file or folder, full
-disk). Ctrl-C prints one line saying what was kept and exits with 130. Anything else is a bug
-and keeps its traceback. Text is printed as written: the consoles read no rich markup or emoji
-codes, and help texts are escaped from markup once, here.
+disk). Anything else is a bug and keeps its traceback. Text is printed as written: the consoles
+read no rich markup or emoji codes, and help texts are escaped from markup once, here; a console
+that cannot encode a character (``PYTHONIOENCODING=ascii``) prints ``?`` for it.
+
+Ctrl-C has one path too: whenever it lands (start-up, compilation, a run, a write, a figure),
+the command ends with exit code 130 and one line saying what is on disk at that moment, from the
+files the command registered as it wrote them (:mod:`._kept`). A Ctrl-C while the package and
+the commands are imported and the command line is parsed is held (:mod:`stickslip._startup`)
+and reported the same way.
 """
 
 from __future__ import annotations
@@ -14,23 +20,27 @@ from __future__ import annotations
 import errno
 import math
 import os
+import re
 import sys
 import warnings
 from pathlib import Path
+from typing import Callable
 
+import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.text import Text
 from typer.core import TyperGroup
 
+from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
 from ..files import lock, refuse_output
-from ..integrate.driver import MAX_SAMPLES
-from ..integrate.interrupt import on_ctrl_c
+from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.parameters import Parameters
+from ._kept import forget_outputs, on_disk, on_interrupt
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -53,10 +63,6 @@ OVERWRITE_FOLDER_HELP = "Write into a folder that is not empty, replacing files 
 RESTART_HELP = ("Start over: replace the output, its journal and its figure (of this or another run) instead of "
                 "resuming or refusing.")
 
-#: Peak memory of `stickslip simulate` per kept sample [bytes]: the run's arrays, the steady-state
-#: analysis, the NetCDF dataset and the figure (measured: about 290 B, from 1e5 to 5e6 samples).
-SAMPLE_BYTES = 300
-
 #: The click base class of usage errors (typer re-exports only its subclass BadParameter; recent
 #: typer versions carry their own copy of click).
 _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
@@ -72,9 +78,30 @@ class CLIError(StickSlipError, ValueError):
     must not be replaced. The message names the option and the fix."""
 
 
+#: A run of this many digits or more in a message is a number typed or computed beyond any
+#: meaning (a 300-digit --n); it is shown with 3 significant digits. Paths keep theirs.
+_LONG_DIGITS = 16
+_LONG_NUMBER = re.compile(r"(?<![\w/.\\])(\d{%d,})(?![\w/\\]|\.\w)" % _LONG_DIGITS)
+
+
+def _short_number(match: re.Match) -> str:
+    """``1.23e+299`` for a long run of digits (not through float, which ends at 1e308)."""
+    digits = match.group(1).lstrip("0") or "0"
+    exponent = len(digits) - 1
+    mantissa = round(int(digits[:4]) / 10 ** (min(len(digits), 4) - 1), 2)
+    if mantissa >= 10:  # 9.999… rounds up to the next power of ten
+        mantissa, exponent = mantissa / 10, exponent + 1
+    return f"{mantissa:g}e+{exponent}"
+
+
+def shorten_numbers(text: str) -> str:
+    """``text`` with every number of :data:`_LONG_DIGITS` digits or more shown as ``1.23e+299``."""
+    return _LONG_NUMBER.sub(_short_number, text)
+
+
 def error_line(message: str) -> None:
-    """Print ``error: message`` as one line on stderr, exactly as written."""
-    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(str(message).split())))
+    """Print ``error: message`` as one line on stderr, exactly as written (long numbers shortened)."""
+    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(shorten_numbers(str(message)).split())))
 
 
 def warning_line(message: str) -> None:
@@ -87,13 +114,39 @@ def note_line(message: str) -> None:
     err_console.print(Text(" ".join(str(message).split()), style="dim"))
 
 
-#: What a Ctrl-C leaves behind, as set by the running command (:func:`on_interrupt`).
-_interrupt_note = {"text": "nothing was written"}
+def resumable_holds(what: str) -> Callable[[Path], str]:
+    """What a resumable command's output holds, read from its ``complete`` attribute when it was
+    written: the finished ``what``, or part of it with the journal that keeps the rest."""
+    def holds(path: Path) -> str:
+        import h5py  # the attributes alone, without opening the dataset (h5py is already loaded by then)
+
+        with h5py.File(path, "r") as fh:
+            complete = int(np.ravel(fh.attrs.get("complete", 1))[0])  # netCDF attributes are arrays
+        if complete:
+            return f"the finished {what} is in {path}"
+        return (f"{path} holds part of the {what} and {journal_of(path)} the finished work; run the same command "
+                "again to resume")
+    return holds
 
 
-def on_interrupt(text: str) -> None:
-    """Say what an interruption from now on keeps (printed after ``interrupted:``)."""
-    _interrupt_note["text"] = text
+#: Whether the running command has printed its ``interrupted:`` line.
+_reported = [False]
+
+
+def report_interrupt() -> None:
+    """Print the one ``interrupted: ...`` line (once per command), from what is on disk now."""
+    if not _reported[0]:
+        _reported[0] = True
+        err_console.print(Text(f"interrupted: {on_disk()}"))
+
+
+def _interrupted_by_ctrl_c(exc: BaseException) -> bool:
+    """A SystemError that a Ctrl-C caused: raised while a compiled kernel returned its result."""
+    while exc is not None:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _path_error_message(exc: OSError) -> str:
@@ -128,9 +181,16 @@ class _Application(TyperGroup):
         _escape_help(self)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        forget_outputs()
+        _reported[0] = False
+        _use_replacement_characters()
         try:
+            if _startup.release(raise_pending=False):  # a Ctrl-C held since the imports
+                raise KeyboardInterrupt
             code = super().main(args=args, prog_name=prog_name, complete_var=complete_var, standalone_mode=False,
                                 **extra)
+        except KeyboardInterrupt:  # before the command ran (the parser's own turns into exit code 130)
+            code = 130
         except _ClickException as exc:  # the parser's: unknown, missing or mistyped options
             code = exc.exit_code
             if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help
@@ -140,13 +200,16 @@ class _Application(TyperGroup):
             error_line("aborted")
             code = 1
         code = code if isinstance(code, int) else 0
+        if code == 130:
+            report_interrupt()  # unless the command has
         if not standalone_mode:
             return code
         sys.exit(code)
 
     def invoke(self, ctx):
-        on_interrupt("nothing was written")
+        forget_ctrl_c()
         try:
+            _check_environment()
             # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
             # `simulate` keeps its one interrupted run instead
             with warnings.catch_warnings(), on_ctrl_c(partial=False):
@@ -159,14 +222,55 @@ class _Application(TyperGroup):
                 raise
             error_line(_path_error_message(exc))
         except KeyboardInterrupt:
-            err_console.print(Text(f"interrupted: {_interrupt_note['text']}"))
+            report_interrupt()
+            raise typer.Exit(130) from None
+        except SystemError as exc:
+            if not _interrupted_by_ctrl_c(exc):
+                raise
+            report_interrupt()
             raise typer.Exit(130) from None
         finally:
             release_outputs()
         raise typer.Exit(2)
 
 
-app = typer.Typer(
+class _Typer(typer.Typer):
+    """The typer application whose start-up (building the command tree, until
+    :meth:`_Application.main` runs) holds Ctrl-C as the imports before it did (:mod:`stickslip._startup`)."""
+
+    def __call__(self, *args, **kwargs):
+        _startup.hold()
+        try:
+            return super().__call__(*args, **kwargs)
+        finally:
+            _startup.release(raise_pending=False)  # main has released it, unless it never ran
+
+
+def _use_replacement_characters() -> None:
+    """Let stdout and stderr print ``?`` for characters their encoding lacks (``PYTHONIOENCODING=ascii``,
+    a C locale) instead of failing on the first ``–`` or ``φ``."""
+    for stream in (sys.stdout, sys.stderr):
+        encoding = getattr(stream, "encoding", None) or "utf-8"
+        try:
+            "–≈φ│".encode(encoding)
+        except (UnicodeEncodeError, LookupError):
+            try:
+                stream.reconfigure(errors="replace")
+            except (AttributeError, ValueError):  # not a text stream of the interpreter's (tests capture it)
+                pass
+
+
+def _check_environment() -> None:
+    """Refuse an environment the kernels cannot run in; say what :mod:`stickslip._startup` changed."""
+    if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
+        raise CLIError(f"NUMBA_DISABLE_JIT={os.environ['NUMBA_DISABLE_JIT']}: stickslip's kernels must be compiled "
+                       "(interpreted, a run would take hours and some kernels cannot run at all); unset "
+                       "NUMBA_DISABLE_JIT or set it to 0")
+    for note in _startup.notes:
+        warning_line(note)
+
+
+app = _Typer(
     name="stickslip",
     cls=_Application,
     help="Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact.",
@@ -369,69 +473,6 @@ def check_finite(flags: dict) -> None:
     for flag, value in flags.items():
         if value is not None and not math.isfinite(value):
             raise CLIError(f"{flag} must be a finite number, got {value}")
-
-
-# ----------------------------------------------------------------------------- memory
-def available_memory() -> float | None:
-    """Memory the system can give this process now [bytes] (``MemAvailable``), else the
-    physical memory, else None when neither can be read."""
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
-    try:
-        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
-def check_memory(need: float, what: str, fix: str) -> None:
-    """Refuse work that needs ``need`` bytes when less memory is available.
-
-    Parameters
-    ----------
-    need : float
-        Estimated peak memory [bytes] (may be inf).
-    what : str
-        What needs it, for the message (``"a 1000 × 1000 map"``).
-    fix : str
-        The options that lower it (``"lower --N-points"``).
-    """
-    memory = available_memory()
-    if memory is not None and not need <= memory:
-        raise CLIError(f"{what} needs ≈ {need / 1e9:.3g} GB, more than the {memory / 1e9:.3g} GB of memory "
-                       f"available; {fix}")
-
-
-def check_samples(duration: float, sample_rate: float, *, time_flag: str = "--t-end",
-                  rate_flag: str | None = "--sample-rate") -> None:
-    """Refuse a run whose samples would not fit: more than the library keeps per run
-    (``MAX_SAMPLES``) or more memory than is available (:data:`SAMPLE_BYTES` each).
-
-    Parameters
-    ----------
-    duration : float
-        Simulated time [s] (finite, > 0).
-    sample_rate : float
-        Samples per second [Hz] (finite, > 0).
-    time_flag, rate_flag : str
-        The options that set them, named in the message (``rate_flag`` None: not an option).
-    """
-    n = duration * sample_rate + 1.0
-    limit, what = float(MAX_SAMPLES), f"the {MAX_SAMPLES} samples a run may keep"
-    memory = available_memory()
-    if memory is not None and memory / SAMPLE_BYTES < limit:
-        limit, what = memory / SAMPLE_BYTES, f"the {memory / 1e9:.3g} GB of memory available"
-    if n <= limit:
-        return
-    fix = f"shorten {time_flag}"
-    if rate_flag is not None:
-        fix = f"lower {rate_flag} to at most {(limit - 1.0) / duration:.3g} Hz or " + fix
-    raise CLIError(f"{time_flag} {duration:g} s at {sample_rate:g} Hz keeps {n:.3g} samples "
-                   f"(≈ {n * SAMPLE_BYTES / 1e9:.3g} GB), more than {what}; {fix}")
 
 
 # ----------------------------------------------------------------------------- outputs

@@ -2,7 +2,8 @@
 
 Parse → library call (:func:`stickslip.basins.basin_stability`) → NetCDF, a figure and a
 summary; no physics here. The command resumes: run it again with the same arguments and it
-classifies only the states it had not finished (none, if the output is complete).
+classifies only the states it had not finished (none, if the output is complete). Ctrl-C ends it
+with one line saying how many states the output holds (the journal keeps them for the resume).
 """
 
 from __future__ import annotations
@@ -17,10 +18,13 @@ from rich.table import Table
 from ..basins import basin_stability, from_csv, parse_param, parse_range
 from ..basins import box as random_box
 from ..basins import grid as regular_grid
+from ..basins.engine import load_result
 from ..files import write_output
+from ..integrate.interrupt import stop_if_interrupted
 from ..plot.basins import save_basins_figure
-from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_resumable_output, console, err_console,
+from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_resumable_output, console, journal_of,
                    parse_assignments)
+from ._kept import keeps, keeps_figure, on_interrupt
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")
@@ -96,23 +100,32 @@ def basins(
         executor = "dask" if scheduler else "processes"
     if scheduler and executor != "dask":
         raise CLIError(f"--scheduler needs --executor dask (got --executor {executor})")
+    keeps(out, _holds)
+    on_interrupt(f"the states classified before are kept in {journal_of(out)}; run the same command again to resume",
+                 journal_of(out))
     result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, executor=executor,
                              workers=workers, address=scheduler, progress=not (no_progress or as_json),
                              overwrite=overwrite, rtol=rtol, atol=atol, match_rtol=match_rtol,
                              confirm=not no_confirm, lyapunov=lyapunov)
+    stop_if_interrupted()  # the study took a Ctrl-C: it wrote what it had
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_basins_figure(result, tmp),
                               overwrite=replace_figure, inputs=inputs)
     if as_json:
         print(json.dumps(result.to_json()))
     else:
         _print_summary(result, out, figure)
-    if not result.complete:
-        err_console.print(f"interrupted: {int(result.dataset.attrs['states_done'])} of {result.dataset['done'].size} "
-                          f"states classified, kept in {out}.journal; run the same command again to resume",
-                          highlight=False, soft_wrap=True)
-        raise typer.Exit(130)
+
+
+def _holds(out: Path) -> str:
+    """What the study's output holds, read from it: the states classified, and how to go on."""
+    ds = load_result(out).dataset
+    done, total = int(ds.attrs["states_done"]), int(ds["done"].size)
+    if int(ds.attrs["complete"]):
+        return f"{out} holds all {total} states, classified"
+    return f"{out} holds {done} of {total} states classified; run the same command again to resume"
 
 
 def _print_summary(result, out: Path, figure) -> None:

@@ -14,14 +14,14 @@ from typing import List, Optional
 import typer
 from rich.table import Table
 
-from ..errors import StickSlipError
-from ..errors import SteadySlidingError
+from ..errors import SteadySlidingError, StickSlipError
 from ..orbits import resolve_section
-from ..orbits.continuation import SPECIAL_KINDS, START_RATE, continue_orbit, start_run
+from ..orbits.continuation import SPECIAL_KINDS, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_finite,
-                   check_positive, check_resumable_output, check_samples, console, error_line, note_line)
+                   check_positive, check_resumable_output, console, error_line, note_line, resumable_holds)
+from ._kept import keeps, keeps_figure
 from .orbit import IC_HELP, model_system, parse_section, parse_start
 
 
@@ -109,7 +109,6 @@ def continue_command(
     _check(start, stop, max_points, step, max_step, search_time, rtol, tol, stop_on)
     ic_start = parse_start(ic)
     check_positive({"--slip-band": slip_band})
-    check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
     system = model_system(model, config, set_, slip_band, swept={param: f"--param {param}"}, N=N, Omega=omega)
     try:
         parameter_value(system, param)
@@ -118,6 +117,7 @@ def continue_command(
         raise CLIError(f"--param {param}: {exc}") from None
     sec = resolve_section(parse_section(section), system)
     check_resumable_output(out, not no_plot, overwrite)
+    keeps(out, resumable_holds("branch"))
     progress = None if (no_progress or as_json) else (
         lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
                                           f"{'stable' if st else 'unstable'}"))
@@ -132,6 +132,7 @@ def continue_command(
         raise _steady_start(exc, system) from None
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = save_branch_figure(branch, out.with_suffix(".png"))
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "param": param,

@@ -19,13 +19,15 @@ from rich.table import Table
 from rich.text import Text
 
 from ..files import write_output
+from ..integrate.interrupt import finish_first
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
-from ..orbits.continuation import START_RATE, start_run
+from ..orbits.continuation import start_run
 from ..orbits.problem import stick_summary
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
-                   check_choice, check_outputs, check_positive, check_samples, console)
+                   check_choice, check_outputs, check_positive, console)
+from ._kept import keeps, keeps_figure
 from .simulate import _parse_ic
 
 #: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
@@ -72,6 +74,15 @@ def parse_section(text: str):
     return text
 
 
+def _write(*, ds_of, out: Path, holds: str, overwrite: bool, inputs: dict) -> None:
+    """Write the dataset ``ds_of()`` to ``out`` whole (:func:`stickslip.files.write_output`); a
+    Ctrl-C meanwhile lets it finish, then stops."""
+    keeps(out, holds)
+    with finish_first():
+        ds = ds_of()
+        write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
+
+
 def _finite_or_none(x: float):
     """A float for JSON, ``None`` where it is not finite (JSON has no ±inf or NaN)."""
     x = float(x)
@@ -106,7 +117,6 @@ def orbit_command(
     start = parse_start(ic)
     check_positive({"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
     check_below_one({"--tol": tol})
-    check_samples(search_time, START_RATE, time_flag="--search-time", rate_flag=None)
     check_choice("--monodromy", monodromy, _METHODS)
     if period_multiplicity < 1:
         raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
@@ -121,10 +131,10 @@ def orbit_command(
     wall = time.perf_counter() - t0
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
-    ds = orbit.to_xarray()
-    write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
+    _write(ds_of=orbit.to_xarray, out=out, holds=f"the orbit is in {out}", overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_orbit_figure(orbit, one_period, tmp),
                               overwrite=overwrite, inputs=inputs)
     others = np.abs(orbit.nontrivial_multipliers)
@@ -187,10 +197,10 @@ def lyapunov_command(
     start = default_start(system) if start is None else start
     spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
                                  method=method)
-    ds = spectrum.to_xarray()
-    write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
+    _write(ds_of=spectrum.to_xarray, out=out, holds=f"the spectrum is in {out}", overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_lyapunov_spectrum_figure(spectrum, tmp),
                               overwrite=overwrite, inputs=inputs)
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk

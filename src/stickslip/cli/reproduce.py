@@ -9,7 +9,8 @@ import typer
 
 from ..studies.reproduce import recipe_names
 from ..studies.reproduce import reproduce as run_reproduce
-from ._app import OVERWRITE_FOLDER_HELP, CLIError, app, check_output_folder, console, note_line, on_interrupt
+from ._app import OVERWRITE_FOLDER_HELP, CLIError, app, check_output_folder, console, note_line
+from ._kept import on_interrupt
 
 
 @app.command("reproduce")

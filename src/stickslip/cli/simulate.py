@@ -1,7 +1,12 @@
 """``stickslip simulate``: one run, written to NetCDF with a figure and a summary.
 
 Parse → library call (:func:`stickslip.simulate`) → write; no physics here. ``--ic RUN.nc``
-continues a saved run: its model, parameters and settings, from its last sample on.
+continues a saved run: its model, parameters and settings, from its last sample on (a ``--model``
+other than the run's is refused: a different model cannot continue it).
+
+Ctrl-C during the run ends it with the part done; that part, or a finished run when Ctrl-C comes
+while it is written, is written whole (a second Ctrl-C stops the write), and the command then
+stops without drawing the figure.
 """
 
 from __future__ import annotations
@@ -19,13 +24,14 @@ from rich.text import Text
 from ..attractors import run_summary, simulate_until_settled
 from ..integrate.driver import simulate as run_simulation
 from ..files import write_output
-from ..integrate.interrupt import on_ctrl_c
+from ..integrate.interrupt import finish_first, on_ctrl_c, stop_if_interrupted
 from ..integrate.result import load_trajectory
 from ..integrate.status import Status
+from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, check_positive, check_samples, console, err_console, error_line, given, note_line,
-                   warning_line)
+                   check_outputs, check_positive, console, error_line, given, note_line, warning_line)
+from ._kept import keeps, keeps_figure, on_interrupt
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
@@ -75,12 +81,29 @@ def _continuation(ctx: typer.Context, ic: str, settings: dict):
     """
     saved = load_trajectory(ic)
     stored = dict(saved.options, model=saved.model, method=saved.method)
-    overridden = [flag for flag, name in _SETTINGS.items() if given(ctx, name)]
+    if given(ctx, "model"):
+        _check_same_model(settings["model"], saved, ic)
+        settings = dict(settings, model=saved.model)
+    overridden = [flag for flag, name in _SETTINGS.items() if given(ctx, name) and name != "model"]
     settings = {name: (value if given(ctx, name) or name not in stored else stored[name])
                 for name, value in settings.items()}
     if stored.get("slip_band") is not None:
         settings["slip_band"] = stored["slip_band"]
     return saved.system, float(saved.t[-1]), settings, overridden
+
+
+def _check_same_model(model: str, saved, ic: str) -> None:
+    """``--model`` with ``--ic RUN.nc`` must name the run's own model (the plates: its variant)."""
+    system = saved.system
+    variant = plates_variant(model)
+    if system.name == "two-plates":
+        same = variant is not None and variant == plates_variant(str(system.parameters.get("variant", "full")))
+    else:
+        same = variant is None and load_model(model).name == system.name
+    if not same:
+        raise CLIError(f"--model {model}: {ic} is a run of model {_model_label(system)}, and a run continues its own "
+                       f"model; drop --model to continue it, or start a run of {model} from a state "
+                       "(--ic NAME=VALUE,... or --ic zero)")
 
 
 def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rate: float) -> None:
@@ -90,6 +113,8 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
         raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
                        f"give a time in that range")
     start = t0 + 0.5 * (t_end - t0) if steady_from is None else steady_from
+    if not math.isfinite((t_end - t0) * sample_rate):  # samples beyond counting: the run refuses them itself
+        return
     first = math.ceil((start - t0) * sample_rate - 1e-9)
     n = math.floor((t_end - t0) * sample_rate + 1e-9) - first + 1
     if n < WINDOW_SAMPLES:
@@ -188,7 +213,6 @@ def simulate(
     check_finite({"--perturb": perturb, "--steady-from": steady_from})
     time_flag = "--cap" if duration is None else "--t-end"
     longest = cap if duration is None else duration
-    check_samples(longest, settings["sample_rate"], time_flag=time_flag)
     if duration is not None:  # with --t-end auto the window is the last part of the settled run
         _check_window(steady_from, t0, t0 + duration, settings["sample_rate"])
     _check_steps(longest, settings["dt"], time_flag)
@@ -213,19 +237,25 @@ def simulate(
             verdict = None
     # a run that stopped early can be too short for its steady-state window, which the file needs
     keep = write and int(np.count_nonzero(traj.t >= traj.steady_from)) >= 2
-    figure = None
+    interrupted = traj.status_code == Status.INTERRUPTED
     if keep:
-        write_output(out, traj.to_netcdf, overwrite=overwrite, inputs=inputs)
-        if not no_plot:
-            figure = write_output(out.with_suffix(".png"), lambda tmp: save_trajectory_figure(traj, tmp),
-                                  overwrite=overwrite, inputs=inputs)
-    kept = f"what it computed is in {out}" if keep else ("it kept too few samples to write" if write else
-                                                         "nothing was written (--json without --out)")
-    if traj.status_code == Status.INTERRUPTED:
-        err_console.print(Text(f"interrupted: {traj.status}; {kept}"))
-        raise typer.Exit(130)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        keeps(out, f"the run up to t = {traj.t[-1]:g} s is in {out}" if interrupted else
+              f"the finished run is in {out}")
+        with finish_first():  # what is done is kept: a Ctrl-C now waits for the file
+            write_output(out, traj.to_netcdf, overwrite=overwrite, inputs=inputs)
+    if interrupted and not keep:
+        on_interrupt(f"the run stopped at t = {traj.t[-1]:g} s with too few samples to write; nothing was written"
+                     if write else "nothing was written (--json without --out)")
+    stop_if_interrupted()  # a Ctrl-C during the run (its part is written) or as it finished
+    figure = None
+    if keep and not no_plot:
+        keeps_figure(out)
+        figure = write_output(out.with_suffix(".png"), lambda tmp: save_trajectory_figure(traj, tmp),
+                              overwrite=overwrite, inputs=inputs)
     if traj.status != "success":
-        error_line(f"the run stopped early: {traj.status}; {kept}")
+        error_line(f"the run stopped early: {traj.status}; " + (f"what it computed is in {out}" if keep else
+                   "it kept too few samples to write" if write else "nothing was written (--json without --out)"))
         raise typer.Exit(1)
     summary = run_summary(traj, verdict)
     if as_json:

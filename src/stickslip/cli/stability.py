@@ -14,14 +14,17 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..integrate.interrupt import finish_first
+from ..memory import check_memory, largest_count
 from ..plot.stability import save_stability_map_figure
 from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ..files import write_output
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_memory, check_outputs, console)
-from .sweep import parse_values
+                   check_outputs, console)
+from ._kept import keeps, keeps_figure
+from .sweep import _VALUE_BYTES, parse_values
 
 _N_HELP = "Normal preload N [N] (default 50)."
 _OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
@@ -57,19 +60,14 @@ def stability(
     modes = Table(title="modes (one per conjugate pair), sorted by growth rate")
     for head in ("#", "growth rate [1/s]", "frequency [Hz]", "dominant DOF", "shape |.| (" + ", ".join(result.dofs) + ")"):
         modes.add_column(head, justify="right" if head != "dominant DOF" else "left")
-    for row in result.modes():
+    for number, row in enumerate(result.modes(), start=1):  # 1, 2, … (row["index"] counts both of each pair)
         shape = ", ".join(f"{abs(c):.3g}" for c in row["shape"].values())
         style = "bold red" if row["growth_rate"] > 0 else None
-        modes.add_row(str(row["index"]), f"{row['growth_rate']:.6g}", f"{row['frequency_hz']:.6g}",
+        modes.add_row(str(number), f"{row['growth_rate']:.6g}", f"{row['frequency_hz']:.6g}",
                       row["dominant_dof"], shape, style=style)
     console.print(modes)
     verdict = Text("stable", style="green") if result.stable else Text("unstable", style="bold red")
     console.print(Text.assemble(f"max real part {result.max_real_part:.6g} 1/s: steady sliding is ", verdict))
-
-
-#: Memory of a stability map [bytes]: per grid point and member, the largest real part and its
-#: stacked copy; per Ω value, a row of 12 × 12 Jacobians and the eigenvalue solver's copy.
-_MAP_POINT_BYTES, _MAP_OMEGA_BYTES = 24, 2 * 12 * 12 * 8
 
 
 def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
@@ -79,16 +77,13 @@ def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
         raise CLIError(f"--{name}-points must be >= 2, got {n}")
     if not hi > lo:
         raise CLIError(f"--{name}-max {hi:g} must be greater than --{name}-min {lo:g}")
+    check_memory(n * float(_VALUE_BYTES), f"--{name}-points {n}",
+                 lambda memory: f"give --{name}-points {largest_count(_VALUE_BYTES, memory)} or fewer")
     if name == "N" and lo <= 0:
         raise CLIError(f"--N-min {lo:g}: normal loads must be > 0 (the plates are pressed together)")
     if name == "omega" and lo <= 0 <= hi:
         raise CLIError(f"--omega-min {lo:g} and --omega-max {hi:g} straddle 0, where there is no steady sliding; "
                        "give a range on one side of 0, e.g. --omega-min 0.2 --omega-max 20")
-
-
-def _check_grid_memory(n_points: int, omega_points: int, members: int) -> None:
-    need = float(n_points) * omega_points * members * _MAP_POINT_BYTES + float(omega_points) * _MAP_OMEGA_BYTES
-    check_memory(need, f"a {n_points} × {omega_points} map of {members} member(s)", "lower --N-points or --omega-points")
 
 
 @app.command("stability-map")
@@ -134,13 +129,15 @@ def stability_map(
     if axis is None and system.name != "two-plates":
         raise CLIError(f"model {system.name!r} has no N and Ω: give its two axes, e.g. "
                        "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
-    _check_grid_memory(values[0].size, values[1].size, 1 if members is None else len(members[1]))
     inputs = {"--config": config}
     check_outputs(out, not no_plot, overwrite, inputs=inputs)
     smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
-    write_output(out, smap.to_netcdf, overwrite=overwrite, inputs=inputs)
+    keeps(out, f"the map is in {out}")
+    with finish_first():  # a Ctrl-C now lets the map be written, then stops
+        write_output(out, smap.to_netcdf, overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_stability_map_figure(smap, tmp),
                               overwrite=overwrite, inputs=inputs)
     rows = []

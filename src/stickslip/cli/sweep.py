@@ -17,6 +17,7 @@ import typer
 from rich.table import Table
 
 from ..analysis.classify import KINDS
+from ..memory import check_memory, largest_count
 from ..model.library import plates_variant
 from ..model.parameters import Parameters
 from ..plot.regions import save_regions_figure
@@ -27,13 +28,11 @@ from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import columns_of
 from ..files import write_output
 from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
-                   check_finite, check_memory, check_positive, check_resumable_output, check_samples, config_values,
-                   console, parse_assignments)
+                   check_finite, check_positive, check_resumable_output, config_values, console, parse_assignments,
+                   resumable_holds)
+from ._kept import keeps, keeps_figure
 
 _CATEGORICAL = ("model", "ic")
-
-#: Memory per grid point of a sweep [bytes]: its coordinate values, done mask and pending index.
-_POINT_BYTES = 32
 
 #: Memory per value of a parsed axis [bytes]: a Python float in a list and its array copies.
 _VALUE_BYTES = 64
@@ -86,7 +85,8 @@ def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
             raise CLIError(f"{given}: count must be >= 2 (for one value write {prefix}{parts[0]})")
         if start == stop:
             raise CLIError(f"{given}: start equals stop; give different ends or a single value")
-        check_memory(count * float(_VALUE_BYTES), f"{given} ({count} values)", f"give a smaller count in {option}")
+        check_memory(count * float(_VALUE_BYTES), f"{given} ({count:.3g} values)",
+                     lambda memory: f"give a count of at most {largest_count(_VALUE_BYTES, memory)}")
         return np.linspace(start, stop, count).tolist()
     try:
         values = [float(v) for v in text.split(",")]
@@ -111,13 +111,6 @@ def parse_grid(items: list[str] | None) -> dict:
     if not grid:
         raise CLIError("give at least one --grid NAME=VALUES, e.g. --grid N=10:130:13")
     return grid
-
-
-def _check_grid(grid: dict, n_peaks: int = 64) -> None:
-    """Refuse a grid whose points (and their peaks) would not fit in memory."""
-    points = math.prod(len(v) for v in grid.values())
-    check_memory(points * (_POINT_BYTES + 8.0 * n_peaks), f"a grid of {points} points with {n_peaks} peaks each",
-                 "give fewer values" + (" or a smaller --peaks" if n_peaks > 64 else ""))
 
 
 def _executor(executor: str | None, scheduler: str | None) -> str:
@@ -159,7 +152,6 @@ def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_
         raise CLIError(f"--workers must be >= 1, got {workers}")
     check_positive({"--t-end": t_end, "--sample-rate": sample_rate, "--rtol": rtol, "--atol": atol})
     check_finite({"--t-from": t_from})
-    check_samples(t_end, sample_rate)
     return dict(executor=_executor(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
                 overwrite=overwrite, t_end=t_end, t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
 
@@ -235,14 +227,15 @@ def sweep_command(
     columns = _plot_columns(system)
     if plot_var not in columns or plot_var == "peaks":
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in columns if c != 'peaks')}")
-    _check_grid(values)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     options.update(_settle_options(settle, cap, t_end))
     inputs = {"--config": config}
     replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
+    keeps(out, resumable_holds("sweep"))
     result = run_sweep(values, target, out=out, model=variant, ic=ic, **options)
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_sweep_figure(result, tmp, var=plot_var),
                               overwrite=replace_figure, inputs=inputs)
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
@@ -303,14 +296,15 @@ def bifurcation(
     grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
-    _check_grid(grid, n_peaks)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     options.update(_settle_options(settle, cap, t_end))
     inputs = {"--config": config}
     replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
+    keeps(out, resumable_holds("bifurcation diagram"))
     result = run_sweep(grid, target, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_bifurcation_figure(result, tmp),
                               overwrite=replace_figure, inputs=inputs)
     _report(f"bifurcation diagram of {coordinate} against {param}", out, figure, result.timings, result.dataset, as_json)
@@ -376,15 +370,16 @@ def regions_command(
     n_values = parse_values("N", N, option="--N")
     w_values = parse_values("Omega", omega, option="--omega")
     models = parse_values("model", model, option="--model")
-    _check_grid({"model": models, "N": n_values, "Omega": w_values, "ic": [0, 0]})
     if t_from is None and math.isfinite(t_end):
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
     inputs = {"--config": config}
     replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
+    keeps(out, resumable_holds("region map"))
     rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
     figure = None
     if not no_plot:
+        keeps_figure(out)
         figure = write_output(out.with_suffix(".png"), lambda tmp: save_regions_figure(rmap, tmp),
                               overwrite=replace_figure, inputs=inputs)
 

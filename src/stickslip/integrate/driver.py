@@ -12,18 +12,68 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import SimulationError
+from ..memory import check_memory, format_bytes, largest_count, sample_bytes
 from ..model.library import resolve_system
 from ..model.library.two_plates import is_plates
 from .fixed_step import run_fixed_step
 from .initial import initial_state
-from .interrupt import partial_on_ctrl_c
+from .interrupt import forget_ctrl_c, partial_on_ctrl_c
 from .result import Stats, Trajectory, Transitions
 from .runner import NO_STEP_CAP, run_event
 
-__all__ = ["simulate", "METHODS", "MAX_SAMPLES"]
+__all__ = ["simulate", "METHODS", "MAX_SAMPLES", "check_samples", "round_down"]
 
 #: Largest number of uniform samples a run may keep (each ~ (2n + 2 + 2 nc) float64 and a flag byte).
 MAX_SAMPLES = 20_000_000
+
+
+def round_down(x: float) -> float:
+    """``x`` (> 0) rounded down to 3 significant digits: a setting quoted in a message that fits."""
+    if not x > 0 or not math.isfinite(x):
+        return 0.0
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    return math.floor(x / step * (1 + 1e-12)) * step  # 1e-12: 582 computed as 581.999… stays 582
+
+
+def check_samples(system, duration: float, sample_rate: float, *, run: str = "the run",
+                  rate_settable: bool = True) -> int:
+    """The samples a run of ``duration`` seconds at ``sample_rate`` keeps, refused before anything is
+    allocated when they are more than :data:`MAX_SAMPLES` or their memory
+    (:func:`stickslip.memory.sample_bytes` each, the run written and drawn) is more than available.
+
+    Parameters
+    ----------
+    system : FrictionModel
+    duration, sample_rate : float
+        Run length [s] and samples per second [Hz], finite and > 0.
+    run : str
+        The run's name in the message (``"the transient (t_transient)"``).
+    rate_settable : bool
+        Whether the caller's user sets the sample rate; if not, the message names only the length.
+
+    Raises
+    ------
+    SimulationError, MemoryLimitError
+        With the sample rate and the run length that fit (each on its own).
+    """
+    raw = duration * sample_rate
+    count = math.floor(raw + 1e-9) + 1.0 if math.isfinite(raw) else math.inf  # a float: a huge request stays a number
+
+    def fits(limit: float) -> str:
+        length = f"shorten {run} to at most {round_down((limit - 1.0) / sample_rate):.3g} s"
+        if not rate_settable:
+            return length
+        return f"lower the sample rate to at most {round_down((limit - 1.0) / duration):.3g} Hz or {length}"
+
+    if count > MAX_SAMPLES:
+        shown = f"{count:.3g}" if math.isfinite(count) else "more than 1e+308"
+        raise SimulationError(f"{run} of {duration:.6g} s at {sample_rate:.6g} Hz keeps {shown} samples, more than the "
+                              f"{MAX_SAMPLES:.3g} a run may keep; {fits(MAX_SAMPLES)}")
+    per = sample_bytes(system.n, system.n_contacts)
+    check_memory(count * per, f"{run} ({count:.3g} samples of model {system.name!r}, {format_bytes(per)} each)",
+                 lambda memory: fits(min(largest_count(per, memory), MAX_SAMPLES)))
+    return int(count)
+
 
 #: Integration methods by name; ``aeom`` and ``naeom`` are the paper's fixed-step methods for the
 #: two plates only.
@@ -106,6 +156,8 @@ def simulate(
     ------
     SimulationError
         For invalid options (each message names the fix).
+    MemoryLimitError
+        When the samples asked for would not fit in the memory available (before any is allocated).
     """
     if method not in METHODS:
         raise SimulationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
@@ -123,11 +175,7 @@ def simulate(
     sample_rate = _check_positive("sample_rate", sample_rate, "give samples per second, e.g. 1000")
     if dt is not None:
         dt = _check_positive("dt", dt, "give a step in seconds, e.g. 1e-4")
-    n_samples = int(math.floor((t_end - t0) * sample_rate + 1e-9)) + 1
-    if n_samples > MAX_SAMPLES:
-        raise SimulationError(
-            f"{n_samples} samples requested (t_end × sample_rate); lower sample_rate to keep ≤ {MAX_SAMPLES}"
-        )
+    n_samples = check_samples(system, t_end - t0, sample_rate)
     y0 = initial_state(system, ic, perturbation)
     sample_times = t0 + np.arange(n_samples) / sample_rate
 
@@ -140,6 +188,7 @@ def simulate(
                           max_steps=NO_STEP_CAP if max_steps is None else int(max_steps))
     wall = time.perf_counter() - start - out.stats["compile_time_s"]  # integration only
     if out.interrupted and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
+        forget_ctrl_c()  # acted on here
         raise KeyboardInterrupt
     code, record, n_kept = out.status, out.record, out.record.n
     if n_kept == 0:

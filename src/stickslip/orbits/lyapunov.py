@@ -21,14 +21,16 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import time as _time
 
 import numpy as np
 
 from .._version import __version__
 from ..errors import OrbitError, SimulationError
-from ..integrate.driver import simulate
+from ..integrate.driver import check_samples, round_down, simulate
 from ..integrate.initial import initial_state
+from ..memory import average_bytes, check_memory, format_bytes, largest_count
 from ..model.system_model import FrictionModel
 from .layout import free_states
 from .linear_flow import propagate
@@ -41,6 +43,9 @@ __all__ = ["LyapunovResult", "lyapunov_exponent", "LyapunovSpectrum", "lyapunov_
 #: Default initial separation in the scaled norm [-]: 1e-7 of the attractor's range is far
 #: above the integration noise at rtol 1e-10 (~1e-10 σ) and far inside the linear regime.
 DEFAULT_D0 = 1e-7
+
+#: Samples per second of the transient run [Hz], whose second half sets the scales of the norm.
+TRANSIENT_RATE = 200.0
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -110,8 +115,26 @@ class LyapunovResult(ModelResult):
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band):
-    """The common start of the Lyapunov computations: resolve the start, run the transient.
+def _check_memory(system, t_transient: float, t_average: float, interval: float, option: str) -> None:
+    """Refuse, before anything runs, a transient whose samples or an average whose running
+    estimates (one per ``interval`` seconds, named by ``option``) would not fit in memory."""
+    if math.isfinite(t_transient):
+        check_samples(system, t_transient, max(TRANSIENT_RATE, 1.0 / t_transient),
+                      run="the transient (t_transient, --t-transient)", rate_settable=False)
+    if not (math.isfinite(interval) and interval > 0):
+        return
+    count = t_average / interval
+    per = average_bytes(2 * system.n)  # at most 2n exponents
+    check_memory(count * per, f"an average over {t_average:.3g} s ({count:.3g} running estimates, one per "
+                 f"{interval:g} s of {option}, {format_bytes(per)} each)",
+                 lambda memory: f"shorten t_average (--t-average) to at most "
+                                f"{round_down(largest_count(per, memory) * interval):.3g} s or lengthen {option}")
+
+
+def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average=0.0,
+                     interval=math.inf, option="chunk"):
+    """The common start of the Lyapunov computations: resolve the start, check the memory of the
+    transient and of the running estimates (one per ``interval`` of ``t_average``), run the transient.
 
     ``ic`` may be a :class:`PeriodicOrbit` (its model is then the default).
     Returns the flow map as a :class:`.problem.ShootingProblem` without a section (σ: the
@@ -125,13 +148,14 @@ def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, s
     atol = 1e-3 * rtol if atol is None else float(atol)
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
+    _check_memory(system, t_transient, t_average, interval, option)
     if perturbation is None and isinstance(ic, str) and ic == "equilibrium":
         perturbation = 1e-3
     try:
         s = initial_state(system, ic, perturbation)
     except SimulationError as exc:
         raise OrbitError(f"bad initial condition: {exc}") from exc
-    tr = simulate(system, t_transient, ic=s, sample_rate=max(200.0, 1.0 / t_transient), rtol=rtol, atol=atol)
+    tr = simulate(system, t_transient, ic=s, sample_rate=max(TRANSIENT_RATE, 1.0 / t_transient), rtol=rtol, atol=atol)
     if tr.status != "success":
         raise OrbitError(f"the transient run failed: {tr.status}")
     half = tr.t >= 0.5 * t_transient
@@ -196,7 +220,8 @@ def lyapunov_exponent(
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
-    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average,
+                                      chunk, "chunk")
     free, sigma = problem.free, problem.sigma
 
     def perturbed(direction):
@@ -367,7 +392,9 @@ def lyapunov_spectrum(
     t_start = _time.perf_counter()
     if t_average <= 0.0:
         raise OrbitError(f"t_average = {t_average} s must be > 0")
-    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band)
+    interval, option = (chunk, "chunk") if method == "finite-difference" else (record, "record")
+    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average,
+                                      interval, option)
     if method == "finite-difference":
         return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
     if method != "variational":

@@ -14,7 +14,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import ContinuationError, OrbitError, SimulationError
-from ..integrate.driver import simulate
+from ..integrate.driver import check_samples, simulate
 from ..integrate.result import Trajectory
 from ..model.system_model import FrictionModel
 from .models import ModelResult, parameter_value, resolve
@@ -56,6 +56,8 @@ def start_run(system, ic=None, *, model=None, t_end: float = START_RUN, rtol: fl
     """
     system = resolve(system, model, slip_band)
     ic = default_start(system) if ic is None else ic
+    if t_end > 0 and t_end < float("inf"):  # its samples: refused by their length, the rate is ours
+        check_samples(system, t_end, START_RATE, run="the start run (--search-time)", rate_settable=False)
     try:
         run = simulate(system, t_end, ic=ic, sample_rate=START_RATE, rtol=rtol, atol=1e-3 * rtol)
     except SimulationError as exc:

@@ -25,6 +25,7 @@ from scipy import optimize
 from .._version import __version__
 from ..errors import ModelError, ParameterError
 from ..files import atomic_write, format_name, open_ours
+from ..memory import check_memory, largest_count, map_point_bytes
 from ..model.library import describe_system, system_from_description
 from ..model.library.two_plates import plates_parameters
 from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
@@ -93,6 +94,27 @@ def _check_axis_values(system, name: str, values: np.ndarray) -> None:
         if min(sliding_speeds(member, np.zeros(member.n))) == 0.0:
             raise ValueError(f"{name} = {v:g} has no steady sliding (a contact does not slide at rest: the friction "
                              "direction is undefined); leave it out of the grid")
+
+
+def _check_memory(system, na: int, nb: int, members: int, every_point: bool = False) -> None:
+    """Refuse a map whose grid would not fit in memory, before it is built: per point and member
+    :func:`stickslip.memory.map_point_bytes`, per axis value (every point when the axes are not
+    separable) a row of the model's data, and the Jacobians of one compiled call with their
+    eigenvalue copy."""
+    row = 8.0 * _row(system).size
+    k = 2 * system.n
+    per = map_point_bytes(members) + (members * row if every_point else 0.0)
+    fixed = members * (na + nb) * row + 2.0 * CHUNK_POINTS * 8 * k * k
+
+    def fits(memory: float) -> str:
+        side = math.isqrt(largest_count(per, memory, fixed))  # of a square grid that fits
+        if side < 2:
+            return f"free memory: its fixed arrays alone take {fixed / 1e6:.3g} MB"
+        return f"give at most {side ** 2:.3g} points, e.g. {side} values per axis"
+
+    check_memory(float(na) * nb * per + fixed,
+                 f"a stability map of {na:.3g} × {nb:.3g} points and {members} member(s) of model {system.name!r}",
+                 fits)
 
 
 def _row(system) -> np.ndarray:
@@ -194,6 +216,7 @@ class MapGrid:
             separable = np.array_equal(np.abs(corner - full) <= 1e-13 * np.maximum(np.abs(full), 1e-300),
                                        np.ones_like(full, dtype=bool))
         if not separable:
+            _check_memory(system, a.size, b.size, 1, every_point=True)
             rows_a = np.array([_row(system.replace(**{names[0]: float(x), names[1]: float(y)}))
                                for x in a for y in b])
             mask_b = np.zeros_like(mask_b)
@@ -520,6 +543,7 @@ def stability_map(
     if fam_name in axes:
         raise ValueError(f"family parameter {fam_name!r} is already an axis of the map; choose another parameter")
     name, values, systems = _members(system, fam)
+    _check_memory(system, N.size, Omega.size, len(systems))
     t0 = time.perf_counter()
     grids = [MapGrid.build(sy, axes, N, Omega) for sy in systems]
     mrp = np.stack([g.max_real_part() for g in grids])

@@ -13,9 +13,11 @@ import numpy as np
 
 from ..analysis.classify import KINDS
 from ..errors import SweepError
+from ..integrate.driver import check_samples
 from ..journal import finished_output, output_path
+from ..memory import check_memory, format_bytes, grid_point_bytes, largest_count, sample_bytes
 from ..parallel import check_executor, check_workers, map_unordered
-from .spec import SweepSpec, evaluate_batch, warm_up
+from .spec import SweepSpec, evaluate_batch, spec_system, warm_up
 from .store import Journal, assemble, load_sweep
 
 __all__ = ["SweepResult", "sweep", "TARGET_BATCH_S"]
@@ -86,6 +88,30 @@ def _settle_attrs(spec: SweepSpec) -> dict:
                      settle_comment="each run extended from its final state in steps of t_end - t_from until "
                                     "settled or cap; settle_time per point, window t_end - t_from at its end")
     return attrs
+
+
+def _check_memory(spec: SweepSpec, runs: int) -> None:
+    """Refuse, before anything runs, a sweep whose runs or grid would not fit in memory: one run
+    (:func:`~stickslip.integrate.driver.check_samples`), then the grid's rows beside ``runs`` runs
+    held at once in this machine's workers."""
+    system = spec_system(spec)
+    run = check_samples(system, spec.t_end, spec.sample_rate) * sample_bytes(system.n, system.n_contacts)
+    points = math.prod(spec.shape)  # a Python int: no overflow for a huge grid
+    per = grid_point_bytes(spec.row_width)
+
+    def fits(memory: float) -> str:
+        fixes = []
+        if largest_count(per, memory, runs * run) >= 1:
+            fixes.append(f"give at most {largest_count(per, memory, runs * run):.3g} points (fewer values)")
+        others = spec.row_width - spec.n_peaks  # the numbers of a point besides its peaks
+        per_peak = grid_point_bytes(1) - grid_point_bytes(0)
+        peaks = largest_count(per_peak, (memory - runs * run) / points, grid_point_bytes(others))
+        if peaks < spec.n_peaks:
+            fixes.append(f"keep at most {peaks} peaks a point (n_peaks, --peaks)")
+        return " or ".join(fixes)
+
+    check_memory(points * per + runs * run, f"a sweep of {points:.3g} points ({format_bytes(per)} each, beside {runs} "
+                 f"run(s) of {format_bytes(run)} at a time)", fits)
 
 
 def _progress_bar():
@@ -169,6 +195,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
     check_executor(executor)
     workers = check_workers(workers, address=address)
+    _check_memory(spec, 0 if address else 1 if executor == "serial" else workers)
     out, tmpdir = output_path(out, "sweep.nc", SweepError)
     ds = finished_output(out, spec.digest, lambda path: load_sweep(path, load="auto"), what="sweep", error=SweepError,
                          overwrite=overwrite)

@@ -267,7 +267,7 @@ class SweepSpec:
             raise SweepError("n_peaks must be >= 1")
         if spec.sample_rate * (t_end - t_from) < 8:
             raise SweepError("the steady window holds fewer than 8 samples; raise sample_rate or t_end")
-        if not (math.isfinite(spec.cap) and spec.cap >= t_end):
+        if spec.settle and not (math.isfinite(spec.cap) and spec.cap >= t_end):
             raise SweepError(f"cap = {spec.cap} s must be a finite number ≥ t_end = {t_end} s")
         return spec
 

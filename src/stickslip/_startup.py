@@ -1,0 +1,106 @@
+"""What must happen before stickslip imports numba: Ctrl-C held during the import, and numba's
+thread count read from the environment made valid.
+
+**Ctrl-C while importing.** ``import stickslip`` takes most of a second (numpy, scipy, numba and
+the package's modules), and the command line imports it before any of its own code runs. A
+SIGINT then would end the process in a traceback from whatever module was being imported. So
+:func:`hold` (the first thing ``stickslip/__init__.py`` does, and the command line around its own
+imports and start-up) replaces the default SIGINT handler by one that records the request;
+:func:`release` puts the handler back and, for a request held meanwhile, raises
+KeyboardInterrupt once, at the end of the import, with a one-line report of it in place of the
+traceback (``interrupted: nothing was written``; the process then ends as Python ends on an
+unhandled Ctrl-C, exit status 130 in a shell). The command line releases with
+``raise_pending=False`` and reports the request itself. A second Ctrl-C while held raises at
+once. Only the default handler is replaced, in the main thread: a process that ignores SIGINT,
+or installed its own handler, keeps it.
+
+**NUMBA_NUM_THREADS.** numba refuses to be imported with ``NUMBA_NUM_THREADS`` below 1 (a
+``ValueError`` from deep inside its import). stickslip runs no parallel numba code, so the
+setting has no effect on it: a value that is not a number ≥ 1 is removed from this process's
+environment before numba is imported, and :data:`notes` says so (the command line prints it as a
+warning line).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+
+__all__ = ["hold", "release", "notes", "INTERRUPTED_LINE"]
+
+#: What a Ctrl-C during the import leaves: nothing was computed or written yet.
+INTERRUPTED_LINE = "interrupted: nothing was written"
+
+#: Messages about the environment, for the caller to show (one line each).
+notes: list[str] = []
+
+_state = {"depth": 0, "previous": None, "pending": False}
+
+
+def _held(signum, frame) -> None:
+    if _state["pending"]:  # a second Ctrl-C: out now
+        raise KeyboardInterrupt
+    _state["pending"] = True
+
+
+def hold() -> None:
+    """Record Ctrl-C instead of raising it, until :func:`release` (nested calls count)."""
+    _state["depth"] += 1
+    if _state["depth"] > 1 or threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        try:
+            _state["previous"] = signal.signal(signal.SIGINT, _held)
+        except ValueError:  # pragma: no cover - not the main interpreter
+            _state["previous"] = None
+
+
+def release(raise_pending: bool = True) -> bool:
+    """End one :func:`hold`; at the outermost, put the handler back. Returns whether a Ctrl-C was
+    held (and forgets it); with ``raise_pending`` such a Ctrl-C raises KeyboardInterrupt instead,
+    reported in one line if nothing catches it."""
+    _state["depth"] = max(_state["depth"] - 1, 0)
+    if _state["depth"] > 0:
+        return False
+    if _state["previous"] is not None:
+        signal.signal(signal.SIGINT, _state["previous"])
+        _state["previous"] = None
+    pending, _state["pending"] = _state["pending"], False
+    if pending and raise_pending:
+        _report_once_if_unhandled()
+        raise KeyboardInterrupt
+    return pending
+
+
+def _report_once_if_unhandled() -> None:
+    """Make an unhandled KeyboardInterrupt print :data:`INTERRUPTED_LINE` instead of a traceback,
+    once (the hook then puts the previous one back)."""
+    previous = sys.excepthook
+
+    def hook(kind, value, tb):
+        sys.excepthook = previous
+        if issubclass(kind, KeyboardInterrupt):
+            print(INTERRUPTED_LINE, file=sys.stderr)
+        else:
+            previous(kind, value, tb)
+
+    sys.excepthook = hook
+
+
+def _check_numba_threads() -> None:
+    text = os.environ.get("NUMBA_NUM_THREADS")
+    if text is None:
+        return
+    try:
+        valid = int(text.strip()) >= 1
+    except ValueError:
+        valid = False  # numba would warn and use its default; say it here once instead
+    if not valid:
+        del os.environ["NUMBA_NUM_THREADS"]
+        notes.append(f"NUMBA_NUM_THREADS={text} is not a number of threads >= 1 and is ignored (stickslip runs "
+                     "no parallel numba code); unset it or give a number >= 1")
+
+
+_check_numba_threads()
