@@ -55,7 +55,7 @@ from .errors import DiskFullError, FileFormatError, LockError, OutputError, Stic
 __all__ = ["FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError", "OutputLock", "lock",
            "lock_path", "atomic_write", "atomic_write_text", "write_output", "refuse_output", "same_file",
            "temporary_path", "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name",
-           "writing_errors"]
+           "writing_errors", "netcdf_writer", "save_netcdf"]
 
 
 #: ``errno`` values of a full disk, an exhausted quota and a file over ``RLIMIT_FSIZE`` (Python
@@ -494,7 +494,8 @@ def same_file(a, b) -> bool:
         return False
 
 
-def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out", what: str | None = None) -> None:
+def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out", what: str | None = None,
+                  overwrite_hint: str = "--overwrite") -> None:
     """Refuse to write ``path`` onto an input, a folder, or (without ``overwrite``) an existing file.
 
     Parameters
@@ -508,6 +509,9 @@ def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out", wh
         The option that names ``path``, for the messages.
     what : str, optional
         How the messages name ``path`` (default ``"{flag} {path}"``; e.g. a figure beside the output).
+    overwrite_hint : str
+        How the caller asks for a replacement (``--overwrite`` on the command line,
+        ``overwrite=True`` in Python).
 
     Raises
     ------
@@ -522,11 +526,11 @@ def refuse_output(path, *, overwrite: bool, inputs=None, flag: str = "--out", wh
     if path.is_dir():
         raise OutputError(f"{what} is a directory; give a file name")
     if (path.exists() or path.is_symlink()) and not overwrite:
-        raise OutputError(f"{path} exists; pass --overwrite to replace it, or give another {flag}")
+        raise OutputError(f"{path} exists; pass {overwrite_hint} to replace it, or give another {flag}")
 
 
 def write_output(path, write: Callable[[Path], object], *, overwrite: bool = False, inputs=None,
-                 flag: str = "--out", kept: str | None = None) -> Path:
+                 flag: str = "--out", kept: str | None = None, overwrite_hint: str = "--overwrite") -> Path:
     """Write the output file ``path``: the one path every command's outputs take.
 
     Takes ``path``'s lock (re-entrant: a command that holds it already keeps it), refuses an
@@ -546,6 +550,8 @@ def write_output(path, write: Callable[[Path], object], *, overwrite: bool = Fal
         The option that names ``path`` (messages).
     kept : str, optional
         What a full disk leaves, for the :class:`WriteError` message.
+    overwrite_hint : str
+        How the caller asks for a replacement, for the :class:`OutputError` message.
 
     Raises
     ------
@@ -558,6 +564,22 @@ def write_output(path, write: Callable[[Path], object], *, overwrite: bool = Fal
     """
     path = Path(path)
     with OutputLock(path):
-        refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag)
+        refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag, overwrite_hint=overwrite_hint)
         path.parent.mkdir(parents=True, exist_ok=True)
         return atomic_write(path, write, kept=kept)
+
+
+def netcdf_writer(ds) -> Callable[[Path], object]:
+    """The ``write(tmp)`` callback of :func:`write_output` that writes the ``xarray.Dataset``
+    ``ds`` as NetCDF-4 (h5netcdf engine)."""
+    return lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf")
+
+
+def save_netcdf(ds, path, *, overwrite: bool = False, kept: str | None = None) -> Path:
+    """Write ``ds`` to ``path`` for a result's ``to_netcdf`` method (:func:`write_output`).
+
+    An existing ``path`` is replaced only with ``overwrite=True`` (else :class:`OutputError`), so
+    a finished run is never lost to a second call with the same name.
+    """
+    return write_output(path, netcdf_writer(ds), overwrite=overwrite, flag="path", kept=kept,
+                        overwrite_hint="overwrite=True")

@@ -2,7 +2,6 @@
 closed form, its slip phases against scipy's solve_ivp with the law written out here in numpy, its
 Jacobian against central differences, and the refusals of a law that cannot be used."""
 
-import math
 
 import numpy as np
 import pytest

@@ -14,7 +14,7 @@ import pytest
 
 from reliability.helpers import wait_for  # the fault suite's helpers (tests/reliability; needs psutil)
 from reliability.test_worker_processes import GRACE_S, _alive, _descendants_once_running
-from stickslip.orbits import arclength, region_edge
+from stickslip.orbits import region_edge
 from stickslip.orbits import continuation as C
 from stickslip.errors import WorkersError
 from stickslip.parallel import default_workers

@@ -8,7 +8,7 @@ import pytest
 
 from stickslip import Parameters, simulate
 from stickslip.orbits import OrbitError, PeriodicOrbit, periodic_orbit
-from stickslip.orbits.section import section_crossings, resolve_section
+from stickslip.orbits.section import section_crossings
 
 
 def belt(Omega=0.5):

@@ -20,7 +20,6 @@ from hypothesis import strategies as st
 from stickslip import files
 from stickslip.files import AppendLog, FileFormatError, LockError, WriteError, atomic_write, lock, open_ours
 
-from .helpers import wait_for
 
 _HOLDER = """
 import sys, time

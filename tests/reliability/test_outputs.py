@@ -177,3 +177,30 @@ def test_a_folder_that_takes_no_files_is_one_honest_line(args):
     line = one_line(invoke(*args))
     assert "/proc/sw.nc" in line and "choose another" in line
     assert "being written" not in line and ".tmp" not in line
+
+
+def test_a_result_written_from_python_never_silently_replaces_a_file(tmp_path):
+    """``Trajectory.to_netcdf`` and ``StabilityMap.to_netcdf`` refuse an existing file unless told
+    ``overwrite=True``, in the Python API's words, and leave the first file as it was."""
+    import numpy as np
+
+    import stickslip
+    from stickslip.errors import OutputError
+
+    belt = stickslip.load_model("belt")
+    first, second = stickslip.simulate(belt, 1.0), stickslip.simulate(belt, 2.0)
+    path = tmp_path / "run.nc"
+    first.to_netcdf(path)
+    with pytest.raises(OutputError, match=r"run\.nc exists; pass overwrite=True to replace it, or give another path"):
+        second.to_netcdf(path)
+    assert stickslip.load_trajectory(path).t[-1] == first.t[-1]
+    second.to_netcdf(path, overwrite=True)
+    assert stickslip.load_trajectory(path).t[-1] == second.t[-1]
+    assert not lock_path(path).exists()
+
+    smap = stickslip.stability_map(belt, np.linspace(0.5, 2.0, 3), np.linspace(0.5, 1.0, 2),
+                                   axes=("contact.0.normal_force", "contact.0.drive"))
+    with pytest.raises(OutputError, match="overwrite=True"):
+        smap.to_netcdf(path)
+    smap.to_netcdf(tmp_path / "map.nc")
+    assert stickslip.load_stability_map(tmp_path / "map.nc").to_xarray().identical(smap.to_xarray())

@@ -11,7 +11,7 @@ from stickslip.analysis.intensity import intensity
 from stickslip.model.library import load_model
 from stickslip.stability.equilibrium import steady_sliding
 from stickslip.sweep import load_sweep, sweep
-from stickslip.sweep.spec import SweepError, SweepSpec
+from stickslip.sweep.spec import SweepSpec
 
 DRIVES = [0.6, 1.5, 2.4]
 RUN = dict(t_end=60.0, t_from=30.0, sample_rate=100.0, ic="zero")

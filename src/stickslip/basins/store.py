@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import BasinError
-from ..files import format_name, open_ours, write_output
+from ..files import format_name, netcdf_writer, open_ours, write_output
 from ..journal import RowJournal, journal_path
 
 __all__ = ["Journal", "journal_dir", "write_dataset", "load_basins", "FORMAT"]
@@ -77,7 +77,7 @@ def write_dataset(ds, path: Path, journal: Journal | None = None) -> Path:
     stickslip.files.WriteError
         If the disk is full; ``path`` is left as it was (and the journal keeps every state).
     """
-    write = lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf")  # noqa: E731
+    write = netcdf_writer(ds)
     if journal is not None:
         return journal.snapshot(write, path)
     return write_output(path, write, overwrite=True)

@@ -18,7 +18,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..files import write_output
+from ..files import netcdf_writer, write_output
 from ..integrate.interrupt import finish_first
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import start_run
@@ -80,7 +80,7 @@ def _write(*, ds_of, out: Path, holds: str, overwrite: bool, inputs: dict) -> No
     keeps(out, holds)
     with finish_first():
         ds = ds_of()
-        write_output(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=overwrite, inputs=inputs)
+        write_output(out, netcdf_writer(ds), overwrite=overwrite, inputs=inputs)
 
 
 def _finite_or_none(x: float):

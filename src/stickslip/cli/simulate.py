@@ -23,7 +23,7 @@ from rich.text import Text
 
 from ..attractors import run_summary, simulate_until_settled
 from ..integrate.driver import simulate as run_simulation
-from ..files import write_output
+from ..files import netcdf_writer, write_output
 from ..integrate.interrupt import finish_first, on_ctrl_c, stop_if_interrupted
 from ..integrate.result import load_trajectory
 from ..integrate.status import Status
@@ -243,7 +243,7 @@ def simulate(
         keeps(out, f"the run up to t = {traj.t[-1]:g} s is in {out}" if interrupted else
               f"the finished run is in {out}")
         with finish_first():  # what is done is kept: a Ctrl-C now waits for the file
-            write_output(out, traj.to_netcdf, overwrite=overwrite, inputs=inputs)
+            write_output(out, netcdf_writer(traj.to_xarray()), overwrite=overwrite, inputs=inputs)
     if interrupted and not keep:
         on_interrupt(f"the run stopped at t = {traj.t[-1]:g} s with too few samples to write; nothing was written"
                      if write else "nothing was written (--json without --out)")

@@ -20,7 +20,7 @@ from ..plot.stability import save_stability_map_figure
 from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
-from ..files import write_output
+from ..files import netcdf_writer, write_output
 from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
                    check_outputs, console)
 from ._kept import keeps, keeps_figure
@@ -134,7 +134,7 @@ def stability_map(
     smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
     keeps(out, f"the map is in {out}")
     with finish_first():  # a Ctrl-C now lets the map be written, then stops
-        write_output(out, smap.to_netcdf, overwrite=overwrite, inputs=inputs)
+        write_output(out, netcdf_writer(smap.to_xarray()), overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
         keeps_figure(out)

@@ -13,7 +13,7 @@ from numba import njit
 from .._version import __version__
 from ..analysis.steady import SteadyState, summarize
 from ..errors import FileFormatError
-from ..files import atomic_write, format_name, open_ours
+from ..files import format_name, open_ours, save_netcdf
 from ..model import physics
 from ..model.library import describe_system, system_from_description, two_plates
 from ..model.library.two_plates import is_plates, plates_parameters
@@ -345,10 +345,13 @@ class Trajectory(Plottable):
                 np.asarray(value, dtype=float) if isinstance(value, tuple) else value
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def to_netcdf(self, path: str | Path) -> Path:
-        """Write :meth:`to_xarray` to a NetCDF-4 file (h5netcdf engine), atomically."""
-        ds = self.to_xarray()
-        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    def to_netcdf(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Write :meth:`to_xarray` to a NetCDF-4 file (h5netcdf engine), atomically.
+
+        An existing ``path`` is replaced only with ``overwrite=True``
+        (:class:`stickslip.errors.OutputError` otherwise).
+        """
+        return save_netcdf(self.to_xarray(), path, overwrite=overwrite)
 
     @classmethod
     def from_xarray(cls, ds, system: FrictionModel | None = None) -> "Trajectory":

@@ -145,9 +145,13 @@ class Branch(ModelResult):
         """``xarray.Dataset`` with dims ``point``, ``state``, ``multiplier`` and ``special``."""
         return store.branch_dataset(self)
 
-    def to_netcdf(self, path) -> Path:
-        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
-        return store.write_dataset(self.to_xarray(), path)
+    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename).
+
+        An existing ``path`` is replaced only with ``overwrite=True``
+        (:class:`stickslip.errors.OutputError` otherwise).
+        """
+        return store.write_dataset(self.to_xarray(), path, overwrite=overwrite)
 
     @classmethod
     def from_xarray(cls, ds) -> "Branch":
@@ -420,7 +424,7 @@ def continue_orbit(
                               walk.elapsed + time.perf_counter() - t_start, resumed if out is not None else None,
                               digest)
     if journal is not None:
-        branch.to_netcdf(out)
+        store.write_dataset(branch.to_xarray(), out)
         journal.remove()
     return branch
 

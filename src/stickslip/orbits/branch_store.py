@@ -43,7 +43,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import FileFormatError, OrbitError
-from ..files import OutputLock, atomic_write, write_output
+from ..files import OutputLock, atomic_write, save_netcdf
 from ..integrate.result import Trajectory
 from ..journal import FORMAT as JOURNAL_FORMAT
 from ..journal import LineJournal, journal_path
@@ -264,13 +264,14 @@ def branch_settings(system, param, start, section, rtol, atol, numerics: dict) -
 
 
 # ----------------------------------------------------------------------- NetCDF
-def write_dataset(ds, path) -> Path:
+def write_dataset(ds, path, *, overwrite: bool = True) -> Path:
     """Write ``ds`` to ``path`` (NetCDF4 via h5netcdf) under the output's lock, atomically
-    (:func:`stickslip.files.write_output`); a full disk names the journal that keeps the run."""
+    (:func:`stickslip.files.save_netcdf`); a full disk names the journal that keeps the run.
+    ``overwrite=True`` for the study's own ``out`` (its command checked it when it started)."""
     path = Path(path)
     journal = journal_path(path)
     kept = f"{path} is left as it was" + (f" and the finished work is kept in {journal}" if journal.exists() else "")
-    return write_output(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"), overwrite=True, kept=kept)
+    return save_netcdf(ds, path, overwrite=overwrite, kept=kept)
 
 
 def branch_dataset(branch):

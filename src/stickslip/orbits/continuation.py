@@ -24,8 +24,8 @@ replaced through it (``monkeypatch.setattr(continuation, "_residual", f)``: an a
 with a known fold, a stand-in for one N): setting them here sets them in the module that calls them.
 """
 
+# ruff: noqa: F401 (tuning constants and the replaceable callables are re-exported for tests and studies)
 from __future__ import annotations
-
 
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_CORRECTOR, MAX_STEPS_PER_SECOND, MIN_TANGENT_COS,
                         ContinuationError, SteadySlidingError, _jacobian, _residual)

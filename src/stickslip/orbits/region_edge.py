@@ -106,9 +106,13 @@ class FoldCurve:
         """``xarray.Dataset`` over ``N``."""
         return store.fold_curve_dataset(self)
 
-    def to_netcdf(self, path) -> Path:
-        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename)."""
-        return store.write_dataset(self.to_xarray(), path)
+    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename).
+
+        An existing ``path`` is replaced only with ``overwrite=True``
+        (:class:`stickslip.errors.OutputError` otherwise).
+        """
+        return store.write_dataset(self.to_xarray(), path, overwrite=overwrite)
 
     def rows(self) -> dict:
         """``{N: row}`` with row = (edge, kind, located, period, omega_stable_max, points, seconds,
@@ -327,7 +331,7 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
                    seconds=np.array(cols[6], dtype=float), message=tuple(cols[7]), omega_start=float(omega_start),
                    params=params, model=model, timings=timings, digest=digest)
     if journal is not None:
-        fc.to_netcdf(out)
+        store.write_dataset(fc.to_xarray(), out)
         journal.remove()
     return fc
 

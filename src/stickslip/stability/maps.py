@@ -24,7 +24,7 @@ from scipy import optimize
 
 from .._version import __version__
 from ..errors import ModelError, ParameterError
-from ..files import atomic_write, format_name, open_ours
+from ..files import format_name, open_ours, save_netcdf
 from ..memory import check_memory, largest_count, map_point_bytes
 from ..model.library import describe_system, system_from_description
 from ..model.library.two_plates import plates_parameters
@@ -433,10 +433,13 @@ class StabilityMap(Plottable):
             attrs.update(parameter_attrs(self.params.to_dict()))
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def to_netcdf(self, path: str | Path) -> Path:
-        """Write :meth:`to_xarray` to NetCDF-4 (h5netcdf engine)."""
-        ds = self.to_xarray()
-        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    def to_netcdf(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Write :meth:`to_xarray` to NetCDF-4 (h5netcdf engine), atomically.
+
+        An existing ``path`` is replaced only with ``overwrite=True``
+        (:class:`stickslip.errors.OutputError` otherwise).
+        """
+        return save_netcdf(self.to_xarray(), path, overwrite=overwrite)
 
 
 
