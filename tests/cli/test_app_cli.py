@@ -126,12 +126,12 @@ def test_a_read_only_folder_is_one_line(tmp_path):
 
 
 def test_an_os_error_while_writing_is_one_line(tmp_path, monkeypatch):
-    from stickslip.integrate.result import Trajectory
+    import stickslip.cli.simulate as command
 
-    def full_disk(self, path):
+    def full_disk(path):
         raise OSError(28, "No space left on device", str(path))
 
-    monkeypatch.setattr(Trajectory, "to_netcdf", full_disk)
+    monkeypatch.setattr(command, "netcdf_writer", lambda ds: full_disk)
     line = one_error_line(invoke("simulate", "--t-end", "1", "--no-plot", "--out", str(tmp_path / "x.nc")))
     assert "No space left on device" in line
 

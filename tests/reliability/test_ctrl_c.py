@@ -100,14 +100,14 @@ def test_simulate_interrupted_in_its_last_chunk_keeps_the_finished_run_and_stops
 
 def test_simulate_interrupted_while_writing_keeps_the_finished_run(tmp_path, monkeypatch):
     """The file is written whole and then the command stops (it was thrown away: "nothing was written")."""
-    monkeypatch.setattr(Trajectory, "to_netcdf", sends_ctrl_c(Trajectory.to_netcdf))
+    monkeypatch.setattr(simulate_cli, "netcdf_writer", sends_ctrl_c(simulate_cli.netcdf_writer))
     line = interrupted(runner.invoke(app, [*SIMULATE, "--out", str(tmp_path / "x.nc")]))
     assert line == f"the finished run is in {tmp_path / 'x.nc'}"
     assert load_trajectory(tmp_path / "x.nc").t[-1] == 30.0 and files(tmp_path) == ["x.nc"]
 
 
 def test_a_second_ctrl_c_while_writing_stops_at_once_and_leaves_nothing(tmp_path, monkeypatch):
-    monkeypatch.setattr(Trajectory, "to_netcdf", sends_ctrl_c(Trajectory.to_netcdf, times=2))
+    monkeypatch.setattr(simulate_cli, "netcdf_writer", sends_ctrl_c(simulate_cli.netcdf_writer, times=2))
     line = interrupted(runner.invoke(app, [*SIMULATE, "--out", str(tmp_path / "x.nc")]))
     assert line == "nothing was written" and files(tmp_path) == []
 
@@ -189,7 +189,7 @@ def test_basins_interrupted_after_its_last_batch_keeps_the_whole_study(tmp_path,
     out = tmp_path / "b.nc"
     line = interrupted(runner.invoke(app, [*BASINS, "--out", str(out)]))
     assert line == f"{out} holds all 200 states, classified"
-    assert int(load_basins(out).attrs["complete"]) and files(tmp_path) == ["b.nc", "b.nc.lock"]
+    assert int(load_basins(out).attrs["complete"]) and files(tmp_path) == ["b.nc"]
 
 
 def test_basins_interrupted_while_drawing_keeps_the_whole_study(tmp_path, monkeypatch):
@@ -221,14 +221,14 @@ def test_orbit_and_lyapunov_during_their_runs_write_nothing(command, holds, tmp_
 
 
 @pytest.mark.parametrize("command, holds", [(ORBIT, "the orbit"), (LYAPUNOV, "the spectrum")])
-@pytest.mark.parametrize("target", ["atomic_write", "figure"])
+@pytest.mark.parametrize("target", ["netcdf_writer", "figure"])
 def test_orbit_and_lyapunov_interrupted_while_writing_keep_their_file(command, holds, target, tmp_path, monkeypatch):
     """(Both said "nothing was written" with the file there.)"""
     if target == "figure":
         name = "save_orbit_figure" if command is ORBIT else "save_lyapunov_spectrum_figure"
         monkeypatch.setattr(orbit_cli, name, sends_ctrl_c(getattr(orbit_cli, name)))
     else:
-        monkeypatch.setattr(orbit_cli, target, sends_ctrl_c(orbit_cli.atomic_write))
+        monkeypatch.setattr(orbit_cli, target, sends_ctrl_c(orbit_cli.netcdf_writer))
     out = tmp_path / "o.nc"
     assert interrupted(runner.invoke(app, [*command, "--out", str(out)])) == f"{holds} is in {out}"
     assert files(tmp_path) == ["o.nc"] and out.stat().st_size > 1000

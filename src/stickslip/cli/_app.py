@@ -39,6 +39,7 @@ from ..errors import StickSlipError
 from ..files import lock, refuse_output
 from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
+from ..model.library.two_plates import is_plates
 from ..model.parameters import Parameters
 from ._kept import forget_outputs, on_disk, on_interrupt
 
@@ -318,56 +319,6 @@ def config_values(config) -> dict:
     return {name: getattr(loaded, name) for name in data.get("parameters", data)}
 
 
-def build_parameters(config, assignments, base=None, swept: dict | None = None, **named):
-    """Parameters from ``base`` (default Table 1), then a TOML file, then ``--set``, then the
-    named options that were given (not None).
-
-    Parameters
-    ----------
-    config : path or None
-        ``--config``.
-    assignments : list of str or None
-        ``--set`` items.
-    base : Parameters, optional
-        What the file and options change (default Table 1).
-    swept : dict of parameter name → option, optional
-        Parameters the command varies itself (``{"N": "--grid N"}``); ``--set`` or a named option
-        for one of them is refused.
-    **named
-        Named options by parameter name (``N=``, ``Omega=``, ...; None: not given).
-
-    Returns
-    -------
-    params : Parameters
-    given : list of str
-        The options that set a parameter (``--config``, ``--set NAME``, ``--N``, ...), in order.
-
-    Raises
-    ------
-    CLIError
-        When two options set the same parameter (a named option and ``--set``, or either and
-        the option that sweeps it).
-    """
-    params = Parameters() if base is None else base
-    given = []
-    if config is not None:
-        params = params.replace(**config_values(config))
-        given.append("--config")
-    changes = parse_assignments(assignments)
-    named = {k: v for k, v in named.items() if v is not None}
-    setters = {item.partition("=")[0].strip(): [f"--set {item.strip()}"] for item in assignments or []}
-    for name, value in named.items():
-        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {value:g}")
-    for name, sweeper in (swept or {}).items():
-        setters.setdefault(name, []).insert(0, sweeper)
-    for name, options in setters.items():
-        if len(options) > 1:
-            raise CLIError(f"{' and '.join(options)} both set {name}; give one of them")
-    given += [f"--set {k}" for k in changes] + [PARAMETER_FLAGS.get(k, f"--{k}") for k in named]
-    changes.update(named)
-    return (params.replace(**changes) if changes else params), given
-
-
 #: Help text of ``--model`` for commands that take any model.
 MODEL_HELP = ("The model: a library name (two-plates, belt, hoffmann, popp-stelter; see 'stickslip models'), a model "
               "file (.toml), or a variant of the two plates: full | x | y | rotation (paper Models 1–4) or DOFs, "
@@ -410,36 +361,41 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
         options that set the same parameter.
     """
     variant = plates_variant(model)
-    if base is not None and base.name == "two-plates" and variant is None:
-        variant = str(base.parameters.get("variant", "full"))
-    if variant is not None:
-        base_params = None
-        if base is not None and base.name == "two-plates":
-            values = dict(base.parameters)
-            values.pop("variant", None)
-            base_params = Parameters.from_dict(values)
-        params, given = build_parameters(config, assignments, base=base_params, swept=swept, **named)
-        system = two_plates(params, variant)
-        return (system if base is None else system.with_slip_band(base.slip_band)), given
-    system = base if base is not None and base.name == model else load_model(model)
-    plates_only = [PARAMETER_FLAGS.get(name, f"--{name}") for name, value in named.items() if value is not None]
-    if plates_only:
-        raise CLIError(f"{plates_only[0]} is a parameter of the two plates; model {system.name!r} takes its numbers "
-                       f"as --set PATH=VALUE ('stickslip models {model}' lists the paths)")
+    if base is not None:  # a continued run: its own model (the caller checked that ``model`` names it)
+        system = base
+    else:
+        system = two_plates(Parameters(), variant) if variant is not None else load_model(model)
+    plates = is_plates(system)
+    named = {k: v for k, v in named.items() if v is not None}
+    if named and not plates:
+        raise CLIError(f"{PARAMETER_FLAGS.get(next(iter(named)), '--' + next(iter(named)))} is a parameter of the two "
+                       f"plates; model {system.name!r} takes its numbers as --set PATH=VALUE ('stickslip models "
+                       f"{model}' lists the paths)")
     changes, given = {}, []
     if config is not None:
-        try:
-            changes.update(tomllib.loads(Path(config).read_text()).get("parameters", {}))
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
+        changes.update(config_values(config) if plates else _config_parameters(config))
         given.append("--config")
     assigned = parse_assignments(assignments)
-    for name in assigned:
-        if name in (swept or {}):
-            raise CLIError(f"{swept[name]} and --set {name} both set {name}; give one of them")
+    setters = {item.partition("=")[0].strip(): [f"--set {item.strip()}"] for item in assignments or []}
+    for name, value in named.items():
+        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {value:g}")
+    for name, sweeper in (swept or {}).items():
+        setters.setdefault(name, []).insert(0, sweeper)
+    for name, options in setters.items():
+        if len(options) > 1:
+            raise CLIError(f"{' and '.join(options)} both set {name}; give one of them")
     changes.update(assigned)
-    given += [f"--set {k}" for k in assigned]
-    return system.replace(**changes), given
+    changes.update(named)
+    given += [f"--set {k}" for k in assigned] + [PARAMETER_FLAGS.get(k, f"--{k}") for k in named]
+    return system.replace(**changes).with_slip_band(system.slip_band), given
+
+
+def _config_parameters(config) -> dict:
+    """The ``[parameters]`` table of a ``--config`` TOML file for a model's named parameters."""
+    try:
+        return dict(tomllib.loads(Path(config).read_text()).get("parameters", {}))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
 
 
 def check_nc_path(out, flag: str = "--out") -> None:
@@ -566,7 +522,7 @@ def check_resumable_output(out: Path, figure: bool, overwrite: bool, inputs: dic
     if figure:
         _check_figure(out, overwrite or not fresh, inputs=inputs)
     hold_output(out)
-    on_interrupt(f"finished work is kept in {journal_of(out)}; run the same command again to resume")
+    on_interrupt(f"finished work is kept in {journal_of(out)}; run the same command again to resume", journal_of(out))
     return overwrite or not fresh
 
 

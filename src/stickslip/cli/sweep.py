@@ -19,6 +19,7 @@ from rich.table import Table
 from ..analysis.classify import KINDS
 from ..memory import check_memory, largest_count
 from ..model.library import plates_variant
+from ..model.library.two_plates import plates_parameters
 from ..model.parameters import Parameters
 from ..plot.regions import save_regions_figure
 from ..plot.sweep import save_bifurcation_figure, save_sweep_figure
@@ -27,7 +28,7 @@ from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import columns_of
 from ..files import write_output
-from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_parameters, build_system,
+from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_system,
                    check_finite, check_positive, check_resumable_output, config_values, console, parse_assignments,
                    resumable_holds)
 from ._kept import keeps, keeps_figure
@@ -319,7 +320,7 @@ def _bifurcation_parameters(config, assignments, named: dict, param: str):
     """Base parameters: :data:`BIFURCATION_BASE` for N and Ω unless the config file, ``--set`` or
     the named options give them, then everything as in :func:`build_parameters` (which refuses
     an option that sets the control parameter ``param``)."""
-    params, _ = build_parameters(config, assignments, swept={param: f"--param {param}"}, **named)
+    params = plates_parameters(build_system("full", config, assignments, swept={param: f"--param {param}"}, **named)[0])
     given = {k for k, v in named.items() if v is not None} | set(parse_assignments(assignments))
     if config is not None:
         given |= set(config_values(config))
@@ -365,8 +366,9 @@ def regions_command(
 
     Every (model, N, Ω) is run from the 'far' and the 'near' initial condition (docs/sweeps.md).
     """
-    params, _ = build_parameters(config, set_, swept={"N": "--N", "Omega": "--omega"}, mu_k=mu_k, delta_mu=delta_mu,
-                                 alpha=alpha)
+    system, _ = build_system("full", config, set_, swept={"N": "--N", "Omega": "--omega"}, mu_k=mu_k,
+                             delta_mu=delta_mu, alpha=alpha)
+    params = plates_parameters(system)
     n_values = parse_values("N", N, option="--N")
     w_values = parse_values("Omega", omega, option="--omega")
     models = parse_values("model", model, option="--model")
