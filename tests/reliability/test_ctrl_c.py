@@ -26,7 +26,6 @@ from stickslip import load_trajectory
 from stickslip.basins import basin_stability, box, engine
 from stickslip.basins.store import load_basins
 from stickslip.cli import app
-from stickslip.integrate.result import Trajectory
 from stickslip.integrate.runner import CHUNK_SAMPLE_NUMBERS, EventStepper, Record, ToTheEnd, run_chunks, run_event
 from stickslip.model.library import load_model
 
