@@ -162,19 +162,23 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch):
     assert not (tmp_path / "x.nc").exists()
 
 
-@pytest.mark.parametrize("target, args, kept", [
-    ("stickslip.cli.continue_.start_run", ["continue", "--from", "5", "--to", "6", "--out", "b.nc"],
+@pytest.mark.parametrize("target, args, journal, kept", [
+    ("stickslip.cli.continue_.start_run", ["continue", "--from", "5", "--to", "6", "--out", "b.nc"], "b.nc.journal",
      "finished work is kept in b.nc.journal; run the same command again to resume"),
-    ("stickslip.cli.sweep.run_sweep", ["sweep", "--grid", "N=30,50", "--out", "s.nc"],
+    ("stickslip.cli.sweep.run_sweep", ["sweep", "--grid", "N=30,50", "--out", "s.nc"], "s.nc.journal",
      "finished work is kept in s.nc.journal; run the same command again to resume"),
-    ("stickslip.cli.reproduce.run_reproduce", ["reproduce", "--only", "fig3", "--out", "paper"],
+    ("stickslip.cli.sweep.run_sweep", ["sweep", "--grid", "N=30,50", "--out", "s.nc"], None, "nothing was written"),
+    ("stickslip.cli.reproduce.run_reproduce", ["reproduce", "--only", "fig3", "--out", "paper"], None,
      "the figures finished so far are listed in paper/report.md"),
-    ("stickslip.cli.orbit.lyapunov_spectrum", ["lyapunov", "--out", "l.nc"], "nothing was written"),
+    ("stickslip.cli.orbit.lyapunov_spectrum", ["lyapunov", "--out", "l.nc"], None, "nothing was written"),
 ])
-def test_ctrl_c_says_what_each_command_keeps(target, args, kept, tmp_path, monkeypatch):
+def test_ctrl_c_says_what_each_command_keeps(target, args, journal, kept, tmp_path, monkeypatch):
+    """A resumable command names its journal when one was started, and only then."""
     module, _, name = target.rpartition(".")
 
     def interrupted(*a, **k):
+        if journal is not None:
+            (tmp_path / journal).mkdir()
         raise KeyboardInterrupt
 
     monkeypatch.setattr(importlib.import_module(module), name, interrupted)
