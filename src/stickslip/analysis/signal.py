@@ -7,7 +7,8 @@ import math
 
 import numpy as np
 
-__all__ = ["REST_AMPLITUDE", "hermite_crossings", "spectrum", "spectral_peak", "stick_time"]
+__all__ = ["REST_AMPLITUDE", "hermite_crossings", "spectrum", "spectral_peak", "stick_time", "open_time", "phase_time",
+           "STICK", "SLIP", "OPEN", "CLOSE"]
 
 #: Peak-to-peak of a coordinate below which the response counts as at rest (no oscillation) [unit of
 #: the coordinate: rad for the plates' φ];
@@ -73,10 +74,69 @@ def spectral_peak(t, x):
     return float(f[k])
 
 
+#: Transition kinds as the integrators record them: slip → stick (+1), stick → slip (−1), a
+#: unilateral contact opening (2) and closing (3).
+STICK, SLIP, OPEN, CLOSE = 1, -1, 2, 3
+
+
+def phase_time(t_from, t_to, flags_at_start, transition_times, transition_kinds, transition_contacts,
+               n_contacts: int, *, enter: int, leave: int, bit_offset: int = 0):
+    """Time spent in one phase of the contacts (stick, or open) within [t_from, t_to] [s], from
+    exact transition instants: by any contact (the union of their intervals), and by each.
+
+    Parameters
+    ----------
+    t_from, t_to : float
+        The window [s].
+    flags_at_start : int
+        The sampled mode just after ``t_from``: bit ``bit_offset + c`` set when contact c is in the phase.
+    transition_times, transition_kinds, transition_contacts : array-like (k,)
+        Transition instants [s], kinds (:data:`STICK`, :data:`SLIP`, :data:`OPEN`, :data:`CLOSE`)
+        and contacts.
+    n_contacts : int
+    enter, leave : int
+        The kinds that start and end the phase.
+    bit_offset : int
+        Where the phase's bits start in the mode (0 for stick, ``n_contacts`` for open).
+
+    Returns
+    -------
+    total : float
+        Time with some contact in the phase [s].
+    each : ndarray (n_contacts,)
+        Each contact's time in the phase [s].
+    """
+    inside = [bool(int(flags_at_start) >> (bit_offset + c) & 1) for c in range(n_contacts)]
+    since = [t_from] * n_contacts
+    each = np.zeros(n_contacts)
+    start = t_from
+    total = 0.0
+    for tt, kind, c in zip(transition_times, transition_kinds, transition_contacts):
+        if tt <= t_from or tt > t_to or (kind != enter and kind != leave):
+            continue
+        c = int(c)
+        was = any(inside)
+        if inside[c] and kind == leave:
+            each[c] += tt - since[c]
+            inside[c] = False
+        elif not inside[c] and kind == enter:
+            since[c] = tt
+            inside[c] = True
+        if was and not any(inside):
+            total += tt - start
+        elif not was and any(inside):
+            start = tt
+    for c in range(n_contacts):
+        if inside[c]:
+            each[c] += t_to - since[c]
+    if any(inside):
+        total += t_to - start
+    return total, each
+
+
 def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, transition_contacts=None,
                n_contacts: int = 1):
-    """Time spent in stick within [t_from, t_to] [s], from exact transition instants: by any
-    contact (the union of their stick intervals), and by each.
+    """Time spent in stick within [t_from, t_to] [s] (:func:`phase_time`): by any contact, and by each.
 
     Parameters
     ----------
@@ -85,7 +145,7 @@ def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, 
     mode_at_start : int
         The mode just after ``t_from``: bit c set when contact c sticks (one contact: 1 in stick).
     transition_times, transition_kinds : array-like (k,)
-        Transition instants [s] and kinds (+1 slip → stick, −1 stick → slip).
+        Transition instants [s] and kinds (+1 slip → stick, −1 stick → slip; others ignored).
     transition_contacts : array-like (k,), optional
         The contact of each transition (default all contact 0).
     n_contacts : int
@@ -96,29 +156,13 @@ def stick_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, 
         Time with some contact stuck [s] (and each contact's own).
     """
     contacts = np.zeros(len(transition_times), dtype=np.int64) if transition_contacts is None else transition_contacts
-    stuck = [bool(int(mode_at_start) >> c & 1) for c in range(n_contacts)]
-    since = [t_from] * n_contacts
-    each = np.zeros(n_contacts)
-    start = t_from
-    total = 0.0
-    for tt, kind, c in zip(transition_times, transition_kinds, contacts):
-        if tt <= t_from or tt > t_to:
-            continue
-        c = int(c)
-        was = any(stuck)
-        if stuck[c] and kind < 0:
-            each[c] += tt - since[c]
-            stuck[c] = False
-        elif not stuck[c] and kind > 0:
-            since[c] = tt
-            stuck[c] = True
-        if was and not any(stuck):
-            total += tt - start
-        elif not was and any(stuck):
-            start = tt
-    for c in range(n_contacts):
-        if stuck[c]:
-            each[c] += t_to - since[c]
-    if any(stuck):
-        total += t_to - start
+    total, each = phase_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, contacts, n_contacts,
+                             enter=STICK, leave=SLIP)
     return total if transition_contacts is None else (total, each)
+
+
+def open_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, transition_contacts, n_contacts: int):
+    """Time unilateral contacts spend open within [t_from, t_to] [s] (:func:`phase_time`; the
+    mode's bit ``n_contacts + c`` is set while contact c is open): by any contact, and by each."""
+    return phase_time(t_from, t_to, mode_at_start, transition_times, transition_kinds, transition_contacts,
+                      n_contacts, enter=OPEN, leave=CLOSE, bit_offset=n_contacts)

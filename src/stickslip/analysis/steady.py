@@ -1,4 +1,4 @@
-"""Steady-state summary of a trajectory: fundamental frequency, stick fraction, extrema."""
+"""Steady-state summary of a trajectory: fundamental frequency, stick and open fractions, extrema."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from .period import detect_period
-from .signal import REST_AMPLITUDE, spectral_peak, stick_time
+from .signal import REST_AMPLITUDE, SLIP, STICK, open_time, spectral_peak, stick_time
 
 __all__ = ["SteadyState", "fundamental_frequency", "summarize"]
 
@@ -43,6 +43,12 @@ class SteadyState:
         The dof followed (the model's observed one: the plates' φ).
     minimum, maximum : float
         Extremes of the coordinate in the window [its unit] (from the uniform samples).
+    open_fraction : float or None
+        Fraction of the window in which some unilateral contact is open [-] (None for a model
+        whose contacts are all pressed).
+    contact_open_fractions : tuple of float
+        Fraction of the window in which each contact is open [-] (empty for a model whose contacts
+        are all pressed).
     """
 
     t_from: float
@@ -57,6 +63,8 @@ class SteadyState:
     coordinate: str
     minimum: float
     maximum: float
+    open_fraction: float | None = None
+    contact_open_fractions: tuple = ()
 
     @property
     def frequency_hz(self) -> float:
@@ -67,6 +75,8 @@ class SteadyState:
         """Plain dict (NaN kept as float NaN), the extremes named after the coordinate
         (``phi_min``, ``phi_max`` for the plates, ``x_min``, ``x_max`` for the belt)."""
         d = dataclasses.asdict(self)
+        if self.open_fraction is None:  # all contacts pressed: nothing opens
+            del d["open_fraction"], d["contact_open_fractions"]
         d[f"{self.coordinate}_min"] = d.pop("minimum")
         d[f"{self.coordinate}_max"] = d.pop("maximum")
         return d
@@ -101,10 +111,10 @@ def fundamental_frequency(t, phi, dphi):
 
 
 def summarize(t, states, mode, transition_times, transition_kinds, transition_contacts, n_contacts: int,
-              t_from, coordinate: int, rate: int, name: str) -> SteadyState:
+              t_from, coordinate: int, rate: int, name: str, unilateral: bool = False) -> SteadyState:
     """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
     state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``, of a model
-    with ``n_contacts`` contacts."""
+    with ``n_contacts`` contacts (``unilateral``: some of them open and close)."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
@@ -117,11 +127,13 @@ def summarize(t, states, mode, transition_times, transition_kinds, transition_co
     mode0 = int(mode[sel][0])
     tt = np.asarray(transition_times)
     kinds = np.asarray(transition_kinds)
-    window = (tt > t0) & (tt <= t1)
+    window = (tt > t0) & (tt <= t1) & ((kinds == STICK) | (kinds == SLIP))
     per = detect_period(ts, phi, dphi)
     at_rest = per.amplitude < REST_AMPLITUDE
     periodic = per.periodic and not at_rest
-    stick, each = stick_time(t0, t1, mode0, tt, kinds, np.asarray(transition_contacts), n_contacts)
+    contacts = np.asarray(transition_contacts)
+    stick, each = stick_time(t0, t1, mode0, tt, kinds, contacts, n_contacts)
+    opened, each_open = open_time(t0, t1, mode0, tt, kinds, contacts, n_contacts) if unilateral else (None, ())
     return SteadyState(
         t_from=t0,
         t_to=t1,
@@ -135,4 +147,6 @@ def summarize(t, states, mode, transition_times, transition_kinds, transition_co
         coordinate=name,
         minimum=float(phi.min()),
         maximum=float(phi.max()),
+        open_fraction=None if opened is None else opened / (t1 - t0),
+        contact_open_fractions=tuple(float(x) / (t1 - t0) for x in each_open),
     )

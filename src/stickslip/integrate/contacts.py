@@ -12,7 +12,11 @@ form ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1] (every Runge–Kutt
 * several contacts: the multipliers of all sticking contacts are solved together; after any
   transition the sticking set is re-checked and a contact whose force exceeds its limit is
   released (:func:`release_most_overloaded`), the active-set view of Pfeiffer and Glocker.
-* a normal force that reaches zero ends the run at that instant (``EVENT_NORMAL``: contact lost).
+* a prescribed normal force that reaches zero ends the run at that instant (``EVENT_NORMAL``:
+  contact lost).
+* a unilateral contact opens where its indicator φ = min(−g, λ/k) falls through zero and closes
+  where −φ does (``EVENT_GAP``, :mod:`stickslip.model.normal`); an open contact carries no force;
+  it closes sliding, or sticking if it arrives with v_c = 0 and the stick force is admissible.
 """
 
 from __future__ import annotations
@@ -26,7 +30,8 @@ from ..model.bundle import CST
 from ..model.jit import kernel
 from ..model.kinematics import model_sizes
 
-__all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP", "EVENT_TIME_TOL",
+__all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP",
+           "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_KINDS", "EVENT_TIME_TOL", "close_contact",
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "contact_lost", "mode_flags"]
@@ -34,9 +39,16 @@ __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "TRANSITION_TO_STICK", "
 EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
 EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
 EVENT_NORMAL = 2  # contact lost: N_c
+EVENT_GAP = 3     # a unilateral contact opens or closes: its indicator
 
 TRANSITION_TO_STICK = 1
 TRANSITION_TO_SLIP = -1
+TRANSITION_OPEN = 2
+TRANSITION_CLOSE = 3
+
+#: Names of the transition kinds, as results write them.
+TRANSITION_KINDS = {TRANSITION_TO_STICK: "stick", TRANSITION_TO_SLIP: "slip", TRANSITION_OPEN: "open",
+                    TRANSITION_CLOSE: "close"}
 
 #: Time resolution [s] to which transition instants are located on the dense output.
 EVENT_TIME_TOL = 1e-12
@@ -92,11 +104,15 @@ def all_finite(y):
 
 @kernel
 def mode_flags(cst, nc):
-    """Bit c set when contact c sticks (the sample's mode; 1 = stick for a one-contact model)."""
+    """Bit c set when contact c sticks, bit nc + c when it is open (the sample's mode; 1 = stick
+    for a one-contact model)."""
     flags = 0
     for c in range(nc):
-        if np.int64(cst[CST * c]) == P.MODE_STICK:
+        mode = np.int64(cst[CST * c])
+        if mode == P.MODE_STICK:
             flags |= 1 << c
+        elif mode == P.MODE_OPEN:
+            flags |= 1 << (nc + c)
     return flags
 
 
@@ -111,6 +127,8 @@ def event_value(kind, c, y, e0x, e0y, cst, md, F, N):
         return vx * e0x + vy * e0y
     if kind == EVENT_NORMAL:
         return P.normal_force(y, c, md)
+    if kind == EVENT_GAP:
+        return P.indicator(y, cst, c, md)
     return P.stick_margin(y, cst, c, md)
 
 
@@ -299,12 +317,39 @@ def release_most_overloaded(y, cst, md, F, N):
 
 @kernel
 def contact_lost(y, md):
-    """Index of the first contact whose normal force is ≤ 0 at ``y``, or −1."""
+    """Index of the first contact with a prescribed load whose normal force is ≤ 0 at ``y``, or −1."""
     nc = model_sizes(md.kin, md.m)[1]
     for c in range(nc):
-        if P.normal_force(y, c, md) <= 0.0:
+        if not P.unilateral(c, md) and P.normal_force(y, c, md) <= 0.0:
             return c
     return -1
+
+
+@kernel
+def close_contact(y, cst, c, md, rtol, atol, F, N):
+    """Unilateral contact ``c`` closes at ``y``: it sticks if it arrives with v_c = 0 (to the
+    arrival speed) under a normal force and the stick force is admissible; else it slides (the
+    exact direction v/|v|; from v = 0 the breakaway direction, or the stored one when no normal
+    force holds it yet, c = 0). Returns whether it sticks; ``y`` may be projected."""
+    n = model_sizes(md.kin, md.m)[0]
+    cst[CST * c] = P.MODE_SLIP_EXACT
+    cst[CST * c + 3] = math.inf
+    vx, vy = P.slip_velocity(y, c, md)
+    speed = math.sqrt(vx * vx + vy * vy)
+    if speed > arrival_speed(y, n, rtol, atol):
+        cst[CST * c + 1] = vx / speed
+        cst[CST * c + 2] = vy / speed
+        return False
+    cst[CST * c] = P.MODE_SLIP_QUASI_STATIC  # from v = 0: the direction the forces give
+    if P.normal_force_of(y, cst, c, md) > 0.0:
+        stick, ex, ey = try_stick(y, cst, c, md, arrival_speed(y, n, rtol, atol), F, N)
+        if stick:
+            cst[CST * c] = P.MODE_STICK
+            return True
+        if ex != 0.0 or ey != 0.0:
+            cst[CST * c + 1] = ex
+            cst[CST * c + 2] = ey
+    return False
 
 
 @kernel
@@ -318,7 +363,13 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
         cst[CST * c] = P.MODE_SLIP
         cst[CST * c + 1] = 1.0
         cst[CST * c + 2] = 0.0
+        cst[CST * c + 3] = math.inf
+    for c in range(nc):  # a unilateral contact that is not closed at the start is open
+        if P.unilateral(c, md) and P.indicator(y, cst, c, md) <= 0.0:
+            cst[CST * c] = P.MODE_OPEN
     for c in range(nc):
+        if np.int64(cst[CST * c]) == P.MODE_OPEN:
+            continue
         stick, ex, ey = try_stick(y, cst, c, md, STICK_SPEED_TOL, F, N)
         if stick:
             cst[CST * c] = P.MODE_STICK
@@ -329,7 +380,7 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
         if release_most_overloaded(y, cst, md, F, N) < 0:
             break
     for c in range(nc):
-        if np.int64(cst[CST * c]) == P.MODE_STICK:
+        if np.int64(cst[CST * c]) == P.MODE_STICK or np.int64(cst[CST * c]) == P.MODE_OPEN:
             continue
         vx, vy = P.slip_velocity(y, c, md)
         speed = math.sqrt(vx * vx + vy * vy)

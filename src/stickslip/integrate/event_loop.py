@@ -8,8 +8,8 @@ One compiled loop for any friction-contact model (no Python per step):
 * error control on the free DOFs with ``rtol``/``atol`` (RMS norm, as scipy's RK45);
 * transitions located on the 4th-order dense output to ``contacts.EVENT_TIME_TOL``: a step whose
   dense output shows a slip velocity through zero is re-taken to end at the root, so no stage
-  ever straddles the non-smooth point; a breakaway cuts the step at its root (the stick flow is
-  smooth up to it);
+  ever straddles the non-smooth point; a breakaway, and the opening or closing of a unilateral
+  contact, cut the step at their root (the flow is smooth up to it);
 * uniform samples written from the dense output.
 
 Time inside the loop is *local*: the caller passes ``t_base`` and the loop integrates
@@ -33,7 +33,8 @@ import numpy as np
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
 from ..model.jit import inlined_kernel, kernel, loop
-from ..model.kinematics import model_sizes
+from ..model.kinematics import has_unilateral, model_sizes
+from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
 from .status import CHUNK_END, CONTACT_LOST, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
@@ -145,6 +146,32 @@ def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
         n_tr += 1
         stats[5] += 1
     return n_tr
+
+
+@kernel
+def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+    """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
+    change its mode, record the transitions (a sticking contact that opens first leaves stick; a
+    contact that closes with v_c = 0 and an admissible stick force sticks), re-check the sticking
+    set, and return the transition count."""
+    if P.is_open(cst, c):
+        record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        n_tr += 1
+        if E.close_contact(y, cst, c, md, rtol, atol, F, N):
+            stats[4] += 1
+            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            n_tr += 1
+    else:
+        if np.int64(cst[CST * c]) == P.MODE_STICK:
+            stats[5] += 1
+            record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            n_tr += 1
+        cst[CST * c] = P.MODE_OPEN
+        cst[CST * c + 3] = math.inf
+        record_transition(n_tr, t, E.TRANSITION_OPEN, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        n_tr += 1
+    P.project_velocities(y, cst, np.int64(-1), md)  # the sticking set's constraints, after the change
+    return settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
 
 
 @loop
@@ -263,7 +290,7 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
         # ---- a normal force through zero: the model ends there (contact lost)
         theta_lost = -1.0
         for c in range(nc):
-            if P.normal_force(ynew, c, md) <= 0.0:
+            if not is_unilateral(md, n, c) and P.normal_force(ynew, c, md) <= 0.0:
                 if not q_ready:
                     DP.dense_coefficients(Kst, Q)
                     q_ready = True
@@ -291,6 +318,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             mode = np.int64(cst[CST * c])
             if mode == P.MODE_STICK:
                 any_stick = True
+                continue
+            if mode == P.MODE_OPEN:
                 continue
             v1x, v1y, a1x, a1y = P.slip_velocity_and_rate(ynew, Kst[6], c, md)
             va1[4 * c] = v1x
@@ -341,6 +370,21 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             stats[3] += 1
             continue
 
+        # ---- unilateral contacts: opening or closing inside the step cuts it at the root
+        theta_g = -1.0
+        c_g = -1
+        if has_unilateral(md.kin, m):
+            for c in range(nc):
+                if is_unilateral(md, n, c) and P.indicator(ynew, cst, c, md) <= 0.0:
+                    if not q_ready:
+                        DP.dense_coefficients(Kst, Q)
+                        q_ready = True
+                    th = E.first_crossing(E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+                    th = 1.0 if th <= 0.0 else th
+                    if theta_g < 0.0 or th < theta_g:
+                        theta_g = th
+                        c_g = c
+
         # ---- sticking contacts: breakaway inside the step cuts it at the root
         theta_b = -1.0
         c_b = -1
@@ -354,7 +398,24 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
                     if th > 0.0 and (theta_b < 0.0 or th < theta_b):
                         theta_b = th
                         c_b = c
-        if theta_b > 0.0:
+        if theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b):
+            # a unilateral contact opens or closes inside the step: cut the step at the root
+            tau_root = tau + theta_g * h
+            idx = write_samples(idx, tau_root, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode,
+                                out_F, work, F, N, vv)
+            E.dense_state(y, Q, h, theta_g, work)
+            for i in range(ns):
+                y[i] = work[i]
+            tau = tau_root
+            n_tr = switch_gap(y, cst, c_g, md, rtol, atol, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr,
+                              stats)
+            stats[0] += 1
+            P.rhs(y, cst, md, k1)
+            stats[2] += 1
+            va_ready = False
+            retakes = 0
+            homing_any = False
+        elif theta_b > 0.0:
             # breakaway inside the step: the flow is smooth up to it, so cut the step at the root
             tau_root = tau + theta_b * h
             idx = write_samples(idx, tau_root, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode,
@@ -402,7 +463,7 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             homing_any = False
             for c in range(nc):
                 mode = np.int64(cst[CST * c])
-                if mode == P.MODE_STICK:
+                if mode == P.MODE_STICK or mode == P.MODE_OPEN:
                     continue
                 v1x = va1[4 * c]
                 v1y = va1[4 * c + 1]

@@ -15,6 +15,7 @@ from ..analysis.steady import SteadyState, summarize
 from ..errors import FileFormatError
 from ..files import format_name, open_ours, save_netcdf
 from ..model import physics
+from ..model.bundle import CST
 from ..model.library import describe_system, system_from_description, two_plates
 from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
@@ -85,10 +86,11 @@ class Transitions:
         return int(self.time.size)
 
 
-def mode_dtype(n_contacts: int):
-    """Integer type of the sampled mode (bit c set: contact c sticks): int8 up to 8 contacts,
-    int16 up to 16 (the most a model may have)."""
-    return np.int8 if n_contacts <= 8 else np.int16
+def mode_dtype(n_contacts: int, unilateral: bool = False):
+    """Integer type of the sampled mode (bit c set: contact c sticks; with unilateral contacts bit
+    nc + c set: contact c is open): the narrowest of int8, int16, int32 with a bit for each flag."""
+    bits = 2 * n_contacts if unilateral else n_contacts
+    return np.int8 if bits <= 8 else np.int16 if bits <= 16 else np.int32
 
 
 @njit(cache=True)
@@ -105,13 +107,28 @@ def _slip_velocities(states, md, nc):
 
 
 @njit(cache=True)
-def _normal_forces(states, md, nc):
-    """Normal force of every contact (k, nc) at each sample [N]."""
+def _normal_forces(states, mode, md, nc):
+    """Normal force of every contact (k, nc) at each sample [N], a unilateral contact's in its
+    sampled state (0 while open: bit nc + c of ``mode``)."""
     k = states.shape[0]
     out = np.empty((k, nc))
+    cst = np.zeros(CST * nc)
     for i in range(k):
         for c in range(nc):
-            out[i, c] = physics.normal_force(states[i], c, md)
+            cst[CST * c] = physics.MODE_OPEN if (np.int64(mode[i]) >> (nc + c)) & 1 else physics.MODE_SLIP
+            out[i, c] = physics.normal_force_of(states[i], cst, c, md)
+    return out
+
+
+@njit(cache=True)
+def _gaps(states, md, nc):
+    """Gap g of every unilateral contact (k, nc) at each sample [m] (NaN for pressed contacts)."""
+    k = states.shape[0]
+    out = np.full((k, nc), np.nan)
+    for c in range(nc):
+        if physics.unilateral(c, md):
+            for i in range(k):
+                out[i, c] = physics.gap(states[i], c, md)[0]
     return out
 
 
@@ -125,8 +142,9 @@ class Trajectory(Plottable):
         Uniform sample times [s].
     states : ndarray (k, 2n)
         s = [q, q̇] in the order of ``system.state_names``.
-    mode : ndarray (k,) int8 (int16 beyond 8 contacts)
-        Bit c set when contact c sticks (a one-contact model: 1 in stick, 0 in slip).
+    mode : ndarray (k,) int8 (wider beyond 8 flags, :func:`mode_dtype`)
+        Bit c set when contact c sticks (a one-contact model: 1 in stick, 0 in slip); for a model
+        with unilateral contacts bit nc + c set when contact c is open.
     friction : ndarray (k, 2 nc)
         Friction force of contact c at columns 2c, 2c+1 [N] (for the plates: (Fx, Fy) on the
         upper plate; for a 1-D contact the second column is 0).
@@ -225,8 +243,26 @@ class Trajectory(Plottable):
 
     @cached_property
     def normal_force(self) -> np.ndarray:
-        """Normal force N of each contact (k, nc) [N]."""
-        return _normal_forces(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
+        """Normal force of each contact (k, nc) [N]: a prescribed N, or a unilateral contact's λ (0 open)."""
+        return _normal_forces(np.ascontiguousarray(self.states), self.mode, self.system.data, self.system.n_contacts)
+
+    @property
+    def stick(self) -> np.ndarray:
+        """Whether each contact sticks at each sample (k, nc) bool."""
+        return ((self.mode[:, None].astype(np.int64) >> np.arange(self.system.n_contacts)) & 1).astype(bool)
+
+    @property
+    def open(self) -> np.ndarray:
+        """Whether each contact is open at each sample (k, nc) bool (always False for pressed contacts)."""
+        nc = self.system.n_contacts
+        if not self.system.unilateral:
+            return np.zeros((self.t.size, nc), dtype=bool)
+        return ((self.mode[:, None].astype(np.int64) >> (nc + np.arange(nc))) & 1).astype(bool)
+
+    @cached_property
+    def gap(self) -> np.ndarray:
+        """Gap g = g0 + W·q of each unilateral contact (k, nc) [m]; NaN for pressed contacts."""
+        return _gaps(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
 
     @property
     def friction_magnitude(self) -> np.ndarray:
@@ -256,7 +292,8 @@ class Trajectory(Plottable):
         i = self.observed
         tr = self.transitions
         return summarize(self.t, self.states, self.mode, tr.time, tr.kind, tr.contact, self.system.n_contacts, t_from,
-                         coordinate=i, rate=i + self.system.n, name=self.system.dofs[i])
+                         coordinate=i, rate=i + self.system.n, name=self.system.dofs[i],
+                         unilateral=self.system.unilateral)
 
     # ------------------------------------------------------------- pieces and joins
     def joined(self, more: "Trajectory") -> "Trajectory":
@@ -301,12 +338,27 @@ class Trajectory(Plottable):
             dof = system.dofs[j % system.n]
             data[name] = ("time", self.states[:, j], {"units": unit, "long_name": ("" if j < system.n else "rate of ") + dof})
         nc = system.n_contacts
-        data["mode"] = ("time", self.mode, {
-            "long_name": "sticking contacts (bit c set: contact c sticks)",
-            **({"flag_values": "0 1", "flag_meanings": "slip stick"} if nc == 1 else {"flag_masks": " ".join(str(1 << c) for c in range(nc))})})
-        data["stick"] = (("time", "contact"), ((self.mode[:, None].astype(np.int64) >> np.arange(nc)) & 1).astype(np.int8),
+        if system.unilateral:
+            mode_attrs = {"long_name": "contact flags (bit c set: contact c sticks; bit nc + c set: contact c is open)",
+                          "flag_masks": " ".join(str(1 << b) for b in range(2 * nc))}
+        elif nc == 1:
+            mode_attrs = {"long_name": "sticking contacts (bit c set: contact c sticks)", "flag_values": "0 1",
+                          "flag_meanings": "slip stick"}
+        else:
+            mode_attrs = {"long_name": "sticking contacts (bit c set: contact c sticks)",
+                          "flag_masks": " ".join(str(1 << c) for c in range(nc))}
+        data["mode"] = ("time", self.mode, mode_attrs)
+        data["stick"] = (("time", "contact"), self.stick.astype(np.int8),
                          {"long_name": "each contact sticks (1) or slips (0)", "flag_values": "0 1",
                           "flag_meanings": "slip stick"})
+        if system.unilateral:
+            data["open"] = (("time", "contact"), self.open.astype(np.int8),
+                            {"long_name": "each unilateral contact is open (1) or closed (0)", "flag_values": "0 1",
+                             "flag_meanings": "closed open"})
+            data["gap"] = (("time", "contact"), self.gap,
+                           {"units": "m", "long_name": "gap g = g0 + W·q of each unilateral contact (NaN: pressed)"})
+            data["normal_force"] = (("time", "contact"), self.normal_force,
+                                    {"units": "N", "long_name": "normal force of each contact (0 while open)"})
         data["friction"] = (("time", "contact", "component"), self.friction.reshape(-1, nc, 2),
                             {"units": "N", "long_name": "friction force of each contact along its tangent rows"})
         data["slip_velocity"] = (("time", "contact", "component"), self.slip_velocity.reshape(-1, nc, 2),
@@ -318,7 +370,9 @@ class Trajectory(Plottable):
         data["work_damping"] = ("time", self.work[:, 1], {"units": "J", "long_name": "work of the dampers since t0"})
         data["transition_time"] = ("transition", self.transitions.time, {"units": "s"})
         data["transition_kind"] = ("transition", self.transitions.kind.astype(np.int8),
-                                   {"flag_values": "-1 1", "flag_meanings": "stick_to_slip slip_to_stick"})
+                                   {"flag_values": "-1 1 2 3" if system.unilateral else "-1 1",
+                                    "flag_meanings": "stick_to_slip slip_to_stick" +
+                                    (" open close" if system.unilateral else "")})
         data["transition_contact"] = ("transition", self.transitions.contact.astype(np.int8))
         data["transition_state"] = (("transition", "state"), self.transitions.state)
         attrs = {
@@ -370,7 +424,7 @@ class Trajectory(Plottable):
         nc = system.n_contacts
         code = Status(int(ds.attrs.get("status_code", 0)))
         return cls(
-            t=ds["time"].values, states=states, mode=ds["mode"].values.astype(mode_dtype(nc)),
+            t=ds["time"].values, states=states, mode=ds["mode"].values.astype(mode_dtype(nc, system.unilateral)),
             friction=ds["friction"].values.reshape(-1, 2 * nc),
             work=np.stack([ds["work_friction"].values, ds["work_damping"].values], axis=1),
             transitions=Transitions(ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),

@@ -145,7 +145,7 @@ class Record:
         self.ns = 2 * system.n + N_EXTRA
         self.capacity = k
         self._states = np.empty((k, self.ns))
-        self._mode = np.empty(k, dtype=mode_dtype(system.n_contacts))
+        self._mode = np.empty(k, dtype=mode_dtype(system.n_contacts, system.unilateral))
         self._friction = np.empty((k, 2 * system.n_contacts))
         self.base = 0
         self.n = 0

@@ -14,15 +14,18 @@ that for kinematics classes that fix n the compiler folds them to constants:
 
 ========================  =========================================================================
 header (``HEADER`` slots)  n, nc, diagonal flag (M, C, K all diagonal), low-speed band [m/s],
-                           constant-kinematics flag (G, w independent of q)
+                           constant-kinematics flag (G, w independent of q), unilateral flag
+                           (some contact has a gap instead of a prescribed load)
 M⁻¹ (n × n)                row-major; rows and columns of locked DOFs are 0
 M (n × n)                  for the kinetic energy
 C, K (n × n each)          damping, stiffness (K may be non-symmetric)
 f0 (n)                     constant generalised force
 free (n)                   1.0 for a free DOF, 0.0 for a locked one
 contacts (nc blocks)       block width ``contact_width(n)``: dim (1 or 2), N0 [N], the friction law
-                           row (:mod:`stickslip.model.friction`), the constant tangent rows G
-                           (2 × n), drive w (2), normal force gradients n (n) and n_v (n)
+                           row (:mod:`stickslip.model.friction`), the normal law (prescribed,
+                           compliant, rigid), gap g0, normal stiffness k, damping c and
+                           restitution e, the constant tangent rows G (2 × n), drive w (2),
+                           normal force gradients n (n) and n_v (n), gap gradient W (n)
 ========================  =========================================================================
 """
 
@@ -35,10 +38,12 @@ import numpy as np
 from .friction import LAW_WIDTH, NoUserLaw
 from .jit import inlined_kernel
 
-__all__ = ["ModelData", "pack", "offsets", "contact_offsets", "contact_width", "contact_state",
-           "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "C_DIM", "C_N0", "C_LAW", "C_G"]
+__all__ = ["ModelData", "pack", "offsets", "contact_offsets", "gap_offset", "contact_width", "contact_state",
+           "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "H_UNILATERAL", "C_DIM", "C_N0",
+           "C_LAW", "C_NORMAL_LAW", "C_GAP", "C_NORMAL_K", "C_NORMAL_C", "C_RESTITUTION", "C_G",
+           "NORMAL_PRESCRIBED", "NORMAL_COMPLIANT", "NORMAL_RIGID", "NORMAL_LAWS"]
 
-H_N, H_NC, H_DIAGONAL, H_BAND, H_CONSTANT = range(5)
+H_N, H_NC, H_DIAGONAL, H_BAND, H_CONSTANT, H_UNILATERAL = range(6)
 HEADER = 8
 
 #: Numbers per contact in the integration state ``cst``: mode, stored slip direction (ex, ey), and
@@ -48,7 +53,17 @@ CST = 4
 C_DIM = 0
 C_N0 = 1
 C_LAW = 2
-C_G = C_LAW + LAW_WIDTH
+C_NORMAL_LAW = C_LAW + LAW_WIDTH  # NORMAL_PRESCRIBED, NORMAL_COMPLIANT or NORMAL_RIGID
+C_GAP = C_NORMAL_LAW + 1          # g0 of g = g0 + W·q
+C_NORMAL_K = C_GAP + 1            # compliant: contact stiffness k
+C_NORMAL_C = C_NORMAL_K + 1       # compliant: contact damping c
+C_RESTITUTION = C_NORMAL_C + 1    # rigid: Newton's restitution coefficient e
+C_G = C_RESTITUTION + 1
+
+#: Normal laws of a contact: a prescribed load N = N0 + n·q + n_v·q̇ (always pressed), a compliant
+#: unilateral contact λ = max(0, −k g − c ġ) (g < 0), a rigid unilateral contact (g ≥ 0, λ ≥ 0, g λ = 0).
+NORMAL_PRESCRIBED, NORMAL_COMPLIANT, NORMAL_RIGID = 0, 1, 2
+NORMAL_LAWS = {"prescribed": NORMAL_PRESCRIBED, "compliant": NORMAL_COMPLIANT, "rigid": NORMAL_RIGID}
 
 
 class ModelData(NamedTuple):
@@ -63,7 +78,7 @@ class ModelData(NamedTuple):
 @inlined_kernel
 def contact_width(n):
     """Numbers in one contact block of a model with n DOFs."""
-    return C_G + 4 * n + 2
+    return C_G + 5 * n + 2
 
 
 @inlined_kernel
@@ -73,6 +88,12 @@ def offsets(n):
     o_minv = HEADER
     o_force = HEADER + 4 * nn
     return o_minv, o_minv + nn, o_minv + 2 * nn, o_minv + 3 * nn, o_force, o_force + n, o_force + 2 * n
+
+
+@inlined_kernel
+def gap_offset(n, c):
+    """Offset of contact ``c``'s gap gradient W (n) in ``m``."""
+    return contact_offsets(n, c)[3] + n
 
 
 @inlined_kernel
@@ -97,7 +118,8 @@ def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np
         Free DOFs; locked ones get zero rows and columns in M⁻¹ (they never move).
     contacts : list of dict
         Per contact: ``dim`` (1 or 2), ``N0``, ``law_row`` (LAW_WIDTH,), and for constant kinematics
-        ``G`` (dim, n), ``w`` (dim,), ``n_q`` (n,), ``n_v`` (n,) (zeros where absent).
+        ``G`` (dim, n), ``w`` (dim,), ``n_q`` (n,), ``n_v`` (n,) (zeros where absent); a unilateral
+        contact also ``normal_law`` (a ``NORMAL_*`` code), ``gap`` g0, ``W`` (n,), ``k``, ``c``, ``e``.
     slip_band : float
         Low-speed band [m/s].
     constant_kinematics : bool
@@ -119,6 +141,8 @@ def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np
     m[H_DIAGONAL] = 1.0 if diagonal else 0.0
     m[H_BAND] = slip_band
     m[H_CONSTANT] = 1.0 if constant_kinematics else 0.0
+    m[H_UNILATERAL] = 1.0 if any(spec.get("normal_law", NORMAL_PRESCRIBED) != NORMAL_PRESCRIBED
+                                 for spec in contacts) else 0.0
     o_minv, o_mass, o_damp, o_stiff, o_force, o_free, _ = offsets.py_func(n)
     for o, a in zip((o_minv, o_mass, o_damp, o_stiff), mats):
         m[o:o + n * n] = a.ravel()
@@ -137,6 +161,13 @@ def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np
             m[ow:ow + dim] = np.asarray(spec["w"], float).reshape(dim)
         m[onq:onv] = np.asarray(spec.get("n_q", np.zeros(n)), float)
         m[onv:onv + n] = np.asarray(spec.get("n_v", np.zeros(n)), float)
+        m[o + C_NORMAL_LAW] = spec.get("normal_law", NORMAL_PRESCRIBED)
+        m[o + C_GAP] = spec.get("gap", 0.0)
+        m[o + C_NORMAL_K] = spec.get("k", 0.0)
+        m[o + C_NORMAL_C] = spec.get("c", 0.0)
+        m[o + C_RESTITUTION] = spec.get("e", 0.0)
+        og = onv + n
+        m[og:og + n] = np.asarray(spec.get("W", np.zeros(n)), float)
     return m
 
 

@@ -28,6 +28,7 @@ from .kinematics import contact_dim, contact_frame
 from .linalg import solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
+from .normal import MODE_OPEN, add_normal_forces, compliant_force, is_open, is_unilateral
 from .stack import DOFS, ROWS, VECTORS, work_matrix
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
@@ -254,10 +255,15 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
     base_force(s, m, n, diagonal, f)
+    add_normal_forces(cst, md, n, nc, N, f)
     in_band = False
     for c in range(nc):
         mode = np.int64(cst[CST * c])
         if mode == MODE_STICK:
+            continue
+        if mode == MODE_OPEN:
+            F[2 * c] = csm.zero(s[0])
+            F[2 * c + 1] = csm.zero(s[0])
             continue
         dim = contact_dim(md.kin, m, n, c)
         speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
@@ -286,7 +292,7 @@ def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
     band = m[H_BAND]
     for c in range(nc):
         mode = np.int64(cst[CST * c])
-        if mode == MODE_STICK:
+        if mode == MODE_STICK or mode == MODE_OPEN:
             continue
         dim = contact_dim(md.kin, m, n, c)
         speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])
@@ -327,11 +333,18 @@ def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
     for c in range(nc):
         G2 = G[2 * c:2 * c + 2]
         normal = contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
-        N[c] = normal
         dim = contact_dim(md.kin, m, n, c)
         v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
         v[2 * c] = v0
         v[2 * c + 1] = v1
+        if is_unilateral(md, n, c):
+            if is_open(cst, c):  # no normal force, no friction
+                N[c] = csm.zero(normal)
+                F[2 * c] = csm.zero(normal)
+                F[2 * c + 1] = csm.zero(normal)
+                continue
+            normal = compliant_force(s, m, n, c)
+        N[c] = normal
         speed = csm.sqrt(v0 * v0 + v1 * v1)
         if not exact_direction(np.int64(cst[CST * c]), speed.real, band):
             return False
@@ -352,4 +365,5 @@ def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
     base_force(s, m, n, diagonal, f)
     for c in range(nc):
         add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+    add_normal_forces(cst, md, n, nc, N, f)
     return True

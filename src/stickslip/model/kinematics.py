@@ -43,11 +43,11 @@ from numba.extending import overload
 from ..errors import KinematicsError
 from . import csmath as csm
 from . import stack
-from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, contact_offsets
+from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
 from .jit import KERNEL_OPTIONS, kernel
 
 __all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "registered_frame_bias", "contact_frame",
-           "constant_frame", "KinematicsError", "model_sizes", "contact_dim"]
+           "constant_frame", "KinematicsError", "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral"]
 
 
 #: Registered frame functions by kinematics class.
@@ -58,11 +58,13 @@ _SIZES: dict[type, tuple] = {}
 _DIMS: dict[type, int | None] = {}
 #: Closed-form frame-and-bias functions by kinematics class (optional).
 _BIASES: dict[type, Callable] = {}
+#: Kinematics classes whose models never have unilateral contacts (their kernels compile without them).
+_PRESSED_ONLY: set[type] = set()
 
 
 def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, ncontacts: int | None = None,
                         diagonal: bool | None = None, dim: int | None = None,
-                        frame_bias: Callable | None = None) -> None:
+                        frame_bias: Callable | None = None, unilateral: bool = True) -> None:
     """Make ``frame`` the contact frame of models whose kinematics data is a ``cls`` instance.
 
     Parameters
@@ -84,6 +86,10 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         ``frame_bias(kin, s, c, m, G, w, h) -> N``: the frame and the velocity bias h = Ġ q̇ − ẇ
         (2,) [m/s²] in closed form (module docstring); complex-safe like ``frame``. Without it
         the bias is taken by complex step of ``frame``.
+    unilateral : bool
+        Whether models of this kinematics may have unilateral contacts (a gap g = g0 + W·q instead
+        of a prescribed load; :mod:`stickslip.model.normal`). False compiles their kernels without
+        the gap's branches (the two plates, always pressed).
     """
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
@@ -96,6 +102,15 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         _BIASES[cls] = frame_bias if hasattr(frame_bias, "py_func") else njit(**KERNEL_OPTIONS)(frame_bias)
     if ndof is not None and ncontacts is not None:
         stack._STATIC[cls] = (ndof, ncontacts)
+    if unilateral:
+        _PRESSED_ONLY.discard(cls)
+    else:
+        _PRESSED_ONLY.add(cls)
+
+
+def allows_unilateral(cls: type) -> bool:
+    """Whether models of kinematics class ``cls`` may have unilateral contacts."""
+    return cls not in _PRESSED_ONLY
 
 
 def registered_kinematics() -> tuple[type, ...]:
@@ -141,6 +156,19 @@ def _model_sizes(kin, m):
         return (np.int64(m[H_N]) if n is None else n, np.int64(m[H_NC]) if nc is None else nc,
                 (m[H_DIAGONAL] != 0.0) if diagonal is None else diagonal)
     return sizes
+
+
+def has_unilateral(kin, m):  # pragma: no cover - resolved by numba (overload below)
+    """Whether the model has a unilateral contact: False at compile time for kinematics classes
+    registered without them, else the header flag."""
+    raise NotImplementedError
+
+
+@overload(has_unilateral, jit_options=KERNEL_OPTIONS)
+def _has_unilateral(kin, m):
+    if getattr(kin, "instance_class", None) in _PRESSED_ONLY:
+        return lambda kin, m: False
+    return lambda kin, m: m[H_UNILATERAL] != 0.0
 
 
 def contact_dim(kin, m, n, c):  # pragma: no cover - resolved by numba (overload below)

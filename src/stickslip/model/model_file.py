@@ -14,8 +14,14 @@ k = 1.0
 [[contact]]               # one table per contact
 tangent = [[1.0]]         # G: 1 row (1-D friction) or 2 rows (2-D), n columns
 drive = [1.5]             # w: surface velocity, one entry per row of G; v_r = G q̇ − drive
-normal_force = 1.0        # N0
+normal_force = 1.0        # N0 (a prescribed load; or, instead, a gap below)
 normal_gradient = [0.0]   # n (optional, default 0): N = N0 + n·q
+# gap = 0.0               # a unilateral contact: g = gap + gap_gradient·q, closed while g <= 0
+# gap_gradient = [-1.0]
+# [contact.normal]        # its normal law
+# law = "compliant"       # λ = max(0, −stiffness g − damping ġ)
+# stiffness = 40.0
+# damping = 0.0
 [contact.friction]
 law = "exponential"       # "coulomb" or "exponential"
 mu_k = 0.5
@@ -28,7 +34,8 @@ the ``[parameters]`` (:mod:`stickslip.model.expressions`). Every parameter is re
 ``--set`` and ``FrictionModel.replace``: a named parameter by its name (``k``), every entry by
 its path: ``mass.0.0``, ``stiffness.x.y`` (indices or dof names), ``force.1``,
 ``contact.0.drive`` (a one-entry vector needs no index), ``contact.0.normal_force``,
-``contact.1.friction.mu_k``, ``slip_band``. An entry written as an expression is set through its
+``contact.1.friction.mu_k``, ``contact.0.gap``, ``contact.0.gap_gradient.y``,
+``contact.0.normal.stiffness``, ``slip_band``. An entry written as an expression is set through its
 parameters (a path into it is refused). Errors name the key and the fix in one line.
 
 The file is checked once, when it is read (keys, shapes, names, expressions), into a
@@ -51,7 +58,7 @@ import numpy as np
 from ..errors import ExpressionError, FrictionLawError, ModelError, ModelFileError
 from .expressions import RESERVED, Expression, finite_number, grammar, parse_expression
 from .friction import FrictionLaw
-from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, check_name, check_text
+from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, NormalLaw, check_name, check_text
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -59,14 +66,19 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["load_model_file", "model_from_spec", "resolve_path", "ModelFileError", "TOP_KEYS", "CONTACT_KEYS",
-           "FRICTION_KEYS", "RESERVED_NAMES"]
+           "FRICTION_KEYS", "NORMAL_KEYS", "RESERVED_NAMES"]
 
 TOP_KEYS = ("name", "description", "parameters", "dofs", "mass", "damping", "stiffness", "force", "units",
             "slip_band", "observe", "contact")
 REQUIRED_TOP = ("dofs", "mass", "damping", "stiffness", "contact")
-CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "friction")
-REQUIRED_CONTACT = ("tangent", "normal_force", "friction")
+CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "gap",
+                "gap_gradient", "normal", "friction")
+REQUIRED_CONTACT = ("tangent", "friction")
 FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v")
+NORMAL_KEYS = ("law", "stiffness", "damping", "restitution")
+#: The keys of a prescribed load and of a unilateral contact (a contact has the one or the other).
+PRESCRIBED_KEYS = ("normal_force", "normal_gradient", "normal_rate_gradient")
+UNILATERAL_KEYS = ("gap", "gap_gradient", "normal")
 
 #: Names a parameter cannot take: the model file's keys (``--set mass=2`` is the path of a 1×1
 #: mass), the functions and constant of expressions, and the names a sweep's grid gives other
@@ -307,9 +319,10 @@ class _Parser:
         _check_keys(table, CONTACT_KEYS, f"{where}: ")
         for key in REQUIRED_CONTACT:
             if key not in table:
-                hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]", "normal_force": "N0 > 0 [N]",
+                hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]",
                         "friction": "add a [contact.friction] table with law, mu_k, delta_mu"}[key]
                 raise ModelFileError(f"{where}.{key} is missing; give {hint}")
+        self.normal_keys(where, table)
         tangent = table["tangent"]
         flat = isinstance(tangent, list) and bool(tangent) and not isinstance(tangent[0], list)
         dim = self.matrix(tangent, None, f"{where}.tangent", f"{c}.tangent", flat=flat)
@@ -319,30 +332,55 @@ class _Parser:
         for key, value in table.items():
             if key in ("drive", "normal_gradient", "normal_rate_gradient"):
                 self.vector(value, dim if key == "drive" else self.n, f"{where}.{key}", f"{c}.{key}")
-            elif key == "normal_force":
-                self.number(value, f"{where}.normal_force", "scalars", f"{c}.normal_force")
+            elif key in ("normal_force", "gap"):
+                self.number(value, f"{where}.{key}", "scalars", f"{c}.{key}")
+            elif key == "gap_gradient":
+                self.vector(value, self.n, f"{where}.{key}", f"{c}.{key}")
             elif key == "friction":
-                self.friction(c, value)
+                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb or exponential")
+            elif key == "normal":
+                self.law_table(value, f"{where}.normal", NORMAL_KEYS, f"{c}.normal", "compliant")
         name = table.get("name", f"contact{c}")
         if not isinstance(name, str):
             raise ModelFileError(f"{where}.name = {_show(name)} must be a string")
         check_text(name, f"{where}.name")
         return name
 
-    def friction(self, c: int, table) -> None:
-        where = f"contact.{c}.friction"
+    @staticmethod
+    def normal_keys(where: str, table) -> None:
+        """A contact has a prescribed load or a gap with a normal law: one of them, whole."""
+        prescribed = [k for k in PRESCRIBED_KEYS if k in table]
+        unilateral = [k for k in UNILATERAL_KEYS if k in table]
+        if prescribed and unilateral:
+            raise ModelFileError(f"{where}: {prescribed[0]} (a prescribed load) and {unilateral[0]} (a unilateral "
+                                 "contact) both given; give normal_force for a contact that is always pressed, or "
+                                 "gap_gradient with a [contact.normal] table for one that opens and closes")
+        if not prescribed and not unilateral:
+            raise ModelFileError(f"{where}.normal_force is missing; give normal_force = N0 > 0 [N] for a contact that "
+                                 "is always pressed, or gap_gradient with a [contact.normal] table for one that opens "
+                                 "and closes")
+        if prescribed and "normal_force" not in table:
+            raise ModelFileError(f"{where}.normal_force is missing; give N0 > 0 [N]")
+        for key in ("gap_gradient", "normal"):
+            if unilateral and key not in table:
+                hint = ("W of g = gap + W·q, one number per dof" if key == "gap_gradient" else
+                        'a [contact.normal] table, e.g. law = "compliant", stiffness = 40.0')
+                raise ModelFileError(f"{where}.{key} is missing for a unilateral contact; give {hint}")
+
+    def law_table(self, table, where: str, keys: tuple, container: str, laws: str) -> None:
+        """A law's table (``[contact.friction]``, ``[contact.normal]``): its law's name and numbers."""
         if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([contact.friction])")
-        _check_keys(table, FRICTION_KEYS, f"{where}: ")
-        self.shapes[f"{c}.friction"] = None
+            raise ModelFileError(f"{where} must be a table ([contact.{where.rsplit('.', 1)[1]}])")
+        _check_keys(table, keys, f"{where}: ")
+        self.shapes[container] = None
         for key, value in table.items():
             if key != "law":
-                self.number(value, f"{where}.{key}", f"{c}.friction", key)
+                self.number(value, f"{where}.{key}", container, key)
             elif isinstance(value, str):
                 self.slots[f"{where}.law"] = value
-                self.targets[f"{where}.law"] = (f"{c}.friction", "law")
+                self.targets[f"{where}.law"] = (container, "law")
             else:
-                raise ModelFileError(f"{where}.law = {_show(value)} is not a law name; choose coulomb or exponential")
+                raise ModelFileError(f"{where}.law = {_show(value)} is not a law name; choose {laws}")
 
 
 def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Template:
@@ -421,14 +459,20 @@ def _build(t: _Template) -> FrictionModel:
     scalars = out["scalars"]
     contacts = []
     for c, name in enumerate(t.contact_names):
-        N0 = scalars[f"{c}.normal_force"]
-        if N0 <= 0.0:
-            raise ModelFileError(f"contact.{c}.normal_force = {N0:g} must be > 0 (the contact must be pressed)")
         try:
             law = FrictionLaw.from_mapping(out[f"{c}.friction"], where=f"contact.{c}.friction")
         except FrictionLawError as exc:
             raise ModelFileError(str(exc)) from None
         G = out[f"{c}.tangent"]
+        if f"{c}.normal" in out:  # unilateral: a gap and its normal law
+            normal = NormalLaw(**out[f"{c}.normal"])
+            contacts.append(Contact(dim=G.shape[0], friction=law, tangent=G, drive=out[f"{c}.drive"], name=name,
+                                    normal=normal, gap=scalars.get(f"{c}.gap", 0.0),
+                                    gap_gradient=out[f"{c}.gap_gradient"]))
+            continue
+        N0 = scalars[f"{c}.normal_force"]
+        if N0 <= 0.0:
+            raise ModelFileError(f"contact.{c}.normal_force = {N0:g} must be > 0 (the contact must be pressed)")
         contacts.append(Contact(dim=G.shape[0], friction=law, normal_force=N0, tangent=G, drive=out[f"{c}.drive"],
                                 normal_gradient=out.get(f"{c}.normal_gradient"),
                                 normal_rate_gradient=out.get(f"{c}.normal_rate_gradient"), name=name))

@@ -1,8 +1,10 @@
 """The physics of every friction-contact model, written once, compiled per kinematics class.
 
-    M q̈ = f0 − C q̇ − K q + Σ_c G_c(q)ᵀ F_c,     v_c = G_c(q) q̇ − w_c(q)
+    M q̈ = f0 − C q̇ − K q + Σ_c G_c(q)ᵀ F_c + Σ_u W_uᵀ λ_u,     v_c = G_c(q) q̇ − w_c(q)
 
-with, for each contact c (1-D or 2-D slip velocity v_c, normal force N_c, friction law μ):
+with, for each contact c (1-D or 2-D slip velocity v_c, normal force N_c, friction law μ), and
+for each closed unilateral contact u its normal force λ_u = N_u on the coordinates
+(:mod:`stickslip.model.normal`; an open one carries neither normal nor friction force):
 
 * slip: F_c = −μ(|v_c|) N_c e_c with e_c = v_c/|v_c| above the low-speed band, inside it the
   quasi-static direction (:func:`~stickslip.model.forces.quasi_static_direction`) for 2-D contacts
@@ -53,9 +55,11 @@ from .kinematics import contact_dim, contact_frame, model_sizes
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
                          apply_inverse_mass, is_stick, kinetic_coefficient, kinetic_energy, law_row, static_limit)
+from .normal import MODE_OPEN, compliant_force, contact_indicator, gap_and_rate, is_open, is_unilateral
 from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
 
-__all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "RANK_TOL",
+__all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
+           "indicator", "gap", "unilateral", "is_open", "normal_force_of",
            "rhs", "rhs_body", "general_rhs", "rhs_and_forces", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP",
@@ -249,6 +253,35 @@ def slip_velocity(s, c, md):
     w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     contact_frame(md.kin, s, c, m, G2, w2)
     return frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
+
+
+@kernel
+def indicator(s, cst, c, md):
+    """Open/closed indicator of unilateral contact ``c`` in its mode of ``cst``: > 0 while it stays
+    closed (open), falls through 0 where it opens (closes) (:func:`~stickslip.model.normal.contact_indicator`)."""
+    return contact_indicator(s, cst, md.m, model_sizes(md.kin, md.m)[0], c)
+
+
+@kernel
+def gap(s, c, md):
+    """(g, ġ) of unilateral contact ``c`` at ``s`` [m, m/s]."""
+    return gap_and_rate(s, md.m, model_sizes(md.kin, md.m)[0], c)
+
+
+@kernel
+def normal_force_of(s, cst, c, md):
+    """Normal force of contact ``c`` at ``s`` in the mode of ``cst`` [N]: a prescribed load, or a
+    unilateral contact's λ (0 while open)."""
+    n = model_sizes(md.kin, md.m)[0]
+    if is_unilateral(md, n, c):
+        return 0.0 if is_open(cst, c) else compliant_force(s, md.m, n, c)
+    return normal_force(s, c, md)
+
+
+@kernel
+def unilateral(c, md):
+    """Whether contact ``c`` has a gap instead of a prescribed normal load."""
+    return is_unilateral(md, model_sizes(md.kin, md.m)[0], c)
 
 
 @kernel

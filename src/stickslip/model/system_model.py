@@ -1,6 +1,10 @@
 """A friction-contact model, stated once and served by every solver and analysis.
 
-    M q̈ = f0 − C q̇ − K q + Σ_c G_c(q)ᵀ F_c,   v_c = G_c(q) q̇ − w_c(q),   N_c = N0 + n·q + n_v·q̇
+    M q̈ = f0 − C q̇ − K q + Σ_c G_c(q)ᵀ F_c + Σ_u W_uᵀ λ_u,   v_c = G_c(q) q̇ − w_c(q)
+
+A contact is pressed by a prescribed load N_c = N0 + n·q + n_v·q̇, or it is *unilateral*: it
+states a gap g_u = g0 + W_u·q and a normal law (:class:`NormalLaw`), opens and closes, and its
+normal force λ_u acts on the coordinates (:mod:`stickslip.model.normal`).
 
 :class:`FrictionModel` holds the ingredients — named coordinates q, the matrices M, C, K, the
 force f0, the contacts (each with its slip-velocity dimension, normal force and friction law) and
@@ -25,11 +29,12 @@ import numpy as np
 from ..errors import ModelError
 from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
-from .kinematics import ConstantKinematics, registered_kinematics
+from .bundle import NORMAL_LAWS
+from .kinematics import ConstantKinematics, allows_unilateral, registered_kinematics
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
-__all__ = ["FrictionModel", "Contact", "NamedState", "ModelError", "DEFAULT_SLIP_BAND", "MAX_MASS_CONDITION",
+__all__ = ["FrictionModel", "Contact", "NormalLaw", "NamedState", "ModelError", "DEFAULT_SLIP_BAND", "MAX_MASS_CONDITION",
            "NAME_RULE", "check_text", "check_name"]
 
 #: Default low-speed band [m/s]: below it the 2-D slip direction is the quasi-static one instead of
@@ -90,6 +95,50 @@ def check_name(name: str, what: str) -> None:
         raise ModelError(f"{what} = {shown} is not a valid name; give a name of {NAME_RULE}")
 
 
+#: Normal laws a unilateral contact may state (:class:`NormalLaw`); ``rigid`` is reserved for the
+#: impact law (Newton restitution and a Coulomb impulse), which is not available yet.
+UNILATERAL_LAWS = ("compliant",)
+
+
+@dataclasses.dataclass(frozen=True)
+class NormalLaw:
+    """The normal law of a unilateral contact.
+
+    Attributes
+    ----------
+    law : {"compliant"}
+        ``compliant``: λ = max(0, −k g − c ġ) while g < 0, else 0 (Kelvin–Voigt, no impulses).
+    stiffness : float
+        Contact stiffness k > 0 [N/m].
+    damping : float
+        Contact damping c ≥ 0 [N s/m].
+    restitution : float
+        Newton's restitution coefficient e ∈ [0, 1] (rigid contacts).
+    """
+
+    law: str = "compliant"
+    stiffness: float = 0.0
+    damping: float = 0.0
+    restitution: float = 0.0
+
+    def check(self, where: str) -> None:
+        """Refuse an unknown law or a value out of its range, naming ``where``.
+
+        Raises
+        ------
+        ModelError
+        """
+        if self.law == "rigid":
+            raise ModelError(f"{where}: law = \"rigid\" (impacts with restitution) is not available yet; give "
+                             "law = \"compliant\" with a contact stiffness (and damping)")
+        if self.law not in UNILATERAL_LAWS:
+            raise ModelError(f"{where}: law = {self.law!r} is not a normal law; choose compliant")
+        if not (math.isfinite(self.stiffness) and self.stiffness > 0.0):
+            raise ModelError(f"{where}: stiffness = {self.stiffness:g} must be a finite contact stiffness > 0 [N/m]")
+        if not (math.isfinite(self.damping) and self.damping >= 0.0):
+            raise ModelError(f"{where}: damping = {self.damping:g} must be finite and >= 0 [N s/m]")
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class Contact:
     """One point contact.
@@ -101,7 +150,7 @@ class Contact:
     friction : FrictionLaw
         The contact's friction law.
     normal_force : float
-        N0 [N], the constant part of the normal force (> 0).
+        N0 [N], the constant part of a prescribed normal force (> 0; 0 for a unilateral contact).
     tangent : ndarray (dim, n) or None
         Constant contact Jacobian G (model files); None when the kinematics computes it.
     drive : ndarray (dim,) or None
@@ -110,16 +159,30 @@ class Contact:
         n and n_v of N = N0 + n·q + n_v·q̇ [N/m, N s/m].
     name : str
         Label for output (``contact0`` …).
+    normal : NormalLaw, optional
+        The normal law of a unilateral contact; None for a prescribed load.
+    gap : float
+        g0 [m] of the gap g = g0 + W·q of a unilateral contact (closed while g ≤ 0).
+    gap_gradient : ndarray (n,), optional
+        W [m per unit of each dof] of a unilateral contact.
     """
 
     dim: int
     friction: FrictionLaw
-    normal_force: float
+    normal_force: float = 0.0
     tangent: np.ndarray | None = None
     drive: np.ndarray | None = None
     normal_gradient: np.ndarray | None = None
     normal_rate_gradient: np.ndarray | None = None
     name: str = ""
+    normal: NormalLaw | None = None
+    gap: float = 0.0
+    gap_gradient: np.ndarray | None = None
+
+    @property
+    def unilateral(self) -> bool:
+        """Whether the contact states a gap (opens and closes) instead of a prescribed load."""
+        return self.normal is not None
 
     def spec(self, n: int) -> dict:
         """The contact as :func:`stickslip.model.bundle.pack` takes it."""
@@ -129,6 +192,9 @@ class Contact:
         if self.tangent is not None:
             out["G"] = self.tangent
             out["w"] = self.drive
+        if self.normal is not None:
+            out.update(normal_law=NORMAL_LAWS[self.normal.law], gap=self.gap, W=self.gap_gradient,
+                       k=self.normal.stiffness, c=self.normal.damping, e=self.normal.restitution)
         return out
 
 
@@ -298,7 +364,9 @@ class FrictionModel:
             check_text(contact.name, f"{where}: name")
             if contact.dim not in (1, 2):
                 raise ModelError(f"{where}: the slip velocity has 1 or 2 components (tangent rows), got {contact.dim}")
-            if not (math.isfinite(contact.normal_force) and contact.normal_force > 0.0):
+            if contact.unilateral:
+                self._check_gap(contact, where)
+            elif not (math.isfinite(contact.normal_force) and contact.normal_force > 0.0):
                 raise ModelError(f"{where}: normal_force = {contact.normal_force} must be > 0 (the contact must be pressed)")
             for key in ("normal_gradient", "normal_rate_gradient"):
                 value = getattr(contact, key)
@@ -325,7 +393,31 @@ class FrictionModel:
                 object.__setattr__(contact, "tangent", G)
                 object.__setattr__(contact, "drive", w)
 
+    def _check_gap(self, contact: Contact, where: str) -> None:
+        """A unilateral contact: its normal law, a finite gap with a gradient, no prescribed load."""
+        if not allows_unilateral(type(self.kinematics)):
+            raise ModelError(f"{where}: kinematics {type(self.kinematics).__name__} was registered for pressed "
+                             "contacts only (unilateral=False); give the contact a normal_force")
+        if contact.normal_force != 0.0 or contact.normal_gradient is not None \
+                or contact.normal_rate_gradient is not None:
+            raise ModelError(f"{where}: give either a prescribed load (normal_force) or a gap with a normal law, "
+                             "not both; a unilateral contact's normal force comes from its gap")
+        contact.normal.check(f"{where}: normal")
+        if not math.isfinite(contact.gap):
+            raise ModelError(f"{where}: gap = {contact.gap} must be finite [m]")
+        W = None if contact.gap_gradient is None else np.array(contact.gap_gradient, dtype=float).reshape(-1)
+        if W is None or W.shape != (self.n,) or not np.isfinite(W).all():
+            raise ModelError(f"{where}: gap_gradient must be {self.n} finite numbers (W of g = g0 + W·q)")
+        if not np.any(W[self.free]):
+            raise ModelError(f"{where}: gap_gradient is zero on every free dof; the contact can never open or close")
+        object.__setattr__(contact, "gap_gradient", W)
+
     # ------------------------------------------------------------------ structure
+    @property
+    def unilateral(self) -> bool:
+        """Whether some contact opens and closes (states a gap instead of a prescribed load)."""
+        return any(c.unilateral for c in self.contacts)
+
     @property
     def n(self) -> int:
         """Number of generalised coordinates."""

@@ -76,4 +76,4 @@ def plate_frame_bias(kin, s, c, m, G, w, h):
 
 
 register_kinematics(PlateKinematics, plate_frame, ndof=6, ncontacts=1, diagonal=True, dim=2,
-                    frame_bias=plate_frame_bias)
+                    frame_bias=plate_frame_bias, unilateral=False)  # the plates are always pressed together

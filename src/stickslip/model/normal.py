@@ -1,0 +1,104 @@
+"""Normal contact of unilateral contacts: gap, compliant normal force, and the open/closed test.
+
+A contact either carries a prescribed normal load N = N0 + n·q + n_v·q̇ (always pressed; the
+model's K and f0 hold its effect on the coordinates) or states a gap
+
+    g(q) = g0 + W·q        (closed while g ≤ 0, open while g > 0)
+
+whose normal force λ ≥ 0 acts on the coordinates as Wᵀλ and bounds the friction, |F| ≤ μ λ, as N
+does for a pressed contact. The *compliant* law (Kelvin–Voigt with max(0, ·)):
+
+    λ = max(0, λ̃),   λ̃ = −k g − c ġ   while g < 0,   λ = 0 while g ≥ 0.
+
+A closed contact (mode not ``MODE_OPEN``) has g < 0 and λ̃ > 0, so its force is λ̃ itself: affine
+in the state, smooth until an event. The contact is closed exactly where
+
+    φ(s) = min(−g, λ̃) > 0,
+
+one continuous function whose zero is both events: opening (λ̃ reaches 0 while g < 0, which with
+c > 0 happens before g reaches 0; or g reaches 0 with c = 0) and closing (g reaches 0 from above
+with ġ < 0, or λ̃ turns positive again while g < 0). :func:`contact_indicator` gives φ for a
+closed contact and −φ for an open one, so an event is always "the indicator falls to 0".
+
+Kernels are complex-safe (polynomial in the state; comparisons on real parts) for the Jacobians.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import csmath as csm
+from .bundle import C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, NORMAL_PRESCRIBED, contact_offsets, gap_offset
+from .jit import inlined_kernel
+from .kinematics import has_unilateral
+
+__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "gap_and_rate", "compliant_force", "contact_indicator",
+           "add_normal_force", "add_normal_forces"]
+
+#: Mode of an open unilateral contact: no normal force, no friction (the stick and slip modes
+#: are in :mod:`stickslip.model.model_data`).
+MODE_OPEN = 4
+
+
+@inlined_kernel
+def is_open(cst, c):
+    return np.int64(cst[CST * c]) == MODE_OPEN
+
+
+@inlined_kernel
+def is_unilateral(md, n, c):
+    """Whether contact ``c`` has a gap instead of a prescribed load (False at compile time for
+    kinematics registered without unilateral contacts)."""
+    if not has_unilateral(md.kin, md.m):
+        return False
+    return md.m[contact_offsets(n, c)[0] + C_NORMAL_LAW] != NORMAL_PRESCRIBED
+
+
+@inlined_kernel
+def gap_and_rate(s, m, n, c):
+    """(g, ġ) = (g0 + W·q, W·q̇) of contact ``c`` [m, m/s]."""
+    o = contact_offsets(n, c)[0]
+    og = gap_offset(n, c)
+    g = m[o + C_GAP] + csm.zero(s[0])
+    rate = csm.zero(s[0])
+    for j in range(n):
+        g += m[og + j] * s[j]
+        rate += m[og + j] * s[n + j]
+    return g, rate
+
+
+@inlined_kernel
+def compliant_force(s, m, n, c):
+    """λ̃ = −k g − c ġ [N] of compliant contact ``c`` (its normal force while closed)."""
+    o = contact_offsets(n, c)[0]
+    g, rate = gap_and_rate(s, m, n, c)
+    return -m[o + C_NORMAL_K] * g - m[o + C_NORMAL_C] * rate
+
+
+@inlined_kernel
+def contact_indicator(s, cst, m, n, c):
+    """φ = min(−g, λ̃) for a closed contact, −φ for an open one: > 0 while the contact stays in its
+    state, its fall through 0 is the opening or closing event [m or N; only the sign matters]."""
+    o = contact_offsets(n, c)[0]
+    g, rate = gap_and_rate(s, m, n, c)
+    lam = -m[o + C_NORMAL_K] * g - m[o + C_NORMAL_C] * rate
+    # φ in the same unit: λ̃ / k is a length (k > 0 for a compliant contact)
+    phi = -g if (-g).real < (lam / m[o + C_NORMAL_K]).real else lam / m[o + C_NORMAL_K]
+    return -phi if is_open(cst, c) else phi
+
+
+@inlined_kernel
+def add_normal_force(m, n, c, lam, f):
+    """f += Wᵀ λ: the normal force λ of contact ``c`` on the coordinates."""
+    og = gap_offset(n, c)
+    for j in range(n):
+        f[j] += m[og + j] * lam
+
+
+@inlined_kernel
+def add_normal_forces(cst, md, n, nc, N, f):
+    """f += Wᵀ λ for every closed unilateral contact (λ = N[c], its normal force)."""
+    if has_unilateral(md.kin, md.m):
+        for c in range(nc):
+            if is_unilateral(md, n, c) and not is_open(cst, c):
+                add_normal_force(md.m, n, c, N[c], f)
