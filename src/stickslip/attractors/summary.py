@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..analysis.signal import OPEN, SLIP, STICK
 from ..integrate.result import Trajectory
 from .verdict import Attractor, attractor
 
@@ -27,7 +28,8 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
         ``settle_time_s``, ``evidence`` (:class:`~.verdict.Attractor`); ``status``, ``model``,
         ``parameters``; ``t_end_s``, ``steady_from_s``, ``stick_fraction`` (some contact stuck),
         ``n_transitions``, ``contacts`` (by name: each contact's ``stick_fraction`` and
-        ``n_transitions`` in the window),
+        ``n_transitions`` stick↔slip in the window); with unilateral contacts also
+        ``open_fraction`` (some contact open) and, by contact, ``open_fraction`` and ``openings``;
         ``coordinate`` (the model's observed dof) and its extremes ``<coordinate>_min``,
         ``<coordinate>_max`` in the window (the plates: ``phi_min``, ``phi_max``); ``steps``, ``wall_time_s``, ``method``; ``settle``
         (the cap and steps of :func:`~.settle.simulate_until_settled`) when the run was extended
@@ -41,15 +43,24 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
            "contacts": _contacts(traj, s), "coordinate": s.coordinate,
            f"{s.coordinate}_min": s.minimum, f"{s.coordinate}_max": s.maximum, "steps": traj.stats.steps,
            "wall_time_s": traj.stats.wall_time_s, "method": traj.method}
+    if s.open_fraction is not None:
+        out["open_fraction"] = s.open_fraction
     if "settle" in traj.options:
         out["settle"] = traj.options["settle"]
     return out
 
 
 def _contacts(traj: Trajectory, steady) -> dict:
-    """Each contact's stick fraction and transitions in the steady window, by name."""
+    """Each contact's stick fraction and stick↔slip transitions in the steady window, by name
+    (and its open fraction and openings where contacts open and close)."""
     tr = traj.transitions
     window = (tr.time > steady.t_from) & (tr.time <= steady.t_to)
-    return {name: {"stick_fraction": steady.contact_stick_fractions[c],
-                   "n_transitions": int(((tr.contact == c) & window).sum())}
-            for c, name in enumerate(traj.system.contact_names)}
+    stick_slip = window & ((tr.kind == STICK) | (tr.kind == SLIP))
+    out = {}
+    for c, name in enumerate(traj.system.contact_names):
+        out[name] = {"stick_fraction": steady.contact_stick_fractions[c],
+                     "n_transitions": int(((tr.contact == c) & stick_slip).sum())}
+        if steady.open_fraction is not None:
+            out[name].update(open_fraction=steady.contact_open_fractions[c],
+                             openings=int(((tr.contact == c) & window & (tr.kind == OPEN)).sum()))
+    return out

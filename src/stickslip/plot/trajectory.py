@@ -22,12 +22,12 @@ def stick_intervals(t: np.ndarray, mode: np.ndarray) -> list[tuple[float, float]
     return [(float(t[a]), float(t[b])) for a, b in zip(starts, ends)]
 
 
-def _shade_stick(ax, intervals, t_lo, t_hi, label="stick", color="tab:orange"):
+def _shade_stick(ax, intervals, t_lo, t_hi, label="stick", color="tab:orange", hatch=None):
     first = True
     for a, b in intervals:
         if b < t_lo or a > t_hi:
             continue
-        ax.axvspan(a, b, color=color, alpha=0.25, lw=0, label=label if first and label else None)
+        ax.axvspan(a, b, facecolor=color, alpha=0.25, lw=0, hatch=hatch, label=label if first and label else None)
         first = False
 
 
@@ -37,13 +37,19 @@ STICK_COLORS = ("tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink"
 
 def shade_contacts(ax, t, mode, system, t_lo, t_hi, labels: bool = True) -> None:
     """Shade the stick phases of each contact of ``system`` in the sampled ``mode`` (bit c: contact c),
-    one colour per contact, labelled ``stick`` (one contact) or ``<contact name> sticks``."""
+    one colour per contact, labelled ``stick`` (one contact) or ``<contact name> sticks``; the open
+    phases of unilateral contacts (bit nc + c) hatched grey, labelled ``open`` or ``<name> open``."""
     mode = np.asarray(mode).astype(np.int64)
     names = system.contact_names
+    nc = len(names)
     for c, name in enumerate(names):
-        label = ("stick" if len(names) == 1 else f"{name} sticks") if labels else None
+        label = ("stick" if nc == 1 else f"{name} sticks") if labels else None
         _shade_stick(ax, stick_intervals(t, (mode >> c) & 1), t_lo, t_hi, label=label,
                      color=STICK_COLORS[c % len(STICK_COLORS)])
+        if system.contacts[c].unilateral:
+            label = ("open" if nc == 1 else f"{name} open") if labels else None
+            _shade_stick(ax, stick_intervals(t, (mode >> (nc + c)) & 1), t_lo, t_hi, label=label, color="0.5",
+                         hatch="//")
 
 
 def plot_trajectory(traj, *, window: float | None = None, fig=None):

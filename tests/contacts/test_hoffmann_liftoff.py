@@ -1,0 +1,147 @@
+"""The hoffmann model past its flutter onset lifts off and settles on a cycle with flight phases;
+checked against a separate event-driven solution written here with scipy.
+
+Equations (unit mass, springs K = [[2, 1], [1, 1]], preload N0 = 1 on y, contact spring k3 = 1,
+belt speed 1, damping c on both dofs, Coulomb friction μ = μs). While the contact is closed
+(λ = 1 + y > 0) the friction force F acts along x, with the slip velocity v = x' − 1:
+
+    x'' = −2x − y − c x' + F,   y'' = −x − 2y − c y',   F = −μ λ sign(v), or the stick force
+    F = 2x + y + c (x' = 1, x'' = 0) while |F| ≤ μ λ;
+
+while open, x'' = −2x − y − c x', y'' = −x − y + 1 − c y' (no contact force). The contact opens
+where λ falls to 0 and closes where it rises through 0; slip reverses or sticks where v passes 0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import stickslip
+from stickslip.analysis.signal import CLOSE, OPEN, SLIP, STICK
+
+MU, C, T_END = 1.3, 0.1, 400.0
+OPEN_MODE, STICK_MODE = "open", "stick"
+
+
+def _field(mode):
+    """Right-hand side in ``mode``: ``open``, ``stick``, or slip with sign(v) = ``mode`` (±1)."""
+    def f(t, s):
+        x, y, dx, dy = s
+        if mode == OPEN_MODE:
+            return [dx, dy, -2 * x - y - C * dx, -x - y + 1 - C * dy]
+        if mode == STICK_MODE:
+            return [dx, dy, 0.0, -x - 2 * y - C * dy]
+        return [dx, dy, -2 * x - y - C * dx - mode * MU * (1 + y), -x - 2 * y - C * dy]
+    return f
+
+
+def _stick_force(s):
+    return 2 * s[0] + s[1] + C * 1.0
+
+
+def _after_zero_slip(s):
+    """Mode where v reaches 0 while closed: stick if the stick force is admissible, else slip on."""
+    F = _stick_force(s)
+    return STICK_MODE if abs(F) <= MU * (1 + s[1]) else (-1 if F > 0 else 1)
+
+
+def reference(t_eval, y0):
+    """scipy DOP853 at rtol 1e-12, restarted at every located event. Returns the states at
+    ``t_eval`` and the instants of each transition kind."""
+    def lam(t, s):
+        return 1.0 + s[1]
+
+    def slip(t, s):
+        return s[2] - 1.0
+
+    def margin(t, s):
+        return MU * (1 + s[1]) - abs(_stick_force(s))
+
+    for event in (lam, slip, margin):
+        event.terminal = True
+    t0, s = 0.0, np.array(y0, dtype=float)
+    mode = -1 if s[2] < 1.0 else 1
+    out = np.empty((len(t_eval), 4))
+    switches = {OPEN: [], CLOSE: [], STICK: [], SLIP: []}
+    while t0 < t_eval[-1]:
+        if mode == OPEN_MODE:
+            lam.direction, events = 1.0, [lam]
+        elif mode == STICK_MODE:
+            lam.direction, margin.direction, events = -1.0, -1.0, [lam, margin]
+        else:
+            lam.direction, slip.direction, events = -1.0, -float(mode), [lam, slip]
+        sol = solve_ivp(_field(mode), (t0, t_eval[-1]), s, method="DOP853", rtol=1e-12, atol=1e-14,
+                        events=events, dense_output=True)
+        t1 = sol.t[-1]
+        sel = (t_eval >= t0) & (t_eval <= t1)
+        out[sel] = sol.sol(t_eval[sel]).T
+        t0, s = t1, sol.y[:, -1]
+        if sol.status != 1:
+            break
+        fired = [k for k, te in enumerate(sol.t_events) if te.size][0]
+        if events[fired] is lam and mode != OPEN_MODE:
+            if mode == STICK_MODE:
+                switches[SLIP].append(t1)
+            switches[OPEN].append(t1)
+            mode = OPEN_MODE
+        elif events[fired] is lam:
+            switches[CLOSE].append(t1)
+            mode = -1 if s[2] < 1.0 else 1
+        elif events[fired] is slip:
+            mode = _after_zero_slip(s)
+            if mode == STICK_MODE:
+                switches[STICK].append(t1)
+        else:  # breakaway: slip leaves opposite to the excess stick force
+            switches[SLIP].append(t1)
+            mode = 1 if _stick_force(s) < 0 else -1
+    return out, {k: np.array(v) for k, v in switches.items()}
+
+
+@pytest.fixture(scope="module")
+def runs():
+    model = stickslip.load_model("hoffmann").replace(
+        **{"contact.0.friction.mu_k": MU, "damping.x.x": C, "damping.y.y": C})
+    traj = stickslip.simulate(model, T_END, ic={"x": 0.01}, rtol=1e-11, atol=1e-13, sample_rate=20.0)
+    ref, switches = reference(traj.t, traj.states[0])
+    return traj, ref, switches
+
+
+def test_past_the_onset_the_contact_lifts_off_and_the_run_goes_on(runs):
+    traj, ref, switches = runs
+    assert traj.status == "success" and traj.t[-1] == T_END
+    tr = traj.transitions
+    assert {OPEN, CLOSE} <= set(np.unique(tr.kind))
+    assert traj.open.any() and (~traj.open).any()
+
+
+def test_the_whole_run_matches_the_scipy_solution(runs):
+    traj, ref, switches = runs
+    tr = traj.transitions
+    for kind in (OPEN, CLOSE, STICK, SLIP):
+        np.testing.assert_allclose(tr.time[tr.kind == kind], switches[kind], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(traj.states, ref, rtol=0, atol=1e-6)
+
+
+def test_the_lift_off_cycle_period_amplitude_and_open_fraction(runs):
+    """On the settled cycle (the last 100 s): the period from successive closings, the open
+    fraction from the flights and the amplitude of x agree with the reference to 1e-5."""
+    traj, ref, switches = runs
+    tr = traj.transitions
+    late = tr.time > T_END - 100.0
+    close = tr.time[late & (tr.kind == CLOSE)]
+    opened = tr.time[late & (tr.kind == OPEN)]
+    ref_close = switches[CLOSE][switches[CLOSE] > T_END - 100.0]
+    ref_open = switches[OPEN][switches[OPEN] > T_END - 100.0]
+    period, ref_period = np.diff(close)[-1], np.diff(ref_close)[-1]
+    assert period == pytest.approx(ref_period, abs=1e-5)
+    assert np.ptp(np.diff(close)) < 1e-6  # settled: one period
+    flight = close[-1] - opened[opened < close[-1]][-1]
+    ref_flight = ref_close[-1] - ref_open[ref_open < ref_close[-1]][-1]
+    assert flight / period == pytest.approx(ref_flight / ref_period, abs=1e-5)
+    window = traj.t >= T_END - 100.0
+    assert np.ptp(traj.states[window, 0]) == pytest.approx(np.ptp(ref[window, 0]), abs=1e-5)
+    steady = traj.steady_state(T_END - 100.0)
+    assert steady.periodic and steady.period_multiplicity == 1
+    assert 1.0 / steady.fundamental_frequency_hz == pytest.approx(ref_period, rel=1e-4)
