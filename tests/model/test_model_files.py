@@ -19,7 +19,7 @@ from stickslip.model.model_file import (CONTACT_KEYS, TOP_KEYS, ModelFileError, 
 from stickslip.model.system_model import Contact, FrictionModel, ModelError
 
 #: Words of the fix that every message gives.
-FIX_WORDS = ("give", "choose", "add", "must", "fix", "valid keys", "e.g.", "needs")
+FIX_WORDS = ("give", "choose", "add", "must", "fix", "valid keys", "e.g.", "needs", "use")
 
 #: Valid specs to corrupt: the library's model files and a 2-D contact on three dofs.
 PLANAR = {
@@ -110,7 +110,7 @@ def test_wrong_shapes(tmp_path, key, value, named):
     ("normal_gradient", [1.0]),
 ])
 def test_wrong_contact_shapes(tmp_path, key, value):
-    spec = copy.deepcopy(BASES[1])
+    spec = copy.deepcopy(BASES[2])  # popp-stelter: two dofs, pressed contacts
     spec["contact"][0][key] = value
     refused(write(tmp_path, spec), f"contact.0.{key}")
 

@@ -113,12 +113,21 @@ def _hoffmann(mu: float, damping) -> FrictionModel:
 
 
 def _characteristic_roots(model: FrictionModel) -> np.ndarray:
-    """Roots of det(λ² M + λ C + K_eff) of a 2-DOF model with one Coulomb contact of constant G,
-    drive w > 0 and N = N0 + n·q: in steady sliding (v = −w) friction is +μ N along G, so
-    K_eff = K − μ G nᵀ."""
+    """Roots of det(λ² M + λ C_eff + K_eff) of a 2-DOF model with one Coulomb contact of constant G
+    and drive w > 0, sliding steadily (v = −w, so friction is +μ N along G). A prescribed load
+    N = N0 + n·q gives K_eff = K − μ G nᵀ; a closed compliant contact, λ = −k (g0 + W·q) − c W·q̇
+    acting as Wᵀλ, gives K_eff = K + k (W + μ G) Wᵀ and C_eff = C + c (W + μ G) Wᵀ (W Wᵀ the
+    contact spring, μ G Wᵀ the friction it carries)."""
     contact = model.contacts[0]
-    K = model.stiffness - contact.friction.mu_k * np.outer(contact.tangent[0], contact.normal_gradient)
-    M, C = model.mass, model.damping
+    G, mu = contact.tangent[0], contact.friction.mu_k
+    K, C = model.stiffness.copy(), model.damping.copy()
+    if contact.unilateral:
+        W, k, c = contact.gap_gradient, contact.normal.stiffness, contact.normal.damping
+        K += k * np.outer(W, W) + mu * k * np.outer(G, W)
+        C += c * np.outer(W, W) + mu * c * np.outer(G, W)
+    else:
+        K -= mu * np.outer(G, contact.normal_gradient)
+    M = model.mass
     # det of the 2×2 matrix polynomial, coefficient by coefficient (λ⁴ … λ⁰)
     a = [np.array([M[i, j], C[i, j], K[i, j]]) for i in range(2) for j in range(2)]
     return np.roots(np.polysub(np.polymul(a[0], a[3]), np.polymul(a[1], a[2])))
