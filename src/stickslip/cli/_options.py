@@ -54,7 +54,7 @@ Alpha = Annotated[Optional[float], typer.Option("--alpha", help="The plates: dec
                                                 "(default 5).")]
 #: ``--N`` of a command that varies one parameter (``--param``).
 VariedLoad = Annotated[Optional[float], typer.Option("--N", help="The plates: normal preload N [N] when --param is "
-                                                  "another parameter (default 50).")]
+                                                     "another parameter (default 50).")]
 #: ``--omega`` of ``continue``.
 ContinuedOmega = Annotated[Optional[float], typer.Option("--omega", help="The plates: angular velocity Ω of the lower "
                                                          "plate [rad/s] when --param is another parameter "

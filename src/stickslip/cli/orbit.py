@@ -105,7 +105,8 @@ def orbit_command(
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
     start = parse_start(ic)
-    # checked here, not left to the library: it refuses them only after the start run
+    # the command line's checks: the library refuses the monodromy and the multiplicity only after the
+    # start run, calls --search-time t_end, and leaves --tol unbounded
     check_positive({"--search-time": search_time, "--tol": tol})
     check_below_one({"--tol": tol})
     check_choice("--monodromy", monodromy, MONODROMY_METHODS)
@@ -180,8 +181,8 @@ def lyapunov_command(
     Runs --t-transient seconds from --ic, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
     """
     start = parse_start(ic)
-    # checked here: the library refuses a method only after the transient run, and a time that is not
-    # finite in the words of its own runs (t_end - t0, memory)
+    # the command line's checks: the library refuses a method only after the transient run, and a
+    # non-finite time in other words (t_end - t0 of a run, a memory estimate)
     check_positive({"--t-transient": t_transient, "--t-average": t_average})
     check_choice("--method", method, _LYAPUNOV_METHODS)
     system = model_system(model, config, set_, slip_band, N=N, Omega=omega)

@@ -115,8 +115,8 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
         raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
                        f"give a time in that range")
     start = t0 + 0.5 * (t_end - t0) if steady_from is None else steady_from
-    if not (sample_rate > 0 and math.isfinite((t_end - t0) * sample_rate)):  # the run refuses such a rate itself
-        return
+    if not (sample_rate > 0 and math.isfinite((t_end - t0) * sample_rate)):
+        return  # a rate of 0 or less, or samples beyond counting: the run refuses them itself
     first = math.ceil((start - t0) * sample_rate - 1e-9)
     n = math.floor((t_end - t0) * sample_rate + 1e-9) - first + 1
     if n < WINDOW_SAMPLES:
