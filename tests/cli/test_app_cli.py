@@ -45,12 +45,25 @@ def commands(typer_app=app, path=()):
 
 
 def options(callback):
-    """(flag, type, help) of every option of a command."""
-    hints = typing.get_type_hints(callback)
+    """(flag, type, help) of every option of a command: declared as the parameter's default, or in
+    its ``Annotated`` type (the shared options of ``stickslip.cli._options``)."""
+    hints = typing.get_type_hints(callback, include_extras=True)
     for name, parameter in inspect.signature(callback).parameters.items():
-        info = parameter.default
+        hint, info, decls = hints.get(name), parameter.default, ()
+        if typing.get_origin(hint) is typing.Annotated:
+            hint, *extras = typing.get_args(hint)
+            info = next((x for x in extras if isinstance(x, typer.models.OptionInfo)), info)
+            decls = () if info.default is ... else (info.default,)  # in Annotated, the first name comes as default
         if isinstance(info, typer.models.OptionInfo):
-            yield (info.param_decls[0] if info.param_decls else f"--{name}"), hints.get(name), info.help or ""
+            decls += tuple(info.param_decls or ())
+            yield (decls[0] if decls else f"--{name}"), hint, info.help or ""
+
+
+def test_options_are_read_from_defaults_and_annotated_types():
+    """The two tests below see every option: an inline one and a shared one, with their types."""
+    found = {(" ".join(path), flag): kind for path, callback in commands() for flag, kind, _ in options(callback)}
+    assert found[("simulate", "--cap")] is float  # declared inline
+    assert found[("sweep", "--t-end")] is float and found[("orbit", "--slip-band")] == typing.Optional[float]
 
 
 # ----------------------------------------------------------------------------- usage errors

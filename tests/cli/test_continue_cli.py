@@ -34,7 +34,8 @@ BAND = 1e-5
     (["--from", "3", "--to", "4", "--set", "k_px"], "--set expects NAME=VALUE"),
     (["--from", "3", "--to", "4", "--set", "N=-5"], "N"),
     (["--from", "3", "--to", "4", "--model", "xyz"], "xyz"),
-    (["--from", "3", "--to", "4", "--slip-band", "-1"], "--slip-band must be a finite number > 0"),
+    (["--from", "3", "--to", "4", "--slip-band", "-1"], "slip_band = -1.0 must be a finite speed > 1e-13 m/s"),
+    (["--from", "3", "--to", "4", "--rtol", "0"], "rtol = 0.0 must be a finite number > 0"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
     res = runner.invoke(app, ["continue", *args] + ([] if "--out" in args else ["--out", str(tmp_path / "b.nc")]))

@@ -98,10 +98,11 @@ def test_an_output_folder_with_files_is_refused(args, tmp_path):
     (["bifurcation", "--range", "30,50", "--peaks", "1000000000000"], "keep at most"),
     (["orbit", "--tol", "1e300"], "--tol 1e+300: a relative tolerance must be < 1"),
     (["continue", "--from", "5", "--to", "6", "--tol", "2"], "--tol 2: a relative tolerance must be < 1"),
+    (["study", "timestep", "--t-end", "0"], "t_end - t0 = 0.0 must be a finite number > 0"),
 ])
 def test_refused_options_say_why_in_one_line(args, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    quiet = {"stability": [], "stability-map": ["--no-plot"], "orbit": ["--no-plot"]}.get(args[0],
+    quiet = {"stability": [], "study": [], "stability-map": ["--no-plot"], "orbit": ["--no-plot"]}.get(args[0],
                                                                                  ["--no-plot", "--no-progress"])
     refused(runner.invoke(app, [*args, *quiet]), words)
     assert not list(tmp_path.iterdir())

@@ -190,7 +190,10 @@ def test_json_alone_writes_nothing(tmp_path, monkeypatch):
     (["--steady-from", "5"], "--steady-from 5 s is outside the run"),
     (["--steady-from", "nan"], "--steady-from must be a finite number"),
     (["--perturb", "inf"], "--perturb must be a finite number"),
-    (["--sample-rate", "0"], "--sample-rate must be a finite number > 0"),
+    (["--sample-rate", "0"], "sample_rate = 0.0 must be a finite number > 0"),
+    (["--sample-rate", "nan"], "sample_rate = nan must be a finite number > 0"),
+    (["--t-end", "auto", "--cap", "0"], "cap = 0.0 s must be a finite number > 0"),
+    (["--t-end", "auto", "--cap", "nan", "--dt", "1e-3"], "cap = nan s must be a finite number > 0"),
     (["--dt", "1e-12"], "--dt 1e-12 s takes at least 1e+12 steps for --t-end 1 s"),
     (["--method", "aeom", "--dt", "1e-300"], "give --dt 1e-10 or more"),
 ])

@@ -51,19 +51,6 @@ else:  # pragma: no cover - exercised only on Python 3.10
 console = Console(markup=False, emoji=False, highlight=False)
 err_console = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
 
-#: Help text of every --config option.
-CONFIG_HELP = "TOML file with a [parameters] table (names not given keep their defaults; --set and named options win)."
-
-#: Help text of every --overwrite option of a command whose outputs are not resumable.
-OVERWRITE_HELP = "Replace existing output files instead of refusing."
-
-#: Help text of the --overwrite option of a command that writes into a folder.
-OVERWRITE_FOLDER_HELP = "Write into a folder that is not empty, replacing files of the same names."
-
-#: Help text of the --overwrite option of a resumable command.
-RESTART_HELP = ("Start over: replace the output, its journal and its figure (of this or another run) instead of "
-                "resuming or refusing.")
-
 #: The click base class of usage errors (typer re-exports only its subclass BadParameter; recent
 #: typer versions carry their own copy of click).
 _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
@@ -319,16 +306,6 @@ def config_values(config) -> dict:
     return {name: getattr(loaded, name) for name in data.get("parameters", data)}
 
 
-#: Help text of ``--model`` for commands that take any model.
-MODEL_HELP = ("The model: a library name (two-plates, belt, hoffmann, popp-stelter; see 'stickslip models'), a model "
-              "file (.toml), or a variant of the two plates: full | x | y | rotation (paper Models 1–4) or DOFs, "
-              "e.g. phi,psi.")
-
-#: Help text of ``--set`` for commands that take any model.
-SET_HELP = ("A parameter as PATH=VALUE (repeatable): a plates parameter (--set k_px=400) or a model file's number "
-            "by its path (--set contact.0.drive=1.8; 'stickslip models NAME' lists them).")
-
-
 def build_system(model: str, config, assignments, *, base=None, swept: dict | None = None, **named):
     """The model a command runs on, from ``--model``, ``--config``, ``--set`` and the plates' named options.
 
@@ -422,6 +399,16 @@ def check_below_one(flags: dict) -> None:
     for flag, value in flags.items():
         if value is not None and not value < 1.0:
             raise CLIError(f"{flag} {value:g}: a relative tolerance must be < 1 (typical values 1e-6 … 1e-10)")
+
+
+def executor_of(executor: str | None, scheduler: str | None) -> str:
+    """The executor of ``--executor`` and ``--scheduler``: by default ``dask`` with a scheduler,
+    else ``processes``; a scheduler with another executor is refused (the library would ignore it)."""
+    if executor is None:
+        return "dask" if scheduler else "processes"
+    if scheduler and executor != "dask":
+        raise CLIError(f"--scheduler needs --executor dask (got --executor {executor})")
+    return executor
 
 
 def check_finite(flags: dict) -> None:

@@ -22,9 +22,11 @@ from ..basins.engine import load_result
 from ..files import write_output
 from ..integrate.interrupt import stop_if_interrupted
 from ..plot.basins import save_basins_figure
-from ._app import (MODEL_HELP, SET_HELP, CLIError, app, build_system, check_resumable_output, console, journal_of,
+from ._app import (CLIError, app, build_system, check_resumable_output, console, executor_of, journal_of,
                    parse_assignments)
 from ._kept import keeps, keeps_figure, on_interrupt
+from ._options import (Atol, Executor, Model, NoPlot, NoProgress, Restart, ResumableOut, Rtol, Scheduler, SetItems,
+                       Workers)
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")
@@ -54,8 +56,8 @@ def _states(model, box, n, seed, grid, ics, base, state):
 
 @app.command()
 def basins(
-    model: str = typer.Option("two-plates", "--model", help=MODEL_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
+    model: Model = "two-plates",
+    set_: SetItems = None,
     box: Optional[List[str]] = typer.Option(None, "--box", help=_BOX_HELP),
     n: Optional[int] = typer.Option(None, "--n", help="Uniform random states in the box (default 1000)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the random states."),
@@ -70,24 +72,21 @@ def basins(
     param: Optional[str] = typer.Option(None, "--param", help="Basin stability against a parameter: "
                                         "PATH=LO:HI:K (any --set path), e.g. contact.0.drive=0.8:2:13."),
     t_end: float = typer.Option(500.0, "--t-end", help="Longest run of a state [s]."),
-    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event integrator."),
-    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event integrator."),
+    rtol: Rtol = 1e-8,
+    atol: Atol = 1e-10,
     match_rtol: float = typer.Option(1e-3, "--match-rtol", help="Tolerance of the cycle matches, relative to a "
                                      "cycle's amplitude and period."),
     no_confirm: bool = typer.Option(False, "--no-confirm", help="Do not shoot orbits to confirm periods of "
                                     "several maxima (such runs stay unsettled)."),
     lyapunov: bool = typer.Option(False, "--lyapunov", help="Compute Lyapunov exponents of runs still "
                                   "non-periodic at --t-end (needed for a chaos claim)."),
-    executor: Optional[str] = typer.Option(None, "--executor", help="serial | processes | dask (default processes; "
-                                           "dask when --scheduler is given)."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Worker processes (default: all cores)."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="dask.distributed scheduler address, e.g. "
-                                            "tcp://head:8786 (implies --executor dask)."),
-    out: Path = typer.Option(Path("basins.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an output (or journal) of a different study, "
-                                   "and an existing figure; never the --ics file."),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
-    no_progress: bool = typer.Option(False, "--no-progress", help="Hide the progress bar."),
+    executor: Executor = None,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    out: ResumableOut = Path("basins.nc"),
+    overwrite: Restart = False,
+    no_plot: NoPlot = False,
+    no_progress: NoProgress = False,
     as_json: bool = typer.Option(False, "--json", help="Print {n, fractions, standard_errors, attractors} as JSON."),
 ) -> None:
     """Basin stability: which attractor each initial state reaches (exact stick), and how often."""
@@ -96,10 +95,7 @@ def basins(
     m, _ = build_system(model, None, set_)
     states = _states(m, box, n, seed, grid, ics, base, state)
     path, values = parse_param(param) if param is not None else (None, ())
-    if executor is None:
-        executor = "dask" if scheduler else "processes"
-    if scheduler and executor != "dask":
-        raise CLIError(f"--scheduler needs --executor dask (got --executor {executor})")
+    executor = executor_of(executor, scheduler)
     keeps(out, _holds)
     on_interrupt(f"the states classified before are kept in {journal_of(out)}; run the same command again to resume",
                  journal_of(out))

@@ -19,22 +19,27 @@ from ..orbits import resolve_section
 from ..orbits.continuation import SPECIAL_KINDS, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
-from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, check_below_one, check_finite,
-                   check_positive, check_resumable_output, console, error_line, note_line, resumable_holds)
+from ._app import (CLIError, app, check_below_one, check_finite, check_positive, check_resumable_output, console,
+                   error_line, note_line, resumable_holds)
 from ._kept import keeps, keeps_figure
-from .orbit import IC_HELP, model_system, parse_section, parse_start
+from ._options import (Config, ContinuedOmega, JsonSummary, Model, NoPlot, OrbitRtol, Restart, ResumableOut,
+                       SearchTime, Section, SetItems, SlipBand, StartIc, Tol, VariedLoad)
+from .orbit import model_system, parse_section, parse_start
 
 
 def _check(start: float, stop: float, max_points: int, step: float, max_step: float, search_time: float,
-           rtol: float, tol: float, stop_on: list[str]) -> None:
-    """Validate the options before anything is computed (one-line CLIError naming the fix)."""
+           tol: float, stop_on: list[str]) -> None:
+    """Validate the options before anything is computed (one-line CLIError naming the fix).
+
+    These checks are the command line's: the library refuses the steps, the number of points and
+    the stop kinds only after the start run, calls the start run's length ``t_end``, leaves the
+    tolerance unbounded, and sees --from and --to only as the bounds and direction made of them."""
     check_finite({"--from": start, "--to": stop})
     if start == stop:
         raise CLIError(f"--from and --to are both {start:g}; give the end of the range to continue to")
     if max_points < 2:
         raise CLIError(f"--max-points must be >= 2, got {max_points}")
-    check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--rtol": rtol,
-                    "--tol": tol})
+    check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--tol": tol})
     check_below_one({"--tol": tol})
     if step > max_step:
         raise CLIError(f"--step {step:g} is larger than --max-step {max_step:g}")
@@ -77,38 +82,35 @@ def continue_command(
                                 "Omega, ...]; the first orbit is found there."),
     stop: float = typer.Option(..., "--to", help="End of the range [the unit of --param]; the branch goes from "
                                "--from towards it."),
-    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not continued (default 50)."),
-    omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not continued (default 5)."),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: Optional[str] = typer.Option(None, "--ic", help=IC_HELP),
-    section: str = typer.Option("max", "--section", help="Poincaré section: max | DOF_max | DOF=LEVEL."),
-    search_time: float = typer.Option(60.0, "--search-time", help="Length of the start run [s]."),
+    N: VariedLoad = None,
+    omega: ContinuedOmega = None,
+    model: Model = "full",
+    ic: StartIc = None,
+    section: Section = "max",
+    search_time: SearchTime = 60.0,
     max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
     step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
     max_step: float = typer.Option(0.2, "--max-step", help="Largest step in scaled arclength."),
     stop_on: Optional[List[str]] = typer.Option(None, "--stop-on", help="Stop after this special point (repeatable): "
                                                 "fold, period-doubling, neimark-sacker, stick-phases."),
-    rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map."),
-    tol: float = typer.Option(1e-8, "--tol", help="Corrector tolerance (scaled shooting residual)."),
-    slip_band: Optional[float] = typer.Option(None, "--slip-band", help="Low-speed band of the slip direction [m/s] "
-                                              "(default: that of stickslip.simulate)."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    out: Path = typer.Option(Path("branch.nc"), "--out", help="NetCDF output, journaled as it goes (OUT.nc.journal): "
-                             "the same command again resumes; the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    rtol: OrbitRtol = 1e-10,
+    tol: Tol = 1e-8,
+    slip_band: SlipBand = None,
+    set_: SetItems = None,
+    config: Config = None,
+    out: ResumableOut = Path("branch.nc"),
+    overwrite: Restart = False,
+    no_plot: NoPlot = False,
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
-    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+    as_json: JsonSummary = False,
 ) -> None:
     """Continue a periodic orbit in one parameter, with stability, folds and stick-phase changes.
 
     The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused). Folds, period doublings and Neimark-Sacker points are told apart by what crosses the unit circle (a real multiplier at +1, at -1, a complex pair), with the multipliers on either side. A start orbit that is steady sliding (the equilibrium, no cycle) is an error (exit 2, nothing written); a continuation that converges onto steady sliding writes the orbits before it and exits 1.
     """
     stop_on = list(stop_on or [])
-    _check(start, stop, max_points, step, max_step, search_time, rtol, tol, stop_on)
+    _check(start, stop, max_points, step, max_step, search_time, tol, stop_on)
     ic_start = parse_start(ic)
-    check_positive({"--slip-band": slip_band})
     system = model_system(model, config, set_, slip_band, swept={param: f"--param {param}"}, N=N, Omega=omega)
     try:
         parameter_value(system, param)

@@ -11,7 +11,6 @@ import json
 import math
 import time
 from pathlib import Path
-from typing import List, Optional
 
 import numpy as np
 import typer
@@ -22,26 +21,18 @@ from ..files import netcdf_writer, write_output
 from ..integrate.interrupt import finish_first
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import start_run
+from ..orbits.problem import METHODS as MONODROMY_METHODS
 from ..orbits.problem import stick_summary
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
-from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_below_one,
-                   check_choice, check_outputs, check_positive, console)
+from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
 from ._kept import keeps, keeps_figure
+from ._options import (Config, JsonSummary, Model, NoPlot, NormalLoad, Omega, OrbitRtol, Out, Overwrite, SearchTime,
+                       Section, SetItems, SlipBand, StartIc, Tol)
 from .simulate import _parse_ic
 
-#: Ways to compute the monodromy matrix / the spectrum (the libraries' ``_var.METHODS``).
-_METHODS = ("saltation", "finite-difference")
+#: Ways to compute the Lyapunov spectrum (:func:`stickslip.orbits.lyapunov_spectrum`).
 _LYAPUNOV_METHODS = ("variational", "finite-difference")
-
-_N_HELP = "The plates: normal preload N [N] (default 50)."
-_OMEGA_HELP = "The plates: angular velocity Ω of the lower plate [rad/s] (default 5)."
-IC_HELP = ("Start run: zero | near | equilibrium | a start of the model's own (the plates' far; `stickslip models "
-            "NAME` lists them) | NAME=VALUE,... by state name, e.g. x=0,dx=1.5. Default: the model's own first "
-            "start (the plates' far), else zero.")
-_SECTION_HELP = ("Poincaré section: max (maximum of the model's observed coordinate, the plates' φ) | DOF_max | "
-                 "DOF=LEVEL (up-crossing of a level), e.g. x2_max.")
-_BAND_HELP = "Low-speed band of the slip direction [m/s] (default: that of stickslip.simulate)."
 
 
 def parse_start(ic: str | None):
@@ -91,33 +82,34 @@ def _finite_or_none(x: float):
 
 @app.command("orbit")
 def orbit_command(
-    N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
-    omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: Optional[str] = typer.Option(None, "--ic", help=IC_HELP),
-    section: str = typer.Option("max", "--section", help=_SECTION_HELP),
-    search_time: float = typer.Option(30.0, "--search-time", help="Length of the start run [s]; the guess is "
-                                      "taken from its last section crossings."),
+    N: NormalLoad = None,
+    omega: Omega = None,
+    model: Model = "full",
+    ic: StartIc = None,
+    section: Section = "max",
+    search_time: SearchTime = 30.0,
     period_multiplicity: int = typer.Option(1, "--period-multiplicity", help="Section crossings per period."),
     monodromy: str = typer.Option("saltation", "--monodromy", help="Monodromy matrix: saltation | finite-difference."),
-    rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of every flow map (atol = 1e-3 rtol)."),
-    tol: float = typer.Option(1e-8, "--tol", help="Newton tolerance (scaled shooting residual)."),
-    slip_band: Optional[float] = typer.Option(None, "--slip-band", help=_BAND_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    out: Path = typer.Option(Path("orbit.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
-    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+    rtol: OrbitRtol = 1e-10,
+    tol: Tol = 1e-8,
+    slip_band: SlipBand = None,
+    set_: SetItems = None,
+    config: Config = None,
+    out: Out = Path("orbit.nc"),
+    overwrite: Overwrite = False,
+    no_plot: NoPlot = False,
+    as_json: JsonSummary = False,
 ) -> None:
     """Find a periodic orbit by Newton shooting on the φ-maximum section, with its Floquet multipliers.
 
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
     start = parse_start(ic)
-    check_positive({"--search-time": search_time, "--rtol": rtol, "--tol": tol, "--slip-band": slip_band})
+    # the command line's checks: the library refuses the monodromy and the multiplicity only after the
+    # start run, calls --search-time t_end, and leaves --tol unbounded
+    check_positive({"--search-time": search_time, "--tol": tol})
     check_below_one({"--tol": tol})
-    check_choice("--monodromy", monodromy, _METHODS)
+    check_choice("--monodromy", monodromy, MONODROMY_METHODS)
     if period_multiplicity < 1:
         raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
     system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
@@ -167,21 +159,21 @@ def orbit_command(
 
 @app.command("lyapunov")
 def lyapunov_command(
-    N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
-    omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    ic: Optional[str] = typer.Option(None, "--ic", help=IC_HELP),
+    N: NormalLoad = None,
+    omega: Omega = None,
+    model: Model = "full",
+    ic: StartIc = None,
     t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first [s]."),
     t_average: float = typer.Option(200.0, "--t-average", help="Averaging time [s]."),
     method: str = typer.Option("variational", "--method", help="variational (saltation matrices) | "
                                "finite-difference (perturbed trajectories; works where the variational one refuses)."),
-    rtol: float = typer.Option(1e-10, "--rtol", help="Relative tolerance of the runs (atol = 1e-3 rtol)."),
-    slip_band: Optional[float] = typer.Option(None, "--slip-band", help=_BAND_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    out: Path = typer.Option(Path("lyapunov.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    rtol: OrbitRtol = 1e-10,
+    slip_band: SlipBand = None,
+    set_: SetItems = None,
+    config: Config = None,
+    out: Out = Path("lyapunov.nc"),
+    overwrite: Overwrite = False,
+    no_plot: NoPlot = False,
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary (exponents largest first)."),
 ) -> None:
     """Lyapunov spectrum (Benettin–Shimada–Nagashima) of the attractor reached from --ic.
@@ -189,7 +181,9 @@ def lyapunov_command(
     Runs --t-transient seconds from --ic, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
     """
     start = parse_start(ic)
-    check_positive({"--t-transient": t_transient, "--t-average": t_average, "--rtol": rtol, "--slip-band": slip_band})
+    # the command line's checks: the library refuses a method only after the transient run, and a
+    # non-finite time in other words (t_end - t0 of a run, a memory estimate)
+    check_positive({"--t-transient": t_transient, "--t-average": t_average})
     check_choice("--method", method, _LYAPUNOV_METHODS)
     system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
     inputs = {"--config": config}

@@ -9,8 +9,9 @@ import typer
 
 from ..studies.reproduce import recipe_names
 from ..studies.reproduce import reproduce as run_reproduce
-from ._app import OVERWRITE_FOLDER_HELP, CLIError, app, check_output_folder, console, note_line
+from ._app import CLIError, app, check_output_folder, console, note_line
 from ._kept import on_interrupt
+from ._options import OverwriteFolder
 
 
 @app.command("reproduce")
@@ -20,7 +21,7 @@ def reproduce(
     only: list[str] = typer.Option(None, "--only", help="Run only these figures (repeatable): "
                                    "fig3, fig4, table2, fig7, fig8, fig9, fig10, fig11, fig12a, "
                                    "fig12b, fig13, fig14, fig15, fig16."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_FOLDER_HELP),
+    overwrite: OverwriteFolder = False,
 ) -> None:
     """Paper Sects. 4.1–4.2: Figs. 3–16 and Table 2 beside the paper's statements, with a table
     "paper says / we measure / agrees?" (OUT/report.md)."""

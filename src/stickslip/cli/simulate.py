@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import List, Optional
+from typing import Optional
 
 import numpy as np
 import typer
@@ -29,9 +29,11 @@ from ..integrate.result import load_trajectory
 from ..integrate.status import Status
 from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
-from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, check_positive, console, error_line, given, note_line, warning_line)
+from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, given,
+                   note_line, warning_line)
 from ._kept import keeps, keeps_figure, on_interrupt
+from ._options import (Alpha, Atol, Config, DeltaMu, Model, MuK, NoPlot, NormalLoad, Omega, Overwrite, Rtol, SampleRate,
+                       SetItems)
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
@@ -113,8 +115,8 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
         raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
                        f"give a time in that range")
     start = t0 + 0.5 * (t_end - t0) if steady_from is None else steady_from
-    if not math.isfinite((t_end - t0) * sample_rate):  # samples beyond counting: the run refuses them itself
-        return
+    if not (sample_rate > 0 and math.isfinite((t_end - t0) * sample_rate)):
+        return  # a rate of 0 or less, or samples beyond counting: the run refuses them itself
     first = math.ceil((start - t0) * sample_rate - 1e-9)
     n = math.floor((t_end - t0) * sample_rate + 1e-9) - first + 1
     if n < WINDOW_SAMPLES:
@@ -123,13 +125,15 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
                        + ("" if steady_from is None else " or an earlier --steady-from"))
 
 
-def _parse_t_end(text: str, cap: float, steady_from: float | None) -> float | None:
-    """The run length [s] from ``--t-end``, or None for ``auto`` (run until settled, up to ``cap``)."""
+def _parse_t_end(text: str, steady_from: float | None) -> float | None:
+    """The run length [s] from ``--t-end``, or None for ``auto`` (run until settled, up to ``--cap``).
+
+    A length is checked here, not left to the run: ``--t-end`` is the time added after the end of
+    a continued run, and the window and step checks below need it first."""
     if text.strip().lower() == "auto":
         if steady_from is not None:
             raise CLIError("--steady-from and --t-end auto both set the steady window (auto: the last 100 s); "
                            "give one of them")
-        check_positive({"--cap": cap})
         return None
     try:
         duration = float(text)
@@ -140,8 +144,9 @@ def _parse_t_end(text: str, cap: float, steady_from: float | None) -> float | No
 
 
 def _check_steps(duration: float, dt: float | None, time_flag: str = "--t-end") -> None:
-    """A step of ``dt`` must cover ``duration`` within :data:`MAX_RUN_STEPS` steps."""
-    if dt is not None and math.isfinite(dt) and dt > 0 and not duration / dt <= MAX_RUN_STEPS:
+    """A step of ``dt`` must cover ``duration`` within :data:`MAX_RUN_STEPS` steps (a step or a
+    length that is not a finite number > 0 is the run's to refuse)."""
+    if dt is not None and 0 < dt < math.inf and 0 < duration < math.inf and not duration / dt <= MAX_RUN_STEPS:
         raise CLIError(f"--dt {dt:g} s takes at least {duration / dt:.3g} steps for {time_flag} {duration:g} s, more "
                        f"than the {MAX_RUN_STEPS:.0e} (hours of computing) a run may take from the command line; give "
                        f"--dt {duration / MAX_RUN_STEPS:.3g} or more, or a shorter {time_flag}")
@@ -150,7 +155,7 @@ def _check_steps(duration: float, dt: float | None, time_flag: str = "--t-end") 
 def _warn_aliasing(system, sample_rate: float) -> None:
     """One warning line when the samples cannot resolve the model's fastest linear mode."""
     highest = float(system.natural_frequencies().max(initial=0.0))
-    if sample_rate < 2.0 * highest:
+    if 0 < sample_rate < 2.0 * highest:  # a rate of 0 or less is the run's to refuse
         observed = system.dofs[system.observed_index]
         warning_line(f"--sample-rate {sample_rate:g} Hz is below twice the highest linear mode frequency of model "
                      f"{_model_label(system)} ({highest:.4g} Hz): the spectrum and the frequency of {observed} alias; "
@@ -166,35 +171,34 @@ def _model_label(system) -> str:
 @app.command()
 def simulate(
     ctx: typer.Context,
-    N: Optional[float] = typer.Option(None, "--N", help="The plates: normal preload N [N] (default 50)."),
-    omega: Optional[float] = typer.Option(None, "--omega", help="The plates: angular velocity Ω of the lower plate "
-                                          "[rad/s] (default 5)."),
-    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="The plates: kinetic friction coefficient μk (default 0.2)."),
-    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="The plates: μs − μk (default 0.1)."),
-    alpha: Optional[float] = typer.Option(None, "--alpha", help="The plates: decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP),
+    N: NormalLoad = None,
+    omega: Omega = None,
+    mu_k: MuK = None,
+    delta_mu: DeltaMu = None,
+    alpha: Alpha = None,
+    model: Model = "full",
     t_end: str = typer.Option("100", "--t-end", help="Simulated time [s], or 'auto': extend the run until it has "
                               "settled, up to --cap (the steady window is then the last 100 s). With --ic RUN.nc, "
                               "the time added after the end of that run."),
     cap: float = typer.Option(2000.0, "--cap", help="With --t-end auto: the longest run [s]."),
     method: str = typer.Option("event", "--method", help="Integration method: event | aeom | naeom."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
-    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance (event)."),
-    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance (event)."),
+    rtol: Rtol = 1e-8,
+    atol: Atol = 1e-10,
     ic: str = typer.Option("zero", "--ic", help="zero | equilibrium (steady sliding) | NAME=VALUE,... by state name "
                            "(e.g. x=1,dx=1; the others 0) | one number per state, comma-separated | RUN.nc: continue "
                            "that run from its end, with its model, parameters and settings unless given here."),
     perturb: Optional[float] = typer.Option(None, "--perturb", help="Added to the observed coordinate of the initial "
                                             "state (the plates' φ [rad])."),
-    sample_rate: float = typer.Option(1000.0, "--sample-rate", help="Output samples per second [Hz]."),
+    sample_rate: SampleRate = 1000.0,
     steady_from: Optional[float] = typer.Option(None, "--steady-from", help="Start of the steady-state window, in the "
                                                 "run's time [s] (default: the last half of the run)."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
+    set_: SetItems = None,
+    config: Config = None,
     out: Optional[Path] = typer.Option(None, "--out", help="NetCDF output (default run.nc; with --json, nothing is "
                                        "written unless --out is given); the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
+    overwrite: Overwrite = False,
+    no_plot: NoPlot = False,
     as_json: bool = typer.Option(False, "--json", help="Print the steady-state summary as one JSON object."),
 ) -> None:
     """Simulate a model with exact stick-slip (default: the two plates, Table 1, N = 50 N, Ω = 5 rad/s, 100 s)."""
@@ -208,8 +212,7 @@ def simulate(
                                   delta_mu=delta_mu, alpha=alpha)
     if "slip_band" in settings:
         system = system.with_slip_band(settings.pop("slip_band"))
-    duration = _parse_t_end(t_end, cap, steady_from)
-    check_positive({"--sample-rate": settings["sample_rate"]})
+    duration = _parse_t_end(t_end, steady_from)
     check_finite({"--perturb": perturb, "--steady-from": steady_from})
     time_flag = "--cap" if duration is None else "--t-end"
     longest = cap if duration is None else duration

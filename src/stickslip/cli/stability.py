@@ -21,25 +21,23 @@ from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ..files import netcdf_writer, write_output
-from ._app import (CONFIG_HELP, MODEL_HELP, OVERWRITE_HELP, SET_HELP, CLIError, app, build_system, check_finite,
-                   check_outputs, console)
+from ._app import CLIError, app, build_system, check_finite, check_outputs, console
 from ._kept import keeps, keeps_figure
+from ._options import (Alpha, Config, DeltaMu, JsonSummary, MapModel, Model, MuK, NoPlot, NormalLoad, Omega, Out,
+                       Overwrite, SetItems)
 from .sweep import _VALUE_BYTES, parse_values
-
-_N_HELP = "Normal preload N [N] (default 50)."
-_OMEGA_HELP = "Angular velocity Ω of the lower plate [rad/s] (default 5)."
 
 
 @app.command()
 def stability(
-    N: Optional[float] = typer.Option(None, "--N", help=_N_HELP),
-    omega: Optional[float] = typer.Option(None, "--omega", help=_OMEGA_HELP),
-    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
-    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
-    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
+    N: NormalLoad = None,
+    omega: Omega = None,
+    mu_k: MuK = None,
+    delta_mu: DeltaMu = None,
+    alpha: Alpha = None,
+    model: Model = "full",
+    set_: SetItems = None,
+    config: Config = None,
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
     """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
@@ -100,17 +98,17 @@ def stability_map(
                                              "Default for the plates: N and Ω from the options above."),
     family: Optional[str] = typer.Option(None, "--family", help="Third parameter and its values, e.g. delta_mu=0.1,0.2,0.3, "
                                          "model=full,rotation or contact.0.friction.alpha=1.5,2."),
-    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
-    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
-    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP + " (Plates variants are ignored with --family model=...)"),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
+    mu_k: MuK = None,
+    delta_mu: DeltaMu = None,
+    alpha: Alpha = None,
+    model: MapModel = "full",
+    set_: SetItems = None,
+    config: Config = None,
     no_boundary: bool = typer.Option(False, "--no-boundary", help="Skip the root-finding of the boundary along the second axis."),
-    out: Path = typer.Option(Path("stability_map.nc"), "--out", help="NetCDF output; the figure goes beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
-    as_json: bool = typer.Option(False, "--json", help="Print a JSON summary instead of the table."),
+    out: Out = Path("stability_map.nc"),
+    overwrite: Overwrite = False,
+    no_plot: NoPlot = False,
+    as_json: JsonSummary = False,
 ) -> None:
     """Stable/unstable regions of steady sliding over two parameters of any model, with the boundary by
     root finding (plates: (N, Ω), Figs. 3, 4)."""

@@ -8,7 +8,8 @@ import typer
 
 from ..plot.timestep import save_timestep_figures
 from ..studies.timestep import DT_FULL, DT_QUICK, run_timestep_study
-from ._app import OVERWRITE_FOLDER_HELP, app, check_output_folder, check_positive, console, note_line
+from ._app import app, check_output_folder, console, note_line
+from ._options import OverwriteFolder
 
 study_app = typer.Typer(help="Reproducible studies of the paper (tables, JSON and figures).", no_args_is_help=True)
 app.add_typer(study_app, name="study")
@@ -19,11 +20,10 @@ def timestep(
     out: Path = typer.Option(Path("study_timestep"), "--out", help="Output folder (created)."),
     quick: bool = typer.Option(False, "--quick", help="Leave out Δt = 1e-5 s (under 2 minutes)."),
     t_end: float = typer.Option(100.0, "--t-end", help="Simulated time [s] (paper: 100)."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_FOLDER_HELP),
+    overwrite: OverwriteFolder = False,
 ) -> None:
     """Paper Sect. 4.2.1: AEOM and NAEOM for Δt = 0.1 … 1e-5 s against a converged `event` run
     (Table 2 beside ours, Figs. 5 and 6)."""
-    check_positive({"--t-end": t_end})
     check_output_folder(out, overwrite)
     study = run_timestep_study(DT_QUICK if quick else DT_FULL, t_end=t_end, progress=note_line)
     files = study.save(out)

@@ -28,25 +28,17 @@ from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import columns_of
 from ..files import write_output
-from ._app import (CONFIG_HELP, MODEL_HELP, RESTART_HELP, SET_HELP, CLIError, app, build_system,
-                   check_finite, check_positive, check_resumable_output, config_values, console, parse_assignments,
-                   resumable_holds)
+from ._app import (CLIError, app, build_system, check_positive, check_resumable_output, config_values, console,
+                   executor_of, parse_assignments, resumable_holds)
 from ._kept import keeps, keeps_figure
+from ._options import (Alpha, Atol, BifurcationModel, BifurcationOmega, Cap, Config, DeltaMu, Executor, GridTEnd,
+                       JsonSummary, MuK, NoPlot, NoProgress, RegionsTEnd, RegionsTFrom, Restart, ResumableOut, Rtol,
+                       SampleRate, Scheduler, SetItems, Settle, SweepModel, TFrom, VariedLoad, Workers)
 
 _CATEGORICAL = ("model", "ic")
 
 #: Memory per value of a parsed axis [bytes]: a Python float in a list and its array copies.
 _VALUE_BYTES = 64
-
-_EXECUTOR_HELP = "serial | processes | dask (default processes; dask when --scheduler is given)."
-_WORKERS_HELP = "Worker processes (default: all cores); with dask and no --scheduler, the LocalCluster size."
-_SCHEDULER_HELP = "dask.distributed scheduler address, e.g. tcp://head-node:8786 (implies --executor dask)."
-_TEND_HELP = "Simulated time of every grid point [s]."
-_TFROM_HELP = "Start of the steady-state window [s] (default t_end/2)."
-_SET_HELP = SET_HELP
-_SETTLE_HELP = ("Extend every run from its end until it has settled (or reaches --cap); --t-end is then the first "
-                "run's length and --t-end minus --t-from the window and the step.")
-_CAP_HELP = "Longest run of a point when settling [s] (default 2000)."
 
 
 def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
@@ -114,23 +106,13 @@ def parse_grid(items: list[str] | None) -> dict:
     return grid
 
 
-def _executor(executor: str | None, scheduler: str | None) -> str:
-    if executor is None:
-        return "dask" if scheduler else "processes"
-    if scheduler and executor != "dask":
-        raise CLIError(f"--scheduler needs --executor dask (got --executor {executor})")
-    return executor
-
-
-def _settle_options(settle: bool, cap: float | None, t_end: float) -> dict:
-    """``settle`` and ``cap`` of the sweep spec from ``--settle`` / ``--cap``."""
+def _settle_options(settle: bool, cap: float | None) -> dict:
+    """``settle`` and ``cap`` of the sweep spec from ``--settle`` / ``--cap`` (the sweep refuses a
+    cap that is not a finite number ≥ ``t_end`` itself)."""
     if cap is None:
         return {"settle": True} if settle else {}
     if not settle:
         raise CLIError("--cap is the longest run when settling; give --settle with it")
-    check_positive({"--cap": cap})
-    if not cap >= t_end:
-        raise CLIError(f"--cap {cap:g} must be >= --t-end {t_end:g} (the first run's length)")
     return {"settle": True, "cap": cap}
 
 
@@ -149,11 +131,13 @@ def _plot_columns(system) -> tuple[str, ...]:
 
 
 def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
-    if workers is not None and workers < 1:
-        raise CLIError(f"--workers must be >= 1, got {workers}")
+    """The run options of the sweep library from the command line.
+
+    The run's length, rate and tolerances are checked here: the sweep does not refuse a tolerance
+    (each of its runs would fail) and names neither the length nor the rate it refuses. It refuses
+    ``--t-from``, ``--workers`` and ``--cap`` itself, naming their values."""
     check_positive({"--t-end": t_end, "--sample-rate": sample_rate, "--rtol": rtol, "--atol": atol})
-    check_finite({"--t-from": t_from})
-    return dict(executor=_executor(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
+    return dict(executor=executor_of(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
                 overwrite=overwrite, t_end=t_end, t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
 
 
@@ -194,28 +178,27 @@ def sweep_command(
                                              "(repeatable; order = dimension order). NAME: a parameter (plates: N, "
                                              "Omega, delta_mu, alpha, mu_k, k_px, ...; other models: a path such as "
                                              "contact.0.drive), model (plates variants), ic or perturb_<state>."),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP + " (Plates: the variant when not swept.)"),
+    model: SweepModel = "full",
     ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium (see docs/sweeps.md) when not swept."),
-    t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
-    t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
-    sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
-    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
-    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
-    settle: bool = typer.Option(False, "--settle", help=_SETTLE_HELP),
-    cap: Optional[float] = typer.Option(None, "--cap", help=_CAP_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
-    workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
-    out: Path = typer.Option(Path("sweep.nc"), "--out", help="NetCDF output (resumes if it or its journal exists); "
-                                                           "the figure goes beside it as .png."),
+    t_end: GridTEnd = 200.0,
+    t_from: TFrom = None,
+    sample_rate: SampleRate = 200.0,
+    rtol: Rtol = 1e-8,
+    atol: Atol = 1e-10,
+    settle: Settle = False,
+    cap: Cap = None,
+    set_: SetItems = None,
+    config: Config = None,
+    executor: Executor = None,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    out: ResumableOut = Path("sweep.nc"),
     plot_var: str = typer.Option("frequency", "--plot", help="Reduction drawn in the figure: frequency, amplitude, "
                                                             "stick_fraction, kind, intensity_r_phi, ..."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
-    no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
-    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+    overwrite: Restart = False,
+    no_plot: NoPlot = False,
+    no_progress: NoProgress = False,
+    as_json: JsonSummary = False,
 ) -> None:
     """Simulate every point of a grid and keep its steady-state reductions.
 
@@ -229,7 +212,7 @@ def sweep_command(
     if plot_var not in columns or plot_var == "peaks":
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in columns if c != 'peaks')}")
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-    options.update(_settle_options(settle, cap, t_end))
+    options.update(_settle_options(settle, cap))
     inputs = {"--config": config}
     replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
     keeps(out, resumable_holds("sweep"))
@@ -249,33 +232,31 @@ def bifurcation(
     param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter "
                                                   "of the plates; for another model a path such as contact.0.drive."),
     range_: str = typer.Option("10:130:121", "--range", help="Its values: start:stop:count or v1,v2,..."),
-    N: Optional[float] = typer.Option(None, "--N", help="Normal preload N [N] when not the control parameter (default 50)."),
-    omega: Optional[float] = typer.Option(None, "--omega", help="Ω [rad/s] when not the control parameter "
-                                                                "(default 0.5, as in Figs. 12(a), 13, 14)."),
-    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
-    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
-    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
-    model: str = typer.Option("full", "--model", help=MODEL_HELP + " For the plates also a comma list of variants "
-                                                                  "(one panel each, Fig. 14)."),
+    N: VariedLoad = None,
+    omega: BifurcationOmega = None,
+    mu_k: MuK = None,
+    delta_mu: DeltaMu = None,
+    alpha: Alpha = None,
+    model: BifurcationModel = "full",
     ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium."),
-    t_end: float = typer.Option(200.0, "--t-end", help=_TEND_HELP),
-    t_from: Optional[float] = typer.Option(None, "--t-from", help=_TFROM_HELP),
+    t_end: GridTEnd = 200.0,
+    t_from: TFrom = None,
     n_peaks: int = typer.Option(64, "--peaks", help="Last peak values of φ kept per point."),
-    sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
-    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
-    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
-    settle: bool = typer.Option(False, "--settle", help=_SETTLE_HELP),
-    cap: Optional[float] = typer.Option(None, "--cap", help=_CAP_HELP),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
-    workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
-    out: Path = typer.Option(Path("bifurcation.nc"), "--out", help="NetCDF output (resumable); figure beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
-    no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
-    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+    sample_rate: SampleRate = 200.0,
+    rtol: Rtol = 1e-8,
+    atol: Atol = 1e-10,
+    settle: Settle = False,
+    cap: Cap = None,
+    set_: SetItems = None,
+    config: Config = None,
+    executor: Executor = None,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    out: ResumableOut = Path("bifurcation.nc"),
+    overwrite: Restart = False,
+    no_plot: NoPlot = False,
+    no_progress: NoProgress = False,
+    as_json: JsonSummary = False,
 ) -> None:
     """Bifurcation diagram of φ: steady-state peak values against one parameter (Figs. 12–14)."""
     if param in _CATEGORICAL:
@@ -298,7 +279,7 @@ def bifurcation(
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
     options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-    options.update(_settle_options(settle, cap, t_end))
+    options.update(_settle_options(settle, cap))
     inputs = {"--config": config}
     replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
     keeps(out, resumable_holds("bifurcation diagram"))
@@ -339,28 +320,26 @@ def regions_command(
     N: str = typer.Option("10:130:13", "--N", help="Normal loads [N]: start:stop:count or v1,v2,..."),
     omega: str = typer.Option("1:15:15", "--omega", help="Ω values [rad/s]: start:stop:count or v1,v2,..."),
     model: str = typer.Option("full", "--model", help="Comma list of full, x, y, rotation (Fig. 9 compares all four)."),
-    mu_k: Optional[float] = typer.Option(None, "--mu-k", help="Kinetic friction coefficient μk (default 0.2)."),
-    delta_mu: Optional[float] = typer.Option(None, "--delta-mu", help="μs − μk (default 0.1)."),
-    alpha: Optional[float] = typer.Option(None, "--alpha", help="Decay factor α of Eq. (4) [s/m] (default 5)."),
+    mu_k: MuK = None,
+    delta_mu: DeltaMu = None,
+    alpha: Alpha = None,
     # 300 s: the 'near' start leaves a weakly unstable equilibrium slowly (growth rate
     # 0.05 1/s at N = 50 N, Ω = 5 rad/s: ~150 s until stick-slip), see docs/sweeps.md
-    t_end: float = typer.Option(300.0, "--t-end", help=_TEND_HELP + " Long, because the 'near' start leaves a "
-                                                     "weakly unstable equilibrium slowly."),
-    t_from: Optional[float] = typer.Option(None, "--t-from", help="Start of the steady-state window [s] "
-                                                                 "(default: the last 100 s, or the last half of shorter runs)."),
-    sample_rate: float = typer.Option(200.0, "--sample-rate", help="Output samples per second of each run [Hz]."),
-    rtol: float = typer.Option(1e-8, "--rtol", help="Relative tolerance of the event method."),
-    atol: float = typer.Option(1e-10, "--atol", help="Absolute tolerance of the event method."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help=_SET_HELP),
-    config: Optional[Path] = typer.Option(None, "--config", help=CONFIG_HELP),
-    executor: Optional[str] = typer.Option(None, "--executor", help=_EXECUTOR_HELP),
-    workers: Optional[int] = typer.Option(None, "--workers", help=_WORKERS_HELP),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help=_SCHEDULER_HELP),
-    out: Path = typer.Option(Path("regions.nc"), "--out", help="NetCDF output (resumable); figure beside it as .png."),
-    overwrite: bool = typer.Option(False, "--overwrite", help=RESTART_HELP),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not draw the figure."),
-    no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
-    as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary."),
+    t_end: RegionsTEnd = 300.0,
+    t_from: RegionsTFrom = None,
+    sample_rate: SampleRate = 200.0,
+    rtol: Rtol = 1e-8,
+    atol: Atol = 1e-10,
+    set_: SetItems = None,
+    config: Config = None,
+    executor: Executor = None,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    out: ResumableOut = Path("regions.nc"),
+    overwrite: Restart = False,
+    no_plot: NoPlot = False,
+    no_progress: NoProgress = False,
+    as_json: JsonSummary = False,
 ) -> None:
     """Regions I/II/III over (N, Ω) (Fig. 8) and stick-slip domains of several models (Fig. 9).
 
