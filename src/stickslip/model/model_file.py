@@ -383,6 +383,16 @@ class _Parser:
                 raise ModelFileError(f"{where}.law = {_show(value)} is not a law name; choose {laws}")
 
 
+def _with_defaults(table):
+    """A unilateral contact's table with its optional numbers written out (gap 0, contact damping 0),
+    so that ``--set`` reaches them like any entry (a copy; the caller's table is not changed)."""
+    if not (isinstance(table, Mapping) and isinstance(table.get("normal"), Mapping)):
+        return table
+    normal = {**table["normal"]}
+    normal.setdefault("damping", 0.0)
+    return {**table, "gap": table.get("gap", 0.0), "normal": normal}
+
+
 def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Template:
     """Check a model file's content (keys, shapes, names, expressions) once."""
     if not isinstance(spec, Mapping):
@@ -415,6 +425,7 @@ def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Templ
         tables = [tables]
     if not isinstance(tables, list) or not tables:
         raise ModelFileError("contact must be one or more [[contact]] tables")
+    tables = [_with_defaults(table) for table in tables]
     n = len(dofs)
     parser = _Parser(n, tuple(named))
     contact_names = []

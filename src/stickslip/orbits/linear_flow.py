@@ -9,7 +9,8 @@ events located on the dense output, and every event is matched with the integrat
 transition (same contact, same kind, instant within :data:`MATCH_TIME_TOL`) and the state there
 with the recorded one (scaled difference within :data:`MATCH_TOL`). Events the integrator does
 not record — a 2-D contact leaving the low-speed band, a velocity reversal through v_c = 0 — get
-their jumps without a match.
+their jumps without a match. A unilateral contact's opening and closing are events of their own
+(:data:`.var_kernels.EV_GAP`), matched with the recorded ``open`` and ``close``.
 """
 
 from __future__ import annotations
@@ -177,15 +178,21 @@ def initial_contacts(system, s0, rtol: float, atol: float):
 
 
 def _events_of(system, cst):
-    """Per-contact event kinds, levels and stored 1-D directions of a segment in the modes of ``cst``,
-    and whether a 2-D contact slips inside the low-speed band (its direction turns with the state)."""
+    """Per-contact event kinds, levels and stored 1-D directions of a segment in the modes of ``cst``
+    (then, with unilateral contacts, each one's open/closed event at nc + c), and whether a 2-D
+    contact slips inside the low-speed band (its direction turns with the state)."""
     nc = system.n_contacts
-    kind = np.zeros(nc, dtype=np.int64)
-    level = np.zeros(nc)
-    e = np.zeros(nc)
+    size = 2 * nc if system.unilateral else nc
+    kind = np.zeros(size, dtype=np.int64)
+    level = np.zeros(size)
+    e = np.zeros(size)
     band = False
     for c in range(nc):
         mode = int(cst[CST * c])
+        if system.contacts[c].unilateral:
+            kind[nc + c] = V.EV_GAP
+        if mode == P.MODE_OPEN:
+            continue
         if mode == P.MODE_STICK:
             kind[c] = V.EV_MARGIN
         elif system.contacts[c].dim == 1:
@@ -292,6 +299,26 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
             y, t, Phi = seg.s, seg.t, after(seg.t, seg.Phi)
             continue
         c, kind = seg.contact, seg.kind
+        if kind == V.EV_GAP:
+            c -= system.n_contacts
+            recorded = E.TRANSITION_CLOSE if int(cst[CST * c]) == P.MODE_OPEN else E.TRANSITION_OPEN
+            # an opening from stick is recorded as stick → slip, then open, at one instant
+            at = [j for j in range(k, n_tr) if abs(float(tr.time[j]) - seg.t) <= MATCH_TIME_TOL
+                  and int(tr.contact[j]) == c]
+            if not any(int(tr.kind[j]) == recorded for j in at):
+                raise OrbitError(f"contact {c} {'closes' if recorded == E.TRANSITION_CLOSE else 'opens'} in the "
+                                 f"re-integration at {seg.t:.9f} s, the integrator's next transition is at "
+                                 f"{t_next:.9f} s")
+            s_g = tr.state[at[-1]][:n2]
+            check(seg.s, s_g)
+            jump, cst = S.gap_jump(system, s_g, cst, c)
+            Phi = after(float(tr.time[at[-1]]), jump @ seg.Phi)
+            events.append((float(tr.time[at[-1]]), E.TRANSITION_KINDS[recorded], c))
+            y, t, k = s_g.copy(), float(tr.time[at[-1]]), at[-1] + 1
+            if int(tr.kind[at[-1]]) == E.TRANSITION_TO_STICK:
+                raise OrbitError(f"contact {c} closes and sticks at {t:.9f} s: stick at closing has no saltation "
+                                 "matrix here; use the finite-difference monodromy")
+            continue
         if kind == V.EV_BAND:
             jump, cst = S.band_exit_jump(system, seg.s, cst, c)
             y, t, Phi = seg.s, seg.t, after(seg.t, jump @ seg.Phi)

@@ -23,6 +23,9 @@ complex steps of the contact's slip velocity, friction and normal force
 * **velocity reversal** (v_c reaches 0 where stick cannot hold, so slip departs again along the
   breakaway direction, not a recorded transition): the same without projection and with f⁺ the
   departing slip field.
+* **a unilateral contact opens or closes** (:func:`gap_jump`): h = φ, the contact's open/closed
+  indicator (:mod:`stickslip.model.normal`); the state is continuous and the field jumps (with
+  contact damping the normal force jumps to −c ġ at closing); f⁺ open, or sliding.
 """
 
 from __future__ import annotations
@@ -35,10 +38,10 @@ from ..model import physics as P
 from ..model.bundle import CST
 from ..model.derivatives import state_jacobian
 from ..model.friction import static_coefficient
-from .var_kernels import contact_gradients
+from .var_kernels import contact_gradients, indicator_gradient
 
 __all__ = ["saltation_matrix", "field", "ContactState", "contact_at", "stick_projection", "breakaway_jump",
-           "band_exit_jump", "arrival_jump", "inverse_mass", "sticking", "with_mode"]
+           "band_exit_jump", "arrival_jump", "gap_jump", "inverse_mass", "sticking", "with_mode"]
 
 
 def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray) -> np.ndarray:
@@ -171,6 +174,38 @@ def breakaway_jump(system, s_b: np.ndarray, cst: np.ndarray, c: int):
     after = with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, e)
     S = saltation_matrix(field(system, s_b, cst), field(system, s_b, after), grad_h)
     return S @ stick_projection(system, s_b, cst), after
+
+
+def gap_jump(system, s: np.ndarray, cst: np.ndarray, c: int):
+    """Saltation matrix (2n × 2n) where unilateral contact ``c`` opens (closed in ``cst``) or
+    closes (open in ``cst``) at ``s``: h = its open/closed indicator. A contact that closes slides
+    (a 1-D one along sign(v_c), a 2-D one along v_c/|v_c|); one that opens from stick leaves its
+    stick manifold (the projection onto it first). Returns (S, the contact states after).
+
+    Raises
+    ------
+    OrbitError
+        If the contact closes with v_c = 0 (stick at closing has no jump matrix here) or grazes.
+    """
+    n2 = 2 * system.n
+    s = np.ascontiguousarray(s[:n2], dtype=float)
+    grad_h = np.empty(n2)
+    indicator_gradient(s, cst, c, system.data, n2, grad_h, np.empty(n2, dtype=np.complex128))
+    projection = stick_projection(system, s, cst)
+    if int(cst[CST * c]) == P.MODE_OPEN:
+        v = np.array(P.slip_velocity(s, c, system.data))
+        speed = float(np.hypot(*v))
+        if speed <= E.STICK_SPEED_TOL:
+            raise OrbitError(f"contact {c} closes with slip velocity {speed:.1e} m/s (v ≈ 0): stick at closing has "
+                             "no saltation matrix here; use the finite-difference monodromy")
+        if system.contacts[c].dim == 1:
+            after = with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, (float(np.sign(v[0])), 0.0))
+        else:
+            after = with_mode(cst, c, P.MODE_SLIP_EXACT, tuple(v / speed))
+    else:
+        after = with_mode(cst, c, P.MODE_OPEN)
+    S = saltation_matrix(field(system, s, cst), field(system, s, after), grad_h)
+    return S @ projection, after
 
 
 def band_exit_jump(system, s: np.ndarray, cst: np.ndarray, c: int):

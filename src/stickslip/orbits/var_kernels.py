@@ -32,20 +32,23 @@ from ..model.jit import kernel, loop
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, VECTORS, work_matrix
 
-__all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "integrate_segment", "variational_rhs",
-           "contact_gradients", "event_value"]
+__all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "EV_GAP", "integrate_segment",
+           "variational_rhs", "contact_gradients", "indicator_gradient", "event_value"]
 
 #: Per-contact event kinds of a segment. Each event function starts positive; the event is its
 #: first zero. ``EV_MARGIN``: μs N_c − |F_c| of a sticking contact (breakaway).
 #: ``EV_ZERO``: e·v_c of a slipping 1-D contact along its stored direction e (arrival at v_c = 0).
 #: ``EV_ARRIVE``: |v_c| − level of a 2-D contact slipping with the exact direction (the approach to
 #: stick is stopped at a small speed, see :mod:`.saltation`). ``EV_BAND``: level − |v_c| of a 2-D
-#: contact slipping with the quasi-static direction (leaving the low-speed band).
+#: contact slipping with the quasi-static direction (leaving the low-speed band). ``EV_GAP``: the
+#: open/closed indicator of a unilateral contact (:func:`stickslip.model.physics.indicator`); its
+#: events sit at index nc + c of the event arrays, beside contact c's tangential one at c.
 EV_NONE = 0
 EV_MARGIN = 1
 EV_ZERO = 2
 EV_ARRIVE = 3
 EV_BAND = 4
+EV_GAP = 5
 
 #: Points per step at which the dense output is checked for an event (as the event integrator).
 EV_CHECKS = 4
@@ -55,9 +58,12 @@ EV_TIME_TOL = 1e-13
 
 @kernel
 def event_value(kind, c, s, level, e0, cst, md):
-    """Event function of contact ``c`` of ``kind`` at the state ``s`` (module constants)."""
+    """Event function of contact ``c`` of ``kind`` at the state ``s`` (module constants; for
+    ``EV_GAP``, ``c`` is nc + the contact)."""
     if kind == EV_MARGIN:
         return P.stick_margin(s, cst, c, md)
+    if kind == EV_GAP:
+        return P.indicator(s, cst, c - model_sizes(md.kin, md.m)[1], md)
     v0, v1 = P.slip_velocity(s, c, md)
     if kind == EV_ZERO:
         return v0 * e0
@@ -237,11 +243,12 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
 
     Parameters
     ----------
-    ev_kind : ndarray (nc,) int64
-        Event kind of each contact (``EV_*``; ``EV_NONE``: not watched).
-    ev_level : ndarray (nc,)
+    ev_kind : ndarray (nc,) or (2 nc,) int64
+        Event kind of each contact (``EV_*``; ``EV_NONE``: not watched), then with unilateral
+        contacts the ``EV_GAP`` of each.
+    ev_level : ndarray, as ``ev_kind``
         Speed level of ``EV_ARRIVE`` / ``EV_BAND`` [m/s].
-    ev_e : ndarray (nc,)
+    ev_e : ndarray, as ``ev_kind``
         Stored slip direction (±1) of ``EV_ZERO``.
     atol : ndarray (2n + 4n²,)
         Absolute tolerances; error control is the RMS of the local error over ``atol + rtol |y|``.
@@ -255,7 +262,7 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
     y : ndarray
         State and variations there.
     contact : int
-        Contact of the event (−1 without).
+        Index of the event in ``ev_kind`` (−1 without).
     """
     n = y0.shape[0]
     nc = ev_kind.shape[0]
@@ -313,6 +320,18 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
             Kst[0, i] = Kst[6, i]
         h *= 5.0 if err_norm == 0.0 else min(5.0, 0.9 * err_norm ** -0.2)
     return 0, t, y, -1
+
+
+@kernel
+def indicator_gradient(s, cst, c, md, n2, out, z):
+    """Complex-step gradient ∂φ/∂s (2n,) of unilateral contact ``c``'s open/closed indicator at the
+    float state ``s`` in its mode of ``cst`` (``z`` (2n,) complex work)."""
+    for i in range(n2):
+        z[i] = s[i]
+    for j in range(n2):
+        z[j] = complex(s[j], P.COMPLEX_STEP)
+        out[j] = P.indicator(z, cst, c, md).imag / P.COMPLEX_STEP
+        z[j] = s[j]
 
 
 @kernel

@@ -17,7 +17,7 @@ from ..errors import EquilibriumError
 from ..model.bundle import CST
 from ..model.library import resolve_system
 from ..model.parameters import Parameters
-from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
+from ..model.physics import MODE_SLIP_EXACT, gap, normal_force_of, rhs, slip_velocity
 from ..model.system_model import FrictionModel
 from . import steady
 
@@ -103,7 +103,35 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         if np.all(np.isfinite(q)) and min(sliding_speeds(system, q)) == 0.0:
             raise EquilibriumError(_not_sliding_message(system, q))
         raise EquilibriumError(_failure_message(system, q, status, rel))
+    _check_closed(system, q)
     return q, float(rel), int(iterations)
+
+
+def _check_closed(system, q: np.ndarray) -> None:
+    """Steady sliding needs every unilateral contact closed (g < 0, λ > 0) at the equilibrium found
+    with them closed; otherwise it does not exist (a contact at rest there is open)."""
+    s = np.zeros(2 * system.n)
+    s[:system.n] = q
+    cst = _sliding_modes(system)
+    for c, contact in enumerate(system.contacts):
+        if not contact.unilateral:
+            continue
+        g = gap(s, c, system.data)[0]
+        lam = normal_force_of(s, cst, c, system.data)
+        if not (g < 0.0 and lam > 0.0):
+            name = system.contact_names[c]
+            raise EquilibriumError(f"no steady sliding at {system.point_text()}: at rest contact {c} ({name}) would "
+                                   f"be open (gap {g:.6g}, normal force {lam:.6g} with it closed), so nothing "
+                                   "presses it onto its surface; press it (a force towards the contact, a negative "
+                                   "gap) or simulate the free motion")
+
+
+def _sliding_modes(system) -> np.ndarray:
+    """Contact states with every contact slipping (exact direction), as steady sliding has them."""
+    cst = np.zeros(CST * system.n_contacts)
+    cst[0::CST] = MODE_SLIP_EXACT
+    cst[3::CST] = np.inf
+    return cst
 
 
 def steady_sliding(system) -> np.ndarray:
@@ -121,10 +149,7 @@ def equilibrium_residual(system, q: np.ndarray) -> np.ndarray:
     s = np.zeros(2 * n)
     s[:n] = q
     ds = np.zeros(2 * n)
-    cst = np.zeros(CST * system.n_contacts)
-    cst[0::CST] = MODE_SLIP_EXACT
-    cst[3::CST] = np.inf
-    rhs(s, cst, system.data, ds)
+    rhs(s, _sliding_modes(system), system.data, ds)
     return np.where(system.free, -(system.mass @ ds[n:]), 0.0)
 
 
