@@ -37,7 +37,7 @@ def test_cap_stops_an_unsettled_run(tmp_path):
 @pytest.mark.parametrize("args, words", [
     (["--t-end", "soon"], "--t-end soon: give a time in seconds or auto"),
     (["--t-end", "auto", "--steady-from", "10"], "--steady-from and --t-end auto both set the steady window"),
-    (["--t-end", "auto", "--cap", "-5"], "--cap must be a finite number > 0, got -5.0"),
+    (["--t-end", "auto", "--cap", "-5"], "cap = -5.0 s must be a finite number > 0"),
 ])
 def test_bad_run_length_is_one_line_and_exit_2(tmp_path, args, words):
     res = runner.invoke(app, ["simulate", *args, "--no-plot", "--out", str(tmp_path / "x.nc")])

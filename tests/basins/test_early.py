@@ -9,6 +9,7 @@ from stickslip.basins import basin_stability, box
 from stickslip.basins.context import make_context
 from stickslip.basins.cycles import MATCH_PERIODS, Cycle, Section, cycles_equal, run_matches
 from stickslip.basins.early import Options, Outcome, classify_state
+from stickslip.model import model_from_spec
 from stickslip.model.library import load_model
 
 BELT = load_model("belt")
@@ -60,10 +61,27 @@ def test_a_known_cycle_stops_runs_early_without_changing_verdicts():
     assert sum(o.t_decided for o in known) < sum(o.t_decided for o in alone)
 
 
+#: hoffmann with its contact spring as a prescribed load N = 1 + y (pressed: a run ends where N
+#: reaches 0, "contact lost"), the form before contacts could open.
+PRESSED_HOFFMANN = model_from_spec({
+    "name": "hoffmann-pressed", "dofs": ["x", "y"], "mass": [[1.0, 0.0], [0.0, 1.0]],
+    "damping": [[0.0, 0.0], [0.0, 0.0]], "stiffness": [[2.0, 1.0], [1.0, 2.0]], "force": [0.0, 0.0],
+    "contact": [{"tangent": [[1.0, 0.0]], "drive": [1.0], "normal_force": 1.0, "normal_gradient": [0.0, 1.0],
+                 "friction": {"law": "coulomb", "mu_k": 0.5, "delta_mu": 0.0}}]})
+
+
 def test_an_open_contact_ends_at_once_as_contact_lost():
-    hoffmann = load_model("hoffmann")  # N = 1 + y: open for y < −1
-    o = classify_state(make_context(hoffmann), hoffmann, np.array([0.0, -2.0, 0.0, 0.0]), [], Options())
+    """A pressed contact without load at the start (N = 1 + y: none for y < −1) ends the run."""
+    model = PRESSED_HOFFMANN
+    o = classify_state(make_context(model), model, np.array([0.0, -2.0, 0.0, 0.0]), [], Options())
     assert (o.verdict, o.decided_by, o.t_decided) == ("contact-lost", "stopped", 0.0)
+
+
+def test_a_unilateral_contact_open_at_the_start_is_no_loss():
+    """hoffmann's contact spring lifts off instead: the same state is a flight, and the run goes on."""
+    hoffmann = load_model("hoffmann")
+    o = classify_state(make_context(hoffmann), hoffmann, np.array([0.0, -2.0, 0.0, 0.0]), [], Options())
+    assert o.verdict != "contact-lost" and o.t_decided > 0.0
 
 
 def _cycle(peaks, period=2.0, amplitude=3.0):
@@ -115,8 +133,7 @@ def test_every_library_model_runs():
         res = basin_stability(model, box(model, ranges, n=6, base="zero"), t_end=100.0, executor="serial")
         assert res.complete and res.n == 6, name
         assert set(res.names) <= {"equilibrium", "periodic", "periodic-2", "unsettled", "contact-lost"}, res.names
-    hoffmann = load_model("hoffmann")
-    res = basin_stability(hoffmann, box(hoffmann, {"y": (-3.0, -1.5)}, n=5, base="zero"), t_end=10.0,
+    res = basin_stability(PRESSED_HOFFMANN, box(PRESSED_HOFFMANN, {"y": (-3.0, -1.5)}, n=5, base="zero"), t_end=10.0,
                           executor="serial")
     assert res.names == ["contact-lost"]
 

@@ -129,5 +129,5 @@ def test_models_lists_the_library_and_shows_a_model():
     assert d["states"] == ["x", "dx"] and d["parameters"]["contact.0.friction.mu_k"] == 0.5
     assert d["natural_frequencies_hz"] == pytest.approx([1 / (2 * math.pi)])
     res = invoke("models", "hoffmann")
-    assert res.exit_code == 0 and "contact.0.normal_gradient.1" in res.output
+    assert res.exit_code == 0 and "contact.0.gap_gradient.1" in res.output
     assert "unknown model 'x.y'" in one_error_line(invoke("models", "x.y"))

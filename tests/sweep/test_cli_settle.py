@@ -15,7 +15,7 @@ def test_cap_needs_settle(tmp_path):
     assert result.exit_code == 2 and "give --settle" in result.output
     result = runner.invoke(app, ["bifurcation", "--range", "30,50", "--settle", "--cap", "5", "--t-end", "10",
                                  "--out", str(tmp_path / "b.nc")])
-    assert result.exit_code == 2 and "--cap 5 must be >= --t-end 10" in result.output
+    assert result.exit_code == 2 and "cap = 5.0 s must be a finite number ≥ t_end = 10.0 s" in result.output
 
 
 def test_settle_runs_each_point_until_settled(tmp_path):
