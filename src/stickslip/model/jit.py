@@ -32,7 +32,11 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import pickle
+import re
+from pathlib import Path
 
 from numba import njit
 
@@ -64,6 +68,64 @@ def _tolerant_index_loading() -> None:
 
 
 _tolerant_index_loading()
+
+#: The package's root folder, and what marks a module of the compiled layer.
+_PACKAGE = Path(__file__).resolve().parents[1]
+_COMPILED = re.compile(rb"@kernel|@inlined_kernel|@loop|njit|@overload|@intrinsic|register_kinematics")
+
+
+@functools.lru_cache(maxsize=1)
+def compiled_layer_digest() -> str:
+    """SHA-256 of every module of the package that defines or specialises compiled code.
+
+    numba checks a cached kernel against its own file only, but the kernels here inline and call
+    one another across modules (the physics into the integrators, the orbits, the steady-state
+    solver), so a kernel whose file did not change would be loaded with the old code of another.
+    Every kernel of the package is therefore stamped with this digest as well
+    (:func:`_stamp_with_package`): a change to any module of the compiled layer recompiles them
+    all, and nothing stale is ever loaded.
+    """
+    digest = hashlib.sha256()
+    for path in sorted(_PACKAGE.rglob("*.py")):
+        text = path.read_bytes()
+        if _COMPILED.search(text):
+            digest.update(str(path.relative_to(_PACKAGE)).encode())
+            digest.update(hashlib.sha256(text).digest())
+    return digest.hexdigest()
+
+
+def _stamp_with_package() -> None:
+    """Make numba's cache locators stamp the package's kernels with :func:`compiled_layer_digest`
+    beside their own file (the cache in ``__pycache__`` or ``NUMBA_CACHE_DIR`` as before)."""
+    try:
+        from numba.core.caching import CacheImpl, InTreeCacheLocator, UserProvidedCacheLocator
+    except ImportError:  # pragma: no cover - a numba without these classes caches differently
+        return
+    if getattr(CacheImpl, "_stickslip_stamped", False):
+        return
+
+    def locator(base):
+        class PackageLocator(base):
+            def get_source_stamp(self):
+                return super().get_source_stamp(), compiled_layer_digest()
+
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                try:
+                    inside = Path(py_file).resolve().is_relative_to(_PACKAGE)
+                except (OSError, ValueError):
+                    inside = False
+                return super().from_function(py_func, py_file) if inside else None
+
+        PackageLocator.__name__ = f"Stickslip{base.__name__}"
+        return PackageLocator
+
+    CacheImpl._locator_classes = [locator(UserProvidedCacheLocator), locator(InTreeCacheLocator),
+                                  *CacheImpl._locator_classes]
+    CacheImpl._stickslip_stamped = True
+
+
+_stamp_with_package()
 
 #: Options of every compiled kernel, also given to the overloads whose implementations numba
 #: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
