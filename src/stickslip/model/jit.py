@@ -36,6 +36,7 @@ import functools
 import hashlib
 import pickle
 import re
+import warnings
 from pathlib import Path
 
 from numba import njit
@@ -68,6 +69,37 @@ def _tolerant_index_loading() -> None:
 
 
 _tolerant_index_loading()
+
+
+def _tolerant_cache_saving() -> None:
+    """Let a kernel run when its cache file cannot be written (a full disk, a file-size limit, a
+    read-only folder): numba raises the OSError from inside the compilation, after the kernel is
+    compiled. The kernel is used uncached instead, with one warning; it is compiled again in the
+    next process."""
+    try:
+        from numba.core.caching import Cache
+    except ImportError:  # pragma: no cover - a numba without this class caches differently
+        return
+    save = Cache.save_overload
+    if getattr(save, "_stickslip_tolerant", False):
+        return
+
+    warned = []
+
+    def save_overload(self, sig, data):
+        try:
+            return save(self, sig, data)
+        except OSError as exc:
+            if not warned:  # once per process: every kernel after it fails alike
+                warned.append(exc)
+                warnings.warn(f"compiled kernels could not be cached ({exc.strerror or exc}); they are used uncached "
+                              "and compiled again in the next process", RuntimeWarning, stacklevel=2)
+
+    save_overload._stickslip_tolerant = True
+    Cache.save_overload = save_overload
+
+
+_tolerant_cache_saving()
 
 #: The package's root folder, and what marks a module of the compiled layer.
 _PACKAGE = Path(__file__).resolve().parents[1]

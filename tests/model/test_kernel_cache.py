@@ -1,0 +1,56 @@
+"""The kernels' disk cache: stamped with the whole compiled layer, and never fatal to write."""
+
+from __future__ import annotations
+
+import errno
+import warnings
+
+import pytest
+from numba.core.caching import Cache, CacheImpl
+
+from stickslip.model import jit
+
+
+def test_every_kernel_of_the_package_is_stamped_with_the_compiled_layer():
+    """A cached kernel is checked against every module it may inline, not only its own file."""
+    from stickslip.model import physics
+
+    locator = physics.rhs._cache._impl.locator
+    stamp = locator.get_source_stamp()
+    assert type(locator).__name__.startswith("Stickslip")
+    assert isinstance(stamp, tuple) and stamp[1] == jit.compiled_layer_digest()
+    assert CacheImpl._locator_classes[0].__name__.startswith("Stickslip")
+
+
+def test_the_digest_covers_the_modules_that_define_or_specialise_kernels():
+    text = (jit._PACKAGE / "model" / "normal.py").read_bytes()
+    assert jit._COMPILED.search(text)  # the unilateral contacts' kernels count
+    assert not jit._COMPILED.search((jit._PACKAGE / "errors.py").read_bytes())
+
+
+def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeypatch):
+    """A full disk or a file-size limit while numba saves a kernel (seen under ulimit -f with an
+    empty cache): the kernel runs uncached; the process warns once."""
+    full = OSError(errno.EFBIG, "File too large")
+
+    class Stub:
+        _enabled = True
+
+        def _guard_against_spurious_io_errors(self):
+            return Cache._guard_against_spurious_io_errors(self)
+
+        def _save_overload(self, sig, data):
+            raise full
+
+    stub = Stub()
+    saved = Cache.save_overload
+    assert saved._stickslip_tolerant
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        saved(stub, None, None)
+        saved(stub, None, None)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) <= 1 and all("could not be cached (File too large)" in m for m in messages)
+    with pytest.raises(TypeError):  # anything but an OSError still surfaces
+        Stub._save_overload = lambda self, sig, data: (_ for _ in ()).throw(TypeError("bug"))
+        saved(stub, None, None)
