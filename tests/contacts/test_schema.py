@@ -93,3 +93,4 @@ def test_pressed_models_keep_their_results_unchanged():
     assert not traj.system.unilateral and not traj.open.any()
     assert "open_fraction" not in traj.steady.to_dict()
     assert "open" not in traj.to_xarray().data_vars
+

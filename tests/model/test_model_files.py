@@ -410,3 +410,14 @@ def test_the_cli_prints_no_escape_sequence_from_a_model_file(tmp_path):
     spec["description"] = "\x1b[31mred\x1b[0m"
     res = CliRunner().invoke(app, ["models", str(write(tmp_path, spec))])
     assert res.exit_code == 2 and "\x1b" not in res.output and len(res.output.strip().splitlines()) == 1
+
+
+def test_units_name_dofs_and_parameters_and_refuse_anything_else():
+    spec = copy.deepcopy(BASES[0])  # the belt
+    spec["parameters"] = {"V": 1.0}
+    spec["contact"][0]["drive"] = ["V"]
+    spec["units"] = {"x": "m", "V": "m/s"}
+    assert model_from_spec(spec).units == {"x": "m", "V": "m/s"}
+    spec["units"]["v"] = "m/s"
+    with pytest.raises(ModelFileError, match="units: 'v' is neither a dof nor a named parameter"):
+        model_from_spec(spec)

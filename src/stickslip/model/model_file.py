@@ -420,6 +420,10 @@ def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Templ
     if not isinstance(units, Mapping) or not all(isinstance(v, str) for v in units.values()):
         raise ModelFileError('units must be a table of dof = "unit", e.g. units = { x = "m" }')
     named = _parameters(spec.get("parameters", {}))
+    unknown = [str(k) for k in units if k not in dofs and k not in named]
+    if unknown:
+        raise ModelFileError(f"units: {unknown[0]!r} is neither a dof nor a named parameter; units are given for "
+                             f"the dofs ({', '.join(dofs)}) and the [parameters] ({', '.join(named) or 'none'})")
     tables = spec["contact"]
     if isinstance(tables, Mapping):
         tables = [tables]
