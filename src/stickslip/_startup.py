@@ -14,6 +14,14 @@ unhandled Ctrl-C, exit status 130 in a shell). The command line releases with
 once. Only the default handler is replaced, in the main thread: a process that ignores SIGINT,
 or installed its own handler, keeps it.
 
+**Ctrl-C inside a finaliser.** Python reports an exception raised in a ``__del__`` method as
+"Exception ignored" and goes on; a KeyboardInterrupt raised by a SIGINT handler while a finaliser
+runs (numba frees LLVM objects in ``__del__`` all through a compilation) was lost that way, and
+the process went on compiling for a minute. :func:`_redeliver_interrupts` hooks
+``sys.unraisablehook`` so that such a KeyboardInterrupt is delivered again to the main thread at
+its next instruction after the finaliser (``_thread.interrupt_main`` from a short-lived thread),
+where it acts as the Ctrl-C the user pressed; other unraisable exceptions go to the previous hook.
+
 **NUMBA_NUM_THREADS.** numba refuses to be imported with ``NUMBA_NUM_THREADS`` below 1 (a
 ``ValueError`` from deep inside its import). stickslip runs no parallel numba code, so the
 setting has no effect on it: a value that is not a number ≥ 1 is removed from this process's
@@ -27,6 +35,8 @@ import os
 import signal
 import sys
 import threading
+import time
+import _thread
 
 __all__ = ["hold", "release", "notes", "INTERRUPTED_LINE"]
 
@@ -103,4 +113,25 @@ def _check_numba_threads() -> None:
                      "no parallel numba code); unset it or give a number >= 1")
 
 
+def _interrupt_main_soon() -> None:
+    time.sleep(0.02)
+    _thread.interrupt_main(signal.SIGINT)
+
+
+def _redeliver_interrupts() -> None:
+    previous = sys.unraisablehook
+
+    def hook(unraisable) -> None:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            # from another thread, a moment later: signalled at once, the handler would run inside this hook
+            threading.Thread(target=_interrupt_main_soon, daemon=True).start()
+        else:
+            previous(unraisable)
+
+    if getattr(previous, "__name__", "") != "redeliver_interrupts":
+        hook.__name__ = "redeliver_interrupts"
+        sys.unraisablehook = hook
+
+
 _check_numba_threads()
+_redeliver_interrupts()

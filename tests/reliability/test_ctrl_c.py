@@ -287,3 +287,21 @@ def test_ctrl_c_while_numba_compiles_is_one_line(tmp_path):
         proc.kill()
     assert proc.returncode == 130, stderr
     assert stderr.strip() == "interrupted: nothing was written" and files(tmp_path / "out") == []
+
+
+def test_ctrl_c_inside_a_finaliser_is_not_lost():
+    """A KeyboardInterrupt raised while a ``__del__`` runs (numba frees LLVM objects that way all
+    through a compilation) is delivered again after it, instead of "Exception ignored" and going on."""
+    code = ("import os, signal, stickslip\n"
+            "class Freed:\n"
+            "    def __del__(self):\n"
+            "        os.kill(os.getpid(), signal.SIGINT)\n"
+            "        sum(range(1000))\n"
+            "try:\n"
+            "    obj = Freed(); del obj\n"
+            "    sum(range(10**8))\n"
+            "    print('went on')\n"
+            "except KeyboardInterrupt:\n"
+            "    print('interrupted')\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert res.stdout.strip() == "interrupted" and res.stderr == "", (res.stdout, res.stderr)
