@@ -29,6 +29,7 @@ from ..model import physics as P
 from ..model.bundle import CST
 from ..model.jit import kernel
 from ..model.kinematics import model_sizes
+from ..model.normal import starts_open
 
 __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP",
            "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_KINDS", "EVENT_TIME_TOL", "close_contact",
@@ -365,7 +366,7 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
         cst[CST * c + 2] = 0.0
         cst[CST * c + 3] = math.inf
     for c in range(nc):  # a unilateral contact that is not closed at the start is open
-        if P.unilateral(c, md) and P.indicator(y, cst, c, md) <= 0.0:
+        if starts_open(y, cst, c, md):
             cst[CST * c] = P.MODE_OPEN
     for c in range(nc):
         if np.int64(cst[CST * c]) == P.MODE_OPEN:

@@ -29,11 +29,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba.extending import overload
 
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
-from ..model.jit import inlined_kernel, kernel, loop
-from ..model.kinematics import has_unilateral, model_sizes
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, loop
+from ..model.kinematics import has_unilateral, model_sizes, pressed_only
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
@@ -148,12 +149,23 @@ def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
     return n_tr
 
 
-@kernel
-def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):  # pragma: no cover
     """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
     change its mode, record the transitions (a sticking contact that opens first leaves stick; a
     contact that closes with v_c = 0 and an admissible stick force sticks), re-check the sticking
-    set, and return the transition count."""
+    set, and return the transition count (resolved by numba: nothing for pressed-only kinematics)."""
+    raise NotImplementedError
+
+
+@overload(switch_gap, jit_options=KERNEL_OPTIONS)
+def _switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+    if pressed_only(md.types[md.fields.index("kin")]):
+        return lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats: n_tr
+    return _switch
+
+
+def _switch(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+    """:func:`switch_gap` of kinematics that may have unilateral contacts."""
     if P.is_open(cst, c):
         record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
         n_tr += 1

@@ -28,7 +28,7 @@ from .kinematics import contact_dim, contact_frame
 from .linalg import solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
-from .normal import MODE_OPEN, add_normal_forces, compliant_force, is_open, is_unilateral
+from .normal import MODE_OPEN, add_normal_forces, normal_in_mode, open_in_mode
 from .stack import DOFS, ROWS, VECTORS, work_matrix
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
@@ -337,14 +337,12 @@ def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
         v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
         v[2 * c] = v0
         v[2 * c + 1] = v1
-        if is_unilateral(md, n, c):
-            if is_open(cst, c):  # no normal force, no friction
-                N[c] = csm.zero(normal)
-                F[2 * c] = csm.zero(normal)
-                F[2 * c + 1] = csm.zero(normal)
-                continue
-            normal = compliant_force(s, m, n, c)
+        normal = normal_in_mode(s, cst, md, n, c, normal)
         N[c] = normal
+        if open_in_mode(cst, md, c):  # no normal force, no friction
+            F[2 * c] = csm.zero(normal)
+            F[2 * c + 1] = csm.zero(normal)
+            continue
         speed = csm.sqrt(v0 * v0 + v1 * v1)
         if not exact_direction(np.int64(cst[CST * c]), speed.real, band):
             return False

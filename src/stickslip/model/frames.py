@@ -20,7 +20,7 @@ from .bundle import H_CONSTANT
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
 from .kinematics import contact_dim, contact_frame, model_sizes, registered_frame_bias
 from .model_data import is_stick
-from .normal import compliant_force, is_open, is_unilateral
+from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
 
 __all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "frame_velocity", "split_complex_frame", "max_rate", "frame_with_bias",
@@ -157,8 +157,7 @@ def all_frames(s, cst, md, n, nc, G, w, v, N, h, with_bias):
             N[c] = frame_with_bias(s, c, md, G2, w2, h[2 * c:2 * c + 2])
         else:
             N[c] = contact_frame(md.kin, s, c, m, G2, w2)
-        if is_unilateral(md, n, c):  # the gap's normal force, none while open
-            N[c] = csm.zero(s[0]) if is_open(cst, c) else compliant_force(s, m, n, c)
+        N[c] = normal_in_mode(s, cst, md, n, c, N[c])  # a unilateral contact's: none while open
         v0, v1 = frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
         v[2 * c] = v0
         v[2 * c + 1] = v1

@@ -46,8 +46,9 @@ from . import stack
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
 from .jit import KERNEL_OPTIONS, kernel
 
-__all__ = ["ConstantKinematics", "register_kinematics", "registered_kinematics", "registered_frame_bias", "contact_frame",
-           "constant_frame", "KinematicsError", "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral"]
+__all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
+           "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
+           "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only"]
 
 
 #: Registered frame functions by kinematics class.
@@ -111,6 +112,13 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
 def allows_unilateral(cls: type) -> bool:
     """Whether models of kinematics class ``cls`` may have unilateral contacts."""
     return cls not in _PRESSED_ONLY
+
+
+def pressed_only(kin_type) -> bool:
+    """At compile time: whether the numba type ``kin_type`` of a kinematics object belongs to a class
+    registered without unilateral contacts (the overloads of :mod:`stickslip.model.normal` then
+    compile none of their code)."""
+    return getattr(kin_type, "instance_class", None) in _PRESSED_ONLY
 
 
 def registered_kinematics() -> tuple[type, ...]:
@@ -187,10 +195,25 @@ def _contact_dim(kin, m, n, c):
 class ConstantKinematics(NamedTuple):
     """Kinematics of a model whose contact Jacobians G and drives w are constant (model files).
 
-    G, w and the affine normal force N = N0 + n·q + n_v·q̇ live in the model's data array.
+    G, w and the affine normal force N = N0 + n·q + n_v·q̇ live in the model's data array. Its
+    contacts are all pressed: a model with unilateral contacts takes
+    :class:`ConstantUnilateralKinematics` (:class:`~stickslip.model.FrictionModel` swaps it in), so
+    that models without them compile none of their code.
     """
 
     constant: float = 1.0
+
+
+class ConstantUnilateralKinematics(NamedTuple):
+    """:class:`ConstantKinematics` of a model with unilateral contacts: a closed compliant contact's
+    force −k (g0 + W·q) − c W·q̇ is affine in the state too, and stands in the data array as its N0,
+    n and n_v (:meth:`stickslip.model.system_model.Contact.spec`), so the frame returns it."""
+
+    constant: float = 1.0
+
+
+#: The kinematics classes of constant G and w.
+CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics)
 
 
 @kernel
@@ -208,4 +231,5 @@ def constant_frame(kin, s, c, m, G, w):
     return normal
 
 
-register_kinematics(ConstantKinematics, constant_frame)
+register_kinematics(ConstantKinematics, constant_frame, unilateral=False)
+register_kinematics(ConstantUnilateralKinematics, constant_frame)

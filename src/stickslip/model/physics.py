@@ -55,7 +55,7 @@ from .kinematics import contact_dim, contact_frame, model_sizes
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
                          apply_inverse_mass, is_stick, kinetic_coefficient, kinetic_energy, law_row, static_limit)
-from .normal import MODE_OPEN, compliant_force, contact_indicator, gap_and_rate, is_open, is_unilateral
+from .normal import MODE_OPEN, gap_and_rate, indicator_of, is_open, is_unilateral, normal_in_mode
 from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
@@ -259,7 +259,7 @@ def slip_velocity(s, c, md):
 def indicator(s, cst, c, md):
     """Open/closed indicator of unilateral contact ``c`` in its mode of ``cst``: > 0 while it stays
     closed (open), falls through 0 where it opens (closes) (:func:`~stickslip.model.normal.contact_indicator`)."""
-    return contact_indicator(s, cst, md.m, model_sizes(md.kin, md.m)[0], c)
+    return indicator_of(s, cst, c, md)
 
 
 @kernel
@@ -272,10 +272,11 @@ def gap(s, c, md):
 def normal_force_of(s, cst, c, md):
     """Normal force of contact ``c`` at ``s`` in the mode of ``cst`` [N]: a prescribed load, or a
     unilateral contact's λ (0 while open)."""
-    n = model_sizes(md.kin, md.m)[0]
-    if is_unilateral(md, n, c):
-        return 0.0 if is_open(cst, c) else compliant_force(s, md.m, n, c)
-    return normal_force(s, c, md)
+    m = md.m
+    n = model_sizes(md.kin, m)[0]
+    G2 = work_matrix(md.kin, TWO, DOFS, s)
+    w2 = work_matrix(md.kin, ONE, TWO, s)[0]
+    return normal_in_mode(s, cst, md, n, c, contact_frame(md.kin, s, c, m, G2, w2))
 
 
 @kernel

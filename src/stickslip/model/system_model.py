@@ -30,7 +30,8 @@ from ..errors import ModelError
 from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
 from .bundle import NORMAL_LAWS
-from .kinematics import ConstantKinematics, allows_unilateral, registered_kinematics
+from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantUnilateralKinematics, allows_unilateral,
+                         registered_kinematics)
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
@@ -193,8 +194,11 @@ class Contact:
             out["G"] = self.tangent
             out["w"] = self.drive
         if self.normal is not None:
-            out.update(normal_law=NORMAL_LAWS[self.normal.law], gap=self.gap, W=self.gap_gradient,
-                       k=self.normal.stiffness, c=self.normal.damping, e=self.normal.restitution)
+            k, c, W = self.normal.stiffness, self.normal.damping, np.asarray(self.gap_gradient, dtype=float)
+            # closed, the compliant force −k (g0 + W·q) − c W·q̇ is the affine N0 + n·q + n_v·q̇ of the
+            # constant kinematics' frame
+            out.update(normal_law=NORMAL_LAWS[self.normal.law], gap=self.gap, W=W, k=k, c=c,
+                       e=self.normal.restitution, N0=-k * self.gap, n_q=-k * W, n_v=-c * W)
         return out
 
 
@@ -313,6 +317,8 @@ class FrictionModel:
         free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
         object.__setattr__(self, "free", free)
         object.__setattr__(self, "contacts", tuple(self.contacts))
+        if type(self.kinematics) is ConstantKinematics and any(c.unilateral for c in self.contacts):
+            object.__setattr__(self, "kinematics", ConstantUnilateralKinematics(*self.kinematics))
         object.__setattr__(self, "dofs", tuple(self.dofs))
         self._check_mass()
         self._check_contacts()
@@ -349,7 +355,7 @@ class FrictionModel:
         if cls not in registered_kinematics():
             raise ModelError(f"model {self.name!r}: kinematics class {cls.__name__} is not registered; "
                              "call stickslip.model.register_kinematics(cls, frame) first")
-        constant = cls is ConstantKinematics
+        constant = cls in CONSTANT_KINEMATICS
         sizes = static_sizes(cls)
         if sizes is not None and sizes != (n, len(self.contacts)):
             raise ModelError(f"model {self.name!r}: kinematics {cls.__name__} is for {sizes[0]} dofs and "
@@ -453,7 +459,7 @@ class FrictionModel:
     @property
     def constant_kinematics(self) -> bool:
         """Whether G and w are constant (model files)."""
-        return type(self.kinematics) is ConstantKinematics
+        return type(self.kinematics) in CONSTANT_KINEMATICS
 
     @cached_property
     def data(self) -> ModelData:
