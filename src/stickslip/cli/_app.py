@@ -17,6 +17,7 @@ and reported the same way.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import math
 import os
@@ -41,6 +42,7 @@ from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.library.two_plates import is_plates
 from ..model.parameters import Parameters
+from ._compiling import compile_notice
 from ._kept import forget_outputs, on_disk, on_interrupt
 
 if sys.version_info >= (3, 11):
@@ -200,7 +202,7 @@ class _Application(TyperGroup):
             _check_environment()
             # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
             # `simulate` keeps its one interrupted run instead
-            with warnings.catch_warnings(), on_ctrl_c(partial=False):
+            with warnings.catch_warnings(), on_ctrl_c(partial=False), _compile_notice():
                 warnings.showwarning = _show_warning
                 return super().invoke(ctx)
         except StickSlipError as exc:
@@ -246,6 +248,13 @@ def _use_replacement_characters() -> None:
                 stream.reconfigure(errors="replace")
             except (AttributeError, ValueError):  # not a text stream of the interpreter's (tests capture it)
                 pass
+
+
+def _compile_notice():
+    """A line while numba compiles (:mod:`._compiling`), when stderr is a terminal."""
+    if getattr(sys.stderr, "isatty", lambda: False)():
+        return compile_notice(note_line)
+    return contextlib.nullcontext()
 
 
 def _check_environment() -> None:

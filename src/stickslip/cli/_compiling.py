@@ -1,0 +1,58 @@
+"""A line on stderr while numba compiles, and the compile time apart from the run's.
+
+A command's first call on a machine (or after stickslip or a model's kinematics changed) compiles
+the kernels of its model class: about a minute on two cores, during which nothing else would
+appear. numba announces each compilation it starts (the ``numba:compile`` event; a kernel loaded
+from the on-disk cache is not one), so :func:`compile_notice` prints one line when the first
+starts and, at the end of the command, how long compiling took in all. The command line shows
+both on stderr when stderr is a terminal (``--json`` output on stdout stays clean; a log of a
+script or a test's captured output keeps only the command's own lines).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+
+from numba.core import event
+
+__all__ = ["compile_notice", "COMPILING_LINE"]
+
+#: The line printed when the first kernel starts compiling.
+COMPILING_LINE = ("compiling kernels for this kind of model (once per machine: later runs load them from numba's "
+                  "cache; about a minute on 2 cores) ...")
+
+
+class _CompileClock(event.Listener):
+    """Counts the seconds spent in outermost compilations (a kernel compiles its callees inside
+    its own compilation), and calls ``announce`` as the first one starts."""
+
+    def __init__(self, announce) -> None:
+        self.announce = announce
+        self.depth = 0
+        self.started = 0.0
+        self.seconds = 0.0
+
+    def on_start(self, ev) -> None:
+        if self.depth == 0:
+            if self.announce is not None:
+                self.announce(COMPILING_LINE)
+                self.announce = None
+            self.started = time.perf_counter()
+        self.depth += 1
+
+    def on_end(self, ev) -> None:
+        self.depth = max(self.depth - 1, 0)
+        if self.depth == 0:
+            self.seconds += time.perf_counter() - self.started
+
+
+@contextlib.contextmanager
+def compile_notice(say):
+    """Within: ``say(line)`` once when numba starts compiling, and once at the end with the time it
+    took (nothing when every kernel came from the cache)."""
+    clock = _CompileClock(say)
+    with event.install_listener("numba:compile", clock):
+        yield clock
+    if clock.seconds > 0.0:  # not after an error or Ctrl-C: their line is the last
+        say(f"compiled kernels in {clock.seconds:.1f} s (cached for later runs)")
