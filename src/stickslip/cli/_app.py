@@ -270,7 +270,7 @@ def _check_environment() -> None:
 app = _Typer(
     name="stickslip",
     cls=_Application,
-    help="Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact.",
+    help="Exact stick-slip simulation and analysis of friction-contact systems (default model: two rigid plates in frictional contact).",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -547,4 +547,4 @@ def _version(value: bool) -> None:
 def main(
     version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit."),
 ) -> None:
-    """Exact 2-D stick-slip simulation and analysis of two rigid plates in frictional contact."""
+    """Exact stick-slip simulation and analysis of friction-contact systems (default model: two rigid plates in frictional contact)."""
