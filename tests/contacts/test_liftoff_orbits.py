@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.linalg import expm
 
 import stickslip
 from stickslip.orbits.linear_flow import flow_jacobian
@@ -42,3 +43,45 @@ def test_saltation_monodromy_of_the_lift_off_cycle_matches_the_flow_map(contact_
     assert np.min(np.abs(orbit.multipliers - 1.0)) < 1e-6
     np.testing.assert_allclose(np.sort(np.abs(np.linalg.eigvals(J))), np.sort(np.abs(orbit.multipliers)),
                                atol=1e-6)
+
+
+OPEN_AT_REST = """
+name = "open-at-rest"
+dofs = ["x", "y"]
+mass = [[1.0, 0.0], [0.0, 2.0]]
+damping = [[0.1, 0.0], [0.0, 0.2]]
+stiffness = [[10.0, 0.0], [0.0, 10.0]]
+[[contact]]
+tangent = [[1.0, 0.0]]
+drive = [0.5]
+gap = 0.1
+gap_gradient = [0.0, -1.0]
+[contact.normal]
+law = "compliant"
+stiffness = 100.0
+[contact.friction]
+law = "coulomb"
+mu_k = 0.3
+delta_mu = 0.1
+"""
+
+
+def test_flow_map_from_an_open_contact(tmp_path):
+    """A run that starts with its contact open: while it stays open the flow is that of the free
+    linear system, exp(A t) in closed form; a run that flies onto the contact and closes on it
+    matches central differences. (The re-integration used to start such a contact slipping.)"""
+    path = tmp_path / "open.toml"
+    path.write_text(OPEN_AT_REST)
+    model = stickslip.load_model(path)
+    M, C, K = np.diag([1.0, 2.0]), np.diag([0.1, 0.2]), np.diag([10.0, 10.0])
+    A = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    s0 = np.array([0.02, 0.0, 0.3, 0.1])  # stays open for 0.5 s (y reaches at most ~0.03 < 0.1)
+    J = flow_jacobian(model, s0, 0.5, rtol=1e-11).matrix
+    np.testing.assert_allclose(J, expm(0.5 * A), rtol=0, atol=1e-9)
+    s0 = np.array([0.0, 0.0, 0.0, 1.2])  # reaches y = 0.1 and closes on the belt
+    T = 0.4
+    tr = stickslip.simulate(model, T, ic=s0, rtol=1e-10, atol=1e-12).transitions
+    assert 3 in set(np.unique(tr.kind))  # it closes inside the window
+    J = flow_jacobian(model, s0, T, rtol=1e-11).matrix
+    D = central_differences(model, s0, T)
+    np.testing.assert_allclose(J, D, rtol=0, atol=1e-6 * np.abs(D).max())

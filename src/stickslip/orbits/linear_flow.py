@@ -156,7 +156,8 @@ def flow_jacobian(system, s0, duration: float, *, rtol: float = 1e-10, atol: flo
 
 def initial_contacts(system, s0, rtol: float, atol: float):
     """The contact states a run from ``s0`` starts in, as the re-integration follows them, and the
-    state (projected where contacts stick): each 1-D slipping contact along its stored direction,
+    state (projected where contacts stick): open and sticking contacts as they are, each 1-D
+    slipping contact along its stored direction,
     each 2-D one with the exact direction, or the quasi-static one if it departs from v_c = 0."""
     md = system.data
     n2 = 2 * system.n
@@ -166,7 +167,7 @@ def initial_contacts(system, s0, rtol: float, atol: float):
     E.initial_modes(y, cst, md, rtol, atol, np.empty(2 * nc), np.empty(nc))
     for c in range(nc):
         mode = int(cst[CST * c])
-        if mode == P.MODE_STICK:
+        if mode == P.MODE_STICK or mode == P.MODE_OPEN:
             continue
         v0, v1 = P.slip_velocity(y, c, md)
         if system.contacts[c].dim == 1:
