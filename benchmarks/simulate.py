@@ -32,7 +32,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 
 import stickslip
 from stickslip.analysis import fundamental_frequency

@@ -20,6 +20,7 @@ from . import continue_  # noqa: E402,F401  (registers `stickslip continue`)
 from . import orbit  # noqa: E402,F401  (registers `stickslip orbit`, `lyapunov`)
 from . import basins  # noqa: E402,F401  (registers `stickslip basins`)
 from . import models  # noqa: E402,F401  (registers `stickslip models`)
+from . import warmup  # noqa: E402,F401  (registers `stickslip warmup`)
 
 _startup.release()  # a Ctrl-C held during these imports is raised here, reported in one line
 
