@@ -145,3 +145,24 @@ def test_the_lift_off_cycle_period_amplitude_and_open_fraction(runs):
     steady = traj.steady_state(T_END - 100.0)
     assert steady.periodic and steady.period_multiplicity == 1
     assert 1.0 / steady.fundamental_frequency_hz == pytest.approx(ref_period, rel=1e-4)
+
+
+def test_a_sweep_over_mu_reports_the_open_fraction_and_openings(runs):
+    """A sweep of hoffmann over μ: below the onset (μ = 0.5) the contact never opens; at μ = 1.3
+    the point's run is the one above, and its open fraction and openings over the last 100 s
+    are the reference's flights cut to that window (pressed models keep their columns as before)."""
+    traj, ref, switches = runs
+    model = stickslip.load_model("hoffmann").replace(**{"damping.x.x": C, "damping.y.y": C})
+    result = stickslip.sweep({"contact.0.friction.mu_k": [0.5, MU], "perturb_x": [0.01]}, model, executor="serial",
+                             t_end=T_END, t_from=T_END - 100.0, ic="zero", rtol=1e-11, atol=1e-13, sample_rate=20.0)
+    ds = result.dataset.squeeze("perturb_x")
+    closed, lifting = ds.sel({"contact.0.friction.mu_k": 0.5}), ds.sel({"contact.0.friction.mu_k": MU})
+    assert float(closed["open_fraction"]) == 0.0 and float(closed["openings"]) == 0.0
+    t0, t1 = T_END - 100.0, traj.t[-1]
+    opens, closes = switches[OPEN], switches[CLOSE]
+    flights = [(a, closes[closes > a][0] if np.any(closes > a) else t1) for a in opens]
+    open_time = sum(max(0.0, min(b, t1) - max(a, t0)) for a, b in flights)
+    assert float(lifting["open_fraction"]) == pytest.approx(open_time / (t1 - t0), abs=1e-5)
+    assert float(lifting["openings"]) == np.sum((opens > t0) & (opens <= t1)) > 0
+    belt = stickslip.sweep({"contact.0.drive": [1.0]}, "belt", executor="serial", t_end=2.0)
+    assert "open_fraction" not in belt.dataset and "openings" not in belt.dataset

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..analysis.classify import kind_code
 from ..analysis.intensity import angle_range, intensity, trajectory_intensities
+from ..analysis.signal import OPEN, SLIP, STICK
 from ..attractors import ATTRACTORS, DEFAULT_CAP_S, attractor, simulate_until_settled
 from ..errors import EquilibriumError, SimulationError, SweepError
 from ..integrate.driver import simulate
@@ -58,13 +59,15 @@ def initial_condition(name: str, system: FrictionModel) -> tuple[Any, float | No
 
 
 # ----------------------------------------------------------------------------- the row schema
-def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str = "rad"):
+def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str = "rad", unilateral: bool = False):
     """(name, width, attrs) of each reduced quantity, in row order.
 
     ``observed``: the model's observed coordinate (the plates' φ), which the ``<observed>_min``,
     ``_max``, ``_mean``, ``amplitude`` and ``peaks`` columns follow, in ``unit``. ``plates``: the
     plates' own reductions (the intensities of Eq. 16 and the sliding angles of Fig. 11); other
-    models get one ``intensity`` of the observed coordinate instead.
+    models get one ``intensity`` of the observed coordinate instead. ``unilateral``: the model has
+    contacts that open and close, and gets ``open_fraction`` and ``openings`` after
+    ``n_transitions``.
     """
     cols = [
         ("kind", 1, {"long_name": "steady-state kind", "flag_values": "-1 0 1 2 3",
@@ -101,6 +104,12 @@ def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str
         ("wall_time", 1, {"units": "s", "long_name": "wall time of the point (simulation and reduction)"}),
         ("peaks", n_peaks, {"units": "rad", "long_name": "last peak values of phi in the steady window (events dphi = 0)"}),
     ]
+    if unilateral:
+        at = [name for name, _, _ in cols].index("n_transitions") + 1
+        cols[at:at] = [
+            ("open_fraction", 1, {"units": "1", "long_name": "fraction of the steady window with some contact open"}),
+            ("openings", 1, {"long_name": "contact openings (closed to open) in the steady window"}),
+        ]
     if plates and observed == "phi":
         return cols
     plates_only = ("intensity_r_phi", "intensity_x1", "intensity_y1", "intensity_translation", "angle_min", "angle_max")
@@ -128,7 +137,7 @@ def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str
 def columns_of(system: FrictionModel, n_peaks: int = 64):
     """(name, width, attrs) of each reduced quantity of a sweep of ``system``, in row order."""
     observed = system.dofs[system.observed_index]
-    return _columns(n_peaks, observed, is_plates(system), system.units.get(observed, ""))
+    return _columns(n_peaks, observed, is_plates(system), system.units.get(observed, ""), system.unilateral)
 
 
 def observed_columns(observed: str) -> tuple[str, str, str]:
@@ -424,7 +433,11 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         out[x_min], out[x_max] = float(x.min()), float(x.max())
         out[x_mean] = float(np.sum(0.5 * (x[1:] + x[:-1]) * np.diff(traj.t[sel])) / (traj.t[sel][-1] - traj.t[sel][0]))
         tt = traj.transitions.time
-        out["n_transitions"] = float(np.sum((tt > t_from) & (tt <= traj.t[-1])))
+        window = (tt > t_from) & (tt <= traj.t[-1])
+        out["n_transitions"] = float(np.sum(window & ((traj.transitions.kind == STICK) | (traj.transitions.kind == SLIP))))
+        if system.unilateral:
+            out["open_fraction"] = traj.steady_state(t_from).open_fraction
+            out["openings"] = float(np.sum(window & (traj.transitions.kind == OPEN)))
         if is_plates(system):  # the plates' own reductions (Eq. 16, Fig. 11)
             for key, val in trajectory_intensities(traj, t_from).items():
                 out[f"intensity_{key}"] = val
