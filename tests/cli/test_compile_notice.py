@@ -3,7 +3,7 @@
 import numpy as np
 from numba import njit
 
-from stickslip.cli._compiling import COMPILING_LINE, compile_notice
+from stickslip.cli._compiling import COMPILING_LINE, compile_notice, compile_seconds
 
 
 def test_one_line_as_compiling_starts_and_the_time_at_the_end():
@@ -41,3 +41,17 @@ def test_nothing_after_an_error():
     except KeyboardInterrupt:
         pass
     assert lines == [COMPILING_LINE]  # the interrupt's own line is the last one the user sees
+
+
+def test_seconds_counted_inside_and_zero_outside():
+    @njit(cache=False)
+    def thrice(x):
+        return 3.0 * x
+
+    assert compile_seconds() == 0.0
+    with compile_notice():  # silent: counts only
+        before = compile_seconds()
+        thrice(np.float64(1.0))
+        spent = compile_seconds() - before
+    assert spent > 0.0
+    assert compile_seconds() == 0.0

@@ -17,7 +17,6 @@ and reported the same way.
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import math
 import os
@@ -251,10 +250,9 @@ def _use_replacement_characters() -> None:
 
 
 def _compile_notice():
-    """A line while numba compiles (:mod:`._compiling`), when stderr is a terminal."""
-    if getattr(sys.stderr, "isatty", lambda: False)():
-        return compile_notice(note_line)
-    return contextlib.nullcontext()
+    """Compile time counted for the command (:mod:`._compiling`), and a line while numba compiles
+    when stderr is a terminal."""
+    return compile_notice(note_line if getattr(sys.stderr, "isatty", lambda: False)() else None)
 
 
 def _check_environment() -> None:

@@ -3,10 +3,12 @@
 A command's first call on a machine (or after stickslip or a model's kinematics changed) compiles
 the kernels of its model class: about a minute on two cores, during which nothing else would
 appear. numba announces each compilation it starts (the ``numba:compile`` event; a kernel loaded
-from the on-disk cache is not one), so :func:`compile_notice` prints one line when the first
-starts and, at the end of the command, how long compiling took in all. The command line shows
-both on stderr when stderr is a terminal (``--json`` output on stdout stays clean; a log of a
-script or a test's captured output keeps only the command's own lines).
+from the on-disk cache is not one), so :func:`compile_notice` counts the seconds spent compiling
+while a command runs (:func:`compile_seconds`, which a command subtracts from its wall time and
+reports apart), and can print one line when the first compilation starts and, at the end, how
+long compiling took in all. The command line prints those two lines on stderr when stderr is a
+terminal (``--json`` output on stdout stays clean; a log of a script or a test's captured output
+keeps only the command's own lines).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import time
 
 from numba.core import event
 
-__all__ = ["compile_notice", "COMPILING_LINE"]
+__all__ = ["compile_notice", "compile_seconds", "COMPILING_LINE"]
 
 #: The line printed when the first kernel starts compiling.
 COMPILING_LINE = ("compiling kernels for this kind of model (once per machine: later runs load them from numba's "
@@ -47,12 +49,29 @@ class _CompileClock(event.Listener):
             self.seconds += time.perf_counter() - self.started
 
 
+_clocks: list[_CompileClock] = []
+
+
+def compile_seconds() -> float:
+    """Seconds spent compiling so far inside the innermost :func:`compile_notice` (0 outside one)."""
+    if not _clocks:
+        return 0.0
+    clock = _clocks[-1]
+    running = time.perf_counter() - clock.started if clock.depth > 0 else 0.0
+    return clock.seconds + running
+
+
 @contextlib.contextmanager
-def compile_notice(say):
-    """Within: ``say(line)`` once when numba starts compiling, and once at the end with the time it
-    took (nothing when every kernel came from the cache)."""
+def compile_notice(say=None):
+    """Within: compile time counted (:func:`compile_seconds`); with ``say``, ``say(line)`` once when
+    numba starts compiling and once at the end with the time it took (nothing when every kernel
+    came from the cache)."""
     clock = _CompileClock(say)
-    with event.install_listener("numba:compile", clock):
-        yield clock
-    if clock.seconds > 0.0:  # not after an error or Ctrl-C: their line is the last
+    _clocks.append(clock)
+    try:
+        with event.install_listener("numba:compile", clock):
+            yield clock
+    finally:
+        _clocks.remove(clock)
+    if say is not None and clock.seconds > 0.0:  # not after an error or Ctrl-C: their line is the last
         say(f"compiled kernels in {clock.seconds:.1f} s (cached for later runs)")

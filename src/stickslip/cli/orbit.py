@@ -26,6 +26,7 @@ from ..orbits.problem import stick_summary
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
+from ._compiling import compile_seconds
 from ._kept import keeps, keeps_figure
 from ._options import (Config, JsonSummary, Model, NoPlot, NormalLoad, Omega, OrbitRtol, Out, Overwrite, SearchTime,
                        Section, SetItems, SlipBand, StartIc, Tol)
@@ -116,11 +117,12 @@ def orbit_command(
     sec = resolve_section(parse_section(section), system)
     inputs = {"--config": config}
     check_outputs(out, not no_plot, overwrite, inputs=inputs)
-    t0 = time.perf_counter()
+    t0, compiling0 = time.perf_counter(), compile_seconds()
     run = start_run(system, start, t_end=search_time, rtol=rtol)
     orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
                            monodromy=monodromy)
-    wall = time.perf_counter() - t0
+    compiling = compile_seconds() - compiling0
+    wall = time.perf_counter() - t0 - compiling
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
     _write(ds_of=orbit.to_xarray, out=out, holds=f"the orbit is in {out}", overwrite=overwrite, inputs=inputs)
@@ -138,6 +140,7 @@ def orbit_command(
         "trivial_multiplier_error": float(abs(orbit.trivial_multiplier - 1.0)),
         "stable": bool(orbit.stable), "monodromy": orbit.options.get("monodromy", monodromy),
         "iterations": int(orbit.iterations), "residual": float(orbit.residual), "wall_time_s": wall,
+        "compile_time_s": compiling,
     }
     if as_json:
         print(json.dumps(summary))
@@ -152,7 +155,8 @@ def orbit_command(
     table.add_row("|μ_trivial − 1|", f"{summary['trivial_multiplier_error']:.2e} ({summary['monodromy']})")
     table.add_row("stability", Text("stable", style="green") if orbit.stable else Text("unstable", style="bold red"))
     table.add_row("Newton", f"{summary['iterations']} iterations, residual {summary['residual']:.2e}")
-    table.add_row("wall time", f"{wall:.2f} s (start run + shooting + multipliers)")
+    table.add_row("wall time", f"{wall:.2f} s (start run + shooting + multipliers"
+                  + (f"; compiling {compiling:.1f} s apart)" if compiling > 0 else ")"))
     table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
     console.print(table)
 
@@ -189,8 +193,11 @@ def lyapunov_command(
     inputs = {"--config": config}
     check_outputs(out, not no_plot, overwrite, inputs=inputs)
     start = default_start(system) if start is None else start
+    compiling0 = compile_seconds()
     spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
                                  method=method)
+    compiling = compile_seconds() - compiling0
+    wall = float(spectrum.wall_time) - compiling
     _write(ds_of=spectrum.to_xarray, out=out, holds=f"the spectrum is in {out}", overwrite=overwrite, inputs=inputs)
     figure = None
     if not no_plot:
@@ -202,7 +209,7 @@ def lyapunov_command(
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,
         "method": method, "t_transient_s": float(t_transient), "t_average_s": float(t_average),
         "exponents": [_finite_or_none(x) for x in ordered], "largest": _finite_or_none(ordered[0]),
-        "stick_phases": int(spectrum.stick_phases), "wall_time_s": float(spectrum.wall_time),
+        "stick_phases": int(spectrum.stick_phases), "wall_time_s": wall, "compile_time_s": compiling,
     }
     if as_json:
         print(json.dumps(summary))
@@ -216,5 +223,6 @@ def lyapunov_command(
         table.add_row(str(i), f"{lam:+.6g}", style="bold red" if lam > 0 else None)
     console.print(table)
     console.print(f"averaged over {t_average:g} s after a {t_transient:g} s transient from --ic {ic}; "
-                  f"{spectrum.stick_phases} stick phases; wall time {spectrum.wall_time:.2f} s", soft_wrap=True)
+                  f"{spectrum.stick_phases} stick phases; wall time {wall:.2f} s"
+                  + (f" (compiling {compiling:.1f} s apart)" if compiling > 0 else ""), soft_wrap=True)
     console.print(f"wrote {out}" + ("" if figure is None else f", {figure}"), soft_wrap=True)

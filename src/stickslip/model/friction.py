@@ -41,7 +41,7 @@ from numba.extending import overload
 
 from ..errors import FrictionLawError
 from . import csmath as csm
-from .jit import KERNEL_OPTIONS, inlined_kernel
+from .jit import KERNEL_OPTIONS, inlined_kernel, track_user_code
 
 __all__ = ["FrictionLaw", "FrictionLawError", "LAWS", "LAW_COULOMB", "LAW_EXPONENTIAL", "LAW_USER", "LAW_WIDTH",
            "NoUserLaw", "register_friction_law", "friction_coefficient", "static_coefficient"]
@@ -84,6 +84,7 @@ def register_friction_law(cls: type, mu: Callable) -> None:
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise FrictionLawError(f"friction law class {cls!r} must be a NamedTuple of numbers")
     _USER_LAWS[cls] = mu if hasattr(mu, "py_func") else njit(**KERNEL_OPTIONS)(mu)
+    track_user_code(cls, mu)
 
 
 def user_coefficient(law, speed):  # pragma: no cover - resolved by numba (overload below)

@@ -36,6 +36,7 @@ import functools
 import hashlib
 import pickle
 import re
+import sys
 import warnings
 from pathlib import Path
 
@@ -159,6 +160,82 @@ def _stamp_with_package() -> None:
 
 _stamp_with_package()
 
+#: Digest of the code behind each kinematics or friction-law class registered from outside the
+#: package (:func:`track_user_code`), which the kernels compiled for that class inline.
+_USER_CODE: dict[type, str] = {}
+
+
+def track_user_code(cls: type, *functions) -> None:
+    """Key the cached kernels compiled for ``cls`` by the code of ``functions`` (a model's frame,
+    a user friction law) when they live outside the package.
+
+    The package's kernels inline such a function, but numba keys a cached kernel by the kernel's
+    own file and signature only: after the user edits the function, the kernel compiled with the
+    old one would be loaded. The digest of each function's whole module file (helpers it calls
+    included) joins the index key of every kernel whose signature holds ``cls``, so an edit
+    recompiles exactly the kernels of that class; every other kernel keeps its cache.
+    """
+    digest = hashlib.sha256()
+    outside = False
+    for function in functions:
+        py_func = getattr(function, "py_func", function)
+        module = sys.modules.get(getattr(py_func, "__module__", None) or "")
+        path = getattr(module, "__file__", None)
+        try:
+            inside = path is not None and Path(path).resolve().is_relative_to(_PACKAGE)
+        except (OSError, ValueError):
+            inside = False
+        if inside:
+            continue
+        outside = True
+        try:
+            digest.update(Path(path).read_bytes())
+        except (OSError, TypeError):  # no file (an interactive session): the function's own code
+            code = py_func.__code__
+            digest.update(code.co_code + repr(code.co_consts).encode())
+    if outside:
+        _USER_CODE[cls] = digest.hexdigest()
+    else:
+        _USER_CODE.pop(cls, None)
+
+
+def _user_code_in(types, seen=None) -> list:
+    """The digests of :data:`_USER_CODE` for the classes found in the numba ``types`` (nested)."""
+    found = []
+    for ty in types:
+        cls = getattr(ty, "instance_class", None)
+        if cls in _USER_CODE:
+            found.append((f"{cls.__module__}.{cls.__qualname__}", _USER_CODE[cls]))
+        inner = getattr(ty, "types", None)
+        if isinstance(inner, tuple):
+            found.extend(_user_code_in(inner))
+    return found
+
+
+def _key_by_user_code() -> None:
+    """Make numba's index key of a cached kernel hold the digests of the user code its signature
+    refers to (:func:`track_user_code`); a signature without such classes keeps numba's own key."""
+    try:
+        from numba.core.caching import Cache
+    except ImportError:  # pragma: no cover - a numba without this class caches differently
+        return
+    index_key = Cache._index_key
+    if getattr(index_key, "_stickslip_user_code", False):
+        return
+
+    def _index_key(self, sig, codegen):
+        key = index_key(self, sig, codegen)
+        if not _USER_CODE:
+            return key
+        user = _user_code_in(tuple(sig) if isinstance(sig, tuple) else getattr(sig, "args", ()))
+        return key if not user else (*key, tuple(sorted(set(user))))
+
+    _index_key._stickslip_user_code = True
+    Cache._index_key = _index_key
+
+
+_key_by_user_code()
+
 #: Options of every compiled kernel, also given to the overloads whose implementations numba
 #: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
 KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy"}
@@ -167,4 +244,4 @@ kernel = njit(cache=True, _nrt=False, error_model="numpy")
 inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy")
 loop = njit(cache=True, error_model="numpy")
 
-__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS"]
+__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "track_user_code"]

@@ -44,7 +44,7 @@ from ..errors import KinematicsError
 from . import csmath as csm
 from . import stack
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
-from .jit import KERNEL_OPTIONS, kernel
+from .jit import KERNEL_OPTIONS, kernel, track_user_code
 
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
@@ -95,6 +95,7 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
     _FRAMES[cls] = frame
+    track_user_code(cls, frame, *([] if frame_bias is None else [frame_bias]))
     _SIZES[cls] = (ndof, ncontacts, diagonal)
     _DIMS[cls] = dim
     if frame_bias is None:
