@@ -22,6 +22,7 @@ from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ..files import netcdf_writer, write_output
 from ._app import CLIError, app, build_system, check_finite, check_outputs, console
+from ._compiling import compile_seconds
 from ._kept import keeps, keeps_figure
 from ._options import (Alpha, Config, DeltaMu, JsonSummary, MapModel, Model, MuK, NoPlot, NormalLoad, Omega, Out,
                        Overwrite, SetItems)
@@ -42,9 +43,10 @@ def stability(
 ) -> None:
     """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
     system, _ = build_system(model, config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    compiling0 = compile_seconds()
     result = run_stability(system)
     if as_json:
-        print(json.dumps(result.summary()))
+        print(json.dumps({**result.summary(), "compile_time_s": compile_seconds() - compiling0}))
         return
     p = result.params
     title = f"steady sliding: model {result.model}"
