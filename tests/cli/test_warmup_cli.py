@@ -4,6 +4,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -29,33 +30,13 @@ def test_a_model_whose_contact_opens():
     assert [row["outcome"] for row in json.loads(result.stdout)] == ["ready"] * 3
 
 
-OPEN_AT_REST = """
-name = "open-at-rest"
-dofs = ["x", "y"]
-mass = [[1.0, 0.0], [0.0, 1.0]]
-damping = [[0.1, 0.0], [0.0, 0.1]]
-stiffness = [[10.0, 0.0], [0.0, 10.0]]
-[[contact]]
-tangent = [[1.0, 0.0]]
-drive = [0.5]
-gap = 0.1
-gap_gradient = [0.0, -1.0]
-[contact.normal]
-law = "compliant"
-stiffness = 100.0
-[contact.friction]
-law = "coulomb"
-mu_k = 0.3
-delta_mu = 0.1
-"""
+OPEN_AT_REST = Path(__file__).parents[1] / "contacts" / "open_at_rest.toml"
 
 
-def test_a_stage_that_fails_is_reported_and_the_others_run(tmp_path):
+def test_a_stage_that_fails_is_reported_and_the_others_run():
     # a contact open at rest: steady sliding has an open contact, which the stability stage
     # reports as its outcome; simulate and the flow map still compile
-    path = tmp_path / "open.toml"
-    path.write_text(OPEN_AT_REST)
-    result = runner.invoke(app, ["warmup", "--model", str(path), "--json"])
+    result = runner.invoke(app, ["warmup", "--model", str(OPEN_AT_REST), "--json"])
     assert result.exit_code == 0, result.output
     outcome = {row["stage"]: row["outcome"] for row in json.loads(result.stdout)}
     assert outcome["simulate (event)"] == outcome["orbits (variational equations)"] == "ready"

@@ -4,6 +4,8 @@ the event integrator from perturbed states)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.linalg import expm
@@ -45,34 +47,16 @@ def test_saltation_monodromy_of_the_lift_off_cycle_matches_the_flow_map(contact_
                                atol=1e-6)
 
 
-OPEN_AT_REST = """
-name = "open-at-rest"
-dofs = ["x", "y"]
-mass = [[1.0, 0.0], [0.0, 2.0]]
-damping = [[0.1, 0.0], [0.0, 0.2]]
-stiffness = [[10.0, 0.0], [0.0, 10.0]]
-[[contact]]
-tangent = [[1.0, 0.0]]
-drive = [0.5]
-gap = 0.1
-gap_gradient = [0.0, -1.0]
-[contact.normal]
-law = "compliant"
-stiffness = 100.0
-[contact.friction]
-law = "coulomb"
-mu_k = 0.3
-delta_mu = 0.1
-"""
+#: A 2-DOF model whose compliant contact is open at rest (gap 0.1; M = diag(1, 2), C = diag(0.1, 0.2),
+#: K = diag(10, 10)).
+OPEN_AT_REST = Path(__file__).with_name("open_at_rest.toml")
 
 
-def test_flow_map_from_an_open_contact(tmp_path):
+def test_flow_map_from_an_open_contact():
     """A run that starts with its contact open: while it stays open the flow is that of the free
     linear system, exp(A t) in closed form; a run that flies onto the contact and closes on it
     matches central differences. (The re-integration used to start such a contact slipping.)"""
-    path = tmp_path / "open.toml"
-    path.write_text(OPEN_AT_REST)
-    model = stickslip.load_model(path)
+    model = stickslip.load_model(OPEN_AT_REST)
     M, C, K = np.diag([1.0, 2.0]), np.diag([0.1, 0.2]), np.diag([10.0, 10.0])
     A = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     s0 = np.array([0.02, 0.0, 0.3, 0.1])  # stays open for 0.5 s (y reaches at most ~0.03 < 0.1)

@@ -44,7 +44,7 @@ def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeyp
 
     stub = Stub()
     saved = Cache.save_overload
-    assert saved._stickslip_tolerant
+    assert saved._stickslip_wrapped
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         saved(stub, None, None)

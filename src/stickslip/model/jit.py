@@ -43,7 +43,23 @@ from pathlib import Path
 from numba import njit
 
 
-def _tolerant_index_loading() -> None:
+def _wrap_caching(class_name: str, method: str, make) -> None:
+    """Replace ``numba.core.caching.<class_name>.<method>`` by ``make(original)``, once per process
+    (a numba whose caching lacks it caches as it does, unchanged)."""
+    try:
+        from numba.core import caching
+        owner = getattr(caching, class_name)
+        original = getattr(owner, method)
+    except (ImportError, AttributeError):  # pragma: no cover - a numba that caches differently
+        return
+    if getattr(original, "_stickslip_wrapped", False):
+        return
+    wrapped = make(original)
+    wrapped._stickslip_wrapped = True
+    setattr(owner, method, wrapped)
+
+
+def _tolerant_index_loading(load):
     """Let numba's on-disk cache survive kinematics classes that can no longer be imported.
 
     A kernel compiled for a model whose kinematics class lives in a user's script is indexed in the
@@ -51,40 +67,23 @@ def _tolerant_index_loading() -> None:
     ImportError in *every* later process, whatever model it runs. Such an index is treated as empty
     instead: the kernel is compiled again for the models in use and the index rewritten.
     """
-    try:
-        from numba.core.caching import IndexDataCacheFile
-    except ImportError:  # pragma: no cover - a numba without this class caches differently
-        return
-    load = IndexDataCacheFile._load_index
-    if getattr(load, "_stickslip_tolerant", False):
-        return
-
     def _load_index(self):
         try:
             return load(self)
         except (ImportError, AttributeError, EOFError, pickle.UnpicklingError):
             return {}
 
-    _load_index._stickslip_tolerant = True
-    IndexDataCacheFile._load_index = _load_index
+    return _load_index
 
 
-_tolerant_index_loading()
+_wrap_caching("IndexDataCacheFile", "_load_index", _tolerant_index_loading)
 
 
-def _tolerant_cache_saving() -> None:
+def _tolerant_cache_saving(save):
     """Let a kernel run when its cache file cannot be written (a full disk, a file-size limit, a
     read-only folder): numba raises the OSError from inside the compilation, after the kernel is
     compiled. The kernel is used uncached instead, with one warning; it is compiled again in the
     next process."""
-    try:
-        from numba.core.caching import Cache
-    except ImportError:  # pragma: no cover - a numba without this class caches differently
-        return
-    save = Cache.save_overload
-    if getattr(save, "_stickslip_tolerant", False):
-        return
-
     warned = []
 
     def save_overload(self, sig, data):
@@ -96,11 +95,10 @@ def _tolerant_cache_saving() -> None:
                 warnings.warn(f"compiled kernels could not be cached ({exc.strerror or exc}); they are used uncached "
                               "and compiled again in the next process", RuntimeWarning, stacklevel=2)
 
-    save_overload._stickslip_tolerant = True
-    Cache.save_overload = save_overload
+    return save_overload
 
 
-_tolerant_cache_saving()
+_wrap_caching("Cache", "save_overload", _tolerant_cache_saving)
 
 #: The package's root folder, and what marks a module of the compiled layer.
 _PACKAGE = Path(__file__).resolve().parents[1]
@@ -212,17 +210,9 @@ def _user_code_in(types, seen=None) -> list:
     return found
 
 
-def _key_by_user_code() -> None:
+def _key_by_user_code(index_key):
     """Make numba's index key of a cached kernel hold the digests of the user code its signature
     refers to (:func:`track_user_code`); a signature without such classes keeps numba's own key."""
-    try:
-        from numba.core.caching import Cache
-    except ImportError:  # pragma: no cover - a numba without this class caches differently
-        return
-    index_key = Cache._index_key
-    if getattr(index_key, "_stickslip_user_code", False):
-        return
-
     def _index_key(self, sig, codegen):
         key = index_key(self, sig, codegen)
         if not _USER_CODE:
@@ -230,11 +220,10 @@ def _key_by_user_code() -> None:
         user = _user_code_in(tuple(sig) if isinstance(sig, tuple) else getattr(sig, "args", ()))
         return key if not user else (*key, tuple(sorted(set(user))))
 
-    _index_key._stickslip_user_code = True
-    Cache._index_key = _index_key
+    return _index_key
 
 
-_key_by_user_code()
+_wrap_caching("Cache", "_index_key", _key_by_user_code)
 
 #: Options of every compiled kernel, also given to the overloads whose implementations numba
 #: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
