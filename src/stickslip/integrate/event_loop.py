@@ -76,6 +76,17 @@ def dp_step(y, k1, h, cst, md, Kst, ynew, ytmp):
 
 
 @kernel
+def crossing_in_step(kind, c, y, Kst, Q, q_ready, h, cst, md, work, F, N):
+    """θ ∈ (0, 1] of the first crossing of event ``kind`` of contact ``c`` inside a step whose end
+    is past it (1.0 where the sample points see no sign change: the root is at the end); forms the
+    step's dense-output coefficients ``Q`` from ``Kst`` first unless ``q_ready``."""
+    if not q_ready:
+        DP.dense_coefficients(Kst, Q)
+    th = E.first_crossing(kind, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+    return 1.0 if th <= 0.0 else th
+
+
+@kernel
 def error_norm(y, ynew, Kst, h, md, rtol, atol):
     """RMS of the embedded error estimate over the free DOFs' positions and velocities."""
     m = md.m
@@ -303,11 +314,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
         theta_lost = -1.0
         for c in range(nc):
             if not is_unilateral(md, n, c) and P.normal_force(ynew, c, md) <= 0.0:
-                if not q_ready:
-                    DP.dense_coefficients(Kst, Q)
-                    q_ready = True
-                th = E.first_crossing(E.EVENT_NORMAL, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
-                th = 1.0 if th <= 0.0 else th
+                th = crossing_in_step(E.EVENT_NORMAL, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
+                q_ready = True
                 if theta_lost < 0.0 or th < theta_lost:
                     theta_lost = th
                     lost = c
@@ -388,11 +396,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
         if has_unilateral(md.kin, m):
             for c in range(nc):
                 if is_unilateral(md, n, c) and P.indicator(ynew, cst, c, md) <= 0.0:
-                    if not q_ready:
-                        DP.dense_coefficients(Kst, Q)
-                        q_ready = True
-                    th = E.first_crossing(E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
-                    th = 1.0 if th <= 0.0 else th
+                    th = crossing_in_step(E.EVENT_GAP, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
+                    q_ready = True
                     if theta_g < 0.0 or th < theta_g:
                         theta_g = th
                         c_g = c

@@ -26,7 +26,7 @@ from ..model.jit import kernel
 from ..model.kinematics import contact_dim, contact_frame, model_sizes
 from ..model.model_data import base_force
 from ..model.physics import write_derivative
-from ..model.stack import DOFS, TWO, VECTORS, work_matrix
+from ..model.stack import DOFS, TWO, work_matrix, work_vectors
 
 __all__ = ["derivative_and_contact", "derivative_under_force", "constraint_metric", "stick_force", "contact_limit"]
 
@@ -38,11 +38,7 @@ def derivative_under_force(s, Fx, Fy, md, ds):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, TWO, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    F = vec[2]
-    f = vec[3]
+    w, v, F, f = work_vectors(md.kin, 4, s)
     contact = np.int64(0)
     contact_frame(md.kin, s, contact, m, G, w)
     dim = contact_dim(md.kin, m, n, contact)
@@ -72,10 +68,8 @@ def constraint_metric(s, md):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, TWO, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    contact_frame(md.kin, s, np.int64(0), m, G, vec[0])
-    mg0 = vec[1]
-    mg1 = vec[2]
+    w, mg0, mg1 = work_vectors(md.kin, 3, s)
+    contact_frame(md.kin, s, np.int64(0), m, G, w)
     P.apply_inverse_mass(m, n, diagonal, G[0], mg0)
     P.apply_inverse_mass(m, n, diagonal, G[1], mg1)
     a11 = 0.0

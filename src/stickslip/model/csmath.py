@@ -76,58 +76,75 @@ def _real_cos(x):
     return math.cos(x)
 
 
-@overload(sin, inline="always", jit_options=KERNEL_OPTIONS)
-def _sin(x):
-    if _is_complex(x):
-        def impl(x):
-            a = x.real
-            b = x.imag
-            if abs(b) <= SHORTCUT * max(1.0, abs(a)):
-                return complex(_real_sin(a), b * _real_cos(a))
-            return cmath.sin(x)
-        return impl
-    return lambda x: _real_sin(x)
+def _complex_step(func, real, applies, parts, full):
+    """Overload ``func``: ``real(x)`` on floats; on complex numbers ``parts(a, b)`` = (real part,
+    imaginary part) of func(a + i b) where ``applies(a, b)`` says the shortcut is exact, else
+    ``full(x)``."""
+    @overload(func, inline="always", jit_options=KERNEL_OPTIONS)
+    def _overload(x):
+        if _is_complex(x):
+            def impl(x):
+                a = x.real
+                b = x.imag
+                if applies(a, b):
+                    re, im = parts(a, b)
+                    return complex(re, im)
+                return full(x)
+            return impl
+        return lambda x: real(x)
 
 
-@overload(cos, inline="always", jit_options=KERNEL_OPTIONS)
-def _cos(x):
-    if _is_complex(x):
-        def impl(x):
-            a = x.real
-            b = x.imag
-            if abs(b) <= SHORTCUT * max(1.0, abs(a)):
-                return complex(_real_cos(a), -b * _real_sin(a))
-            return cmath.cos(x)
-        return impl
-    return lambda x: _real_cos(x)
+@register_jitable
+def _angle_step(a, b):
+    return abs(b) <= SHORTCUT * max(1.0, abs(a))
 
 
-@overload(exp, inline="always", jit_options=KERNEL_OPTIONS)
-def _exp(x):
-    if _is_complex(x):
-        def impl(x):
-            a = x.real
-            b = x.imag
-            if abs(b) <= SHORTCUT:
-                e = math.exp(a)
-                return complex(e, e * b)
-            return cmath.exp(x)
-        return impl
-    return lambda x: math.exp(x)
+@register_jitable
+def _exp_step(a, b):
+    return abs(b) <= SHORTCUT
 
 
-@overload(sqrt, inline="always", jit_options=KERNEL_OPTIONS)
-def _sqrt(x):
-    if _is_complex(x):
-        def impl(x):
-            a = x.real
-            b = x.imag
-            if a > 0.0 and abs(b) <= SHORTCUT * a:
-                r = math.sqrt(a)
-                return complex(r, 0.5 * b / r)
-            return cmath.sqrt(x)
-        return impl
-    return lambda x: math.sqrt(x)
+@register_jitable
+def _sqrt_step(a, b):
+    return a > 0.0 and abs(b) <= SHORTCUT * a
+
+
+@register_jitable
+def _sin_parts(a, b):
+    return _real_sin(a), b * _real_cos(a)
+
+
+@register_jitable
+def _cos_parts(a, b):
+    return _real_cos(a), -b * _real_sin(a)
+
+
+@register_jitable
+def _exp_parts(a, b):
+    e = math.exp(a)
+    return e, e * b
+
+
+@register_jitable
+def _sqrt_parts(a, b):
+    r = math.sqrt(a)
+    return r, 0.5 * b / r
+
+
+@register_jitable
+def _real_exp(x):
+    return math.exp(x)
+
+
+@register_jitable
+def _real_sqrt(x):
+    return math.sqrt(x)
+
+
+_complex_step(sin, _real_sin, _angle_step, _sin_parts, cmath.sin)
+_complex_step(cos, _real_cos, _angle_step, _cos_parts, cmath.cos)
+_complex_step(exp, _real_exp, _exp_step, _exp_parts, cmath.exp)
+_complex_step(sqrt, _real_sqrt, _sqrt_step, _sqrt_parts, cmath.sqrt)
 
 
 def zero(x):  # pragma: no cover

@@ -29,7 +29,7 @@ from .linalg import solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, normal_in_mode, open_in_mode
-from .stack import DOFS, ROWS, VECTORS, work_matrix
+from .stack import DOFS, ROWS, work_matrix, work_vectors
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
@@ -126,10 +126,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     """
     m = md.m
     MG = work_matrix(md.kin, ROWS, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    a = vec[0]
-    b = vec[1]
-    x = vec[2]
+    a, b, x = work_vectors(md.kin, 3, s)
     V = work_matrix(md.kin, ROWS, ROWS, s)
     apply_inverse_mass(m, n, diagonal, f, a)
     k = 0
@@ -189,10 +186,7 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
     G_S M⁻¹ G_Sᵀ (a01 = a11 = 0 for one row)."""
     m = md.m
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    a = vec[0]
-    mg0 = vec[1]
-    mg1 = vec[2]
+    a, mg0, mg1 = work_vectors(md.kin, 3, s)
     apply_inverse_mass(m, n, diagonal, f, a)
     apply_inverse_mass(m, n, diagonal, G[r0], mg0)
     a00 = csm.zero(s[0])

@@ -56,7 +56,7 @@ from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
                          apply_inverse_mass, is_stick, kinetic_coefficient, kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, gap_and_rate, indicator_of, is_open, is_unilateral, normal_in_mode
-from .stack import DOFS, ONE, ROWS, TWO, VECTORS, work_matrix
+from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
            "indicator", "gap", "unilateral", "is_open", "normal_force_of",
@@ -103,13 +103,7 @@ def general_rhs(s, cst, md, ds):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
 
@@ -124,12 +118,7 @@ def rhs_body(s, cst, md, ds):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    F = vec[3]
-    f = vec[4]
+    w, v, N, F, f = work_vectors(md.kin, 5, s)
     if sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
         write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
     else:
@@ -146,6 +135,16 @@ def rhs(s, cst, md, ds):
 
 
 # ----------------------------------------------------------------------------- queries
+@inlined_kernel
+def export_contacts(nc, N, F, v, N_out, F_out, v_out):
+    """Copy each contact's normal force, friction force and slip velocity into the caller's arrays."""
+    for c in range(nc):
+        N_out[c] = N[c]
+        for i in range(2):
+            F_out[2 * c + i] = F[2 * c + i]
+            v_out[2 * c + i] = v[2 * c + i]
+
+
 @kernel
 def contact_forces(s, cst, md, F_out, N_out, v_out):
     """Each contact's friction force F (2 nc,) [N], normal force N (nc,) [N] and slip velocity
@@ -153,20 +152,10 @@ def contact_forces(s, cst, md, F_out, N_out, v_out):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     if not sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
         general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
-    for c in range(nc):
-        N_out[c] = N[c]
-        for i in range(2):
-            F_out[2 * c + i] = F[2 * c + i]
-            v_out[2 * c + i] = v[2 * c + i]
+    export_contacts(nc, N, F, v, N_out, F_out, v_out)
 
 
 @kernel
@@ -176,21 +165,11 @@ def rhs_and_forces(s, cst, md, ds, F_out, N_out, v_out):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     if not sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
         general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
-    for c in range(nc):
-        N_out[c] = N[c]
-        for i in range(2):
-            F_out[2 * c + i] = F[2 * c + i]
-            v_out[2 * c + i] = v[2 * c + i]
+    export_contacts(nc, N, F, v, N_out, F_out, v_out)
 
 
 @kernel
@@ -201,13 +180,7 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     if extra >= 0 and not is_stick(cst, extra):
         # solve again with the extra contact held: remove the forces of the contacts to be solved
@@ -233,13 +206,7 @@ def stick_margin(s, cst, c, md):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)  # a call: events only, not the rhs
     return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
 
@@ -326,13 +293,7 @@ def band_direction(s, cst, c, md, speed):
         return ex, 0.0
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if is_stick(cst, c2) or c2 == c:
@@ -371,10 +332,7 @@ def project_velocities(s, cst, extra, md):
     MG = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
     V = work_matrix(md.kin, ROWS, ROWS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    b = vec[1]
-    x = vec[2]
+    w, b, x = work_vectors(md.kin, 3, s)
     k = 0
     for c in range(nc):
         if is_stick(cst, c) or c == extra:

@@ -30,7 +30,7 @@ from ..model import physics as P
 from ..model.bundle import CST, H_BAND
 from ..model.jit import kernel, loop
 from ..model.kinematics import contact_dim, model_sizes
-from ..model.stack import DOFS, ROWS, VECTORS, work_matrix
+from ..model.stack import DOFS, ROWS, work_matrix, work_vectors
 
 __all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "EV_GAP", "integrate_segment",
            "variational_rhs", "contact_gradients", "indicator_gradient", "event_value"]
@@ -86,13 +86,7 @@ def direction_residual(s, cst, c, md, ct, st):
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
-    vec = work_matrix(md.kin, VECTORS, VECTORS, s)
-    w = vec[0]
-    v = vec[1]
-    N = vec[2]
-    h = vec[3]
-    F = vec[4]
-    f = vec[5]
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     P.general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if P.is_stick(cst, c2) or c2 == c:
@@ -141,7 +135,7 @@ def band_correction(s, cst, md, n2, Phi, out, z, gq):
             a0, a1 = P.slip_velocity(z, c, md)  # linear in q̇: Im is the column G_c[:, j]
             gq[j] = muN * st * a0.imag - muN * ct * a1.imag
             z[n + j] = s[n + j]
-        acc = work_matrix(md.kin, VECTORS, VECTORS, s)[0]
+        acc, = work_vectors(md.kin, 1, s)
         P.apply_inverse_mass(m, n, diagonal, gq, acc)
         for col in range(Phi.shape[1]):
             for j in range(n2):
