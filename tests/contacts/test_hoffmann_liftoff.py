@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import stickslip
 from stickslip.analysis.signal import CLOSE, OPEN, SLIP, STICK
 
+from .event_reference import OPEN_MODE, STICK_MODE, event_driven
+
 MU, C, T_END = 1.3, 0.1, 400.0
-OPEN_MODE, STICK_MODE = "open", "stick"
 
 
 def _field(mode):
@@ -37,66 +37,13 @@ def _field(mode):
     return f
 
 
-def _stick_force(s):
-    return 2 * s[0] + s[1] + C * 1.0
-
-
-def _after_zero_slip(s):
-    """Mode where v reaches 0 while closed: stick if the stick force is admissible, else slip on."""
-    F = _stick_force(s)
-    return STICK_MODE if abs(F) <= MU * (1 + s[1]) else (-1 if F > 0 else 1)
-
-
 def reference(t_eval, y0):
-    """scipy DOP853 at rtol 1e-12, restarted at every located event. Returns the states at
-    ``t_eval`` and the instants of each transition kind."""
-    def lam(t, s):
-        return 1.0 + s[1]
-
-    def slip(t, s):
-        return s[2] - 1.0
-
-    def margin(t, s):
-        return MU * (1 + s[1]) - abs(_stick_force(s))
-
-    for event in (lam, slip, margin):
-        event.terminal = True
-    t0, s = 0.0, np.array(y0, dtype=float)
-    mode = -1 if s[2] < 1.0 else 1
-    out = np.empty((len(t_eval), 4))
-    switches = {OPEN: [], CLOSE: [], STICK: [], SLIP: []}
-    while t0 < t_eval[-1]:
-        if mode == OPEN_MODE:
-            lam.direction, events = 1.0, [lam]
-        elif mode == STICK_MODE:
-            lam.direction, margin.direction, events = -1.0, -1.0, [lam, margin]
-        else:
-            lam.direction, slip.direction, events = -1.0, -float(mode), [lam, slip]
-        sol = solve_ivp(_field(mode), (t0, t_eval[-1]), s, method="DOP853", rtol=1e-12, atol=1e-14,
-                        events=events, dense_output=True)
-        t1 = sol.t[-1]
-        sel = (t_eval >= t0) & (t_eval <= t1)
-        out[sel] = sol.sol(t_eval[sel]).T
-        t0, s = t1, sol.y[:, -1]
-        if sol.status != 1:
-            break
-        fired = [k for k, te in enumerate(sol.t_events) if te.size][0]
-        if events[fired] is lam and mode != OPEN_MODE:
-            if mode == STICK_MODE:
-                switches[SLIP].append(t1)
-            switches[OPEN].append(t1)
-            mode = OPEN_MODE
-        elif events[fired] is lam:
-            switches[CLOSE].append(t1)
-            mode = -1 if s[2] < 1.0 else 1
-        elif events[fired] is slip:
-            mode = _after_zero_slip(s)
-            if mode == STICK_MODE:
-                switches[STICK].append(t1)
-        else:  # breakaway: slip leaves opposite to the excess stick force
-            switches[SLIP].append(t1)
-            mode = 1 if _stick_force(s) < 0 else -1
-    return out, {k: np.array(v) for k, v in switches.items()}
+    """scipy DOP853 at rtol 1e-12, restarted at every located event (λ = 1 + y for the contact,
+    v = x' − 1, the stick force 2x + y + c within μ λ). Returns the states at ``t_eval`` and the
+    instants of each transition kind."""
+    return event_driven(_field, phi=lambda s: 1.0 + s[1], slip_speed=lambda s: s[2] - 1.0,
+                        stick_force=lambda s: 2 * s[0] + s[1] + C * 1.0, limit=lambda s: MU * (1 + s[1]),
+                        t_eval=t_eval, y0=y0)
 
 
 @pytest.fixture(scope="module")

@@ -5,6 +5,7 @@
 ``belt``            1-DOF mass on a moving belt, the bSTAB friction case (``belt.toml``)
 ``hoffmann``        2-DOF mode-coupling (flutter) model (``hoffmann.toml``)
 ``popp-stelter``    two masses on one belt, two contacts (``popp_stelter.toml``)
+``slider-belt``     2-DOF slider on a belt, contact opens and closes (``slider_belt.toml``)
 ==================  ==========================================================================
 
 Library models stated as model files live beside this module as TOML; ``stickslip models``
