@@ -291,7 +291,9 @@ class RowJournal(Journal):
     def _check(self, header) -> None:
         super()._check(header)
         if header.get("row_width") != self.width:
-            raise self._corrupt(f"its rows have {header.get('row_width')!r} numbers, this run's {self.width}")
+            raise self.error(f"{self.location} holds rows of {header.get('row_width')!r} numbers where this "
+                             f"stickslip writes {self.width} (a journal of another version); finish it with the "
+                             f"version that started it, or {self.restart} to start over")
 
     def _create(self, header_text: str) -> None:
         self.dir.mkdir(parents=True, exist_ok=True)

@@ -19,6 +19,7 @@ import pytest
 
 import stickslip
 from stickslip.analysis.signal import CLOSE, OPEN, SLIP, STICK
+from stickslip.basins import basin_stability, box
 
 from .event_reference import OPEN_MODE, STICK_MODE, event_driven
 
@@ -113,3 +114,26 @@ def test_a_sweep_over_mu_reports_the_open_fraction_and_openings(runs):
     assert float(lifting["openings"]) == np.sum((opens > t0) & (opens <= t1)) > 0
     belt = stickslip.sweep({"contact.0.drive": [1.0]}, "belt", executor="serial", t_end=2.0)
     assert "open_fraction" not in belt.dataset and "openings" not in belt.dataset
+
+
+def test_basins_give_the_lift_off_cycle_its_open_fraction(runs):
+    """Basins at μ = 1.3: every state reaches the lift-off cycle, whose open fraction (over the
+    whole periods that end each state's window) is the reference's flight over its period, to
+    the window's sample spacing (a window starts on a sample: ≤ one T_c / 64 of the window's
+    16 or more periods, ~2e-3 relative); a pressed model's attractors have no open fraction."""
+    traj, ref, switches = runs
+    model = stickslip.load_model("hoffmann").replace(
+        **{"contact.0.friction.mu_k": MU, "damping.x.x": C, "damping.y.y": C})
+    states = box(model, {"x": (-0.5, 0.5), "dx": (-0.5, 0.5)}, n=4, seed=3)
+    result = basin_stability(model, states, t_end=400.0, executor="serial")
+    [cycle] = [a for a in result.attractors() if a["name"] == "periodic"]
+    assert cycle["count"] == 4
+    closes = switches[CLOSE]
+    ref_period = np.diff(closes)[-1]
+    ref_flight = closes[-1] - switches[OPEN][switches[OPEN] < closes[-1]][-1]
+    assert cycle["period"] == pytest.approx(ref_period, rel=1e-4)
+    assert cycle["open_fraction"] == pytest.approx(ref_flight / ref_period, rel=2e-3)
+    belt = stickslip.load_model("belt")
+    pressed = basin_stability(belt, box(belt, {"x": (-1.0, 1.0)}, n=2, seed=1), t_end=100.0, executor="serial")
+    assert all("open_fraction" not in a for a in pressed.attractors())
+    assert "open_fraction" not in pressed.dataset

@@ -59,6 +59,9 @@ class Cycle:
         Fraction of a period in stick (of any contact) [-].
     state : ndarray (2n,)
         A state on the cycle: the sample nearest to its largest maximum.
+    open_fraction : float or None
+        Fraction of a period with some unilateral contact open [-]; None for a model whose contacts
+        are all pressed.
     """
 
     multiplicity: int
@@ -67,6 +70,7 @@ class Cycle:
     peaks: np.ndarray
     stick_fraction: float
     state: np.ndarray
+    open_fraction: float | None = None
 
     @property
     def frequency(self) -> float:
@@ -163,7 +167,7 @@ def find_cycle(cycles, candidate: Cycle, rtol: float) -> int:
 
 
 def cycle_from_section(section: Section, t: np.ndarray, states: np.ndarray, multiplicity: int, period: float,
-                       stick_fraction: float) -> Cycle:
+                       stick_fraction: float, open_fraction: float | None = None) -> Cycle:
     """The features of a settled periodic window.
 
     Parameters
@@ -178,6 +182,8 @@ def cycle_from_section(section: Section, t: np.ndarray, states: np.ndarray, mult
         k and T of the settled period (:func:`stickslip.analysis.period.detect_period`).
     stick_fraction : float
         Fraction of the window in stick [-].
+    open_fraction : float or None
+        Fraction of the window with some contact open [-] (None: all contacts pressed).
     """
     k = int(multiplicity)
     top = int(np.argmax(section.maxima[-k:]))
@@ -185,4 +191,4 @@ def cycle_from_section(section: Section, t: np.ndarray, states: np.ndarray, mult
     when = section.times[-k:][top]
     i = int(np.argmin(np.abs(t - when)))
     return Cycle(k, float(period), section.amplitude(k + 1), peaks.astype(float), float(stick_fraction),
-                 states[i].copy())
+                 states[i].copy(), None if open_fraction is None else float(open_fraction))

@@ -72,8 +72,8 @@ DEFAULT_MAX_STEPS = 10_000_000
 #: Section crossings an outcome keeps (enough to match a cycle of KMAX maxima per period).
 N_CROSSINGS = MATCH_PERIODS * KMAX + 1
 
-_HEAD = ("verdict", "decided_by", "t_decided", "period", "multiplicity", "amplitude", "stick_fraction", "steps",
-         "wall_time")
+_HEAD = ("verdict", "decided_by", "t_decided", "period", "multiplicity", "amplitude", "stick_fraction",
+         "open_fraction", "steps", "wall_time")
 
 
 def row_width(n: int) -> int:
@@ -151,6 +151,7 @@ class Outcome:
         row[:len(_HEAD)] = (OUTCOMES.index(self.verdict), DECIDED.index(self.decided_by), self.t_decided,
                             math.nan if c is None else c.period, 0 if c is None else c.multiplicity,
                             math.nan if c is None else c.amplitude, math.nan if c is None else c.stick_fraction,
+                            math.nan if c is None or c.open_fraction is None else c.open_fraction,
                             self.steps, self.wall_time)
         o = len(_HEAD)
         if c is not None:
@@ -168,11 +169,12 @@ class Outcome:
     @classmethod
     def from_row(cls, row: np.ndarray, n: int) -> "Outcome":
         """The outcome written by :meth:`to_row` (n: the model's coordinates)."""
-        verdict, decided, t, period, k, amp, stick, steps, wall = row[:len(_HEAD)]
+        verdict, decided, t, period, k, amp, stick, opened, steps, wall = row[:len(_HEAD)]
         o = len(_HEAD)
         k = int(k)
         state = row[o + KMAX:o + KMAX + 2 * n].copy()
-        cycle = Cycle(k, float(period), float(amp), row[o:o + k].copy(), float(stick), state) if k > 0 else None
+        cycle = Cycle(k, float(period), float(amp), row[o:o + k].copy(), float(stick), state,
+                      float(opened) if math.isfinite(opened) else None) if k > 0 else None
         o += KMAX + 2 * n
         times, maxima, minima = (row[o + j * N_CROSSINGS:o + (j + 1) * N_CROSSINGS] for j in range(3))
         keep = np.isfinite(times)
@@ -359,5 +361,8 @@ def classify_state(ctx: Context, model, s0: np.ndarray, cycles, opts: Options) -
     return stop.outcome
 def _cycle(section: Section, traj, verdict) -> Cycle:
     """The features of the window's settled periodic verdict."""
+    window = verdict.classification
+    # the open fraction over the whole periods that end the window (exact for a settled cycle)
+    whole = math.floor((window.t_to - window.t_from) / verdict.period_s) * verdict.period_s
     return cycle_from_section(section, traj.t, traj.states, verdict.period_count, verdict.period_s,
-                              verdict.classification.stick_fraction)
+                              window.stick_fraction, traj.steady_state(window.t_to - whole).open_fraction)

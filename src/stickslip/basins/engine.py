@@ -115,8 +115,8 @@ def _check_memory(model, spec: BasinSpec) -> None:
 
 def _contexts(models, keys):
     ctxs = [make_context(m, key=k) for m, k in zip(models, keys)]
-    info = [{"equilibrium": c.equilibrium, "stable": c.stable, "max_real_part": c.max_real_part, "period": c.period}
-            for c in ctxs]
+    info = [{"equilibrium": c.equilibrium, "stable": c.stable, "max_real_part": c.max_real_part, "period": c.period,
+             "unilateral": bool(m.unilateral)} for c, m in zip(ctxs, models)]
     return ctxs, info
 
 

@@ -77,7 +77,8 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
     spec : BasinSpec
     models : list of dict
         Per parameter value: ``equilibrium`` ((2n,) or None), ``stable`` (bool), ``max_real_part``
-        [1/s], ``period`` (T_c [s]).
+        [1/s], ``period`` (T_c [s]), ``unilateral`` (bool: the model has contacts that open; its
+        attractors then get an ``open_fraction``).
     initial : ndarray (n_params, n_states, 2n)
         The initial states.
     indices, rows : ndarray
@@ -108,7 +109,7 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
     t_decided = np.full((P, N), np.nan)
     steps = np.full((P, N), -1, dtype=np.int64)
     wall = np.full((P, N), np.nan)
-    table = {key: np.full((P, L), np.nan) for key in ("period", "amplitude", "stick_fraction")}
+    table = {key: np.full((P, L), np.nan) for key in ("period", "amplitude", "stick_fraction", "open_fraction")}
     multiplicity = np.zeros((P, L), dtype=np.int16)
     count = np.zeros((P, L), dtype=np.int64)
     rep = np.full((P, L, 2 * n), np.nan)
@@ -125,12 +126,13 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
             a = code[cycle_name(r)]
             table["period"][p, a], table["amplitude"][p, a], table["stick_fraction"][p, a] = \
                 c.period, c.amplitude, c.stick_fraction
+            table["open_fraction"][p, a] = np.nan if c.open_fraction is None else c.open_fraction
             multiplicity[p, a] = c.multiplicity
             rep[p, a] = c.state
         eq = models[p]["equilibrium"]
         if "equilibrium" in code and eq is not None:
             a = code["equilibrium"]
-            table["amplitude"][p, a], table["stick_fraction"][p, a] = 0.0, 0.0
+            table["amplitude"][p, a], table["stick_fraction"][p, a], table["open_fraction"][p, a] = 0.0, 0.0, 0.0
             rep[p, a] = eq
     done = label >= 0
     n_done = done.sum(axis=1)
@@ -180,6 +182,9 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
         "characteristic_period": v(np.array([m["period"] for m in models]), (),
                                    {"units": "s", "long_name": "T_c: chunks and samples are sized by it"}),
     }
+    if any(m.get("unilateral") for m in models):
+        data["open_fraction"] = v(table["open_fraction"], ("attractor",),
+                                  {"long_name": "fraction of a period with some contact open"})
     coords = {"state": ("state", np.arange(N)), "attractor": ("attractor", np.array(names, dtype=object)),
               "state_name": ("state_name", np.array(spec.state_names, dtype=object))}
     if spec.param:
@@ -263,8 +268,9 @@ class BasinResult:
 
     def attractors(self, param_index: int | None = None) -> list[dict]:
         """The attractor table (of one parameter value for a study): label, name, count, fraction,
-        standard error, period [s], frequency [Hz], amplitude, multiplicity, stick fraction and a
-        representative state {state name: value}; attractors not reached there are left out."""
+        standard error, period [s], frequency [Hz], amplitude, multiplicity, stick fraction (and open
+        fraction for a model with contacts that open) and a representative state {state name:
+        value}; attractors not reached there are left out."""
         ds = self.dataset if param_index is None or "param" not in self.dataset.dims else \
             self.dataset.isel(param=param_index)
         if "param" in ds.dims:
@@ -283,6 +289,7 @@ class BasinResult:
                         "standard_error": num("standard_error"), "period": num("period"),
                         "frequency": num("frequency"), "amplitude": num("amplitude"),
                         "multiplicity": int(ds["multiplicity"].values[i]), "stick_fraction": num("stick_fraction"),
+                        **({"open_fraction": num("open_fraction")} if "open_fraction" in ds else {}),
                         "state": {str(s): (float(x) if math.isfinite(x) else None)
                                   for s, x in zip(ds["state_name"].values, state)}})
         return out
