@@ -108,9 +108,9 @@ def test_stability_reports_steady_sliding_below_mu_star_and_none_above_it():
     lines = [ln for ln in above.output.splitlines() if ln.strip()]
     # the closed form on the open side: λ = P/(1 − 1.02) = −50, gap −P/kc − y = 0.5
     assert above.exit_code == 2 and lines == [
-        "error: no steady sliding at model 'sprag-slip': at rest contact 0 (tip) would be open (gap 0.5, normal "
-        "force -50 with it closed), so nothing presses it onto its surface; press it (a force towards the contact, "
-        "a negative gap) or simulate the free motion"]
+        "error: no steady sliding at model 'sprag-slip': contact 0 (tip) would be open (gap 0.5, normal force -50 "
+        "with it closed), though it is pressed without friction: the friction jams it (sprag: the friction "
+        "coefficient is past the model's threshold); lower it or simulate the motion"]
     default = runner.invoke(app, ["stability", "--model", "sprag-slip"])
     assert default.exit_code == 2 and "normal force -8.21111 with it closed" in default.output
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import EquilibriumError
+from ..errors import EquilibriumError, StickSlipError
 from ..model.bundle import CST
 from ..model.library import resolve_system
 from ..model.parameters import Parameters
@@ -93,6 +93,13 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         0) or, for a 2-D contact, slides inside the low-speed band (the simulator's slip direction
         there is not v/|v|, so steady sliding is not an equilibrium of the simulated equations).
     """
+    q, rel, iterations = _solve_closed(system)
+    _check_closed(system, q)
+    return q, rel, iterations
+
+
+def _solve_closed(system) -> tuple[np.ndarray, float, int]:
+    """:func:`solve_steady` with every unilateral contact held closed, whatever its normal force."""
     if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:  # a contact at rest does not slide (e.g. Ω = 0)
         raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
     free = np.flatnonzero(system.free).astype(np.int64)
@@ -103,27 +110,51 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         if np.all(np.isfinite(q)) and min(sliding_speeds(system, q)) == 0.0:
             raise EquilibriumError(_not_sliding_message(system, q))
         raise EquilibriumError(_failure_message(system, q, status, rel))
-    _check_closed(system, q)
     return q, float(rel), int(iterations)
 
 
-def _check_closed(system, q: np.ndarray) -> None:
-    """Steady sliding needs every unilateral contact closed (g < 0, λ > 0) at the equilibrium found
-    with them closed; otherwise it does not exist (a contact at rest there is open)."""
+def _open_contact(system, q: np.ndarray):
+    """(c, g, λ) of the first unilateral contact that is not closed (g < 0, λ > 0) at the steady
+    state ``q`` solved with it closed, or None."""
     s = np.zeros(2 * system.n)
     s[:system.n] = q
     cst = _sliding_modes(system)
     for c, contact in enumerate(system.contacts):
-        if not contact.unilateral:
-            continue
-        g = gap(s, c, system.data)[0]
-        lam = normal_force_of(s, cst, c, system.data)
-        if not (g < 0.0 and lam > 0.0):
-            name = system.contact_names[c]
-            raise EquilibriumError(f"no steady sliding at {system.point_text()}: at rest contact {c} ({name}) would "
-                                   f"be open (gap {g:.6g}, normal force {lam:.6g} with it closed), so nothing "
-                                   "presses it onto its surface; press it (a force towards the contact, a negative "
-                                   "gap) or simulate the free motion")
+        if contact.unilateral:
+            g = gap(s, c, system.data)[0]
+            lam = normal_force_of(s, cst, c, system.data)
+            if not (g < 0.0 and lam > 0.0):
+                return c, g, lam
+    return None
+
+
+def _closed_without_friction(system) -> bool:
+    """Whether the model's steady state with every friction coefficient 0 has its unilateral
+    contacts closed (False where that model cannot be built or solved: a user law, say)."""
+    zero = {f"contact.{c}.friction.{key}": 0.0 for c in range(system.n_contacts) for key in ("mu_k", "delta_mu")}
+    try:
+        smooth = system.replace(**zero)
+        return _open_contact(smooth, _solve_closed(smooth)[0]) is None
+    except (StickSlipError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return False
+
+
+def _check_closed(system, q: np.ndarray) -> None:
+    """Steady sliding needs every unilateral contact closed (g < 0, λ > 0) at the equilibrium found
+    with them closed; otherwise it does not exist. The refusal says why: the contact is not pressed
+    at all, or it is pressed without friction and the friction pulls it open (sprag: a friction
+    coefficient past the model's threshold)."""
+    found = _open_contact(system, q)
+    if found is None:
+        return
+    c, g, lam = found
+    head = (f"no steady sliding at {system.point_text()}: contact {c} ({system.contact_names[c]}) would be open "
+            f"(gap {g:.6g}, normal force {lam:.6g} with it closed)")
+    if _closed_without_friction(system):
+        raise EquilibriumError(f"{head}, though it is pressed without friction: the friction jams it (sprag: the "
+                               "friction coefficient is past the model's threshold); lower it or simulate the motion")
+    raise EquilibriumError(f"{head}, so nothing presses it onto its surface; press it (a force towards the contact, a "
+                           "negative gap) or simulate the free motion")
 
 
 def _sliding_modes(system) -> np.ndarray:

@@ -6,6 +6,7 @@
 ``hoffmann``        2-DOF mode-coupling (flutter) model (``hoffmann.toml``)
 ``popp-stelter``    two masses on one belt, two contacts (``popp_stelter.toml``)
 ``slider-belt``     2-DOF slider on a belt, contact opens and closes (``slider_belt.toml``)
+``sprag-slip``      tilted beam on a belt: no steady sliding above μ* (``sprag_slip.toml``)
 ==================  ==========================================================================
 
 Library models stated as model files live beside this module as TOML; ``stickslip models``
