@@ -1,4 +1,4 @@
-"""The options that several commands take, each defined once.
+"""The options that several commands take, each defined once, and the groups they come in.
 
 Each option is a :data:`typing.Annotated` alias that a command uses as a parameter's type, with
 its default where the parameter is declared (``rtol: Rtol = 1e-8``): the flag, the type and the
@@ -9,14 +9,22 @@ of a one-shot command replaces its outputs, of a resumable one it also discards 
 a resume), each meaning has its own alias. An option that only one command takes, or that means
 something only one command means (``simulate --t-end auto``, a command's own JSON object), is
 declared with that command.
+
+Options that commands take together are a group (:mod:`._groups`): a frozen dataclass whose
+fields are the options, in the order ``--help`` lists them, taken as one parameter
+(``plates: Plates = Plates()``). A field's default is that of every command taking the group;
+where commands differ, the field has none and the command gives it (``Outputs(out=Path("orbit.nc"))``).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Annotated, List, Optional
 
 import typer
+
+from ._app import executor_of
 
 # ----------------------------------------------------------------------------- the model
 #: Help text of ``--model`` for commands that take any model.
@@ -43,6 +51,20 @@ MapModel = Annotated[str, typer.Option("--model", help=MODEL_HELP + " (Plates va
 SetItems = Annotated[Optional[List[str]], typer.Option("--set", help=SET_HELP)]
 Config = Annotated[Optional[Path], typer.Option("--config", help=CONFIG_HELP)]
 
+
+@dataclass(frozen=True, kw_only=True)
+class ModelChanges:
+    """The model's parameters as given: ``--set`` and ``--config``."""
+
+    set_: SetItems = None
+    config: Config = None
+
+    @property
+    def inputs(self) -> dict:
+        """``{option: path}`` of the files read, which no output may replace."""
+        return {"--config": self.config}
+
+
 # The plates' parameters with options of their own (None: not given, the model's value holds).
 NormalLoad = Annotated[Optional[float], typer.Option("--N", help="The plates: normal preload N [N] (default 50).")]
 Omega = Annotated[Optional[float], typer.Option("--omega", help="The plates: angular velocity Ω of the lower plate "
@@ -64,6 +86,66 @@ BifurcationOmega = Annotated[Optional[float], typer.Option("--omega", help="The 
                                                            "lower plate [rad/s] when --param is another parameter "
                                                            "(default 0.5, as in Figs. 12(a), 13, 14).")]
 
+
+class PlatesOptions:
+    """A group of the plates' parameters with options of their own (None: not given, the model's value holds)."""
+
+    #: The parameter of each field whose name is not the parameter's (the plates' Ω is ``--omega``).
+    _PARAMETERS = {"omega": "Omega"}
+
+    def named(self) -> dict:
+        """``{parameter name: value}`` of the group's options, those of groups within included, as
+        :func:`~._app.build_system` takes the plates' named options."""
+        named = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, PlatesOptions):
+                named.update(value.named())
+            else:
+                named[self._PARAMETERS.get(f.name, f.name)] = value
+        return named
+
+
+@dataclass(frozen=True, kw_only=True)
+class OperatingPoint(PlatesOptions):
+    """The plates' operating point: ``--N`` and ``--omega``."""
+
+    N: NormalLoad = None
+    omega: Omega = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContinuedPoint(OperatingPoint):
+    """:class:`OperatingPoint` of ``continue``, whose ``--param`` may be N or Ω."""
+
+    N: VariedLoad = None
+    omega: ContinuedOmega = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Friction(PlatesOptions):
+    """The plates' friction law: ``--mu-k``, ``--delta-mu``, ``--alpha``."""
+
+    mu_k: MuK = None
+    delta_mu: DeltaMu = None
+    alpha: Alpha = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Plates(OperatingPoint):
+    """The plates' parameters with options of their own: :class:`OperatingPoint` and :class:`Friction`."""
+
+    friction: Friction = field(default_factory=Friction)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BifurcationPlates(Plates):
+    """:class:`Plates` of ``bifurcation``, whose ``--param`` may vary N or Ω and whose Ω has a base of its own."""
+
+    N: VariedLoad = None
+    omega: BifurcationOmega = None
+
+
 # ----------------------------------------------------------------------------- runs
 #: Tolerances of the event method (``simulate`` and every run of a sweep or basin study).
 Rtol = Annotated[float, typer.Option("--rtol", help="Relative tolerance of the event method.")]
@@ -75,6 +157,15 @@ Tol = Annotated[float, typer.Option("--tol", help="Newton tolerance of every orb
 SlipBand = Annotated[Optional[float], typer.Option("--slip-band", help="Low-speed band of the slip direction [m/s] "
                                                    "(default: that of stickslip.simulate).")]
 SampleRate = Annotated[float, typer.Option("--sample-rate", help="Output samples per second of each run [Hz].")]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Tolerances:
+    """``--rtol`` and ``--atol`` of the event method."""
+
+    rtol: Rtol = 1e-8
+    atol: Atol = 1e-10
+
 
 # ----------------------------------------------------------------------------- orbits
 #: Help text of ``--ic`` of the commands that start from a run (``orbit``, ``lyapunov``, ``continue``).
@@ -88,6 +179,16 @@ SearchTime = Annotated[float, typer.Option("--search-time", help="Length of the 
 Section = Annotated[str, typer.Option("--section", help="Poincaré section: max (maximum of the model's observed "
                                       "coordinate, the plates' φ) | DOF_max | DOF=LEVEL (up-crossing of a level), "
                                       "e.g. x2_max.")]
+
+
+@dataclass(frozen=True, kw_only=True)
+class OrbitSearch:
+    """Where shooting starts: a run of ``--search-time`` from ``--ic``, and its last ``--section`` crossings."""
+
+    ic: StartIc = None
+    section: Section = "max"
+    search_time: SearchTime
+
 
 # ----------------------------------------------------------------------------- sweeps
 _TEND_HELP = "Simulated time of every grid point [s]."
@@ -107,6 +208,15 @@ Settle = Annotated[bool, typer.Option("--settle", help=_SETTLE_HELP)]
 Cap = Annotated[Optional[float], typer.Option("--cap", help="Longest run of a point when settling [s] "
                                               "(default 2000).")]
 
+
+@dataclass(frozen=True, kw_only=True)
+class Settling:
+    """``--settle`` and ``--cap``: runs of a grid extended until they have settled."""
+
+    settle: Settle = False
+    cap: Cap = None
+
+
 # ----------------------------------------------------------------------------- parallel work
 Executor = Annotated[Optional[str], typer.Option("--executor", help="serial | processes | dask (default processes; "
                                                  "dask when --scheduler is given).")]
@@ -115,6 +225,26 @@ Workers = Annotated[Optional[int], typer.Option("--workers", help="Worker proces
 Scheduler = Annotated[Optional[str], typer.Option("--scheduler", help="dask.distributed scheduler address, e.g. "
                                                   "tcp://head-node:8786 (implies --executor dask).")]
 NoProgress = Annotated[bool, typer.Option("--no-progress", help="No progress bar.")]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Parallel:
+    """Where the runs of a study go: ``--executor``, ``--workers``, ``--scheduler``."""
+
+    executor: Executor = None
+    workers: Workers = None
+    scheduler: Scheduler = None
+
+    def options(self) -> dict:
+        """``executor``, ``workers`` and ``address`` as the library's parallel studies take them.
+
+        Raises
+        ------
+        CLIError
+            For a scheduler with an executor other than dask (:func:`~._app.executor_of`).
+        """
+        return dict(executor=executor_of(self.executor, self.scheduler), workers=self.workers, address=self.scheduler)
+
 
 # ----------------------------------------------------------------------------- outputs
 #: Help text of ``--overwrite`` of a command whose outputs are not resumable.
@@ -138,3 +268,24 @@ OverwriteFolder = Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_FOL
 NoPlot = Annotated[bool, typer.Option("--no-plot", help="Do not draw the figure.")]
 #: ``--json`` of a command that prints a summary table.
 JsonSummary = Annotated[bool, typer.Option("--json", help="Print a one-line JSON summary instead of the table.")]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Outputs:
+    """A one-shot command's outputs: ``--out``, ``--overwrite``, ``--no-plot``."""
+
+    out: Out
+    overwrite: Overwrite = False
+    no_plot: NoPlot = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class Study:
+    """A resumable study's runs and outputs: :class:`Parallel`, ``--out``, ``--overwrite``,
+    ``--no-plot``, ``--no-progress``."""
+
+    parallel: Parallel = field(default_factory=Parallel)
+    out: ResumableOut
+    overwrite: Restart = False
+    no_plot: NoPlot = False
+    no_progress: NoProgress = False

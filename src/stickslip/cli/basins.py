@@ -19,14 +19,13 @@ from ..basins import basin_stability, from_csv, parse_param, parse_range
 from ..basins import box as random_box
 from ..basins import grid as regular_grid
 from ..basins.engine import load_result
-from ..files import write_output
 from ..integrate.interrupt import stop_if_interrupted
 from ..plot.basins import save_basins_figure
-from ._app import (CLIError, app, build_system, check_resumable_output, console, executor_of, journal_of,
-                   parse_assignments)
-from ._kept import keeps, keeps_figure, on_interrupt
-from ._options import (Atol, Executor, Model, NoPlot, NoProgress, Restart, ResumableOut, Rtol, Scheduler, SetItems,
-                       Workers)
+from ._app import CLIError, app, build_system, check_resumable_output, console, journal_of, parse_assignments
+from ._groups import grouped
+from ._kept import keeps, on_interrupt
+from ._options import Model, SetItems, Study, Tolerances
+from ._outputs import draw_figure
 
 _BOX_HELP = ("A state to vary and its range, NAME=LO:HI (repeatable), e.g. --box x=-2:2 --box dx=-2:2; the "
              "other states are held at the base state.")
@@ -55,6 +54,7 @@ def _states(model, box, n, seed, grid, ics, base, state):
 
 
 @app.command()
+@grouped
 def basins(
     model: Model = "two-plates",
     set_: SetItems = None,
@@ -72,43 +72,33 @@ def basins(
     param: Optional[str] = typer.Option(None, "--param", help="Basin stability against a parameter: "
                                         "PATH=LO:HI:K (any --set path), e.g. contact.0.drive=0.8:2:13."),
     t_end: float = typer.Option(500.0, "--t-end", help="Longest run of a state [s]."),
-    rtol: Rtol = 1e-8,
-    atol: Atol = 1e-10,
+    tolerances: Tolerances = Tolerances(),
     match_rtol: float = typer.Option(1e-3, "--match-rtol", help="Tolerance of the cycle matches, relative to a "
                                      "cycle's amplitude and period."),
     no_confirm: bool = typer.Option(False, "--no-confirm", help="Do not shoot orbits to confirm periods of "
                                     "several maxima (such runs stay unsettled)."),
     lyapunov: bool = typer.Option(False, "--lyapunov", help="Compute Lyapunov exponents of runs still "
                                   "non-periodic at --t-end (needed for a chaos claim)."),
-    executor: Executor = None,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    out: ResumableOut = Path("basins.nc"),
-    overwrite: Restart = False,
-    no_plot: NoPlot = False,
-    no_progress: NoProgress = False,
+    study: Study = Study(out=Path("basins.nc")),
     as_json: bool = typer.Option(False, "--json", help="Print {n, fractions, standard_errors, attractors} as JSON."),
 ) -> None:
     """Basin stability: which attractor each initial state reaches (exact stick), and how often."""
-    inputs = {"--ics": ics}
-    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
+    out, inputs = study.out, {"--ics": ics}
+    replace_figure = check_resumable_output(out, not study.no_plot, study.overwrite, inputs)
     m, _ = build_system(model, None, set_)
     states = _states(m, box, n, seed, grid, ics, base, state)
     path, values = parse_param(param) if param is not None else (None, ())
-    executor = executor_of(executor, scheduler)
+    parallel = study.parallel.options()
     keeps(out, _holds)
     on_interrupt(f"the states classified before are kept in {journal_of(out)}; run the same command again to resume",
                  journal_of(out))
-    result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, executor=executor,
-                             workers=workers, address=scheduler, progress=not (no_progress or as_json),
-                             overwrite=overwrite, rtol=rtol, atol=atol, match_rtol=match_rtol,
+    result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, **parallel,
+                             progress=not (study.no_progress or as_json), overwrite=study.overwrite,
+                             rtol=tolerances.rtol, atol=tolerances.atol, match_rtol=match_rtol,
                              confirm=not no_confirm, lyapunov=lyapunov)
     stop_if_interrupted()  # the study took a Ctrl-C: it wrote what it had
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_basins_figure(result, tmp),
-                              overwrite=replace_figure, inputs=inputs)
+    figure = draw_figure(out, lambda tmp: save_basins_figure(result, tmp), skip=study.no_plot,
+                         overwrite=replace_figure, inputs=inputs)
     if as_json:
         print(json.dumps(result.to_json()))
     else:

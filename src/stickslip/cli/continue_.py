@@ -22,9 +22,10 @@ from ..plot.continuation import save_branch_figure
 from ._app import (CLIError, app, check_below_one, check_finite, check_positive, check_resumable_output, console,
                    error_line, note_line, resumable_holds)
 from ._compiling import compile_seconds
+from ._groups import grouped
 from ._kept import keeps, keeps_figure
-from ._options import (Config, ContinuedOmega, JsonSummary, Model, NoPlot, OrbitRtol, Restart, ResumableOut,
-                       SearchTime, Section, SetItems, SlipBand, StartIc, Tol, VariedLoad)
+from ._options import (ContinuedPoint, JsonSummary, Model, ModelChanges, NoPlot, OrbitRtol, OrbitSearch, Restart,
+                       ResumableOut, SlipBand, Tol)
 from .orbit import model_system, parse_section, parse_start
 
 
@@ -75,6 +76,7 @@ def _pairs(mu) -> list:
 
 
 @app.command("continue")
+@grouped
 def continue_command(
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: any numeric parameter of the model, the "
                               "plates' N, Omega, delta_mu, alpha, mu_k, k_px, ... or a model file's path such as "
@@ -83,12 +85,9 @@ def continue_command(
                                 "Omega, ...]; the first orbit is found there."),
     stop: float = typer.Option(..., "--to", help="End of the range [the unit of --param]; the branch goes from "
                                "--from towards it."),
-    N: VariedLoad = None,
-    omega: ContinuedOmega = None,
+    point: ContinuedPoint = ContinuedPoint(),
     model: Model = "full",
-    ic: StartIc = None,
-    section: Section = "max",
-    search_time: SearchTime = 60.0,
+    search: OrbitSearch = OrbitSearch(search_time=60.0),
     max_points: int = typer.Option(200, "--max-points", help="Orbits to compute (the start included)."),
     step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
     max_step: float = typer.Option(0.2, "--max-step", help="Largest step in scaled arclength."),
@@ -97,8 +96,7 @@ def continue_command(
     rtol: OrbitRtol = 1e-10,
     tol: Tol = 1e-8,
     slip_band: SlipBand = None,
-    set_: SetItems = None,
-    config: Config = None,
+    changes: ModelChanges = ModelChanges(),
     out: ResumableOut = Path("branch.nc"),
     overwrite: Restart = False,
     no_plot: NoPlot = False,
@@ -110,22 +108,22 @@ def continue_command(
     The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused). Folds, period doublings and Neimark-Sacker points are told apart by what crosses the unit circle (a real multiplier at +1, at -1, a complex pair), with the multipliers on either side. A start orbit that is steady sliding (the equilibrium, no cycle) is an error (exit 2, nothing written); a continuation that converges onto steady sliding writes the orbits before it and exits 1.
     """
     stop_on = list(stop_on or [])
-    _check(start, stop, max_points, step, max_step, search_time, tol, stop_on)
-    ic_start = parse_start(ic)
-    system = model_system(model, config, set_, slip_band, swept={param: f"--param {param}"}, N=N, Omega=omega)
+    _check(start, stop, max_points, step, max_step, search.search_time, tol, stop_on)
+    ic_start = parse_start(search.ic)
+    system = model_system(model, changes, slip_band, swept={param: f"--param {param}"}, **point.named())
     try:
         parameter_value(system, param)
         system = with_parameter(system, param, start)
     except StickSlipError as exc:
         raise CLIError(f"--param {param}: {exc}") from None
-    sec = resolve_section(parse_section(section), system)
+    sec = resolve_section(parse_section(search.section), system)
     check_resumable_output(out, not no_plot, overwrite)
     keeps(out, resumable_holds("branch"))
     progress = None if (no_progress or as_json) else (
         lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
                                           f"{'stable' if st else 'unstable'}"))
     compiling0 = compile_seconds()
-    run = start_run(system, ic_start, t_end=search_time, rtol=rtol)
+    run = start_run(system, ic_start, t_end=search.search_time, rtol=rtol)
     out.parent.mkdir(parents=True, exist_ok=True)
     compiling1 = compile_seconds()
     try:

@@ -17,8 +17,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..files import netcdf_writer, write_output
-from ..integrate.interrupt import finish_first
+from ..files import netcdf_writer
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import start_run
 from ..orbits.problem import METHODS as MONODROMY_METHODS
@@ -27,9 +26,10 @@ from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
 from ._compiling import compile_seconds
-from ._kept import keeps, keeps_figure
-from ._options import (Config, JsonSummary, Model, NoPlot, NormalLoad, Omega, OrbitRtol, Out, Overwrite, SearchTime,
-                       Section, SetItems, SlipBand, StartIc, Tol)
+from ._groups import grouped
+from ._options import (JsonSummary, Model, ModelChanges, OperatingPoint, OrbitRtol, OrbitSearch, Outputs, SlipBand,
+                       StartIc, Tol)
+from ._outputs import write_result
 from .simulate import _parse_ic
 
 #: Ways to compute the Lyapunov spectrum (:func:`stickslip.orbits.lyapunov_spectrum`).
@@ -42,10 +42,10 @@ def parse_start(ic: str | None):
     return None if ic is None else _parse_ic(ic)
 
 
-def model_system(model: str, config, assignments, slip_band, *, swept=None, **named):
+def model_system(model: str, changes: ModelChanges, slip_band, *, swept=None, **named):
     """The FrictionModel of ``--model``, ``--config``, ``--set``, the plates' named options (the CLI's
     :func:`~._app.build_system`) and ``--slip-band``."""
-    system, _ = build_system(model, config, assignments, swept=swept, **named)
+    system, _ = build_system(model, changes.config, changes.set_, swept=swept, **named)
     return system if slip_band is None else system.with_slip_band(slip_band)
 
 
@@ -66,15 +66,6 @@ def parse_section(text: str):
     return text
 
 
-def _write(*, ds_of, out: Path, holds: str, overwrite: bool, inputs: dict) -> None:
-    """Write the dataset ``ds_of()`` to ``out`` whole (:func:`stickslip.files.write_output`); a
-    Ctrl-C meanwhile lets it finish, then stops."""
-    keeps(out, holds)
-    with finish_first():
-        ds = ds_of()
-        write_output(out, netcdf_writer(ds), overwrite=overwrite, inputs=inputs)
-
-
 def _finite_or_none(x: float):
     """A float for JSON, ``None`` where it is not finite (JSON has no ±inf or NaN)."""
     x = float(x)
@@ -82,55 +73,46 @@ def _finite_or_none(x: float):
 
 
 @app.command("orbit")
+@grouped
 def orbit_command(
-    N: NormalLoad = None,
-    omega: Omega = None,
+    point: OperatingPoint = OperatingPoint(),
     model: Model = "full",
-    ic: StartIc = None,
-    section: Section = "max",
-    search_time: SearchTime = 30.0,
+    search: OrbitSearch = OrbitSearch(search_time=30.0),
     period_multiplicity: int = typer.Option(1, "--period-multiplicity", help="Section crossings per period."),
     monodromy: str = typer.Option("saltation", "--monodromy", help="Monodromy matrix: saltation | finite-difference."),
     rtol: OrbitRtol = 1e-10,
     tol: Tol = 1e-8,
     slip_band: SlipBand = None,
-    set_: SetItems = None,
-    config: Config = None,
-    out: Out = Path("orbit.nc"),
-    overwrite: Overwrite = False,
-    no_plot: NoPlot = False,
+    changes: ModelChanges = ModelChanges(),
+    outputs: Outputs = Outputs(out=Path("orbit.nc")),
     as_json: JsonSummary = False,
 ) -> None:
     """Find a periodic orbit by Newton shooting on the φ-maximum section, with its Floquet multipliers.
 
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
-    start = parse_start(ic)
+    start = parse_start(search.ic)
     # the command line's checks: the library refuses the monodromy and the multiplicity only after the
     # start run, calls --search-time t_end, and leaves --tol unbounded
-    check_positive({"--search-time": search_time, "--tol": tol})
+    check_positive({"--search-time": search.search_time, "--tol": tol})
     check_below_one({"--tol": tol})
     check_choice("--monodromy", monodromy, MONODROMY_METHODS)
     if period_multiplicity < 1:
         raise CLIError(f"--period-multiplicity must be >= 1, got {period_multiplicity}")
-    system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
-    sec = resolve_section(parse_section(section), system)
-    inputs = {"--config": config}
-    check_outputs(out, not no_plot, overwrite, inputs=inputs)
+    system = model_system(model, changes, slip_band, **point.named())
+    sec = resolve_section(parse_section(search.section), system)
+    out, inputs = outputs.out, changes.inputs
+    check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     t0, compiling0 = time.perf_counter(), compile_seconds()
-    run = start_run(system, start, t_end=search_time, rtol=rtol)
+    run = start_run(system, start, t_end=search.search_time, rtol=rtol)
     orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
                            monodromy=monodromy)
     compiling = compile_seconds() - compiling0
     wall = time.perf_counter() - t0 - compiling
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
-    _write(ds_of=orbit.to_xarray, out=out, holds=f"the orbit is in {out}", overwrite=overwrite, inputs=inputs)
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_orbit_figure(orbit, one_period, tmp),
-                              overwrite=overwrite, inputs=inputs)
+    figure = write_result(outputs, lambda: netcdf_writer(orbit.to_xarray()), holds=f"the orbit is in {out}",
+                          inputs=inputs, draw=lambda tmp: save_orbit_figure(orbit, one_period, tmp))
     others = np.abs(orbit.nontrivial_multipliers)
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": orbit.model,
@@ -162,9 +144,9 @@ def orbit_command(
 
 
 @app.command("lyapunov")
+@grouped
 def lyapunov_command(
-    N: NormalLoad = None,
-    omega: Omega = None,
+    point: OperatingPoint = OperatingPoint(),
     model: Model = "full",
     ic: StartIc = None,
     t_transient: float = typer.Option(50.0, "--t-transient", help="Transient simulated and discarded first [s]."),
@@ -173,11 +155,8 @@ def lyapunov_command(
                                "finite-difference (perturbed trajectories; works where the variational one refuses)."),
     rtol: OrbitRtol = 1e-10,
     slip_band: SlipBand = None,
-    set_: SetItems = None,
-    config: Config = None,
-    out: Out = Path("lyapunov.nc"),
-    overwrite: Overwrite = False,
-    no_plot: NoPlot = False,
+    changes: ModelChanges = ModelChanges(),
+    outputs: Outputs = Outputs(out=Path("lyapunov.nc")),
     as_json: bool = typer.Option(False, "--json", help="Print a one-line JSON summary (exponents largest first)."),
 ) -> None:
     """Lyapunov spectrum (Benettin–Shimada–Nagashima) of the attractor reached from --ic.
@@ -189,21 +168,17 @@ def lyapunov_command(
     # non-finite time in other words (t_end - t0 of a run, a memory estimate)
     check_positive({"--t-transient": t_transient, "--t-average": t_average})
     check_choice("--method", method, _LYAPUNOV_METHODS)
-    system = model_system(model, config, set_, slip_band, N=N, Omega=omega)
-    inputs = {"--config": config}
-    check_outputs(out, not no_plot, overwrite, inputs=inputs)
+    system = model_system(model, changes, slip_band, **point.named())
+    out, inputs = outputs.out, changes.inputs
+    check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     start = default_start(system) if start is None else start
     compiling0 = compile_seconds()
     spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
                                  method=method)
     compiling = compile_seconds() - compiling0
     wall = float(spectrum.wall_time) - compiling
-    _write(ds_of=spectrum.to_xarray, out=out, holds=f"the spectrum is in {out}", overwrite=overwrite, inputs=inputs)
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_lyapunov_spectrum_figure(spectrum, tmp),
-                              overwrite=overwrite, inputs=inputs)
+    figure = write_result(outputs, lambda: netcdf_writer(spectrum.to_xarray()), holds=f"the spectrum is in {out}",
+                          inputs=inputs, draw=lambda tmp: save_lyapunov_spectrum_figure(spectrum, tmp))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,

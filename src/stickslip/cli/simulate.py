@@ -31,9 +31,10 @@ from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
 from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, given,
                    note_line, warning_line)
-from ._kept import keeps, keeps_figure, on_interrupt
-from ._options import (Alpha, Atol, Config, DeltaMu, Model, MuK, NoPlot, NormalLoad, Omega, Overwrite, Rtol, SampleRate,
-                       SetItems)
+from ._groups import grouped
+from ._kept import keeps, on_interrupt
+from ._options import Model, ModelChanges, NoPlot, Overwrite, Plates, SampleRate, Tolerances
+from ._outputs import draw_figure
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
@@ -169,13 +170,10 @@ def _model_label(system) -> str:
 
 
 @app.command()
+@grouped
 def simulate(
     ctx: typer.Context,
-    N: NormalLoad = None,
-    omega: Omega = None,
-    mu_k: MuK = None,
-    delta_mu: DeltaMu = None,
-    alpha: Alpha = None,
+    plates: Plates = Plates(),
     model: Model = "full",
     t_end: str = typer.Option("100", "--t-end", help="Simulated time [s], or 'auto': extend the run until it has "
                               "settled, up to --cap (the steady window is then the last 100 s). With --ic RUN.nc, "
@@ -183,8 +181,7 @@ def simulate(
     cap: float = typer.Option(2000.0, "--cap", help="With --t-end auto: the longest run [s]."),
     method: str = typer.Option("event", "--method", help="Integration method: event | aeom | naeom."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Fixed step (fixed-step methods) or largest step (event) [s]."),
-    rtol: Rtol = 1e-8,
-    atol: Atol = 1e-10,
+    tolerances: Tolerances = Tolerances(),
     ic: str = typer.Option("zero", "--ic", help="zero | equilibrium (steady sliding) | NAME=VALUE,... by state name "
                            "(e.g. x=1,dx=1; the others 0) | one number per state, comma-separated | RUN.nc: continue "
                            "that run from its end, with its model, parameters and settings unless given here."),
@@ -193,8 +190,7 @@ def simulate(
     sample_rate: SampleRate = 1000.0,
     steady_from: Optional[float] = typer.Option(None, "--steady-from", help="Start of the steady-state window, in the "
                                                 "run's time [s] (default: the last half of the run)."),
-    set_: SetItems = None,
-    config: Config = None,
+    changes: ModelChanges = ModelChanges(),
     out: Optional[Path] = typer.Option(None, "--out", help="NetCDF output (default run.nc; with --json, nothing is "
                                        "written unless --out is given); the figure goes beside it as .png."),
     overwrite: Overwrite = False,
@@ -203,13 +199,13 @@ def simulate(
 ) -> None:
     """Simulate a model with exact stick-slip (default: the two plates, Table 1, N = 50 N, Ω = 5 rad/s, 100 s)."""
     start = _parse_ic(ic)
-    settings = dict(model=model, method=method, rtol=rtol, atol=atol, dt=dt, sample_rate=sample_rate)
+    settings = dict(model=model, method=method, rtol=tolerances.rtol, atol=tolerances.atol, dt=dt,
+                    sample_rate=sample_rate)
     run_file = Path(start) if isinstance(start, str) and start.endswith(".nc") else None
     base, t0, overridden = None, 0.0, []
     if run_file is not None:
         base, t0, settings, overridden = _continuation(ctx, start, settings)
-    system, set_by = build_system(settings.pop("model"), config, set_, base=base, N=N, Omega=omega, mu_k=mu_k,
-                                  delta_mu=delta_mu, alpha=alpha)
+    system, set_by = build_system(settings.pop("model"), changes.config, changes.set_, base=base, **plates.named())
     if "slip_band" in settings:
         system = system.with_slip_band(settings.pop("slip_band"))
     duration = _parse_t_end(t_end, steady_from)
@@ -221,7 +217,7 @@ def simulate(
     _check_steps(longest, settings["dt"], time_flag)
     write = out is not None or not as_json
     out = Path("run.nc") if out is None else out
-    inputs = {"--ic": run_file, "--config": config}
+    inputs = {"--ic": run_file, **changes.inputs}
     if write:
         check_outputs(out, not no_plot, overwrite, inputs=inputs)
     if run_file is not None:
@@ -251,11 +247,8 @@ def simulate(
         on_interrupt(f"the run stopped at t = {traj.t[-1]:g} s with too few samples to write; nothing was written"
                      if write else "nothing was written (--json without --out)")
     stop_if_interrupted()  # a Ctrl-C during the run (its part is written) or as it finished
-    figure = None
-    if keep and not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_trajectory_figure(traj, tmp),
-                              overwrite=overwrite, inputs=inputs)
+    figure = draw_figure(out, lambda tmp: save_trajectory_figure(traj, tmp), skip=not keep or no_plot,
+                         overwrite=overwrite, inputs=inputs)
     if traj.status != "success":
         error_line(f"the run stopped early: {traj.status}; " + (f"what it computed is in {out}" if keep else
                    "it kept too few samples to write" if write else "nothing was written (--json without --out)"))

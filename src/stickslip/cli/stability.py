@@ -14,35 +14,30 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..integrate.interrupt import finish_first
+from ..files import netcdf_writer
 from ..memory import check_memory, largest_count
 from ..plot.stability import save_stability_map_figure
 from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
-from ..files import netcdf_writer, write_output
 from ._app import CLIError, app, build_system, check_finite, check_outputs, console
 from ._compiling import compile_seconds
-from ._kept import keeps, keeps_figure
-from ._options import (Alpha, Config, DeltaMu, JsonSummary, MapModel, Model, MuK, NoPlot, NormalLoad, Omega, Out,
-                       Overwrite, SetItems)
+from ._groups import grouped
+from ._options import Friction, JsonSummary, MapModel, Model, ModelChanges, Outputs, Plates
+from ._outputs import write_result
 from .sweep import _VALUE_BYTES, parse_values
 
 
 @app.command()
+@grouped
 def stability(
-    N: NormalLoad = None,
-    omega: Omega = None,
-    mu_k: MuK = None,
-    delta_mu: DeltaMu = None,
-    alpha: Alpha = None,
+    plates: Plates = Plates(),
     model: Model = "full",
-    set_: SetItems = None,
-    config: Config = None,
+    changes: ModelChanges = ModelChanges(),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
     """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
-    system, _ = build_system(model, config, set_, N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    system, _ = build_system(model, changes.config, changes.set_, **plates.named())
     compiling0 = compile_seconds()
     result = run_stability(system)
     if as_json:
@@ -87,6 +82,7 @@ def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
 
 
 @app.command("stability-map")
+@grouped
 def stability_map(
     n_min: float = typer.Option(2.0, "--N-min", help="Smallest normal load [N]."),
     n_max: float = typer.Option(200.0, "--N-max", help="Largest normal load [N]."),
@@ -100,16 +96,11 @@ def stability_map(
                                              "Default for the plates: N and Ω from the options above."),
     family: Optional[str] = typer.Option(None, "--family", help="Third parameter and its values, e.g. delta_mu=0.1,0.2,0.3, "
                                          "model=full,rotation or contact.0.friction.alpha=1.5,2."),
-    mu_k: MuK = None,
-    delta_mu: DeltaMu = None,
-    alpha: Alpha = None,
+    friction: Friction = Friction(),
     model: MapModel = "full",
-    set_: SetItems = None,
-    config: Config = None,
+    changes: ModelChanges = ModelChanges(),
     no_boundary: bool = typer.Option(False, "--no-boundary", help="Skip the root-finding of the boundary along the second axis."),
-    out: Out = Path("stability_map.nc"),
-    overwrite: Overwrite = False,
-    no_plot: NoPlot = False,
+    outputs: Outputs = Outputs(out=Path("stability_map.nc")),
     as_json: JsonSummary = False,
 ) -> None:
     """Stable/unstable regions of steady sliding over two parameters of any model, with the boundary by
@@ -125,21 +116,15 @@ def stability_map(
              {"N": "--N-min/--N-max", "Omega": "--omega-min/--omega-max"})
     if members is not None and members[0] != "model":
         swept[members[0]] = f"--family {members[0]}"
-    system, _ = build_system(model, config, set_, swept=swept, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    system, _ = build_system(model, changes.config, changes.set_, swept=swept, **friction.named())
     if axis is None and system.name != "two-plates":
         raise CLIError(f"model {system.name!r} has no N and Ω: give its two axes, e.g. "
                        "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
-    inputs = {"--config": config}
-    check_outputs(out, not no_plot, overwrite, inputs=inputs)
+    out, inputs = outputs.out, changes.inputs
+    check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
-    keeps(out, f"the map is in {out}")
-    with finish_first():  # a Ctrl-C now lets the map be written, then stops
-        write_output(out, netcdf_writer(smap.to_xarray()), overwrite=overwrite, inputs=inputs)
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_stability_map_figure(smap, tmp),
-                              overwrite=overwrite, inputs=inputs)
+    figure = write_result(outputs, lambda: netcdf_writer(smap.to_xarray()), holds=f"the map is in {out}",
+                          inputs=inputs, draw=lambda tmp: save_stability_map_figure(smap, tmp))
     rows = []
     for f, label in enumerate(smap.family_labels):
         mrp = smap.max_real_part[f]

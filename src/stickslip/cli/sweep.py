@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import List, Optional
+from typing import Callable, List, Optional
 
 import numpy as np
 import typer
@@ -27,13 +27,14 @@ from ..sweep import regions as run_regions
 from ..sweep import sweep as run_sweep
 from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import columns_of
-from ..files import write_output
 from ._app import (CLIError, app, build_system, check_positive, check_resumable_output, config_values, console,
-                   executor_of, parse_assignments, resumable_holds)
-from ._kept import keeps, keeps_figure
-from ._options import (Alpha, Atol, BifurcationModel, BifurcationOmega, Cap, Config, DeltaMu, Executor, GridTEnd,
-                       JsonSummary, MuK, NoPlot, NoProgress, RegionsTEnd, RegionsTFrom, Restart, ResumableOut, Rtol,
-                       SampleRate, Scheduler, SetItems, Settle, SweepModel, TFrom, VariedLoad, Workers)
+                   parse_assignments, resumable_holds)
+from ._groups import grouped
+from ._kept import keeps
+from ._options import (BifurcationModel, BifurcationPlates, Friction, GridTEnd, JsonSummary, ModelChanges, NoPlot,
+                       NoProgress, Parallel, RegionsTEnd, RegionsTFrom, Restart, ResumableOut, SampleRate, Settling,
+                       Study, SweepModel, TFrom, Tolerances)
+from ._outputs import draw_figure
 
 _CATEGORICAL = ("model", "ic")
 
@@ -106,14 +107,14 @@ def parse_grid(items: list[str] | None) -> dict:
     return grid
 
 
-def _settle_options(settle: bool, cap: float | None) -> dict:
+def _settle_options(settling: Settling) -> dict:
     """``settle`` and ``cap`` of the sweep spec from ``--settle`` / ``--cap`` (the sweep refuses a
     cap that is not a finite number ≥ ``t_end`` itself)."""
-    if cap is None:
-        return {"settle": True} if settle else {}
-    if not settle:
+    if settling.cap is None:
+        return {"settle": True} if settling.settle else {}
+    if not settling.settle:
         raise CLIError("--cap is the longest run when settling; give --settle with it")
-    return {"settle": True, "cap": cap}
+    return {"settle": True, "cap": settling.cap}
 
 
 def _sweep_target(system) -> tuple:
@@ -130,15 +131,48 @@ def _plot_columns(system) -> tuple[str, ...]:
     return tuple(c[0] for c in columns_of(system))
 
 
-def _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol) -> dict:
+def _run_options(study: Study, t_end: float, t_from: float | None, sample_rate: float, tolerances: Tolerances) -> dict:
     """The run options of the sweep library from the command line.
 
     The run's length, rate and tolerances are checked here: the sweep does not refuse a tolerance
     (each of its runs would fail) and names neither the length nor the rate it refuses. It refuses
     ``--t-from``, ``--workers`` and ``--cap`` itself, naming their values."""
+    rtol, atol = tolerances.rtol, tolerances.atol
     check_positive({"--t-end": t_end, "--sample-rate": sample_rate, "--rtol": rtol, "--atol": atol})
-    return dict(executor=executor_of(executor, scheduler), workers=workers, address=scheduler, progress=not no_progress,
-                overwrite=overwrite, t_end=t_end, t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
+    return dict(study.parallel.options(), progress=not study.no_progress, overwrite=study.overwrite, t_end=t_end,
+                t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
+
+
+def _study(study: Study, what: str, inputs: dict, compute: Callable[[], object],
+           draw: Callable[[object, Path], object]) -> tuple:
+    """Run a resumable study into ``study.out`` and draw its figure beside it.
+
+    Parameters
+    ----------
+    study : Study
+        Its outputs (checked first, before anything is computed).
+    what : str
+        What the output holds, for the line of a Ctrl-C (``"sweep"``).
+    inputs : dict of option → Path
+        Files the command reads; no output may replace them.
+    compute : callable
+        ``compute()``: the study's result (it resumes from the journal beside ``study.out``).
+    draw : callable
+        ``draw(result, tmp)`` saves the figure to ``tmp`` (not called with ``--no-plot``).
+
+    Returns
+    -------
+    result
+        What ``compute`` returned.
+    figure : Path or None
+        The figure written.
+    """
+    replace_figure = check_resumable_output(study.out, not study.no_plot, study.overwrite, inputs)
+    keeps(study.out, resumable_holds(what))
+    result = compute()
+    figure = draw_figure(study.out, lambda tmp: draw(result, tmp), skip=study.no_plot, overwrite=replace_figure,
+                         inputs=inputs)
+    return result, figure
 
 
 def _kind_counts(ds) -> dict:
@@ -173,6 +207,7 @@ def _report(title: str, out: Path, figure, timings: dict, ds, as_json: bool, ext
 
 # ----------------------------------------------------------------------------- stickslip sweep
 @app.command("sweep")
+@grouped
 def sweep_command(
     grid: Optional[List[str]] = typer.Option(None, "--grid", help="Swept dimension NAME=start:stop:count or NAME=v1,v2,... "
                                              "(repeatable; order = dimension order). NAME: a parameter (plates: N, "
@@ -183,15 +218,10 @@ def sweep_command(
     t_end: GridTEnd = 200.0,
     t_from: TFrom = None,
     sample_rate: SampleRate = 200.0,
-    rtol: Rtol = 1e-8,
-    atol: Atol = 1e-10,
-    settle: Settle = False,
-    cap: Cap = None,
-    set_: SetItems = None,
-    config: Config = None,
-    executor: Executor = None,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
+    tolerances: Tolerances = Tolerances(),
+    settling: Settling = Settling(),
+    changes: ModelChanges = ModelChanges(),
+    parallel: Parallel = Parallel(),
     out: ResumableOut = Path("sweep.nc"),
     plot_var: str = typer.Option("frequency", "--plot", help="Reduction drawn in the figure: frequency, amplitude, "
                                                             "stick_fraction, kind, intensity_r_phi, ..."),
@@ -206,56 +236,40 @@ def sweep_command(
     frequency, stick fraction, intensity (Eq. 16), relative-motion angle.
     """
     values = parse_grid(grid)
-    system, _ = build_system(model, config, set_, swept={k: f"--grid {k}" for k in values})
+    system, _ = build_system(model, changes.config, changes.set_, swept={k: f"--grid {k}" for k in values})
     target, variant = _sweep_target(system)
     columns = _plot_columns(system)
     if plot_var not in columns or plot_var == "peaks":
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in columns if c != 'peaks')}")
-    options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-    options.update(_settle_options(settle, cap))
-    inputs = {"--config": config}
-    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
-    keeps(out, resumable_holds("sweep"))
-    result = run_sweep(values, target, out=out, model=variant, ic=ic, **options)
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_sweep_figure(result, tmp, var=plot_var),
-                              overwrite=replace_figure, inputs=inputs)
+    # the options of a Study, taken one by one because --plot stands among them
+    study = Study(parallel=parallel, out=out, overwrite=overwrite, no_plot=no_plot, no_progress=no_progress)
+    options = _run_options(study, t_end, t_from, sample_rate, tolerances)
+    options.update(_settle_options(settling))
+    result, figure = _study(study, "sweep", changes.inputs,
+                            lambda: run_sweep(values, target, out=out, model=variant, ic=ic, **options),
+                            lambda result, tmp: save_sweep_figure(result, tmp, var=plot_var))
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
             result.dataset, as_json)
 
 
 # ----------------------------------------------------------------------------- stickslip bifurcation
 @app.command("bifurcation")
+@grouped
 def bifurcation(
     param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter "
                                                   "of the plates; for another model a path such as contact.0.drive."),
     range_: str = typer.Option("10:130:121", "--range", help="Its values: start:stop:count or v1,v2,..."),
-    N: VariedLoad = None,
-    omega: BifurcationOmega = None,
-    mu_k: MuK = None,
-    delta_mu: DeltaMu = None,
-    alpha: Alpha = None,
+    plates: BifurcationPlates = BifurcationPlates(),
     model: BifurcationModel = "full",
     ic: str = typer.Option("zero", "--ic", help="zero | far | near | equilibrium."),
     t_end: GridTEnd = 200.0,
     t_from: TFrom = None,
     n_peaks: int = typer.Option(64, "--peaks", help="Last peak values of φ kept per point."),
     sample_rate: SampleRate = 200.0,
-    rtol: Rtol = 1e-8,
-    atol: Atol = 1e-10,
-    settle: Settle = False,
-    cap: Cap = None,
-    set_: SetItems = None,
-    config: Config = None,
-    executor: Executor = None,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    out: ResumableOut = Path("bifurcation.nc"),
-    overwrite: Restart = False,
-    no_plot: NoPlot = False,
-    no_progress: NoProgress = False,
+    tolerances: Tolerances = Tolerances(),
+    settling: Settling = Settling(),
+    changes: ModelChanges = ModelChanges(),
+    study: Study = Study(out=Path("bifurcation.nc")),
     as_json: JsonSummary = False,
 ) -> None:
     """Bifurcation diagram of φ: steady-state peak values against one parameter (Figs. 12–14)."""
@@ -263,33 +277,29 @@ def bifurcation(
         raise CLIError(f"--param {param}: the control parameter must be numeric; use --model full,x,y,rotation "
                        "for one panel per model")
 
-    named = dict(N=N, Omega=omega, mu_k=mu_k, delta_mu=delta_mu, alpha=alpha)
+    named = plates.named()
     values = parse_values(param, range_, option="--range")
     models = parse_values("model", model, option="--model") if "," in model else [model]
     coordinate = "φ"
     if plates_variant(models[0]) is None:  # a library model or a model file
         if len(models) > 1:
             raise CLIError(f"--model {model}: a list of models is for the plates' variants; give one model")
-        target, _ = build_system(models[0], config, set_, swept={param: f"--param {param}"}, **named)
+        target, _ = build_system(models[0], changes.config, changes.set_, swept={param: f"--param {param}"}, **named)
         coordinate = target.dofs[target.observed_index]
         models = [None]
     else:
-        target = _bifurcation_parameters(config, set_, named, param)
+        target = _bifurcation_parameters(changes.config, changes.set_, named, param)
     grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
-    options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-    options.update(_settle_options(settle, cap))
-    inputs = {"--config": config}
-    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
-    keeps(out, resumable_holds("bifurcation diagram"))
-    result = run_sweep(grid, target, out=out, model=models[0], ic=ic, n_peaks=n_peaks, **options)
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_bifurcation_figure(result, tmp),
-                              overwrite=replace_figure, inputs=inputs)
-    _report(f"bifurcation diagram of {coordinate} against {param}", out, figure, result.timings, result.dataset, as_json)
+    options = _run_options(study, t_end, t_from, sample_rate, tolerances)
+    options.update(_settle_options(settling))
+    result, figure = _study(study, "bifurcation diagram", changes.inputs,
+                            lambda: run_sweep(grid, target, out=study.out, model=models[0], ic=ic, n_peaks=n_peaks,
+                                              **options),
+                            save_bifurcation_figure)
+    _report(f"bifurcation diagram of {coordinate} against {param}", study.out, figure, result.timings, result.dataset,
+            as_json)
 
 
 #: Base values of the paper's bifurcation diagrams (Figs. 12–14): N = 50 N and Ω = 0.5 rad/s
@@ -316,53 +326,38 @@ def _bifurcation_parameters(config, assignments, named: dict, param: str):
 REGIONS_WINDOW_S = 100.0
 
 @app.command("regions")
+@grouped
 def regions_command(
     N: str = typer.Option("10:130:13", "--N", help="Normal loads [N]: start:stop:count or v1,v2,..."),
     omega: str = typer.Option("1:15:15", "--omega", help="Ω values [rad/s]: start:stop:count or v1,v2,..."),
     model: str = typer.Option("full", "--model", help="Comma list of full, x, y, rotation (Fig. 9 compares all four)."),
-    mu_k: MuK = None,
-    delta_mu: DeltaMu = None,
-    alpha: Alpha = None,
+    friction: Friction = Friction(),
     # 300 s: the 'near' start leaves a weakly unstable equilibrium slowly (growth rate
     # 0.05 1/s at N = 50 N, Ω = 5 rad/s: ~150 s until stick-slip), see docs/sweeps.md
     t_end: RegionsTEnd = 300.0,
     t_from: RegionsTFrom = None,
     sample_rate: SampleRate = 200.0,
-    rtol: Rtol = 1e-8,
-    atol: Atol = 1e-10,
-    set_: SetItems = None,
-    config: Config = None,
-    executor: Executor = None,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    out: ResumableOut = Path("regions.nc"),
-    overwrite: Restart = False,
-    no_plot: NoPlot = False,
-    no_progress: NoProgress = False,
+    tolerances: Tolerances = Tolerances(),
+    changes: ModelChanges = ModelChanges(),
+    study: Study = Study(out=Path("regions.nc")),
     as_json: JsonSummary = False,
 ) -> None:
     """Regions I/II/III over (N, Ω) (Fig. 8) and stick-slip domains of several models (Fig. 9).
 
     Every (model, N, Ω) is run from the 'far' and the 'near' initial condition (docs/sweeps.md).
     """
-    system, _ = build_system("full", config, set_, swept={"N": "--N", "Omega": "--omega"}, mu_k=mu_k,
-                             delta_mu=delta_mu, alpha=alpha)
+    system, _ = build_system("full", changes.config, changes.set_, swept={"N": "--N", "Omega": "--omega"},
+                             **friction.named())
     params = plates_parameters(system)
     n_values = parse_values("N", N, option="--N")
     w_values = parse_values("Omega", omega, option="--omega")
     models = parse_values("model", model, option="--model")
     if t_from is None and math.isfinite(t_end):
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
-    options = _run_options(executor, workers, scheduler, no_progress, overwrite, t_end, t_from, sample_rate, rtol, atol)
-    inputs = {"--config": config}
-    replace_figure = check_resumable_output(out, not no_plot, overwrite, inputs)
-    keeps(out, resumable_holds("region map"))
-    rmap = run_regions(n_values, w_values, params, models=models, out=out, **options)
-    figure = None
-    if not no_plot:
-        keeps_figure(out)
-        figure = write_output(out.with_suffix(".png"), lambda tmp: save_regions_figure(rmap, tmp),
-                              overwrite=replace_figure, inputs=inputs)
+    options = _run_options(study, t_end, t_from, sample_rate, tolerances)
+    rmap, figure = _study(study, "region map", changes.inputs,
+                          lambda: run_regions(n_values, w_values, params, models=models, out=study.out, **options),
+                          save_regions_figure)
 
     region = rmap.region
     counts = {REGION_NAMES[c]: int(np.sum(region == c)) for c in sorted(REGION_NAMES) if np.any(region == c)}
@@ -371,4 +366,4 @@ def regions_command(
     extra = {"regions": ", ".join(f"{k}: {v}" for k, v in counts.items())}
     if as_json:
         extra = {"regions": counts, "stick_slip_omega_max": edges}
-    _report("regions of steady states over (N, Ω)", out, figure, rmap.timings, rmap.dataset, as_json, extra)
+    _report("regions of steady states over (N, Ω)", study.out, figure, rmap.timings, rmap.dataset, as_json, extra)
