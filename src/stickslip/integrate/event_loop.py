@@ -134,6 +134,19 @@ def write_samples(idx, tau_to, y0, Q, h, tau_step, t_base, cst, md, sample_times
 
 
 @kernel
+def cut_step(theta, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F, work, F, N, v):
+    """End the step at θ ∈ (0, 1] of its length ``h`` (an event's root): write the samples up to
+    there and move ``y`` (the step's start) onto it. Returns (idx, local time of the cut)."""
+    tau_cut = tau + theta * h
+    idx = write_samples(idx, tau_cut, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F, work, F, N,
+                        v)
+    E.dense_state(y, Q, h, theta, work)
+    for i in range(y.shape[0]):
+        y[i] = work[i]
+    return idx, tau_cut
+
+
+@kernel
 def record_transition(n_tr, t, kind, contact, y, tr_t, tr_kind, tr_contact, tr_s):
     """Write transition ``n_tr`` (time [s], kind, contact, state) into the buffers if they have
     room; the caller counts on and runs again with room for all (buffers that grew inside the
@@ -320,12 +333,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
                     theta_lost = th
                     lost = c
         if theta_lost > 0.0:
-            idx = write_samples(idx, tau + theta_lost * h, y, Q, h, tau, t_base, cst, md, sample_times, out_s,
-                                out_mode, out_F, work, F, N, vv)
-            E.dense_state(y, Q, h, theta_lost, work)
-            for i in range(ns):
-                y[i] = work[i]
-            tau += theta_lost * h
+            idx, tau = cut_step(theta_lost, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
+                                work, F, N, vv)
             stats[0] += 1
             status = CONTACT_LOST
             break
@@ -417,13 +426,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
                         c_b = c
         if theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b):
             # a unilateral contact opens or closes inside the step: cut the step at the root
-            tau_root = tau + theta_g * h
-            idx = write_samples(idx, tau_root, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode,
-                                out_F, work, F, N, vv)
-            E.dense_state(y, Q, h, theta_g, work)
-            for i in range(ns):
-                y[i] = work[i]
-            tau = tau_root
+            idx, tau = cut_step(theta_g, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
+                                work, F, N, vv)
             n_tr = switch_gap(y, cst, c_g, md, rtol, atol, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr,
                               stats)
             stats[0] += 1
@@ -434,14 +438,9 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             homing_any = False
         elif theta_b > 0.0:
             # breakaway inside the step: the flow is smooth up to it, so cut the step at the root
-            tau_root = tau + theta_b * h
-            idx = write_samples(idx, tau_root, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode,
-                                out_F, work, F, N, vv)
-            E.dense_state(y, Q, h, theta_b, work)
-            for i in range(ns):
-                y[i] = work[i]
+            idx, tau = cut_step(theta_b, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
+                                work, F, N, vv)
             P.project_velocities(y, cst, np.int64(-1), md)
-            tau = tau_root
             P.stick_forces(y, cst, np.int64(-1), md, F, N)
             ex, ey = E.breakaway_direction(F[2 * c_b], F[2 * c_b + 1], P.contact_dim(md.kin, m, n, c_b))
             cst[CST * c_b] = P.MODE_SLIP_QUASI_STATIC
