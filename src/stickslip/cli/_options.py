@@ -24,11 +24,12 @@ from typing import Annotated, List, Optional
 
 import typer
 
+from ..model.library import library_names
 from ._app import executor_of
 
 # ----------------------------------------------------------------------------- the model
 #: Help text of ``--model`` for commands that take any model.
-MODEL_HELP = ("The model: a library name (two-plates, belt, hoffmann, popp-stelter; see 'stickslip models'), a model "
+MODEL_HELP = (f"The model: a library name ({', '.join(library_names())}; see 'stickslip models'), a model "
               "file (.toml), or a variant of the two plates: full | x | y | rotation (paper Models 1–4) or DOFs, "
               "e.g. phi,psi.")
 

@@ -25,10 +25,15 @@ from ..variants import MODELS
 from .two_plates import NAME as TWO_PLATES
 from .two_plates import two_plates
 
-__all__ = ["load_model", "library", "two_plates", "TWO_PLATES", "describe_system", "system_from_description",
+__all__ = ["load_model", "library", "library_names", "two_plates", "TWO_PLATES", "describe_system", "system_from_description",
            "resolve_system", "plates_variant"]
 
 HERE = Path(__file__).resolve().parent
+
+
+def library_names() -> list[str]:
+    """Library model names, the default first (without reading the files)."""
+    return [TWO_PLATES] + [path.stem.replace("_", "-") for path in sorted(HERE.glob("*.toml"))]
 
 
 def library() -> dict[str, str]:
