@@ -127,13 +127,18 @@ def _print_summary(result, out: Path, figure) -> None:
                                           for i in range(len(result.names))))
     else:
         table = Table(title=f"basin stability of {ds.attrs['model']}: {result.n} states")
-        for col in ("attractor", "fraction ± se", "period", "amplitude", "stick fraction"):
+        opens = "open_fraction" in ds  # a model with contacts that open
+        for col in ("attractor", "fraction ± se", "period", "amplitude", "stick fraction") + (("open fraction",) if opens
+                                                                                             else ()):
             table.add_column(col)
+
+        def cell(value, form):
+            return "–" if value is None else format(value, form)
+
         for a in result.attractors():
-            table.add_row(a["name"], f"{a['fraction']:.4f} ± {a['standard_error']:.4f}",
-                          "–" if a["period"] is None else f"{a['period']:.6g}",
-                          "–" if a["amplitude"] is None else f"{a['amplitude']:.4g}",
-                          "–" if a["stick_fraction"] is None else f"{a['stick_fraction']:.3f}")
+            table.add_row(a["name"], f"{a['fraction']:.4f} ± {a['standard_error']:.4f}", cell(a["period"], ".6g"),
+                          cell(a["amplitude"], ".4g"), cell(a["stick_fraction"], ".3f"),
+                          *((cell(a["open_fraction"], ".3f"),) if opens else ()))
     console.print(table)
     computed = timings.get("states_computed", 0)
     console.print(f"states computed / resumed: {computed} / {timings.get('states_resumed', 0)}; "
