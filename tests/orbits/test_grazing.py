@@ -31,6 +31,12 @@ DRIVE = "contact.0.drive"
 #: bracket the bisection leaves, 6e-6 measured).
 SIDE = 1e-3
 
+#: Largest gap of a flight the event integrator (rtol 1e-10) may step over without recording an
+#: opening: the count, hence the located λ*, changes only once the flight is resolved. Measured on
+#: orbits shot 1e-7 … 4e-5 above the scaling prediction of λ*: largest gap 1.3e-5 (a ~9 ms flight)
+#: not recorded, 2.5e-5 (12 ms) recorded; i.e. up to 4e-6 in belt speed past the zero of the gap.
+MISSED_GAP = 2.5e-5
+
 
 def _hoffmann(drive: float):
     return load_model("hoffmann").replace(**{"contact.0.friction.mu_k": 1.3, "damping.0.0": 0.1,
@@ -85,7 +91,9 @@ def test_grazing_is_found_again_from_above_and_stops_when_asked(up):
     down = _branch(0.12, 0.1)
     g_down = _grazing(down)
     assert (g_down.before, g_down.after) == (1, 0)
-    assert abs(g_down.value - g.value) <= 2.0 * (g.bracket + g_down.bracket)  # 7e-6 apart, brackets 6e-6
+    slope = 6.3  # d g_max / d λ [gap per unit of belt speed], measured on either side of λ*
+    # measured 7.5e-6 apart, brackets 5.8e-6 and 4.5e-6
+    assert abs(g_down.value - g.value) <= g.bracket + g_down.bracket + MISSED_GAP / slope
     stopped = _branch(0.1, 0.13, stop_on=("grazing",))
     assert stopped.stop_reason == "stop_on grazing" and stopped.values[-1] < 0.12
 
@@ -103,8 +111,9 @@ def test_open_time_grows_like_the_square_root_of_the_distance_from_grazing(up):
 def test_orbits_shot_on_either_side_of_grazing_differ_in_their_flight(up):
     """Independent of the continuation: Newton shooting at λ*(1 ∓ 10⁻³) from the grazing state.
     Below, the contact stays closed (g < 0 all period); above, it opens once (g > 0 at its
-    peak); at λ* the largest gap is zero to within what the bracket allows, |dg_max/dλ| · bracket
-    (measured: g_max = 1.4e-7 at λ*, ±7.0e-4 at the sides, so 6.4 per unit of λ; bound 3.7e-5)."""
+    peak); at λ* the largest gap is zero to within what the location allows: the bracket,
+    |dg_max/dλ| · bracket, plus the flights too short to be recorded (:data:`MISSED_GAP`)
+    (measured: g_max = 1.4e-7 at λ*, ∓7.0e-4 at the sides, so 6.4 per unit of λ; bound 6.2e-5)."""
     g = _grazing(up)
     below, _, s_below = _largest_gap(g.value * (1.0 - SIDE), g.state)
     above, _, s_above = _largest_gap(g.value * (1.0 + SIDE), g.state)
@@ -114,7 +123,7 @@ def test_orbits_shot_on_either_side_of_grazing_differ_in_their_flight(up):
     assert s_below["open_fraction"] == 0.0 and s_above["open_fraction"] > 0.0
     assert s_above["contacts"]["belt"]["open_phases"] == 1 and s_above["contacts"]["belt"]["stick_phases"] == 1
     slope = (above - below) / (2.0 * SIDE * g.value)
-    assert abs(at) <= slope * g.bracket and abs(at) < 1e-4 * ptp
+    assert abs(at) <= slope * g.bracket + MISSED_GAP and abs(at) < 1e-4 * ptp
 
 
 def test_grazing_is_where_the_scaled_closed_cycle_reaches_zero_gap(up):
@@ -122,14 +131,16 @@ def test_grazing_is_where_the_scaled_closed_cycle_reaches_zero_gap(up):
     linear in each of slip and stick and μ_s = μ_k, so the cycle's deviation from steady sliding
     scales with the belt speed d (the period does not change: 4.539271 s at 0.1 and 0.105). The
     largest gap is then g_max(d) = g_eq + d u, zero at d* = −g_eq d0 / (g_max(d0) − g_eq) from the
-    one orbit at d0 = 0.1 (measured: 0.11016496, 2e-8 from the located λ*; bracket 6e-6)."""
+    one orbit at d0 = 0.1 (measured: 0.11016496, 2e-8 from the located λ*; bracket 6e-6; allowed
+    the bracket and the λ of the shortest recorded flight, :data:`MISSED_GAP` / u, 4e-6)."""
     g = _grazing(up)
     largest, _, summary = _largest_gap(0.1, up.states[0])
     assert summary["open_phases"] == 0
     system = _hoffmann(0.1)
     contact = system.contacts[0]
     g_eq = contact.gap + equilibrium_state(system)[:system.n] @ contact.gap_gradient
-    assert abs(-g_eq * 0.1 / (largest - g_eq) - g.value) <= g.bracket
+    u = (largest - g_eq) / 0.1  # d g_max / d λ
+    assert abs(-g_eq / u - g.value) <= g.bracket + MISSED_GAP / u
 
 
 def test_open_phases_are_written_and_read_back(up, tmp_path):

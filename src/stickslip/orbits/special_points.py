@@ -24,7 +24,10 @@ consecutive points that have multipliers, and classify a change by what crossed 
 ``grazing``           the number of flight phases per period of the unilateral contacts (their
                       openings) changes: the orbit's gap touches zero with zero normal speed and
                       a flight phase appears or vanishes (located by bisection; the branch goes
-                      on through it). Tested only where the model has a unilateral contact.
+                      on through it). Tested only where the model has a unilateral contact. A
+                      flight shorter than the integrator's step is not recorded, so the count
+                      changes a little past the zero of the largest gap (measured on hoffmann at
+                      rtol 1e-10: flights up to ~9 ms, largest gap 1.3e-5, 4e-6 in belt speed).
 ``hopf``              the branch turns where a pure-slip cycle has shrunk onto the equilibrium
                       (distance from it < :data:`HOPF_RATIO` of the start's): the Hopf point of
                       the linearisation (paper Eq. 15, Appendix); the branch ends.
