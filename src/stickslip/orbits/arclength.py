@@ -29,7 +29,8 @@ import numpy as np
 from ..errors import ContinuationError, OrbitError, SteadySlidingError
 from ..model.system_model import FrictionModel
 from .models import parameter_value, with_parameter
-from .problem import DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, sorted_eigenvalues, stick_count, stick_time
+from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, open_count, open_time, sorted_eigenvalues,
+                      stick_count, stick_time)
 
 __all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR",
            "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND"]
@@ -176,7 +177,13 @@ def _correct(problem: Problem, v: np.ndarray, J: np.ndarray, row: np.ndarray, ta
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Point:
-    """One converged orbit of a branch (internal)."""
+    """One converged orbit of a branch (internal).
+
+    ``stick_phases`` and ``stick_time`` [s] count the slip → stick transitions of its period and
+    the time in stick; ``open_phases`` and ``open_time`` [s] the openings of unilateral contacts
+    (flight phases) and the time with some contact open, None for a model without unilateral
+    contacts.
+    """
 
     v: np.ndarray
     J: np.ndarray
@@ -187,6 +194,8 @@ class Point:
     stick_time: float
     residual: float
     iterations: int
+    open_phases: int | None = None
+    open_time: float | None = None
 
     @property
     def fresh(self) -> bool:
@@ -194,12 +203,23 @@ class Point:
         return bool(np.all(np.isfinite(self.multipliers)))
 
 
+def phases(problem: Problem, v: np.ndarray, tr) -> dict:
+    """The stick and flight phases of the period at ``v`` from its run's transitions ``tr``: the
+    :class:`Point` fields ``stick_phases``, ``stick_time`` and, where the model has unilateral
+    contacts, ``open_phases`` and ``open_time``."""
+    out = {"stick_phases": stick_count(tr), "stick_time": stick_time(tr)}
+    if problem.shooting.system.unilateral:
+        s, T, lam = problem.unpack(v)
+        out.update(open_phases=open_count(tr), open_time=open_time(tr, T, problem.system_at(lam), s))
+    return out
+
+
 def _make_point(problem: Problem, v, R, end, tr, iterations, previous_tangent, direction) -> Point:
     """The point at ``v`` with its finite-difference Jacobian, tangent and multipliers."""
     J, M = _jacobian(problem, v, end)
     return Point(v=v, J=J, M=M, tangent=_tangent(J, previous_tangent, direction),
-                  multipliers=sorted_eigenvalues(M), stick_phases=stick_count(tr), stick_time=stick_time(tr),
-                  residual=float(np.max(np.abs(R))), iterations=iterations)
+                  multipliers=sorted_eigenvalues(M), residual=float(np.max(np.abs(R))), iterations=iterations,
+                  **phases(problem, v, tr))
 
 
 def point_at(problem: Problem, v: np.ndarray, iterations: int, previous_tangent=None, direction: float = 1.0) -> Point:
@@ -215,8 +235,8 @@ def step_from(problem: Problem, point: Point, h: float, tol: float, with_jacobia
     if not with_jacobian:  # Broyden-updated Jacobian: tangent, but no multipliers
         n = point.M.shape[0]
         return Point(v=v, J=J, M=np.full((n, n), np.nan), tangent=_tangent(J, point.tangent),
-                      multipliers=np.full(n, np.nan + 0j), stick_phases=stick_count(tr), stick_time=stick_time(tr),
-                      residual=float(np.max(np.abs(R))), iterations=it)
+                      multipliers=np.full(n, np.nan + 0j), residual=float(np.max(np.abs(R))), iterations=it,
+                      **phases(problem, v, tr))
     return _make_point(problem, v, R, end, tr, it, point.tangent, 1.0)
 
 

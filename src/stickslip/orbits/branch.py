@@ -98,6 +98,11 @@ class Branch(ModelResult):
     digest : str
         Digest of everything that determines the branch (start and settings); a run writing to
         the same ``out`` with another digest is refused.
+    open_phases : ndarray (n,) int, or None
+        Openings of the unilateral contacts per period (flight phases; 0: the contacts stay
+        closed); None for a model without unilateral contacts.
+    open_time : ndarray (n,), or None
+        Time with some unilateral contact open per period [s]; None as ``open_phases``.
     """
 
     param: str
@@ -120,6 +125,8 @@ class Branch(ModelResult):
     options: dict
     timings: dict
     digest: str = ""
+    open_phases: np.ndarray | None = None
+    open_time: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.values.size)
@@ -252,7 +259,9 @@ def continue_orbit(
     bounds : (lo, hi), optional
         Interval of λ; the continuation ends on its edge (the last point is corrected at λ = edge).
     stop_on : sequence of str
-        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``.
+        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``;
+        ``grazing`` (a flight phase of a unilateral contact appears or vanishes) is tested only
+        where the model has a unilateral contact.
     locate : bool
         Locate special points (Illinois/bisection); otherwise they are reported at the next point.
     model, section, rtol, atol, slip_band
@@ -304,7 +313,8 @@ def continue_orbit(
         at ``out``).
     stickslip.orbits.branch_store.JournalMismatch
         If ``out`` or its journal was written with another start or other settings (an
-        :class:`~stickslip.orbits.OrbitError`, like ContinuationError).
+        :class:`~stickslip.orbits.OrbitError`, like ContinuationError), or, for a model with
+        unilateral contacts, by an earlier version that did not count their open phases.
     """
     t_start = time.perf_counter()
     _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
@@ -330,6 +340,8 @@ def continue_orbit(
     journal = None
     if out is not None:
         journal, finished = store.open_output(out, "branch", digest, settings, resume, _read_branch)
+        if system.unilateral:
+            _refuse_without_open_phases(out, journal, finished)
         if finished is not None:  # nothing left to compute
             if on_resume is not None:
                 on_resume(len(finished))
@@ -444,6 +456,17 @@ def _check_request(direction, step, min_step, max_step, max_points, jacobian_eve
         raise ContinuationError(f"unknown stop_on kind(s) {', '.join(unknown)}; choose from {', '.join(SPECIAL_KINDS)}")
 
 
+def _refuse_without_open_phases(out, journal, finished) -> None:
+    """Refuse the journal or finished output of an earlier version that did not count the open
+    phases (:func:`.branch_store.refuse_without_open_phases`), releasing the output's lock."""
+    try:
+        store.refuse_without_open_phases(out, None if journal is None else journal.records, finished)
+    except store.JournalMismatch:
+        if journal is not None:
+            journal.close()
+        raise
+
+
 def _first_walk(problem: Problem, begin: Start, direction: int, step: float, measure) -> "_Walk":
     """The walk at its first point: the start orbit with its Jacobian, tangent and amplitude."""
     v0 = problem.pack(begin.state, begin.period, numeric_parameter(begin.system, problem.param))
@@ -513,6 +536,8 @@ def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: s
     mult = np.array([p.multipliers for p in points])
     n_unst = np.array([unstable_count(p.multipliers) if p.fresh else -1 for p in points])
     timings = {"total_s": total_s, "points": len(points), "simulations": problem.counter["simulations"]}
+    opened = {} if points[0].open_phases is None else {
+        "open_phases": np.array([p.open_phases for p in points]), "open_time": np.array([p.open_time for p in points])}
     if resumed is not None:
         timings["points_resumed"] = resumed
     return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
@@ -522,6 +547,6 @@ def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: s
                   residuals=np.array([p.residual for p in points]),
                   iterations=np.array([p.iterations for p in points]), special=list(walk.special),
                   stop_reason=stop_reason, system=begin.system, section=begin.section,
-                  options=options, timings=timings, digest=digest)
+                  options=options, timings=timings, digest=digest, **opened)
 
 

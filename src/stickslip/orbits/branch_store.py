@@ -57,7 +57,7 @@ __all__ = ["Journal", "JournalMismatch", "journal_path", "digest_of", "array_dig
            "decode_array", "write_atomically", "check_output", "open_output", "JOURNAL_FORMAT", "section_spec",
            "section_of", "point_record", "point_fields", "start_record", "start_fields", "start_digest",
            "branch_settings", "branch_dataset", "branch_fields", "fold_curve_dataset", "fold_curve_fields",
-           "plain_row", "write_dataset"]
+           "plain_row", "write_dataset", "refuse_without_open_phases"]
 
 
 class JournalMismatch(OrbitError):
@@ -208,20 +208,45 @@ def section_of(spec) -> Section:
 
 
 def point_record(point) -> dict:
-    """A branch point as a JSON-ready dict (exact floats: a resumed run restarts bit for bit)."""
+    """A branch point as a JSON-ready dict (exact floats: a resumed run restarts bit for bit);
+    ``open_phases`` and ``open_time`` only where the model has unilateral contacts."""
     enc = encode_array
-    return {"v": enc(point.v), "J": enc(point.J), "M": enc(point.M), "tangent": enc(point.tangent),
-            "multipliers": enc(point.multipliers), "stick_phases": int(point.stick_phases),
-            "stick_time": float(point.stick_time), "residual": float(point.residual),
-            "iterations": int(point.iterations)}
+    rec = {"v": enc(point.v), "J": enc(point.J), "M": enc(point.M), "tangent": enc(point.tangent),
+           "multipliers": enc(point.multipliers), "stick_phases": int(point.stick_phases),
+           "stick_time": float(point.stick_time), "residual": float(point.residual),
+           "iterations": int(point.iterations)}
+    if point.open_phases is not None:
+        rec.update(open_phases=int(point.open_phases), open_time=float(point.open_time))
+    return rec
 
 
 def point_fields(rec: dict) -> dict:
     """The fields of the branch point of a :func:`point_record`."""
     dec = decode_array
+    opened = {} if "open_phases" not in rec else dict(open_phases=int(rec["open_phases"]),
+                                                      open_time=float(rec["open_time"]))
     return dict(v=dec(rec["v"]), J=dec(rec["J"]), M=dec(rec["M"]), tangent=dec(rec["tangent"]),
                 multipliers=dec(rec["multipliers"]).astype(complex), stick_phases=int(rec["stick_phases"]),
-                stick_time=float(rec["stick_time"]), residual=float(rec["residual"]), iterations=int(rec["iterations"]))
+                stick_time=float(rec["stick_time"]), residual=float(rec["residual"]), iterations=int(rec["iterations"]),
+                **opened)
+
+
+def refuse_without_open_phases(out, records: list | None = None, branch=None) -> None:
+    """Refuse the journal ``records`` or the finished ``branch`` of a run writing to ``out`` of a
+    model with unilateral contacts when they lack the open phases (written by an earlier version,
+    which did not count them: resumed, the branch would miss its grazing points).
+
+    Raises
+    ------
+    JournalMismatch
+        One line naming the fix (start over).
+    """
+    old_points = records is not None and any("point" in r and "open_phases" not in r for r in records)
+    if old_points or (branch is not None and branch.open_phases is None):
+        where = journal_path(Path(out)) if old_points else out
+        raise JournalMismatch(f"{where} was written by an earlier stickslip that did not count the open phases of "
+                              "the unilateral contacts (its grazing points would be missing); start over with "
+                              "resume=False (--overwrite) or choose another output (--out)")
 
 
 def start_record(start) -> dict:
@@ -298,6 +323,7 @@ def branch_dataset(branch):
         "arclength": ("point", branch.arclength, {"long_name": "scaled pseudo-arclength", "units": "1"}),
         "residual": ("point", branch.residuals, {"long_name": "scaled shooting residual", "units": "1"}),
         "iterations": ("point", branch.iterations.astype(np.int16), {"long_name": "corrector iterations"}),
+        **_open_variables(branch),
         "special_kind": ("special", np.array([p.kind for p in sp], dtype=str), {"long_name": "kind of special point"}),
         "special_index": ("special", np.array([p.index for p in sp], dtype=np.int32),
                           {"long_name": "lies between branch points index and index + 1"}),
@@ -341,10 +367,22 @@ def branch_dataset(branch):
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def _open_variables(branch) -> dict:
+    """The flight phases of a branch's points as dataset variables (none for a model without
+    unilateral contacts)."""
+    if branch.open_phases is None:
+        return {}
+    return {"open_phases": ("point", branch.open_phases.astype(np.int16),
+                            {"long_name": "openings of the unilateral contacts per period (flight phases)"}),
+            "open_time": ("point", branch.open_time, {"long_name": "time with some unilateral contact open per period",
+                                                      "units": "s"})}
+
+
 def branch_fields(ds) -> dict:
     """The fields of the branch of a dataset written by :func:`branch_dataset` (files of this
     version: with ``section_spec`` and the special points' multipliers); ``special`` is a list of
-    the fields of each special point."""
+    the fields of each special point; ``open_phases`` and ``open_time`` are None where the file has
+    no such variables (a model without unilateral contacts, or a file of an earlier version)."""
     mult = ds["multiplier_real"].values + 1j * ds["multiplier_imag"].values
     smult = ds["special_multiplier_real"].values + 1j * ds["special_multiplier_imag"].values
     side = {k: (ds[f"special_{k}_real"].values + 1j * ds[f"special_{k}_imag"].values) if f"special_{k}_real" in ds
@@ -364,7 +402,9 @@ def branch_fields(ds) -> dict:
                 iterations=ds["iterations"].values.astype(int), special=special, stop_reason=ds.attrs["stop_reason"],
                 system=system_from_description(json.loads(ds.attrs["system"])),
                 section=section_of(json.loads(ds.attrs["section_spec"])), options=json.loads(ds.attrs["options"]),
-                timings=json.loads(ds.attrs["timings"]), digest=str(ds.attrs.get("digest", "")))
+                timings=json.loads(ds.attrs["timings"]), digest=str(ds.attrs.get("digest", "")),
+                open_phases=ds["open_phases"].values.astype(int) if "open_phases" in ds else None,
+                open_time=ds["open_time"].values if "open_time" in ds else None)
 
 
 def fold_curve_dataset(fc):

@@ -11,8 +11,9 @@ are located. The work is split by responsibility:
 :mod:`.arclength`              the corrector: λ as an unknown, Jacobian, tangent, Newton–Broyden
 :mod:`.branch`                 :func:`continue_orbit` (steps, step control, stops) and :class:`Branch`
 :mod:`.special_points`         folds, period doubling, Neimark–Sacker (by what crosses the unit
-                               circle), stick phases appearing or vanishing, Hopf points, steady
-                               sliding: detection and location
+                               circle), stick phases appearing or vanishing, grazing (a flight
+                               phase of a unilateral contact appearing or vanishing), Hopf
+                               points, steady sliding: detection and location
 :mod:`.start`                  the first orbit: :func:`start_run`, :func:`start_orbit_from_run`
 :mod:`.branch_store`           journals (resume), JSON records, NetCDF of branches and fold curves
 :mod:`.region_edge`            the Region II edge over N (:func:`fold_curve`), :func:`unstable_cycle`

@@ -30,6 +30,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .._version import __version__
+from ..analysis.signal import CLOSE, OPEN
+from ..analysis.signal import open_time as signal_open_time
 from ..analysis.signal import stick_time as signal_stick_time
 from ..errors import OrbitError, SimulationError
 from ..model.bundle import CST
@@ -42,6 +44,7 @@ from .section import Section, flow, vector_field
 
 __all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
            "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time", "stick_summary",
+           "open_count", "open_time",
            "check_method", "check_section", "METHODS", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
 
 #: Ways of computing ∂Φ/∂s0: variational equations with saltation matrices, or central differences.
@@ -146,16 +149,60 @@ def stick_count(transitions) -> int:
 
 
 def stick_summary(traj, period: float) -> dict:
-    """The stick of one period of an orbit's run (``PeriodicOrbit.trajectory(1.0)``):
-    ``stick_fraction`` (some contact stuck) and, by contact name, ``contacts`` with each one's
-    ``stick_phases`` and ``stick_fraction`` of the period."""
+    """The stick (and flight) of one period of an orbit's run (``PeriodicOrbit.trajectory(1.0)``).
+
+    Returns
+    -------
+    dict
+        ``stick_fraction`` (some contact stuck) and, by contact name, ``contacts`` with each one's
+        ``stick_phases`` and ``stick_fraction`` of the period. Where the model has unilateral
+        contacts, also ``open_phases`` (openings per period, all contacts) and ``open_fraction``
+        (some contact open), and each unilateral contact's own ``open_phases`` and
+        ``open_fraction``; a model without them gets none of these keys.
+    """
     tr = traj.transitions
-    nc = traj.system.n_contacts
-    total, each = signal_stick_time(0.0, period, int(traj.mode[0]), tr.time, tr.kind, tr.contact, nc)
+    system = traj.system
+    nc = system.n_contacts
+    mode0 = int(traj.mode[0])
+    total, each = signal_stick_time(0.0, period, mode0, tr.time, tr.kind, tr.contact, nc)
     contacts = {name: {"stick_phases": int(np.sum((tr.kind == 1) & (tr.contact == c))),
                        "stick_fraction": float(each[c] / period)}
-                for c, name in enumerate(traj.system.contact_names)}
-    return {"stick_fraction": float(total / period), "contacts": contacts}
+                for c, name in enumerate(system.contact_names)}
+    out = {"stick_fraction": float(total / period), "contacts": contacts}
+    if system.unilateral:
+        opened, each_open = signal_open_time(0.0, period, mode0, tr.time, tr.kind, tr.contact, nc)
+        for c, name in enumerate(system.contact_names):
+            if system.contacts[c].unilateral:
+                contacts[name].update(open_phases=int(np.sum((tr.kind == OPEN) & (tr.contact == c))),
+                                      open_fraction=float(each_open[c] / period))
+        out.update(open_phases=open_count(tr), open_fraction=float(opened / period))
+    return out
+
+
+def open_count(transitions) -> int:
+    """Openings of unilateral contacts in a run (its flight phases, all contacts)."""
+    return int(np.sum(transitions.kind == OPEN))
+
+
+def open_time(transitions, period: float, system: FrictionModel, state: np.ndarray) -> float:
+    """Time with some unilateral contact open over one period of a periodic orbit [s].
+
+    ``transitions`` are those of the run over one period ``period`` from ``state``. A contact
+    whose first opening or closing in the run is a closing was open at the start; one with
+    neither is open all period if its gap g = g0 + W·q is positive at ``state``, else closed.
+    """
+    nc = system.n_contacts
+    n = system.n
+    flags = 0
+    for c, contact in enumerate(system.contacts):
+        if not contact.unilateral:
+            continue
+        mine = (transitions.contact == c) & ((transitions.kind == OPEN) | (transitions.kind == CLOSE))
+        kinds = transitions.kind[mine]
+        was_open = kinds[0] == CLOSE if kinds.size else contact.gap + float(contact.gap_gradient @ state[:n]) > 0.0
+        flags |= int(bool(was_open)) << (nc + c)
+    total, _ = signal_open_time(0.0, period, flags, transitions.time, transitions.kind, transitions.contact, nc)
+    return float(total)
 
 
 def stick_time(transitions) -> float:
