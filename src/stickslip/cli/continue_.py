@@ -92,7 +92,7 @@ def continue_command(
     step: float = typer.Option(0.02, "--step", help="Initial step in scaled arclength (≈ relative parameter change)."),
     max_step: float = typer.Option(0.2, "--max-step", help="Largest step in scaled arclength."),
     stop_on: Optional[List[str]] = typer.Option(None, "--stop-on", help="Stop after this special point (repeatable): "
-                                                "fold, period-doubling, neimark-sacker, stick-phases."),
+                                                "fold, period-doubling, neimark-sacker, stick-phases, grazing."),
     rtol: OrbitRtol = 1e-10,
     tol: Tol = 1e-8,
     slip_band: SlipBand = None,
@@ -103,9 +103,9 @@ def continue_command(
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
     as_json: JsonSummary = False,
 ) -> None:
-    """Continue a periodic orbit in one parameter, with stability, folds and stick-phase changes.
+    """Continue a periodic orbit in one parameter, with stability, folds, stick-phase changes and grazing.
 
-    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused). Folds, period doublings and Neimark-Sacker points are told apart by what crosses the unit circle (a real multiplier at +1, at -1, a complex pair), with the multipliers on either side. A start orbit that is steady sliding (the equilibrium, no cycle) is an error (exit 2, nothing written); a continuation that converges onto steady sliding writes the orbits before it and exits 1.
+    The first orbit is shot from a run of --search-time seconds from --ic at --from; the branch follows it towards --to (pseudo-arclength, so it passes folds) and ends at --to, after --max-points orbits, or where the stick phase vanishes. With a contact that opens and closes, grazing points (a flight phase appears or vanishes) are reported and passed. Every orbit is written to OUT.nc.journal as it is found; running the same command again after an interruption resumes from the last one (a different command with the same --out is refused). Folds, period doublings and Neimark-Sacker points are told apart by what crosses the unit circle (a real multiplier at +1, at -1, a complex pair), with the multipliers on either side. A start orbit that is steady sliding (the equilibrium, no cycle) is an error (exit 2, nothing written); a continuation that converges onto steady sliding writes the orbits before it and exits 1.
     """
     stop_on = list(stop_on or [])
     _check(start, stop, max_points, step, max_step, search.search_time, tol, stop_on)

@@ -24,6 +24,7 @@ SPECIAL_MARKERS = {
     "neimark-sacker": ("D", "#2ca02c"),
     "stick-phases": ("^", "#ff7f0e"),
     "stick-vanishing": ("v", "#ff7f0e"),
+    "grazing": ("P", "#17becf"),
     "hopf": ("*", "#8c564b"),
 }
 
