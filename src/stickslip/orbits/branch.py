@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -49,7 +48,7 @@ AMPLITUDE_SAMPLES = 400
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class Branch(ModelResult):
+class Branch(ModelResult, store.NetCDFResult):
     """A branch of periodic orbits computed by :func:`continue_orbit`.
 
     Attributes
@@ -151,14 +150,6 @@ class Branch(ModelResult):
     def to_xarray(self):
         """``xarray.Dataset`` with dims ``point``, ``state``, ``multiplier`` and ``special``."""
         return store.branch_dataset(self)
-
-    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
-        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename).
-
-        An existing ``path`` is replaced only with ``overwrite=True``
-        (:class:`stickslip.errors.OutputError` otherwise).
-        """
-        return store.write_dataset(self.to_xarray(), path, overwrite=overwrite)
 
     @classmethod
     def from_xarray(cls, ds) -> "Branch":

@@ -56,7 +56,7 @@ from .shooting import PeriodicOrbit
 __all__ = ["Journal", "JournalMismatch", "journal_path", "digest_of", "array_digest", "encode_array",
            "decode_array", "write_atomically", "check_output", "open_output", "JOURNAL_FORMAT", "section_spec",
            "section_of", "point_record", "point_fields", "start_record", "start_fields", "start_digest",
-           "branch_settings", "branch_dataset", "branch_fields", "fold_curve_dataset", "fold_curve_fields",
+           "branch_settings", "branch_dataset", "branch_fields", "fold_curve_dataset", "fold_curve_fields", "NetCDFResult",
            "plain_row", "write_dataset", "refuse_without_open_phases"]
 
 
@@ -289,6 +289,18 @@ def branch_settings(system, param, start, section, rtol, atol, numerics: dict) -
 
 
 # ----------------------------------------------------------------------- NetCDF
+class NetCDFResult:
+    """``to_netcdf`` of a result that has ``to_xarray`` (a branch, a fold curve)."""
+
+    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
+        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename).
+
+        An existing ``path`` is replaced only with ``overwrite=True``
+        (:class:`stickslip.errors.OutputError` otherwise).
+        """
+        return write_dataset(self.to_xarray(), path, overwrite=overwrite)
+
+
 def write_dataset(ds, path, *, overwrite: bool = True) -> Path:
     """Write ``ds`` to ``path`` (NetCDF4 via h5netcdf) under the output's lock, atomically
     (:func:`stickslip.files.save_netcdf`); a full disk names the journal that keeps the run.

@@ -13,7 +13,6 @@ from __future__ import annotations
 import dataclasses
 import time
 from concurrent.futures import as_completed
-from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -48,7 +47,7 @@ FOLD_JACOBIAN_EVERY = 4
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class FoldCurve:
+class FoldCurve(store.NetCDFResult):
     """The upper edge of the stick-slip domain over N: where the stable stick-slip orbit ends.
 
     For each N the stick-slip orbit found from the ``far`` initial condition at ``omega_start``
@@ -105,14 +104,6 @@ class FoldCurve:
     def to_xarray(self):
         """``xarray.Dataset`` over ``N``."""
         return store.fold_curve_dataset(self)
-
-    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
-        """Write :meth:`to_xarray` to ``path`` (NetCDF4 via h5netcdf; atomically: temporary file + rename).
-
-        An existing ``path`` is replaced only with ``overwrite=True``
-        (:class:`stickslip.errors.OutputError` otherwise).
-        """
-        return store.write_dataset(self.to_xarray(), path, overwrite=overwrite)
 
     def rows(self) -> dict:
         """``{N: row}`` with row = (edge, kind, located, period, omega_stable_max, points, seconds,
