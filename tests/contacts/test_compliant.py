@@ -13,9 +13,12 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import stickslip
 from stickslip.analysis.signal import CLOSE, OPEN
+from stickslip.integrate.contacts import hermite_dip
 from stickslip.model import model_from_spec
 
 
@@ -108,3 +111,45 @@ def test_friction_acts_only_while_the_contact_is_closed():
     closed = ~is_open
     np.testing.assert_allclose(traj.friction[closed, 0], 0.3 * traj.normal_force[closed, 0], rtol=1e-12)
     assert tr.kind.size and set(np.unique(tr.kind)) <= {OPEN, CLOSE}
+
+
+def test_a_flight_shorter_than_a_step_is_found():
+    """A preload F presses the mass into the stop (closed: y'' = −(1 + k) y + F about y_e = F/(1+k));
+    started at y_e with ẏ = −v_s it leaves at speed v0 = √(v_s² − (1+k) y_e²) and flies for
+    t_f = 2 atan(v0/F) (y = F (1 − cos t) − v0 sin t), then stays closed for
+    t_c = (2π − 2 atan(v0/(ω y_e)))/ω, ω = √(1+k). With v0 = 0.001 each flight lasts 2 ms, inside
+    one step of the integrator (both of whose ends see the contact closed): every flight is found,
+    at the closed-form instants. The gap crosses zero at speed v0, so a state error δ of the run
+    moves an instant by δ/v0: 5e-8 s here (the error falls tenfold per tenfold tighter rtol)."""
+    k, F, v0 = 3.0, 1.0, 0.001
+    w, ye = math.sqrt(1.0 + k), F / (1.0 + k)
+    vs = math.sqrt(v0 * v0 + (1.0 + k) * ye * ye)
+    model = bouncer(k).replace(**{"force.y": F})
+    traj = stickslip.simulate(model, 20.0, ic={"y": ye, "dy": -vs}, rtol=1e-11, atol=1e-13)
+    close, opened = events(traj)
+    t_open = math.asin(w * ye / vs) / w
+    t_f = 2.0 * math.atan(v0 / F)
+    t_c = (2.0 * math.pi - 2.0 * math.atan(v0 / (w * ye))) / w
+    expected_open = t_open + np.arange(opened.size) * (t_f + t_c)
+    assert traj.status == "success" and opened.size == math.floor((20.0 - t_open) / (t_f + t_c)) + 1
+    assert close.size == opened.size or close.size == opened.size - 1
+    np.testing.assert_allclose(opened, expected_open, rtol=0, atol=5e-8)
+    np.testing.assert_allclose(close, expected_open[:close.size] + t_f, rtol=0, atol=5e-8)
+    assert 20.0 / traj.stats.accepted_steps > 4.0 * t_f  # the flights are shorter than the steps
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(0.01, 1.0), st.floats(-8.0, 8.0), st.floats(0.01, 1.0), st.floats(-8.0, 8.0))
+def test_the_hermite_dip_is_the_interior_minimum_of_the_cubic(g0, dg0, g1, dg1):
+    """hermite_dip finds the interior minimum of the cubic Hermite interpolant (against the cubic on
+    a grid of 20 001 points) where it falls to half the smaller end value, and nothing elsewhere."""
+    th = np.linspace(0.0, 1.0, 20001)
+    cubic = ((2 * th**3 - 3 * th**2 + 1) * g0 + (th**3 - 2 * th**2 + th) * dg0 + (-2 * th**3 + 3 * th**2) * g1
+             + (th**3 - th**2) * dg1)
+    i = int(np.argmin(cubic))
+    got = hermite_dip(g0, dg0, g1, dg1)
+    floor = 0.5 * min(g0, g1)
+    if 0 < i < th.size - 1 and cubic[i] <= floor - 1e-9:
+        assert got == pytest.approx(th[i], abs=2e-4)
+    elif not (0 < i < th.size - 1) or cubic[i] > floor + 1e-9:
+        assert got == -1.0

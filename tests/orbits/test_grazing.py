@@ -31,11 +31,12 @@ DRIVE = "contact.0.drive"
 #: bracket the bisection leaves, 6e-6 measured).
 SIDE = 1e-3
 
-#: Largest gap of a flight the event integrator (rtol 1e-10) may step over without recording an
-#: opening: the count, hence the located λ*, changes only once the flight is resolved. Measured on
-#: orbits shot 1e-7 … 4e-5 above the scaling prediction of λ*: largest gap 1.3e-5 (a ~9 ms flight)
-#: not recorded, 2.5e-5 (12 ms) recorded; i.e. up to 4e-6 in belt speed past the zero of the gap.
-MISSED_GAP = 2.5e-5
+#: Largest gap of a flight the event integrator may step over without recording an opening: it
+#: finds a flight inside a step where the step's cubic Hermite interpolant of the gap dips, so one
+#: whose peak lies below that interpolant's error (~h⁴ max|d⁴g/dt⁴| / 384) may pass unseen.
+#: Measured on orbits shot 1e-8 … 1e-6 past the scaling prediction of λ*: every flight recorded,
+#: the smallest with largest gap 9.4e-8.
+MISSED_GAP = 1e-7
 
 
 def _hoffmann(drive: float):
@@ -112,7 +113,7 @@ def test_orbits_shot_on_either_side_of_grazing_differ_in_their_flight(up):
     """Independent of the continuation: Newton shooting at λ*(1 ∓ 10⁻³) from the grazing state.
     Below, the contact stays closed (g < 0 all period); above, it opens once (g > 0 at its
     peak); at λ* the largest gap is zero to within what the location allows: the bracket,
-    |dg_max/dλ| · bracket, plus the flights too short to be recorded (:data:`MISSED_GAP`)
+    |dg_max/dλ| · bracket, plus the flights too small to be seen inside a step (:data:`MISSED_GAP`)
     (measured: g_max = 1.4e-7 at λ*, ∓7.0e-4 at the sides, so 6.4 per unit of λ; bound 6.2e-5)."""
     g = _grazing(up)
     below, _, s_below = _largest_gap(g.value * (1.0 - SIDE), g.state)
@@ -132,7 +133,7 @@ def test_grazing_is_where_the_scaled_closed_cycle_reaches_zero_gap(up):
     scales with the belt speed d (the period does not change: 4.539271 s at 0.1 and 0.105). The
     largest gap is then g_max(d) = g_eq + d u, zero at d* = −g_eq d0 / (g_max(d0) − g_eq) from the
     one orbit at d0 = 0.1 (measured: 0.11016496, 2e-8 from the located λ*; bracket 6e-6; allowed
-    the bracket and the λ of the shortest recorded flight, :data:`MISSED_GAP` / u, 4e-6)."""
+    the bracket and the λ of the smallest flight that may pass unseen, :data:`MISSED_GAP` / u)."""
     g = _grazing(up)
     largest, _, summary = _largest_gap(0.1, up.states[0])
     assert summary["open_phases"] == 0

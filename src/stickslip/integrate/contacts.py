@@ -26,16 +26,17 @@ import math
 import numpy as np
 
 from ..model import physics as P
-from ..model.bundle import CST
+from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
 from ..model.jit import kernel
 from ..model.kinematics import model_sizes
-from ..model.normal import starts_open
+from ..model.normal import gap_and_rate, is_open, starts_open
 
 __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP",
            "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_KINDS", "EVENT_TIME_TOL", "close_contact",
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
-           "time_to_zero_of", "slip_event_possible", "contact_lost", "mode_flags"]
+           "time_to_zero_of", "slip_event_possible", "hermite_dip", "gap_dip", "probed_crossing", "contact_lost",
+           "mode_flags"]
 
 EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
 EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
@@ -167,12 +168,24 @@ def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
     the crossing lies in the first sub-interval (it is the bracket's left end). Refinement:
     Illinois regula falsi.
     """
+    return probed_crossing(-1.0, kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N)
+
+
+@kernel
+def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
+    """:func:`first_crossing` with one more sample point at θ = ``probe`` ∈ (0, 1) (−1.0: none),
+    where a dip of the event function between the regular sample points is expected."""
     a = 0.0
     ga = -1.0  # not yet computed (the function is > 0 at θ = 0)
     b = -1.0
     gb = 0.0
-    for j in range(1, EVENT_CHECKS + 1):
+    j = 1
+    while j <= EVENT_CHECKS:
         theta = j / EVENT_CHECKS
+        if a < probe < theta:  # the probe lies before the next regular point: sample it first
+            theta = probe
+        else:
+            j += 1
         dense_state(y0, Q, h, theta, work)
         g = event_value(kind, c, work, e0x, e0y, cst, md, F, N)
         if g <= 0.0:
@@ -209,6 +222,61 @@ def time_to_zero_of(vx, vy, ax, ay):
     if va >= -0.5 * math.sqrt((vx * vx + vy * vy) * (ax * ax + ay * ay)):  # cos 60° = 0.5
         return math.inf
     return -(vx * vx + vy * vy) / va
+
+
+@kernel
+def hermite_dip(g0, dg0, g1, dg1):
+    """θ ∈ (0, 1) where the cubic Hermite interpolant of a function over a step (values ``g0, g1``
+    > 0 at its ends, derivatives ``dg0, dg1`` with respect to θ ∈ [0, 1]) has its lowest interior
+    minimum, if that comes at or below half the smaller end value (a dip that may reach zero inside
+    the step, to be checked on the step's dense output there); −1.0 otherwise.
+
+    The cubic is a θ³ + b θ² + dg0 θ + g0 with a = 2 (g0 − g1) + dg0 + dg1, b = 3 (g1 − g0) − 2 dg0
+    − dg1; its one local minimum is the root of 3a θ² + 2b θ + dg0 where the second derivative is
+    2 √(b² − 3a dg0) > 0: θ = (√(b² − 3a dg0) − b) / (3a), or −dg0 / (b + √(b² − 3a dg0)) where
+    b > 0 (the same root without cancellation, and right for a parabola, a = 0).
+    """
+    a = 2.0 * (g0 - g1) + dg0 + dg1
+    b = 3.0 * (g1 - g0) - 2.0 * dg0 - dg1
+    disc = b * b - 3.0 * a * dg0
+    if disc <= 0.0:
+        return -1.0
+    r = math.sqrt(disc)
+    if b > 0.0:
+        th = -dg0 / (b + r)
+    elif a != 0.0:
+        th = (r - b) / (3.0 * a)
+    else:
+        return -1.0
+    if not (0.0 < th < 1.0) or ((a * th + b) * th + dg0) * th + g0 > 0.5 * min(g0, g1):
+        return -1.0
+    return th
+
+
+@kernel
+def gap_dip(y0, dy0, y1, dy1, h, cst, c, md):
+    """θ where unilateral contact ``c`` may open or close *inside* a step from ``y0`` to ``y1`` of
+    length ``h`` [s] although its indicator is positive at both ends (a flight, or a touch, shorter
+    than the step); −1.0 where it cannot (:func:`hermite_dip` on the step's cubic Hermite
+    interpolants, ``dy0``, ``dy1`` the state derivatives at the ends).
+
+    A closed contact opens where −g or λ̃/k = −g − (c/k) ġ reaches 0; an open one can close only
+    where g reaches 0.
+    """
+    m = md.m
+    n = model_sizes(md.kin, m)[0]
+    g0, r0 = gap_and_rate(y0, m, n, c)
+    g1, r1 = gap_and_rate(y1, m, n, c)
+    if is_open(cst, c):
+        return hermite_dip(g0, h * r0, g1, h * r1)
+    dip = hermite_dip(-g0, -h * r0, -g1, -h * r1)
+    o = contact_offsets(n, c)[0]
+    ratio = m[o + C_NORMAL_C] / m[o + C_NORMAL_K]
+    if dip > 0.0 or ratio == 0.0:
+        return dip
+    a0 = gap_and_rate(dy0, m, n, c)[1]  # W·q̈ (the first value, g0 + W·q̇, is not used)
+    a1 = gap_and_rate(dy1, m, n, c)[1]
+    return hermite_dip(-g0 - ratio * r0, -h * (r0 + ratio * a0), -g1 - ratio * r1, -h * (r1 + ratio * a1))
 
 
 @kernel

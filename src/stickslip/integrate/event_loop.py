@@ -399,17 +399,28 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             stats[3] += 1
             continue
 
-        # ---- unilateral contacts: opening or closing inside the step cuts it at the root
+        # ---- unilateral contacts: opening or closing inside the step cuts it at the root; so
+        # does a flight (or a touch) that begins and ends inside it, where the step's Hermite
+        # interpolant of the gap dips and the dense output there confirms it
         theta_g = -1.0
         c_g = -1
         if has_unilateral(md.kin, m):
             for c in range(nc):
-                if is_unilateral(md, n, c) and P.indicator(ynew, cst, c, md) <= 0.0:
+                if not is_unilateral(md, n, c):
+                    continue
+                if P.indicator(ynew, cst, c, md) <= 0.0:
                     th = crossing_in_step(E.EVENT_GAP, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
-                    q_ready = True
-                    if theta_g < 0.0 or th < theta_g:
-                        theta_g = th
-                        c_g = c
+                else:
+                    probe = E.gap_dip(y, k1, ynew, Kst[6], h, cst, c, md)
+                    if probe < 0.0:
+                        continue
+                    if not q_ready:
+                        DP.dense_coefficients(Kst, Q)
+                    th = E.probed_crossing(probe, E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+                q_ready = True
+                if th > 0.0 and (theta_g < 0.0 or th < theta_g):
+                    theta_g = th
+                    c_g = c
 
         # ---- sticking contacts: breakaway inside the step cuts it at the root
         theta_b = -1.0

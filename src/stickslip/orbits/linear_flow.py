@@ -294,6 +294,14 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
         t_next = float(tr.time[k]) if k < n_tr else T
         t1 = min(t + max_interval, t_next + 1.0 if k < n_tr else T)
         seg = _segment(system, y, Phi, t, t1, cst, rtol)
+        if not seg.event and k < n_tr and seg.t >= t_next + MATCH_TIME_TOL and \
+                int(tr.kind[k]) in (E.TRANSITION_OPEN, E.TRANSITION_CLOSE):
+            # a flight (or touch) shorter than the re-integration's steps, which see the contact
+            # alike at both ends of one: the run found it inside its step (on the gap's Hermite
+            # dip), so carry the variations to its recorded instant and take its jump there
+            seg = _segment(system, y, Phi, t, t_next, cst, rtol)
+            if not seg.event:
+                seg.event, seg.contact, seg.kind = True, system.n_contacts + int(tr.contact[k]), V.EV_GAP
         if not seg.event:
             if k < n_tr and seg.t >= t_next + MATCH_TIME_TOL:
                 raise OrbitError(f"the re-integration did not meet the integrator's transition at {t_next:.9f} s")
