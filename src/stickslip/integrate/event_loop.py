@@ -435,20 +435,16 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
                     if th > 0.0 and (theta_b < 0.0 or th < theta_b):
                         theta_b = th
                         c_b = c
-        if theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b):
+        cut = theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b)
+        if cut:
             # a unilateral contact opens or closes inside the step: cut the step at the root
             idx, tau = cut_step(theta_g, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
                                 work, F, N, vv)
             n_tr = switch_gap(y, cst, c_g, md, rtol, atol, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr,
                               stats)
-            stats[0] += 1
-            P.rhs(y, cst, md, k1)
-            stats[2] += 1
-            va_ready = False
-            retakes = 0
-            homing_any = False
         elif theta_b > 0.0:
             # breakaway inside the step: the flow is smooth up to it, so cut the step at the root
+            cut = True
             idx, tau = cut_step(theta_b, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
                                 work, F, N, vv)
             P.project_velocities(y, cst, np.int64(-1), md)
@@ -461,12 +457,6 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             stats[5] += 1
             record_transition(n_tr, t_base + tau, E.TRANSITION_TO_SLIP, c_b, y, tr_t, tr_kind, tr_contact, tr_s)
             n_tr = settle(y, cst, md, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr + 1, stats)
-            stats[0] += 1
-            P.rhs(y, cst, md, k1)
-            stats[2] += 1
-            va_ready = False
-            retakes = 0
-            homing_any = False
         else:
             # ---- accept the whole step
             if idx < n_samples and sample_times[idx] - t_base <= tau + h:
@@ -567,6 +557,13 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
                 h_override = max(h * factor, h_free)
                 h_free = -1.0
             retakes = 0
+        if cut:  # a new smooth piece starts at the root
+            stats[0] += 1
+            P.rhs(y, cst, md, k1)
+            stats[2] += 1
+            va_ready = False
+            retakes = 0
+            homing_any = False
         if not E.all_finite(y):
             status = NOT_FINITE
             break
