@@ -132,7 +132,7 @@ def test_a_basin_study_is_refused_before_a_model_is_rebuilt_and_told_the_n_that_
     with pytest.raises(MemoryLimitError) as info:
         basin_stability(model, states, executor="serial")
     text = str(info.value)
-    per = memory.state_bytes(60, 172 + 120)  # an outcome row of 9 + 16 + 2n + 3 · 49 numbers
+    per = memory.state_bytes(60, 173 + 120)  # an outcome row of 10 + 16 + 2n + 3 · 49 numbers
     n = int(number(r"give --n (\d+)", text))
     assert n * per + memory.param_bytes(60) <= 20 * GB < (n + 1000) * per
     assert f"≈ {1e7 * per / GB + memory.param_bytes(60) / GB:.3g} GB" in text
