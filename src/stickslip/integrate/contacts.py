@@ -27,7 +27,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
-from ..model.jit import kernel
+from ..model.jit import inlined_kernel, kernel
 from ..model.kinematics import model_sizes
 from ..model.normal import gap_and_rate, is_open, starts_open
 
@@ -236,6 +236,12 @@ def hermite_dip(g0, dg0, g1, dg1):
     2 √(b² − 3a dg0) > 0: θ = (√(b² − 3a dg0) − b) / (3a), or −dg0 / (b + √(b² − 3a dg0)) where
     b > 0 (the same root without cancellation, and right for a parabola, a = 0).
     """
+    # the cubic minus the chord is θ (1 − θ) ((dg0 − Δ)(1 − θ) − (dg1 − Δ) θ), Δ = g1 − g0: at
+    # most a quarter of the larger |dg − Δ| below the chord, so no dip is possible unless that
+    # reaches from the smaller end value down to half of it
+    delta = g1 - g0
+    if max(abs(dg0 - delta), abs(dg1 - delta)) < 2.0 * min(g0, g1):
+        return -1.0
     a = 2.0 * (g0 - g1) + dg0 + dg1
     b = 3.0 * (g1 - g0) - 2.0 * dg0 - dg1
     disc = b * b - 3.0 * a * dg0
@@ -253,7 +259,7 @@ def hermite_dip(g0, dg0, g1, dg1):
     return th
 
 
-@kernel
+@inlined_kernel
 def gap_dip(y0, dy0, y1, dy1, h, cst, c, md):
     """θ where unilateral contact ``c`` may open or close *inside* a step from ``y0`` to ``y1`` of
     length ``h`` [s] although its indicator is positive at both ends (a flight, or a touch, shorter
