@@ -181,6 +181,49 @@ def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr
     raise NotImplementedError
 
 
+def gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):  # pragma: no cover
+    """(θ, contact, q_ready) of the first opening or closing of a unilateral contact inside the step
+    from ``y`` (derivative ``k1``) to ``ynew`` (stages ``Kst``), θ = −1.0 and contact −1 for none.
+    Besides a contact whose indicator has turned at the step's end, a flight (or a touch) that
+    begins and ends inside the step is found where the step's Hermite interpolant of the gap dips
+    and the dense output there confirms it. Resolved by numba: nothing for pressed-only kinematics,
+    whose kernels then compile none of it."""
+    raise NotImplementedError
+
+
+@overload(gap_crossing, jit_options=KERNEL_OPTIONS, inline="always")
+def _gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):
+    if pressed_only(md.types[md.fields.index("kin")]):
+        return lambda y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N: (-1.0, np.int64(-1), q_ready)
+    return _gap_roots
+
+
+def _gap_roots(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):
+    """:func:`gap_crossing` of kinematics that may have unilateral contacts."""
+    theta_g = -1.0
+    c_g = np.int64(-1)
+    n, nc, _ = model_sizes(md.kin, md.m)
+    if not has_unilateral(md.kin, md.m):
+        return theta_g, c_g, q_ready
+    for c in range(nc):
+        if not is_unilateral(md, n, c):
+            continue
+        if P.indicator(ynew, cst, c, md) <= 0.0:
+            th = crossing_in_step(E.EVENT_GAP, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
+        else:
+            probe = E.gap_dip(y, k1, ynew, Kst[6], h, cst, c, md)
+            if probe < 0.0:
+                continue
+            if not q_ready:
+                DP.dense_coefficients(Kst, Q)
+            th = E.probed_crossing(probe, E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+        q_ready = True
+        if th > 0.0 and (theta_g < 0.0 or th < theta_g):
+            theta_g = th
+            c_g = np.int64(c)
+    return theta_g, c_g, q_ready
+
+
 @overload(switch_gap, jit_options=KERNEL_OPTIONS)
 def _switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
     if pressed_only(md.types[md.fields.index("kin")]):
@@ -399,28 +442,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             stats[3] += 1
             continue
 
-        # ---- unilateral contacts: opening or closing inside the step cuts it at the root; so
-        # does a flight (or a touch) that begins and ends inside it, where the step's Hermite
-        # interpolant of the gap dips and the dense output there confirms it
-        theta_g = -1.0
-        c_g = -1
-        if has_unilateral(md.kin, m):
-            for c in range(nc):
-                if not is_unilateral(md, n, c):
-                    continue
-                if P.indicator(ynew, cst, c, md) <= 0.0:
-                    th = crossing_in_step(E.EVENT_GAP, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
-                else:
-                    probe = E.gap_dip(y, k1, ynew, Kst[6], h, cst, c, md)
-                    if probe < 0.0:
-                        continue
-                    if not q_ready:
-                        DP.dense_coefficients(Kst, Q)
-                    th = E.probed_crossing(probe, E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
-                q_ready = True
-                if th > 0.0 and (theta_g < 0.0 or th < theta_g):
-                    theta_g = th
-                    c_g = c
+        # ---- unilateral contacts: opening or closing inside the step cuts it at the root
+        theta_g, c_g, q_ready = gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N)
 
         # ---- sticking contacts: breakaway inside the step cuts it at the root
         theta_b = -1.0
