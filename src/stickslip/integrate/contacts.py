@@ -159,7 +159,7 @@ def illinois_update(a, ga, b, gb, c, gc, before, side):
     return a, ga, c, gc, -1
 
 
-@kernel
+@inlined_kernel
 def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
     """First θ ∈ (0, 1] where the event function of contact ``c`` turns ≤ 0, located to
     EVENT_TIME_TOL; −1.0 if no sign change is seen at the EVENT_CHECKS sample points.

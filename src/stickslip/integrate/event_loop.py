@@ -75,7 +75,7 @@ def dp_step(y, k1, h, cst, md, Kst, ynew, ytmp):
     P.rhs(ynew, cst, md, Kst[6])
 
 
-@kernel
+@inlined_kernel
 def crossing_in_step(kind, c, y, Kst, Q, q_ready, h, cst, md, work, F, N):
     """θ ∈ (0, 1] of the first crossing of event ``kind`` of contact ``c`` inside a step whose end
     is past it (1.0 where the sample points see no sign change: the root is at the end); forms the
@@ -133,7 +133,7 @@ def write_samples(idx, tau_to, y0, Q, h, tau_step, t_base, cst, md, sample_times
     return idx
 
 
-@kernel
+@inlined_kernel
 def cut_step(theta, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F, work, F, N, v):
     """End the step at θ ∈ (0, 1] of its length ``h`` (an event's root): write the samples up to
     there and move ``y`` (the step's start) onto it. Returns (idx, local time of the cut)."""
