@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import BasinError
 from .context import model_key
 from .early import Options, row_width
-from .states import MAX_STATES, StateSpec
+from .states import MAX_STATES, StateSpec, split_fields
 
 __all__ = ["BasinSpec", "build_spec", "parse_param"]
 
@@ -89,14 +89,9 @@ def parse_param(text: str) -> tuple[str, list[float]]:
     BasinError
         One line naming the fix.
     """
-    name, sep, rest = str(text).partition("=")
-    name = name.strip()
     example = "--param contact.0.drive=0.8:2:13"
-    if not sep or not name:
-        raise BasinError(f"--param expects PATH=LO:HI:K, got {text!r}; e.g. {example}")
-    parts = rest.split(":")
-    if len(parts) != 3:
-        raise BasinError(f"--param {text}: give PATH=LO:HI:K (K values from LO to HI); e.g. {example}")
+    name, parts = split_fields(text, "--param", "PATH=LO:HI:K", "give PATH=LO:HI:K (K values from LO to HI)", 3,
+                               example)
     try:
         lo, hi, k = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:

@@ -142,6 +142,26 @@ class StateSpec:
         return out
 
 
+def split_fields(text: str, option: str, form: str, hint: str, count: int, example: str) -> tuple[str, list[str]]:
+    """``"NAME=A:B…"`` → (NAME, [A, B, …]) with exactly ``count`` fields, for the options that
+    take a name and a colon-separated range.
+
+    Raises
+    ------
+    BasinError
+        ``{option} expects {form}`` without a name or ``=``; ``{option} {text}: {hint}`` for
+        another number of fields; both end with ``e.g. {example}``.
+    """
+    name, sep, rest = str(text).partition("=")
+    name = name.strip()
+    if not sep or not name:
+        raise BasinError(f"{option} expects {form}, got {text!r}; e.g. {example}")
+    parts = rest.split(":")
+    if len(parts) != count:
+        raise BasinError(f"{option} {text}: {hint}; e.g. {example}")
+    return name, parts
+
+
 def parse_range(text: str, option: str = "--box") -> tuple[str, float, float]:
     """``"x=-1:2"`` → ``("x", -1.0, 2.0)``.
 
@@ -150,14 +170,8 @@ def parse_range(text: str, option: str = "--box") -> tuple[str, float, float]:
     BasinError
         One line naming the fix for anything that is not NAME=LO:HI with finite numbers.
     """
-    name, sep, rest = str(text).partition("=")
-    name = name.strip()
     example = f"{option} x=-1:2"
-    if not sep or not name:
-        raise BasinError(f"{option} expects NAME=LO:HI, got {text!r}; e.g. {example}")
-    parts = rest.split(":")
-    if len(parts) != 2:
-        raise BasinError(f"{option} {text}: a range is LO:HI; e.g. {example}")
+    name, parts = split_fields(text, option, "NAME=LO:HI", "a range is LO:HI", 2, example)
     try:
         lo, hi = float(parts[0]), float(parts[1])
     except ValueError:

@@ -29,12 +29,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba.extending import overload
 
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
-from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, loop
-from ..model.kinematics import has_unilateral, model_sizes, pressed_only
+from ..model.jit import inlined_kernel, kernel, loop
+from ..model.kinematics import has_unilateral, model_sizes, unilateral_kernel
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
@@ -173,33 +172,41 @@ def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
     return n_tr
 
 
+@unilateral_kernel(lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats: n_tr)
 def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):  # pragma: no cover
     """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
     change its mode, record the transitions (a sticking contact that opens first leaves stick; a
     contact that closes with v_c = 0 and an admissible stick force sticks), re-check the sticking
-    set, and return the transition count (resolved by numba: nothing for pressed-only kinematics)."""
-    raise NotImplementedError
+    set, and return the transition count (nothing for pressed-only kinematics)."""
+    if P.is_open(cst, c):
+        record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        n_tr += 1
+        if E.close_contact(y, cst, c, md, rtol, atol, F, N):
+            stats[4] += 1
+            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            n_tr += 1
+    else:
+        if np.int64(cst[CST * c]) == P.MODE_STICK:
+            stats[5] += 1
+            record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            n_tr += 1
+        cst[CST * c] = P.MODE_OPEN
+        cst[CST * c + 3] = math.inf
+        record_transition(n_tr, t, E.TRANSITION_OPEN, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        n_tr += 1
+    P.project_velocities(y, cst, np.int64(-1), md)  # the sticking set's constraints, after the change
+    return settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
 
 
+@unilateral_kernel(lambda y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N: (-1.0, np.int64(-1), q_ready),
+                   inline="always")
 def gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):  # pragma: no cover
     """(θ, contact, q_ready) of the first opening or closing of a unilateral contact inside the step
     from ``y`` (derivative ``k1``) to ``ynew`` (stages ``Kst``), θ = −1.0 and contact −1 for none.
     Besides a contact whose indicator has turned at the step's end, a flight (or a touch) that
     begins and ends inside the step is found where the step's Hermite interpolant of the gap dips
-    and the dense output there confirms it. Resolved by numba: nothing for pressed-only kinematics,
-    whose kernels then compile none of it."""
-    raise NotImplementedError
-
-
-@overload(gap_crossing, jit_options=KERNEL_OPTIONS, inline="always")
-def _gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N: (-1.0, np.int64(-1), q_ready)
-    return _gap_roots
-
-
-def _gap_roots(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):
-    """:func:`gap_crossing` of kinematics that may have unilateral contacts."""
+    and the dense output there confirms it. Nothing for pressed-only kinematics, whose kernels then
+    compile none of it."""
     theta_g = -1.0
     c_g = np.int64(-1)
     n, nc, _ = model_sizes(md.kin, md.m)
@@ -222,35 +229,6 @@ def _gap_roots(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):
             theta_g = th
             c_g = np.int64(c)
     return theta_g, c_g, q_ready
-
-
-@overload(switch_gap, jit_options=KERNEL_OPTIONS)
-def _switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats: n_tr
-    return _switch
-
-
-def _switch(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
-    """:func:`switch_gap` of kinematics that may have unilateral contacts."""
-    if P.is_open(cst, c):
-        record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-        if E.close_contact(y, cst, c, md, rtol, atol, F, N):
-            stats[4] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
-            n_tr += 1
-    else:
-        if np.int64(cst[CST * c]) == P.MODE_STICK:
-            stats[5] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
-            n_tr += 1
-        cst[CST * c] = P.MODE_OPEN
-        cst[CST * c + 3] = math.inf
-        record_transition(n_tr, t, E.TRANSITION_OPEN, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-    P.project_velocities(y, cst, np.int64(-1), md)  # the sticking set's constraints, after the change
-    return settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
 
 
 @loop

@@ -30,11 +30,6 @@ from .contacts import (EVENT_SLIP, EVENT_STICK, EVENT_TIME_TOL, STICK_SPEED_TOL,
                        TRANSITION_TO_STICK, all_finite, breakaway_direction, dense_state, event_value, first_crossing,
                        try_stick)
 
-#: Largest number of bisections of one transition bracket (fixed-step methods): the bracket
-#: halves each time, so 200 is far more than the ~40 needed to go from Δt = 0.1 s to
-#: EVENT_TIME_TOL.
-MAX_BISECTIONS = 200
-
 #: First half-width, as a fraction of the step, of the bracket that bisection on re-stepping
 #: (the fixed-step methods) tries around the root of the event on the step's cubic Hermite
 #: interpolant (:func:`bisection_point`), widened ×10 while the root lies outside. AEOM's
@@ -88,8 +83,13 @@ def bisection_point(a, b, estimate, h):
     halved. Every trial narrows the bracket, so a poor estimate costs a few trials and never
     the result. With a good one the halving starts from a bracket of ~1e-7 of the step instead
     of the whole step (AEOM at Δt = 1e-3 s: ~12 re-steps per breakaway instead of 31).
+
+    Every trial lies strictly inside (a, b), so the search ends: ~40 halvings take a bracket
+    from Δt = 0.1 s to the tolerance, and a bracket that no longer halves in floating point (or
+    a step length that is not a finite number) ends it as well.
     """
-    if (b - a) * h <= EVENT_TIME_TOL:
+    mid = 0.5 * (a + b)
+    if not ((b - a) * h > EVENT_TIME_TOL and a < mid < b and h < math.inf):
         return -1.0
     if estimate > 0.0:
         w = ROOT_BRACKET
@@ -99,7 +99,28 @@ def bisection_point(a, b, estimate, h):
             if a < estimate + w < b:
                 return estimate + w
             w *= 10.0
-    return 0.5 * (a + b)
+    return mid
+
+
+@kernel
+def first_trial(estimate, h):
+    """Start of the search for a root inside a step of length ``h`` [s] that ends past it: the
+    bracket [a, b] = [0, 1] (fractions of the step), where the step's end state stands (θ = 1),
+    and the first θ to re-take the step to (:func:`bisection_point`). Returns (a, b, at, θ)."""
+    return 0.0, 1.0, 1.0, bisection_point(0.0, 1.0, estimate, h)
+
+
+@kernel
+def narrowed(a, b, theta, before_root, estimate, h):
+    """The bracket after the step was re-taken to ``theta``: [θ, b] when that step still ends
+    before the root (``before_root``), else [a, θ]. Returns (a, b, at, next θ) with ``at`` = θ,
+    where the end state now stands, and the next trial from :func:`bisection_point` (−1.0 once
+    the bracket is short enough: the caller then re-takes the step to b unless ``at`` is b)."""
+    if before_root:
+        a = theta
+    else:
+        b = theta
+    return a, b, theta, bisection_point(a, b, estimate, h)
 
 
 @kernel

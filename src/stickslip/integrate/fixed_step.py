@@ -136,23 +136,13 @@ def slip_step_with_event(y, K, h, rx, ry, cst, md, ynew, fnew, ytmp, F, N, v, st
     if v1x * rx + v1y * ry > 0.0:  # the slip event v_r·e0 (events.EVENT_SLIP) stays positive
         return h, False, v1x, v1y, F1x, F1y
     contact = np.int64(0)
-    a = 0.0
-    b = 1.0
-    at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
-    for _ in range(E.MAX_BISECTIONS):
-        c = E.bisection_point(a, b, -1.0, h)
-        if c < 0.0:
-            break
+    a, b, at, c = E.first_trial(-1.0, h)
+    while c >= 0.0:
         stats[2] += rk4_slip_step(y, K, c * h, cst, md, ynew, ytmp)
         stats[3] += 1
         vx, vy = P.slip_velocity(ynew, contact, md)
-        if vx * rx + vy * ry > 0.0:
-            a = c
-            at_b = False
-        else:
-            b = c
-            at_b = True
-    if not at_b:
+        a, b, at, c = E.narrowed(a, b, c, vx * rx + vy * ry > 0.0, -1.0, h)
+    if at != b:  # the last step re-taken ends before the root: re-take it to b
         stats[2] += rk4_slip_step(y, K, b * h, cst, md, ynew, ytmp)
         stats[3] += 1
     F1x, F1y, v1x, v1y, _ = derivative_and_contact(ynew, cst, md, fnew, F, N, v)

@@ -173,22 +173,12 @@ def aeom_stick_branch(y, K, h, stick, md, ynew, fnew, ytmp, Q, work, F, N, v, st
     if limit - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
         return h, 0, Fx, Fy
     estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, fnew, h, stick, md, Q, work, F, N)
-    a = 0.0
-    b = 1.0
-    at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
-    for _ in range(E.MAX_BISECTIONS):
-        c = E.bisection_point(a, b, estimate, h)
-        if c < 0.0:
-            break
+    a, b, at, c = E.first_trial(estimate, h)
+    while c >= 0.0:
         stats[2] += aeom_stick_step(y, K, c * h, stick, md, ynew, ytmp)
         stats[3] += 1
-        if E.stick_margin(ynew, stick, md, F, N) > 0.0:
-            a = c
-            at_b = False
-        else:
-            b = c
-            at_b = True
-    if not at_b:
+        a, b, at, c = E.narrowed(a, b, c, E.stick_margin(ynew, stick, md, F, N) > 0.0, estimate, h)
+    if at != b:  # the last step re-taken ends before the root: re-take it to b
         stats[2] += aeom_stick_step(y, K, b * h, stick, md, ynew, ytmp)
         stats[3] += 1
     Fx, Fy, _, _, _ = derivative_and_contact(ynew, stick, md, fnew, F, N, v)

@@ -183,24 +183,14 @@ def naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, K, Q, F, N, stats):
         derivative_under_force(y, Fx, Fy, md, K[0])
         derivative_under_force(ynew, Fx, Fy, md, K[1])
         estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, K[1], h, stick, md, Q, ytmp, F, N)
-        a = 0.0
-        b = 1.0
-        at_b = True  # whether ynew is the step to b (a trial to a leaves it at a)
-        for _ in range(E.MAX_BISECTIONS):
-            c = E.bisection_point(a, b, estimate, h)
-            if c < 0.0:
-                break
+        a, b, at, c = E.first_trial(estimate, h)
+        while c >= 0.0:
             Fx, Fy, it = solve_stick_step(y, c * h, Fx, Fy, md, ynew, ytmp, K, stats)
             stats[3] += 1
             if it < 0:
                 return h, 0, Fx, Fy, False
-            if E.stick_margin(ynew, stick, md, F, N) > 0.0:
-                a = c
-                at_b = False
-            else:
-                b = c
-                at_b = True
-        if not at_b:
+            a, b, at, c = E.narrowed(a, b, c, E.stick_margin(ynew, stick, md, F, N) > 0.0, estimate, h)
+        if at != b:  # the last step re-taken ends before the root: re-take it to b
             Fx, Fy, it = solve_stick_step(y, b * h, Fx, Fy, md, ynew, ytmp, K, stats)
             stats[3] += 1
             if it < 0:

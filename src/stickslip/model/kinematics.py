@@ -34,6 +34,7 @@ acceleration bias Ġ q̇ are taken by complex step): use ``np.sin``, ``np.cos``,
 
 from __future__ import annotations
 
+import inspect
 from typing import Callable, NamedTuple
 
 import numpy as np
@@ -48,7 +49,7 @@ from .jit import KERNEL_OPTIONS, kernel, track_user_code
 
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
-           "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only"]
+           "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel"]
 
 
 #: Registered frame functions by kinematics class.
@@ -120,6 +121,30 @@ def pressed_only(kin_type) -> bool:
     registered without unilateral contacts (the overloads of :mod:`stickslip.model.normal` then
     compile none of their code)."""
     return getattr(kin_type, "instance_class", None) in _PRESSED_ONLY
+
+
+def unilateral_kernel(pressed: Callable, *, inline: str = "never") -> Callable:
+    """Decorator for a kernel that only kinematics with unilateral contacts need.
+
+    Numba resolves each call of the decorated function at compile time by the type of its
+    argument ``md``: for a kinematics class registered without unilateral contacts
+    (:func:`pressed_only`) it compiles ``pressed`` instead (the same argument names; a constant,
+    the identity or nothing), so those kernels compile none of the decorated code. ``inline`` is
+    numba's overload option (``"always"`` for the small ones). Returns the decorated function,
+    the name compiled code calls (it is never run by Python).
+    """
+    def register(impl: Callable) -> Callable:
+        signature = inspect.signature(impl)
+        at = list(signature.parameters).index("md")
+
+        def choose(*args):
+            md = args[at]
+            return pressed if pressed_only(md.types[md.fields.index("kin")]) else impl
+
+        choose.__signature__ = signature  # numba checks each implementation against it
+        overload(impl, jit_options=KERNEL_OPTIONS, inline=inline)(choose)
+        return impl
+    return register
 
 
 def registered_kinematics() -> tuple[type, ...]:

@@ -33,13 +33,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from numba.extending import overload
-
 from . import csmath as csm
 from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, NORMAL_PRESCRIBED, contact_offsets,
                      gap_offset)
-from .jit import KERNEL_OPTIONS, inlined_kernel
-from .kinematics import has_unilateral, model_sizes, pressed_only
+from .jit import inlined_kernel
+from .kinematics import has_unilateral, model_sizes, unilateral_kernel
 
 __all__ = ["MODE_OPEN", "is_open", "is_unilateral", "gap_and_rate", "compliant_force", "contact_indicator",
            "add_normal_force", "add_normal_forces", "normal_in_mode", "starts_open", "open_in_mode", "indicator_of"]
@@ -104,86 +102,44 @@ def add_normal_force(m, n, c, lam, f):
         f[j] += m[og + j] * lam
 
 
-def add_normal_forces(cst, md, n, nc, N, f):  # pragma: no cover - resolved by numba (overload below)
+@unilateral_kernel(lambda cst, md, n, nc, N, f: None, inline="always")
+def add_normal_forces(cst, md, n, nc, N, f):  # pragma: no cover - compiled only
     """f += Wᵀ λ for every closed unilateral contact (λ = N[c], its normal force)."""
-    raise NotImplementedError
+    if has_unilateral(md.kin, md.m):
+        for c in range(nc):
+            if is_unilateral(md, n, c) and not is_open(cst, c):
+                add_normal_force(md.m, n, c, N[c], f)
 
 
-@overload(add_normal_forces, jit_options=KERNEL_OPTIONS, inline="always")
-def _add_normal_forces(cst, md, n, nc, N, f):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda cst, md, n, nc, N, f: None
-
-    def add(cst, md, n, nc, N, f):
-        if has_unilateral(md.kin, md.m):
-            for c in range(nc):
-                if is_unilateral(md, n, c) and not is_open(cst, c):
-                    add_normal_force(md.m, n, c, N[c], f)
-    return add
-
-
-def normal_in_mode(s, cst, md, n, c, normal):  # pragma: no cover - resolved by numba (overload below)
+@unilateral_kernel(lambda s, cst, md, n, c, normal: normal, inline="always")
+def normal_in_mode(s, cst, md, n, c, normal):  # pragma: no cover - compiled only
     """Normal force of contact ``c`` in its mode, given ``normal`` as its frame returned it: the
     frame's for a pressed contact; 0 for an open unilateral one; for a closed one λ̃ (which constant
     kinematics return from the frame already)."""
-    raise NotImplementedError
+    if not is_unilateral(md, n, c):
+        return normal
+    if is_open(cst, c):
+        return csm.zero(normal)
+    if md.m[H_CONSTANT] != 0.0:
+        return normal
+    return compliant_force(s, md.m, n, c) + csm.zero(normal)
 
 
-@overload(normal_in_mode, jit_options=KERNEL_OPTIONS, inline="always")
-def _normal_in_mode(s, cst, md, n, c, normal):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda s, cst, md, n, c, normal: normal
-
-    def in_mode(s, cst, md, n, c, normal):
-        if not is_unilateral(md, n, c):
-            return normal
-        if is_open(cst, c):
-            return csm.zero(normal)
-        if md.m[H_CONSTANT] != 0.0:
-            return normal
-        return compliant_force(s, md.m, n, c) + csm.zero(normal)
-    return in_mode
-
-
-def open_in_mode(cst, md, c):  # pragma: no cover - resolved by numba (overload below)
+@unilateral_kernel(lambda cst, md, c: False, inline="always")
+def open_in_mode(cst, md, c):  # pragma: no cover - compiled only
     """Whether contact ``c`` is open in ``cst`` (False at compile time for pressed-only kinematics)."""
-    raise NotImplementedError
+    return is_open(cst, c)
 
 
-@overload(open_in_mode, jit_options=KERNEL_OPTIONS, inline="always")
-def _open_in_mode(cst, md, c):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda cst, md, c: False
-    return lambda cst, md, c: is_open(cst, c)
-
-
-def indicator_of(s, cst, c, md):  # pragma: no cover - resolved by numba (overload below)
+@unilateral_kernel(lambda s, cst, c, md: 1.0 + csm.zero(s[0]))
+def indicator_of(s, cst, c, md):  # pragma: no cover - compiled only
     """:func:`contact_indicator` of contact ``c`` (1.0 for pressed-only kinematics, never an event)."""
-    raise NotImplementedError
+    return contact_indicator(s, cst, md.m, model_sizes(md.kin, md.m)[0], c)
 
 
-@overload(indicator_of, jit_options=KERNEL_OPTIONS)
-def _indicator_of(s, cst, c, md):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda s, cst, c, md: 1.0 + csm.zero(s[0])
-
-    def indicator(s, cst, c, md):
-        return contact_indicator(s, cst, md.m, model_sizes(md.kin, md.m)[0], c)
-    return indicator
-
-
-def starts_open(y, cst, c, md):  # pragma: no cover - resolved by numba (overload below)
+@unilateral_kernel(lambda y, cst, c, md: False)
+def starts_open(y, cst, c, md):  # pragma: no cover - compiled only
     """Whether unilateral contact ``c`` is open at the state ``y`` (its indicator ≤ 0 when closed);
     False for a pressed contact."""
-    raise NotImplementedError
-
-
-@overload(starts_open, jit_options=KERNEL_OPTIONS)
-def _starts_open(y, cst, c, md):
-    if pressed_only(md.types[md.fields.index("kin")]):
-        return lambda y, cst, c, md: False
-
-    def is_open_at(y, cst, c, md):
-        n = model_sizes(md.kin, md.m)[0]
-        return is_unilateral(md, n, c) and contact_indicator(y, cst, md.m, n, c) <= 0.0
-    return is_open_at
+    n = model_sizes(md.kin, md.m)[0]
+    return is_unilateral(md, n, c) and contact_indicator(y, cst, md.m, n, c) <= 0.0
