@@ -57,7 +57,8 @@ def event_driven(field, phi, slip_speed, stick_force, limit, t_eval, y0):
                         events=events, dense_output=True)
         t1 = sol.t[-1]
         sel = (t_eval >= t0) & (t_eval <= t1)
-        out[sel] = sol.sol(t_eval[sel]).T
+        if sel.any():  # a segment between two close events may hold no sample
+            out[sel] = sol.sol(t_eval[sel]).T
         t0, s = t1, sol.y[:, -1]
         if sol.status != 1:
             break

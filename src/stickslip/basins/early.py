@@ -362,7 +362,9 @@ def classify_state(ctx: Context, model, s0: np.ndarray, cycles, opts: Options) -
 def _cycle(section: Section, traj, verdict) -> Cycle:
     """The features of the window's settled periodic verdict."""
     window = verdict.classification
-    # the open fraction over the whole periods that end the window (exact for a settled cycle)
+    # the stick and open fractions over the whole periods that end the window, from the located
+    # transitions (exact for a settled cycle, wherever the window starts in it)
     whole = math.floor((window.t_to - window.t_from) / verdict.period_s) * verdict.period_s
+    steady = traj.steady_state(window.t_to - whole)
     return cycle_from_section(section, traj.t, traj.states, verdict.period_count, verdict.period_s,
-                              window.stick_fraction, traj.steady_state(window.t_to - whole).open_fraction)
+                              steady.stick_fraction, steady.open_fraction)
