@@ -29,7 +29,7 @@ from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
 from ..model.jit import inlined_kernel, kernel
 from ..model.kinematics import model_sizes
-from ..model.normal import gap_and_rate, is_open, starts_open
+from ..model.normal import gap_and_rate, gap_with_rate, is_open, starts_open
 
 __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP",
            "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_KINDS", "EVENT_TIME_TOL", "close_contact",
@@ -271,8 +271,8 @@ def gap_dip(y0, dy0, y1, dy1, h, cst, c, md):
     """
     m = md.m
     n = model_sizes(md.kin, m)[0]
-    g0, r0 = gap_and_rate(y0, m, n, c)
-    g1, r1 = gap_and_rate(y1, m, n, c)
+    g0, r0 = gap_and_rate(y0, md, n, c)
+    g1, r1 = gap_and_rate(y1, md, n, c)
     if is_open(cst, c):
         return hermite_dip(g0, h * r0, g1, h * r1)
     dip = hermite_dip(-g0, -h * r0, -g1, -h * r1)
@@ -280,8 +280,8 @@ def gap_dip(y0, dy0, y1, dy1, h, cst, c, md):
     ratio = m[o + C_NORMAL_C] / m[o + C_NORMAL_K]
     if dip > 0.0 or ratio == 0.0:
         return dip
-    a0 = gap_and_rate(dy0, m, n, c)[1]  # W·q̈ (the first value, g0 + W·q̇, is not used)
-    a1 = gap_and_rate(dy1, m, n, c)[1]
+    a0 = gap_with_rate(y0, dy0, md, n, c)[1]  # W·q̈ (of a nonlinear gap, g̈ less its q̇ᵀ ∂W/∂q q̇)
+    a1 = gap_with_rate(y1, dy1, md, n, c)[1]
     return hermite_dip(-g0 - ratio * r0, -h * (r0 + ratio * a0), -g1 - ratio * r1, -h * (r1 + ratio * a1))
 
 

@@ -261,7 +261,8 @@ class Trajectory(Plottable):
 
     @cached_property
     def gap(self) -> np.ndarray:
-        """Gap g = g0 + W·q of each unilateral contact (k, nc) [m]; NaN for pressed contacts."""
+        """Gap g of each unilateral contact (k, nc) [m] (g0 + W·q, or the kinematics' gap function); NaN
+        for pressed contacts."""
         return _gaps(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
 
     @property

@@ -249,7 +249,7 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
     base_force(s, m, n, diagonal, f)
-    add_normal_forces(cst, md, n, nc, N, f)
+    add_normal_forces(s, cst, md, n, nc, N, f)
     in_band = False
     for c in range(nc):
         mode = np.int64(cst[CST * c])
@@ -357,5 +357,5 @@ def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
     base_force(s, m, n, diagonal, f)
     for c in range(nc):
         add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
-    add_normal_forces(cst, md, n, nc, N, f)
+    add_normal_forces(s, cst, md, n, nc, N, f)
     return True

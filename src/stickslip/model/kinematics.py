@@ -49,7 +49,8 @@ from .jit import KERNEL_OPTIONS, kernel, track_user_code
 
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
-           "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel"]
+           "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel",
+           "contact_gap", "computes_gap", "gap_computed"]
 
 
 #: Registered frame functions by kinematics class.
@@ -60,13 +61,16 @@ _SIZES: dict[type, tuple] = {}
 _DIMS: dict[type, int | None] = {}
 #: Closed-form frame-and-bias functions by kinematics class (optional).
 _BIASES: dict[type, Callable] = {}
+#: Gap functions by kinematics class (optional; without one a unilateral contact's gap is g0 + W·q).
+_GAPS: dict[type, Callable] = {}
 #: Kinematics classes whose models never have unilateral contacts (their kernels compile without them).
 _PRESSED_ONLY: set[type] = set()
 
 
 def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, ncontacts: int | None = None,
                         diagonal: bool | None = None, dim: int | None = None,
-                        frame_bias: Callable | None = None, unilateral: bool = True) -> None:
+                        frame_bias: Callable | None = None, unilateral: bool = True,
+                        gap: Callable | None = None) -> None:
     """Make ``frame`` the contact frame of models whose kinematics data is a ``cls`` instance.
 
     Parameters
@@ -92,11 +96,16 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         Whether models of this kinematics may have unilateral contacts (a gap g = g0 + W·q instead
         of a prescribed load; :mod:`stickslip.model.normal`). False compiles their kernels without
         the gap's branches (the two plates, always pressed).
+    gap : numba-compilable function, optional
+        ``gap(kin, s, c, m, W) -> g``: the gap g(q) [m] of unilateral contact ``c`` at state ``s``,
+        filling ``W`` (n,) with its gradient ∂g/∂q; complex-safe like ``frame``. The contact's normal
+        force λ acts on the coordinates as W(q)ᵀ λ and its gap rate is ġ = W(q)·q̇. Without it the
+        gap is the contact's affine g0 + W·q (``Contact.gap``, ``Contact.gap_gradient``).
     """
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
     _FRAMES[cls] = frame
-    track_user_code(cls, frame, *([] if frame_bias is None else [frame_bias]))
+    track_user_code(cls, frame, *[f for f in (frame_bias, gap) if f is not None])
     _SIZES[cls] = (ndof, ncontacts, diagonal)
     _DIMS[cls] = dim
     if frame_bias is None:
@@ -105,6 +114,12 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         _BIASES[cls] = frame_bias if hasattr(frame_bias, "py_func") else njit(**KERNEL_OPTIONS)(frame_bias)
     if ndof is not None and ncontacts is not None:
         stack._STATIC[cls] = (ndof, ncontacts)
+    if gap is None:
+        _GAPS.pop(cls, None)
+    else:
+        if not unilateral:
+            raise KinematicsError(f"kinematics class {cls.__name__}: a gap function needs unilateral=True")
+        _GAPS[cls] = gap
     if unilateral:
         _PRESSED_ONLY.discard(cls)
     else:
@@ -114,6 +129,11 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
 def allows_unilateral(cls: type) -> bool:
     """Whether models of kinematics class ``cls`` may have unilateral contacts."""
     return cls not in _PRESSED_ONLY
+
+
+def computes_gap(cls: type) -> bool:
+    """Whether kinematics class ``cls`` registered a gap function (its contacts' gaps need no W)."""
+    return cls in _GAPS
 
 
 def pressed_only(kin_type) -> bool:
@@ -171,6 +191,26 @@ def _contact_frame(kin, s, c, m, G, w):
     # the Python source, compiled for each caller's types as an ordinary call (LLVM inlines it): numba's
     # IR-level inlining mis-scoped the accumulator of constant_frame's loop (a 'not in scope' warning)
     return getattr(frame, "py_func", frame)
+
+
+def contact_gap(kin, s, c, m, W):  # pragma: no cover - resolved by numba (overload below)
+    """Fill W (n,) with ∂g/∂q of unilateral contact ``c`` at state ``s`` and return its gap g [m]:
+    the gap function registered for the kinematics class (none for the others)."""
+    raise NotImplementedError("contact_gap is called from compiled code only")
+
+
+@overload(contact_gap, jit_options=KERNEL_OPTIONS)
+def _contact_gap(kin, s, c, m, W):
+    gap = _GAPS.get(getattr(kin, "instance_class", None))
+    if gap is None:
+        return None
+    return getattr(gap, "py_func", gap)
+
+
+def gap_computed(kin_type) -> bool:
+    """At compile time: whether the numba type ``kin_type`` of a kinematics object belongs to a class
+    that registered a gap function (else its gaps are the data array's affine g0 + W·q)."""
+    return getattr(kin_type, "instance_class", None) in _GAPS
 
 
 def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below)

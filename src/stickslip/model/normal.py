@@ -32,14 +32,16 @@ exist.
 from __future__ import annotations
 
 import numpy as np
+from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, NORMAL_PRESCRIBED, contact_offsets,
                      gap_offset)
-from .jit import inlined_kernel
-from .kinematics import has_unilateral, model_sizes, unilateral_kernel
+from .jit import KERNEL_OPTIONS, inlined_kernel
+from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, unilateral_kernel
+from .stack import work_vectors
 
-__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "gap_and_rate", "compliant_force", "contact_indicator",
+__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator",
            "add_normal_force", "add_normal_forces", "normal_in_mode", "starts_open", "open_in_mode", "indicator_of"]
 
 #: Mode of an open unilateral contact: no normal force, no friction (the stick and slip modes
@@ -62,53 +64,103 @@ def is_unilateral(md, n, c):
 
 
 @inlined_kernel
-def gap_and_rate(s, m, n, c):
-    """(g, ġ) = (g0 + W·q, W·q̇) of contact ``c`` [m, m/s]."""
+def affine_gap_with_rate(s, d, m, n, c):
+    """(g0 + W·q, W·d[n:2n]) of contact ``c`` with g0 and W from the data array ``m``."""
     o = contact_offsets(n, c)[0]
     og = gap_offset(n, c)
     g = m[o + C_GAP] + csm.zero(s[0])
     rate = csm.zero(s[0])
     for j in range(n):
         g += m[og + j] * s[j]
-        rate += m[og + j] * s[n + j]
+        rate += m[og + j] * d[n + j]
     return g, rate
 
 
 @inlined_kernel
-def compliant_force(s, m, n, c):
-    """λ̃ = −k g − c ġ [N] of compliant contact ``c`` (its normal force while closed)."""
-    o = contact_offsets(n, c)[0]
-    g, rate = gap_and_rate(s, m, n, c)
-    return -m[o + C_NORMAL_K] * g - m[o + C_NORMAL_C] * rate
+def computed_gap_with_rate(s, d, md, n, c):
+    """(g(q), W(q)·d[n:2n]) of contact ``c`` from the kinematics' gap function."""
+    W = work_vectors(md.kin, 1, s)[0]
+    g = contact_gap(md.kin, s, c, md.m, W)
+    rate = csm.zero(s[0])
+    for j in range(n):
+        rate += W[j] * d[n + j]
+    return g, rate
+
+
+def gap_with_rate(s, d, md, n, c):  # pragma: no cover - resolved by numba (overload below)
+    """(g(q), W(q)·d[n:2n]) of contact ``c`` at ``s`` = [q, …] (W = ∂g/∂q) [m, m/s for d = s]:
+    the gap and its rate along the velocities held in ``d`` (``s`` itself, or a derivative
+    [q̇, q̈] for W·q̈). The kinematics' gap function where it registered one, else g0 + W·q."""
+    raise NotImplementedError
+
+
+@overload(gap_with_rate, jit_options=KERNEL_OPTIONS)
+def _gap_with_rate(s, d, md, n, c):
+    # an ordinary call that LLVM inlines: numba's IR inlining of these loops, nested in the inlined
+    # kernels that call them, mis-scopes their accumulators (a 'not in scope' warning)
+    if gap_computed(md.types[md.fields.index("kin")]):
+        return computed_gap_with_rate.py_func
+    return lambda s, d, md, n, c: affine_gap_with_rate(s, d, md.m, n, c)
 
 
 @inlined_kernel
-def contact_indicator(s, cst, m, n, c):
+def gap_and_rate(s, md, n, c):
+    """(g, ġ) = (g(q), W(q)·q̇) of contact ``c`` [m, m/s]: g0 + W·q for a gap the kinematics does
+    not compute (:func:`~stickslip.model.kinematics.contact_gap`)."""
+    return gap_with_rate(s, s, md, n, c)
+
+
+@inlined_kernel
+def compliant_force(s, md, n, c):
+    """λ̃ = −k g − c ġ [N] of compliant contact ``c`` (its normal force while closed)."""
+    o = contact_offsets(n, c)[0]
+    g, rate = gap_and_rate(s, md, n, c)
+    return -md.m[o + C_NORMAL_K] * g - md.m[o + C_NORMAL_C] * rate
+
+
+@inlined_kernel
+def contact_indicator(s, cst, md, n, c):
     """φ = min(−g, λ̃) for a closed contact, −φ for an open one: > 0 while the contact stays in its
     state, its fall through 0 is the opening or closing event [m or N; only the sign matters]."""
+    m = md.m
     o = contact_offsets(n, c)[0]
-    g, rate = gap_and_rate(s, m, n, c)
+    g, rate = gap_and_rate(s, md, n, c)
     lam = -m[o + C_NORMAL_K] * g - m[o + C_NORMAL_C] * rate
     # φ in the same unit: λ̃ / k is a length (k > 0 for a compliant contact)
     phi = -g if (-g).real < (lam / m[o + C_NORMAL_K]).real else lam / m[o + C_NORMAL_K]
     return -phi if is_open(cst, c) else phi
 
 
-@inlined_kernel
-def add_normal_force(m, n, c, lam, f):
-    """f += Wᵀ λ: the normal force λ of contact ``c`` on the coordinates."""
-    og = gap_offset(n, c)
-    for j in range(n):
-        f[j] += m[og + j] * lam
+def add_normal_force(s, md, n, c, lam, f):  # pragma: no cover - resolved by numba (overload below)
+    """f += W(q)ᵀ λ: the normal force λ of contact ``c`` on the coordinates (W from the kinematics'
+    gap function where it registered one, else the data array's)."""
+    raise NotImplementedError
 
 
-@unilateral_kernel(lambda cst, md, n, nc, N, f: None, inline="always")
-def add_normal_forces(cst, md, n, nc, N, f):  # pragma: no cover - compiled only
+@overload(add_normal_force, jit_options=KERNEL_OPTIONS)
+def _add_normal_force(s, md, n, c, lam, f):
+    if gap_computed(md.types[md.fields.index("kin")]):
+        def computed(s, md, n, c, lam, f):
+            W = work_vectors(md.kin, 1, s)[0]
+            contact_gap(md.kin, s, c, md.m, W)
+            for j in range(n):
+                f[j] += W[j] * lam
+        return computed
+
+    def affine(s, md, n, c, lam, f):
+        og = gap_offset(n, c)
+        for j in range(n):
+            f[j] += md.m[og + j] * lam
+    return affine
+
+
+@unilateral_kernel(lambda s, cst, md, n, nc, N, f: None, inline="always")
+def add_normal_forces(s, cst, md, n, nc, N, f):  # pragma: no cover - compiled only
     """f += Wᵀ λ for every closed unilateral contact (λ = N[c], its normal force)."""
     if has_unilateral(md.kin, md.m):
         for c in range(nc):
             if is_unilateral(md, n, c) and not is_open(cst, c):
-                add_normal_force(md.m, n, c, N[c], f)
+                add_normal_force(s, md, n, c, N[c], f)
 
 
 @unilateral_kernel(lambda s, cst, md, n, c, normal: normal, inline="always")
@@ -122,7 +174,7 @@ def normal_in_mode(s, cst, md, n, c, normal):  # pragma: no cover - compiled onl
         return csm.zero(normal)
     if md.m[H_CONSTANT] != 0.0:
         return normal
-    return compliant_force(s, md.m, n, c) + csm.zero(normal)
+    return compliant_force(s, md, n, c) + csm.zero(normal)
 
 
 @unilateral_kernel(lambda cst, md, c: False, inline="always")
@@ -134,7 +186,7 @@ def open_in_mode(cst, md, c):  # pragma: no cover - compiled only
 @unilateral_kernel(lambda s, cst, c, md: 1.0 + csm.zero(s[0]))
 def indicator_of(s, cst, c, md):  # pragma: no cover - compiled only
     """:func:`contact_indicator` of contact ``c`` (1.0 for pressed-only kinematics, never an event)."""
-    return contact_indicator(s, cst, md.m, model_sizes(md.kin, md.m)[0], c)
+    return contact_indicator(s, cst, md, model_sizes(md.kin, md.m)[0], c)
 
 
 @unilateral_kernel(lambda y, cst, c, md: False)
@@ -142,4 +194,4 @@ def starts_open(y, cst, c, md):  # pragma: no cover - compiled only
     """Whether unilateral contact ``c`` is open at the state ``y`` (its indicator ≤ 0 when closed);
     False for a pressed contact."""
     n = model_sizes(md.kin, md.m)[0]
-    return is_unilateral(md, n, c) and contact_indicator(y, cst, md.m, n, c) <= 0.0
+    return is_unilateral(md, n, c) and contact_indicator(y, cst, md, n, c) <= 0.0

@@ -232,7 +232,7 @@ def indicator(s, cst, c, md):
 @kernel
 def gap(s, c, md):
     """(g, ġ) of unilateral contact ``c`` at ``s`` [m, m/s]."""
-    return gap_and_rate(s, md.m, model_sizes(md.kin, md.m)[0], c)
+    return gap_and_rate(s, md, model_sizes(md.kin, md.m)[0], c)
 
 
 @kernel

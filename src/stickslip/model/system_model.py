@@ -31,7 +31,7 @@ from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
 from .bundle import NORMAL_LAWS
 from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantUnilateralKinematics, allows_unilateral,
-                         registered_kinematics)
+                         computes_gap, registered_kinematics)
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
@@ -163,9 +163,10 @@ class Contact:
     normal : NormalLaw, optional
         The normal law of a unilateral contact; None for a prescribed load.
     gap : float
-        g0 [m] of the gap g = g0 + W·q of a unilateral contact (closed while g ≤ 0).
+        g0 [m] of the gap g = g0 + W·q of a unilateral contact (closed while g ≤ 0); 0 when the
+        kinematics computes the gap (``register_kinematics(..., gap=...)``).
     gap_gradient : ndarray (n,), optional
-        W [m per unit of each dof] of a unilateral contact.
+        W [m per unit of each dof] of a unilateral contact; None when the kinematics computes the gap.
     """
 
     dim: int
@@ -194,7 +195,8 @@ class Contact:
             out["G"] = self.tangent
             out["w"] = self.drive
         if self.normal is not None:
-            k, c, W = self.normal.stiffness, self.normal.damping, np.asarray(self.gap_gradient, dtype=float)
+            k, c = self.normal.stiffness, self.normal.damping
+            W = np.zeros(n) if self.gap_gradient is None else np.asarray(self.gap_gradient, dtype=float)
             # closed, the compliant force −k (g0 + W·q) − c W·q̇ is the affine N0 + n·q + n_v·q̇ of the
             # constant kinematics' frame
             out.update(normal_law=NORMAL_LAWS[self.normal.law], gap=self.gap, W=W, k=k, c=c,
@@ -411,6 +413,11 @@ class FrictionModel:
         contact.normal.check(f"{where}: normal")
         if not math.isfinite(contact.gap):
             raise ModelError(f"{where}: gap = {contact.gap} must be finite [m]")
+        if computes_gap(type(self.kinematics)):
+            if contact.gap != 0.0 or contact.gap_gradient is not None:
+                raise ModelError(f"{where}: kinematics {type(self.kinematics).__name__} computes the gap (its "
+                                 "registered gap function); give neither gap nor gap_gradient")
+            return
         W = None if contact.gap_gradient is None else np.array(contact.gap_gradient, dtype=float).reshape(-1)
         if W is None or W.shape != (self.n,) or not np.isfinite(W).all():
             raise ModelError(f"{where}: gap_gradient must be {self.n} finite numbers (W of g = g0 + W·q)")

@@ -35,7 +35,7 @@ from ..analysis.signal import open_time as signal_open_time
 from ..analysis.signal import stick_time as signal_stick_time
 from ..errors import OrbitError, SimulationError
 from ..model.bundle import CST
-from ..model.physics import MODE_STICK
+from ..model.physics import MODE_STICK, gap
 from ..model.system_model import FrictionModel
 from . import linear_flow as _lin
 from .layout import free_states, resting_contacts, stick_projected
@@ -189,17 +189,17 @@ def open_time(transitions, period: float, system: FrictionModel, state: np.ndarr
 
     ``transitions`` are those of the run over one period ``period`` from ``state``. A contact
     whose first opening or closing in the run is a closing was open at the start; one with
-    neither is open all period if its gap g = g0 + W·q is positive at ``state``, else closed.
+    neither is open all period if its gap is positive at ``state``, else closed.
     """
     nc = system.n_contacts
-    n = system.n
+    start = np.ascontiguousarray(state, dtype=float)
     flags = 0
     for c, contact in enumerate(system.contacts):
         if not contact.unilateral:
             continue
         mine = (transitions.contact == c) & ((transitions.kind == OPEN) | (transitions.kind == CLOSE))
         kinds = transitions.kind[mine]
-        was_open = kinds[0] == CLOSE if kinds.size else contact.gap + float(contact.gap_gradient @ state[:n]) > 0.0
+        was_open = kinds[0] == CLOSE if kinds.size else gap(start, c, system.data)[0] > 0.0
         flags |= int(bool(was_open)) << (nc + c)
     total, _ = signal_open_time(0.0, period, flags, transitions.time, transitions.kind, transitions.contact, nc)
     return float(total)
