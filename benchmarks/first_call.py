@@ -3,11 +3,18 @@
 What a new user waits for: each command is run as its own process (as a user runs it), first with
 ``NUMBA_CACHE_DIR`` a new empty folder, then again with that folder filled. The model-file
 commands (``simulate``, ``stability``, ``orbit`` of a two-mass belt written as a model file) run
-one after the other on one cache, as a first sitting with one's own model does. With
+one after the other on one cache, as a first sitting with one's own model does; ``sweep`` and
+``basins`` (of the belt) each start from an empty cache. The last row is the loop a researcher
+lives in: a Python model whose kinematics is defined in a module of its own is simulated once
+(filling the cache), its frame function is edited, and the next ``simulate`` is timed.
+
+With ``--rev REV`` every row is also run with the package at a git revision (``git archive`` of
+``src/stickslip`` into a temporary folder, put first on ``PYTHONPATH``), one command after the
+other alternately, so that both columns see the same machine: the before/after table. With
 ``--breakdown`` it also compiles the default ``simulate`` in this process with numba's compile
 events recorded, and prints the outermost kernels by compile time (what a cold start is made of).
 
-    python benchmarks/first_call.py [--breakdown] [--top 15]
+    python benchmarks/first_call.py [--rev REV] [--only simulate,basins] [--breakdown] [--top 15]
 Writes benchmarks/results/first_call.json.
 """
 
@@ -15,11 +22,14 @@ from __future__ import annotations
 
 import argparse
 import collections
+import io
 import json
 import os
 import subprocess
 import sys
+import tarfile
 import tempfile
+import textwrap
 import time
 from pathlib import Path
 
@@ -33,17 +43,82 @@ COMMANDS = [
     ("stability (model file)", ["stability", "--model", str(MODEL_FILE), "--json"], False),
     ("orbit (model file)", ["orbit", "--model", str(MODEL_FILE), "--search-time", "30", "--json", "--no-plot",
                             "--out", "{tmp}/orbit.nc"], False),
+    ("sweep (belt, 4 points)", ["sweep", "--model", "belt", "--grid", "contact.0.drive=0.5:2:4", "--t-end", "50",
+                                "--out", "{tmp}/sweep.nc", "--no-plot"], True),
+    ("basins (belt, 16 states)", ["basins", "--model", "belt", "--box", "x=-1:1", "--box", "dx=-1:1", "--grid", "4",
+                                  "--t-end", "100", "--out", "{tmp}/basins.nc", "--no-plot"], True),
 ]
 
+#: A Python model whose kinematics lives in a module of its own (the frame's gain is edited).
+USER_MODULE = textwrap.dedent('''
+    from typing import NamedTuple
+    from stickslip.model import Contact, FrictionLaw, FrictionModel, register_kinematics
+    from stickslip.model import csmath as csm
 
-def _run(args, cache: Path, tmp: Path) -> dict:
+    class Arm(NamedTuple):
+        H: float
+        V: float
+
+    def arm_frame(kin, s, c, m, G, w):
+        cos = csm.cos(s[0])
+        G[0, 0] = GAIN * kin.H / (cos * cos)
+        G[1, 0] = 0.0
+        w[0] = kin.V
+        w[1] = 0.0
+        return 1.0 + csm.zero(s[0])
+
+    register_kinematics(Arm, arm_frame, ndof=1, ncontacts=1, dim=1)
+
+    def model():
+        return FrictionModel(name="arm", dofs=("theta",), mass=[[1.0]], damping=[[0.02]], stiffness=[[1.0]],
+                             force=[0.0], contacts=(Contact(dim=1, friction=FrictionLaw("coulomb", 0.2, 0.1),
+                                                            normal_force=1.0),), kinematics=Arm(1.0, 0.1))
+    ''')
+USER_RUN = "import user_arm, stickslip; stickslip.simulate(user_arm.model(), 60.0, ic=[0.0, 0.1])"
+EDITED = "after editing a Python model's frame"
+
+
+def baseline_tree(rev: str, into: Path) -> Path:
+    """``src/stickslip`` at ``rev`` extracted under ``into``; returns the folder to put on PYTHONPATH."""
+    data = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "src/stickslip"], check=True,
+                          capture_output=True).stdout
+    with tarfile.open(fileobj=io.BytesIO(data)) as tar:
+        tar.extractall(into, filter="data")
+    return into / "src"
+
+
+def _env(cache: Path, tree: Path | None, extra: Path | None = None) -> dict:
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
-    args = [a.replace("{tmp}", str(tmp)) for a in args]
+    paths = [str(p) for p in (tree, extra) if p is not None]
+    if paths:
+        env["PYTHONPATH"] = os.pathsep.join(paths + [env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    return env
+
+
+def _timed(command, env, cwd) -> dict:
     start = time.perf_counter()
-    res = subprocess.run([sys.executable, "-c", "from stickslip.cli import app; app()", *args], env=env,
-                         capture_output=True, text=True, cwd=tmp)
+    res = subprocess.run(command, env=env, capture_output=True, text=True, cwd=cwd)
     return {"seconds": time.perf_counter() - start, "exit": res.returncode,
             "stderr_tail": res.stderr.strip().splitlines()[-1:] if res.returncode else []}
+
+
+def edited_model(root: Path, tree: Path | None) -> dict:
+    """Seconds of a ``simulate`` of the Python model after its frame was edited (the cache filled
+    with the unedited one first); the run before the edit is not timed."""
+    folder = Path(tempfile.mkdtemp(dir=root, prefix="user"))
+    cache = Path(tempfile.mkdtemp(dir=root, prefix="cache"))
+    module = folder / "user_arm.py"
+    module.write_text("GAIN = 1.0\n" + USER_MODULE)
+    first = _timed([sys.executable, "-c", USER_RUN], _env(cache, tree, folder), folder)
+    module.write_text("GAIN = 1.0000001\n" + USER_MODULE)
+    edited = _timed([sys.executable, "-c", USER_RUN], _env(cache, tree, folder), folder)
+    edited["empty_cache_s"] = first["seconds"]
+    return edited
+
+
+def _run(args, cache: Path, tmp: Path, tree: Path | None = None) -> dict:
+    args = [a.replace("{tmp}", str(tmp)) for a in args]
+    return _timed([sys.executable, "-c", "from stickslip.cli import app; app()", *args], _env(cache, tree), tmp)
 
 
 def breakdown(top: int) -> list[dict]:
@@ -78,24 +153,46 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--breakdown", action="store_true", help="also list the kernels a cold simulate compiles")
     ap.add_argument("--top", type=int, default=15)
+    ap.add_argument("--rev", default=None, help="also run every row with the package at this git revision")
+    ap.add_argument("--only", default=None, help="comma-separated words; the rows whose label has one of them")
     args = ap.parse_args()
-    rows = []
+    words = None if args.only is None else [w.strip() for w in args.only.split(",") if w.strip()]
+    chosen = [c for c in COMMANDS if words is None or any(w in c[0] for w in words)]
     with tempfile.TemporaryDirectory() as tmp_root:
-        cache = Path(tmp_root) / "cache"
-        for label, cli_args, fresh in COMMANDS:
-            if fresh:
-                cache = Path(tempfile.mkdtemp(dir=tmp_root, prefix="cache"))
-            work = Path(tempfile.mkdtemp(dir=tmp_root, prefix="work"))
-            cold = _run(cli_args, cache, work)
-            work = Path(tempfile.mkdtemp(dir=tmp_root, prefix="work"))
-            warm = _run(cli_args, cache, work)
-            rows.append({"command": label, "empty_cache_s": round(cold["seconds"], 2), "cached_s": round(warm["seconds"], 2),
-                         "exit": [cold["exit"], warm["exit"]], "error": cold["stderr_tail"] + warm["stderr_tail"]})
-            print(f"{label:<24} empty cache {cold['seconds']:6.1f} s   cached {warm['seconds']:5.1f} s"
-                  + (f"   exit {cold['exit']}/{warm['exit']}: {rows[-1]['error']}" if cold["exit"] or warm["exit"] else ""))
-    sitting = sum(r["empty_cache_s"] for r in rows[1:])
-    print(f"a new model file: simulate, stability, orbit from an empty cache: {sitting:.1f} s together")
-    out = {"commands": rows, "model_file_sitting_s": round(sitting, 2)}
+        trees = {"working tree": None}
+        if args.rev:
+            trees[args.rev] = baseline_tree(args.rev, Path(tmp_root) / "baseline")
+        rows = {name: [] for name in trees}
+        caches = {name: Path(tmp_root) / f"cache-{i}" for i, name in enumerate(trees)}
+        for label, cli_args, fresh in chosen:
+            for i, (name, tree) in enumerate(trees.items()):
+                if fresh:
+                    caches[name] = Path(tempfile.mkdtemp(dir=tmp_root, prefix=f"cache{i}-"))
+                cold = _run(cli_args, caches[name], Path(tempfile.mkdtemp(dir=tmp_root, prefix="work")), tree)
+                warm = _run(cli_args, caches[name], Path(tempfile.mkdtemp(dir=tmp_root, prefix="work")), tree)
+                rows[name].append({"command": label, "empty_cache_s": round(cold["seconds"], 2),
+                                   "cached_s": round(warm["seconds"], 2), "exit": [cold["exit"], warm["exit"]],
+                                   "error": cold["stderr_tail"] + warm["stderr_tail"]})
+        if words is None or any(w in EDITED for w in words):
+            for name, tree in trees.items():
+                edit = edited_model(Path(tmp_root), tree)
+                rows[name].append({"command": EDITED, "empty_cache_s": round(edit["empty_cache_s"], 2),
+                                   "cached_s": round(edit["seconds"], 2), "exit": [edit["exit"], edit["exit"]],
+                                   "error": edit["stderr_tail"]})
+    out = {}
+    for name, table in rows.items():
+        print(f"-- {name}")
+        for r in table:
+            print(f"{r['command']:<38} empty cache {r['empty_cache_s']:6.1f} s   cached {r['cached_s']:5.1f} s"
+                  + (f"   exit {r['exit']}: {r['error']}" if any(r["exit"]) else ""))
+        sitting = sum(r["empty_cache_s"] for r in table if "model file" in r["command"])
+        if sitting:
+            print(f"a new model file: simulate, stability, orbit from an empty cache: {sitting:.1f} s together")
+        out[name] = {"commands": table, "model_file_sitting_s": round(sitting, 2)}
+    if args.rev:
+        for new, old in zip(rows["working tree"], rows[args.rev]):
+            print(f"{new['command']:<38} empty cache {new['empty_cache_s']:6.1f} s against {old['empty_cache_s']:6.1f} s "
+                  f"at {args.rev} ({new['empty_cache_s'] / old['empty_cache_s']:.2f})")
     if args.breakdown:
         out["simulate_kernels"] = breakdown(args.top)
         for row in out["simulate_kernels"]:
