@@ -20,7 +20,6 @@ thrown off again.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -28,44 +27,16 @@ from scipy.optimize import fsolve
 
 import stickslip
 from stickslip.analysis.signal import CLOSE, OPEN, SLIP, STICK
-from stickslip.model import Contact, FrictionLaw, FrictionModel, ModelError, register_kinematics
+from stickslip.model import Contact, FrictionLaw, FrictionModel, ModelError
 from stickslip.model.system_model import NormalLaw
-from stickslip.model import csmath as csm
 
+from .arm_kinematics import HingedArm
 from .event_reference import OPEN_MODE, STICK_MODE, event_driven
 
 J, C, K, L, H, V = 1.0, 0.05, 1.0, 1.0, 0.9, 0.2
 MY, CY, KY, P = 1.0, 0.1, 1.0, 1.0
 KC, MU_K, DELTA_MU = 50.0, 0.3, 0.2
 T_END = 60.0
-
-
-class HingedArm(NamedTuple):
-    """Kinematics data: arm length L, hinge height H at y = 0, belt speed V."""
-
-    L: float
-    H: float
-    V: float
-
-
-def arm_frame(kin, s, c, m, G, w):
-    cos = csm.cos(s[0])
-    G[0, 0] = kin.L * cos
-    G[0, 1] = 0.0
-    G[1, 0] = 0.0
-    G[1, 1] = 0.0
-    w[0] = kin.V
-    w[1] = 0.0
-    return csm.zero(s[0])
-
-
-def arm_gap(kin, s, c, m, W):
-    W[0] = kin.L * csm.sin(s[0])
-    W[1] = 1.0
-    return kin.H + s[1] - kin.L * csm.cos(s[0])
-
-
-register_kinematics(HingedArm, arm_frame, ndof=2, ncontacts=1, dim=1, gap=arm_gap)
 
 
 def hinged_arm(contact_damping=0.0, **contact) -> FrictionModel:

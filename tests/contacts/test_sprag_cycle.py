@@ -26,7 +26,6 @@ off, the arm springs back past α in flight and lands again.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -34,10 +33,10 @@ from scipy.optimize import brentq
 
 import stickslip
 from stickslip.analysis.signal import CLOSE, OPEN, SLIP, STICK
-from stickslip.model import Contact, FrictionLaw, FrictionModel, register_kinematics
+from stickslip.model import Contact, FrictionLaw, FrictionModel
 from stickslip.model.system_model import NormalLaw
-from stickslip.model import csmath as csm
 
+from .arm_kinematics import HingedArm
 from .event_reference import OPEN_MODE, STICK_MODE, event_driven
 
 J, C, K, ALPHA, L, V = 0.1, 0.05, 5.0, 0.6, 1.0, -0.2
@@ -47,40 +46,13 @@ H = P / KY + L * math.cos(ALPHA) - DELTA
 T_END, RATE = 80.0, 100.0
 
 
-class SpragArm(NamedTuple):
-    """Kinematics data: arm length L, hinge height H at y = 0, belt speed V."""
-
-    L: float
-    H: float
-    V: float
-
-
-def sprag_frame(kin, s, c, m, G, w):
-    G[0, 0] = kin.L * csm.cos(s[0])
-    G[0, 1] = 0.0
-    G[1, 0] = 0.0
-    G[1, 1] = 0.0
-    w[0] = kin.V
-    w[1] = 0.0
-    return csm.zero(s[0])
-
-
-def sprag_gap(kin, s, c, m, W):
-    W[0] = kin.L * csm.sin(s[0])
-    W[1] = 1.0
-    return kin.H + s[1] - kin.L * csm.cos(s[0])
-
-
-register_kinematics(SpragArm, sprag_frame, ndof=2, ncontacts=1, dim=1, gap=sprag_gap)
-
-
 def sprag_arm() -> FrictionModel:
     return FrictionModel(
         name="sprag-arm", dofs=("theta", "y"), mass=[[J, 0.0], [0.0, MY]], damping=[[C, 0.0], [0.0, CY]],
         stiffness=[[K, 0.0], [0.0, KY]], force=[K * ALPHA, -P],
         contacts=(Contact(dim=1, friction=FrictionLaw("coulomb", MU_K, DELTA_MU),
                           normal=NormalLaw("compliant", KC, 0.0), name="tip"),),
-        kinematics=SpragArm(L, H, V), units={"theta": "rad", "y": "m"})
+        kinematics=HingedArm(L, H, V), units={"theta": "rad", "y": "m"})
 
 
 def gap(s):
