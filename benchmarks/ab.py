@@ -72,7 +72,9 @@ def main() -> None:
         if args.model is not None:
             ic = dict(item.split("=") for item in args.ic.split(",")) if args.ic else None
             ic = None if ic is None else {k: float(v) for k, v in ic.items()}
-            kw.update(method="event", dt=args.dt, ic=ic)  # dt of the event method: its largest step
+            kw.update(method="event", dt=args.dt)  # dt of the event method: its largest step
+            if ic is not None:
+                kw["ic"] = ic
             cases = [({}, args.t_end)]
         context = multiprocessing.get_context("spawn")
         workers = []
@@ -82,8 +84,10 @@ def main() -> None:
             proc.start()
             workers.append((proc, mine))
         for _, pipe in workers:  # each compiles (or loads) its kernels outside the timing
-            if pipe.recv() != "ready":
-                raise SystemExit("a worker failed to start")
+            try:
+                pipe.recv()
+            except EOFError:
+                raise SystemExit("a worker failed to start (its traceback is above)") from None
         base, new = [], []
         for i in range(args.pairs):
             order = (0, 1) if i % 2 else (1, 0)  # alternate which goes first

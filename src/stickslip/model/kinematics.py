@@ -202,15 +202,22 @@ def contact_gap(kin, s, c, m, W):  # pragma: no cover - resolved by numba (overl
 @overload(contact_gap, jit_options=KERNEL_OPTIONS)
 def _contact_gap(kin, s, c, m, W):
     gap = _GAPS.get(getattr(kin, "instance_class", None))
-    if gap is None:
-        return None
+    if gap is None:  # never run: callers take the affine branch (gap_computed is False)
+        return lambda kin, s, c, m, W: csm.zero(s[0])
     return getattr(gap, "py_func", gap)
 
 
-def gap_computed(kin_type) -> bool:
-    """At compile time: whether the numba type ``kin_type`` of a kinematics object belongs to a class
-    that registered a gap function (else its gaps are the data array's affine g0 + W·q)."""
-    return getattr(kin_type, "instance_class", None) in _GAPS
+def gap_computed(kin):  # pragma: no cover - resolved by numba (overload below)
+    """Whether the kinematics class of ``kin`` registered a gap function: a compile-time constant
+    (else its gaps are the data array's affine g0 + W·q)."""
+    raise NotImplementedError
+
+
+@overload(gap_computed, jit_options=KERNEL_OPTIONS)
+def _gap_computed(kin):
+    if getattr(kin, "instance_class", None) in _GAPS:
+        return lambda kin: True
+    return lambda kin: False
 
 
 def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below)

@@ -32,12 +32,11 @@ exist.
 from __future__ import annotations
 
 import numpy as np
-from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, NORMAL_PRESCRIBED, contact_offsets,
                      gap_offset)
-from .jit import KERNEL_OPTIONS, inlined_kernel
+from .jit import inlined_kernel
 from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, unilateral_kernel
 from .stack import work_vectors
 
@@ -64,43 +63,26 @@ def is_unilateral(md, n, c):
 
 
 @inlined_kernel
-def affine_gap_with_rate(s, d, m, n, c):
-    """(g0 + W·q, W·d[n:2n]) of contact ``c`` with g0 and W from the data array ``m``."""
+def gap_with_rate(s, d, md, n, c):
+    """(g(q), W(q)·d[n:2n]) of contact ``c`` at ``s`` = [q, …] (W = ∂g/∂q) [m, m/s for d = s]:
+    the gap and its rate along the velocities held in ``d`` (``s`` itself, or a derivative
+    [q̇, q̈] for W·q̈). The kinematics' gap function where it registered one, else g0 + W·q from
+    the data array (the other branch is a compile-time constant's dead code)."""
+    m = md.m
+    rate = csm.zero(s[0])
+    if gap_computed(md.kin):
+        W = work_vectors(md.kin, 1, s)[0]
+        g = contact_gap(md.kin, s, c, m, W)
+        for j in range(n):
+            rate += W[j] * d[n + j]
+        return g, rate
     o = contact_offsets(n, c)[0]
     og = gap_offset(n, c)
     g = m[o + C_GAP] + csm.zero(s[0])
-    rate = csm.zero(s[0])
     for j in range(n):
         g += m[og + j] * s[j]
         rate += m[og + j] * d[n + j]
     return g, rate
-
-
-@inlined_kernel
-def computed_gap_with_rate(s, d, md, n, c):
-    """(g(q), W(q)·d[n:2n]) of contact ``c`` from the kinematics' gap function."""
-    W = work_vectors(md.kin, 1, s)[0]
-    g = contact_gap(md.kin, s, c, md.m, W)
-    rate = csm.zero(s[0])
-    for j in range(n):
-        rate += W[j] * d[n + j]
-    return g, rate
-
-
-def gap_with_rate(s, d, md, n, c):  # pragma: no cover - resolved by numba (overload below)
-    """(g(q), W(q)·d[n:2n]) of contact ``c`` at ``s`` = [q, …] (W = ∂g/∂q) [m, m/s for d = s]:
-    the gap and its rate along the velocities held in ``d`` (``s`` itself, or a derivative
-    [q̇, q̈] for W·q̈). The kinematics' gap function where it registered one, else g0 + W·q."""
-    raise NotImplementedError
-
-
-@overload(gap_with_rate, jit_options=KERNEL_OPTIONS)
-def _gap_with_rate(s, d, md, n, c):
-    # an ordinary call that LLVM inlines: numba's IR inlining of these loops, nested in the inlined
-    # kernels that call them, mis-scopes their accumulators (a 'not in scope' warning)
-    if gap_computed(md.types[md.fields.index("kin")]):
-        return computed_gap_with_rate.py_func
-    return lambda s, d, md, n, c: affine_gap_with_rate(s, d, md.m, n, c)
 
 
 @inlined_kernel
@@ -131,27 +113,19 @@ def contact_indicator(s, cst, md, n, c):
     return -phi if is_open(cst, c) else phi
 
 
-def add_normal_force(s, md, n, c, lam, f):  # pragma: no cover - resolved by numba (overload below)
+@inlined_kernel
+def add_normal_force(s, md, n, c, lam, f):
     """f += W(q)ᵀ λ: the normal force λ of contact ``c`` on the coordinates (W from the kinematics'
     gap function where it registered one, else the data array's)."""
-    raise NotImplementedError
-
-
-@overload(add_normal_force, jit_options=KERNEL_OPTIONS)
-def _add_normal_force(s, md, n, c, lam, f):
-    if gap_computed(md.types[md.fields.index("kin")]):
-        def computed(s, md, n, c, lam, f):
-            W = work_vectors(md.kin, 1, s)[0]
-            contact_gap(md.kin, s, c, md.m, W)
-            for j in range(n):
-                f[j] += W[j] * lam
-        return computed
-
-    def affine(s, md, n, c, lam, f):
-        og = gap_offset(n, c)
+    if gap_computed(md.kin):
+        W = work_vectors(md.kin, 1, s)[0]
+        contact_gap(md.kin, s, c, md.m, W)
         for j in range(n):
-            f[j] += md.m[og + j] * lam
-    return affine
+            f[j] += W[j] * lam
+        return
+    og = gap_offset(n, c)
+    for j in range(n):
+        f[j] += md.m[og + j] * lam
 
 
 @unilateral_kernel(lambda s, cst, md, n, nc, N, f: None, inline="always")
