@@ -82,3 +82,15 @@ def event_driven(field, phi, slip_speed, stick_force, limit, t_eval, y0):
             switches[SLIP].append(t1)
             mode = 1 if stick_force(s) < 0 else -1
     return out, {k: np.array(v) for k, v in switches.items()}
+
+
+def assert_matches(traj, ref, switches, atol, least=1):
+    """The run ``traj`` against the reference: it ended successfully, has at least ``least``
+    transitions of each kind (OPEN, CLOSE, STICK, SLIP), each at the reference's instant, and every
+    sample's state equal to ``ref``, all to ``atol``."""
+    assert traj.status == "success"
+    tr = traj.transitions
+    for kind in (OPEN, CLOSE, STICK, SLIP):
+        assert np.sum(tr.kind == kind) >= least, kind
+        np.testing.assert_allclose(tr.time[tr.kind == kind], switches[kind], rtol=0, atol=atol)
+    np.testing.assert_allclose(traj.states, ref, rtol=0, atol=atol)

@@ -39,9 +39,9 @@ MU_K, DELTA_MU, ALPHA = 0.3, 0.6, 2.0
 CONTACT_DAMPINGS = (0.0, 0.5)
 
 
-def equations(cc):
+def equations(cc, V=V, CX=CX, ALPHA=ALPHA):
     """``field``, ``phi``, ``slip_speed``, ``stick_force``, ``limit`` of the model with contact
-    damping ``cc``, for :func:`event_driven`."""
+    damping ``cc`` (and the belt speed, x damping and friction decay given), for :func:`event_driven`."""
     def lam(s):
         return P - KC * s[1] - cc * s[3]
 

@@ -43,7 +43,8 @@ import stickslip
 from stickslip.analysis.signal import CLOSE, OPEN, SLIP, STICK
 from stickslip.basins import basin_stability, grid
 
-from .event_reference import OPEN_MODE, STICK_MODE, event_driven
+from . import test_slider_belt as slider_belt
+from .event_reference import event_driven
 
 K11, K12, K22 = 13 / 4, -3 * math.sqrt(3) / 4, 7 / 4
 CX, CY, P, KC, V = 0.1, 0.2, 0.5, 5.0, 0.6
@@ -65,24 +66,9 @@ def mu(speed):
 
 
 def equations():
-    """``field``, ``phi``, ``slip_speed``, ``stick_force``, ``limit`` for :func:`event_driven`."""
-    def lam(s):
-        return P - KC * s[1]
-
-    def field(mode):
-        def f(t, s):
-            x, y, dx, dy = s
-            spring_x, spring_y = -K11 * x - K12 * y, -K12 * x - K22 * y - P
-            if mode == OPEN_MODE:
-                return [dx, dy, spring_x - CX * dx, spring_y - CY * dy]
-            if mode == STICK_MODE:
-                return [dx, dy, 0.0, spring_y - CY * dy + lam(s)]
-            return [dx, dy, spring_x - CX * dx - mode * mu(abs(dx - V)) * lam(s), spring_y - CY * dy + lam(s)]
-        return f
-
-    return {"field": field, "phi": lambda s: min(P / KC - s[1], lam(s) / KC), "slip_speed": lambda s: s[2] - V,
-            "stick_force": lambda s: K11 * s[0] + K12 * s[1] + CX * V,
-            "limit": lambda s: (MU_K + DELTA_MU) * lam(s)}
+    """The model by hand for :func:`event_driven`: ``test_slider_belt.equations`` at this case's
+    values, without contact damping."""
+    return slider_belt.equations(0.0, V=V, CX=CX, ALPHA=ALPHA)
 
 
 def steady_sliding():
