@@ -49,6 +49,11 @@ class SteadyState:
     contact_open_fractions : tuple of float
         Fraction of the window in which each contact is open [-] (empty for a model whose contacts
         are all pressed).
+    impacts : int or None
+        Impacts of rigid contacts in the window (None for a model without rigid contacts).
+    max_impact_speed : float or None
+        Largest normal speed |ġ⁻| at those impacts [m/s] (0 without impacts; None for a model
+        without rigid contacts).
     """
 
     t_from: float
@@ -65,6 +70,8 @@ class SteadyState:
     maximum: float
     open_fraction: float | None = None
     contact_open_fractions: tuple = ()
+    impacts: int | None = None
+    max_impact_speed: float | None = None
 
     @property
     def frequency_hz(self) -> float:
@@ -77,6 +84,8 @@ class SteadyState:
         d = dataclasses.asdict(self)
         if self.open_fraction is None:  # all contacts pressed: nothing opens
             del d["open_fraction"], d["contact_open_fractions"]
+        if self.impacts is None:  # no rigid contacts: no impacts
+            del d["impacts"], d["max_impact_speed"]
         d[f"{self.coordinate}_min"] = d.pop("minimum")
         d[f"{self.coordinate}_max"] = d.pop("maximum")
         return d
@@ -111,10 +120,12 @@ def fundamental_frequency(t, phi, dphi):
 
 
 def summarize(t, states, mode, transition_times, transition_kinds, transition_contacts, n_contacts: int,
-              t_from, coordinate: int, rate: int, name: str, unilateral: bool = False) -> SteadyState:
+              t_from, coordinate: int, rate: int, name: str, unilateral: bool = False,
+              impacts=None) -> SteadyState:
     """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
     state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``, of a model
-    with ``n_contacts`` contacts (``unilateral``: some of them open and close)."""
+    with ``n_contacts`` contacts (``unilateral``: some of them open and close; ``impacts``: the
+    instants [s] and normal speeds ġ⁻ [m/s] of its rigid contacts' impacts, None without them)."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
@@ -149,4 +160,15 @@ def summarize(t, states, mode, transition_times, transition_kinds, transition_co
         maximum=float(phi.max()),
         open_fraction=None if opened is None else opened / (t1 - t0),
         contact_open_fractions=tuple(float(x) / (t1 - t0) for x in each_open),
+        **_impacts_in(impacts, t0, t1),
     )
+
+
+def _impacts_in(impacts, t0: float, t1: float) -> dict:
+    """``impacts`` and ``max_impact_speed`` of the impacts in (t0, t1] (nothing without rigid contacts)."""
+    if impacts is None:
+        return {}
+    times, speeds = (np.asarray(a, dtype=float) for a in impacts)
+    inside = (times > t0) & (times <= t1)
+    return {"impacts": int(inside.sum()),
+            "max_impact_speed": float(np.abs(speeds[inside]).max()) if inside.any() else 0.0}

@@ -197,6 +197,7 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     t_start = time.perf_counter()
     check_executor(executor, BasinError)
     model = load_model(model)
+    model.refuse_rigid("basin stability")
     unknown = set(options) - {"rtol", "atol", "match_rtol", "confirm", "lyapunov", "max_steps"}
     if unknown:
         raise BasinError(f"unknown option(s) {', '.join(sorted(unknown))}")

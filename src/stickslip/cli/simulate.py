@@ -285,6 +285,8 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
         (f"dominant frequency of {symbol}", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         *([("open fraction", f"{s.open_fraction:.4f}")] if s.open_fraction is not None else []),
+        *([("impacts", f"{s.impacts}"), ("max impact speed", f"{s.max_impact_speed:.4g}")]
+          if s.impacts is not None else []),
         ("transitions in window", str(s.n_transitions)),
         (f"{symbol} min / max", f"{s.minimum:.6g} / {s.maximum:.6g}" + f" {system.units.get(observed, '')}".rstrip(" -")),
         ("steps (accepted + rejected)", f"{traj.stats.steps} ({traj.method})"),

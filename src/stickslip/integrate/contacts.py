@@ -17,6 +17,10 @@ form ``y(θ) = y0 + h Σ_j Q[:, j] θ^(j+1)``, θ ∈ [0, 1] (every Runge–Kutt
 * a unilateral contact opens where its indicator φ = min(−g, λ/k) falls through zero and closes
   where −φ does (``EVENT_GAP``, :mod:`stickslip.model.normal`); an open contact carries no force;
   it closes sliding, or sticking if it arrives with v_c = 0 and the stick force is admissible.
+* a rigid contact opens where its normal force (a multiplier) falls through zero and closes where
+  its gap does, with an impact (:func:`land`, :mod:`stickslip.model.impact`): it bounces off, or
+  stays closed (sliding or sticking), or, where its bounces would accumulate within ZENO_TIME,
+  closes at once (a Zeno sequence's limit).
 """
 
 from __future__ import annotations
@@ -29,10 +33,12 @@ from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
 from ..model.jit import inlined_kernel, kernel
 from ..model.kinematics import model_sizes
-from ..model.normal import gap_and_rate, gap_with_rate, is_open, starts_open
+from ..model.impact import IMPACT_INCONSISTENT, impact, remove_gap_rate, restitution_of
+from ..model.normal import gap_and_rate, gap_with_rate, is_open, is_rigid, starts_open
 
 __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP",
-           "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_KINDS", "EVENT_TIME_TOL", "close_contact",
+           "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_IMPACT", "TRANSITION_KINDS",
+           "LAND_OPEN", "LAND_CLOSED", "LAND_ZENO", "LAND_INCONSISTENT", "ZENO_TIME", "land", "EVENT_TIME_TOL", "close_contact",
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "hermite_dip", "gap_dip", "probed_crossing", "contact_lost",
@@ -47,10 +53,20 @@ TRANSITION_TO_STICK = 1
 TRANSITION_TO_SLIP = -1
 TRANSITION_OPEN = 2
 TRANSITION_CLOSE = 3
+TRANSITION_IMPACT = 4
 
 #: Names of the transition kinds, as results write them.
 TRANSITION_KINDS = {TRANSITION_TO_STICK: "stick", TRANSITION_TO_SLIP: "slip", TRANSITION_OPEN: "open",
-                    TRANSITION_CLOSE: "close"}
+                    TRANSITION_CLOSE: "close", TRANSITION_IMPACT: "impact"}
+
+#: What follows the impact of a rigid contact (:func:`land`): it bounces off, stays closed, closes
+#: at the accumulation point of its bounces, or has no consistent impulse.
+LAND_OPEN, LAND_CLOSED, LAND_ZENO, LAND_INCONSISTENT = 0, 1, 2, 3
+
+#: [s] A rigid contact whose bounces would all end within this time (their geometric series,
+#: 2 ġ⁺ / (|g̈| (1 − e)) under the normal acceleration of its flight) closes at the impact
+#: instead: the instant it comes to rest is then off by less than this.
+ZENO_TIME = 1e-9
 
 #: Time resolution [s] to which transition instants are located on the dense output.
 EVENT_TIME_TOL = 1e-12
@@ -275,6 +291,8 @@ def gap_dip(y0, dy0, y1, dy1, h, cst, c, md):
     g1, r1 = gap_and_rate(y1, md, n, c)
     if is_open(cst, c):
         return hermite_dip(g0, h * r0, g1, h * r1)
+    if is_rigid(md, n, c):  # closed: g ≡ 0; it opens only where its multiplier λ falls through 0
+        return -1.0
     dip = hermite_dip(-g0, -h * r0, -g1, -h * r1)
     o = contact_offsets(n, c)[0]
     ratio = m[o + C_NORMAL_C] / m[o + C_NORMAL_K]
@@ -454,6 +472,11 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
     for _ in range(MAX_SETTLE):
         if release_most_overloaded(y, cst, md, F, N) < 0:
             break
+    for c in range(nc):  # a closed rigid contact that nothing presses is open (where its normal force is
+        # consistent at all: else it stays closed and the run reports that, Painlevé)
+        if is_rigid(md, n, c) and not is_open(cst, c) and P.indicator(y, cst, c, md) <= 0.0 \
+                and P.rigid_pivot(y, cst, md) > 0.0:
+            cst[CST * c] = P.MODE_OPEN
     for c in range(nc):
         if np.int64(cst[CST * c]) == P.MODE_STICK or np.int64(cst[CST * c]) == P.MODE_OPEN:
             continue
@@ -469,3 +492,37 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
             if speed > P.SPEED_FLOOR:
                 cst[CST * c + 1] = vx / speed
                 cst[CST * c + 2] = vy / speed
+
+
+@kernel
+def land(y, cst, c, md, rtol, atol, F, N, work):
+    """Rigid contact ``c`` closes at ``y`` (its gap through 0): the impact, then what follows.
+
+    Returns (phase, sticks, impulse, before, after, flight): ``phase`` one of ``LAND_*``; ``sticks``
+    whether it closed sticking; the normal impulse [N s]; ġ⁻ and ġ⁺ [m/s]; for ``LAND_OPEN`` the
+    flight time [s] that the normal acceleration at the take-off predicts (∞ if it does not pull
+    the contact back). ``y`` and ``cst`` are updated. A contact that stays closed but whose
+    normal force comes out ≤ 0 (the motion leaves it with ġ = 0) is left open.
+    """
+    n = model_sizes(md.kin, md.m)[0]
+    e = restitution_of(c, md)
+    outcome, impulse, before, after = impact(y, cst, c, md, e)
+    if outcome == IMPACT_INCONSISTENT:
+        return LAND_INCONSISTENT, False, impulse, before, after, math.inf
+    phase = LAND_CLOSED
+    if after > 0.0:
+        cst[CST * c] = P.MODE_OPEN
+        P.rhs(y, cst, md, work)
+        acc = gap_with_rate(y, work, md, n, c)[1]  # g̈ = W q̈ in flight
+        flight = 2.0 * after / -acc if acc < 0.0 else math.inf
+        if not (e < 1.0 and flight <= ZENO_TIME * (1.0 - e)):
+            return LAND_OPEN, False, impulse, before, after, flight
+        remove_gap_rate(y, c, md)  # the bounces' limit: at rest on the contact
+        phase = LAND_ZENO
+    cst[CST * c] = P.MODE_SLIP
+    sticks = close_contact(y, cst, c, md, rtol, atol, F, N)
+    if P.indicator(y, cst, c, md) <= 0.0:
+        cst[CST * c] = P.MODE_OPEN
+        cst[CST * c + 3] = math.inf
+        return LAND_OPEN, False, impulse, before, after, math.inf
+    return phase, sticks, impulse, before, after, math.inf

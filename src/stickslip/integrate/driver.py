@@ -16,7 +16,7 @@ from ..memory import check_memory, format_bytes, largest_count, sample_bytes
 from ..model.library import resolve_system
 from ..model.library.two_plates import is_plates
 from .fixed_step import run_fixed_step
-from .initial import initial_state
+from .initial import check_rigid_start, initial_state
 from .interrupt import forget_ctrl_c, partial_on_ctrl_c
 from .result import Stats, Trajectory, Transitions
 from .runner import NO_STEP_CAP, run_event
@@ -177,6 +177,7 @@ def simulate(
         dt = _check_positive("dt", dt, "give a step in seconds, e.g. 1e-4")
     n_samples = check_samples(system, t_end - t0, sample_rate)
     y0 = initial_state(system, ic, perturbation)
+    check_rigid_start(system, y0)
     sample_times = t0 + np.arange(n_samples) / sample_rate
 
     if method != "event" and not is_plates(system):

@@ -37,7 +37,7 @@ from ..model.kinematics import has_unilateral, model_sizes, unilateral_kernel
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
-from .status import CHUNK_END, CONTACT_LOST, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
+from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
 
 __all__ = ["integrate_event", "N_EXTRA"]
 
@@ -172,13 +172,34 @@ def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
     return n_tr
 
 
-@unilateral_kernel(lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats: n_tr)
-def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):  # pragma: no cover
+@unilateral_kernel(lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work:
+                   (n_tr, SUCCESS, math.inf))
+def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work):  # pragma: no cover
     """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
     change its mode, record the transitions (a sticking contact that opens first leaves stick; a
-    contact that closes with v_c = 0 and an admissible stick force sticks), re-check the sticking
-    set, and return the transition count (nothing for pressed-only kinematics)."""
-    if P.is_open(cst, c):
+    contact that closes with v_c = 0 and an admissible stick force sticks; a rigid one closes with
+    an impact, recorded with the state before it, then ``open`` where it bounces off or ``close``
+    where it stays, with the state after it), re-check the sticking set.
+
+    Returns (transition count, status, flight): status SUCCESS, or INCONSISTENT where a rigid
+    contact's impact has no consistent impulse; flight the predicted time [s] to a bounced
+    contact's next landing (∞ otherwise), which bounds the next step (nothing for pressed-only
+    kinematics)."""
+    flight = math.inf
+    if P.is_open(cst, c) and P.rigid(c, md):
+        record_transition(n_tr, t, E.TRANSITION_IMPACT, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        n_tr += 1
+        phase, sticks, impulse, before, after, flight = E.land(y, cst, c, md, rtol, atol, F, N, work)
+        if phase == E.LAND_INCONSISTENT:
+            return n_tr, INCONSISTENT, flight
+        kind = E.TRANSITION_OPEN if phase == E.LAND_OPEN else E.TRANSITION_CLOSE
+        record_transition(n_tr, t, kind, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        n_tr += 1
+        if sticks:
+            stats[4] += 1
+            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            n_tr += 1
+    elif P.is_open(cst, c):
         record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
         n_tr += 1
         if E.close_contact(y, cst, c, md, rtol, atol, F, N):
@@ -195,7 +216,22 @@ def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr
         record_transition(n_tr, t, E.TRANSITION_OPEN, c, y, tr_t, tr_kind, tr_contact, tr_s)
         n_tr += 1
     P.project_velocities(y, cst, np.int64(-1), md)  # the sticking set's constraints, after the change
-    return settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
+    n_tr = settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
+    return n_tr, SUCCESS, flight
+
+
+@unilateral_kernel(lambda y, cst, md: np.int64(-1))
+def jammed_contact(y, cst, md):  # pragma: no cover - compiled only
+    """A closed rigid contact whose normal force has no consistent solution at ``y`` (Painlevé:
+    the relative pivot of its normal-force system is not positive), or −1."""
+    m = md.m
+    n, nc, _ = model_sizes(md.kin, m)
+    if P.rigid_pivot(y, cst, md) > 0.0:
+        return np.int64(-1)
+    for c in range(nc):
+        if P.rigid(c, md) and not P.is_open(cst, c):
+            return np.int64(c)
+    return np.int64(-1)
 
 
 @unilateral_kernel(lambda y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N: (-1.0, np.int64(-1), q_ready),
@@ -306,7 +342,9 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
         idx += 1
 
     status = SUCCESS
-    lost = -1
+    lost = jammed_contact(y, cst, md)
+    if lost >= 0:
+        return INCONSISTENT, 0.0, h_init, idx, n_tr, lost
     retakes = 0
     h_override = -1.0   # step length imposed on the next step (homing), if > 0
     h_free = -1.0       # step size before a homing episode, if > 0
@@ -441,8 +479,15 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             # a unilateral contact opens or closes inside the step: cut the step at the root
             idx, tau = cut_step(theta_g, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
                                 work, F, N, vv)
-            n_tr = switch_gap(y, cst, c_g, md, rtol, atol, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr,
-                              stats)
+            n_tr, gap_status, flight = switch_gap(y, cst, c_g, md, rtol, atol, F, N, t_base + tau, tr_t, tr_kind,
+                                                  tr_contact, tr_s, n_tr, stats, ytmp)
+            if gap_status != SUCCESS:
+                stats[0] += 1
+                status = gap_status
+                lost = c_g
+                break
+            if flight < math.inf:  # a bounce: the next step ends inside its flight
+                h_override = 0.5 * flight
         elif theta_b > 0.0:
             # breakaway inside the step: the flow is smooth up to it, so cut the step at the root
             cut = True
@@ -567,6 +612,10 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             homing_any = False
         if not E.all_finite(y):
             status = NOT_FINITE
+            break
+        lost = jammed_contact(y, cst, md)
+        if lost >= 0:
+            status = INCONSISTENT
             break
         if h_override > 0.0:
             h = h_override

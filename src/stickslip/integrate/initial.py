@@ -16,7 +16,7 @@ from ..model.system_model import FrictionModel
 from ..stability.equilibrium import steady_sliding
 from .result import Trajectory, load_trajectory
 
-__all__ = ["initial_state", "NAMED_STARTS", "NEAR_PERTURBATION", "start_names", "start_description"]
+__all__ = ["initial_state", "NAMED_STARTS", "NEAR_PERTURBATION", "start_names", "start_description", "check_rigid_start"]
 
 #: Perturbation of the observed coordinate added to steady sliding by the ``near`` start [unit of
 #: the coordinate; rad for the plates' φ]: 5 % of φ_e ≈ 0.0197 rad at N = 50 N (Eq. 14), small
@@ -126,3 +126,28 @@ def initial_state(system: FrictionModel, ic="zero", perturbation=None) -> np.nda
             "set them to 0 or choose a model that frees them"
         )
     return s
+
+
+def check_rigid_start(system: FrictionModel, y0: np.ndarray) -> None:
+    """Refuse a start that a rigid contact cannot take: inside its stop (g < 0), or at it and
+    moving into it (g = 0, ġ < 0: an impact at the start; start just above it instead).
+
+    Raises
+    ------
+    SimulationError
+    """
+    n = system.n
+    for c, contact in enumerate(system.contacts):
+        if not (contact.unilateral and contact.normal.law == "rigid"):
+            continue
+        W = np.asarray(contact.gap_gradient, dtype=float)
+        g = contact.gap + float(W @ y0[:n])
+        rate = float(W @ y0[n:2 * n])
+        tol = 1e-12 * (1.0 + abs(contact.gap) + float(np.abs(W * y0[:n]).sum()))
+        name = system.contact_names[c]
+        if g < -tol:
+            raise SimulationError(f"rigid contact {c} ({name}) starts inside its stop: gap {g:.6g} < 0; start with "
+                                  "gap >= 0 (on it or above it)")
+        if g <= tol and rate < 0.0:
+            raise SimulationError(f"rigid contact {c} ({name}) starts at its stop moving into it (normal speed "
+                                  f"{rate:.6g} < 0); start just above it (gap > 0) or at rest on it")

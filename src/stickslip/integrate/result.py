@@ -21,9 +21,10 @@ from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
 from ..results import Plottable
+from .contacts import TRANSITION_IMPACT
 from .status import Status
 
-__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype"]
+__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "Impacts", "find_impacts"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -109,13 +110,18 @@ def _slip_velocities(states, md, nc):
 @njit(cache=True)
 def _normal_forces(states, mode, md, nc):
     """Normal force of every contact (k, nc) at each sample [N], a unilateral contact's in its
-    sampled state (0 while open: bit nc + c of ``mode``)."""
+    sampled state (0 while open: bit nc + c of ``mode``; a closed rigid contact's multiplier with
+    the sampled stick set, bit c)."""
     k = states.shape[0]
     out = np.empty((k, nc))
     cst = np.zeros(CST * nc)
     for i in range(k):
         for c in range(nc):
-            cst[CST * c] = physics.MODE_OPEN if (np.int64(mode[i]) >> (nc + c)) & 1 else physics.MODE_SLIP
+            flags = np.int64(mode[i])
+            cst[CST * c] = physics.MODE_OPEN if (flags >> (nc + c)) & 1 else \
+                physics.MODE_STICK if (flags >> c) & 1 else physics.MODE_SLIP
+            cst[CST * c + 1] = 1.0
+        for c in range(nc):
             out[i, c] = physics.normal_force_of(states[i], cst, c, md)
     return out
 
@@ -130,6 +136,60 @@ def _gaps(states, md, nc):
             for i in range(k):
                 out[i, c] = physics.gap(states[i], c, md)[0]
     return out
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Impacts:
+    """Impacts of the rigid contacts in a run, in order.
+
+    Attributes
+    ----------
+    time : ndarray (k,)
+        Instants [s].
+    contact : ndarray (k,) int
+        The contact that closed.
+    speed_before, speed_after : ndarray (k,)
+        Its normal speed ġ = W·q̇ just before (< 0) and after (−e ġ⁻, or 0 where it stays closed
+        or its bounces accumulated) [m/s].
+    impulse : ndarray (k,)
+        The normal impulse P_N [N s]: the W-component of the momentum change M Δq̇ written in the
+        contacts' normal and tangent directions (least squares, exact where they are independent).
+    """
+
+    time: np.ndarray
+    contact: np.ndarray
+    speed_before: np.ndarray
+    speed_after: np.ndarray
+    impulse: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.time.size)
+
+
+def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
+    """The impacts of a run from its transitions: each ``impact`` record holds the state before,
+    the record after it (``open`` or ``close`` of the same contact at the same instant) the state
+    after (:func:`stickslip.integrate.event_loop.switch_gap`)."""
+    n = system.n
+    kinds = transitions.kind
+    rows = [i for i in np.flatnonzero(kinds == TRANSITION_IMPACT) if i + 1 < kinds.size]
+    directions = [np.asarray(c.gap_gradient, float) for c in system.contacts if c.gap_gradient is not None]
+    directions += [row for c in system.contacts if c.tangent is not None for row in np.atleast_2d(c.tangent)]
+    out = {key: np.empty(len(rows)) for key in ("time", "before", "after", "impulse")}
+    contact = np.empty(len(rows), dtype=int)
+    for j, i in enumerate(rows):
+        c = int(transitions.contact[i])
+        W = np.asarray(system.contacts[c].gap_gradient, float)
+        before, after = transitions.state[i], transitions.state[i + 1]
+        change = system.mass @ (after[n:2 * n] - before[n:2 * n])
+        basis = np.array([W] + [d for d in directions if d is not W and not np.array_equal(d, W)]).T
+        coef = np.linalg.lstsq(basis, change, rcond=None)[0]
+        out["time"][j] = transitions.time[i]
+        out["before"][j] = W @ before[n:2 * n]
+        out["after"][j] = W @ after[n:2 * n]
+        out["impulse"][j] = coef[0]
+        contact[j] = c
+    return Impacts(out["time"], contact, out["before"], out["after"], out["impulse"])
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -265,6 +325,11 @@ class Trajectory(Plottable):
         for pressed contacts."""
         return _gaps(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
 
+    @cached_property
+    def impacts(self) -> Impacts:
+        """The impacts of the rigid contacts (:class:`Impacts`; empty for other models)."""
+        return find_impacts(self.system, self.transitions)
+
     @property
     def friction_magnitude(self) -> np.ndarray:
         """|F| of the first contact (k,) [N]."""
@@ -292,9 +357,10 @@ class Trajectory(Plottable):
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
         tr = self.transitions
+        impacts = (self.impacts.time, self.impacts.speed_before) if self.system.rigid else None
         return summarize(self.t, self.states, self.mode, tr.time, tr.kind, tr.contact, self.system.n_contacts, t_from,
                          coordinate=i, rate=i + self.system.n, name=self.system.dofs[i],
-                         unilateral=self.system.unilateral)
+                         unilateral=self.system.unilateral, impacts=impacts)
 
     # ------------------------------------------------------------- pieces and joins
     def joined(self, more: "Trajectory") -> "Trajectory":
@@ -371,9 +437,10 @@ class Trajectory(Plottable):
         data["work_damping"] = ("time", self.work[:, 1], {"units": "J", "long_name": "work of the dampers since t0"})
         data["transition_time"] = ("transition", self.transitions.time, {"units": "s"})
         data["transition_kind"] = ("transition", self.transitions.kind.astype(np.int8),
-                                   {"flag_values": "-1 1 2 3" if system.unilateral else "-1 1",
+                                   {"flag_values": "-1 1" + (" 2 3" if system.unilateral else "") +
+                                    (" 4" if system.rigid else ""),
                                     "flag_meanings": "stick_to_slip slip_to_stick" +
-                                    (" open close" if system.unilateral else "")})
+                                    (" open close" if system.unilateral else "") + (" impact" if system.rigid else "")})
         data["transition_contact"] = ("transition", self.transitions.contact.astype(np.int8))
         data["transition_state"] = (("transition", "state"), self.transitions.state)
         attrs = {

@@ -15,7 +15,8 @@ that for kinematics classes that fix n the compiler folds them to constants:
 ========================  =========================================================================
 header (``HEADER`` slots)  n, nc, diagonal flag (M, C, K all diagonal), low-speed band [m/s],
                            constant-kinematics flag (G, w independent of q), unilateral flag
-                           (some contact has a gap instead of a prescribed load)
+                           (some contact has a gap instead of a prescribed load), rigid flag
+                           (some unilateral contact has the rigid normal law)
 M⁻¹ (n × n)                row-major; rows and columns of locked DOFs are 0
 M (n × n)                  for the kinetic energy
 C, K (n × n each)          damping, stiffness (K may be non-symmetric)
@@ -39,11 +40,11 @@ from .friction import LAW_WIDTH, NoUserLaw
 from .jit import inlined_kernel
 
 __all__ = ["ModelData", "pack", "offsets", "contact_offsets", "gap_offset", "contact_width", "contact_state",
-           "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "H_UNILATERAL", "C_DIM", "C_N0",
+           "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "H_UNILATERAL", "H_RIGID", "C_DIM", "C_N0",
            "C_LAW", "C_NORMAL_LAW", "C_GAP", "C_NORMAL_K", "C_NORMAL_C", "C_RESTITUTION", "C_G",
            "NORMAL_PRESCRIBED", "NORMAL_COMPLIANT", "NORMAL_RIGID", "NORMAL_LAWS"]
 
-H_N, H_NC, H_DIAGONAL, H_BAND, H_CONSTANT, H_UNILATERAL = range(6)
+H_N, H_NC, H_DIAGONAL, H_BAND, H_CONSTANT, H_UNILATERAL, H_RIGID = range(7)
 HEADER = 8
 
 #: Numbers per contact in the integration state ``cst``: mode, stored slip direction (ex, ey), and
@@ -143,6 +144,7 @@ def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np
     m[H_CONSTANT] = 1.0 if constant_kinematics else 0.0
     m[H_UNILATERAL] = 1.0 if any(spec.get("normal_law", NORMAL_PRESCRIBED) != NORMAL_PRESCRIBED
                                  for spec in contacts) else 0.0
+    m[H_RIGID] = 1.0 if any(spec.get("normal_law", NORMAL_PRESCRIBED) == NORMAL_RIGID for spec in contacts) else 0.0
     o_minv, o_mass, o_damp, o_stiff, o_force, o_free, _ = offsets.py_func(n)
     for o, a in zip((o_minv, o_mass, o_damp, o_stiff), mats):
         m[o:o + n * n] = a.ravel()

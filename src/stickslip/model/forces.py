@@ -6,7 +6,9 @@
   (:func:`quasi_static_direction`, found with the force that would hold the contact,
   :func:`band_forces`), the stored direction for a 1-D contact;
 * stick: the Lagrange multipliers of all sticking contacts, solved together
-  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more).
+  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more);
+* closed rigid contacts: their normal forces λ are multipliers too (:func:`rigid_normal_forces`),
+  and so is the friction of one that slides, −μ λ e.
 
 :func:`sliding_forces` computes the common case, every contact sliding outside the band, on the
 caller's stack arrays (:func:`sliding_friction` its friction forces alone, for the queries); :func:`general_forces_body` any mix of modes. Both fill the generalised
@@ -21,19 +23,19 @@ import math
 import numpy as np
 
 from . import csmath as csm
-from .bundle import CST, H_BAND
+from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel
-from .kinematics import contact_dim, contact_frame
-from .linalg import solve_psd, solve_psd_2x2
+from .kinematics import contact_dim, contact_frame, unilateral_kernel
+from .linalg import solve_in_order, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
-from .normal import MODE_OPEN, add_normal_forces, normal_in_mode, open_in_mode
-from .stack import DOFS, ROWS, work_matrix, work_vectors
+from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
+from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
-           "general_forces", "sliding_friction", "sliding_forces"]
+           "general_forces", "sliding_friction", "sliding_forces", "rigid_normal_forces", "add_rigid_normal_forces"]
 
 
 # ----------------------------------------------------------------------------- slip forces
@@ -242,7 +244,8 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
 
     Order: slip forces with the exact direction, then those inside the low-speed band (their
     quasi-static direction sees the forces already known), then the stick multipliers of all
-    sticking contacts together.
+    sticking contacts together, then the normal forces of closed rigid contacts. Returns the
+    smallest relative pivot of the last (:func:`rigid_normal_forces`; 1.0 without them).
     """
     m = md.m
     band = m[H_BAND]
@@ -275,6 +278,110 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
         for c in range(nc):
             if is_stick(cst, c):
                 add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+    return add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A)
+
+
+@unilateral_kernel(lambda s, cst, md, n, nc, diagonal, G, v, N, F, f, A: 1.0, inline="always")
+def add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):  # pragma: no cover - compiled only
+    """:func:`rigid_normal_forces` where some rigid contact is closed, returning its smallest
+    relative pivot; 1.0 where none is (and, at compile time, for kinematics registered without
+    unilateral contacts)."""
+    if any_rigid_closed(cst, md, n, nc):
+        return rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A)
+    return 1.0
+
+
+@kernel
+def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
+    """Normal forces λ_R of the closed rigid contacts R: the multipliers that keep their gaps'
+    accelerations at 0, with everything that depends on them (the friction of a sliding one,
+    −μ λ e, and the response of the stick multipliers), added to N, F and f.
+
+    Called with ``f``, ``F`` the forces at λ_R = 0 (every other force in its mode, the stick
+    multipliers solved). Everything in the acceleration is affine in λ_R, so with r_j the
+    generalised force of a unit λ_j (W_jᵀ, its sliding friction −μ G_jᵀ e_j, and the stick
+    multipliers' response to both, solved with zero bias):
+
+        q̈ = M⁻¹ (f + Σ_j λ_j r_j),   g̈_i = W_i q̈ = 0   →   D λ = −W M⁻¹ f,   D_ij = W_i M⁻¹ r_j
+
+    (g affine in q, so g̈ = W q̈). D is W M⁻¹ Wᵀ (symmetric positive definite) when nothing slides;
+    a sliding rigid contact adds −μ W M⁻¹ Gᵀ e, which can make a pivot of D non-positive: then
+    the closed contact problem has no solution or two (Painlevé), reported by the return value,
+    the smallest pivot relative to W_i M⁻¹ W_iᵀ (1 without friction; ≤ 0: inconsistent).
+    """
+    m = md.m
+    band = m[H_BAND]
+    R = work_matrix(md.kin, CONTACTS, DOFS, s)      # r_j
+    RF = work_matrix(md.kin, CONTACTS, ROWS, s)     # the friction forces that come with a unit λ_j
+    D = work_matrix(md.kin, CONTACTS, CONTACTS, s)
+    a, d, zero_bias, Fs, lam, b, W = work_vectors(md.kin, 7, s)
+    zero = csm.zero(s[0])
+    apply_inverse_mass(m, n, diagonal, f, a)
+    for i in range(2 * nc):
+        zero_bias[i] = zero
+    k = 0
+    for r in range(nc):
+        if not is_rigid(md, n, r) or is_open(cst, r):
+            continue
+        og = gap_offset(n, r)
+        for j in range(n):
+            R[k, j] = m[og + j] + zero
+        for i in range(2 * nc):
+            RF[k, i] = zero
+        dim = contact_dim(md.kin, m, n, r)
+        if not is_stick(cst, r):
+            speed = csm.sqrt(v[2 * r] * v[2 * r] + v[2 * r + 1] * v[2 * r + 1])
+            if exact_direction(np.int64(cst[CST * r]), speed.real, band):
+                e0 = v[2 * r] / speed
+                e1 = v[2 * r + 1] / speed
+            else:
+                e0 = cst[CST * r + 1] + zero
+                e1 = cst[CST * r + 2] + zero
+            F0, F1 = slip_force(md, n, r, dim, speed, e0, e1, 1.0)
+            RF[k, 2 * r] = F0
+            RF[k, 2 * r + 1] = F1
+            add_contact_force(G[2 * r:2 * r + 2], dim, n, F0, F1, R[k])
+        if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, zero_bias, R[k], Fs, A)[0] > 0:
+            for c in range(nc):
+                if is_stick(cst, c):
+                    RF[k, 2 * c] = Fs[2 * c]
+                    RF[k, 2 * c + 1] = Fs[2 * c + 1]
+                    add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, Fs[2 * c], Fs[2 * c + 1],
+                                      R[k])
+        k += 1
+    i = 0
+    for r in range(nc):  # row i: g̈_i = 0, scaled by W_i M⁻¹ W_iᵀ so that the pivots are relative
+        if not is_rigid(md, n, r) or is_open(cst, r):
+            continue
+        og = gap_offset(n, r)
+        for j in range(n):
+            W[j] = m[og + j] + zero
+        apply_inverse_mass(m, n, diagonal, W, d)
+        scale = zero
+        acc = zero
+        for j in range(n):
+            scale += W[j] * d[j]
+            acc += W[j] * a[j]
+        b[i] = -acc / scale
+        for jj in range(k):
+            apply_inverse_mass(m, n, diagonal, R[jj], d)
+            acc = zero
+            for j in range(n):
+                acc += W[j] * d[j]
+            D[i, jj] = acc / scale
+        i += 1
+    smallest = solve_in_order(D, b, lam, k)
+    i = 0
+    for r in range(nc):
+        if is_rigid(md, n, r) and not is_open(cst, r):
+            N[r] = lam[i]
+            i += 1
+    for jj in range(k):
+        for j in range(n):
+            f[j] += lam[jj] * R[jj, j]
+        for j in range(2 * nc):
+            F[j] += lam[jj] * RF[jj, j]
+    return smallest
 
 
 @kernel
@@ -311,18 +418,21 @@ def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
 def general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     """:func:`general_forces_body` as a call (for the queries; :func:`~stickslip.model.physics.general_rhs`
     inlines it)."""
-    general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    return general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
 
 
 @inlined_kernel
 def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
     """The friction forces of the common case, every contact sliding outside the low-speed band:
     fills G, w, v, N and F and returns True; returns False (arrays incomplete) as soon as a
-    contact sticks or is inside the band."""
+    contact sticks or is inside the band, or when a rigid contact is closed (its normal force is a
+    multiplier)."""
     m = md.m
     for c in range(nc):
         if is_stick(cst, c):
             return False
+    if any_rigid_closed(cst, md, n, nc):
+        return False
     band = m[H_BAND]
     for c in range(nc):
         G2 = G[2 * c:2 * c + 2]

@@ -5,16 +5,20 @@ The stick multipliers of the sticking contacts solve (G_S M⁻¹ G_Sᵀ) F_S = b
 same matrix (:func:`stickslip.model.physics.project_velocities`). That matrix is rank-deficient
 for some models (the plates' Model 4, where an eigenvalue is 0 up to round-off), so the solution
 taken is the minimal-norm one: in closed form for one or two rows (:func:`solve_psd_2x2`, the
-common case), by cyclic Jacobi rotations for more (:func:`solve_psd`). Generic in the number type:
+common case), by cyclic Jacobi rotations for more (:func:`solve_psd`). The normal forces of
+closed rigid contacts solve a system that is not symmetric while they slide
+(:func:`solve_in_order`). Generic in the number type:
 decisions read real parts only, so a complex step through the solves stays exact.
 """
 
 from __future__ import annotations
 
+import math
+
 from . import csmath as csm
 from .jit import inlined_kernel, kernel
 
-__all__ = ["RANK_TOL", "JACOBI_SWEEPS", "solve_psd_2x2", "solve_psd"]
+__all__ = ["RANK_TOL", "JACOBI_SWEEPS", "solve_psd_2x2", "solve_psd", "solve_in_order"]
 
 #: Relative size below which an eigenvalue of G_S M⁻¹ G_Sᵀ counts as zero (rank deficiency,
 #: e.g. the plates' Model 4, where it is exactly 0 up to round-off ~1e-16 relative).
@@ -138,3 +142,35 @@ def solve_psd(A, b, x, V, k):
         for i in range(k):
             x[i] += V[i, j] * coef
     return rank
+
+
+@kernel
+def solve_in_order(A, b, x, k):
+    """x (k,) with A[:k, :k] x = b[:k], by Gaussian elimination in the given order; returns the
+    smallest pivot's real part (A and b are overwritten).
+
+    No pivoting, on purpose: the callers' matrices (the normal-force system of closed rigid
+    contacts, :func:`stickslip.model.forces.rigid_normal_forces`, and the impulse system of an
+    impact) have positive leading principal minors exactly where the contact problem has one
+    solution, so a pivot that is not positive is their finding (Painlevé-type inconsistency), not
+    a numerical accident. A zero pivot leaves x = 0 for the rows after it.
+    """
+    smallest = math.inf
+    for p in range(k):
+        piv = A[p, p]
+        smallest = min(smallest, piv.real)
+        if piv.real == 0.0:
+            for i in range(k):
+                x[i] = csm.zero(b[0])
+            return smallest
+        for i in range(p + 1, k):
+            factor = A[i, p] / piv
+            for j in range(p, k):
+                A[i, j] = A[i, j] - factor * A[p, j]
+            b[i] = b[i] - factor * b[p]
+    for i in range(k - 1, -1, -1):
+        acc = b[i]
+        for j in range(i + 1, k):
+            acc = acc - A[i, j] * x[j]
+        x[i] = acc / A[i, i]
+    return smallest

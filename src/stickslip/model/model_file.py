@@ -384,12 +384,16 @@ class _Parser:
 
 
 def _with_defaults(table):
-    """A unilateral contact's table with its optional numbers written out (gap 0, contact damping 0),
+    """A unilateral contact's table with its optional numbers written out (gap 0, contact damping 0
+    or a rigid contact's restitution 0),
     so that ``--set`` reaches them like any entry (a copy; the caller's table is not changed)."""
     if not (isinstance(table, Mapping) and isinstance(table.get("normal"), Mapping)):
         return table
     normal = {**table["normal"]}
-    normal.setdefault("damping", 0.0)
+    if normal.get("law") == "rigid":
+        normal.setdefault("restitution", 0.0)
+    else:
+        normal.setdefault("damping", 0.0)
     return {**table, "gap": table.get("gap", 0.0), "normal": normal}
 
 

@@ -20,6 +20,12 @@ c > 0 happens before g reaches 0; or g reaches 0 with c = 0) and closing (g reac
 with ġ < 0, or λ̃ turns positive again while g < 0). :func:`contact_indicator` gives φ for a
 closed contact and −φ for an open one, so an event is always "the indicator falls to 0".
 
+A *rigid* contact (g ≥ 0, λ ≥ 0, g λ = 0) has no force law: while closed its λ is the multiplier
+that keeps g̈ = 0, solved with the stick multipliers (:func:`stickslip.model.forces.rigid_normal_forces`);
+it opens where that λ falls through 0 and closes where g does, with an impact
+(:mod:`stickslip.model.impact`). Here it contributes its gap (the open contact's indicator is g) and
+nothing else: :func:`normal_in_mode` gives 0 for it, and the multiplier replaces that.
+
 Kernels are complex-safe (polynomial in the state; comparisons on real parts) for the Jacobians.
 
 What the generic kernels call (:func:`normal_in_mode`, :func:`add_normal_forces`,
@@ -34,14 +40,14 @@ from __future__ import annotations
 import numpy as np
 
 from . import csmath as csm
-from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, NORMAL_PRESCRIBED, contact_offsets,
-                     gap_offset)
+from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, H_RIGID, NORMAL_PRESCRIBED,
+                     NORMAL_RIGID, contact_offsets, gap_offset)
 from .jit import inlined_kernel
 from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, unilateral_kernel
 from .stack import work_vectors
 
-__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator",
-           "add_normal_force", "add_normal_forces", "normal_in_mode", "starts_open", "open_in_mode", "indicator_of"]
+__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "is_rigid", "any_rigid_closed", "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator",
+           "add_normal_force", "add_normal_forces", "normal_in_mode", "starts_open", "open_in_mode"]
 
 #: Mode of an open unilateral contact: no normal force, no friction (the stick and slip modes
 #: are in :mod:`stickslip.model.model_data`).
@@ -60,6 +66,26 @@ def is_unilateral(md, n, c):
     if not has_unilateral(md.kin, md.m):
         return False
     return md.m[contact_offsets(n, c)[0] + C_NORMAL_LAW] != NORMAL_PRESCRIBED
+
+
+@inlined_kernel
+def is_rigid(md, n, c):
+    """Whether contact ``c`` is a rigid unilateral contact (False at compile time for kinematics
+    registered without unilateral contacts; a header flag skips the look-up for models without any)."""
+    if not has_unilateral(md.kin, md.m) or md.m[H_RIGID] == 0.0:
+        return False
+    return md.m[contact_offsets(n, c)[0] + C_NORMAL_LAW] == NORMAL_RIGID
+
+
+@unilateral_kernel(lambda cst, md, n, nc: False, inline="always")
+def any_rigid_closed(cst, md, n, nc):  # pragma: no cover - compiled only
+    """Whether some rigid contact is closed in ``cst`` (its normal force is then a multiplier)."""
+    if md.m[H_RIGID] == 0.0:
+        return False
+    for c in range(nc):
+        if is_rigid(md, n, c) and not is_open(cst, c):
+            return True
+    return False
 
 
 @inlined_kernel
@@ -103,10 +129,14 @@ def compliant_force(s, md, n, c):
 @inlined_kernel
 def contact_indicator(s, cst, md, n, c):
     """φ = min(−g, λ̃) for a closed contact, −φ for an open one: > 0 while the contact stays in its
-    state, its fall through 0 is the opening or closing event [m or N; only the sign matters]."""
+    state, its fall through 0 is the opening or closing event [m or N; only the sign matters].
+    A rigid contact: g while open (−g while closed, which is not its event:
+    :func:`stickslip.model.physics.indicator` gives its λ instead)."""
     m = md.m
     o = contact_offsets(n, c)[0]
     g, rate = gap_and_rate(s, md, n, c)
+    if is_rigid(md, n, c):  # open: g; closed: −g ≡ 0 (its event, λ through 0, needs the forces)
+        return g if is_open(cst, c) else -g
     lam = -m[o + C_NORMAL_K] * g - m[o + C_NORMAL_C] * rate
     # φ in the same unit: λ̃ / k is a length (k > 0 for a compliant contact)
     phi = -g if (-g).real < (lam / m[o + C_NORMAL_K]).real else lam / m[o + C_NORMAL_K]
@@ -130,21 +160,23 @@ def add_normal_force(s, md, n, c, lam, f):
 
 @unilateral_kernel(lambda s, cst, md, n, nc, N, f: None, inline="always")
 def add_normal_forces(s, cst, md, n, nc, N, f):  # pragma: no cover - compiled only
-    """f += Wᵀ λ for every closed unilateral contact (λ = N[c], its normal force)."""
+    """f += Wᵀ λ for every closed compliant contact (λ = N[c], its normal force; a rigid one's is
+    added with its multiplier)."""
     if has_unilateral(md.kin, md.m):
         for c in range(nc):
-            if is_unilateral(md, n, c) and not is_open(cst, c):
+            if is_unilateral(md, n, c) and not is_open(cst, c) and not is_rigid(md, n, c):
                 add_normal_force(s, md, n, c, N[c], f)
 
 
 @unilateral_kernel(lambda s, cst, md, n, c, normal: normal, inline="always")
 def normal_in_mode(s, cst, md, n, c, normal):  # pragma: no cover - compiled only
     """Normal force of contact ``c`` in its mode, given ``normal`` as its frame returned it: the
-    frame's for a pressed contact; 0 for an open unilateral one; for a closed one λ̃ (which constant
-    kinematics return from the frame already)."""
+    frame's for a pressed contact; 0 for an open unilateral one; for a closed compliant one λ̃
+    (which constant kinematics return from the frame already); 0 for a rigid one (its multiplier
+    replaces it)."""
     if not is_unilateral(md, n, c):
         return normal
-    if is_open(cst, c):
+    if is_open(cst, c) or is_rigid(md, n, c):
         return csm.zero(normal)
     if md.m[H_CONSTANT] != 0.0:
         return normal
@@ -157,15 +189,13 @@ def open_in_mode(cst, md, c):  # pragma: no cover - compiled only
     return is_open(cst, c)
 
 
-@unilateral_kernel(lambda s, cst, c, md: 1.0 + csm.zero(s[0]))
-def indicator_of(s, cst, c, md):  # pragma: no cover - compiled only
-    """:func:`contact_indicator` of contact ``c`` (1.0 for pressed-only kinematics, never an event)."""
-    return contact_indicator(s, cst, md, model_sizes(md.kin, md.m)[0], c)
-
-
 @unilateral_kernel(lambda y, cst, c, md: False)
 def starts_open(y, cst, c, md):  # pragma: no cover - compiled only
     """Whether unilateral contact ``c`` is open at the state ``y`` (its indicator ≤ 0 when closed);
-    False for a pressed contact."""
+    False for a pressed contact. A rigid contact is open where g > 0 or ġ > 0 (whether a closed
+    one is pressed, λ > 0, takes the forces: :func:`stickslip.integrate.contacts.initial_modes`)."""
     n = model_sizes(md.kin, md.m)[0]
+    if is_rigid(md, n, c):
+        g, rate = gap_and_rate(y, md, n, c)
+        return g > 0.0 or rate > 0.0
     return is_unilateral(md, n, c) and contact_indicator(y, cst, md, n, c) <= 0.0

@@ -51,15 +51,15 @@ from .forces import (add_contact_force, general_forces, general_forces_body, qua
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel
-from .kinematics import contact_dim, contact_frame, model_sizes
+from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
                          apply_inverse_mass, is_stick, kinetic_coefficient, kinetic_energy, law_row, static_limit)
-from .normal import MODE_OPEN, gap_and_rate, indicator_of, is_open, is_unilateral, normal_in_mode
+from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
 from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
-           "indicator", "gap", "unilateral", "is_open", "normal_force_of",
+           "indicator", "gap", "unilateral", "rigid", "rigid_pivot", "is_open", "normal_force_of",
            "rhs", "rhs_body", "general_rhs", "rhs_and_forces", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP",
@@ -222,11 +222,39 @@ def slip_velocity(s, c, md):
     return frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
 
 
+@unilateral_kernel(lambda s, cst, c, md: 1.0 + csm.zero(s[0]))
+def contact_event(s, cst, c, md):  # pragma: no cover - compiled only
+    """:func:`indicator` (1.0 for pressed-only kinematics, never an event)."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    if is_rigid(md, n, c) and not is_open(cst, c):
+        G = work_matrix(md.kin, ROWS, DOFS, s)
+        w, v, N, h, F, f = work_vectors(md.kin, 6, s)
+        general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+        return N[c]
+    return contact_indicator(s, cst, md, n, c)
+
+
 @kernel
 def indicator(s, cst, c, md):
     """Open/closed indicator of unilateral contact ``c`` in its mode of ``cst``: > 0 while it stays
-    closed (open), falls through 0 where it opens (closes) (:func:`~stickslip.model.normal.contact_indicator`)."""
-    return indicator_of(s, cst, c, md)
+    closed (open), falls through 0 where it opens (closes) (:func:`~stickslip.model.normal.contact_indicator`;
+    a closed rigid contact's is its normal force, the multiplier λ [N])."""
+    return contact_event(s, cst, c, md)
+
+
+@kernel
+def rigid_pivot(s, cst, md):
+    """Smallest relative pivot of the normal-force system of the closed rigid contacts at ``s``
+    (:func:`~stickslip.model.forces.rigid_normal_forces`): ≤ 0 where they have no consistent
+    normal force (Painlevé); 1.0 where none is closed."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    if not any_rigid_closed(cst, md, n, nc):
+        return 1.0
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
+    return general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
 
 
 @kernel
@@ -241,6 +269,8 @@ def normal_force_of(s, cst, c, md):
     unilateral contact's λ (0 while open)."""
     m = md.m
     n = model_sizes(md.kin, m)[0]
+    if is_rigid(md, n, c) and not is_open(cst, c):  # the multiplier: the forces in the modes of cst
+        return contact_event(s, cst, c, md)
     G2 = work_matrix(md.kin, TWO, DOFS, s)
     w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     return normal_in_mode(s, cst, md, n, c, contact_frame(md.kin, s, c, m, G2, w2))
@@ -250,6 +280,12 @@ def normal_force_of(s, cst, c, md):
 def unilateral(c, md):
     """Whether contact ``c`` has a gap instead of a prescribed normal load."""
     return is_unilateral(md, model_sizes(md.kin, md.m)[0], c)
+
+
+@kernel
+def rigid(c, md):
+    """Whether contact ``c`` is a rigid unilateral contact (impacts; its normal force a multiplier)."""
+    return is_rigid(md, model_sizes(md.kin, md.m)[0], c)
 
 
 @kernel

@@ -9,7 +9,7 @@ array of shape (rows, cols), where the sizes are codes resolved *at compile time
 kinematics class of the model (:func:`stickslip.model.kinematics.register_kinematics`):
 
 ``DOFS`` n, ``STATES`` 2n, ``CONTACTS`` nc, ``ROWS`` 2 nc (the tangent rows of all contacts),
-``ONE``, ``TWO``.
+``ONE``, ``TWO``, ``IMPULSE_ROWS`` 3 nc (the normal and tangent rows of all contacts: impacts).
 
 :func:`work_vectors` creates several scratch vectors of length max(n, 2 nc) at once (long enough
 for a generalised force and for one entry per tangent row), unpacked by the caller:
@@ -27,14 +27,14 @@ from numba.extending import intrinsic
 from numba.np.arrayobj import populate_array
 
 __all__ = ["work_matrix", "work_vectors", "static_sizes", "MAX_DOFS", "MAX_CONTACTS", "DOFS", "STATES", "CONTACTS", "ROWS",
-           "ONE", "TWO"]
+           "ONE", "TWO", "IMPULSE_ROWS"]
 
 #: Largest model (DOFs, contacts) whose kinematics class does not fix its size; a larger one is
 #: refused when it is built (the stack frames of the kernels hold arrays of this size).
 MAX_DOFS = 64
 MAX_CONTACTS = 16
 
-DOFS, STATES, CONTACTS, ROWS, ONE, TWO = range(6)
+DOFS, STATES, CONTACTS, ROWS, ONE, TWO, IMPULSE_ROWS = range(7)
 
 #: Sizes fixed by kinematics classes: class → (n, nc); filled by register_kinematics.
 _STATIC: dict[type, tuple[int, int]] = {}
@@ -46,7 +46,7 @@ def static_sizes(cls) -> tuple[int, int] | None:
 
 
 def _extent(code: int, n: int, nc: int) -> int:
-    return {DOFS: n, STATES: 2 * n, CONTACTS: nc, ROWS: 2 * nc, ONE: 1, TWO: 2}[code]
+    return {DOFS: n, STATES: 2 * n, CONTACTS: nc, ROWS: 2 * nc, ONE: 1, TWO: 2, IMPULSE_ROWS: 3 * nc}[code]
 
 
 @intrinsic(prefer_literal=True)

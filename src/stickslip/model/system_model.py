@@ -96,9 +96,8 @@ def check_name(name: str, what: str) -> None:
         raise ModelError(f"{what} = {shown} is not a valid name; give a name of {NAME_RULE}")
 
 
-#: Normal laws a unilateral contact may state (:class:`NormalLaw`); ``rigid`` is reserved for the
-#: impact law (Newton restitution and a Coulomb impulse), which is not available yet.
-UNILATERAL_LAWS = ("compliant",)
+#: Normal laws a unilateral contact may state (:class:`NormalLaw`).
+UNILATERAL_LAWS = ("compliant", "rigid")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -107,14 +106,16 @@ class NormalLaw:
 
     Attributes
     ----------
-    law : {"compliant"}
+    law : {"compliant", "rigid"}
         ``compliant``: λ = max(0, −k g − c ġ) while g < 0, else 0 (Kelvin–Voigt, no impulses).
+        ``rigid``: g ≥ 0, λ ≥ 0, g λ = 0; closing is an impact (Newton's restitution, a Coulomb
+        impulse).
     stiffness : float
-        Contact stiffness k > 0 [N/m].
+        Contact stiffness k > 0 [N/m] (compliant contacts).
     damping : float
-        Contact damping c ≥ 0 [N s/m].
+        Contact damping c ≥ 0 [N s/m] (compliant contacts).
     restitution : float
-        Newton's restitution coefficient e ∈ [0, 1] (rigid contacts).
+        Newton's restitution coefficient e ∈ [0, 1] (rigid contacts): ġ⁺ = −e ġ⁻.
     """
 
     law: str = "compliant"
@@ -129,11 +130,19 @@ class NormalLaw:
         ------
         ModelError
         """
-        if self.law == "rigid":
-            raise ModelError(f"{where}: law = \"rigid\" (impacts with restitution) is not available yet; give "
-                             "law = \"compliant\" with a contact stiffness (and damping)")
         if self.law not in UNILATERAL_LAWS:
-            raise ModelError(f"{where}: law = {self.law!r} is not a normal law; choose compliant")
+            raise ModelError(f"{where}: law = {self.law!r} is not a normal law; choose compliant or rigid")
+        if self.law == "rigid":
+            if self.stiffness != 0.0 or self.damping != 0.0:
+                raise ModelError(f"{where}: a rigid contact has no stiffness or damping; give restitution = e in "
+                                 "[0, 1], or law = \"compliant\" for a contact spring")
+            if not (math.isfinite(self.restitution) and 0.0 <= self.restitution <= 1.0):
+                raise ModelError(f"{where}: restitution = {self.restitution:g} must lie in [0, 1] (Newton's e: "
+                                 "0 plastic, 1 elastic)")
+            return
+        if self.restitution != 0.0:
+            raise ModelError(f"{where}: restitution is a rigid contact's; a compliant contact dissipates through "
+                             "its damping")
         if not (math.isfinite(self.stiffness) and self.stiffness > 0.0):
             raise ModelError(f"{where}: stiffness = {self.stiffness:g} must be a finite contact stiffness > 0 [N/m]")
         if not (math.isfinite(self.damping) and self.damping >= 0.0):
@@ -199,6 +208,7 @@ class Contact:
             W = np.zeros(n) if self.gap_gradient is None else np.asarray(self.gap_gradient, dtype=float)
             # closed, the compliant force −k (g0 + W·q) − c W·q̇ is the affine N0 + n·q + n_v·q̇ of the
             # constant kinematics' frame
+            # (a rigid contact has k = c = 0: its normal force is a multiplier, not part of the frame)
             out.update(normal_law=NORMAL_LAWS[self.normal.law], gap=self.gap, W=W, k=k, c=c,
                        e=self.normal.restitution, N0=-k * self.gap, n_q=-k * W, n_v=-c * W)
         return out
@@ -414,6 +424,9 @@ class FrictionModel:
         if not math.isfinite(contact.gap):
             raise ModelError(f"{where}: gap = {contact.gap} must be finite [m]")
         if computes_gap(type(self.kinematics)):
+            if contact.normal.law == "rigid":
+                raise ModelError(f"{where}: a rigid contact needs a gap affine in q (gap and gap_gradient); a gap "
+                                 "that kinematics compute takes law = \"compliant\"")
             if contact.gap != 0.0 or contact.gap_gradient is not None:
                 raise ModelError(f"{where}: kinematics {type(self.kinematics).__name__} computes the gap (its "
                                  "registered gap function); give neither gap nor gap_gradient")
@@ -430,6 +443,22 @@ class FrictionModel:
     def unilateral(self) -> bool:
         """Whether some contact opens and closes (states a gap instead of a prescribed load)."""
         return any(c.unilateral for c in self.contacts)
+
+    @property
+    def rigid(self) -> bool:
+        """Whether some contact is rigid (closes with impacts; its normal force a multiplier)."""
+        return any(c.unilateral and c.normal.law == "rigid" for c in self.contacts)
+
+    def refuse_rigid(self, what: str) -> None:
+        """Refuse ``what`` (an analysis that does not take rigid contacts yet) for a model with one.
+
+        Raises
+        ------
+        ModelError
+        """
+        if self.rigid:
+            raise ModelError(f"{what} of model {self.name!r}: not available for rigid contacts (impacts) yet; "
+                             "simulate it (simulate, sweep), or state its contacts with law = \"compliant\"")
 
     @property
     def n(self) -> int:

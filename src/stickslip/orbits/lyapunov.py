@@ -145,6 +145,7 @@ def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, s
         system = ic.system if system is None and model is None else system
         ic = ic.state
     system = resolve(system, model, slip_band)
+    system.refuse_rigid("Lyapunov exponents (variations across impacts)")
     atol = 1e-3 * rtol if atol is None else float(atol)
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")

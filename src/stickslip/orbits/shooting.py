@@ -241,6 +241,7 @@ def periodic_orbit(
         system = resolve(system, guess.system.parameters["variant"], slip_band)  # new parameters, the run's variant
     else:
         system = resolve(system, model, slip_band)
+    system.refuse_rigid("a periodic orbit (saltation across impacts)")
     k = int(period_multiplicity)
     if k < 1:
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")

@@ -93,6 +93,7 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         0) or, for a 2-D contact, slides inside the low-speed band (the simulator's slip direction
         there is not v/|v|, so steady sliding is not an equilibrium of the simulated equations).
     """
+    system.refuse_rigid("steady sliding")
     q, rel, iterations = _solve_closed(system)
     _check_closed(system, q)
     return q, rel, iterations
