@@ -308,6 +308,31 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
             y, t, Phi = seg.s, seg.t, after(seg.t, seg.Phi)
             continue
         c, kind = seg.contact, seg.kind
+        if kind == V.EV_GAP and system.contacts[c - system.n_contacts].unilateral \
+                and system.contacts[c - system.n_contacts].normal.law == "rigid" \
+                and int(cst[CST * (c - system.n_contacts)]) == P.MODE_OPEN:
+            c -= system.n_contacts
+            at = [j for j in range(k, n_tr) if abs(float(tr.time[j]) - seg.t) <= MATCH_TIME_TOL
+                  and int(tr.contact[j]) == c]
+            kinds = [int(tr.kind[j]) for j in at]
+            if E.TRANSITION_IMPACT not in kinds or kinds[-1] not in (E.TRANSITION_OPEN, E.TRANSITION_CLOSE):
+                raise OrbitError(f"contact {c} lands in the re-integration at {seg.t:.9f} s, the integrator's next "
+                                 f"transition is at {t_next:.9f} s" + (" (it sticks there: no saltation matrix "
+                                                                      "for stick at an impact; use the "
+                                                                      "finite-difference monodromy)"
+                                                                      if E.TRANSITION_TO_STICK in kinds else ""))
+            i_impact = at[kinds.index(E.TRANSITION_IMPACT)]
+            bounced = kinds[-1] == E.TRANSITION_OPEN
+            if not bounced and system.contacts[c].normal.restitution > 0.0:
+                raise OrbitError(f"contact {c}'s bounces accumulate at {seg.t:.9f} s (a Zeno sequence): no saltation "
+                                 "matrix; use the finite-difference monodromy")
+            s_i = tr.state[i_impact][:n2]
+            check(seg.s, s_i)
+            jump, cst = S.impact_jump(system, s_i, cst, c, bounced)
+            Phi = after(float(tr.time[i_impact]), jump @ seg.Phi)
+            events.append((float(tr.time[i_impact]), "impact", c))
+            y, t, k = tr.state[at[-1]][:n2].copy(), float(tr.time[at[-1]]), at[-1] + 1
+            continue
         if kind == V.EV_GAP:
             c -= system.n_contacts
             recorded = E.TRANSITION_CLOSE if int(cst[CST * c]) == P.MODE_OPEN else E.TRANSITION_OPEN

@@ -25,7 +25,16 @@ complex steps of the contact's slip velocity, friction and normal force
   departing slip field.
 * **a unilateral contact opens or closes** (:func:`gap_jump`): h = φ, the contact's open/closed
   indicator (:mod:`stickslip.model.normal`); the state is continuous and the field jumps (with
-  contact damping the normal force jumps to −c ġ at closing); f⁺ open, or sliding.
+  contact damping the normal force jumps to −c ġ at closing); f⁺ open, or sliding. A closed
+  rigid contact's indicator is its normal force λ, continuous through 0 at opening.
+* **an impact of a rigid contact** (:func:`impact_jump`): the state jumps, s⁺ = Π(s⁻) (Newton's
+  restitution, the Coulomb impulse; :mod:`stickslip.model.impact`), so
+
+      S = R + (f⁺ − R f⁻) ∇gᵀ / (∇g · f⁻),    R = ∂Π/∂s
+
+  (Leine & Nijmeijer 2004, ch. 3), with h = g the gap, R by central differences of the compiled
+  impact map (linear in the velocities for constant G and W, so exact to round-off there), f⁺ at
+  s⁺ in the modes after (bounced off: open; stayed: sliding).
 """
 
 from __future__ import annotations
@@ -38,10 +47,12 @@ from ..model import physics as P
 from ..model.bundle import CST
 from ..model.derivatives import state_jacobian
 from ..model.friction import static_coefficient
+from ..model.impact import IMPACT_INCONSISTENT, impact, restitution_of
 from .var_kernels import contact_gradients, indicator_gradient
 
 __all__ = ["saltation_matrix", "field", "ContactState", "contact_at", "stick_projection", "breakaway_jump",
-           "band_exit_jump", "arrival_jump", "gap_jump", "inverse_mass", "sticking", "with_mode"]
+           "band_exit_jump", "arrival_jump", "gap_jump", "impact_jump", "impact_map", "inverse_mass", "sticking",
+           "with_mode"]
 
 
 def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray) -> np.ndarray:
@@ -206,6 +217,56 @@ def gap_jump(system, s: np.ndarray, cst: np.ndarray, c: int):
         after = with_mode(cst, c, P.MODE_OPEN)
     S = saltation_matrix(field(system, s, cst), field(system, s, after), grad_h)
     return S @ projection, after
+
+
+def impact_map(system, s: np.ndarray, cst: np.ndarray, c: int) -> np.ndarray:
+    """Π(s): the state (2n,) right after the impact of rigid contact ``c`` (open in ``cst``) at ``s``."""
+    out = np.ascontiguousarray(s[:2 * system.n], dtype=float).copy()
+    if impact(out, cst, c, system.data, restitution_of(c, system.data))[0] == IMPACT_INCONSISTENT:
+        raise OrbitError(f"contact {c}'s impact has no consistent impulse (Painlevé): no saltation matrix")
+    return out
+
+
+def impact_jump(system, s: np.ndarray, cst: np.ndarray, c: int, bounced: bool):
+    """Saltation matrix (2n × 2n) of the impact of rigid contact ``c`` (open in ``cst``) at ``s``
+    (module docstring); ``bounced``: whether it leaves the stop again (open after), else it stays
+    closed and slides. Returns (S, the contact states after).
+
+    Raises
+    ------
+    OrbitError
+        If it stays closed with v_c = 0 (stick at an impact has no jump matrix here) or grazes.
+    """
+    n2 = 2 * system.n
+    s = np.ascontiguousarray(s[:n2], dtype=float)
+    after_state = impact_map(system, s, cst, c)
+    R = np.empty((n2, n2))
+    for j in range(n2):
+        h = 1e-7 * max(1.0, abs(s[j]))
+        up, down = s.copy(), s.copy()
+        up[j] += h
+        down[j] -= h
+        R[:, j] = (impact_map(system, up, cst, c) - impact_map(system, down, cst, c)) / (2.0 * h)
+    if bounced:
+        after = cst.copy()
+    else:
+        v = np.array(P.slip_velocity(after_state, c, system.data))
+        speed = float(np.hypot(*v))
+        if speed <= E.STICK_SPEED_TOL:
+            raise OrbitError(f"contact {c} sticks at its impact: stick at an impact has no saltation matrix here; "
+                             "use the finite-difference monodromy")
+        if system.contacts[c].dim == 1:
+            after = with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, (float(np.sign(v[0])), 0.0))
+        else:
+            after = with_mode(cst, c, P.MODE_SLIP_EXACT, tuple(v / speed))
+    grad_h = np.empty(n2)
+    indicator_gradient(s, cst, c, system.data, n2, grad_h, np.empty(n2, dtype=np.complex128))
+    f_minus = field(system, s, cst)
+    rate = float(grad_h @ f_minus)
+    if rate == 0.0 or not np.isfinite(rate):
+        raise OrbitError("tangential event crossing (dg/dt = 0): grazing, no saltation matrix")
+    S = R + np.outer(field(system, after_state, after) - R @ f_minus, grad_h) / rate
+    return S @ stick_projection(system, s, cst), after
 
 
 def band_exit_jump(system, s: np.ndarray, cst: np.ndarray, c: int):
