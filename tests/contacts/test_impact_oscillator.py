@@ -212,7 +212,7 @@ def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_statu
     assert "Painlevé" in tr.status and "\n" not in tr.status
 
 
-@pytest.mark.parametrize("command", [["stability"], ["orbit", "--search-time", "5"]])
+@pytest.mark.parametrize("command", [["orbit", "--search-time", "5"], ["basins", "--box", "x=0:1", "--n", "2"]])
 def test_analyses_without_rigid_contacts_refuse_in_one_line(command):
     result = CliRunner().invoke(app, [*command, "--model", "impact-oscillator"])
     assert result.exit_code == 2, result.output

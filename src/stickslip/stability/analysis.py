@@ -16,7 +16,7 @@ from ..model.library.two_plates import plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.physics import MODE_SLIP_EXACT
 from ..model.variants import DOF_NAMES
-from .equilibrium import model_of, point_text, solve_steady
+from .equilibrium import model_of, point_text, rigid_constraint, solve_steady
 
 __all__ = ["StabilityResult", "stability", "linearization", "model_stability"]
 
@@ -45,6 +45,8 @@ class StabilityResult:
         M_L on the free DOFs: its diagonal when M is diagonal (the plates) [kg, kg m²], else the matrix.
     eigenvalues : ndarray (2k,) complex
         Sorted by real part, descending (conjugate pairs: positive imaginary part first) [1/s].
+        With m closed rigid contacts 2(k − m): those of the motion that keeps them closed (the
+        constrained eigenproblem: ``jacobian`` restricted to W q = 0, W q̇ = 0).
     mode_shapes : ndarray (2k, k) complex
         Displacement part of each eigenvector, scaled so that its largest entry is 1 (real).
     """
@@ -141,7 +143,7 @@ class StabilityResult:
             "mass_L": (("dof",) if self.mass.ndim == 1 else ("dof", "dof_col"), self.mass, {"long_name": "M_L of Eq. (15)"}),
         }
         coords = {
-            "mode": ("mode", np.arange(2 * k)),
+            "mode": ("mode", np.arange(self.eigenvalues.size)),
             "dof": ("dof", list(self.dofs)),
             "dof_col": ("dof_col", list(self.dofs)),
             "dof_all": ("dof_all", list(self.all_dofs)),
@@ -229,12 +231,18 @@ def model_stability(system) -> StabilityResult:
     if not np.all(np.isfinite(J)):
         raise EquilibriumError(f"the linearisation at steady sliding is not finite ({point_text(system)}: overflow); "
                                "give values of physical size")
-    lam, vec = np.linalg.eig(J)
-    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
-    lam = lam[order]
-    vec = vec[:, order]
     free = np.flatnonzero(system.free)
     k = free.size
+    basis = np.eye(k)
+    if system.rigid:
+        # the closed rigid contacts hold W q = −g0 and W q̇ = 0, an invariant subspace of the
+        # linearised flow (J T = T Tᵀ J T): its eigenvalues are those of Tᵀ J T, T = diag(Z, Z)
+        basis = rigid_constraint(system)[1][free]
+    T = np.kron(np.eye(2), basis)
+    lam, vec = np.linalg.eig(T.T @ J @ T)
+    order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
+    lam = lam[order]
+    vec = T @ vec[:, order]
     shapes = vec[:k, :].T.copy()
     for j in range(shapes.shape[0]):
         m = int(np.argmax(np.abs(shapes[j])))

@@ -4,6 +4,11 @@ q̇ = 0 and f0 − K q + Σ_c G_cᵀ F_c(q, 0) = 0 with every contact slipping, 
 from q = 0 with the exact Jacobian of the simulator's own right-hand side (complex step), with a
 continuation in the normal load as a fallback near the fold where steady sliding ceases to exist
 (:mod:`stickslip.stability.steady`, compiled).
+
+A model with rigid contacts: each closed rigid contact holds its gap at 0, W_R q = −g0, and its
+normal force is the multiplier of the simulator's right-hand side. The equilibrium is then solved
+on that constraint, q = q_p + Z r (q_p the least-norm point on it, Z an orthonormal basis of
+null(W_R) on the free DOFs), for Zᵀ q̈(q, 0) = 0 (:func:`_solve_rigid`); W_R q̈ = 0 holds already.
 """
 
 from __future__ import annotations
@@ -12,17 +17,19 @@ import math
 from pathlib import Path
 
 import numpy as np
+from scipy.linalg import null_space
+from scipy.optimize import root
 
 from ..errors import EquilibriumError, StickSlipError
 from ..model.bundle import CST
 from ..model.library import resolve_system
 from ..model.parameters import Parameters
-from ..model.physics import MODE_SLIP_EXACT, gap, normal_force_of, rhs, slip_velocity
+from ..model.physics import MODE_SLIP_EXACT, gap, normal_force_of, rhs, rigid_pivot, slip_velocity
 from ..model.system_model import FrictionModel
 from . import steady
 
 __all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "RESIDUAL_TOL", "steady_sliding",
-           "steady_residual", "solve_steady", "point_text", "sliding_speeds", "model_of"]
+           "steady_residual", "solve_steady", "point_text", "sliding_speeds", "model_of", "rigid_constraint"]
 
 #: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved. Newton reaches ~1e-16
 #: (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while still
@@ -93,10 +100,54 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         0) or, for a 2-D contact, slides inside the low-speed band (the simulator's slip direction
         there is not v/|v|, so steady sliding is not an equilibrium of the simulated equations).
     """
-    system.refuse_rigid("steady sliding")
-    q, rel, iterations = _solve_closed(system)
+    q, rel, iterations = _solve_rigid(system) if system.rigid else _solve_closed(system)
     _check_closed(system, q)
     return q, rel, iterations
+
+
+def rigid_constraint(system) -> tuple[np.ndarray, np.ndarray]:
+    """(q_p, Z): the least-norm point q_p (n,) of W_R q = −g0 and an orthonormal basis Z (n, k − m)
+    of null(W_R) on the free DOFs (zero rows on locked ones), W_R (m, n) the rigid contacts' gap
+    gradients, g0 their gaps."""
+    rows = [(np.asarray(c.gap_gradient, float), c.gap) for c in system.contacts
+            if c.unilateral and c.normal.law == "rigid"]
+    W = np.array([w for w, _ in rows])
+    g0 = np.array([g for _, g in rows])
+    free = np.flatnonzero(system.free)
+    q_p = np.zeros(system.n)
+    q_p[free] = -np.linalg.pinv(W[:, free]) @ g0
+    Z = np.zeros((system.n, free.size - np.linalg.matrix_rank(W[:, free])))
+    Z[free] = null_space(W[:, free])
+    return q_p, Z
+
+
+def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
+    """:func:`solve_steady` with every contact sliding and the rigid ones closed (module docstring):
+    scipy's hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0, the rigid normal forces
+    the right-hand side's multipliers."""
+    if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:
+        raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
+    q_p, Z = rigid_constraint(system)
+    n = system.n
+    cst = _sliding_modes(system)
+
+    def acceleration(r):
+        s = np.zeros(2 * n)
+        s[:n] = q_p + Z @ r
+        ds = np.zeros(2 * n)
+        rhs(s, cst, system.data, ds)
+        return Z.T @ ds[n:]
+    sol = root(acceleration, np.zeros(Z.shape[1]), method="hybr", options={"xtol": 1e-14})
+    q = q_p + Z @ sol.x
+    s = np.zeros(2 * n)
+    s[:n] = q
+    if rigid_pivot(s, cst, system.data) <= 0.0:
+        raise EquilibriumError(f"no steady sliding at {system.point_text()}: a sliding rigid contact has no "
+                               "consistent normal force there (Painlevé); lower the friction coefficient")
+    rel = steady_residual(system, q)
+    if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
+        raise EquilibriumError(_failure_message(system, q, steady.NEWTON_MAX_ITER, rel))
+    return q, float(rel), int(sol.nfev)
 
 
 def _solve_closed(system) -> tuple[np.ndarray, float, int]:
@@ -115,8 +166,8 @@ def _solve_closed(system) -> tuple[np.ndarray, float, int]:
 
 
 def _open_contact(system, q: np.ndarray):
-    """(c, g, λ) of the first unilateral contact that is not closed (g < 0, λ > 0) at the steady
-    state ``q`` solved with it closed, or None."""
+    """(c, g, λ) of the first unilateral contact that is not closed (g < 0, λ > 0; a rigid one:
+    λ > 0, its gap held at 0) at the steady state ``q`` solved with it closed, or None."""
     s = np.zeros(2 * system.n)
     s[:system.n] = q
     cst = _sliding_modes(system)
@@ -124,7 +175,8 @@ def _open_contact(system, q: np.ndarray):
         if contact.unilateral:
             g = gap(s, c, system.data)[0]
             lam = normal_force_of(s, cst, c, system.data)
-            if not (g < 0.0 and lam > 0.0):
+            closed = lam > 0.0 if contact.normal.law == "rigid" else (g < 0.0 and lam > 0.0)
+            if not closed:
                 return c, g, lam
     return None
 
@@ -135,7 +187,7 @@ def _closed_without_friction(system) -> bool:
     zero = {f"contact.{c}.friction.{key}": 0.0 for c in range(system.n_contacts) for key in ("mu_k", "delta_mu")}
     try:
         smooth = system.replace(**zero)
-        return _open_contact(smooth, _solve_closed(smooth)[0]) is None
+        return _open_contact(smooth, (_solve_rigid if smooth.rigid else _solve_closed)(smooth)[0]) is None
     except (StickSlipError, ValueError, ArithmeticError, np.linalg.LinAlgError):
         return False
 

@@ -536,6 +536,7 @@ def stability_map(
         value that makes the model invalid.
     """
     system = model_of(params, model)
+    system.refuse_rigid("a stability map")
     axes = tuple(axes)
     N = _as_float_array(axes[0], N)
     Omega = _as_float_array(axes[1], Omega)

@@ -1,0 +1,57 @@
+"""Steady sliding with a closed rigid contact, and the constrained eigenproblem, against the hand
+solution of the rigid slider (tests/contacts/rigid_slider.toml).
+
+With the contact closed, y ≡ 0 and the normal force is what the y equation needs,
+λ = P + K12 x (K12 = k3 cos θ sin θ); the slider slides against the belt (v = −V), F = μ(V − ẋ) λ:
+
+    x_e = μ(V) P / (K11 − μ(V) K12),      ẍ = −(K11 − μ K12) x − (cx + μ'(V) λ_e) ẋ   (linearised),
+
+μ(s) = μk + Δμ e^(−α s), μ' = −α Δμ e^(−α s): two eigenvalues, of the motion that keeps y = 0.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stickslip
+from stickslip.errors import EquilibriumError
+from stickslip.stability.analysis import model_stability
+
+RIGID_SLIDER = Path(__file__).with_name("rigid_slider.toml")
+KX, K3, THETA, CX, MU_K, DELTA_MU, ALPHA = 1.0, 3.0, math.radians(150.0), 0.05, 0.3, 0.6, 2.0
+K11 = KX + K3 * math.cos(THETA) ** 2
+K12 = K3 * math.cos(THETA) * math.sin(THETA)
+
+
+def hand(P, V):
+    mu = MU_K + DELTA_MU * math.exp(-ALPHA * V)
+    dmu = -ALPHA * DELTA_MU * math.exp(-ALPHA * V)
+    x = mu * P / (K11 - mu * K12)
+    lam = P + K12 * x
+    A = np.array([[0.0, 1.0], [-(K11 - mu * K12), -(CX + dmu * lam)]])
+    eig = np.linalg.eigvals(A)
+    return x, lam, eig[np.lexsort((-eig.imag, -eig.real))]
+
+
+@pytest.mark.parametrize(("P", "V"), [(0.3, 0.5), (0.3, 2.0), (1.0, 0.2)])
+def test_steady_sliding_and_constrained_eigenvalues_match_the_hand_solution(P, V):
+    model = stickslip.load_model(RIGID_SLIDER).replace(P=P, V=V)
+    result = model_stability(model)
+    x, lam, eig = hand(P, V)
+    np.testing.assert_allclose(result.equilibrium, [x, 0.0], atol=1e-12)
+    assert result.eigenvalues.size == 2  # y and ẏ are held by the closed contact
+    np.testing.assert_allclose(result.eigenvalues, eig, atol=1e-9)
+    s = np.zeros(4)
+    s[0] = x
+    tr = stickslip.simulate(model, 0.01, ic=s, sample_rate=1000.0)
+    np.testing.assert_allclose(tr.normal_force[0, 0], lam, rtol=1e-10)
+
+
+def test_a_rigid_contact_that_nothing_presses_is_no_steady_sliding():
+    model = stickslip.load_model(RIGID_SLIDER).replace(P=-0.3)
+    with pytest.raises(EquilibriumError, match="would be open"):
+        model_stability(model)
