@@ -34,12 +34,33 @@ def cycle():
     return model, s0, period
 
 
-def test_saltation_flow_jacobian_of_a_cycle_with_an_impact_matches_central_differences(cycle):
+@pytest.fixture(scope="module")
+def flow_map_differences(cycle):
+    model, s0, period = cycle
+    return central_differences(model, s0, period)
+
+
+def test_saltation_flow_jacobian_of_a_cycle_with_an_impact_matches_central_differences(cycle,
+                                                                                       flow_map_differences):
     model, s0, period = cycle
     fj = flow_jacobian(model, s0, period, rtol=1e-11)
     kinds = [kind for _, kind, _ in fj.events]
     assert kinds.count("impact") == 1 and "stick" in kinds and "breakaway" in kinds and "open" in kinds
-    D = central_differences(model, s0, period)
+    D = flow_map_differences
     np.testing.assert_allclose(fj.matrix, D, rtol=0, atol=1e-6 * np.abs(D).max())
     # one period from a point of the cycle: the trivial multiplier 1 of an autonomous cycle
     assert np.min(np.abs(np.linalg.eigvals(fj.matrix) - 1.0)) < 1e-5
+
+
+def test_lyapunov_spectrum_across_impacts(cycle, flow_map_differences):
+    """The cycle keeps one direction per period (the flow's own): the plastic impact and the
+    closed contact hold y and y', stick holds x'. The flow map's central differences have rank 1
+    (singular values below 1e-6 of the largest otherwise), so the exponents are 0 and three that
+    diverge to −∞; the variational spectrum gives ~0 and three strongly negative ones."""
+    model, s0, period = cycle
+    singular = np.linalg.svd(flow_map_differences, compute_uv=False)
+    assert singular[1] < 1e-6 * singular[0]
+    spectrum = stickslip.lyapunov_spectrum(model, ic=s0, t_transient=10.0, t_average=100.0, rtol=1e-10)
+    exponents = np.sort(spectrum.exponents)[::-1]
+    assert abs(exponents[0]) < 2e-3
+    assert (exponents[1:] < -10.0).all()

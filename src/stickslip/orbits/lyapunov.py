@@ -132,11 +132,13 @@ def _check_memory(system, t_transient: float, t_average: float, interval: float,
 
 
 def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average=0.0,
-                     interval=math.inf, option="chunk"):
+                     interval=math.inf, option="chunk", variational=False):
     """The common start of the Lyapunov computations: resolve the start, check the memory of the
     transient and of the running estimates (one per ``interval`` of ``t_average``), run the transient.
 
-    ``ic`` may be a :class:`PeriodicOrbit` (its model is then the default).
+    ``ic`` may be a :class:`PeriodicOrbit` (its model is then the default). A model with rigid
+    contacts is refused unless ``variational`` (perturbed trajectories may start inside a closed
+    rigid contact's stop; the variations cross its impacts by their saltation matrices).
     Returns the flow map as a :class:`.problem.ShootingProblem` without a section (σ: the
     peak-to-peak ranges over the transient's second half) and the exact state at the end of the
     transient.
@@ -145,7 +147,8 @@ def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, s
         system = ic.system if system is None and model is None else system
         ic = ic.state
     system = resolve(system, model, slip_band)
-    system.refuse_rigid("Lyapunov exponents (variations across impacts)")
+    if not variational:
+        system.refuse_rigid("Lyapunov exponents from perturbed trajectories (use the variational method)")
     atol = 1e-3 * rtol if atol is None else float(atol)
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
@@ -395,7 +398,7 @@ def lyapunov_spectrum(
         raise OrbitError(f"t_average = {t_average} s must be > 0")
     interval, option = (chunk, "chunk") if method == "finite-difference" else (record, "record")
     problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average,
-                                      interval, option)
+                                      interval, option, variational=method == "variational")
     if method == "finite-difference":
         return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
     if method != "variational":
