@@ -127,7 +127,6 @@ class StabilityResult:
         import xarray as xr
 
 
-        k = len(self.dofs)
         states = list(self.dofs) + ["d" + d for d in self.dofs]
         data = {
             "equilibrium": ("dof_all", self.equilibrium,
