@@ -126,7 +126,6 @@ class StabilityResult:
         """``xarray.Dataset`` with units, long names and the full parameter set in attrs."""
         import xarray as xr
 
-
         states = list(self.dofs) + ["d" + d for d in self.dofs]
         data = {
             "equilibrium": ("dof_all", self.equilibrium,
