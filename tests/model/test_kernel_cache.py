@@ -54,3 +54,36 @@ def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeyp
     with pytest.raises(TypeError):  # anything but an OSError still surfaces
         Stub._save_overload = lambda self, sig, data: (_ for _ in ()).throw(TypeError("bug"))
         saved(stub, None, None)
+
+
+def test_an_index_naming_a_class_this_process_cannot_import_keeps_its_entries(tmp_path, monkeypatch):
+    """A cache index whose keys name a class from a module that is gone (a user's script, a test
+    folder) still loads: that entry with a stand-in, the others as they were; saved again, the
+    stand-in is written as the original name, so a process that can import it gets it back."""
+    import pickle
+    import sys
+    import types
+
+    from numba.core.caching import IndexDataCacheFile
+
+    module = types.ModuleType("gone_kinematics")
+    exec("class Arm:\n    pass\n", module.__dict__)
+    monkeypatch.setitem(sys.modules, "gone_kinematics", module)
+    index = {("sig", module.Arm): "kernel-1.nbc", ("sig", int): "kernel-2.nbc"}
+    data = pickle.dumps(("stamp", index), protocol=-1)
+    monkeypatch.delitem(sys.modules, "gone_kinematics")
+    path = tmp_path / "kernel.nbi"
+    with open(path, "wb") as f:
+        pickle.dump("v1", f, protocol=-1)
+        f.write(data)
+    fake = types.SimpleNamespace(_index_path=str(path), _version="v1", _source_stamp="stamp")
+    loaded = IndexDataCacheFile._load_index(fake)
+    assert sorted(loaded.values()) == ["kernel-1.nbc", "kernel-2.nbc"]
+    stand_in = next(key[1] for key, value in loaded.items() if value == "kernel-1.nbc")
+    assert stand_in.__name__ == "Arm" and stand_in is not int
+    again = pickle.dumps(loaded, protocol=-1)  # as numba saves it
+    monkeypatch.setitem(sys.modules, "gone_kinematics", module)
+    restored = pickle.loads(again)
+    assert ("sig", module.Arm) in restored and restored[("sig", int)] == "kernel-2.nbc"
+    fake._source_stamp = "another"  # a stale index is empty, as numba has it
+    assert IndexDataCacheFile._load_index(fake) == {}

@@ -32,8 +32,10 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 
 from __future__ import annotations
 
+import copyreg
 import functools
 import hashlib
+import io
 import pickle
 import re
 import sys
@@ -59,19 +61,68 @@ def _wrap_caching(class_name: str, method: str, make) -> None:
     setattr(owner, method, wrapped)
 
 
-def _tolerant_index_loading(load):
-    """Let numba's on-disk cache survive kinematics classes that can no longer be imported.
+class _Unavailable(type):
+    """Metaclass of the stand-ins for classes that a cache index names but this process cannot
+    import (:func:`_tolerant_index_loading`); pickled again as the name of the original."""
 
-    A kernel compiled for a model whose kinematics class lives in a user's script is indexed in the
-    kernel's cache by that class; when the script is gone, unpickling the index fails with an
-    ImportError in *every* later process, whatever model it runs. Such an index is treated as empty
-    instead: the kernel is compiled again for the models in use and the index rewritten.
+
+def unavailable_class(module: str, name: str) -> type:
+    """The class ``module.name`` if this process can import it, else a stand-in of that name (an
+    index entry keyed by it then matches nothing here, and keeps its name when the index is saved)."""
+    try:
+        return pickle.Unpickler.find_class(_REAL_FINDER, module, name)
+    except (ImportError, AttributeError):
+        return _STAND_INS.setdefault((module, name), _Unavailable(name, (), {"__module__": module,
+                                                                             "_stickslip_origin": (module, name)}))
+
+
+_STAND_INS: dict = {}
+copyreg.pickle(_Unavailable, lambda cls: (unavailable_class, cls._stickslip_origin))
+
+
+class _TolerantUnpickler(pickle.Unpickler):
+    """An unpickler that puts a stand-in (:func:`unavailable_class`) where a class cannot be imported."""
+
+    def find_class(self, module, name):
+        try:
+            return super().find_class(module, name)
+        except (ImportError, AttributeError):
+            return unavailable_class(module, name)
+
+
+_REAL_FINDER = _TolerantUnpickler(io.BytesIO(b""))
+
+
+def _tolerant_index_loading(load):
+    """Let numba's on-disk cache survive kinematics classes that this process cannot import.
+
+    A kernel's cache index holds one entry per compiled signature, keyed by its argument types,
+    which name the model's kinematics class. A class that lives in a user's script or a test
+    folder cannot be imported by other processes, and unpickling the whole index then fails in
+    each of them, whatever model it runs. The index is read again with a stand-in for each such
+    class: its entries match nothing here, the other entries load, and when this process adds its
+    own and saves the index they are all kept (the stand-ins pickled as their original names).
+    Without that, every such process recompiled its kernels and rewrote the index with its own
+    entries alone, so that the next process recompiled the others again. An index that cannot be
+    read at all counts as empty.
     """
     def _load_index(self):
         try:
             return load(self)
-        except (ImportError, AttributeError, EOFError, pickle.UnpicklingError):
+        except (ImportError, AttributeError):
+            pass
+        except (EOFError, pickle.UnpicklingError):
             return {}
+        try:
+            with open(self._index_path, "rb") as f:
+                version = pickle.load(f)
+                data = f.read()
+            if version != self._version:
+                return {}
+            stamp, overloads = _TolerantUnpickler(io.BytesIO(data)).load()
+        except Exception:  # noqa: BLE001 - an unreadable index is an empty one
+            return {}
+        return overloads if stamp == self._source_stamp else {}
 
     return _load_index
 
