@@ -25,7 +25,7 @@ __all__ = ["StabilityResult", "stability", "linearization", "model_stability"]
 class StabilityResult:
     """Linear stability of the steady-sliding equilibrium (paper Sect. 4.1).
 
-    Attributes
+    Parameters
     ----------
     params : Parameters or None
         The plates' parameters (None for other models: see ``system.parameters``).
@@ -47,6 +47,10 @@ class StabilityResult:
         Sorted by real part, descending (conjugate pairs: positive imaginary part first) [1/s].
     mode_shapes : ndarray (2k, k) complex
         Displacement part of each eigenvector, scaled so that its largest entry is 1 (real).
+    system : FrictionModel, optional
+        The model linearised.
+    all_dofs : tuple of str
+        Every dof of the model, free or locked, in q order (the order of ``equilibrium``).
     """
 
     params: Parameters
