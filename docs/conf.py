@@ -37,7 +37,6 @@ root_doc = "index"
 exclude_patterns = ["_build", "auto_examples/*.ipynb", "auto_examples/*.py", "auto_examples/*.zip",
                     "auto_examples/*.md5", "auto_examples/*.codeobj.json", "**/*.pickle",
                     "figures/**/*.md"]  # tables a study writes beside its figures, not pages
-templates_path = ["_templates"]
 html_static_path = ["_static"]
 
 # -- Markdown pages (the user guide) ---------------------------------------------------------

@@ -46,7 +46,7 @@ with tempfile.TemporaryDirectory() as tmp:
     path.write_text(MODEL)
     model = stickslip.load_model(path)
 
-print(model.state_names, model.parameters)
+print(model.state_names, {name: model.parameters[name] for name in ("V", "m2", "k1", "kc")})
 print("steady sliding stable:", stickslip.stability(model).stable)
 
 # %%

@@ -29,7 +29,8 @@ belt = FrictionModel(name="stribeck-belt", dofs=("x",), mass=[[1.0]], damping=[[
                      force=[0.0], contacts=(Contact(dim=1, friction=FrictionLaw.from_user(law), normal_force=1.0,
                                                     tangent=[[1.0]], drive=[0.3]),))
 traj = stickslip.simulate(belt, 60.0)
-print(traj.steady)
+steady = traj.steady
+print(f"stick fraction {steady.stick_fraction:.3f}, x between {steady.minimum:.3f} and {steady.maximum:.3f}")
 
 # %%
 speed = np.linspace(0.0, 3.0, 200)

@@ -17,13 +17,13 @@ from stickslip.basins import box, grid
 from stickslip.plot.basins import plot_basins, plot_parameter_study
 
 belt = stickslip.load_model("belt")
-image = stickslip.basin_stability(belt, grid(belt, {"x": (-2, 2), "dx": (0, 2)}, 16), t_end=200.0,
+image = stickslip.basin_stability(belt, grid(belt, {"x": (-2, 2), "dx": (0, 2)}, 24), t_end=200.0,
                                   executor="serial")
 print(image.fractions, image.standard_errors)
 
 # %%
 # The fractions against the belt speed (random states in the same box).
-study = stickslip.basin_stability(belt, box(belt, {"x": (-2, 2), "dx": (0, 2)}, n=60, seed=0), t_end=200.0,
+study = stickslip.basin_stability(belt, box(belt, {"x": (-2, 2), "dx": (0, 2)}, n=100, seed=0), t_end=200.0,
                                   param="contact.0.drive", values=[1.2, 1.5, 1.8], executor="serial")
 print(study.fractions)
 

@@ -14,7 +14,9 @@ import stickslip
 from stickslip.plot.models import plot_popp_stelter
 
 traj = stickslip.simulate("popp-stelter", 80.0, ic={"x1": 0.1}, sample_rate=200.0)
-print(traj.steady)
+steady = traj.steady
+print("stick fraction of each contact:", [round(f, 3) for f in steady.contact_stick_fractions])
+print("dominant frequency:", round(steady.dominant_frequency_hz, 4))
 
 # %%
 # Each mass's displacement with the stick phases of its contact, and the phase portraits.
