@@ -23,9 +23,11 @@ from stickslip.plot.sweep import plot_reduction
 
 with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster, \
         tempfile.TemporaryDirectory() as tmp:
-    res = stickslip.sweep({"contact.0.drive": np.linspace(0.2, 2.6, 25)}, "belt", executor="dask", address=cluster.scheduler_address, out=Path(tmp) / "belt.nc", t_end=150.0)
-    ds = res.to_xarray()
-print(ds)
+    res = stickslip.sweep({"contact.0.drive": np.linspace(0.2, 2.6, 25)}, "belt", t_end=150.0,
+                          executor="dask", address=cluster.scheduler_address, out=Path(tmp) / "belt.nc")
+    ds = res.to_xarray().load()
+print(dict(ds.sizes), list(ds.data_vars)[:8], "...")
+print(res.kinds())
 
 # %%
 # The amplitude of the observed coordinate x and the fraction of time stuck, against the belt speed.

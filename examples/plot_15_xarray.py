@@ -32,6 +32,6 @@ print("read back:", again.t.shape, again.state_names)
 # Variables carry their units; selections and plots work on names.
 name = list(ds.data_vars)[0]
 print(name, ds[name].attrs)
-late = ds.sel(t=slice(20.0, 40.0))
+late = ds.sel(time=slice(20.0, 40.0))
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
-late[name].plot.line(ax=ax, x="t")
+late[name].plot.line(ax=ax, x="time")
