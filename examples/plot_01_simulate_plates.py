@@ -18,9 +18,9 @@ import stickslip
 params = stickslip.Parameters(N=50.0, Omega=5.0)
 traj = stickslip.simulate(params, 20.0)
 steady = traj.steady
-print(f"{traj.status}: {len(traj.transitions)} transitions; over {steady.t_from:g}-{steady.t_to:g} s the contact "
-      f"sticks {steady.stick_fraction:.1%} of the time, φ between {steady.minimum:.4f} and {steady.maximum:.4f} rad, "
-      f"dominant frequency {steady.dominant_frequency_hz:.3f} Hz")
+print(f"{traj.status}: {len(traj.transitions)} transitions")
+print(f"steady window {steady.t_from:g}-{steady.t_to:g} s: stick {steady.stick_fraction:.1%} of the time")
+print(f"φ from {steady.minimum:.4f} to {steady.maximum:.4f} rad, dominant frequency {steady.dominant_frequency_hz:.3f} Hz")
 
 # %%
 # The result's own figure: φ and ψ with the stick phases shaded, the friction force against μs N, the φ–φ̇

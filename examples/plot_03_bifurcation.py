@@ -19,8 +19,8 @@ import stickslip
 from stickslip.plot.sweep import plot_bifurcation
 
 with tempfile.TemporaryDirectory() as tmp:
-    res = stickslip.sweep({"N": np.linspace(10, 130, 25)}, stickslip.Parameters(Omega=0.5),
-                          out=Path(tmp) / "bifurcation.nc", t_end=150.0, executor="serial")
+    res = stickslip.sweep({"N": np.linspace(10, 130, 21)}, stickslip.Parameters(Omega=0.5),
+                          out=Path(tmp) / "bifurcation.nc", t_end=200.0, executor="serial")
     print(res.kinds())
 
 # %%
