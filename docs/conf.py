@@ -45,7 +45,6 @@ myst_heading_anchors = 4  # [text](page.md#a-heading) links between the guide's 
 
 # -- API reference --------------------------------------------------------------------------
 autosummary_generate = True
-autodoc_default_options = {"members": False}
 autodoc_typehints = "none"          # the numpydoc sections state the types
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
