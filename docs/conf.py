@@ -38,6 +38,7 @@ exclude_patterns = ["_build", "auto_examples/*.ipynb", "auto_examples/*.py", "au
                     "auto_examples/*.md5", "auto_examples/*.codeobj.json", "**/*.pickle",
                     "figures/**/*.md"]  # tables a study writes beside its figures, not pages
 html_static_path = ["_static"]
+html_css_files = ["stickslip.css"]
 
 # -- Markdown pages (the user guide) ---------------------------------------------------------
 myst_enable_extensions = ["dollarmath", "deflist"]
@@ -46,6 +47,7 @@ myst_heading_anchors = 4  # [text](page.md#a-heading) links between the guide's 
 # -- API reference --------------------------------------------------------------------------
 autosummary_generate = True
 autodoc_typehints = "none"          # the numpydoc sections state the types
+toc_object_entries_show_parents = "hide"  # methods in the page contents by their own names
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
