@@ -25,8 +25,8 @@ with tempfile.TemporaryDirectory() as tmp:
 
 # %%
 # The peaks show the diagram's structure: one branch at low N, two and more above ≈ 75 N. Over
-# windows this short (the translational modes decay over ~200 s) no point is settled enough for a
-# period to be claimed, so every point is drawn as non-periodic; ``stickslip bifurcation
-# --t-end 400 --t-from 300`` settles more of them.
+# windows this short (the translational modes decay over ~200 s) the settle rule claims no period,
+# so the points are drawn as non-periodic; a period is claimed only from longer runs
+# (``t_end``, ``t_from``).
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
 plot_bifurcation(res, ax)
