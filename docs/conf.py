@@ -15,7 +15,7 @@ matplotlib.use("Agg")
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))  # the checkout's package when it is not installed
 
-import stickslip  # noqa: E402
+import stickslip
 
 project = "stickslip"
 author = "the stickslip authors"

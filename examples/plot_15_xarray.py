@@ -30,7 +30,7 @@ print("read back:", again.t.shape, again.state_names)
 
 # %%
 # Variables carry their units; selections and plots work on names.
-name = list(ds.data_vars)[0]
+name = next(iter(ds.data_vars))
 print(name, ds[name].attrs)
 late = ds.sel(time=slice(20.0, 40.0))
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")

@@ -34,7 +34,7 @@ def test_there_are_at_least_twelve_examples():
 def test_example_runs_as_a_script(path, tmp_path):
     before = snapshot(ROOT / "examples")
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    run = subprocess.run([sys.executable, str(path)], cwd=tmp_path, env=env, capture_output=True, text=True,
+    run = subprocess.run([sys.executable, str(path)], cwd=tmp_path, env=env, capture_output=True, text=True, check=False,
                          timeout=900)
     assert run.returncode == 0, f"{path.name} failed:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}"
     assert not list(tmp_path.iterdir()), f"{path.name} wrote into its working folder: {list(tmp_path.iterdir())}"
