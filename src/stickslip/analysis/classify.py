@@ -78,7 +78,7 @@ def kind_code(kind: str) -> int:
 class Classification:
     """Classification of a response over [t_from, t_to] from the signal alone.
 
-    Attributes
+    Parameters
     ----------
     kind : str
         One of :data:`KINDS`.
@@ -240,6 +240,20 @@ def classify(traj, t_from: float | None = None, dof: str | None = None) -> Class
     trajectory's ``steady_from`` (the last half of the run unless set). This is the signal's
     verdict; :func:`stickslip.attractors.attractor` adds the dynamical confirmations.
     ``dof`` defaults to the model's observed coordinate (the plates' φ).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A run of any model.
+    t_from : float, optional
+        Start of the window judged [s]; default ``traj.steady_from``.
+    dof : str, optional
+        The coordinate whose signal is classified (a name of ``traj.system.dofs``); default the
+        model's observed coordinate.
+
+    Returns
+    -------
+    Classification
     """
     system = traj.system
     j = dof_index(traj, dof)

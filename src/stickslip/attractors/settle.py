@@ -35,7 +35,7 @@ DEFAULT_T_MIN_S = 200.0
 class SettledRun:
     """A run extended until settled (:func:`simulate_until_settled`), with the verdict it reached.
 
-    Attributes
+    Parameters
     ----------
     trajectory : Trajectory
         The run; ``steady_from`` is the start of the last window judged and ``options["settle"]``

@@ -49,7 +49,7 @@ def attractor_code(name: str) -> int:
 class Attractor:
     """What a run's window settles to.
 
-    Attributes
+    Parameters
     ----------
     attractor : str
         One of :data:`ATTRACTORS`.

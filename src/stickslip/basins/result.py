@@ -209,7 +209,7 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
 class BasinResult:
     """A basin-stability study's result (a view on its dataset).
 
-    Attributes
+    Parameters
     ----------
     path : Path or None
         The NetCDF file (``format = stickslip-basins-1``).

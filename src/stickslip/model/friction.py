@@ -127,7 +127,7 @@ def static_coefficient(row):
 class FrictionLaw:
     """A contact's friction law.
 
-    Attributes
+    Parameters
     ----------
     law : {"exponential", "coulomb", "user"}
         ``exponential``: μ = μk + Δμ exp(−α|v|) + μv |v|; ``coulomb``: μ = μk in slip; ``user``: a

@@ -85,7 +85,7 @@ def parameter_attrs(values: Mapping[str, Any], units: Mapping[str, str] | None =
 class Parameters:
     """Parameters of the two-plate friction model, SI units (paper Table 1).
 
-    Attributes
+    Parameters
     ----------
     m_p, m_d : float
         Masses of the upper plate and the lower plate [kg].

@@ -25,7 +25,7 @@ __all__ = ["StabilityResult", "stability", "linearization", "model_stability"]
 class StabilityResult:
     """Linear stability of the steady-sliding equilibrium (paper Sect. 4.1).
 
-    Attributes
+    Parameters
     ----------
     params : Parameters or None
         The plates' parameters (None for other models: see ``system.parameters``).
@@ -49,6 +49,10 @@ class StabilityResult:
         constrained eigenproblem: ``jacobian`` restricted to W q = 0, W q̇ = 0).
     mode_shapes : ndarray (2k, k) complex
         Displacement part of each eigenvector, scaled so that its largest entry is 1 (real).
+    system : FrictionModel, optional
+        The model linearised.
+    all_dofs : tuple of str
+        Every dof of the model, free or locked, in q order (the order of ``equilibrium``).
     """
 
     params: Parameters

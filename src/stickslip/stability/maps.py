@@ -311,7 +311,7 @@ def boundary_omegas(grid: MapGrid, i: int, values: np.ndarray):
 class StabilityMap(Plottable):
     """Stability of steady sliding over a grid of two parameters, for a family of a third.
 
-    Attributes
+    Parameters
     ----------
     params : Parameters or None
         The plates' base parameters (None for other models: see ``system``).
@@ -325,6 +325,7 @@ class StabilityMap(Plottable):
     family_name : str
         Name of the varied parameter, ``"model"``, or ``""`` for a single map.
     family_values : list
+        The values of the family's parameter (variant names for ``model``); ``[]`` for a single map.
     max_real_part : ndarray (nF, nA, nB)
         Largest real part of the eigenvalues [1/s]; NaN where no equilibrium was found.
     boundary : ndarray (nF, nA, nC)
@@ -444,7 +445,22 @@ class StabilityMap(Plottable):
 
 
 def load_stability_map(path: str | Path) -> StabilityMap:
-    """Read a map written by :meth:`StabilityMap.to_netcdf`."""
+    """Read a map written by :meth:`StabilityMap.to_netcdf`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The NetCDF file (``stickslip stability-map --out``).
+
+    Returns
+    -------
+    StabilityMap
+
+    Raises
+    ------
+    FileFormatError
+        When the file is not a stability map written by stickslip.
+    """
     ds = open_ours(path, "stabilitymap", noun="stability map", what="a .nc file written by `stickslip stability-map`")
     name = ds.attrs["family_name"]
     fam = [str(v) for v in ds["family"].values] if name in ("model", "") else [float(v) for v in ds["family"].values]

@@ -67,13 +67,15 @@ def classify_regions(kind: np.ndarray, stick_fraction: np.ndarray) -> np.ndarray
 class RegionMap(Plottable):
     """Regions I/II/III over (model, N, Ω) and the stick-slip boundary.
 
-    Attributes
+    Parameters
     ----------
     dataset : xarray.Dataset
         The sweep (dims model, N, Omega, ic) plus ``region`` (model, N, Omega) and
         ``stick_slip_omega_max`` (model, N) [rad/s].
     path : Path or None
+        The NetCDF file, or None when the map was computed without ``out``.
     timings : dict
+        Wall times [s] and counts of the underlying sweep (:attr:`SweepResult.timings`).
     """
 
     FIGURE = "regions"
@@ -164,7 +166,22 @@ def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | Non
 
 
 def load_region_map(path) -> RegionMap:
-    """Read a region map written by :func:`regions` (``out=``)."""
+    """Read a region map written by :func:`regions` (``out=``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The NetCDF file.
+
+    Returns
+    -------
+    RegionMap
+
+    Raises
+    ------
+    SweepError
+        When the file is a sweep but not a region map.
+    """
     ds = load_sweep(path, load="auto")
     if not {"model", "N", "Omega", "ic"} <= set(ds.dims):
         raise SweepError(f"{path} is a stickslip sweep but not a region map (dims {tuple(ds.dims)}); "

@@ -36,11 +36,12 @@ MIN_BATCHES_PER_WORKER = 4
 class SweepResult:
     """A finished sweep.
 
-    Attributes
+    Parameters
     ----------
     path : Path
         The NetCDF file (``format = stickslip-sweep-1``).
     spec : SweepSpec
+        The grid and the run options (:class:`stickslip.sweep.spec.SweepSpec`).
     dataset : xarray.Dataset
         Dimensions: the swept names in order (plus ``peak`` for ``peaks``); variables as listed in
         :data:`stickslip.sweep.spec.COLUMNS` with units and long names, and ``done``. Loaded into

@@ -46,7 +46,25 @@ def library() -> dict[str, str]:
 
 
 def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
-    """A library model by name (``two-plates``, ``belt``, ...) or a model file by path."""
+    """A library model by name (``two-plates``, ``belt``, ...) or a model file by path.
+
+    Parameters
+    ----------
+    name : str, Path or FrictionModel
+        A library name (``stickslip models`` lists them: ``two-plates``, ``belt``, ``hoffmann``,
+        ``popp-stelter``, ``slider-belt``, ``sprag-slip``), the path of a model file (``.toml``),
+        or a model, returned as it is. Default: the two plates with Table 1 parameters.
+
+    Returns
+    -------
+    FrictionModel
+
+    Raises
+    ------
+    ModelError
+        On an unknown name, naming the library's models; on a model file that does not hold a
+        valid model, naming the key and the fix.
+    """
     if isinstance(name, FrictionModel):
         return name
     text = str(name)
