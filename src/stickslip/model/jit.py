@@ -32,7 +32,6 @@ callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a vari
 
 from __future__ import annotations
 
-import copyreg
 import functools
 import hashlib
 import io
@@ -61,23 +60,35 @@ def _wrap_caching(class_name: str, method: str, make) -> None:
     setattr(owner, method, wrapped)
 
 
-class _Unavailable(type):
-    """Metaclass of the stand-ins for classes that a cache index names but this process cannot
-    import (:func:`_tolerant_index_loading`); pickled again as the name of the original."""
+class _StandIn:
+    """Stands in for a class that a cache index names but this process cannot import
+    (:func:`_tolerant_index_loading`). Not a class itself, so that numba's pickler (cloudpickle)
+    pickles it by :meth:`__reduce__`, as the original's name, instead of by value."""
+
+    __slots__ = ("module", "name")
+
+    def __init__(self, module: str, name: str):
+        self.module = module
+        self.name = name
+
+    def __reduce__(self):
+        return unavailable_class, (self.module, self.name)
+
+    def __repr__(self) -> str:
+        return f"<unavailable class {self.module}.{self.name}>"
 
 
-def unavailable_class(module: str, name: str) -> type:
-    """The class ``module.name`` if this process can import it, else a stand-in of that name (an
-    index entry keyed by it then matches nothing here, and keeps its name when the index is saved)."""
+def unavailable_class(module: str, name: str):
+    """The class ``module.name`` if this process can import it, else its stand-in (one per name):
+    an index entry keyed by it then matches nothing here, and keeps its name when the index is
+    saved again."""
     try:
         return pickle.Unpickler.find_class(_REAL_FINDER, module, name)
     except (ImportError, AttributeError):
-        return _STAND_INS.setdefault((module, name), _Unavailable(name, (), {"__module__": module,
-                                                                             "_stickslip_origin": (module, name)}))
+        return _STAND_INS.setdefault((module, name), _StandIn(module, name))
 
 
 _STAND_INS: dict = {}
-copyreg.pickle(_Unavailable, lambda cls: (unavailable_class, cls._stickslip_origin))
 
 
 class _TolerantUnpickler(pickle.Unpickler):
@@ -101,7 +112,8 @@ def _tolerant_index_loading(load):
     folder cannot be imported by other processes, and unpickling the whole index then fails in
     each of them, whatever model it runs. The index is read again with a stand-in for each such
     class: its entries match nothing here, the other entries load, and when this process adds its
-    own and saves the index they are all kept (the stand-ins pickled as their original names).
+    own and saves the index they are all kept (the stand-ins pickled as their original names, so a
+    process that can import the class finds its kernels again).
     Without that, every such process recompiled its kernels and rewrote the index with its own
     entries alone, so that the next process recompiled the others again. An index that cannot be
     read at all counts as empty.
