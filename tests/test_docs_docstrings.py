@@ -11,25 +11,10 @@ import stickslip
 # numpydoc comes with the docs extra (pip install -e ".[docs]"); CI's documentation step runs this file
 NumpyDocString = pytest.importorskip("numpydoc.docscrape", reason="needs the docs extra").NumpyDocString
 
-#: Public names whose docstrings do not list their parameters yet, with the names they miss. They
-#: live in modules being changed elsewhere at the time of writing; remove an entry once its
+#: Public names whose docstrings do not list their parameters yet, with the names they miss (e.g.
+#: ``{"Name": "all"}`` while a module is being changed elsewhere); remove an entry once its
 #: docstring is complete (the test fails on an entry that is no longer needed).
-INCOMPLETE = {
-    "FrictionModel": "all",   # model/system_model.py
-    "Contact": "all",         # model/system_model.py
-    "Trajectory": "all",      # integrate/result.py
-    "load_trajectory": "all", # integrate/result.py
-    "PeriodicOrbit": "all",   # orbits/shooting.py
-    "Monodromy": "all",       # orbits/problem.py
-    "FlowJacobian": "all",    # orbits/linear_flow.py
-    "LyapunovResult": "all",  # orbits/lyapunov.py
-    "LyapunovSpectrum": "all",  # orbits/lyapunov.py
-    "Branch": "all",          # orbits/branch.py
-    "load_branch": "all",     # orbits/branch.py
-    "SpecialPoint": "all",    # orbits/special_points.py
-    "FoldCurve": "all",       # orbits/region_edge.py
-    "fold_curve": "jacobian_every",  # orbits/region_edge.py
-}
+INCOMPLETE: dict[str, str] = {}
 
 
 def public_callables():

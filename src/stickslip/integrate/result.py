@@ -196,7 +196,7 @@ def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
 class Trajectory(Plottable):
     """Result of :func:`stickslip.simulate`.
 
-    Attributes
+    Parameters
     ----------
     t : ndarray (k,)
         Uniform sample times [s].
@@ -211,17 +211,25 @@ class Trajectory(Plottable):
     work : ndarray (k, 2)
         Work done since t0 by friction and by the dampers [J].
     transitions : Transitions
+        The exact transition instants of the run, with the states there (:class:`Transitions`;
+        the impacts of rigid contacts: :attr:`impacts`).
     stats : Stats
+        Integrator statistics: steps, right-hand-side calls, transition counts, wall and compile
+        times (:class:`Stats`).
     status : str
         ``"success"`` or the reason the run stopped early (:attr:`status_code` as an enum).
     system : FrictionModel
         The model simulated, with its parameters.
     method : str
+        The integration method: ``event`` (adaptive, exact transitions), ``aeom`` or ``naeom``
+        (the paper's fixed-step methods, two plates only).
     options : dict
-        rtol, atol, dt, sample_rate, ic, t0, t_end, slip_band.
+        rtol, atol, dt, sample_rate, ic, perturbation, t0, t_end, slip_band.
     steady_from : float
         Start of the steady-state window used by :attr:`steady` [s].
     status_code : Status
+        How the run ended, as an enum (``Status.SUCCESS``, ``Status.INCONSISTENT``, ...);
+        :attr:`status` is its message.
     """
 
     FIGURE = "trajectory"
@@ -526,8 +534,17 @@ class Trajectory(Plottable):
 def load_trajectory(path: str | Path, system: FrictionModel | None = None) -> Trajectory:
     """Read a trajectory written by :meth:`Trajectory.to_netcdf`.
 
-    ``system``: the model, for runs of a model defined in Python (files and library models are
-    rebuilt from the file itself).
+    Parameters
+    ----------
+    path : str or Path
+        The NetCDF file (``stickslip simulate --out``).
+    system : FrictionModel, optional
+        The model, for runs of a model defined in Python (files and library models are rebuilt
+        from the file itself).
+
+    Returns
+    -------
+    Trajectory
 
     Raises
     ------

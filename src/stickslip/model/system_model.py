@@ -153,7 +153,7 @@ class NormalLaw:
 class Contact:
     """One point contact.
 
-    Attributes
+    Parameters
     ----------
     dim : {1, 2}
         Dimension of the tangential slip velocity (1: along a line; 2: in the contact plane).
@@ -225,7 +225,7 @@ class NamedState(NamedTuple):
 class FrictionModel:
     """A friction-contact system (module docstring).
 
-    Attributes
+    Parameters
     ----------
     name : str
         Short name (``belt``, ``two-plates``, the file's ``name``).
@@ -236,6 +236,7 @@ class FrictionModel:
     force : ndarray (n,)
         Constant generalised force f0.
     contacts : tuple of Contact
+        The point contacts, in the order of the results' contact columns (``contact0`` …).
     kinematics : NamedTuple
         Kinematics data; its class selects the compiled contact frame
         (:class:`~stickslip.model.kinematics.ConstantKinematics` for constant G and w).

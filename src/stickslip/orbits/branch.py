@@ -51,7 +51,7 @@ AMPLITUDE_SAMPLES = 400
 class Branch(ModelResult, store.NetCDFResult):
     """A branch of periodic orbits computed by :func:`continue_orbit`.
 
-    Attributes
+    Parameters
     ----------
     param : str
         Name of the continuation parameter (a name of ``system.parameters``: the plates' ``N``,
@@ -82,6 +82,8 @@ class Branch(ModelResult, store.NetCDFResult):
     iterations : ndarray (n,) int
         Corrector iterations of each point (0 for the start).
     special : list of SpecialPoint
+        The special points located on the branch (folds, period doublings, changes in the stick
+        or flight phases, ...), in the order found.
     stop_reason : str
         Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``,
         ``steady sliding at <param> = <value>`` where the corrector converged onto the equilibrium
@@ -90,6 +92,7 @@ class Branch(ModelResult, store.NetCDFResult):
         The model at the start (the continuation parameter at its start value); ``params`` and
         ``model``: the plates' Parameters and variant, or None and the model's name.
     section : Section
+        The Poincaré section of every point's state (:class:`stickslip.orbits.section.Section`).
     options : dict
         Numerical options (rtol, atol, tol, fd_step, step bounds, scales).
     timings : dict
@@ -161,6 +164,17 @@ class Branch(ModelResult, store.NetCDFResult):
 
 def load_branch(path):
     """Read a branch written by :meth:`Branch.to_netcdf` as an ``xarray.Dataset``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The NetCDF file (``stickslip continue --out``, :meth:`Branch.to_netcdf`).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``point``, ``state``, ``multiplier`` and ``special`` (:meth:`Branch.to_xarray`);
+        :meth:`Branch.from_xarray` rebuilds the :class:`Branch`.
 
     Raises
     ------

@@ -64,7 +64,7 @@ _RECORDED_KIND = {V.EV_MARGIN: E.TRANSITION_TO_SLIP, V.EV_ZERO: E.TRANSITION_TO_
 class FlowJacobian:
     """Linearised flow ∂Φ(s0, t)/∂s0 across stick↔slip transitions.
 
-    Attributes
+    Parameters
     ----------
     matrix : ndarray (2n, 2n)
         ∂s(t)/∂s0 in the model's units (rows and columns of locked states are zero).
@@ -73,12 +73,15 @@ class FlowJacobian:
     duration : float
         t [s].
     events : tuple of (float, str, int)
-        (instant [s], kind, contact) of every jump applied: "stick", "breakaway", "band", "reversal".
+        (instant [s], kind, contact) of every jump applied, kind one of ``"stick"``,
+        ``"breakaway"``, ``"band"``, ``"reversal"``, ``"open"``, ``"close"`` (a unilateral contact's
+        gap) and ``"impact"`` (a rigid contact's saltation matrix).
     mismatch : float
         Largest scaled difference between a re-integrated state and the event integrator's [-].
     wall_time : float
         Seconds taken.
     state_names : tuple of str
+        Names of the states (rows and columns of :attr:`matrix`), the model's ``state_names``.
     """
 
     matrix: np.ndarray

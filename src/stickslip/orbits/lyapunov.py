@@ -52,7 +52,7 @@ TRANSIENT_RATE = 200.0
 class LyapunovResult(ModelResult):
     """Largest Lyapunov exponent with its convergence history.
 
-    Attributes
+    Parameters
     ----------
     exponent : float
         λ_max over the whole averaging time [1/s].
@@ -71,7 +71,9 @@ class LyapunovResult(ModelResult):
     scale : ndarray (2 n_free,)
         Scales σ of the norm [state units].
     system : FrictionModel
+        The model.
     options : dict
+        rtol, atol, slip_band of the runs, seed and perturbation.
     """
 
     exponent: float
@@ -261,7 +263,7 @@ def lyapunov_exponent(
 class LyapunovSpectrum(ModelResult):
     """Full Lyapunov spectrum with its convergence history.
 
-    Attributes
+    Parameters
     ----------
     exponents : ndarray (k,)
         λ_1 ≥ … ≥ λ_k over the whole averaging time [1/s] (k = 2 n_free). Directions that a
@@ -280,7 +282,10 @@ class LyapunovSpectrum(ModelResult):
     wall_time : float
         Seconds taken.
     system : FrictionModel
+        The model.
     options : dict
+        rtol, atol, slip_band of the runs, perturbation and method (``variational``: with record
+        and qr_interval; ``finite-difference``: with chunk and d0).
     """
 
     exponents: np.ndarray

@@ -443,7 +443,7 @@ def multiplier_variables(multipliers: np.ndarray, dims) -> dict:
 class Monodromy(ModelResult, Multipliers):
     """Monodromy matrix and Floquet multipliers of a periodic orbit.
 
-    Attributes
+    Parameters
     ----------
     matrix : ndarray (2 n_free, 2 n_free)
         ∂Φ(s0, T)/∂s0 on the free states [state units].
@@ -454,11 +454,15 @@ class Monodromy(ModelResult, Multipliers):
     period : float
         T [s].
     free_states : tuple of str
+        Names of the free states (rows/columns of :attr:`matrix`).
     events : tuple of (float, str, int)
-        Jumps applied (saltation only): (instant [s], "stick" | "breakaway" | "band" | "reversal", contact).
+        Jumps applied (saltation only): (instant [s], kind, contact), kind one of ``"stick"``,
+        ``"breakaway"``, ``"band"``, ``"reversal"``, ``"open"``, ``"close"``, ``"impact"``
+        (as in :class:`stickslip.FlowJacobian`).
     wall_time : float
         Seconds taken.
     system : FrictionModel
+        The model of the orbit.
     """
 
     matrix: np.ndarray

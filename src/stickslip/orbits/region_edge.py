@@ -56,7 +56,7 @@ class FoldCurve(store.NetCDFResult):
     this branch exists; between the linear-stability boundary Ω_c(N) and the edge it coexists with
     the stable equilibrium (Region II of paper Fig. 8).
 
-    Attributes
+    Parameters
     ----------
     N : ndarray (n,)
         Normal loads [N].
@@ -79,7 +79,9 @@ class FoldCurve(store.NetCDFResult):
     omega_start : float
         Ω of the start orbits [rad/s].
     params : Parameters
+        The plates' base parameters (N is set to each of :attr:`N` in turn, Ω continued).
     model : str
+        The plates' variant (``full``, ``x``, ``y``, ``rotation``).
     timings : dict
         ``total_s``, ``workers``, ``n`` (and ``n_resumed``, the N read back, when written to ``out``).
     digest : str
@@ -256,12 +258,18 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     omega_max : float
         Upper bound of the continuation [rad/s].
     model : str
+        The plates' variant (``full``: Model 1, default; ``x``, ``y``, ``rotation``).
     workers : int
         Processes (one N per task; at most the CPUs this process may run on). They end with this
         process, also when it is killed (:func:`stickslip.parallel.worker_pool`).
     step, max_step, max_points, rtol, tol, **options
         Passed to :func:`continue_orbit` (``rtol``/``tol`` are looser than its defaults: the
         edge needs the branch, not 1e-8 orbits; see :data:`FOLD_RTOL`).
+    jacobian_every : int
+        Passed to :func:`continue_orbit`: a finite-difference Jacobian at every
+        ``jacobian_every``-th point of each branch only, Broyden updates in between (default
+        :data:`FOLD_JACOBIAN_EVERY`): the edge needs the tangent and the stick time, not the
+        multipliers of every point.
     out : path, optional
         NetCDF output (:meth:`FoldCurve.to_netcdf`). Each N's result is appended to the journal
         ``OUT.nc.journal`` as soon as it finishes; a later call with the same settings (base

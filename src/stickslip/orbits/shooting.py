@@ -50,7 +50,7 @@ SEARCH_TIME = 30.0
 class PeriodicOrbit(ModelResult, Multipliers):
     """A periodic orbit found by :func:`periodic_orbit`.
 
-    Attributes
+    Parameters
     ----------
     state : ndarray (2n,)
         State on the section, s = [q, q̇] (the model's ``state_names``).
@@ -78,8 +78,11 @@ class PeriodicOrbit(ModelResult, Multipliers):
     system : FrictionModel
         The model (``params`` and ``model``: the plates' Parameters and variant, or None and the name).
     section : Section
+        The Poincaré section the orbit's state lies on (:class:`stickslip.orbits.section.Section`:
+        the state fixed and its value, the direction of crossing).
     options : dict
-        rtol, atol, tol, fd_step, slip_band, max_iter, monodromy (the method used).
+        rtol, atol, tol, fd_step, slip_band, max_iter, monodromy (the method used),
+        newton_jacobian.
     """
 
     state: np.ndarray

@@ -114,7 +114,7 @@ _COUNTED = ("stick-phases", "grazing", "neimark-sacker")
 class SpecialPoint:
     """A special point located on a branch.
 
-    Attributes
+    Parameters
     ----------
     kind : str
         One of :data:`SPECIAL_KINDS`.
