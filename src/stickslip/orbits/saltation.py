@@ -51,19 +51,22 @@ from ..model.impact import IMPACT_INCONSISTENT, impact, restitution_of
 from .var_kernels import contact_gradients, indicator_gradient
 
 __all__ = ["saltation_matrix", "field", "ContactState", "contact_at", "stick_projection", "breakaway_jump",
-           "band_exit_jump", "arrival_jump", "gap_jump", "impact_jump", "impact_map", "inverse_mass", "sticking",
-           "with_mode"]
+           "band_exit_jump", "arrival_jump", "gap_jump", "impact_jump", "impact_map", "sliding_after_closing",
+           "inverse_mass", "sticking", "with_mode"]
 
 
-def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray) -> np.ndarray:
-    """S = I + (f⁺ − f⁻) ∇hᵀ / (∇h · f⁻) (2n × 2n) for a transversal crossing of h(s) = 0.
+def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray, jump=None) -> np.ndarray:
+    """S = R + (f⁺ − R f⁻) ∇hᵀ / (∇h · f⁻) (2n × 2n) for a transversal crossing of h(s) = 0.
 
     Parameters
     ----------
     f_minus, f_plus : ndarray (2n,)
-        Vector fields before and after the event at the event state [state units / s].
+        Vector fields before and after the event (f⁺ at the state after a jump) [state units / s].
     grad_h : ndarray (2n,)
         Gradient of the event function [unit of h per state unit].
+    jump : ndarray (2n, 2n), optional
+        R, the Jacobian of the state's jump at the event (an impact); None: the state is
+        continuous, R = I.
 
     Raises
     ------
@@ -73,7 +76,8 @@ def saltation_matrix(f_minus: np.ndarray, f_plus: np.ndarray, grad_h: np.ndarray
     rate = float(grad_h @ f_minus)
     if rate == 0.0 or not np.isfinite(rate):
         raise OrbitError("tangential event crossing (dh/dt = 0): grazing, no saltation matrix")
-    return np.eye(f_minus.size) + np.outer(f_plus - f_minus, grad_h) / rate
+    R = np.eye(f_minus.size) if jump is None else jump
+    return R + np.outer(f_plus - R @ f_minus, grad_h) / rate
 
 
 def field(system, s: np.ndarray, cst: np.ndarray) -> np.ndarray:
@@ -203,20 +207,29 @@ def gap_jump(system, s: np.ndarray, cst: np.ndarray, c: int):
     grad_h = np.empty(n2)
     indicator_gradient(s, cst, c, system.data, n2, grad_h, np.empty(n2, dtype=np.complex128))
     projection = stick_projection(system, s, cst)
-    if int(cst[CST * c]) == P.MODE_OPEN:
-        v = np.array(P.slip_velocity(s, c, system.data))
-        speed = float(np.hypot(*v))
-        if speed <= E.STICK_SPEED_TOL:
-            raise OrbitError(f"contact {c} closes with slip velocity {speed:.1e} m/s (v ≈ 0): stick at closing has "
-                             "no saltation matrix here; use the finite-difference monodromy")
-        if system.contacts[c].dim == 1:
-            after = with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, (float(np.sign(v[0])), 0.0))
-        else:
-            after = with_mode(cst, c, P.MODE_SLIP_EXACT, tuple(v / speed))
-    else:
-        after = with_mode(cst, c, P.MODE_OPEN)
+    after = sliding_after_closing(system, s, cst, c) if int(cst[CST * c]) == P.MODE_OPEN else \
+        with_mode(cst, c, P.MODE_OPEN)
     S = saltation_matrix(field(system, s, cst), field(system, s, after), grad_h)
     return S @ projection, after
+
+
+def sliding_after_closing(system, s: np.ndarray, cst: np.ndarray, c: int) -> np.ndarray:
+    """The contact states after contact ``c`` closes at ``s`` (after an impact: the state after it)
+    and slides: a 1-D contact along sign(v_c), a 2-D one along v_c/|v_c|.
+
+    Raises
+    ------
+    OrbitError
+        If it closes with v_c ≈ 0 (into stick: no jump matrix here).
+    """
+    v = np.array(P.slip_velocity(np.ascontiguousarray(s, dtype=float), c, system.data))
+    speed = float(np.hypot(*v))
+    if speed <= E.STICK_SPEED_TOL:
+        raise OrbitError(f"contact {c} closes with slip velocity {speed:.1e} m/s (v ≈ 0): stick at closing has "
+                         "no saltation matrix here; use the finite-difference monodromy")
+    if system.contacts[c].dim == 1:
+        return with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, (float(np.sign(v[0])), 0.0))
+    return with_mode(cst, c, P.MODE_SLIP_EXACT, tuple(v / speed))
 
 
 def impact_map(system, s: np.ndarray, cst: np.ndarray, c: int) -> np.ndarray:
@@ -247,25 +260,10 @@ def impact_jump(system, s: np.ndarray, cst: np.ndarray, c: int, bounced: bool):
         up[j] += h
         down[j] -= h
         R[:, j] = (impact_map(system, up, cst, c) - impact_map(system, down, cst, c)) / (2.0 * h)
-    if bounced:
-        after = cst.copy()
-    else:
-        v = np.array(P.slip_velocity(after_state, c, system.data))
-        speed = float(np.hypot(*v))
-        if speed <= E.STICK_SPEED_TOL:
-            raise OrbitError(f"contact {c} sticks at its impact: stick at an impact has no saltation matrix here; "
-                             "use the finite-difference monodromy")
-        if system.contacts[c].dim == 1:
-            after = with_mode(cst, c, P.MODE_SLIP_QUASI_STATIC, (float(np.sign(v[0])), 0.0))
-        else:
-            after = with_mode(cst, c, P.MODE_SLIP_EXACT, tuple(v / speed))
+    after = cst.copy() if bounced else sliding_after_closing(system, after_state, cst, c)
     grad_h = np.empty(n2)
     indicator_gradient(s, cst, c, system.data, n2, grad_h, np.empty(n2, dtype=np.complex128))
-    f_minus = field(system, s, cst)
-    rate = float(grad_h @ f_minus)
-    if rate == 0.0 or not np.isfinite(rate):
-        raise OrbitError("tangential event crossing (dg/dt = 0): grazing, no saltation matrix")
-    S = R + np.outer(field(system, after_state, after) - R @ f_minus, grad_h) / rate
+    S = saltation_matrix(field(system, s, cst), field(system, after_state, after), grad_h, jump=R)
     return S @ stick_projection(system, s, cst), after
 
 
