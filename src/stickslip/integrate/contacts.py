@@ -32,7 +32,7 @@ import numpy as np
 from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
 from ..model.jit import inlined_kernel, kernel
-from ..model.kinematics import model_sizes
+from ..model.kinematics import model_sizes, rigid_kernel
 from ..model.impact import IMPACT_INCONSISTENT, impact, remove_gap_rate, restitution_of
 from ..model.normal import gap_and_rate, gap_with_rate, is_open, is_rigid, starts_open
 
@@ -494,15 +494,16 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
                 cst[CST * c + 2] = vy / speed
 
 
-@kernel
-def land(y, cst, c, md, rtol, atol, F, N, work):
+@rigid_kernel(lambda y, cst, c, md, rtol, atol, F, N, work: (LAND_INCONSISTENT, False, 0.0, 0.0, 0.0, math.inf))
+def land(y, cst, c, md, rtol, atol, F, N, work):  # pragma: no cover - compiled only
     """Rigid contact ``c`` closes at ``y`` (its gap through 0): the impact, then what follows.
 
     Returns (phase, sticks, impulse, before, after, flight): ``phase`` one of ``LAND_*``; ``sticks``
     whether it closed sticking; the normal impulse [N s]; ġ⁻ and ġ⁺ [m/s]; for ``LAND_OPEN`` the
     flight time [s] that the normal acceleration at the take-off predicts (∞ if it does not pull
     the contact back). ``y`` and ``cst`` are updated. A contact that stays closed but whose
-    normal force comes out ≤ 0 (the motion leaves it with ġ = 0) is left open.
+    normal force comes out ≤ 0 (the motion leaves it with ġ = 0) is left open. (Compiled only for
+    kinematics that may have rigid contacts.)
     """
     n = model_sizes(md.kin, md.m)[0]
     e = restitution_of(c, md)

@@ -33,7 +33,7 @@ import numpy as np
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
 from ..model.jit import inlined_kernel, kernel, loop
-from ..model.kinematics import has_unilateral, model_sizes, unilateral_kernel
+from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
@@ -220,7 +220,7 @@ def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr
     return n_tr, SUCCESS, flight
 
 
-@unilateral_kernel(lambda y, cst, md: np.int64(-1))
+@rigid_kernel(lambda y, cst, md: np.int64(-1))
 def jammed_contact(y, cst, md):  # pragma: no cover - compiled only
     """A closed rigid contact whose normal force has no consistent solution at ``y`` (Painlevé:
     the relative pivot of its normal-force system is not positive), or −1."""

@@ -26,7 +26,7 @@ from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel
-from .kinematics import contact_dim, contact_frame, unilateral_kernel
+from .kinematics import contact_dim, contact_frame, rigid_kernel
 from .linalg import solve_in_order, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
@@ -281,11 +281,11 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     return add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A)
 
 
-@unilateral_kernel(lambda s, cst, md, n, nc, diagonal, G, v, N, F, f, A: 1.0, inline="always")
+@rigid_kernel(lambda s, cst, md, n, nc, diagonal, G, v, N, F, f, A: 1.0, inline="always")
 def add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):  # pragma: no cover - compiled only
     """:func:`rigid_normal_forces` where some rigid contact is closed, returning its smallest
     relative pivot; 1.0 where none is (and, at compile time, for kinematics registered without
-    unilateral contacts)."""
+    rigid contacts)."""
     if any_rigid_closed(cst, md, n, nc):
         return rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A)
     return 1.0

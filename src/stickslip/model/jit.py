@@ -165,7 +165,7 @@ _wrap_caching("Cache", "save_overload", _tolerant_cache_saving)
 
 #: The package's root folder, and what marks a module of the compiled layer.
 _PACKAGE = Path(__file__).resolve().parents[1]
-_COMPILED = re.compile(rb"@kernel|@inlined_kernel|@unilateral_kernel|@loop|njit|@overload|@intrinsic|register_kinematics")
+_COMPILED = re.compile(rb"@kernel|@inlined_kernel|@unilateral_kernel|@rigid_kernel|@loop|njit|@overload|@intrinsic|register_kinematics")
 
 
 @functools.lru_cache(maxsize=1)

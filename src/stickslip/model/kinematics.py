@@ -35,7 +35,7 @@ acceleration bias Ġ q̇ are taken by complex step): use ``np.sin``, ``np.cos``,
 from __future__ import annotations
 
 import inspect
-from typing import Callable, NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -50,7 +50,7 @@ from .jit import KERNEL_OPTIONS, kernel, track_user_code
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
            "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel",
-           "contact_gap", "computes_gap", "gap_computed"]
+           "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid"]
 
 
 #: Registered frame functions by kinematics class.
@@ -65,12 +65,15 @@ _BIASES: dict[type, Callable] = {}
 _GAPS: dict[type, Callable] = {}
 #: Kinematics classes whose models never have unilateral contacts (their kernels compile without them).
 _PRESSED_ONLY: set[type] = set()
+#: Kinematics classes whose models never have rigid contacts (their kernels compile without the
+#: rigid normal forces and impacts).
+_NO_RIGID: set[type] = set()
 
 
 def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, ncontacts: int | None = None,
                         diagonal: bool | None = None, dim: int | None = None,
                         frame_bias: Callable | None = None, unilateral: bool = True,
-                        gap: Callable | None = None) -> None:
+                        gap: Callable | None = None, rigid: bool = True) -> None:
     """Make ``frame`` the contact frame of models whose kinematics data is a ``cls`` instance.
 
     Parameters
@@ -101,6 +104,10 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         filling ``W`` (n,) with its gradient ∂g/∂q; complex-safe like ``frame``. The contact's normal
         force λ acts on the coordinates as W(q)ᵀ λ and its gap rate is ġ = W(q)·q̇. Without it the
         gap is the contact's affine g0 + W·q (``Contact.gap``, ``Contact.gap_gradient``).
+    rigid : bool
+        Whether models of this kinematics may have rigid unilateral contacts (impacts; their normal
+        force a multiplier). False compiles their kernels without that code (the model files' class
+        for compliant contacts).
     """
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
@@ -124,6 +131,15 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         _PRESSED_ONLY.discard(cls)
     else:
         _PRESSED_ONLY.add(cls)
+    if unilateral and rigid:
+        _NO_RIGID.discard(cls)
+    else:
+        _NO_RIGID.add(cls)
+
+
+def allows_rigid(cls: type) -> bool:
+    """Whether models of kinematics class ``cls`` may have rigid contacts."""
+    return cls not in _NO_RIGID
 
 
 def allows_unilateral(cls: type) -> bool:
@@ -143,28 +159,41 @@ def pressed_only(kin_type) -> bool:
     return getattr(kin_type, "instance_class", None) in _PRESSED_ONLY
 
 
-def unilateral_kernel(pressed: Callable, *, inline: str = "never") -> Callable:
-    """Decorator for a kernel that only kinematics with unilateral contacts need.
+def rigid_free(kin_type) -> bool:
+    """At compile time: whether the numba type ``kin_type`` of a kinematics object belongs to a class
+    whose models have no rigid contacts (pressed-only ones included)."""
+    return getattr(kin_type, "instance_class", None) in _NO_RIGID
+
+
+def _kernel_without(lacks: Callable[[Any], bool], what: str) -> Callable:
+    """A decorator like :func:`unilateral_kernel` for the kinematics classes where ``lacks(type)``."""
+    def decorator(stub: Callable, *, inline: str = "never") -> Callable:
+        def register(impl: Callable) -> Callable:
+            signature = inspect.signature(impl)
+            at = list(signature.parameters).index("md")
+
+            def choose(*args):
+                md = args[at]
+                return stub if lacks(md.types[md.fields.index("kin")]) else impl
+
+            choose.__signature__ = signature  # numba checks each implementation against it
+            overload(impl, jit_options=KERNEL_OPTIONS, inline=inline)(choose)
+            return impl
+        return register
+    decorator.__doc__ = f"""Decorator for a kernel that only kinematics with {what} need.
 
     Numba resolves each call of the decorated function at compile time by the type of its
-    argument ``md``: for a kinematics class registered without unilateral contacts
-    (:func:`pressed_only`) it compiles ``pressed`` instead (the same argument names; a constant,
-    the identity or nothing), so those kernels compile none of the decorated code. ``inline`` is
-    numba's overload option (``"always"`` for the small ones). Returns the decorated function,
-    the name compiled code calls (it is never run by Python).
+    argument ``md``: for a kinematics class registered without {what} it compiles the stub
+    instead (the same argument names; a constant, the identity or nothing), so those kernels
+    compile none of the decorated code. ``inline`` is numba's overload option (``"always"`` for
+    the small ones). Returns the decorated function, the name compiled code calls (it is never
+    run by Python).
     """
-    def register(impl: Callable) -> Callable:
-        signature = inspect.signature(impl)
-        at = list(signature.parameters).index("md")
+    return decorator
 
-        def choose(*args):
-            md = args[at]
-            return pressed if pressed_only(md.types[md.fields.index("kin")]) else impl
 
-        choose.__signature__ = signature  # numba checks each implementation against it
-        overload(impl, jit_options=KERNEL_OPTIONS, inline=inline)(choose)
-        return impl
-    return register
+unilateral_kernel = _kernel_without(pressed_only, "unilateral contacts")
+rigid_kernel = _kernel_without(rigid_free, "rigid contacts")
 
 
 def registered_kinematics() -> tuple[type, ...]:
@@ -278,15 +307,22 @@ class ConstantKinematics(NamedTuple):
 
 
 class ConstantUnilateralKinematics(NamedTuple):
-    """:class:`ConstantKinematics` of a model with unilateral contacts: a closed compliant contact's
-    force −k (g0 + W·q) − c W·q̇ is affine in the state too, and stands in the data array as its N0,
-    n and n_v (:meth:`stickslip.model.system_model.Contact.spec`), so the frame returns it."""
+    """:class:`ConstantKinematics` of a model with compliant unilateral contacts: a closed compliant
+    contact's force −k (g0 + W·q) − c W·q̇ is affine in the state too, and stands in the data array
+    as its N0, n and n_v (:meth:`stickslip.model.system_model.Contact.spec`), so the frame returns it."""
+
+    constant: float = 1.0
+
+
+class ConstantRigidKinematics(NamedTuple):
+    """:class:`ConstantUnilateralKinematics` of a model with a rigid contact: only such models compile
+    the rigid normal forces and the impacts."""
 
     constant: float = 1.0
 
 
 #: The kinematics classes of constant G and w.
-CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics)
+CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics, ConstantRigidKinematics)
 
 
 @kernel
@@ -305,4 +341,5 @@ def constant_frame(kin, s, c, m, G, w):
 
 
 register_kinematics(ConstantKinematics, constant_frame, unilateral=False)
-register_kinematics(ConstantUnilateralKinematics, constant_frame)
+register_kinematics(ConstantUnilateralKinematics, constant_frame, rigid=False)
+register_kinematics(ConstantRigidKinematics, constant_frame)

@@ -43,7 +43,7 @@ from . import csmath as csm
 from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, H_RIGID, NORMAL_PRESCRIBED,
                      NORMAL_RIGID, contact_offsets, gap_offset)
 from .jit import inlined_kernel
-from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, unilateral_kernel
+from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from .stack import work_vectors
 
 __all__ = ["MODE_OPEN", "is_open", "is_unilateral", "is_rigid", "any_rigid_closed", "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator",
@@ -77,7 +77,7 @@ def is_rigid(md, n, c):
     return md.m[contact_offsets(n, c)[0] + C_NORMAL_LAW] == NORMAL_RIGID
 
 
-@unilateral_kernel(lambda cst, md, n, nc: False, inline="always")
+@rigid_kernel(lambda cst, md, n, nc: False, inline="always")
 def any_rigid_closed(cst, md, n, nc):  # pragma: no cover - compiled only
     """Whether some rigid contact is closed in ``cst`` (its normal force is then a multiplier)."""
     if md.m[H_RIGID] == 0.0:

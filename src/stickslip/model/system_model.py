@@ -30,7 +30,8 @@ from ..errors import ModelError
 from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
 from .bundle import NORMAL_LAWS
-from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantUnilateralKinematics, allows_unilateral,
+from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantRigidKinematics, ConstantUnilateralKinematics,
+                         allows_rigid, allows_unilateral,
                          computes_gap, registered_kinematics)
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
@@ -330,8 +331,11 @@ class FrictionModel:
         free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
         object.__setattr__(self, "free", free)
         object.__setattr__(self, "contacts", tuple(self.contacts))
-        if type(self.kinematics) is ConstantKinematics and any(c.unilateral for c in self.contacts):
-            object.__setattr__(self, "kinematics", ConstantUnilateralKinematics(*self.kinematics))
+        if type(self.kinematics) in CONSTANT_KINEMATICS and any(c.unilateral for c in self.contacts):
+            # the class compiles what the contacts need: rigid contacts' code only where there are some
+            rigid = any(c.unilateral and c.normal.law == "rigid" for c in self.contacts)
+            cls = ConstantRigidKinematics if rigid else ConstantUnilateralKinematics
+            object.__setattr__(self, "kinematics", cls(*self.kinematics))
         object.__setattr__(self, "dofs", tuple(self.dofs))
         self._check_mass()
         self._check_contacts()
@@ -422,6 +426,9 @@ class FrictionModel:
             raise ModelError(f"{where}: give either a prescribed load (normal_force) or a gap with a normal law, "
                              "not both; a unilateral contact's normal force comes from its gap")
         contact.normal.check(f"{where}: normal")
+        if contact.normal.law == "rigid" and not allows_rigid(type(self.kinematics)):
+            raise ModelError(f"{where}: kinematics {type(self.kinematics).__name__} was registered without rigid "
+                             "contacts (rigid=False); give the contact law = \"compliant\", or register it with rigid=True")
         if not math.isfinite(contact.gap):
             raise ModelError(f"{where}: gap = {contact.gap} must be finite [m]")
         if computes_gap(type(self.kinematics)):
