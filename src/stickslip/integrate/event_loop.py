@@ -33,11 +33,12 @@ import numpy as np
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
 from ..model.jit import inlined_kernel, kernel, loop
-from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
+from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
+from .transitions import crossing_in_step, gap_crossing, jammed_contact, record_transition, settle, switch_gap
 
 __all__ = ["integrate_event", "N_EXTRA"]
 
@@ -72,17 +73,6 @@ def dp_step(y, k1, h, cst, md, Kst, ynew, ytmp):
         P.rhs_body(ytmp, cst, md, Kst[stage])
     DP.stage_state(y, Kst, h, np.int64(6), ynew)  # not a literal: one compiled version
     P.rhs(ynew, cst, md, Kst[6])
-
-
-@inlined_kernel
-def crossing_in_step(kind, c, y, Kst, Q, q_ready, h, cst, md, work, F, N):
-    """θ ∈ (0, 1] of the first crossing of event ``kind`` of contact ``c`` inside a step whose end
-    is past it (1.0 where the sample points see no sign change: the root is at the end); forms the
-    step's dense-output coefficients ``Q`` from ``Kst`` first unless ``q_ready``."""
-    if not q_ready:
-        DP.dense_coefficients(Kst, Q)
-    th = E.first_crossing(kind, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
-    return 1.0 if th <= 0.0 else th
 
 
 @kernel
@@ -143,128 +133,6 @@ def cut_step(theta, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out
     for i in range(y.shape[0]):
         y[i] = work[i]
     return idx, tau_cut
-
-
-@kernel
-def record_transition(n_tr, t, kind, contact, y, tr_t, tr_kind, tr_contact, tr_s):
-    """Write transition ``n_tr`` (time [s], kind, contact, state) into the buffers if they have
-    room; the caller counts on and runs again with room for all (buffers that grew inside the
-    loop would be loop-carried arrays, which numba reference-counts on every iteration)."""
-    if n_tr < tr_t.shape[0]:
-        tr_t[n_tr] = t
-        tr_kind[n_tr] = kind
-        tr_contact[n_tr] = contact
-        for i in range(tr_s.shape[1]):
-            tr_s[n_tr, i] = y[i]
-
-
-@kernel
-def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
-    """Release sticking contacts whose joint stick force exceeds the static limit (the most
-    overloaded first) and record their breakaways at time ``t``; returns the transition count."""
-    for _ in range(E.MAX_SETTLE):
-        c = E.release_most_overloaded(y, cst, md, F, N)
-        if c < 0:
-            break
-        record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-        stats[5] += 1
-    return n_tr
-
-
-@unilateral_kernel(lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work:
-                   (n_tr, SUCCESS, math.inf))
-def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work):  # pragma: no cover
-    """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
-    change its mode, record the transitions (a sticking contact that opens first leaves stick; a
-    contact that closes with v_c = 0 and an admissible stick force sticks; a rigid one closes with
-    an impact, recorded with the state before it, then ``open`` where it bounces off or ``close``
-    where it stays, with the state after it), re-check the sticking set.
-
-    Returns (transition count, status, flight): status SUCCESS, or INCONSISTENT where a rigid
-    contact's impact has no consistent impulse; flight the predicted time [s] to a bounced
-    contact's next landing (∞ otherwise), which bounds the next step (nothing for pressed-only
-    kinematics)."""
-    flight = math.inf
-    if P.is_open(cst, c) and P.rigid(c, md):
-        record_transition(n_tr, t, E.TRANSITION_IMPACT, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-        phase, sticks, impulse, before, after, flight = E.land(y, cst, c, md, rtol, atol, F, N, work)
-        if phase == E.LAND_INCONSISTENT:
-            return n_tr, INCONSISTENT, flight
-        kind = E.TRANSITION_OPEN if phase == E.LAND_OPEN else E.TRANSITION_CLOSE
-        record_transition(n_tr, t, kind, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-        if sticks:
-            stats[4] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
-            n_tr += 1
-    elif P.is_open(cst, c):
-        record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-        if E.close_contact(y, cst, c, md, rtol, atol, F, N):
-            stats[4] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
-            n_tr += 1
-    else:
-        if np.int64(cst[CST * c]) == P.MODE_STICK:
-            stats[5] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
-            n_tr += 1
-        cst[CST * c] = P.MODE_OPEN
-        cst[CST * c + 3] = math.inf
-        record_transition(n_tr, t, E.TRANSITION_OPEN, c, y, tr_t, tr_kind, tr_contact, tr_s)
-        n_tr += 1
-    P.project_velocities(y, cst, np.int64(-1), md)  # the sticking set's constraints, after the change
-    n_tr = settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
-    return n_tr, SUCCESS, flight
-
-
-@rigid_kernel(lambda y, cst, md: np.int64(-1))
-def jammed_contact(y, cst, md):  # pragma: no cover - compiled only
-    """A closed rigid contact whose normal force has no consistent solution at ``y`` (Painlevé:
-    the relative pivot of its normal-force system is not positive), or −1."""
-    m = md.m
-    n, nc, _ = model_sizes(md.kin, m)
-    if P.rigid_pivot(y, cst, md) > 0.0:
-        return np.int64(-1)
-    for c in range(nc):
-        if P.rigid(c, md) and not P.is_open(cst, c):
-            return np.int64(c)
-    return np.int64(-1)
-
-
-@unilateral_kernel(lambda y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N: (-1.0, np.int64(-1), q_ready),
-                   inline="always")
-def gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):  # pragma: no cover
-    """(θ, contact, q_ready) of the first opening or closing of a unilateral contact inside the step
-    from ``y`` (derivative ``k1``) to ``ynew`` (stages ``Kst``), θ = −1.0 and contact −1 for none.
-    Besides a contact whose indicator has turned at the step's end, a flight (or a touch) that
-    begins and ends inside the step is found where the step's Hermite interpolant of the gap dips
-    and the dense output there confirms it. Nothing for pressed-only kinematics, whose kernels then
-    compile none of it."""
-    theta_g = -1.0
-    c_g = np.int64(-1)
-    n, nc, _ = model_sizes(md.kin, md.m)
-    if not has_unilateral(md.kin, md.m):
-        return theta_g, c_g, q_ready
-    for c in range(nc):
-        if not is_unilateral(md, n, c):
-            continue
-        if P.indicator(ynew, cst, c, md) <= 0.0:
-            th = crossing_in_step(E.EVENT_GAP, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
-        else:
-            probe = E.gap_dip(y, k1, ynew, Kst[6], h, cst, c, md)
-            if probe < 0.0:
-                continue
-            if not q_ready:
-                DP.dense_coefficients(Kst, Q)
-            th = E.probed_crossing(probe, E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
-        q_ready = True
-        if th > 0.0 and (theta_g < 0.0 or th < theta_g):
-            theta_g = th
-            c_g = np.int64(c)
-    return theta_g, c_g, q_ready
 
 
 @loop

@@ -169,7 +169,7 @@ class Impacts:
 def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
     """The impacts of a run from its transitions: each ``impact`` record holds the state before,
     the record after it (``open`` or ``close`` of the same contact at the same instant) the state
-    after (:func:`stickslip.integrate.event_loop.switch_gap`)."""
+    after (:func:`stickslip.integrate.transitions.switch_gap`)."""
     n = system.n
     kinds = transitions.kind
     rows = [i for i in np.flatnonzero(kinds == TRANSITION_IMPACT) if i + 1 < kinds.size]
