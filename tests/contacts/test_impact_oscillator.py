@@ -212,9 +212,8 @@ def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_statu
     assert "Painlevé" in tr.status and "\n" not in tr.status
 
 
-@pytest.mark.parametrize("command", [["orbit", "--search-time", "5"], ["basins", "--box", "x=0:1", "--n", "2"]])
-def test_analyses_without_rigid_contacts_refuse_in_one_line(command):
-    result = CliRunner().invoke(app, [*command, "--model", "impact-oscillator"])
+def test_lyapunov_from_perturbed_trajectories_refuses_rigid_contacts_in_one_line():
+    result = CliRunner().invoke(app, ["lyapunov", "--model", "impact-oscillator", "--method", "finite-difference"])
     assert result.exit_code == 2, result.output
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and "not available for rigid contacts" in lines[0]

@@ -55,3 +55,20 @@ def test_a_rigid_contact_that_nothing_presses_is_no_steady_sliding():
     model = stickslip.load_model(RIGID_SLIDER).replace(P=-0.3)
     with pytest.raises(EquilibriumError, match="would be open"):
         model_stability(model)
+
+
+def test_stability_map_of_the_constrained_eigenproblem_matches_the_hand_solution():
+    """The map over (P, V) and its boundary in V: the linearised x equation loses its damping where
+    cx + μ'(V) λ_e(P, V) = 0 (the hand solution's root, by brentq on the closed form)."""
+    from scipy import optimize
+
+    P = np.array([0.2, 0.3, 0.5])
+    V = np.linspace(0.3, 2.0, 8)
+    smap = stickslip.stability_map(stickslip.load_model(RIGID_SLIDER), N=P, Omega=V, axes=("P", "V"))
+    expected = np.array([[hand(p, v)[2].real.max() for v in V] for p in P])
+    np.testing.assert_allclose(smap.max_real_part[0], expected, atol=1e-9)
+    for i, p in enumerate(P):
+        root = optimize.brentq(lambda v: hand(p, v)[2].real.max(), V[0], V[-1], xtol=1e-13)
+        found = smap.boundary[0, i][np.isfinite(smap.boundary[0, i])]
+        np.testing.assert_allclose(found, [root], atol=1e-8)
+        assert smap.boundary_direction[0, i, 0] == -1  # stable above the boundary: μ' → 0 as V grows

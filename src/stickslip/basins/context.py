@@ -29,6 +29,7 @@ import numpy as np
 from ..errors import StickSlipError
 from ..model.library import describe_system, system_from_description
 from ..stability.analysis import stability
+from ..stability.equilibrium import rigid_constraint
 
 __all__ = ["Context", "make_context", "model_of", "model_key", "SAMPLES_PER_PERIOD", "CHUNK_PERIODS",
            "WINDOW_PERIODS", "register_model"]
@@ -179,9 +180,15 @@ def make_context(model, *, key: str | None = None) -> Context:
         if stable:
             A = np.asarray(stab.jacobian, dtype=float)
             Q = np.diag(_energy_weights(model, free_dofs))
-            P = solve_continuous_lyapunov(A.T, -Q)
-            P = 0.5 * (P + P.T)
-            flow = expm(A * chunk * dt)
+            # closed rigid contacts: the linear flow lives on W q = −g0, W q̇ = 0 (orthonormal
+            # basis T); off it (a flight) the deviation counts with the weights Q and is not
+            # linear motion (the flow's prediction drops it)
+            T = np.kron(np.eye(2), rigid_constraint(model)[1][free_dofs]) if model.rigid else np.eye(k2)
+            A_c = T.T @ A @ T
+            P = T @ solve_continuous_lyapunov(A_c.T, -(T.T @ Q @ T)) @ T.T
+            off = np.eye(k2) - T @ T.T
+            P = 0.5 * (P + P.T) + off @ Q @ off
+            flow = T @ expm(A_c * chunk * dt) @ T.T
             se = equilibrium[free]
             rest = 1e-6 * math.sqrt(max(float(se @ P @ se), float(np.trace(P)) * 1e-12))
     return Context(key or model_key(model), period, dt, chunk, WINDOW_PERIODS * SAMPLES_PER_PERIOD, equilibrium,

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import BasinError, StickSlipError
+from ..integrate.initial import refused_rigid_starts, rigid_gaps
 from ..integrate.interrupt import interruptible
 from ..journal import finished_output, output_path
 from ..memory import check_memory, format_bytes, largest_count, param_bytes, state_bytes
@@ -67,6 +68,24 @@ def evaluate_batch(task):
             cycles.append(o.cycle)
         rows.append(o.to_row())
     return indices, np.array(rows)
+
+
+def _refuse_inside_stops(models, initial: np.ndarray) -> None:
+    """Refuse states that start inside a rigid contact's stop or at it moving into it (no motion
+    starts there), in one line that says how many and how to keep them out.
+
+    Raises
+    ------
+    BasinError
+    """
+    for m, states in zip(models, initial):
+        refused = refused_rigid_starts(m, states)
+        if refused.any():
+            first = int(np.flatnonzero(refused)[0])
+            names = ", ".join(m.contact_names[c] for c, *_ in rigid_gaps(m, states[first]))
+            raise BasinError(f"{int(refused.sum())} of {refused.size} states of model {m.name!r} start inside a rigid "
+                             f"contact's stop ({names}: gap < 0) or at it moving into it (the first: state {first}); "
+                             "choose states with gap > 0 (the range of the dofs that open the gap above 0)")
 
 
 def _state_units(model) -> dict:
@@ -197,7 +216,6 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
     t_start = time.perf_counter()
     check_executor(executor, BasinError)
     model = load_model(model)
-    model.refuse_rigid("basin stability")
     unknown = set(options) - {"rtol", "atol", "match_rtol", "confirm", "lyapunov", "max_steps"}
     if unknown:
         raise BasinError(f"unknown option(s) {', '.join(sorted(unknown))}")
@@ -215,6 +233,8 @@ def basin_stability(model, states: StateSpec, *, param: str | None = None, value
                          f"{model.name!r} (its slowest oscillation); give several periods, e.g. --t-end {100 * period:.3g}")
     initial = np.stack([states.states(m, None if c.equilibrium is None else c.equilibrium[:m.n])
                         for m, c in zip(models, ctxs)])
+    if model.rigid:
+        _refuse_inside_stops(models, initial)
     out, tmpdir = output_path(out, "basins.nc", BasinError)
     ds = finished_output(out, spec.digest, load_basins, what="basin study", error=BasinError, overwrite=overwrite)
     if ds is not None and int(ds.attrs.get("complete", 0)):

@@ -16,7 +16,7 @@ from ..model.system_model import FrictionModel
 from ..stability.equilibrium import steady_sliding
 from .result import Trajectory, load_trajectory
 
-__all__ = ["initial_state", "NAMED_STARTS", "NEAR_PERTURBATION", "start_names", "start_description", "check_rigid_start"]
+__all__ = ["initial_state", "NAMED_STARTS", "NEAR_PERTURBATION", "start_names", "start_description", "check_rigid_start", "rigid_gaps", "refused_rigid_starts"]
 
 #: Perturbation of the observed coordinate added to steady sliding by the ``near`` start [unit of
 #: the coordinate; rad for the plates' φ]: 5 % of φ_e ≈ 0.0197 rad at N = 50 N (Eq. 14), small
@@ -128,6 +128,44 @@ def initial_state(system: FrictionModel, ic="zero", perturbation=None) -> np.nda
     return s
 
 
+def rigid_gaps(system: FrictionModel, states: np.ndarray):
+    """Gap and normal speed of every rigid contact at each of ``states``.
+
+    Parameters
+    ----------
+    system : FrictionModel
+    states : ndarray (k, 2n) or (2n,)
+        States [q, q̇].
+
+    Yields
+    ------
+    c : int
+        The rigid contact.
+    g, rate : ndarray (k,)
+        Its gap g0 + W·q and normal speed W·q̇ [m, m/s].
+    tol : ndarray (k,)
+        Round-off of the gap: |g| below it counts as g = 0 [m].
+    """
+    n = system.n
+    S = np.atleast_2d(np.asarray(states, dtype=float))
+    for c, contact in enumerate(system.contacts):
+        if not (contact.unilateral and contact.normal.law == "rigid"):
+            continue
+        W = np.asarray(contact.gap_gradient, dtype=float)
+        g = contact.gap + S[:, :n] @ W
+        tol = 1e-12 * (1.0 + abs(contact.gap) + np.abs(S[:, :n] * W).sum(axis=1))
+        yield c, g, S[:, n:2 * n] @ W, tol
+
+
+def refused_rigid_starts(system: FrictionModel, states: np.ndarray) -> np.ndarray:
+    """Which of ``states`` (k, 2n) a rigid contact cannot start from (:func:`check_rigid_start`):
+    bool (k,)."""
+    refused = np.zeros(np.atleast_2d(states).shape[0], dtype=bool)
+    for _, g, rate, tol in rigid_gaps(system, states):
+        refused |= (g < -tol) | ((g <= tol) & (rate < 0.0))
+    return refused
+
+
 def check_rigid_start(system: FrictionModel, y0: np.ndarray) -> None:
     """Refuse a start that a rigid contact cannot take: inside its stop (g < 0), or at it and
     moving into it (g = 0, ġ < 0: an impact at the start; start just above it instead).
@@ -136,14 +174,8 @@ def check_rigid_start(system: FrictionModel, y0: np.ndarray) -> None:
     ------
     SimulationError
     """
-    n = system.n
-    for c, contact in enumerate(system.contacts):
-        if not (contact.unilateral and contact.normal.law == "rigid"):
-            continue
-        W = np.asarray(contact.gap_gradient, dtype=float)
-        g = contact.gap + float(W @ y0[:n])
-        rate = float(W @ y0[n:2 * n])
-        tol = 1e-12 * (1.0 + abs(contact.gap) + float(np.abs(W * y0[:n]).sum()))
+    for c, g, rate, tol in rigid_gaps(system, y0):
+        g, rate, tol = float(g[0]), float(rate[0]), float(tol[0])
         name = system.contact_names[c]
         if g < -tol:
             raise SimulationError(f"rigid contact {c} ({name}) starts inside its stop: gap {g:.6g} < 0; start with "

@@ -71,12 +71,22 @@ def resolve_section(section, system) -> Section:
     )
 
 
-def modes_at(system, s: np.ndarray, stick_flags: int = 0) -> np.ndarray:
-    """Contact states at ``s``: the contacts whose bit is set in ``stick_flags`` stick, the others
-    slip with the exact direction v_c/|v_c| (a Trajectory's ``mode`` gives the flags)."""
+def modes_at(system, s: np.ndarray, stick_flags: int | None = None) -> np.ndarray:
+    """Contact states at ``s``: the contacts whose bit c is set in ``stick_flags`` stick, those
+    whose bit n_contacts + c is set are open, the others slip with the exact direction
+    v_c/|v_c| (a Trajectory's ``mode`` gives the flags). Without flags every contact slips but
+    the unilateral ones whose gap is positive at ``s``, which are open."""
     md = system.data
+    nc = system.n_contacts
     cst = contact_state(md.m)
-    for c in range(system.n_contacts):
+    if stick_flags is None:
+        y = np.ascontiguousarray(s[:2 * system.n], dtype=float)
+        stick_flags = sum(1 << (nc + c) for c, contact in enumerate(system.contacts)
+                          if contact.unilateral and P.gap(y, c, md)[0] > 0.0)
+    for c in range(nc):
+        if (int(stick_flags) >> (nc + c)) & 1:
+            cst[CST * c] = P.MODE_OPEN
+            continue
         if (int(stick_flags) >> c) & 1:
             cst[CST * c] = P.MODE_STICK
             continue
@@ -89,8 +99,9 @@ def modes_at(system, s: np.ndarray, stick_flags: int = 0) -> np.ndarray:
     return cst
 
 
-def vector_field(system, s: np.ndarray, stick_flags: int = 0) -> np.ndarray:
-    """ds/dt (2n,) at state ``s`` (:func:`modes_at`: slip with the exact direction by default)."""
+def vector_field(system, s: np.ndarray, stick_flags: int | None = None) -> np.ndarray:
+    """ds/dt (2n,) at state ``s`` (:func:`modes_at`: slip with the exact direction, unilateral
+    contacts open where their gap is positive, by default)."""
     y = np.ascontiguousarray(s[:2 * system.n], dtype=float)
     ds = np.zeros(2 * system.n)
     P.rhs(y, modes_at(system, y, stick_flags), system.data, ds)

@@ -29,7 +29,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import OrbitError, SimulationError
 from ..integrate.driver import simulate
-from ..integrate.initial import initial_state
+from ..integrate.initial import initial_state, rigid_gaps
 from ..integrate.result import Trajectory
 from ..model.system_model import FrictionModel
 from .layout import free_states
@@ -156,13 +156,24 @@ def _guess_from_samples(system, section, t, states, mode, multiplicity, *, rtol,
         )
     c = times.size - 1 - multiplicity
     i = max(int(idx[c]) - 1, 0)  # start one sample early, so the landing time is ≥ one interval
-    if mode[i] != 0 or mode[int(idx[c]) + 1] != 0:
+    sticking = (1 << system.n_contacts) - 1  # the stick bits of mode (the others flag open contacts)
+    if mode[i] & sticking or mode[int(idx[c]) + 1] & sticking:
         raise OrbitError(f"section {section.name} is crossed in stick; choose a section crossed in slip")
     T0 = float(times[c + multiplicity] - times[c])
     s0, _, miss = land_on_section(system, section, states[i], float(times[c] - t[i]), rtol=rtol, atol=atol)
     window = (t >= times[c]) & (t <= times[c + multiplicity])
     ptp = np.ptp(states[window], axis=0) if window.sum() > 1 else np.ptp(states, axis=0)
     return s0, T0, ptp, miss
+
+
+def _refuse_closed_rigid(system, section, s0) -> None:
+    """Refuse a section crossed with a rigid contact closed: the unknowns would leave g = 0 (into
+    the stop, or off it without an opening), so such an orbit is shot from a flight."""
+    closed = [system.contact_names[c] for c, g, _, tol in rigid_gaps(system, s0) if g[0] <= tol[0]]
+    if closed:
+        raise OrbitError(f"section {section.name} is crossed with rigid contact {', '.join(closed)} closed; choose a "
+                         "section crossed while the rigid contacts are open, e.g. the highest point of a flight "
+                         "('<dof>_max' of the dof that opens the gap)")
 
 
 def periodic_orbit(
@@ -244,7 +255,6 @@ def periodic_orbit(
         system = resolve(system, guess.system.parameters["variant"], slip_band)  # new parameters, the run's variant
     else:
         system = resolve(system, model, slip_band)
-    system.refuse_rigid("a periodic orbit (saltation across impacts)")
     k = int(period_multiplicity)
     if k < 1:
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")
@@ -266,6 +276,7 @@ def periodic_orbit(
         if guess.status != "success":
             raise OrbitError(f"the search run failed: {guess.status}")
     s0, T, ptp, _ = _guess_from_samples(system, sec, guess.t, guess.states, guess.mode, k, **opts)
+    _refuse_closed_rigid(system, sec, s0)
     problem = ShootingProblem.build(system, sigma=scales(ptp, free_states(system)), section=sec, fd_step=fd_step,
                                     **opts)
     orbit = problem.newton(s0, T, tol=tol, max_iter=max_iter, method=newton_jacobian)

@@ -23,7 +23,7 @@ import numpy as np
 from scipy import optimize
 
 from .._version import __version__
-from ..errors import ModelError, ParameterError
+from ..errors import EquilibriumError, ModelError, ParameterError
 from ..files import format_name, open_ours, save_netcdf
 from ..memory import check_memory, largest_count, map_point_bytes
 from ..model.library import describe_system, system_from_description
@@ -32,6 +32,7 @@ from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
 from ..model.variants import resolve_variant
 from ..results import Plottable
 from . import steady
+from .analysis import model_stability
 from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds
 
 __all__ = ["StabilityMap", "stability_map", "max_real_part", "boundary_omegas", "load_stability_map",
@@ -240,6 +241,8 @@ class MapGrid:
     def max_real_part(self) -> np.ndarray:
         """max Re λ over the grid (nA, nB) [1/s], NaN where no steady sliding exists."""
         nA, nB = self.a.size, self.b.size
+        if self.system.rigid:
+            return np.array([[self.value_at(i, y) for y in self.b] for i in range(nA)]).reshape(nA, nB)
         ia_all = np.repeat(np.arange(nA, dtype=np.int64), nB)
         ib_all = np.tile(np.arange(nB, dtype=np.int64), nA)
         out = np.full(nA * nB, np.nan)
@@ -253,11 +256,27 @@ class MapGrid:
 
     def value_at(self, i: int, y: float) -> float:
         """max Re λ at the first axis' value ``a[i]`` and the second parameter = ``y`` [1/s]."""
+        if self.system.rigid:
+            return _constrained_max_real_part(self.system.replace(**{self.names[0]: float(self.a[i]),
+                                                                     self.names[1]: float(y)}))
         if self.separable:
             J = self.jacobians(np.array([i]), np.array([0]), self.axis_b.rows([y]))
         else:
             J = _jacobian_of(self.system.replace(**{self.names[0]: float(self.a[i]), self.names[1]: float(y)}))
         return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
+
+
+def _constrained_max_real_part(system) -> float:
+    """max Re λ at steady sliding of a model with rigid contacts [1/s], NaN without steady sliding.
+
+    Its closed rigid contacts make the eigenproblem a constrained one (the motion that keeps them
+    closed, :func:`~stickslip.stability.analysis.model_stability`), which the compiled grid kernel
+    does not solve: each point is one Newton solve and one eigenproblem in Python (milliseconds).
+    """
+    try:
+        return float(np.max(model_stability(system).eigenvalues.real))
+    except EquilibriumError:
+        return math.nan
 
 
 def _jacobian_of(system) -> np.ndarray:
@@ -552,7 +571,6 @@ def stability_map(
         value that makes the model invalid.
     """
     system = model_of(params, model)
-    system.refuse_rigid("a stability map")
     axes = tuple(axes)
     N = _as_float_array(axes[0], N)
     Omega = _as_float_array(axes[1], Omega)

@@ -1,0 +1,108 @@
+"""The orbit tools and basin stability on a model with a rigid contact (the rigid slider of
+tests/contacts/rigid_slider.toml): its cycle of a plastic impact, slip, stick, slip and a flight.
+
+Independent references: the settled cycle of a long run (its impact interval), central
+differences of the flow map for the monodromy, the hand solution of steady sliding
+(tests/contacts/test_rigid_steady.py) for the equilibrium a basin study finds.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stickslip
+from stickslip.basins.states import box
+from stickslip.errors import BasinError
+from stickslip.orbits.continuation import continue_orbit
+from stickslip.orbits.problem import stick_summary
+
+RIGID_SLIDER = Path(__file__).with_name("rigid_slider.toml")
+
+
+@pytest.fixture(scope="module")
+def model():
+    return stickslip.load_model(RIGID_SLIDER)
+
+
+@pytest.fixture(scope="module")
+def settled(model):
+    """The impact interval of the settled cycle at V = 0.5 (a 150 s run at rtol 1e-11) [s]."""
+    run = stickslip.simulate(model, 150.0, rtol=1e-11, atol=1e-13, sample_rate=10.0)
+    intervals = np.diff(run.impacts.time[-6:])
+    assert np.ptp(intervals) < 1e-8
+    return float(intervals.mean())
+
+
+@pytest.fixture(scope="module")
+def orbit(model):
+    """Shot from a state near the cycle (a flight, y = 0.05 above the belt), on the section of the
+    highest point of the flight."""
+    return stickslip.periodic_orbit(model, {"x": 1.0, "y": 0.05}, section="y_max", search_time=60.0)
+
+
+def test_periodic_orbit_with_an_impact_is_the_settled_cycle(orbit, settled):
+    assert orbit.residual <= 1e-9
+    assert orbit.period == pytest.approx(settled, rel=1e-8)
+    assert orbit.stick_phases == 1
+    summary = stick_summary(orbit.trajectory(1.0, sample_rate=100.0), orbit.period)
+    assert summary["open_phases"] == 1 and 0.3 < summary["open_fraction"] < 0.6
+    assert orbit.state[1] > 0.0  # the section lies in the flight
+
+
+def test_saltation_multipliers_across_the_impact_match_finite_differences(model, orbit):
+    fd = stickslip.periodic_orbit(model, orbit.trajectory(3.0, sample_rate=200.0), section="y_max",
+                                  monodromy="finite-difference")
+    np.testing.assert_allclose(orbit.monodromy, fd.monodromy, rtol=0, atol=1e-6 * np.abs(fd.monodromy).max())
+    # the trivial multiplier 1; the plastic impact and the stick phase collapse every other direction
+    moduli = np.abs(orbit.multipliers)
+    assert moduli[0] == pytest.approx(1.0, abs=1e-6) and (moduli[1:] < 1e-6).all()
+
+
+def test_continuation_in_the_belt_speed_follows_the_cycle(model, orbit):
+    branch = continue_orbit(model, "V", orbit, direction=-1, max_points=4, step=0.05, amplitude=False)
+    assert branch.values.size == 4 and branch.values[-1] < 0.5
+    assert (branch.open_phases == 1).all() and (branch.stick_phases == 1).all()
+    # the last point against a periodic orbit shot at its speed from a fresh run
+    last = model.replace(V=float(branch.values[-1]))
+    direct = stickslip.periodic_orbit(last, {"x": 1.0, "y": 0.05}, section="y_max", search_time=60.0)
+    assert branch.periods[-1] == pytest.approx(direct.period, rel=1e-8)
+
+
+def test_basins_find_the_impacting_cycle_and_steady_sliding(model, orbit, tmp_path):
+    states = box(model, {"x": (-4, 4), "dx": (-3, 3), "y": (0.001, 1.0), "dy": (-1, 1)}, n=12, seed=0)
+    study = stickslip.basin_stability(model, states, t_end=400.0, workers=1, out=tmp_path / "b.nc",
+                                      param="V", values=[0.5, 1.05])
+    ds = study.dataset
+    # V = 0.5: steady sliding is unstable and every state reaches the cycle with the impact
+    cycle = int(np.flatnonzero(ds["fraction"].values[0] > 0)[0])
+    assert ds["fraction"].values[0, cycle] == 1.0
+    assert ds["period"].values[0, cycle] == pytest.approx(orbit.period, rel=1e-4)
+    assert 0.3 < ds["open_fraction"].values[0, cycle] < 0.6
+    # V = 1.05: steady sliding (the hand solution x_e = μ(V) P / (K11 − μ(V) K12)) attracts every state
+    assert int(ds["steady_sliding_stable"].values[1]) == 1
+    k11 = 1.0 + 3.0 * math.cos(math.radians(150.0)) ** 2
+    k12 = 3.0 * math.cos(math.radians(150.0)) * math.sin(math.radians(150.0))
+    mu = 0.3 + 0.6 * math.exp(-2.0 * 1.05)
+    np.testing.assert_allclose(ds["steady_sliding"].values[1], [mu * 0.3 / (k11 - mu * k12), 0, 0, 0], atol=1e-10)
+    assert ds["fraction"].values[1].max() == 1.0 and ds["attractor"].values[np.argmax(ds["fraction"].values[1])] \
+        == "equilibrium"
+
+
+def test_basins_refuse_states_inside_the_stop(model, tmp_path):
+    states = box(model, {"x": (-1, 1), "y": (-0.5, 0.5)}, n=10, seed=0)
+    with pytest.raises(BasinError, match=r"start inside a rigid contact's stop \(belt: gap < 0\)"):
+        stickslip.basin_stability(model, states, t_end=100.0, workers=1, out=tmp_path / "b.nc")
+
+
+def test_a_section_crossed_with_the_rigid_contact_closed_is_refused(model, orbit):
+    """An up-crossing of x in a slip phase of the closed contact:
+    Newton's unknowns would leave the stop's surface."""
+    run = orbit.trajectory(3.0, sample_rate=1000.0)
+    rising = ~run.open[:, 0] & ~run.stick[:, 0] & (run.states[:, 2] > 0.0)
+    level = float(np.median(run.states[rising, 0]))
+    with pytest.raises(stickslip.errors.OrbitError, match="crossed with rigid contact belt closed"):
+        stickslip.periodic_orbit(model, run, section=("x", level))
