@@ -17,6 +17,7 @@ import pytest
 import stickslip
 from stickslip.basins.states import box
 from stickslip.errors import BasinError
+from stickslip.integrate.contacts import TRANSITION_OPEN
 from stickslip.orbits.continuation import continue_orbit
 from stickslip.orbits.problem import stick_summary
 
@@ -106,3 +107,24 @@ def test_a_section_crossed_with_the_rigid_contact_closed_is_refused(model, orbit
     level = float(np.median(run.states[rising, 0]))
     with pytest.raises(stickslip.errors.OrbitError, match="crossed with rigid contact belt closed"):
         stickslip.periodic_orbit(model, run, section=("x", level))
+
+
+def test_continuation_ends_at_the_grazing_of_the_rigid_contact(model, orbit):
+    """Towards lower belt speeds the cycle's flight shortens (τ_open² linear in V) until it
+    vanishes at a grazing; the branch ends there with a located ``grazing`` point, which must
+    agree with a bisection on independent runs: whether the settled motion still opens the contact."""
+    branch = continue_orbit(model, "V", orbit, direction=-1, max_points=60, step=0.1, max_step=1.0, amplitude=False)
+    assert branch.stop_reason == "flight vanishing (grazing of a rigid contact)"
+    grazing = branch.special[-1]
+    assert grazing.kind == "grazing" and grazing.located and grazing.before == 1.0 and grazing.after == 0.0
+
+    def flies(speed):
+        run = stickslip.simulate(model.replace(V=speed), 300.0, rtol=1e-12, atol=1e-14, sample_rate=1.0)
+        return bool(np.any((run.transitions.kind == TRANSITION_OPEN) & (run.transitions.time > 250.0)))
+
+    lo, hi = 0.3655, 0.3665
+    assert flies(hi) and not flies(lo)
+    while hi - lo > 1e-7:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if flies(mid) else (mid, hi)
+    assert grazing.value == pytest.approx(0.5 * (lo + hi), abs=1e-5)

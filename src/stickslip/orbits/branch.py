@@ -31,8 +31,8 @@ from .models import ModelResult, plates_parameters, resolve, with_parameter
 from .problem import unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
-from .special_points import (MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point, detect_after_renewal,
-                             distance_from_equilibrium, is_orbit)
+from .special_points import (FLIGHT_VANISHING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
+                             detect_after_renewal, distance_from_equilibrium, flight_vanishing, is_orbit)
 from .start import Start, start_orbit
 
 __all__ = ["Branch", "continue_orbit", "load_branch"]
@@ -87,7 +87,8 @@ class Branch(ModelResult, store.NetCDFResult):
     stop_reason : str
         Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``,
         ``steady sliding at <param> = <value>`` where the corrector converged onto the equilibrium
-        (that point is not in the branch), ...).
+        (that point is not in the branch), ``flight vanishing (grazing of a rigid contact)``
+        with a ``grazing`` point after the last, ...).
     system : FrictionModel
         The model at the start (the continuation parameter at its start value); ``params`` and
         ``model``: the plates' Parameters and variant, or None and the model's name.
@@ -429,6 +430,11 @@ def continue_orbit(
         if callback is not None and not quiet:
             _s, T_new, lam_cb = problem.unpack(new.v)
             callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
+    if walk.stop == "min_step" and problem.shooting.system.rigid:
+        grazing = flight_vanishing(problem, walk.points)
+        if grazing is not None:
+            walk.special.append(grazing)
+            walk.stop = FLIGHT_VANISHING_STOP
     stop_reason = walk.stop or "max_points"
     if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
         journal.append({"end": stop_reason})

@@ -28,6 +28,10 @@ consecutive points that have multipliers, and classify a change by what crossed 
                       flight shorter than the integrator's step is not recorded, so the count
                       changes a little past the zero of the largest gap (measured on hoffmann at
                       rtol 1e-10: flights up to ~9 ms, largest gap 1.3e-5, 4e-6 in belt speed).
+                      A rigid contact's grazing ends the branch instead (its return map is
+                      singular there): where the steps shrink below ``min_step`` and the flight
+                      time τ_open of the last points extrapolates to zero (τ_open² linear in λ,
+                      as for ``stick-vanishing``), the grazing is reported after the last point.
 ``hopf``              the branch turns where a pure-slip cycle has shrunk onto the equilibrium
                       (distance from it < :data:`HOPF_RATIO` of the start's): the Hopf point of
                       the linearisation (paper Eq. 15, Appendix); the branch ends.
@@ -96,6 +100,8 @@ LOCATE_RTOL, MAX_LOCATE = 1e-3, 12
 
 #: Stop reason of a branch that ends at a Hopf point.
 HOPF_STOP = "hopf (the cycle shrinks onto the equilibrium)"
+#: Stop reason of a branch that ends at a rigid contact's grazing (:func:`flight_vanishing`).
+FLIGHT_VANISHING_STOP = "flight vanishing (grazing of a rigid contact)"
 
 #: Tests located by the Illinois method (sign changes of a continuous function).
 _CONTINUOUS = ("fold", "period-doubling")
@@ -445,19 +451,19 @@ def _stop_reason(found: list, stop_on) -> str | None:
     return None
 
 
-def _stick_vanishing(problem: Problem, points: list, index: int) -> SpecialPoint:
-    """Where the stick time of the last points extrapolates to zero (τ_stick² linear in λ).
+def _extrapolated_zero(problem: Problem, points: list, duration) -> tuple[float, bool]:
+    """Where ``duration(point)`` (a phase's time per period [s]) of the last points extrapolates to
+    zero, its square linear in λ: (λ*, located).
 
-    A least-squares line through τ_stick² of the last :data:`VANISH_FIT_POINTS` stick-slip
-    points; the root counts as located if the line fits them to :data:`VANISH_FIT_RTOL` and the
-    root lies ahead of the last point by at most twice the λ span of the fit.
+    A least-squares line through duration² of the last :data:`VANISH_FIT_POINTS` points that have
+    the phase; the root counts as located if the line fits them to :data:`VANISH_FIT_RTOL` and the
+    root lies ahead of the last point by at most twice the λ span of the fit (else λ* is the last
+    point's λ).
     """
-    use = [p for p in points[-VANISH_FIT_POINTS:] if p.stick_time > 0.0]
+    use = [p for p in points[-VANISH_FIT_POINTS:] if duration(p) > 0.0]
     lam = np.array([problem.unpack(p.v)[2] for p in use])
-    tau2 = np.array([p.stick_time ** 2 for p in use])
-    last = points[-1]
-    s, T, lam_last = problem.unpack(last.v)
-    value, located = lam_last, False
+    tau2 = np.array([duration(p) ** 2 for p in use])
+    lam_last = problem.unpack(points[-1].v)[2]
     if lam.size >= 3 and np.ptp(lam) > 0.0:
         slope, intercept = np.polyfit(lam, tau2, 1)
         fit_ok = np.max(np.abs(slope * lam + intercept - tau2)) <= VANISH_FIT_RTOL * np.max(tau2)
@@ -465,8 +471,41 @@ def _stick_vanishing(problem: Problem, points: list, index: int) -> SpecialPoint
             root = -intercept / slope
             ahead = (root - lam_last) * np.sign(lam[-1] - lam[0])
             if fit_ok and 0.0 <= ahead <= 2.0 * np.ptp(lam):
-                value, located = float(root), True
+                return float(root), True
+    return float(lam_last), False
+
+
+def _stick_vanishing(problem: Problem, points: list, index: int) -> SpecialPoint:
+    """Where the stick time of the last points extrapolates to zero (:func:`_extrapolated_zero`;
+    τ_stick ∝ √(λ* − λ))."""
+    last = points[-1]
+    s, T, lam_last = problem.unpack(last.v)
+    value, located = _extrapolated_zero(problem, points, lambda p: p.stick_time)
     return SpecialPoint(kind="stick-vanishing", index=index, value=value, period=T, state=s,
                         multipliers=last.multipliers, before=float(points[-2].stick_time),
                         after=float(last.stick_time), bracket=float(abs(value - lam_last)), located=located,
                         multipliers_before=points[-2].multipliers, multipliers_after=last.multipliers)
+
+
+def flight_vanishing(problem: Problem, points: list) -> SpecialPoint | None:
+    """The grazing of a rigid contact where a branch ends, or None.
+
+    Towards a rigid contact's grazing the flight of the orbit shortens as τ_open ∝ √(λ* − λ)
+    (measured on the rigid slider: τ_open² linear in the belt speed to 1 % over its last points)
+    and its landing speed vanishes; the return map is singular there, so the corrector's steps
+    shrink to ``min_step`` before it. When the branch ends so, the grazing is where τ_open of the
+    last points extrapolates to zero (:func:`_extrapolated_zero`): a ``grazing`` point after the
+    last (``before`` its flight phases per period, ``after`` 0), reported only where the
+    extrapolation locates it.
+    """
+    last = points[-1]
+    if not last.open_phases:
+        return None
+    value, located = _extrapolated_zero(problem, points, lambda p: p.open_time or 0.0)
+    if not located:
+        return None
+    s, T, lam_last = problem.unpack(last.v)
+    return SpecialPoint(kind="grazing", index=len(points) - 1, value=value, period=T, state=s,
+                        multipliers=last.multipliers, before=float(last.open_phases), after=0.0,
+                        bracket=float(abs(value - lam_last)), located=True, multipliers_before=last.multipliers,
+                        multipliers_after=_nan_like(last))
