@@ -210,11 +210,3 @@ def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_statu
     tr = stickslip.simulate(model, 1.0, sample_rate=100.0)
     assert tr.status_code is Status.INCONSISTENT
     assert "Painlevé" in tr.status and "\n" not in tr.status
-
-
-def test_lyapunov_from_perturbed_trajectories_refuses_rigid_contacts_in_one_line():
-    result = CliRunner().invoke(app, ["lyapunov", "--model", "impact-oscillator", "--method", "finite-difference"])
-    assert result.exit_code == 2, result.output
-    lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 1 and "not available for rigid contacts" in lines[0]
-    assert "Traceback" not in result.output

@@ -128,3 +128,54 @@ def test_continuation_ends_at_the_grazing_of_the_rigid_contact(model, orbit):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if flies(mid) else (mid, hi)
     assert grazing.value == pytest.approx(0.5 * (lo + hi), abs=1e-5)
+
+
+def test_lyapunov_exponents_from_perturbed_trajectories_across_impacts(model, orbit):
+    """Perturbed states stay where the rigid contact lets a motion start (on the surface of the
+    closed contact, above the stop in a flight); on the impacting cycle the largest exponent is 0
+    (a periodic attractor), and the finite-difference spectrum's largest equals the variational
+    one's (the same averaging)."""
+    largest = stickslip.lyapunov_exponent(model, ic=orbit, t_transient=10.0, t_average=100.0, chunk=1.0)
+    assert abs(largest.exponent) < 1e-2
+    kw = dict(ic=orbit, t_transient=10.0, t_average=60.0)
+    fd = np.sort(stickslip.lyapunov_spectrum(model, method="finite-difference", **kw).exponents)[::-1]
+    variational = np.sort(stickslip.lyapunov_spectrum(model, **kw).exponents)[::-1]
+    assert abs(fd[0]) < 1e-2 and (fd[1:] < -10.0).all()
+    assert fd[0] == pytest.approx(variational[0], abs=1e-6)
+
+
+def test_variational_spectrum_on_a_closed_rigid_contact_collapses_the_directions_it_forbids(model):
+    """At V = 1.05 the run lands (plastic) and settles on steady sliding with the contact closed.
+    The off-surface directions (y, y') are no motion: they collapse at the start (large negative
+    exponents) instead of staying frozen at 0; the other two tend to Re λ of the constrained
+    eigenproblem (the hand solution: −(cx + μ'(V) λ_e)/2)."""
+    fast = model.replace(V=1.05)
+    exponents = np.sort(stickslip.lyapunov_spectrum(fast, ic={"x": 1.0, "y": 0.05}, t_transient=100.0,
+                                                    t_average=200.0).exponents)[::-1]
+    k12 = 3.0 * math.cos(math.radians(150.0)) * math.sin(math.radians(150.0))
+    k11 = 1.0 + 3.0 * math.cos(math.radians(150.0)) ** 2
+    mu, dmu = 0.3 + 0.6 * math.exp(-2.1), -1.2 * math.exp(-2.1)
+    lam = 0.3 + k12 * mu * 0.3 / (k11 - mu * k12)
+    re = -(0.05 + dmu * lam) / 2.0
+    assert (exponents[2:] < -1.0).all()
+    np.testing.assert_allclose(exponents[:2], re, atol=2e-3)
+
+
+def test_orbit_command_with_a_rigid_contact(tmp_path):
+    """The command line shoots the impacting cycle from a flight state, and refuses a section
+    crossed with the contact closed in one line."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from stickslip.cli import app
+
+    runner = CliRunner()
+    common = ["orbit", "--model", str(RIGID_SLIDER), "--ic", "x=1,y=0.05", "--search-time", "60", "--no-plot"]
+    result = runner.invoke(app, [*common, "--section", "y_max", "--json", "--out", str(tmp_path / "o.nc")])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output.strip().splitlines()[-1])
+    assert summary["period_s"] == pytest.approx(3.1792661354, rel=1e-8) and summary["open_phases"] == 1
+    refused = runner.invoke(app, [*common, "--section", "x=0.0", "--out", str(tmp_path / "p.nc")])
+    lines = [line for line in refused.output.splitlines() if line.strip()]
+    assert refused.exit_code == 2 and len(lines) == 1, refused.output

@@ -457,17 +457,6 @@ class FrictionModel:
         """Whether some contact is rigid (closes with impacts; its normal force a multiplier)."""
         return any(c.unilateral and c.normal.law == "rigid" for c in self.contacts)
 
-    def refuse_rigid(self, what: str) -> None:
-        """Refuse ``what`` (an analysis that does not take rigid contacts yet) for a model with one.
-
-        Raises
-        ------
-        ModelError
-        """
-        if self.rigid:
-            raise ModelError(f"{what} of model {self.name!r}: not available for rigid contacts (impacts) yet; "
-                             "simulate it (simulate, sweep), or state its contacts with law = \"compliant\"")
-
     @property
     def n(self) -> int:
         """Number of generalised coordinates."""

@@ -3,7 +3,8 @@
 Every model's state is s = [q, q̇] (:attr:`FrictionModel.state_names`: the dofs, then ``d`` + each
 dof); a model frees some of its dofs (:attr:`FrictionModel.free`). Everything the orbit tools need
 to know about that layout — which states are free, the units, the steady-sliding state, the
-projection onto the stick constraint of the contacts at rest — is here.
+projection onto the stick constraint of the contacts at rest, the states a rigid contact lets a
+motion start from — is here.
 """
 
 from __future__ import annotations
@@ -11,11 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.contacts import STICK_SPEED_TOL
+from ..integrate.initial import refused_rigid_starts, rigid_gaps
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from ..stability.equilibrium import steady_sliding
 
-__all__ = ["free_states", "equilibrium_state", "stick_projected", "resting_contacts"]
+__all__ = ["free_states", "equilibrium_state", "stick_projected", "resting_contacts", "rigid_admissible"]
 
 
 def free_states(system) -> np.ndarray:
@@ -50,3 +52,25 @@ def stick_projected(system, s: np.ndarray, cst: np.ndarray | None = None) -> np.
     cst = resting_contacts(system, y) if cst is None else cst
     P.project_velocities(y, cst, np.int64(-1), system.data)
     return y
+
+
+def rigid_admissible(system, s: np.ndarray, sp: np.ndarray) -> np.ndarray:
+    """``sp``, a state near ``s``, where the rigid contacts let a motion start.
+
+    The deviation sp − s is projected (Euclidean) onto W δq = 0, W δq̇ = 0 of the rigid contacts
+    closed at ``s`` (g = 0: a perturbed closed contact stays closed, as the constrained linear
+    flow has it), and mirrored through ``s`` (2s − sp) where it would start inside the stop of one
+    open at ``s``, or at it moving into it (a flight near its landing). Returns a new array (2n,).
+    """
+    n = system.n
+    out = np.array(sp, dtype=float)
+    closed = [np.asarray(system.contacts[c].gap_gradient, dtype=float)
+              for c, g, _, tol in rigid_gaps(system, s) if g[0] <= tol[0]]
+    if closed:
+        W = np.array(closed)
+        for part in (slice(0, n), slice(n, 2 * n)):
+            d = out[part] - s[part]
+            out[part] = s[part] + d - W.T @ np.linalg.lstsq(W @ W.T, W @ d, rcond=None)[0]
+    if refused_rigid_starts(system, out)[0]:
+        out = 2.0 * np.asarray(s, dtype=float) - out
+    return out

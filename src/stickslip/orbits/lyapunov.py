@@ -29,10 +29,12 @@ import numpy as np
 from .._version import __version__
 from ..errors import OrbitError, SimulationError
 from ..integrate.driver import check_samples, round_down, simulate
-from ..integrate.initial import initial_state
+from ..integrate.initial import initial_state, rigid_gaps
+from ..model.bundle import CST
+from ..model.physics import MODE_STICK
 from ..memory import average_bytes, check_memory, format_bytes, largest_count
 from ..model.system_model import FrictionModel
-from .layout import free_states
+from .layout import free_states, resting_contacts
 from .linear_flow import propagate
 from .models import ModelResult, model_attrs, resolve
 from .problem import ShootingProblem, scales, stick_count
@@ -134,13 +136,11 @@ def _check_memory(system, t_transient: float, t_average: float, interval: float,
 
 
 def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average=0.0,
-                     interval=math.inf, option="chunk", variational=False):
+                     interval=math.inf, option="chunk"):
     """The common start of the Lyapunov computations: resolve the start, check the memory of the
     transient and of the running estimates (one per ``interval`` of ``t_average``), run the transient.
 
-    ``ic`` may be a :class:`PeriodicOrbit` (its model is then the default). A model with rigid
-    contacts is refused unless ``variational`` (perturbed trajectories may start inside a closed
-    rigid contact's stop; the variations cross its impacts by their saltation matrices).
+    ``ic`` may be a :class:`PeriodicOrbit` (its model is then the default).
     Returns the flow map as a :class:`.problem.ShootingProblem` without a section (σ: the
     peak-to-peak ranges over the transient's second half) and the exact state at the end of the
     transient.
@@ -149,8 +149,6 @@ def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, s
         system = ic.system if system is None and model is None else system
         ic = ic.state
     system = resolve(system, model, slip_band)
-    if not variational:
-        system.refuse_rigid("Lyapunov exponents from perturbed trajectories (use the variational method)")
     atol = 1e-3 * rtol if atol is None else float(atol)
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
@@ -403,7 +401,7 @@ def lyapunov_spectrum(
         raise OrbitError(f"t_average = {t_average} s must be > 0")
     interval, option = (chunk, "chunk") if method == "finite-difference" else (record, "record")
     problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average,
-                                      interval, option, variational=method == "variational")
+                                      interval, option)
     if method == "finite-difference":
         return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
     if method != "variational":
@@ -412,8 +410,7 @@ def lyapunov_spectrum(
     free, sigma = problem.free, problem.sigma
 
     k = free.size
-    D = np.zeros((2 * problem.system.n, k))
-    D[free, np.arange(k)] = sigma          # columns: σ-scaled unit vectors
+    D = _initial_frame(problem, s_ref)
     log_sum = np.zeros(k)
     times, sums = [0.0], [np.zeros(k)]
 
@@ -432,6 +429,30 @@ def lyapunov_spectrum(
     time = np.array(times[1:])
     return _spectrum(problem, np.array(sums[1:]) / time[:, None], time, t_transient, stick_count(transitions), t_start,
                      dict(perturbation=perturbation, record=record, qr_interval=QR_INTERVAL, method="variational"))
+
+
+#: Step [σ] of the differences that project the initial frame of the variational spectrum.
+FRAME_STEP = 1e-6
+
+
+def _initial_frame(problem, s_ref: np.ndarray) -> np.ndarray:
+    """The variations (2n, 2 n_free) the variational spectrum starts from: σ-scaled unit vectors
+    of the free states; where a contact sticks or a rigid contact is closed at ``s_ref``, projected
+    as perturbed states are (:meth:`.problem.ShootingProblem.perturbed`, by differences of
+    :data:`FRAME_STEP`), so the directions those constraints forbid collapse at once (exponents
+    −∞, large negative numbers from round-off) instead of staying frozen (exponent 0) until an
+    event collapses them."""
+    free, sigma = problem.free, problem.sigma
+    k = free.size
+    D = np.zeros((2 * problem.system.n, k))
+    D[free, np.arange(k)] = sigma
+    system = problem.system
+    stuck = np.any(resting_contacts(system, s_ref)[::CST] == MODE_STICK)
+    closed = system.rigid and any(g[0] <= tol[0] for _, g, _, tol in rigid_gaps(system, s_ref))
+    if stuck or closed:
+        for j in range(k):
+            D[:, j] = (problem.perturbed(s_ref, np.eye(k)[j], FRAME_STEP) - s_ref) / FRAME_STEP
+    return D
 
 
 def _qr(A: np.ndarray):

@@ -38,7 +38,7 @@ from ..model.bundle import CST
 from ..model.physics import MODE_STICK, gap
 from ..model.system_model import FrictionModel
 from . import linear_flow as _lin
-from .layout import free_states, resting_contacts, stick_projected
+from .layout import free_states, resting_contacts, rigid_admissible, stick_projected
 from .models import ModelResult, model_attrs
 from .section import Section, flow, vector_field
 
@@ -399,9 +399,12 @@ class ShootingProblem:
     def perturbed(self, s: np.ndarray, direction: np.ndarray, d: float) -> np.ndarray:
         """``s`` moved by ``d`` along the σ-scaled ``direction`` (2 n_free,); projected onto v_c = 0
         for the contacts at rest in ``s`` (a perturbed stuck state sticks too, so this is the dynamics' own first
-        instant, and the integrator need not resolve a 1e-9 m/s slip against the constraint)."""
+        instant, and the integrator need not resolve a 1e-9 m/s slip against the constraint), and
+        kept where the rigid contacts let a motion start (:func:`.layout.rigid_admissible`)."""
         sp = s.copy()
         sp[self.free] += d * direction * self.sigma
+        if self.system.rigid:
+            sp[:2 * self.system.n] = rigid_admissible(self.system, s[:2 * self.system.n], sp[:2 * self.system.n])
         at_rest = resting_contacts(self.system, s)
         if np.any(at_rest[::CST] == MODE_STICK):
             sp = stick_projected(self.system, sp, at_rest)
