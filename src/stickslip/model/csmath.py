@@ -152,7 +152,7 @@ def zero(x):  # pragma: no cover
     return 0 * x
 
 
-@overload(zero, inline="always", jit_options=KERNEL_OPTIONS)
+@overload(zero, jit_options=KERNEL_OPTIONS)
 def _zero(x):
     if _is_complex(x):
         return lambda x: 0j
