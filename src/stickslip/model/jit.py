@@ -25,8 +25,7 @@ of raising ZeroDivisionError, so divisions carry no zero test and branch to an e
 (speed floors, rank tests), and the integrators check that the state stays finite.
 
 Compile time: numba's inliner copies an inlined callee's scope once per inlined call here, not once
-per block, and numba's compiler flags hash without reading every option (:mod:`.compile_speedups`,
-installed on import: a third of a cold compile). A slice
+per block (:mod:`.inline_copy`, installed on import: a quarter of a cold compile). A slice
 assignment from an array inside compiled code (``a[:n] = b[:n]``) makes
 numba compile its shape-mismatch error message (string formatting, ~10 s of a cold start); use
 element loops. Literal arguments (``f(x, 0)``, ``f(x, True)``) compile a second version of the
@@ -46,9 +45,9 @@ from pathlib import Path
 
 from numba import njit
 
-from . import compile_speedups
+from . import inline_copy
 
-compile_speedups.install()
+inline_copy.install()
 
 
 def _wrap_caching(class_name: str, method: str, make) -> None:

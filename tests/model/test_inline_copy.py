@@ -1,4 +1,4 @@
-"""Exact speed-ups of numba's compiler front end (stickslip.model.compile_speedups)."""
+"""numba's inliner with one scope copy per inlined call (stickslip.model.inline_copy)."""
 
 from __future__ import annotations
 
@@ -10,13 +10,13 @@ from numba.core import inline_closurecall as icc
 from numba.core import ir
 
 import stickslip.model.jit  # noqa: F401  (installs it)
-from stickslip.model import compile_speedups
+from stickslip.model import inline_copy
 
 
 def test_installed_with_the_compiled_layer():
-    assert compile_speedups.installed()
-    assert compile_speedups.install()  # a second install changes nothing
-    assert isinstance(icc.copy, compile_speedups._SharedScopeCopy)
+    assert inline_copy.installed()
+    assert inline_copy.install()  # a second install changes nothing
+    assert isinstance(icc.copy, inline_copy._SharedScopeCopy)
 
 
 def _blocks(n_blocks: int):
@@ -32,11 +32,11 @@ def _blocks(n_blocks: int):
 
 def test_blocks_copied_for_one_inlined_call_share_one_scope_copy():
     scope, blocks = _blocks(3)
-    compile_speedups._state.scopes = {}
+    inline_copy._state.scopes = {}
     try:
         copies = [icc.copy.deepcopy(b) for b in blocks]
     finally:
-        compile_speedups._state.scopes = None
+        inline_copy._state.scopes = None
     assert copies[0].scope is copies[1].scope is copies[2].scope
     assert copies[0].scope is not scope and copies[0].scope == scope
     assert copies[2].body[0].target.scope is copies[0].scope
@@ -70,15 +70,3 @@ def test_inlined_kernels_compute_what_python_computes():
     a = np.linspace(-2.0, 2.0, 41)
     expected = np.array([_clipped.py_func(x, -1.0, 1.0) + _clipped.py_func(2.0 * x, -0.5, 0.5) for x in a])
     np.testing.assert_array_equal(_uses_inlined(a), expected)
-
-
-def test_flags_hash_is_numbas_own_number():
-    """numba's TargetConfig hashed the sorted keys of its values dict: the same number, once per class."""
-    from numba.core.compiler import Flags
-
-    flags = Flags()
-    flags.nrt = True
-    other = Flags()
-    assert hash(flags) == hash(tuple(sorted({k: getattr(flags, k) for k in flags.options})))
-    assert hash(flags) == hash(other) and flags != other  # equal hashes, values still compared
-    assert {flags: 1}.get(Flags(flags)) == 1
