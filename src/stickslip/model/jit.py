@@ -24,9 +24,7 @@ of raising ZeroDivisionError, so divisions carry no zero test and branch to an e
 (measured −2 % per fixed-step run). Every kernel guards its divisions where zero can occur
 (speed floors, rank tests), and the integrators check that the state stays finite.
 
-Compile time: numba's inliner copies an inlined callee's scope once per inlined call here, not once
-per block (:mod:`.inline_copy`, installed on import: a quarter of a cold compile). A slice
-assignment from an array inside compiled code (``a[:n] = b[:n]``) makes
+Compile time: a slice assignment from an array inside compiled code (``a[:n] = b[:n]``) makes
 numba compile its shape-mismatch error message (string formatting, ~10 s of a cold start); use
 element loops. Literal arguments (``f(x, 0)``, ``f(x, True)``) compile a second version of the
 callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a variable.
@@ -44,10 +42,6 @@ import warnings
 from pathlib import Path
 
 from numba import njit
-
-from . import inline_copy
-
-inline_copy.install()
 
 
 def _wrap_caching(class_name: str, method: str, make) -> None:
