@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import time
 
 import pytest
@@ -72,6 +73,49 @@ def test_workers_end_after_the_parent_is_killed(executor, tmp_path):
         print(f"{executor}: {len(children)} worker processes gone {time.monotonic() - t:.2f} s after kill -9")
     finally:  # never leave processes of this test behind, whatever failed
         for pid in _alive([proc.pid] + children):
+            os.kill(pid, signal.SIGKILL)
+
+
+#: A dask LocalCluster whose one worker holds the GIL in one long C call (as a compiled kernel does),
+#: after writing its pid to the file named by argv[1].
+_GIL_HOLDING_CLUSTER = """
+import os, sys
+from distributed import Client
+from stickslip.parallel import local_cluster
+
+def hold_the_gil(path):
+    with open(path + ".tmp", "w") as f:
+        f.write(str(os.getpid()))
+    os.replace(path + ".tmp", path)
+    exponent = 60_000_000
+    return pow(3, exponent).bit_length()  # one C call of ~30 s that never releases the GIL
+
+if __name__ == "__main__":
+    client = Client(local_cluster(1))
+    client.submit(hold_the_gil, sys.argv[1]).result()
+"""
+
+
+def test_a_dask_worker_inside_a_long_call_ends_with_its_killed_parent(tmp_path):
+    """dask's own watch (a thread reading a pipe to the parent) needs the GIL; the worker must end
+    without it, as the kernel ends it (PR_SET_PDEATHSIG) where it can."""
+    if not sys.platform.startswith("linux"):
+        pytest.skip("the parent's death signal is Linux's")
+    script = tmp_path / "cluster.py"
+    script.write_text(_GIL_HOLDING_CLUSTER)
+    marker = tmp_path / "worker.pid"
+    with open(tmp_path / "log", "w") as log:
+        proc = subprocess.Popen([sys.executable, str(script), str(marker)], stdout=log, stderr=log)
+    worker = None
+    try:
+        assert wait_for(marker.exists, 120), (tmp_path / "log").read_text()
+        worker = int(marker.read_text())
+        time.sleep(0.5)  # inside the long call
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        assert wait_for(lambda: not _alive([worker]), 5.0), "the worker outlived its parent's kill -9 by 5 s"
+    finally:
+        for pid in _alive([proc.pid] + ([worker] if worker else [])):
             os.kill(pid, signal.SIGKILL)
 
 

@@ -24,7 +24,10 @@ of raising ZeroDivisionError, so divisions carry no zero test and branch to an e
 (measured −2 % per fixed-step run). Every kernel guards its divisions where zero can occur
 (speed floors, rank tests), and the integrators check that the state stays finite.
 
-Compile time: a slice assignment from an array inside compiled code (``a[:n] = b[:n]``) makes
+Compile time: numba's inliner copies an inlined callee's scope once per inlined call here, not once
+per block, and numba's compiler flags hash without reading every option (:mod:`.compile_speedups`,
+installed on import: a third of a cold compile). A slice
+assignment from an array inside compiled code (``a[:n] = b[:n]``) makes
 numba compile its shape-mismatch error message (string formatting, ~10 s of a cold start); use
 element loops. Literal arguments (``f(x, 0)``, ``f(x, True)``) compile a second version of the
 callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a variable.
@@ -42,6 +45,10 @@ import warnings
 from pathlib import Path
 
 from numba import njit
+
+from . import compile_speedups
+
+compile_speedups.install()
 
 
 def _wrap_caching(class_name: str, method: str, make) -> None:

@@ -1,0 +1,84 @@
+"""Exact speed-ups of numba's compiler front end (stickslip.model.compile_speedups)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+from numba import njit
+from numba.core import inline_closurecall as icc
+from numba.core import ir
+
+import stickslip.model.jit  # noqa: F401  (installs it)
+from stickslip.model import compile_speedups
+
+
+def test_installed_with_the_compiled_layer():
+    assert compile_speedups.installed()
+    assert compile_speedups.install()  # a second install changes nothing
+    assert isinstance(icc.copy, compile_speedups._SharedScopeCopy)
+
+
+def _blocks(n_blocks: int):
+    scope = ir.Scope(None, ir.Loc("f", 1))
+    blocks = []
+    for b in range(n_blocks):
+        block = ir.Block(scope, ir.Loc("f", b))
+        var = scope.redefine(f"v{b}", ir.Loc("f", b))
+        block.append(ir.Assign(ir.Const(b, ir.Loc("f", b)), var, ir.Loc("f", b)))
+        blocks.append(block)
+    return scope, blocks
+
+
+def test_blocks_copied_for_one_inlined_call_share_one_scope_copy():
+    scope, blocks = _blocks(3)
+    compile_speedups._state.scopes = {}
+    try:
+        copies = [icc.copy.deepcopy(b) for b in blocks]
+    finally:
+        compile_speedups._state.scopes = None
+    assert copies[0].scope is copies[1].scope is copies[2].scope
+    assert copies[0].scope is not scope and copies[0].scope == scope
+    assert copies[2].body[0].target.scope is copies[0].scope
+    # outside an inlined call: numba's per-block copies, as before
+    plain = [icc.copy.deepcopy(b) for b in blocks]
+    assert plain[0].scope is not plain[1].scope
+    assert icc.copy.copy is copy.copy
+
+
+@njit(inline="always")
+def _clipped(x, lo, hi):
+    if x < lo:
+        return lo
+    if x > hi:
+        return hi
+    total = 0.0
+    for i in range(3):
+        total += x * i
+    return total
+
+
+@njit
+def _uses_inlined(a):
+    out = np.empty(a.size)
+    for i in range(a.size):
+        out[i] = _clipped(a[i], -1.0, 1.0) + _clipped(2.0 * a[i], -0.5, 0.5)
+    return out
+
+
+def test_inlined_kernels_compute_what_python_computes():
+    a = np.linspace(-2.0, 2.0, 41)
+    expected = np.array([_clipped.py_func(x, -1.0, 1.0) + _clipped.py_func(2.0 * x, -0.5, 0.5) for x in a])
+    np.testing.assert_array_equal(_uses_inlined(a), expected)
+
+
+def test_flags_hash_is_numbas_own_number():
+    """numba's TargetConfig hashed the sorted keys of its values dict: the same number, once per class."""
+    from numba.core.compiler import Flags
+
+    flags = Flags()
+    flags.nrt = True
+    other = Flags()
+    assert hash(flags) == hash(tuple(sorted({k: getattr(flags, k) for k in flags.options})))
+    assert hash(flags) == hash(other) and flags != other  # equal hashes, values still compared
+    assert {flags: 1}.get(Flags(flags)) == 1
