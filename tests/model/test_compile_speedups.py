@@ -82,3 +82,20 @@ def test_flags_hash_is_numbas_own_number():
     assert hash(flags) == hash(tuple(sorted({k: getattr(flags, k) for k in flags.options})))
     assert hash(flags) == hash(other) and flags != other  # equal hashes, values still compared
     assert {flags: 1}.get(Flags(flags)) == 1
+
+
+def test_flags_equality_is_numbas():
+    """Equal where every option's value is equal, set or defaulted (numba's own comparison)."""
+    from numba.core.compiler import Flags
+
+    a, b = Flags(), Flags()
+    assert a == a and a == b
+    a.nrt = True
+    assert a != b
+    b.nrt = True
+    assert a == b
+    c = Flags()
+    c.boundscheck = Flags.options["boundscheck"].default  # set to its default: equal to unset
+    assert c == Flags() and Flags() == c
+    c.boundscheck = not Flags.options["boundscheck"].default if Flags.options["boundscheck"].default is not None else True
+    assert c != Flags()

@@ -331,7 +331,7 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
 
         # ---- sticking contacts: breakaway inside the step cuts it at the root
         theta_b = -1.0
-        c_b = -1
+        c_b = np.int64(-1)  # not a literal: numba would type the call below for it first
         if any_stick:
             if not q_ready:
                 DP.dense_coefficients(Kst, Q)

@@ -131,7 +131,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     a, b, x = work_vectors(md.kin, 3, s)
     V = work_matrix(md.kin, ROWS, ROWS, s)
     apply_inverse_mass(m, n, diagonal, f, a)
-    k = 0
+    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
             for i in range(contact_dim(md.kin, m, n, c)):
@@ -220,7 +220,7 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     return a00, a01, a11
 
 
-@inlined_kernel
+@kernel
 def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     """Stick multipliers of the sticking contacts and contact ``extra`` (F written for those), by
     :func:`small_stick_system` when there are at most two rows, else :func:`stick_system`. Returns

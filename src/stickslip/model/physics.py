@@ -104,7 +104,7 @@ def general_rhs(s, cst, md, ds):
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
     write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
 
 
@@ -369,7 +369,7 @@ def project_velocities(s, cst, extra, md):
     A = work_matrix(md.kin, ROWS, ROWS, s)
     V = work_matrix(md.kin, ROWS, ROWS, s)
     w, b, x = work_vectors(md.kin, 3, s)
-    k = 0
+    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
             G2 = G[2 * c:2 * c + 2]
