@@ -297,10 +297,10 @@ _wrap_caching("Cache", "_index_key", _key_by_user_code)
 
 #: Options of every compiled kernel, also given to the overloads whose implementations numba
 #: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
-KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy"}
+KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy", "no_cfunc_wrapper": True}
 
-kernel = njit(cache=True, _nrt=False, error_model="numpy")
-inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy")
-loop = njit(cache=True, error_model="numpy")
+kernel = njit(cache=True, _nrt=False, error_model="numpy", no_cfunc_wrapper=True)
+inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy", no_cfunc_wrapper=True)
+loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 
 __all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "track_user_code"]
