@@ -134,7 +134,7 @@ def mode_flags(cst, nc):
     return flags
 
 
-@kernel
+@inlined_kernel
 def event_value(kind, c, y, e0x, e0y, cst, md, F, N):
     """Event function of ``kind`` for contact ``c`` at state ``y`` (module docstring).
 
@@ -445,7 +445,7 @@ def close_contact(y, cst, c, md, rtol, atol, F, N):
     return False
 
 
-@kernel
+@inlined_kernel
 def initial_modes(y, cst, md, rtol, atol, F, N):
     """Modes a state starts in: each contact sticks if its v = 0 (to STICK_SPEED_TOL) and the joint
     stick force is admissible; the others slip (the exact direction when sliding, the

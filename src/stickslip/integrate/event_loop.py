@@ -32,7 +32,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
-from ..model.jit import inlined_kernel, kernel, loop
+from ..model.jit import inlined_kernel, kernel
 from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
 from . import contacts as E
@@ -135,12 +135,17 @@ def cut_step(theta, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out
     return idx, tau_cut
 
 
-@loop
 def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps,
-                    sample_times, idx0, out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0):
+                    sample_times, idx0, out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0,
+                    start_modes=False):
     """Integrate from ``y0`` at local time 0 (absolute ``t_base``) towards ``tau_end``: allocates the
-    work arrays and runs :func:`event_loop` (see there for arguments and results)."""
-    n, nc, diagonal = model_sizes(md.kin, md.m)
+    work arrays and runs :func:`event_loop` (see there for arguments and results).
+
+    Plain Python: a compiled wrapper would link the whole loop, physics included, into a module of
+    its own and have LLVM optimise and emit all of it a second time on a cold start (2.5 s of a
+    model file's first ``simulate``); a call from Python costs microseconds per chunk.
+    """
+    nc = out_F.shape[1] // 2
     ns = y0.shape[0]
     y = y0.copy()
     work = np.empty((5, ns))
@@ -153,15 +158,16 @@ def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, 
     homing = np.zeros(nc, dtype=np.int64)
     stats = np.zeros(6, dtype=np.int64)
     status, tau, h, idx, n_tr, lost = event_loop(
-        y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps, sample_times, idx0, out_s,
-        out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0, work, Kst, Q, F, N, vv, va, homing, stats)
+        y, cst, float(t_base), float(tau_stop), float(tau_end), md, float(rtol), float(atol), float(h_init),
+        float(h_max), int(max_steps), sample_times, int(idx0), out_s, out_mode, out_F, tr_t, tr_kind, tr_contact,
+        tr_s, int(n_tr0), work, Kst, Q, F, N, vv, va, homing, stats, bool(start_modes))
     return status, tau, y, h, idx, n_tr, stats, lost
 
 
 @kernel
 def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps, sample_times, idx0,
                out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0, work5, Kst, Q, F, N, vv, va2, homing,
-               stats):
+               stats, start_modes):
     """The loop of :func:`integrate_event` (module docstring), free of reference counting.
 
     ``y`` (2n + 2,) is advanced in place from local time 0 (absolute ``t_base``) towards
@@ -170,7 +176,10 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
     ``out_F`` at the absolute ``sample_times``; transitions from number ``n_tr0`` to the ``tr_*``
     buffers as far as they have room. ``work5`` … ``homing`` are work arrays; ``stats`` (6,)
     receives accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
-    slip → stick and stick → slip transitions.
+    slip → stick and stick → slip transitions. With ``start_modes``, ``cst`` is first set to the modes
+    that ``y`` starts in (:func:`~stickslip.integrate.contacts.initial_modes`, which may project
+    ``y``): the first call of a run, made with ``tau_end = 0``, does only that (one compiled
+    module instead of two, on a cold start).
 
     Returns
     -------
@@ -199,6 +208,8 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
     n_tr = n_tr0
     band = m[H_BAND]
 
+    if start_modes:
+        E.initial_modes(y, cst, md, rtol, atol, F, N)
     P.rhs(y, cst, md, k1)
     stats[2] += 1
     tau = 0.0

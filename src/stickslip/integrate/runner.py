@@ -264,19 +264,17 @@ class EventStepper:
         self.open_contact = int(E.contact_lost(self.y, md))
         if self.open_contact < 0:
             self._warm_up(system)
-            F = np.empty(2 * system.n_contacts)
-            N = np.empty(system.n_contacts)
-            E.initial_modes(self.y, self.cst, md, rtol, atol, F, N)
         prepared = time.perf_counter() - start
         self.prepare_s = prepared if prepared > COMPILE_REPORT_S else 0.0
 
     def _warm_up(self, system: FrictionModel) -> None:
-        """Compile (or load from cache) the event loop for this kinematics class on a 1 µs run."""
-        st = np.array([0.0])
+        """Compile (or load from cache) the event loop for this kinematics class and set the modes
+        the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇)."""
         tr = transition_room(0.0, self.ns, 1)
-        integrate_event(self.y.copy(), contact_state(self.md.m), 0.0, 1e-6, 1e-6, self.md, self.rtol, self.atol, 1e-7,
-                        1e-6, 10, st, 0, np.empty((1, self.ns)), np.empty(1, dtype=np.int8),
-                        np.empty((1, 2 * system.n_contacts)), tr[0], tr[1], tr[2], tr[3], 0)
+        y = integrate_event(self.y, self.cst, 0.0, 0.0, 0.0, self.md, self.rtol, self.atol, 1e-7, 1e-6, 10,
+                            np.empty(0), 0, np.empty((1, self.ns)), np.empty(1, dtype=np.int8),
+                            np.empty((1, 2 * system.n_contacts)), tr[0], tr[1], tr[2], tr[3], 0, start_modes=True)[2]
+        self.y = y
 
     def advance(self, tau_stop: float, record: Record) -> Chunk:
         """Integrate about ``tau_stop`` seconds more (to the first accepted step past it outside an

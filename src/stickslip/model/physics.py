@@ -199,7 +199,7 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
     return k
 
 
-@kernel
+@inlined_kernel
 def stick_margin(s, cst, c, md):
     """μs N_c − |F_c| [N] of sticking contact ``c`` at ``s``: the stick → slip event (paper Eq. 10),
     with the multipliers of all sticking contacts solved together."""
@@ -342,7 +342,7 @@ def band_direction(s, cst, c, md, speed):
     return quasi_static_direction(a00, a01, a11, F[2 * c], F[2 * c + 1], muN, ex, ey)
 
 
-@kernel
+@inlined_kernel
 def slip_direction(s, cst, c, md, v0, v1):
     """Unit slip direction (e0, e1) of slipping contact ``c`` with slip velocity (v0, v1) at ``s``:
     v/|v| above the low-speed band, inside it :func:`band_direction`."""
