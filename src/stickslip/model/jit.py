@@ -41,10 +41,14 @@ import io
 import pickle
 import re
 import sys
+import threading
 import warnings
 from pathlib import Path
 
+from numba import config as numba_config
 from numba import njit
+from numba.core import sigutils
+from numba.core.registry import CPUDispatcher
 
 from . import compile_speedups
 
@@ -282,9 +286,12 @@ def _user_code_in(types, seen=None) -> list:
 
 def _key_by_user_code(index_key):
     """Make numba's index key of a cached kernel hold the digests of the user code its signature
-    refers to (:func:`track_user_code`); a signature without such classes keeps numba's own key."""
+    refers to (:func:`track_user_code`), and whether it was compiled without its Python entry
+    (:class:`KernelDispatcher`); a kernel with neither keeps numba's own key."""
     def _index_key(self, sig, codegen):
         key = index_key(self, sig, codegen)
+        if getattr(_ENTRY, "without", False):
+            key = (*key, "without a Python entry")
         if not _USER_CODE:
             return key
         user = _user_code_in(tuple(sig) if isinstance(sig, tuple) else getattr(sig, "args", ()))
@@ -295,12 +302,92 @@ def _key_by_user_code(index_key):
 
 _wrap_caching("Cache", "_index_key", _key_by_user_code)
 
+#: Whether the compilation under way on this thread makes a kernel without its Python entry.
+_ENTRY = threading.local()
+
+
+class KernelDispatcher(CPUDispatcher):
+    """numba's dispatcher for a :func:`kernel`, whose Python entry is compiled only for Python.
+
+    numba compiles every jitted function with a CPython wrapper, the code that unboxes Python
+    arguments and boxes the result (for a kernel with a dozen array and record arguments about
+    45 ms of a cold start each, half of what a small kernel costs), although most kernels are only
+    called by other kernels, which call the function itself. A kernel here is compiled for
+    another kernel's call without the wrapper; a call from Python compiles (or loads) the
+    signature with it, once, and from then on kernels and Python share that version. A version
+    without the wrapper is never entered from Python: numba's C dispatcher only calls the versions
+    this class inserts into its table, those with the wrapper. The on-disk cache keeps the two
+    apart (:func:`_key_by_user_code`).
+    """
+
+    def _compile_for_args(self, *args, **kws):  # numba's path for a call from Python
+        self._python_entry = True
+        try:
+            return super()._compile_for_args(*args, **kws)
+        finally:
+            self._python_entry = False
+
+    def compile(self, sig):
+        wanted = getattr(self, "_python_entry", False)
+        self._python_entry = False  # the kernels compiled inside this one are called by kernels
+        args = tuple(sigutils.normalize_signature(sig)[0])
+        existing = self.overloads.get(args)
+        if wanted and existing is not None and args not in self._with_entry:
+            del self.overloads[args]  # compile it again, now with the Python entry
+        outer = getattr(_ENTRY, "without", False)
+        self._compiler.targetoptions = self._options_without_entry if not wanted else self.targetoptions
+        _ENTRY.without = not wanted
+        try:
+            return super().compile(sig)
+        except BaseException:
+            if args not in self.overloads and existing is not None:
+                self.overloads[args] = existing
+            raise
+        finally:
+            _ENTRY.without = outer
+            self._compiler.targetoptions = self.targetoptions
+
+    def add_overload(self, cres):
+        args = tuple(cres.signature.args)
+        if getattr(_ENTRY, "without", False):
+            self.overloads[args] = cres  # for kernels only: not in the table that Python calls go through
+            return
+        self._with_entry.add(args)
+        super().add_overload(cres)
+
+    @property
+    def _with_entry(self) -> set:
+        try:
+            return self.__dict__["_with_entry_args"]
+        except KeyError:
+            return self.__dict__.setdefault("_with_entry_args", set())
+
+    @property
+    def _options_without_entry(self) -> dict:
+        return {**self.targetoptions, "no_cpython_wrapper": True}
+
+
+def _kernel_decorator(**options):
+    """A decorator like ``njit(cache=True, **options)`` that makes a :class:`KernelDispatcher`."""
+    targetoptions = {"nopython": True, "boundscheck": None, **options}
+
+    def decorate(func):
+        if numba_config.DISABLE_JIT:
+            return func
+        dispatcher = KernelDispatcher(py_func=func, locals={}, targetoptions=dict(targetoptions))
+        dispatcher.enable_caching()
+        return dispatcher
+
+    return decorate
+
+
 #: Options of every compiled kernel, also given to the overloads whose implementations numba
 #: compiles itself (otherwise those get the NRT's reference counting and Python's error model).
+#: No kernel is called through a C function pointer, so none needs numba's C-callable wrapper.
 KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy", "no_cfunc_wrapper": True}
 
-kernel = njit(cache=True, _nrt=False, error_model="numpy", no_cfunc_wrapper=True)
-inlined_kernel = njit(cache=True, _nrt=False, inline="always", error_model="numpy", no_cfunc_wrapper=True)
+kernel = _kernel_decorator(**KERNEL_OPTIONS)
+inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 
-__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "track_user_code"]
+__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code"]
