@@ -24,13 +24,23 @@ of raising ZeroDivisionError, so divisions carry no zero test and branch to an e
 (measured −2 % per fixed-step run). Every kernel guards its divisions where zero can occur
 (speed floors, rank tests), and the integrators check that the state stays finite.
 
-Compile time: numba's inliner copies an inlined callee's scope once per inlined call here, not once
-per block, and numba's compiler flags hash without reading every option (:mod:`.compile_speedups`,
-installed on import: a third of a cold compile). A slice
-assignment from an array inside compiled code (``a[:n] = b[:n]``) makes
-numba compile its shape-mismatch error message (string formatting, ~10 s of a cold start); use
-element loops. Literal arguments (``f(x, 0)``, ``f(x, True)``) compile a second version of the
-callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a variable.
+Compile time (a cold start compiles every kernel a command needs; on two cores that was a
+minute): numba gives each kernel that is not inlined a module of its own, into which it links
+the code of every kernel it calls, and LLVM optimises and emits all of that code again there.
+A thin kernel over a large one therefore costs the large one's optimisation once more: such
+kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
+``contacts.event_value``, ``initial_modes``, ``transitions.settle``), a compiled wrapper that
+only allocates is Python instead (``event_loop.integrate_event``), and the stick solve
+(``forces.solve_stick_rows``) is one kernel called from five places rather than inlined into
+each. A kernel gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`),
+and no kernel a C-callable wrapper. numba's inliner copies an inlined callee's scope once per
+inlined call here, not once per block, and numba's compiler flags hash and compare without
+reading every option (:mod:`.compile_speedups`, installed on import). A slice assignment from an
+array inside compiled code (``a[:n] = b[:n]``) makes numba compile its shape-mismatch error
+message (string formatting, ~10 s of a cold start); use element loops. Literal arguments
+(``f(x, 0)``, ``f(x, True)``) compile a second version of the callee for the literal type; pass
+``np.int64(0)`` / ``np.bool_(True)`` or a variable, and start a counter that is passed to a
+kernel as ``np.int64(0)`` (numba types the call for the literal first).
 """
 
 from __future__ import annotations
@@ -157,12 +167,19 @@ def _tolerant_cache_saving(save):
     """Let a kernel run when its cache file cannot be written (a full disk, a file-size limit, a
     read-only folder): numba raises the OSError from inside the compilation, after the kernel is
     compiled. The kernel is used uncached instead, with one warning; it is compiled again in the
-    next process."""
+    next process. Likewise, silently, when numba holds no object code to save (a Ctrl-C landed in
+    LLVM's callback that hands it over: the interrupt follows at once)."""
     warned = []
 
     def save_overload(self, sig, data):
         try:
             return save(self, sig, data)
+        except RuntimeError as exc:
+            # LLVM hands the emitted object code to numba in a callback; a Ctrl-C inside that
+            # callback is reported as unraisable (and delivered again by stickslip._startup), and
+            # numba then has nothing to save. The kernel runs; it is compiled again next time.
+            if "no compiled object" not in str(exc):
+                raise
         except OSError as exc:
             if not warned:  # once per process: every kernel after it fails alike
                 warned.append(exc)

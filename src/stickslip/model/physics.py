@@ -47,7 +47,7 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, H_BAND, offsets
-from .forces import (add_contact_force, general_forces, general_forces_body, quasi_static_direction, sliding_forces,
+from .forces import (add_contact_force, general_forces, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel
