@@ -156,18 +156,18 @@ def worker_pool(workers: int, warm: Callable[[], object] | None = None) -> Proce
 DROPPED_NANNY_ENVIRON = ("MALLOC_TRIM_THRESHOLD_",)
 
 
-#: The environment variable that tells a LocalCluster worker the pid of the process whose cluster it
-#: serves (:func:`dask_setup`).
-CLUSTER_PARENT_ENV = "STICKSLIP_CLUSTER_PARENT"
+#: The pid of the process that started this process's LocalCluster: set before the cluster forks
+#: its workers, which inherit it (:func:`dask_setup`). Not an environment variable: dask's nanny
+#: copies those into its own process too, and its subprocesses would inherit a stale pid.
+_cluster_parent: int | None = None
 
 
 def dask_setup(worker=None) -> None:
     """dask's worker preload hook (this module is named in ``distributed.worker.preload`` by
     :func:`local_cluster`): the worker watches the process that started the cluster
-    (:func:`watch_parent`), so that it ends when that process does, even after ``kill -9``."""
-    parent = os.environ.get(CLUSTER_PARENT_ENV)
-    if parent is not None:
-        watch_parent(int(parent))
+    (:func:`watch_parent`), so that it ends when that process does, even after ``kill -9``.
+    A worker that was spawned rather than forked watches its parent process."""
+    watch_parent(_cluster_parent)
 
 
 def local_cluster(workers: int):
@@ -180,13 +180,14 @@ def local_cluster(workers: int):
     worker warm-up 0.44 s forked, 0.87 s and 0.7–1.1 s spawned (dask's default), which on the
     10 s Fig. 12(a) benchmark is the difference between 1.35× and ≥ 1.6× the serial speed.
     """
+    global _cluster_parent
     import dask  # dask is imported only by campaigns that use it (~1 s of imports)
     from distributed import LocalCluster
 
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {})
     for name in DROPPED_NANNY_ENVIRON:
         environ.pop(name, None)
-    environ[CLUSTER_PARENT_ENV] = str(os.getpid())
+    _cluster_parent = os.getpid()
     preload = list(dask.config.get("distributed.worker.preload", default=[]) or [])
     config = {"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.preload": [*preload, __name__]}
     if "fork" in multiprocessing.get_all_start_methods():

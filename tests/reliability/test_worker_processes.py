@@ -121,6 +121,8 @@ def test_a_dask_worker_inside_a_long_call_ends_with_its_killed_parent(tmp_path):
 
 def test_unreachable_scheduler_is_one_line(tmp_path):
     import dask
+    import distributed  # noqa: F401  (its defaults join dask's config now, not inside the block below,
+    # whose exit would take them out again for every later test of this process)
 
     with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
         res = CliRunner().invoke(app, ["sweep", "--grid", "N=30,50", "--t-end", "1", "--no-plot", "--no-progress",
