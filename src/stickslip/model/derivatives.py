@@ -15,7 +15,7 @@ in stick, which is what stability and the variational equations of orbits need.
 
 from __future__ import annotations
 
-from .jit import kernel
+from .jit import inlined_kernel, kernel
 from .kinematics import model_sizes
 from .physics import COMPLEX_STEP, rhs
 
@@ -41,7 +41,7 @@ def state_jacobian(s, cst, md, J, z, dz):
         z[j] = s[j]
 
 
-@kernel
+@inlined_kernel
 def acceleration_jacobian(q, cst, md, Jqq, acc, z, dz):
     """∂q̈/∂q (n × n) at rest (q̇ = 0) into ``Jqq`` and the accelerations q̈ (n,) there into ``acc``.
 

@@ -23,7 +23,7 @@ from numba.extending import overload
 
 from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
 from ..model.derivatives import acceleration_jacobian, state_jacobian
-from ..model.jit import KERNEL_OPTIONS, kernel, loop
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, loop
 from ..model.kinematics import model_sizes
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
@@ -90,7 +90,7 @@ def _sliding_modes(cst, nc):
         cst[c * CST + 3] = np.inf
 
 
-@kernel
+@inlined_kernel
 def _residual(q, cst, md, free, s, ds, Q):
     """Forces Q = M q̈ at rest (free DOFs) into ``Q``; returns max|Q| / max(|K q|, |f0|, |Σ Gᵀ F|)."""
     m = md.m
