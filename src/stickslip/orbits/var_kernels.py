@@ -28,7 +28,7 @@ from ..integrate import dormand_prince as DP
 from ..model import csmath as csm
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
-from ..model.jit import kernel, loop
+from ..model.jit import inlined_kernel, kernel, loop
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, work_matrix, work_vectors
 
@@ -104,7 +104,7 @@ def direction_residual(s, cst, c, md, ct, st):
     return g, dg, muN, k
 
 
-@kernel
+@inlined_kernel
 def band_correction(s, cst, md, n2, Phi, out, z, gq):
     """Add to ``out`` (2n × k) the turn of the quasi-static direction of every 2-D contact inside the
     low-speed band along the variations ``Phi`` (2n × k): out += [0; M⁻¹ G_cᵀ ∂F_c/∂θ] (∇θ · Φ), with
