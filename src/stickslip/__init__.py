@@ -80,6 +80,18 @@ from .integrate.driver import simulate  # noqa: E402
 from .integrate.result import Trajectory, load_trajectory  # noqa: E402
 from .model.parameters import Parameters  # noqa: E402
 from .model.variants import DOF_NAMES, MODELS, STATE_NAMES  # noqa: E402
+from .results import Plottable  # noqa: E402
+
+
+def _draw(result, **kwargs):
+    """A result's figure (:meth:`stickslip.results.Plottable.plot`): the plot layer, and matplotlib
+    with it, is imported only when a figure is asked for."""
+    from .plot import figure
+
+    return figure(result, **kwargs)
+
+
+Plottable.draw = staticmethod(_draw)
 
 _startup.release()  # a Ctrl-C held during the import is raised here
 

@@ -3,9 +3,9 @@
 Results (:class:`~stickslip.integrate.result.Trajectory`,
 :class:`~stickslip.stability.maps.StabilityMap`, :class:`~stickslip.sweep.bistability.RegionMap`)
 hold data and write themselves to NetCDF; figures are drawn by :mod:`stickslip.plot`, the top
-layer, which takes results and never computes physics. This module's one import of
-:mod:`stickslip.plot` is the package's one import that runs up the layers (docs/architecture.md):
-it happens when a figure is asked for, so matplotlib is loaded only then.
+layer, which takes results and never computes physics. This module does not import it: the
+package (``stickslip/__init__.py``, above every layer) hands :class:`Plottable` the plot layer's
+figure function when it is imported, which is before any result exists (docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -25,9 +25,10 @@ class Plottable:
     #: Name of the figure function of this result type in :data:`stickslip.plot.FIGURES`.
     FIGURE: ClassVar[str] = ""
 
+    #: ``draw(result, **kwargs) -> figure``: :func:`stickslip.plot.figure`, set by the package.
+    draw: ClassVar = None
+
     def plot(self, **kwargs):
         """The result's figure (keyword arguments go to its figure function in
         :data:`stickslip.plot.FIGURES`). Returns the matplotlib figure."""
-        from .plot import figure  # the one upward import: results hand their figure to the plot layer
-
-        return figure(self, **kwargs)
+        return Plottable.draw(self, **kwargs)
