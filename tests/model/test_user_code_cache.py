@@ -1,6 +1,7 @@
 """Cached kernels of a model whose frame (or friction law) is the user's own code follow that code:
-numba keys a cached kernel by the kernel's file and signature only, and the package's kernels
-inline the user's frame, so an edited frame used to load the kernel compiled with the old one."""
+numba keys a cached kernel by the kernel's file and signature only, and with ``inline=True`` the
+package's kernels inline the user's frame, so an edited frame used to load the kernel compiled
+with the old one. (A frame compiled apart: ``test_frame_pointers.py``.)"""
 
 import importlib
 import json
@@ -38,7 +39,7 @@ def arm_frame(kin, s, c, m, G, w):
     return FACTOR * m[contact_offsets(1, c)[0] + C_N0] + csm.zero(s[0])
 
 
-register_kinematics(ArmKin, arm_frame, ndof=1, ncontacts=1, dim=1)
+register_kinematics(ArmKin, arm_frame, ndof=1, ncontacts=1, dim=1, inline={inline})
 """
 
 
@@ -56,14 +57,14 @@ def _code_part(kin):
 def test_the_index_key_follows_the_users_module(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(str(tmp_path))
     path = tmp_path / "user_arm_kinematics.py"
-    path.write_text(MODULE.format(factor=1.0))
+    path.write_text(MODULE.format(factor=1.0, inline=True))
     module = importlib.import_module("user_arm_kinematics")
     first = _code_part(module.ArmKin(1.0, 0.1))
     assert _code_part(module.ArmKin(2.0, 0.3)) == first  # numbers are data: the same kernels
-    path.write_text(MODULE.format(factor=2.0))
+    path.write_text(MODULE.format(factor=2.0, inline=True))
     module = importlib.reload(module)  # registers the edited frame for the new class
     assert _code_part(module.ArmKin(1.0, 0.1)) != first
-    path.write_text(MODULE.format(factor=1.0))
+    path.write_text(MODULE.format(factor=1.0, inline=True))
     module = importlib.reload(module)
     assert _code_part(module.ArmKin(1.0, 0.1)) == first  # back to the first code: its kernels again
 
@@ -79,7 +80,7 @@ def test_a_signature_without_user_code_keeps_numbas_key():
 def test_an_edited_frame_recompiles_its_kernels_and_gives_the_new_result(tmp_path):
     """Three processes on one cache: the frame as written, edited (the normal force doubled), and
     the edited one again. Against numba's compile events and the results."""
-    (tmp_path / "user_arm_kinematics.py").write_text(MODULE.format(factor=1.0))
+    (tmp_path / "user_arm_kinematics.py").write_text(MODULE.format(factor=1.0, inline=True))
     code = ("import json, sys\n"
             f"sys.path.insert(0, {str(tmp_path)!r})\n"
             "from numba.core import event\n"
@@ -105,7 +106,7 @@ def test_an_edited_frame_recompiles_its_kernels_and_gives_the_new_result(tmp_pat
         return json.loads(res.stdout.strip().splitlines()[-1])
 
     first = run()
-    (tmp_path / "user_arm_kinematics.py").write_text(MODULE.format(factor=2.0))
+    (tmp_path / "user_arm_kinematics.py").write_text(MODULE.format(factor=2.0, inline=True))
     edited = run()
     again = run()
     assert first["compiles"] > 0 and edited["compiles"] > 0 and again["compiles"] == 0

@@ -18,7 +18,7 @@ from numba.extending import overload
 from . import csmath as csm
 from .bundle import H_CONSTANT
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
-from .kinematics import contact_dim, contact_frame, model_sizes, registered_frame_bias
+from .kinematics import bias_at_run_time, contact_dim, contact_frame, model_sizes, pointer_bias, registered_frame_bias
 from .model_data import is_stick
 from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
@@ -129,15 +129,29 @@ def frame_with_bias(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by num
 
 @overload(frame_with_bias, jit_options=KERNEL_OPTIONS)
 def _frame_with_bias(s, c, md, G2, w2, h2):
-    closed_form = registered_frame_bias(md.types[md.fields.index("kin")])
+    kin_type = md.types[md.fields.index("kin")]
+    closed_form = registered_frame_bias(kin_type)
     if closed_form is not None:  # chosen at compile time, like the frame itself
         def with_closed_form(s, c, md, G2, w2, h2):
             return closed_form(md.kin, s, c, md.m, G2, w2, h2)
         return with_closed_form
     if isinstance(s.dtype, types.Complex):
+        if bias_at_run_time(kin_type):  # a frame compiled apart: its bias function where it has one
+            def central_or_pointer(s, c, md, G2, w2, h2):
+                if md.kin.bias_complex != 0:
+                    return pointer_bias(md.kin, s, c, md.m, G2, w2, h2)
+                return _frame_bias_central(s, c, md, G2, w2, h2)
+            return central_or_pointer
+
         def by_central_difference(s, c, md, G2, w2, h2):
             return _frame_bias_central(s, c, md, G2, w2, h2)
         return by_central_difference
+    if bias_at_run_time(kin_type):
+        def step_or_pointer(s, c, md, G2, w2, h2):
+            if md.kin.bias != 0:
+                return pointer_bias(md.kin, s, c, md.m, G2, w2, h2)
+            return _frame_bias_complex_step(s, c, md, G2, w2, h2)
+        return step_or_pointer
 
     def by_complex_step(s, c, md, G2, w2, h2):
         return _frame_bias_complex_step(s, c, md, G2, w2, h2)

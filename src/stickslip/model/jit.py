@@ -268,15 +268,10 @@ def track_user_code(cls: type, *functions) -> None:
     digest = hashlib.sha256()
     outside = False
     for function in functions:
-        py_func = getattr(function, "py_func", function)
-        module = sys.modules.get(getattr(py_func, "__module__", None) or "")
-        path = getattr(module, "__file__", None)
-        try:
-            inside = path is not None and Path(path).resolve().is_relative_to(_PACKAGE)
-        except (OSError, ValueError):
-            inside = False
-        if inside:
+        if defined_in_package(function):
             continue
+        py_func = getattr(function, "py_func", function)
+        path = _module_file(py_func)
         outside = True
         try:
             digest.update(Path(path).read_bytes())
@@ -287,6 +282,20 @@ def track_user_code(cls: type, *functions) -> None:
         _USER_CODE[cls] = digest.hexdigest()
     else:
         _USER_CODE.pop(cls, None)
+
+
+def _module_file(py_func) -> str | None:
+    module = sys.modules.get(getattr(py_func, "__module__", None) or "")
+    return getattr(module, "__file__", None)
+
+
+def defined_in_package(obj) -> bool:
+    """Whether ``obj`` (a function, a numba dispatcher or a class) is defined in a module of this package."""
+    path = _module_file(getattr(obj, "py_func", obj))
+    try:
+        return path is not None and Path(path).resolve().is_relative_to(_PACKAGE)
+    except (OSError, ValueError):
+        return False
 
 
 def _user_code_in(types, seen=None) -> list:
@@ -408,4 +417,5 @@ kernel = _kernel_decorator(**KERNEL_OPTIONS)
 inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 
-__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code"]
+__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
+           "defined_in_package"]

@@ -35,6 +35,7 @@ acceleration bias Ġ q̇ are taken by complex step): use ``np.sin``, ``np.cos``,
 from __future__ import annotations
 
 import inspect
+import re
 from typing import Any, Callable, NamedTuple
 
 import numpy as np
@@ -44,13 +45,16 @@ from numba.extending import overload
 from ..errors import KinematicsError
 from . import csmath as csm
 from . import stack
+from .frame_pointers import (FramePointerFields, compiled_addresses, forget, is_pointer_class, origin_class, pointer_bias,
+                             pointer_frame, pointer_gap)
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
-from .jit import KERNEL_OPTIONS, kernel, track_user_code
+from .jit import KERNEL_OPTIONS, defined_in_package, kernel, track_user_code
 
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
            "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel",
-           "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid"]
+           "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid",
+           "kernel_kinematics", "frame_compiled_apart", "bias_at_run_time", "pointer_bias", "pointer_class"]
 
 
 #: Registered frame functions by kinematics class.
@@ -73,7 +77,7 @@ _NO_RIGID: set[type] = set()
 def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, ncontacts: int | None = None,
                         diagonal: bool | None = None, dim: int | None = None,
                         frame_bias: Callable | None = None, unilateral: bool = True,
-                        gap: Callable | None = None, rigid: bool = True) -> None:
+                        gap: Callable | None = None, rigid: bool = True, inline: bool | None = None) -> None:
     """Make ``frame`` the contact frame of models whose kinematics data is a ``cls`` instance.
 
     Parameters
@@ -108,6 +112,15 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         Whether models of this kinematics may have rigid unilateral contacts (impacts; their normal
         force a multiplier). False compiles their kernels without that code (the model files' class
         for compliant contacts).
+    inline : bool, optional
+        True: ``frame`` (and ``frame_bias``, ``gap``) is compiled into every kernel that calls it,
+        each kernel specialised for ``cls`` (the fastest runs; editing the frame recompiles every
+        kernel of the class, half a minute and more). False: they are compiled on their own and the
+        kernels call them through their addresses (:mod:`stickslip.model.frame_pointers`): the
+        kernels are shared by every class registered so and compiled once per machine, and an edit
+        recompiles the edited function alone (about a second); ``ndof``, ``ncontacts``,
+        ``diagonal`` and ``dim`` then only check the models, the kernels read the sizes at run
+        time. Default: True for the package's own classes, False for any other.
     """
     if not (isinstance(cls, type) and issubclass(cls, tuple) and hasattr(cls, "_fields")):
         raise KinematicsError(f"kinematics class {cls!r} must be a NamedTuple of numbers")
@@ -135,6 +148,94 @@ def register_kinematics(cls: type, frame: Callable, *, ndof: int | None = None, 
         _NO_RIGID.discard(cls)
     else:
         _NO_RIGID.add(cls)
+    if inline is None:
+        inline = defined_in_package(cls)
+    forget(cls)
+    if inline:
+        _APART.pop(cls, None)
+    else:
+        _APART[cls] = ((frame, frame_bias, gap), (ndof, ncontacts, diagonal, dim))
+
+
+#: Classes registered with ``inline=False``: their (frame, bias, gap) and the sizes they fix.
+_APART: dict[type, tuple] = {}
+
+
+def frame_compiled_apart(cls: type) -> bool:
+    """Whether kinematics class ``cls`` was registered with ``inline=False``."""
+    return cls in _APART
+
+
+def kernel_kinematics(kin, unilateral: bool, rigid: bool):
+    """The kinematics data the kernels take for a model's ``kin``: ``kin`` itself, or for a class
+    registered with ``inline=False`` its functions' addresses (compiled where needed:
+    :func:`~stickslip.model.frame_pointers.compiled_addresses`) and its values, in the
+    :func:`pointer_class` instance for a model with (``unilateral``) unilateral contacts,
+    (``rigid``) a rigid one: a model's kernels compile the code of the contacts it has."""
+    apart = _APART.get(type(kin))
+    if apart is None:
+        return kin
+    functions, sizes = apart
+    return pointer_class(unilateral, rigid, sizes)(*compiled_addresses(kin, functions), tuple(kin))
+
+
+#: Which contacts a pointer class's kernels compile code for, by the kind in its name.
+_KINDS = {"Pressed": (False, False), "Compliant": (True, False), "Rigid": (True, True)}
+_POINTER_NAME = re.compile(r"FramePointers(Pressed|Compliant|Rigid)(?:_n(\d+)_c(\d+))?(?:_(diagonal|dense))?"
+                           r"(?:_dim(\d))?$")
+_POINTER_CLASSES: dict[str, type] = {}
+
+
+def pointer_class(unilateral: bool, rigid: bool, sizes: tuple) -> type:
+    """The class of the kinematics data of a model whose frame is compiled apart
+    (:class:`~stickslip.model.frame_pointers.FramePointerFields`): its kernels compile the code of
+    unilateral (``unilateral``) and rigid (``rigid``) contacts where the model has them, for the
+    (ndof, ncontacts, diagonal, dim) that the user's class fixed (None where it did not), so they
+    are specialised as the user's class would be, and shared by every class with the same ones.
+
+    The class is made on first use and registered as a kinematics class of its own; its name says
+    what it stands for, so that a process which reads it from numba's cache index makes it again
+    (this module's ``__getattr__``).
+    """
+    ndof, ncontacts, diagonal, dim = sizes
+    name = "FramePointers" + ("Rigid" if rigid else "Compliant" if unilateral else "Pressed")
+    if ndof is not None and ncontacts is not None:
+        name += f"_n{ndof}_c{ncontacts}"
+    if diagonal is not None:
+        name += "_diagonal" if diagonal else "_dense"
+    if dim is not None:
+        name += f"_dim{dim}"
+    return _POINTER_CLASSES.get(name) or _make_pointer_class(name)
+
+
+def _make_pointer_class(name: str) -> type:
+    match = _POINTER_NAME.match(name)
+    if match is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    kind, ndof, ncontacts, diagonal, dim = match.groups()
+    unilateral, rigid = _KINDS[kind]
+    cls = type(name, (FramePointerFields,), {"__slots__": (), "__reduce__": _reduce_pointers, "__module__": __name__,
+                                              "__doc__": f"Kinematics data of {name[13:]} models whose frame is "
+                                                         "compiled apart."})
+    register_kinematics(cls, pointer_frame, ndof=None if ndof is None else int(ndof),
+                        ncontacts=None if ncontacts is None else int(ncontacts),
+                        diagonal=None if diagonal is None else diagonal == "diagonal",
+                        dim=None if dim is None else int(dim), gap=pointer_gap if unilateral else None,
+                        unilateral=unilateral, rigid=rigid, inline=True)
+    _POINTER_CLASSES[name] = cls
+    return cls
+
+
+def _reduce_pointers(self):
+    """Pickle a pointer instance as the user's kinematics object (addresses belong to one process)."""
+    kind = type(self).__name__[len("FramePointers"):].split("_")[0]
+    return kernel_kinematics, (origin_class(self)(*self.values), *_KINDS[kind])
+
+
+def __getattr__(name: str) -> type:  # a pointer class named by numba's cache index, made again
+    if name.startswith("FramePointers"):
+        return _POINTER_CLASSES.get(name) or _make_pointer_class(name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def allows_rigid(cls: type) -> bool:
@@ -203,8 +304,15 @@ def registered_kinematics() -> tuple[type, ...]:
 
 def registered_frame_bias(kin_type) -> Callable | None:
     """The compiled closed-form frame-and-bias function registered for the numba type ``kin_type``
-    of a kinematics object, or None."""
+    of a kinematics object, or None (for the pointer classes of frames compiled apart, whether
+    there is one is known at run time only: :func:`bias_at_run_time`)."""
     return _BIASES.get(getattr(kin_type, "instance_class", None))
+
+
+def bias_at_run_time(kin_type) -> bool:
+    """At compile time: whether the numba type ``kin_type`` is a pointer class, whose closed-form
+    bias is called through its address where one was registered (``kin.bias != 0``)."""
+    return is_pointer_class(getattr(kin_type, "instance_class", None))
 
 
 def contact_frame(kin, s, c, m, G, w):  # pragma: no cover - resolved by numba (overload below)
@@ -244,6 +352,8 @@ def gap_computed(kin):  # pragma: no cover - resolved by numba (overload below)
 
 @overload(gap_computed, jit_options=KERNEL_OPTIONS)
 def _gap_computed(kin):
+    if is_pointer_class(getattr(kin, "instance_class", None)):  # whether a gap function was registered
+        return lambda kin: kin.gap != 0
     if getattr(kin, "instance_class", None) in _GAPS:
         return lambda kin: True
     return lambda kin: False

@@ -32,7 +32,7 @@ from .friction import FrictionLaw, NoUserLaw
 from .bundle import NORMAL_LAWS
 from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantRigidKinematics, ConstantUnilateralKinematics,
                          allows_rigid, allows_unilateral,
-                         computes_gap, registered_kinematics)
+                         computes_gap, kernel_kinematics, registered_kinematics)
 from .physics import SPEED_FLOOR
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
@@ -331,9 +331,9 @@ class FrictionModel:
         free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
         object.__setattr__(self, "free", free)
         object.__setattr__(self, "contacts", tuple(self.contacts))
-        if type(self.kinematics) in CONSTANT_KINEMATICS and any(c.unilateral for c in self.contacts):
+        unilateral, rigid = self._contact_kinds()
+        if type(self.kinematics) in CONSTANT_KINEMATICS and unilateral:
             # the class compiles what the contacts need: rigid contacts' code only where there are some
-            rigid = any(c.unilateral and c.normal.law == "rigid" for c in self.contacts)
             cls = ConstantRigidKinematics if rigid else ConstantUnilateralKinematics
             object.__setattr__(self, "kinematics", cls(*self.kinematics))
         object.__setattr__(self, "dofs", tuple(self.dofs))
@@ -499,7 +499,13 @@ class FrictionModel:
         """The model as the compiled kernels take it (:class:`~stickslip.model.bundle.ModelData`)."""
         m = pack(self.mass, self.damping, self.stiffness, self.force, self.free,
                  [contact.spec(self.n) for contact in self.contacts], self.slip_band, self.constant_kinematics)
-        return ModelData(m, self.kinematics, self.user_law)
+        return ModelData(m, kernel_kinematics(self.kinematics, *self._contact_kinds()), self.user_law)
+
+    def _contact_kinds(self) -> tuple[bool, bool]:
+        """Whether the model has unilateral contacts, and a rigid one (the kernels compile their code
+        only then)."""
+        return (any(c.unilateral for c in self.contacts),
+                any(c.unilateral and c.normal.law == "rigid" for c in self.contacts))
 
     @property
     def user_law(self):

@@ -24,6 +24,7 @@ from numba.extending import overload
 from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
 from ..model.derivatives import acceleration_jacobian, state_jacobian
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, loop
+from ..model.frame_pointers import is_pointer_class
 from ..model.kinematics import model_sizes
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
@@ -55,8 +56,9 @@ def kinematics_values(kin) -> np.ndarray:
     TypeError
         When a field is not a number (such kinematics cannot be varied over a grid).
     """
+    fields = kin.values if is_pointer_class(type(kin)) else kin  # a frame compiled apart: the user's fields
     try:
-        return np.array([float(v) for v in kin], dtype=float)
+        return np.array([float(v) for v in fields], dtype=float)
     except (TypeError, ValueError):
         raise TypeError(f"the kinematics data {type(kin).__name__} has fields that are not numbers") from None
 
@@ -70,11 +72,15 @@ def kinematics_from(kin, values):  # pragma: no cover - resolved by numba (overl
 def _kinematics_from(kin, values):
     cls = getattr(kin, "instance_class", None)
     types = getattr(kin, "types", ())
-    if cls is None or not all(str(t) == "float64" for t in types):
+    pointers = is_pointer_class(cls)  # the addresses kept, the user's fields (the last one, a tuple) replaced
+    fields = getattr(types[-1], "types", ()) if pointers else types
+    if cls is None or not all(str(t) == "float64" for t in fields):
         def same(kin, values):  # fields that are not all floats are never varied
             return kin
         return same
-    args = ", ".join(f"values[{i}]" for i in range(len(types)))
+    args = ", ".join(f"values[{i}]" for i in range(len(fields)))
+    if pointers:
+        args = ", ".join(f"kin[{i}]" for i in range(len(types) - 1)) + f", ({args},)"
     namespace = {"cls": cls}
     exec(f"def build(kin, values):\n    return cls({args})\n", namespace)  # noqa: S102 - fixed template
     return namespace["build"]
