@@ -18,7 +18,8 @@ from numba.extending import overload
 from . import csmath as csm
 from .bundle import H_CONSTANT
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
-from .kinematics import bias_at_run_time, contact_dim, contact_frame, model_sizes, pointer_bias, registered_frame_bias
+from .frame_pointers import pointer_bias
+from .kinematics import bias_at_run_time, contact_dim, contact_frame, model_sizes, registered_frame_bias
 from .model_data import is_stick
 from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
