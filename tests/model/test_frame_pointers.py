@@ -4,9 +4,9 @@ every such class and do not compile again when the frame is edited.
 
 Against the same frame compiled into the kernels (the worked example's ``BeltArm``, a class of
 the package): the same runs bit for bit; steady sliding against its closed-form eigenvalues; a
-closed-form bias through its address
-against the complex-step bias; a stability map over a kinematics field against the stability of
-each point; a model sent to another process; and the edit, against numba's compile events.
+closed-form bias through its address against the complex-step bias; a stability map over a
+kinematics field against the stability of each point; a model sent to another process; and the
+edit, against numba's compile events.
 """
 
 import dataclasses
