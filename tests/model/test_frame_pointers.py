@@ -10,6 +10,7 @@ edit, against numba's compile events.
 """
 
 import dataclasses
+import inspect
 import json
 import os
 import pickle
@@ -24,6 +25,7 @@ from numba import njit
 
 import stickslip
 from stickslip.model import csmath as csm
+from stickslip.model.bundle import C_N0, contact_offsets
 from stickslip.model.frame_pointers import is_pointer_class
 from stickslip.model.kinematics import register_kinematics
 from stickslip.studies import models as studies
@@ -91,6 +93,22 @@ def test_a_frame_compiled_apart_runs_bit_for_bit_like_the_inlined_one():
     np.testing.assert_array_equal(apart.states, inlined.states)
     np.testing.assert_array_equal(apart.transitions.time, inlined.transitions.time)
     np.testing.assert_array_equal(apart.friction, inlined.friction)
+
+
+class TypedArm(NamedTuple):
+    H: float
+    V: float
+
+
+def test_a_frame_without_a_source_file_is_compiled_uncached_and_runs_alike():
+    """A frame typed in an interactive session has no file for numba's cache to key it by: it is
+    compiled in each process instead, and runs as the same frame from a module does."""
+    namespace = {"csm": csm, "C_N0": C_N0, "contact_offsets": contact_offsets}
+    exec(compile(inspect.getsource(studies.belt_arm_frame), "<stdin>", "exec"), namespace)  # noqa: S102
+    register_kinematics(TypedArm, namespace["belt_arm_frame"], ndof=1, ncontacts=1, dim=1)
+    typed = stickslip.simulate(arm(TypedArm), 60.0, ic=IC)
+    from_module = stickslip.simulate(arm(ApartArm), 60.0, ic=IC)
+    np.testing.assert_array_equal(typed.states, from_module.states)
 
 
 def test_steady_sliding_of_a_frame_compiled_apart_has_the_closed_form_eigenvalues():
