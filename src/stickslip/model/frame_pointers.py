@@ -154,8 +154,10 @@ def call_native(typingctx, address, arguments):
     state = arguments[1]
     if not isinstance(state, types.Array):
         raise TypingError(f"call_native: the state must be an array, got {state}")
+    if types.unliteral(arguments[2]) != types.int64:  # the callee takes the contact index as an int64
+        raise TypingError(f"call_native: the contact index must be an int64, got {arguments[2]}")
     result = state.dtype
-    for ty in arguments[2:]:
+    for ty in arguments[3:]:
         if isinstance(ty, types.Array) and ty.dtype not in (types.float64, result):
             raise TypingError(f"call_native: an array of {ty.dtype} beside a state of {result}")
     argument_types = tuple(arguments)

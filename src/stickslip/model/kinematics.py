@@ -211,6 +211,7 @@ def _make_pointer_class(name: str) -> type:
     kind, ndof, ncontacts, diagonal, dim = match.groups()
     unilateral, rigid = _KINDS[kind]
     cls = type(name, (FramePointerFields,), {"__slots__": (), "__reduce__": _reduce_pointers, "__module__": __name__,
+                                              "contact_kinds": (unilateral, rigid),
                                               "__doc__": f"Kinematics data of {name[13:]} models whose frame is "
                                                          "compiled apart."})
     register_kinematics(cls, pointer_frame, ndof=None if ndof is None else int(ndof),
@@ -224,8 +225,7 @@ def _make_pointer_class(name: str) -> type:
 
 def _reduce_pointers(self):
     """Pickle a pointer instance as the user's kinematics object (addresses belong to one process)."""
-    kind = type(self).__name__[len("FramePointers"):].split("_")[0]
-    return kernel_kinematics, (origin_class(self)(*self.values), *_KINDS[kind])
+    return kernel_kinematics, (origin_class(self)(*self.values), *self.contact_kinds)
 
 
 def __getattr__(name: str) -> type:  # a pointer class named by numba's cache index, made again
