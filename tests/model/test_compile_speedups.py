@@ -72,6 +72,38 @@ def test_inlined_kernels_compute_what_python_computes():
     np.testing.assert_array_equal(_uses_inlined(a), expected)
 
 
+def test_an_inlined_callee_is_translated_once_for_all_its_call_sites(monkeypatch):
+    """Three call sites of a fresh callee in two callers: the untyped pipeline runs on it once, and
+    each site's copy computes with its own variables (what Python computes)."""
+    calls = []
+    run = icc.InlineWorker.run_untyped_passes
+    monkeypatch.setattr(icc.InlineWorker, "run_untyped_passes",
+                        lambda self, func, enable_ssa=False: calls.append(func.__name__) or run(self, func, enable_ssa))
+
+    @njit(inline="always")
+    def weighted(x, k):
+        acc = 0.0
+        for i in range(k):
+            acc += x * (i + 1)
+        return acc
+
+    @njit
+    def first(a):
+        return weighted(a[0], 2) + weighted(a[1], 3)
+
+    @njit
+    def second(a):
+        s = 0.0
+        for v in a:
+            s += weighted(v, 4)
+        return s
+
+    a = np.array([0.5, -1.25, 2.0])
+    assert first(a) == weighted.py_func(0.5, 2) + weighted.py_func(-1.25, 3)
+    assert second(a) == sum(weighted.py_func(v, 4) for v in a)
+    assert calls.count("weighted") == 1
+
+
 def test_flags_hash_is_numbas_own_number():
     """numba's TargetConfig hashed the sorted keys of its values dict: the same number, once per class."""
     from numba.core.compiler import Flags
