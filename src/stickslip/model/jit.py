@@ -35,8 +35,9 @@ only allocates is Python instead (``event_loop.integrate_event``), and the stick
 (``forces.solve_stick_rows``) is one kernel called from five places rather than inlined into
 each. A kernel gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`),
 and no kernel a C-callable wrapper. numba's inliner copies an inlined callee's scope once per
-inlined call here, not once per block, and numba's compiler flags hash and compare without
-reading every option (:mod:`.compile_speedups`, installed on import). A slice assignment from an
+inlined call here, not once per block, and translates an inlined callee once per function, not
+once per call site; numba's compiler flags hash and compare without reading every option
+(:mod:`.compile_speedups`, installed on import). A slice assignment from an
 array inside compiled code (``a[:n] = b[:n]``) makes numba compile its shape-mismatch error
 message (string formatting, ~10 s of a cold start); use element loops. Literal arguments
 (``f(x, 0)``, ``f(x, True)``) compile a second version of the callee for the literal type; pass
