@@ -1,5 +1,6 @@
 """Shared set-up."""
 
+import os
 import signal
 
 import matplotlib
@@ -11,3 +12,7 @@ matplotlib.use("Agg")
 # rightly ignores Ctrl-C throughout; the children of a test session get the terminal's default.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+# pytest-xdist's workers already fill the cores: a cold start compiles in one process per worker
+# (tests/integrate/test_compile_ahead.py turns the helper process on where it tests it).
+os.environ.setdefault("STICKSLIP_COMPILE_PROCESSES", "1")

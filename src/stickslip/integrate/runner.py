@@ -33,6 +33,7 @@ from ..errors import SimulationError
 from ..model.bundle import contact_state
 from ..model.system_model import FrictionModel
 from . import contacts as E
+from .compile_ahead import compile_callees
 from .event_loop import N_EXTRA, integrate_event
 from .interrupt import interruptible
 from .result import Transitions, mode_dtype
@@ -269,7 +270,9 @@ class EventStepper:
 
     def _warm_up(self, system: FrictionModel) -> None:
         """Compile (or load from cache) the event loop for this kinematics class and set the modes
-        the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇)."""
+        the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇).
+        On a cold start the loop's callees compile in two processes (:mod:`.compile_ahead`)."""
+        compile_callees(self.md)
         tr = transition_room(0.0, self.ns, 1)
         y = integrate_event(self.y, self.cst, 0.0, 0.0, 0.0, self.md, self.rtol, self.atol, 1e-7, 1e-6, 10,
                             np.empty(0), 0, np.empty((1, self.ns)), np.empty(1, dtype=np.int8),

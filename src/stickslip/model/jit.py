@@ -355,6 +355,20 @@ class KernelDispatcher(CPUDispatcher):
         finally:
             self._python_entry = False
 
+    def available(self, sig) -> bool:
+        """Whether the version of ``sig`` that kernels call is compiled in this process or in
+        numba's on-disk cache (looked up without compiling)."""
+        args = tuple(sigutils.normalize_signature(sig)[0])
+        if args in self.overloads:
+            return True
+        cache = getattr(self, "_cache", None)
+        outer = getattr(_ENTRY, "without", False)
+        _ENTRY.without = True
+        try:
+            return cache is not None and cache.load_overload(args, self.targetctx) is not None
+        finally:
+            _ENTRY.without = outer
+
     def compile(self, sig):
         wanted = getattr(self, "_python_entry", False)
         self._python_entry = False  # the kernels compiled inside this one are called by kernels

@@ -1,0 +1,79 @@
+"""A cold start compiles the event loop's callees in two processes (stickslip.integrate.compile_ahead)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import numba
+import numpy as np
+import pytest
+
+import stickslip
+from stickslip.integrate import compile_ahead
+
+MODEL_FILE = os.path.join(os.path.dirname(__file__), "..", "orbits", "two_mass_belt.toml")
+
+
+@pytest.mark.parametrize("model", ["two-plates", MODEL_FILE])
+def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
+    """Every kernel the two processes compile ahead, with the argument types written in
+    SIGNATURES, is one the event loop then calls (else the helper would compile in vain)."""
+    system = stickslip.load_model(model)
+    stickslip.simulate(system, 0.5)
+    md_type = numba.typeof(system.data)
+    for name in compile_ahead.HELPER_KERNELS + compile_ahead.OWN_KERNELS:
+        kernel = compile_ahead._kernel(name)
+        assert compile_ahead.signature(name, md_type) in kernel.signatures, name
+
+
+COLD_RUN = textwrap.dedent("""
+    import hashlib, json, sys
+    import numpy as np
+    from numba.core import event
+    import stickslip
+    outermost, depth = [], [0]
+    class Outermost(event.Listener):
+        def on_start(self, ev):
+            if depth[0] == 0:
+                outermost.append(ev.data["dispatcher"].py_func.__name__)
+            depth[0] += 1
+        def on_end(self, ev):
+            depth[0] -= 1
+    nested = []
+    class Every(event.Listener):
+        def on_start(self, ev):
+            nested.append(ev.data["dispatcher"].py_func.__name__)
+        def on_end(self, ev):
+            pass
+    with event.install_listener("numba:compile", Outermost()), event.install_listener("numba:compile", Every()):
+        tr = stickslip.simulate(None, 5.0)
+    print(json.dumps({"states": hashlib.sha256(np.ascontiguousarray(tr.states).tobytes()).hexdigest(),
+                      "outermost": outermost, "compiled": nested}))
+""")
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="the helper process runs only with two or more cores")
+def test_a_cold_start_in_two_processes_runs_alike_and_compiles_the_stick_solve_once(tmp_path):
+    """From an empty cache with the helper on: the same states bit for bit as a run in this
+    process, and this process loads the helper's kernels from the cache instead of compiling them."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), STICKSLIP_COMPILE_PROCESSES="2")
+    out = subprocess.run([sys.executable, "-c", COLD_RUN], env=env, capture_output=True, text=True, check=True,
+                         timeout=900)
+    cold = json.loads(out.stdout.strip().splitlines()[-1])
+    here = stickslip.simulate(None, 5.0)
+    assert cold["states"] == hashlib.sha256(np.ascontiguousarray(here.states).tobytes()).hexdigest()
+    assert "try_stick" not in cold["compiled"] and "stick_forces" not in cold["compiled"]
+    assert "rhs" in cold["compiled"] and "event_loop" in cold["outermost"]
+
+
+def test_the_helper_is_off_on_request(monkeypatch):
+    monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "1")
+    assert not compile_ahead.enabled()
+    assert not compile_ahead.compile_callees(stickslip.load_model("belt").data)
+    monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "2")
+    assert compile_ahead.enabled() == ((os.cpu_count() or 1) >= 2)
