@@ -8,9 +8,12 @@ Dormand–Prince step, the crossings' probes, the release of an overloaded stick
 So when neither this process nor numba's on-disk cache holds the stick solve's kernels for the
 model's class, :func:`compile_callees` starts a helper process (:func:`helper_main`) that compiles the stick solve's subtree into the shared
 cache, compiles the step's subtree here meanwhile, and waits for the helper; the event loop then
-loads the helper's kernels from the cache and compiles its own body. The plates' cold
-``simulate`` on two cores: −23 % (``benchmarks/first_call.py``); the same kernels, so the same
-results bit for bit.
+loads the helper's kernels from the cache and compiles its own body. On two cores, from an
+empty cache: the plates' ``simulate`` −17 % (23–25 s against 28–29 s), a model file's through the
+command line −18 % (36–37 s against 42–48 s); the same kernels, so the same results bit for bit.
+The helper's kernels and this process's share ``general_forces``, which both compile: the split
+is as even as the event loop's call tree allows, and the loop's own body (a third of the time)
+compiles after both.
 
 The callees' argument types are written below as short codes (they are the event loop's own
 call sites; ``tests/integrate/test_compile_ahead.py`` checks that they are the signatures the
