@@ -128,8 +128,14 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
     threading.Thread(target=poll, name="stickslip-watch-parent", daemon=True).start()
 
 
+#: Set in every pool and dask worker: the workers fill the cores, so a cold start in a worker
+#: compiles there alone, without the helper process of ``integrate/compile_ahead.py``.
+ONE_COMPILE_PROCESS = ("STICKSLIP_COMPILE_PROCESSES", "1")
+
+
 def _init_worker(parent: int, warm: Callable[[], object] | None) -> None:
     watch_parent(parent)
+    os.environ[ONE_COMPILE_PROCESS[0]] = ONE_COMPILE_PROCESS[1]
     if warm is not None:
         warm()
 
@@ -168,6 +174,7 @@ def dask_setup(worker=None) -> None:
     (:func:`watch_parent`), so that it ends when that process does, even after ``kill -9``.
     A worker that was spawned rather than forked watches its parent process."""
     watch_parent(_cluster_parent)
+    os.environ[ONE_COMPILE_PROCESS[0]] = ONE_COMPILE_PROCESS[1]
 
 
 def local_cluster(workers: int):

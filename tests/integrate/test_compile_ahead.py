@@ -77,3 +77,16 @@ def test_the_helper_is_off_on_request(monkeypatch):
     assert not compile_ahead.compile_callees(stickslip.load_model("belt").data)
     monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "2")
     assert compile_ahead.enabled() == ((os.cpu_count() or 1) >= 2)
+
+
+def _compile_processes_setting():
+    return os.environ.get("STICKSLIP_COMPILE_PROCESSES")
+
+
+def test_pool_workers_compile_alone(monkeypatch):
+    """The workers of a sweep fill the cores: each compiles a cold start by itself."""
+    from stickslip.parallel import worker_pool
+
+    monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "2")
+    with worker_pool(1) as pool:
+        assert pool.submit(_compile_processes_setting).result(timeout=120) == "1"
