@@ -2,24 +2,24 @@
 
 A model class's first ``simulate`` on a machine compiles the event loop and, inside its type
 inference, every kernel it calls, one after the other on one core. The loop's callees fall into
-subtrees that share little: the stick solve's (:func:`~stickslip.integrate.contacts.try_stick`,
-the contact forces and the low-speed band's direction) and the step's (the right-hand side, the
-Dormand–Prince step, the crossings' probes, the release of an overloaded stick, the samples).
-So when neither this process nor numba's on-disk cache holds the stick solve's kernels for the
-model's class, :func:`compile_callees` starts a helper process (:func:`helper_main`) that compiles the stick solve's subtree into the shared
-cache, compiles the step's subtree here meanwhile, and waits for the helper; the event loop then
-loads the helper's kernels from the cache and compiles its own body. On two cores, from an
-empty cache: the plates' ``simulate`` −17 % (23–25 s against 28–29 s), a model file's through the
-command line −18 % (36–37 s against 42–48 s); the same kernels, so the same results bit for bit.
-The helper's kernels and this process's share ``general_forces``, which both compile: the split
-is as even as the event loop's call tree allows, and the loop's own body (a third of the time)
-compiles after both.
+two subtrees: the stick solve's (:func:`~stickslip.integrate.contacts.try_stick`, the release of
+an overloaded stick, the contact forces and the low-speed band's direction) and the step's (the
+right-hand side, the Dormand–Prince step, the crossings' probe, the samples). So when neither
+this process nor numba's on-disk cache holds the stick solve's kernels for the model's class,
+:func:`compile_callees` starts a helper process (:func:`helper_main`) that compiles the stick
+solve's subtree into the shared cache, compiles the step's subtree here meanwhile and waits for
+the helper; the event loop then loads the helper's kernels from the cache and compiles its own
+body. On two cores, from an empty cache: the plates' ``simulate`` −17 % (23–25 s against
+28–29 s), a model file's through the command line −18 % (36–37 s against 42–48 s); the same
+kernels, so the same results bit for bit. The two subtrees share ``general_forces``, which both
+compile: the split is as even as the event loop's call tree allows, and the loop's own body (a
+third of the time) compiles after both.
 
 The callees' argument types are written below as short codes (they are the event loop's own
 call sites; ``tests/integrate/test_compile_ahead.py`` checks that they are the signatures the
-loop compiles for every kind of model). Where the helper cannot run (one core, a model class its
-process cannot import, a failure) this process compiles everything itself as before: the helper
-only ever adds kernels to the cache. ``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test
+loop compiles, for the plates and for a model file). Where the helper cannot run (one core, a
+model class its process cannot import, a failure) this process compiles everything itself as
+before: the helper only ever adds kernels to the cache. ``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test
 suite does, its workers already fill the cores).
 """
 
@@ -101,11 +101,13 @@ def compile_callees(md) -> bool:
     if _kernel(HELPER_KERNELS[0]).available(signature(HELPER_KERNELS[0], md_type)):
         return False
     with tempfile.NamedTemporaryFile(suffix=".pkl", delete=False) as handle:
+        path = Path(handle.name)
         try:
             pickle.dump(md, handle)
         except Exception:  # noqa: BLE001 - a model that does not pickle compiles here alone
+            handle.close()
+            path.unlink(missing_ok=True)
             return False
-    path = Path(handle.name)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     try:
         helper = subprocess.Popen([sys.executable, "-c", _HELPER, str(path), str(os.getpid())], env=env,
