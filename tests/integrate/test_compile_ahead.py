@@ -22,13 +22,17 @@ MODEL_FILE = os.path.join(os.path.dirname(__file__), "..", "orbits", "two_mass_b
 @pytest.mark.parametrize("model", ["two-plates", MODEL_FILE])
 def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     """Every kernel the two processes compile ahead, with the argument types written in
-    SIGNATURES, is one the event loop then calls (else the helper would compile in vain)."""
+    SIGNATURES, is one the event loop calls (else the helper would compile in vain): once the loop
+    is compiled (here or, loaded from the cache, by another process) that version of each is in
+    this process or in the cache. A wrong code is not."""
     system = stickslip.load_model(model)
     stickslip.simulate(system, 0.5)
     md_type = numba.typeof(system.data)
     for name in compile_ahead.HELPER_KERNELS + compile_ahead.OWN_KERNELS:
         kernel = compile_ahead._kernel(name)
-        assert compile_ahead.signature(name, md_type) in kernel.signatures, name
+        assert kernel.available(compile_ahead.signature(name, md_type)), name
+    wrong = compile_ahead.signature("physics.rhs", md_type)[:-1] + (numba.types.float64[:, ::1],)
+    assert not compile_ahead._kernel("physics.rhs").available(wrong)
 
 
 COLD_RUN = textwrap.dedent("""
