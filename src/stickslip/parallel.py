@@ -128,14 +128,19 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
     threading.Thread(target=poll, name="stickslip-watch-parent", daemon=True).start()
 
 
-#: Set in every pool and dask worker: the workers fill the cores, so a cold start in a worker
-#: compiles there alone, without the helper process of ``integrate/compile_ahead.py``.
-ONE_COMPILE_PROCESS = ("STICKSLIP_COMPILE_PROCESSES", "1")
+#: The setting of how many processes a cold start compiles in (``integrate/compile_ahead.py``).
+COMPILE_PROCESSES_ENV = "STICKSLIP_COMPILE_PROCESSES"
+
+
+def _compile_alone() -> None:
+    """In a pool or dask worker: the workers fill the cores, so a cold start in a worker compiles
+    there alone, without the helper process of ``integrate/compile_ahead.py``."""
+    os.environ[COMPILE_PROCESSES_ENV] = "1"
 
 
 def _init_worker(parent: int, warm: Callable[[], object] | None) -> None:
     watch_parent(parent)
-    os.environ[ONE_COMPILE_PROCESS[0]] = ONE_COMPILE_PROCESS[1]
+    _compile_alone()
     if warm is not None:
         warm()
 
@@ -174,7 +179,7 @@ def dask_setup(worker=None) -> None:
     (:func:`watch_parent`), so that it ends when that process does, even after ``kill -9``.
     A worker that was spawned rather than forked watches its parent process."""
     watch_parent(_cluster_parent)
-    os.environ[ONE_COMPILE_PROCESS[0]] = ONE_COMPILE_PROCESS[1]
+    _compile_alone()
 
 
 def local_cluster(workers: int):

@@ -68,7 +68,9 @@ _started: set = set()
 
 def enabled() -> bool:
     """Whether a cold start may use a helper process (two or more cores, not turned off)."""
-    return os.environ.get("STICKSLIP_COMPILE_PROCESSES", "2").strip() != "1" and (os.cpu_count() or 1) >= 2
+    from ..parallel import COMPILE_PROCESSES_ENV  # not at import: `import stickslip` does not load it
+
+    return os.environ.get(COMPILE_PROCESSES_ENV, "2").strip() != "1" and (os.cpu_count() or 1) >= 2
 
 
 def _kernel(name: str):
