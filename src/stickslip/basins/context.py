@@ -47,6 +47,11 @@ CHUNK_PERIODS = 4
 #: nine periods (ten maxima), so a cycle of up to 3 maxima per T_c is claimed within it.
 WINDOW_PERIODS = 32
 
+#: Decay rate, relative to the largest |λ|, below which steady sliding counts as marginal rather
+#: than asymptotically stable for the linear test: an undamped centre's real parts are round-off
+#: (±1e-17), its Lyapunov equation singular, and a decay that slow never settles within a run.
+MARGINAL_DECAY = 1e-9
+
 #: Models defined in Python (not rebuildable from their description) by key, for processes
 #: forked from the one that registered them.
 _PYTHON_MODELS: dict = {}
@@ -176,7 +181,8 @@ def make_context(model, *, key: str | None = None) -> Context:
     if stab is not None:
         equilibrium = np.concatenate([stab.equilibrium, np.zeros(n)])
         max_re = float(stab.max_real_part)
-        stable = bool(stab.stable)
+        scale = float(np.max(np.abs(stab.eigenvalues), initial=0.0))
+        stable = bool(stab.stable) and max_re < -MARGINAL_DECAY * scale
         if stable:
             A = np.asarray(stab.jacobian, dtype=float)
             Q = np.diag(_energy_weights(model, free_dofs))
@@ -190,6 +196,9 @@ def make_context(model, *, key: str | None = None) -> Context:
             P = 0.5 * (P + P.T) + off @ Q @ off
             flow = T @ expm(A_c * chunk * dt) @ T.T
             se = equilibrium[free]
-            rest = 1e-6 * math.sqrt(max(float(se @ P @ se), float(np.trace(P)) * 1e-12))
+            if np.all(np.isfinite(P)) and np.linalg.eigvalsh(P)[0] > 0.0:
+                rest = 1e-6 * math.sqrt(max(float(se @ P @ se), float(np.trace(P)) * 1e-12))
+            else:  # the Lyapunov solve failed (ill-conditioned): no linear test
+                stable, P, flow = False, np.zeros((k2, k2)), np.zeros((k2, k2))
     return Context(key or model_key(model), period, dt, chunk, WINDOW_PERIODS * SAMPLES_PER_PERIOD, equilibrium,
                    stable, max_re, free, P, flow, rest)
