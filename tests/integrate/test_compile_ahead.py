@@ -15,24 +15,54 @@ import pytest
 
 import stickslip
 from stickslip.integrate import compile_ahead
+from stickslip.model.jit import KernelDispatcher
+from stickslip.orbits.linear_flow import VARIATIONAL, flow_jacobian
 
 MODEL_FILE = os.path.join(os.path.dirname(__file__), "..", "orbits", "two_mass_belt.toml")
 
 
+def _available(split, name, md_type) -> bool:
+    """Whether the version of kernel ``name`` that ``split`` compiles is in this process or the cache."""
+    kernel = compile_ahead.kernel_named(name)
+    sig = split.signature(name, md_type)
+    if isinstance(kernel, KernelDispatcher):
+        return kernel.available(sig, python=name in split.from_python)
+    return sig in kernel.overloads or kernel._cache.load_overload(sig, kernel.targetctx) is not None
+
+
 @pytest.mark.parametrize("model", ["two-plates", MODEL_FILE])
 def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
-    """Every kernel the two processes compile ahead, with the argument types written in
-    SIGNATURES, is one the event loop calls (else the helper would compile in vain): once the loop
-    is compiled (here or, loaded from the cache, by another process) that version of each is in
-    this process or in the cache. A wrong code is not."""
+    """Every kernel the two processes compile ahead, with the argument types written in the
+    split, is one the event loop calls (else the helper would compile in vain): once the loop is
+    compiled (here or, loaded from the cache, by another process) that version of each is in this
+    process or in the cache. A wrong code is not."""
     system = stickslip.load_model(model)
     stickslip.simulate(system, 0.5)
     md_type = numba.typeof(system.data)
-    for name in compile_ahead.HELPER_KERNELS + compile_ahead.OWN_KERNELS:
-        kernel = compile_ahead._kernel(name)
-        assert kernel.available(compile_ahead.signature(name, md_type)), name
-    wrong = compile_ahead.signature("physics.rhs", md_type)[:-1] + (numba.types.float64[:, ::1],)
-    assert not compile_ahead._kernel("physics.rhs").available(wrong)
+    split = compile_ahead.EVENT_LOOP
+    for name in split.helper + split.own:
+        assert _available(split, name, md_type), name
+    rhs = "stickslip.model.physics.rhs"
+    wrong = split.signature(rhs, md_type)[:-1] + (numba.types.float64[:, ::1],)
+    assert not compile_ahead.kernel_named(rhs).available(wrong)
+
+
+def test_the_variational_splits_signatures_are_the_ones_the_orbit_tools_compile():
+    """As above for the variational equations: after a linearised flow across stick-slip
+    transitions, every kernel of the split is there with the written argument types (those Python
+    calls with their Python entry)."""
+    system = stickslip.load_model(MODEL_FILE)
+    run = stickslip.simulate(system, 30.0)
+    assert len(run.transitions.time) > 2
+    t0 = float(run.transitions.time[0]) - 0.1
+    s0 = run.states[np.searchsorted(run.t, t0)]
+    fj = flow_jacobian(system, s0, float(run.transitions.time[2]) + 0.1 - t0)
+    assert len(fj.events) >= 2
+    md_type = numba.typeof(system.data)
+    for name in VARIATIONAL.helper + VARIATIONAL.own:
+        assert _available(VARIATIONAL, name, md_type), name
+    assert not _available(VARIATIONAL, "stickslip.orbits.var_kernels.contact_gradients",
+                          numba.types.float32)  # any model data type but this one's: not compiled
 
 
 COLD_RUN = textwrap.dedent("""

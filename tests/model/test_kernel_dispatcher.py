@@ -99,3 +99,50 @@ def test_the_on_disk_cache_keeps_the_two_versions_apart(tmp_path):
     assert first[:2] == ["3.0", "30.0"] and first[3] == "1"  # compiled with the entry
     again = run("python-first")
     assert again[:2] == ["3.0", "30.0"] and again[2:] == ["1", "0"]  # and now loaded from the cache
+
+
+def test_an_api_kernel_compiled_for_a_kernel_serves_python_without_a_second_compile():
+    def _scaled(a, w):
+        return w * a[0]
+
+    scaled = uncached(_scaled)
+    scaled.always_entry = True  # as stickslip.model.jit.api_kernel makes it
+
+    @uncached
+    def caller(a):
+        return scaled(a, 4.0)
+
+    a = np.array([1.5])
+    assert caller(a) == 6.0  # compiles scaled for the kernel's call, with its Python entry
+    args = next(iter(scaled.overloads))
+    assert args in scaled._with_entry
+    compiled = scaled.overloads[args]
+    assert scaled(a, 2.0) == 3.0  # Python's call enters that version
+    assert len(scaled.overloads) == 1 and scaled.overloads[args] is compiled
+
+
+def test_the_physics_that_analyses_call_from_python_are_api_kernels():
+    """The kernels ``stability`` and the orbit tools call from Python, which ``simulate``'s event
+    loop calls too: one compiled version serves both (from the cache in a later command)."""
+    from stickslip.model import physics as P
+
+    for name in ("rhs", "contact_forces", "stick_forces", "slip_velocity", "project_velocities"):
+        assert getattr(P, name).always_entry, name
+    assert not P.general_rhs.always_entry  # a kernel only kernels call keeps to no entry
+
+
+def test_the_cache_gives_an_api_kernel_compiled_for_a_kernel_to_python(tmp_path):
+    module = _MODULE.replace("import kernel", "import api_kernel, kernel").replace("@kernel\ndef inner", "@api_kernel\ndef inner")
+    assert "@api_kernel" in module
+    (tmp_path / "cached_kernels.py").write_text(module)
+    (tmp_path / "run.py").write_text(_CACHED)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+
+    def run(order):
+        res = subprocess.run([sys.executable, str(tmp_path / "run.py"), str(tmp_path), order], capture_output=True,
+                             text=True, env=env, timeout=300)
+        assert res.returncode == 0, res.stderr
+        return res.stdout.split()
+
+    assert run("kernel-only")[:2] == ["30.0", "-"]  # inner compiled for outer, with its entry, and cached
+    assert run("python-first") == ["3.0", "30.0", "1", "0"]  # Python's call loads it: a hit, no compile

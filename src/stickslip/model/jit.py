@@ -34,7 +34,9 @@ residual and Jacobian, the variational right-hand side's band correction), a com
 only allocates is Python instead (``event_loop.integrate_event``), and the stick solve
 (``forces.solve_stick_rows``) is one kernel called from five places rather than inlined into
 each. A kernel gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`),
-and no kernel a C-callable wrapper. numba's inliner copies an inlined callee's scope once per
+the physics that both the event loop and the analyses' Python call always (``api_kernel``: one
+version, compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a
+C-callable wrapper. numba's inliner copies an inlined callee's scope once per
 inlined call here, not once per block, and translates an inlined callee once per function, not
 once per call site; numba's compiler flags hash and compare without reading every option
 (:mod:`.compile_speedups`, installed on import). A slice assignment from an
@@ -355,22 +357,26 @@ class KernelDispatcher(CPUDispatcher):
         finally:
             self._python_entry = False
 
-    def available(self, sig) -> bool:
-        """Whether the version of ``sig`` that kernels call is compiled in this process or in
-        numba's on-disk cache (looked up without compiling)."""
+    def available(self, sig, python: bool = False) -> bool:
+        """Whether the version of ``sig`` that kernels call (``python``: that Python calls) is
+        compiled in this process or in numba's on-disk cache (looked up without compiling)."""
         args = tuple(sigutils.normalize_signature(sig)[0])
-        if args in self.overloads:
+        entry = python or self.always_entry
+        if args in self.overloads and (args in self._with_entry or not entry):
             return True
         cache = getattr(self, "_cache", None)
         outer = getattr(_ENTRY, "without", False)
-        _ENTRY.without = True
+        _ENTRY.without = not entry
         try:
             return cache is not None and cache.load_overload(args, self.targetctx) is not None
         finally:
             _ENTRY.without = outer
 
+    #: Whether every version gets the Python entry (:func:`api_kernel`), kernels' calls included.
+    always_entry = False
+
     def compile(self, sig):
-        wanted = getattr(self, "_python_entry", False)
+        wanted = self.always_entry or getattr(self, "_python_entry", False)
         self._python_entry = False  # the kernels compiled inside this one are called by kernels
         args = tuple(sigutils.normalize_signature(sig)[0])
         existing = self.overloads.get(args)
@@ -409,7 +415,7 @@ class KernelDispatcher(CPUDispatcher):
         return {**self.targetoptions, "no_cpython_wrapper": True}
 
 
-def _kernel_decorator(**options):
+def _kernel_decorator(always_entry: bool = False, **options):
     """A decorator like ``njit(cache=True, **options)`` that makes a :class:`KernelDispatcher`."""
     targetoptions = {"nopython": True, "boundscheck": None, **options}
 
@@ -417,6 +423,7 @@ def _kernel_decorator(**options):
         if numba_config.DISABLE_JIT:
             return func
         dispatcher = KernelDispatcher(py_func=func, locals={}, targetoptions=dict(targetoptions))
+        dispatcher.always_entry = always_entry
         dispatcher.enable_caching()
         return dispatcher
 
@@ -429,8 +436,14 @@ def _kernel_decorator(**options):
 KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy", "no_cfunc_wrapper": True}
 
 kernel = _kernel_decorator(**KERNEL_OPTIONS)
+#: A :func:`kernel` that the analyses also call from Python (the right-hand side, the contact and
+#: stick forces, the slip velocity, the projection onto the stick constraints): every version is
+#: compiled with its Python entry, so that the one a ``simulate`` compiled for the event loop is
+#: also the one ``stability`` or ``orbit`` calls, loaded from the cache (a Python entry costs
+#: ~45 ms; compiling the version again for Python cost a model file's ``orbit`` ~8 s).
+api_kernel = _kernel_decorator(always_entry=True, **KERNEL_OPTIONS)
 inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 
-__all__ = ["kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
+__all__ = ["kernel", "api_kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
            "defined_in_package"]

@@ -50,7 +50,7 @@ from .bundle import CST, H_BAND, offsets
 from .forces import (add_contact_force, general_forces, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
-from .jit import inlined_kernel, kernel
+from .jit import api_kernel, inlined_kernel, kernel
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
@@ -125,7 +125,7 @@ def rhs_body(s, cst, md, ds):
         general_rhs(s, cst, md, ds)
 
 
-@kernel
+@api_kernel
 def rhs(s, cst, md, ds):
     """State derivative ds/dt = [q̇, M⁻¹ (f0 − C q̇ − K q + Σ G_cᵀ F_c)] in the modes of ``cst``.
 
@@ -145,7 +145,7 @@ def export_contacts(nc, N, F, v, N_out, F_out, v_out):
             v_out[2 * c + i] = v[2 * c + i]
 
 
-@kernel
+@api_kernel
 def contact_forces(s, cst, md, F_out, N_out, v_out):
     """Each contact's friction force F (2 nc,) [N], normal force N (nc,) [N] and slip velocity
     v (2 nc,) [m/s] at ``s`` in the modes of ``cst`` (contact c at entries 2c, 2c+1 / c)."""
@@ -172,7 +172,7 @@ def rhs_and_forces(s, cst, md, ds, F_out, N_out, v_out):
     export_contacts(nc, N, F, v, N_out, F_out, v_out)
 
 
-@kernel
+@api_kernel
 def stick_forces(s, cst, extra, md, F_out, N_out):
     """Stick multipliers F (2 nc,) [N] of the sticking contacts and contact ``extra`` (≥ 0, or −1),
     the other contacts slipping in their modes; N_out (nc,) the normal forces. Returns the rows."""
@@ -211,7 +211,7 @@ def stick_margin(s, cst, c, md):
     return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
 
 
-@kernel
+@api_kernel
 def slip_velocity(s, c, md):
     """Slip velocity (v0, v1) of contact ``c`` at ``s`` [m/s] (v1 = 0 for a 1-D contact)."""
     m = md.m
@@ -352,7 +352,7 @@ def slip_direction(s, cst, c, md, v0, v1):
     return band_direction(s, cst, c, md, speed)
 
 
-@kernel
+@api_kernel
 def project_velocities(s, cst, extra, md):
     """Project q̇ onto v_c = 0 for every sticking contact and contact ``extra`` (≥ 0; −1: none),
     in the M-metric, in place; returns the kinetic energy change [J] (≤ 0).

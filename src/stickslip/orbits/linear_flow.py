@@ -25,6 +25,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import OrbitError
 from ..integrate import contacts as E
+from ..integrate.compile_ahead import Split, compile_apart
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from . import saltation as S
@@ -54,6 +55,25 @@ MATCH_TIME_TOL = 1e-6
 
 #: Step cap of one segment.
 MAX_SEGMENT_STEPS = 1_000_000
+
+#: A cold start's variational kernels in two processes (:mod:`stickslip.integrate.compile_ahead`):
+#: the variational right-hand side (with the complex-step physics under it) in the helper; the
+#: event functions, the contact gradients of the saltation matrices and the starting modes here;
+#: the segment integrator then loads both. A model file's ``orbit`` after its ``stability``, from
+#: an empty cache otherwise: the variational kernels in 14 s instead of 21 s.
+VARIATIONAL = Split(
+    helper=("stickslip.orbits.var_kernels.variational_rhs",),
+    own=("stickslip.orbits.var_kernels.event_value", "stickslip.orbits.var_kernels._first_event",
+         "stickslip.orbits.var_kernels.contact_gradients", "stickslip.integrate.contacts.initial_modes"),
+    caller="stickslip.orbits.var_kernels.integrate_segment",
+    signatures={
+        "stickslip.orbits.var_kernels.variational_rhs": "v v M i B v v z z v",
+        "stickslip.orbits.var_kernels.event_value": "i i v f f v M",
+        "stickslip.orbits.var_kernels._first_event": "I v v v v m f v M i v v v",
+        "stickslip.orbits.var_kernels.contact_gradients": "v v i M i m m v z z z z",
+        "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
+    },
+    from_python=("stickslip.orbits.var_kernels.contact_gradients", "stickslip.integrate.contacts.initial_modes"))
 
 #: Kind of the recorded transition each event kind ends in (+1 slip → stick, −1 stick → slip).
 _RECORDED_KIND = {V.EV_MARGIN: E.TRANSITION_TO_SLIP, V.EV_ZERO: E.TRANSITION_TO_STICK,
@@ -277,6 +297,7 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
                 f"difference {d:.1e} > {MATCH_TOL:.0e}): the event sequence differs (grazing, or a "
                 "return to v ≈ 0 inside the low-speed band?)")
 
+    compile_apart(system.data, VARIATIONAL, f"{__name__}:VARIATIONAL")
     y, cst = initial_contacts(system, np.asarray(s0, dtype=float), rtol, atol)
     user_after = (lambda t, Q: Q) if after is None else after
 
