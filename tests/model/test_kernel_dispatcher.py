@@ -124,10 +124,12 @@ def test_an_api_kernel_compiled_for_a_kernel_serves_python_without_a_second_comp
 def test_the_physics_that_analyses_call_from_python_are_api_kernels():
     """The kernels ``stability`` and the orbit tools call from Python, which ``simulate``'s event
     loop calls too: one compiled version serves both (from the cache in a later command)."""
+    from stickslip.integrate import contacts
     from stickslip.model import physics as P
 
     for name in ("rhs", "contact_forces", "stick_forces", "slip_velocity", "project_velocities"):
         assert getattr(P, name).always_entry, name
+    assert contacts.initial_modes.always_entry
     assert not P.general_rhs.always_entry  # a kernel only kernels call keeps to no entry
 
 

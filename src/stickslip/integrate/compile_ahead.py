@@ -13,13 +13,13 @@ Two splits:
 
 * :data:`EVENT_LOOP` (``simulate`` and everything that runs the event loop): the stick solve's
   subtree (:func:`~stickslip.integrate.contacts.try_stick`, the release of an overloaded stick,
-  the contact forces and the low-speed band's direction) in the helper, the step's (the
-  right-hand side, the Dormand–Prince step, the crossings' probe, the samples) here. On two
+  the contact forces, the low-speed band's direction and the starting modes) in the helper, the
+  step's (the right-hand side, the Dormand–Prince step, the crossings' probe, the samples) here. On two
   cores, from an empty cache: the plates' ``simulate`` −17 %, a model file's −18 %. The two
   subtrees share ``general_forces``, which both compile: the split is as even as the loop's call
   tree allows, and the loop's own body (a third of the time) compiles after both.
 * the variational equations of the orbit tools, declared beside them
-  (:data:`stickslip.orbits.var_kernels.VARIATIONAL`).
+  (:data:`stickslip.orbits.linear_flow.VARIATIONAL`).
 
 The callees' argument types are written as short codes (:data:`CODES`: the callers' own call
 sites; the tests check that they are the signatures the callers compile). Where the helper cannot
@@ -88,12 +88,14 @@ class Split:
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.
 EVENT_LOOP = Split(
     helper=("stickslip.integrate.contacts.try_stick", "stickslip.integrate.contacts.release_most_overloaded",
-            "stickslip.model.physics.contact_forces", "stickslip.model.physics.band_direction"),
+            "stickslip.model.physics.contact_forces", "stickslip.model.physics.band_direction",
+            "stickslip.integrate.contacts.initial_modes"),
     own=("stickslip.model.physics.rhs", "stickslip.integrate.event_loop.dp_step",
          "stickslip.integrate.contacts.probed_crossing", "stickslip.integrate.event_loop.write_samples"),
     caller="stickslip.integrate.event_loop.event_loop",
     signatures={
         "stickslip.integrate.contacts.try_stick": "v v i M f v v",
+        "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
         "stickslip.model.physics.contact_forces": "v v M v v v",
         "stickslip.model.physics.band_direction": "v v i M f",
         "stickslip.model.physics.rhs": "v v M v",

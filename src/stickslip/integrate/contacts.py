@@ -31,7 +31,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
-from ..model.jit import inlined_kernel, kernel
+from ..model.jit import api_kernel, inlined_kernel, kernel
 from ..model.kinematics import model_sizes, rigid_kernel
 from ..model.impact import IMPACT_INCONSISTENT, impact, remove_gap_rate, restitution_of
 from ..model.normal import gap_and_rate, gap_with_rate, is_open, is_rigid, starts_open
@@ -445,7 +445,7 @@ def close_contact(y, cst, c, md, rtol, atol, F, N):
     return False
 
 
-@inlined_kernel
+@api_kernel
 def initial_modes(y, cst, md, rtol, atol, F, N):
     """Modes a state starts in: each contact sticks if its v = 0 (to STICK_SPEED_TOL) and the joint
     stick force is admissible; the others slip (the exact direction when sliding, the

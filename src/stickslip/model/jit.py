@@ -29,14 +29,14 @@ minute): numba gives each kernel that is not inlined a module of its own, into w
 the code of every kernel it calls, and LLVM optimises and emits all of that code again there.
 A thin kernel over a large one therefore costs the large one's optimisation once more: such
 kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
-``contacts.event_value``, ``initial_modes``, ``transitions.settle``, the steady-sliding Newton's
+``contacts.event_value``, ``transitions.settle``, the steady-sliding Newton's
 residual and Jacobian, the variational right-hand side's band correction), a compiled wrapper that
 only allocates is Python instead (``event_loop.integrate_event``), and the stick solve
 (``forces.solve_stick_rows``) is one kernel called from five places rather than inlined into
 each. A kernel gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`),
-the physics that both the event loop and the analyses' Python call always (``api_kernel``: one
-version, compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a
-C-callable wrapper. numba's inliner copies an inlined callee's scope once per
+the physics and the starting modes that both the event loop and the analyses' Python call always
+(``api_kernel``: one version, compiled by ``simulate`` and loaded by ``stability`` and ``orbit``),
+and no kernel a C-callable wrapper. numba's inliner copies an inlined callee's scope once per
 inlined call here, not once per block, and translates an inlined callee once per function, not
 once per call site; numba's compiler flags hash and compare without reading every option
 (:mod:`.compile_speedups`, installed on import). A slice assignment from an
@@ -437,10 +437,11 @@ KERNEL_OPTIONS = {"_nrt": False, "error_model": "numpy", "no_cfunc_wrapper": Tru
 
 kernel = _kernel_decorator(**KERNEL_OPTIONS)
 #: A :func:`kernel` that the analyses also call from Python (the right-hand side, the contact and
-#: stick forces, the slip velocity, the projection onto the stick constraints): every version is
-#: compiled with its Python entry, so that the one a ``simulate`` compiled for the event loop is
-#: also the one ``stability`` or ``orbit`` calls, loaded from the cache (a Python entry costs
-#: ~45 ms; compiling the version again for Python cost a model file's ``orbit`` ~8 s).
+#: stick forces, the slip velocity, the projection onto the stick constraints, the starting
+#: modes): every version is compiled with its Python entry, so that the one a ``simulate``
+#: compiled for the event loop is also the one ``stability`` or ``orbit`` calls, loaded from the
+#: cache (a Python entry costs ~45 ms; compiling the version again for Python cost a model file's
+#: ``orbit`` ~8 s).
 api_kernel = _kernel_decorator(always_entry=True, **KERNEL_OPTIONS)
 inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
