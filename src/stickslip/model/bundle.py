@@ -37,7 +37,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .friction import LAW_WIDTH, NoUserLaw
-from .jit import inlined_kernel
+from .jit import inlined_kernel, kernel
 
 __all__ = ["ModelData", "pack", "offsets", "contact_offsets", "gap_offset", "contact_width", "contact_state",
            "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "H_UNILATERAL", "H_RIGID", "C_DIM", "C_N0",
@@ -82,7 +82,7 @@ def contact_width(n):
     return C_G + 5 * n + 2
 
 
-@inlined_kernel
+@kernel
 def offsets(n):
     """Offsets of (M⁻¹, M, C, K, f0, free, contact 0) in ``m`` for a model with n DOFs."""
     nn = n * n
@@ -91,13 +91,13 @@ def offsets(n):
     return o_minv, o_minv + nn, o_minv + 2 * nn, o_minv + 3 * nn, o_force, o_force + n, o_force + 2 * n
 
 
-@inlined_kernel
+@kernel
 def gap_offset(n, c):
     """Offset of contact ``c``'s gap gradient W (n) in ``m``."""
     return contact_offsets(n, c)[3] + n
 
 
-@inlined_kernel
+@kernel
 def contact_offsets(n, c):
     """(o, o_w, o_nq, o_nv): offsets of contact ``c``'s block, its drive w and its normal gradients."""
     o = HEADER + 4 * n * n + 2 * n + c * contact_width(n)

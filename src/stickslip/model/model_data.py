@@ -43,19 +43,19 @@ def law_row(m, n, c):
     return m[o:o + LAW_WIDTH]
 
 
-@inlined_kernel
+@kernel
 def kinetic_coefficient(md, n, c, speed):
     """Kinetic friction coefficient μ(|v| = ``speed``) [-] of contact ``c`` (float or complex speed)."""
     return friction_coefficient(speed, law_row(md.m, n, c), md.law)
 
 
-@inlined_kernel
+@kernel
 def static_limit(m, n, c, normal):
     """Largest admissible stick force μs N [N] of contact ``c`` (paper Eq. 10)."""
     return static_coefficient(law_row(m, n, c)) * normal.real
 
 
-@inlined_kernel
+@kernel
 def is_stick(cst, c):
     return np.int64(cst[CST * c]) == MODE_STICK
 

@@ -42,7 +42,7 @@ import numpy as np
 from . import csmath as csm
 from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, H_RIGID, NORMAL_PRESCRIBED,
                      NORMAL_RIGID, contact_offsets, gap_offset)
-from .jit import inlined_kernel
+from .jit import inlined_kernel, kernel
 from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from .stack import work_vectors
 
@@ -54,12 +54,12 @@ __all__ = ["MODE_OPEN", "is_open", "is_unilateral", "is_rigid", "any_rigid_close
 MODE_OPEN = 4
 
 
-@inlined_kernel
+@kernel
 def is_open(cst, c):
     return np.int64(cst[CST * c]) == MODE_OPEN
 
 
-@inlined_kernel
+@kernel
 def is_unilateral(md, n, c):
     """Whether contact ``c`` has a gap instead of a prescribed load (False at compile time for
     kinematics registered without unilateral contacts)."""
@@ -68,7 +68,7 @@ def is_unilateral(md, n, c):
     return md.m[contact_offsets(n, c)[0] + C_NORMAL_LAW] != NORMAL_PRESCRIBED
 
 
-@inlined_kernel
+@kernel
 def is_rigid(md, n, c):
     """Whether contact ``c`` is a rigid unilateral contact (False at compile time for kinematics
     registered without unilateral contacts; a header flag skips the look-up for models without any)."""
