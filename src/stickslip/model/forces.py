@@ -39,7 +39,7 @@ __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "qua
 
 
 # ----------------------------------------------------------------------------- slip forces
-@inlined_kernel
+@kernel
 def exact_direction(mode, speed, band):
     """Whether slip in ``mode`` at |v| = ``speed`` takes the direction v/|v| (else the quasi-static one).
 

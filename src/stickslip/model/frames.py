@@ -37,7 +37,7 @@ BIAS_TIME_STEP = 1e-5
 
 
 # ----------------------------------------------------------------------------- frames
-@inlined_kernel
+@kernel
 def frame_velocity(s, n, dim, G2, w2):
     """(v0, v1) = G q̇ − w of one contact from its frame rows (v1 = 0 for a 1-D contact)."""
     v0 = -w2[0]

@@ -41,7 +41,7 @@ from numba.extending import overload
 
 from ..errors import FrictionLawError
 from . import csmath as csm
-from .jit import KERNEL_OPTIONS, inlined_kernel, track_user_code
+from .jit import KERNEL_OPTIONS, inlined_kernel, kernel, track_user_code
 
 __all__ = ["FrictionLaw", "FrictionLawError", "LAWS", "LAW_COULOMB", "LAW_EXPONENTIAL", "LAW_USER", "LAW_WIDTH",
            "NoUserLaw", "register_friction_law", "friction_coefficient", "static_coefficient"]
@@ -116,7 +116,7 @@ def friction_coefficient(speed, row, law):
     return row[L_MU_K] + row[L_DELTA_MU] * csm.exp(-row[L_ALPHA] * speed) + row[L_MU_V] * speed
 
 
-@inlined_kernel
+@kernel
 def static_coefficient(row):
     """Static friction coefficient μs [-]: stick holds while |F| ≤ μs N (paper Eq. 10); for the
     built-in laws μs = μk + Δμ (the exponential law's μ(0)), a user law's row holds μs there."""

@@ -17,14 +17,19 @@ inside the loop over its stages (a call passes each array as 7 words, ~40 per rh
 −1.5…6 % per fixed-step run). Each inlined copy of the rhs costs ~2.3 s of cold compile: three
 copies (one per RK4 stage) took it +5…9 s for about the speed of one copy in a loop. Inlining
 larger step functions (``fixed_step.rk4_slip_step``) into the loop made runs 1.5× *slower*, and
-inlining every kernel took the cold compile from 15 s to 295 s. The small predicates and
-offsets that kernels call at tens of sites (``bundle.offsets``, ``contact_offsets``,
-``gap_offset``, ``normal.is_open``, ``is_rigid``, ``is_unilateral``, ``model_data.is_stick``,
-``static_limit``, ``kinetic_coefficient``) are plain kernels instead: numba types an inlined
-body again at every call site (and at every site of every inlined caller), a kernel once, and
-LLVM still inlines the small function into its caller's module (a cold ``simulate`` of the plates
-in one process 25.0–25.5 s against 27.7–34.9 s; the same speed: event 1000 s 0.983–1.009, AEOM
-0.983, the belt 0.983 in `benchmarks/ab.py`; the same states bit for bit).
+inlining every kernel took the cold compile from 15 s to 295 s. The small predicates, offsets
+and formulas that kernels call at tens of sites (``bundle.offsets``, ``contact_offsets``,
+``gap_offset``, ``normal.is_open``, ``is_rigid``, ``is_unilateral``, ``gap_and_rate``,
+``gap_with_rate``, ``contact_indicator``, ``model_data.is_stick``, ``static_limit``,
+``kinetic_coefficient``, ``frames.frame_velocity``, ``friction.static_coefficient``,
+``linalg.solve_psd_2x2``, ``forces.exact_direction``) are plain kernels instead: numba types an
+inlined body again at every call site (and at every site of every inlined caller), a kernel
+once, and LLVM still inlines the small function into its caller's module. A cold ``simulate`` of
+the plates in one process: 25.0–25.5 s against 27.7–34.9 s for the first nine, 21.8–22.5 s
+against 22.9–23.6 s for the rest; the same states bit for bit and the same speed
+(``benchmarks/ab.py``: event 1000 s 0.983–1.009 and 0.989, AEOM 0.983 and 1.001, the belt 0.983).
+``model_data.apply_inverse_mass`` and ``base_force``, loops on the right-hand side's path, stay
+inlined: as kernels the plates' event runs took 1.016× as long.
 
 ``error_model="numpy"`` everywhere: a float division by zero gives inf/nan as in numpy instead
 of raising ZeroDivisionError, so divisions carry no zero test and branch to an exception

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 from . import csmath as csm
-from .jit import inlined_kernel, kernel
+from .jit import kernel
 
 __all__ = ["RANK_TOL", "JACOBI_SWEEPS", "solve_psd_2x2", "solve_psd", "solve_in_order"]
 
@@ -30,7 +30,7 @@ JACOBI_SWEEPS = 30
 
 
 # ----------------------------------------------------------------------------- linear algebra
-@inlined_kernel
+@kernel
 def solve_psd_2x2(a11, a12, a22, b1, b2):
     """Minimal-norm solution of the symmetric positive semi-definite 2×2 system A x = b.
 

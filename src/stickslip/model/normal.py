@@ -88,7 +88,7 @@ def any_rigid_closed(cst, md, n, nc):  # pragma: no cover - compiled only
     return False
 
 
-@inlined_kernel
+@kernel
 def gap_with_rate(s, d, md, n, c):
     """(g(q), W(q)·d[n:2n]) of contact ``c`` at ``s`` = [q, …] (W = ∂g/∂q) [m, m/s for d = s]:
     the gap and its rate along the velocities held in ``d`` (``s`` itself, or a derivative
@@ -111,7 +111,7 @@ def gap_with_rate(s, d, md, n, c):
     return g, rate
 
 
-@inlined_kernel
+@kernel
 def gap_and_rate(s, md, n, c):
     """(g, ġ) = (g(q), W(q)·q̇) of contact ``c`` [m, m/s]: g0 + W·q for a gap the kinematics does
     not compute (:func:`~stickslip.model.kinematics.contact_gap`)."""
@@ -126,7 +126,7 @@ def compliant_force(s, md, n, c):
     return -md.m[o + C_NORMAL_K] * g - md.m[o + C_NORMAL_C] * rate
 
 
-@inlined_kernel
+@kernel
 def contact_indicator(s, cst, md, n, c):
     """φ = min(−g, λ̃) for a closed contact, −φ for an open one: > 0 while the contact stays in its
     state, its fall through 0 is the opening or closing event [m or N; only the sign matters].
