@@ -81,10 +81,10 @@ _MODULE = textwrap.dedent('''
 ''')
 
 
-def test_the_on_disk_cache_keeps_the_two_versions_apart(tmp_path):
-    """A version without the entry, cached by one process, is never what another process's Python
-    call loads (it would have no code to enter)."""
-    (tmp_path / "cached_kernels.py").write_text(_MODULE)
+def _cached_runs(tmp_path, module: str):
+    """A function that runs ``_CACHED`` with ``module`` as ``cached_kernels`` in a new process on one
+    numba cache under ``tmp_path``, in the given order, and returns what it printed (split)."""
+    (tmp_path / "cached_kernels.py").write_text(module)
     (tmp_path / "run.py").write_text(_CACHED)
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
 
@@ -93,6 +93,14 @@ def test_the_on_disk_cache_keeps_the_two_versions_apart(tmp_path):
                              text=True, env=env, timeout=300)
         assert res.returncode == 0, res.stderr
         return res.stdout.split()
+
+    return run
+
+
+def test_the_on_disk_cache_keeps_the_two_versions_apart(tmp_path):
+    """A version without the entry, cached by one process, is never what another process's Python
+    call loads (it would have no code to enter)."""
+    run = _cached_runs(tmp_path, _MODULE)
 
     assert run("kernel-only")[:2] == ["30.0", "-"]  # inner compiled and cached without its entry
     first = run("python-first")  # its Python call must not load that one (it would crash)
@@ -136,15 +144,7 @@ def test_the_physics_that_analyses_call_from_python_are_api_kernels():
 def test_the_cache_gives_an_api_kernel_compiled_for_a_kernel_to_python(tmp_path):
     module = _MODULE.replace("import kernel", "import api_kernel, kernel").replace("@kernel\ndef inner", "@api_kernel\ndef inner")
     assert "@api_kernel" in module
-    (tmp_path / "cached_kernels.py").write_text(module)
-    (tmp_path / "run.py").write_text(_CACHED)
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
-
-    def run(order):
-        res = subprocess.run([sys.executable, str(tmp_path / "run.py"), str(tmp_path), order], capture_output=True,
-                             text=True, env=env, timeout=300)
-        assert res.returncode == 0, res.stderr
-        return res.stdout.split()
+    run = _cached_runs(tmp_path, module)
 
     assert run("kernel-only")[:2] == ["30.0", "-"]  # inner compiled for outer, with its entry, and cached
     assert run("python-first") == ["3.0", "30.0", "1", "0"]  # Python's call loads it: a hit, no compile
