@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from stickslip.model.bundle import CST, contact_state
-from stickslip.model.derivatives import state_jacobian
+from stickslip.model.derivatives import state_jacobian, state_jacobian_from_python
 from stickslip.model.library import library, load_model
 from stickslip.model.physics import MODE_SLIP_EXACT, MODE_STICK, project_velocities, rhs, slip_velocity
 from stickslip.studies.models import belt_arm
@@ -65,6 +65,7 @@ def assert_jacobians_agree(model, modes, seed=0):
         else:
             assert speed > 100 * model.slip_band  # exact slip direction, far from the band
     J = derived(s, cst, model.data)
+    np.testing.assert_array_equal(state_jacobian_from_python(s, cst, model.data), J)  # the same steps from Python
     J_fd = central_differences(s, cst, model.data)
     assert np.all(np.isfinite(J))
     np.testing.assert_allclose(J, J_fd, rtol=1e-6, atol=1e-7 * np.max(np.abs(J)))

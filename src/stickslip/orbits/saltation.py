@@ -45,7 +45,7 @@ from ..errors import OrbitError
 from ..integrate import contacts as E
 from ..model import physics as P
 from ..model.bundle import CST
-from ..model.derivatives import state_jacobian
+from ..model.derivatives import state_jacobian_from_python
 from ..model.friction import static_coefficient
 from ..model.impact import IMPACT_INCONSISTENT, impact, restitution_of
 from .var_kernels import contact_gradients, indicator_gradient
@@ -327,9 +327,7 @@ def arrival_jump(system, s_c: np.ndarray, cst: np.ndarray, c: int, s_stick: np.n
             raise OrbitError("the slip velocity does not head into zero at the stick arrival (grazing); "
                              "no saltation matrix")
         mu = -float(e @ k.F) / k.N  # the friction coefficient at |v_c|
-        J = np.empty((n2, n2))
-        state_jacobian(np.ascontiguousarray(s_c[:n2], dtype=float), cst, system.data, J,
-                       np.empty(n2, complex), np.empty(n2, complex))
+        J = state_jacobian_from_python(s_c[:n2], cst, system.data)
         # the slip Jacobian without the rotation of the friction direction, −μN (I − e eᵀ)/|v| ∂v/∂s
         J_reg = J + B @ (mu * k.N / speed * (np.eye(2) - np.outer(e, e))) @ k.Dv
         pre = (np.eye(n2) + speed / approach * J_reg) @ pre

@@ -11,7 +11,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import EquilibriumError
 from ..model.bundle import CST, contact_state
-from ..model.derivatives import state_jacobian
+from ..model.derivatives import state_jacobian_from_python
 from ..model.library.two_plates import plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.physics import MODE_SLIP_EXACT
@@ -185,8 +185,7 @@ def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     s[:n] = q
     cst = contact_state(system.data.m)
     cst[0::CST] = MODE_SLIP_EXACT
-    J_full = np.empty((2 * n, 2 * n))
-    state_jacobian(s, cst, system.data, J_full, np.zeros(2 * n, dtype=complex), np.zeros(2 * n, dtype=complex))
+    J_full = state_jacobian_from_python(s, cst, system.data)
     free = np.flatnonzero(system.free)
     k = free.size
     idx = np.concatenate([free, n + free])
