@@ -26,7 +26,7 @@ def _available(split, name, md_type) -> bool:
     kernel = compile_ahead.kernel_named(name)
     sig = split.signature(name, md_type)
     if isinstance(kernel, KernelDispatcher):
-        return kernel.available(sig, python=name in split.from_python)
+        return kernel.available(sig)
     return sig in kernel.overloads or kernel._cache.load_overload(sig, kernel.targetctx) is not None
 
 
@@ -49,8 +49,8 @@ def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
 
 def test_the_variational_splits_signatures_are_the_ones_the_orbit_tools_compile():
     """As above for the variational equations: after a linearised flow across stick-slip
-    transitions, every kernel of the split is there with the written argument types (those Python
-    calls with their Python entry)."""
+    transitions, every kernel of the split is there with the written argument types (the api kernels,
+    which Python calls, with their Python entry)."""
     system = stickslip.load_model(MODEL_FILE)
     run = stickslip.simulate(system, 30.0)
     assert len(run.transitions.time) > 2

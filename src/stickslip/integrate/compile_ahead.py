@@ -70,15 +70,12 @@ class Split:
         The kernel that calls them, compiled after both (its compile event spans the pair).
     signatures : mapping of str to str
         Each kernel's argument codes (:data:`CODES`), separated by spaces.
-    from_python : tuple of str
-        Those of ``own`` that Python calls: compiled with their Python entry.
     """
 
     helper: tuple
     own: tuple
     caller: str
     signatures: Mapping
-    from_python: tuple = ()
 
     def signature(self, name: str, md_type) -> tuple:
         """The argument types of kernel ``name`` for model data of numba type ``md_type``."""
@@ -125,8 +122,6 @@ def _compile(split: Split, names, md_type) -> None:
     for name in names:
         kernel = kernel_named(name)
         with contextlib.suppress(numba.core.errors.NumbaError):
-            if name in split.from_python:
-                kernel._python_entry = True  # as a call from Python compiles it (model/jit.py)
             kernel.compile(split.signature(name, md_type))
 
 

@@ -369,16 +369,15 @@ class KernelDispatcher(CPUDispatcher):
         finally:
             self._python_entry = False
 
-    def available(self, sig, python: bool = False) -> bool:
-        """Whether the version of ``sig`` that kernels call (``python``: that Python calls) is
-        compiled in this process or in numba's on-disk cache (looked up without compiling)."""
+    def available(self, sig) -> bool:
+        """Whether the version of ``sig`` that kernels call is compiled in this process or in
+        numba's on-disk cache (looked up without compiling)."""
         args = tuple(sigutils.normalize_signature(sig)[0])
-        entry = python or self.always_entry
-        if args in self.overloads and (args in self._with_entry or not entry):
+        if args in self.overloads:
             return True
         cache = getattr(self, "_cache", None)
         outer = getattr(_ENTRY, "without", False)
-        _ENTRY.without = not entry
+        _ENTRY.without = not self.always_entry
         try:
             return cache is not None and cache.load_overload(args, self.targetctx) is not None
         finally:
@@ -453,7 +452,8 @@ kernel = _kernel_decorator(**KERNEL_OPTIONS)
 #: modes): every version is compiled with its Python entry, so that the one a ``simulate``
 #: compiled for the event loop is also the one ``stability`` or ``orbit`` calls, loaded from the
 #: cache (a Python entry costs ~45 ms; compiling the version again for Python cost a model file's
-#: ``orbit`` ~8 s).
+#: ``orbit`` ~8 s). A kernel only Python calls is one too where a cold start compiles it ahead
+#: (``integrate/compile_ahead.py``): its version then has the entry its first call needs.
 api_kernel = _kernel_decorator(always_entry=True, **KERNEL_OPTIONS)
 inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)

@@ -72,8 +72,7 @@ VARIATIONAL = Split(
         "stickslip.orbits.var_kernels._first_event": "I v v v v m f v M i v v v",
         "stickslip.orbits.var_kernels.contact_gradients": "v v i M i m m v z z z z",
         "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
-    },
-    from_python=("stickslip.orbits.var_kernels.contact_gradients", "stickslip.integrate.contacts.initial_modes"))
+    })
 
 #: Kind of the recorded transition each event kind ends in (+1 slip → stick, −1 stick → slip).
 _RECORDED_KIND = {V.EV_MARGIN: E.TRANSITION_TO_SLIP, V.EV_ZERO: E.TRANSITION_TO_STICK,

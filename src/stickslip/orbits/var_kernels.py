@@ -28,7 +28,7 @@ from ..integrate import dormand_prince as DP
 from ..model import csmath as csm
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
-from ..model.jit import inlined_kernel, kernel, loop
+from ..model.jit import api_kernel, inlined_kernel, kernel, loop
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, work_matrix, work_vectors
 
@@ -328,7 +328,7 @@ def indicator_gradient(s, cst, c, md, n2, out, z):
         z[j] = s[j]
 
 
-@kernel
+@api_kernel
 def contact_gradients(s, cst, c, md, n2, Dv, DF, DN, z, F, N, v):
     """Complex-step gradients of contact ``c`` at the float state ``s`` in the modes of ``cst``:
     ∂v_c/∂s into ``Dv`` (2 × 2n), ∂F_c/∂s into ``DF`` (2 × 2n; the stick multiplier if c sticks),
