@@ -17,14 +17,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import inlined_kernel, kernel
+from .jit import inlined_kernel
 from .kinematics import model_sizes
 from .physics import COMPLEX_STEP, rhs
 
 __all__ = ["state_jacobian", "state_jacobian_from_python", "acceleration_jacobian"]
 
 
-@kernel
+@inlined_kernel
 def state_jacobian(s, cst, md, J, z, dz):
     """J = ∂f/∂s (2n × 2n) of the right-hand side in the modes of ``cst`` at the float state ``s``.
 

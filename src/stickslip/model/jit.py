@@ -457,6 +457,7 @@ kernel = _kernel_decorator(**KERNEL_OPTIONS)
 api_kernel = _kernel_decorator(always_entry=True, **KERNEL_OPTIONS)
 inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
+inlined_loop = njit(cache=True, inline="always", error_model="numpy", no_cfunc_wrapper=True)
 
-__all__ = ["kernel", "api_kernel", "inlined_kernel", "loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
+__all__ = ["kernel", "api_kernel", "inlined_kernel", "loop", "inlined_loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
            "defined_in_package"]

@@ -23,7 +23,7 @@ from numba.extending import overload
 
 from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
 from ..model.derivatives import acceleration_jacobian, state_jacobian
-from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, loop
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
 from ..model.frame_pointers import is_pointer_class
 from ..model.kinematics import model_sizes
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
@@ -160,7 +160,7 @@ def _solve_inplace(A, b):
     return True
 
 
-@loop
+@inlined_loop
 def _newton_from(q, cst, md, free, max_iter):
     """Damped Newton on the forces at rest from ``q`` (changed in place).
 
@@ -252,42 +252,60 @@ def steady_sliding_point(md, free, max_iter):
     iterations : int
         Newton iterations in all.
     """
+    return _steady_sliding(md, free, max_iter)
+
+
+@inlined_loop
+def _steady_sliding(md, free, max_iter):
+    """:func:`steady_sliding_point`'s body, inlined into it and into :func:`steady_jacobian` (a
+    compiled call would link and optimise the complex-step physics below it once more)."""
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     cst = np.zeros(CST * nc)
     _sliding_modes(cst, nc)
     q = np.zeros(n)
-    status, rel, iterations = _newton_from(q, cst, md, free, max_iter)
-    if not rel <= CONTINUATION_ACCEPT:
-        mw = m.copy()
-        mdw = ModelData(mw, md.kin, md.law)
-        lam = 0.0
-        step = 0.125
-        qc = np.zeros(n)
-        qt = np.zeros(n)
-        while lam < 1.0:
-            trial = min(1.0, lam + step)
-            for c in range(nc):
-                o = contact_offsets(n, c)[0]
-                mw[o + C_N0] = trial * m[o + C_N0]
+    # One call of the Newton, inlined: the first pass is the full load from q = 0, later passes
+    # the load continuation, each from the previous load's solution.
+    mw = m.copy()
+    mdw = ModelData(mw, md.kin, md.law)
+    qc = np.zeros(n)
+    qt = np.zeros(n)
+    status = NEWTON_MAX_ITER
+    rel = np.inf
+    iterations = 0
+    full_load = True
+    lam = 0.0
+    step = 0.125
+    while full_load or lam < 1.0:
+        trial = 1.0 if full_load else min(1.0, lam + step)
+        for c in range(nc):
+            o = contact_offsets(n, c)[0]
+            mw[o + C_N0] = trial * m[o + C_N0]
+        for i in range(n):
+            qt[i] = qc[i]
+        # from the previous load's solution Newton converges in a few steps or not at all
+        st, rt, it = _newton_from(qt, cst, mdw, free, max_iter if full_load else min(max_iter, 20))
+        iterations += it
+        if full_load:
+            full_load = False
             for i in range(n):
-                qt[i] = qc[i]
-            # from the previous load's solution Newton converges in a few steps or not at all
-            st, rt, it = _newton_from(qt, cst, mdw, free, min(max_iter, 20))
-            iterations += it
-            if rt <= CONTINUATION_ACCEPT:
-                lam = trial
+                q[i] = qt[i]
+            status, rel = st, rt
+            if rel <= CONTINUATION_ACCEPT:
+                break
+        elif rt <= CONTINUATION_ACCEPT:
+            lam = trial
+            for i in range(n):
+                qc[i] = qt[i]
+                q[i] = qt[i]
+            status, rel = st, rt
+            step = min(2.0 * step, 0.25)
+        else:
+            step *= 0.5
+            if step < 1e-3:  # the equilibrium branch from N0 = 0 ends (fold) before the full load
                 for i in range(n):
-                    qc[i] = qt[i]
                     q[i] = qt[i]
-                status, rel = st, rt
-                step = min(2.0 * step, 0.25)
-            else:
-                step *= 0.5
-                if step < 1e-3:  # the equilibrium branch from N0 = 0 ends (fold) before the full load
-                    for i in range(n):
-                        q[i] = qt[i]
-                    return q, st, rt, iterations
+                return q, st, rt, iterations
     if rel <= CONTINUATION_ACCEPT:
         s = np.zeros(2 * n)
         for i in range(n):
@@ -310,7 +328,7 @@ def steady_jacobian(md, free, max_iter, tol, J):
     """
     n, nc, diagonal = model_sizes(md.kin, md.m)
     k = free.shape[0]
-    q, status, rel, _ = steady_sliding_point(md, free, max_iter)
+    q, status, rel, _ = _steady_sliding(md, free, max_iter)
     if not (rel <= tol) or status == NEWTON_NOT_SLIDING:
         for i in range(2 * k):
             for j in range(2 * k):
