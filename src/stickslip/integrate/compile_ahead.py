@@ -69,8 +69,7 @@ class Split:
     caller : str
         The kernel that calls them, compiled after both (its compile event spans the pair).
     signatures : mapping of str to str
-        Each kernel's argument codes (:data:`CODES`), separated by spaces; a kernel compiled for
-        several argument types (real and complex) has its versions separated by ``|``.
+        Each kernel's argument codes (:data:`CODES`), separated by spaces.
     """
 
     helper: tuple
@@ -78,11 +77,9 @@ class Split:
     caller: str
     signatures: Mapping
 
-    def signatures_of(self, name: str, md_type) -> list:
-        """The argument types (tuples) of each version of kernel ``name`` for model data of numba
-        type ``md_type``."""
-        return [tuple(md_type if code == "M" else CODES[code] for code in version.split())
-                for version in self.signatures[name].split("|")]
+    def signature(self, name: str, md_type) -> tuple:
+        """The argument types of kernel ``name`` for model data of numba type ``md_type``."""
+        return tuple(md_type if code == "M" else CODES[code] for code in self.signatures[name].split())
 
 
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.
@@ -124,9 +121,8 @@ def kernel_named(name: str):
 def _compile(split: Split, names, md_type) -> None:
     for name in names:
         kernel = kernel_named(name)
-        for signature in split.signatures_of(name, md_type):
-            with contextlib.suppress(numba.core.errors.NumbaError):
-                kernel.compile(signature)
+        with contextlib.suppress(numba.core.errors.NumbaError):
+            kernel.compile(split.signature(name, md_type))
 
 
 def compile_apart(md, split: Split, split_name: str) -> bool:
@@ -140,7 +136,7 @@ def compile_apart(md, split: Split, split_name: str) -> bool:
         return False
     _started.add((split_name, md_type))
     probe = split.helper[0]
-    if kernel_named(probe).available(split.signatures_of(probe, md_type)[0]):
+    if kernel_named(probe).available(split.signature(probe, md_type)):
         return False
     with tempfile.NamedTemporaryFile(suffix=".pkl", delete=False) as handle:
         path = Path(handle.name)

@@ -57,18 +57,17 @@ MATCH_TIME_TOL = 1e-6
 MAX_SEGMENT_STEPS = 1_000_000
 
 #: A cold start's variational kernels in two processes (:mod:`stickslip.integrate.compile_ahead`):
-#: the quasi-static direction's residual (real and complex) and the complex-step right-hand side
-#: (loaded where ``stability`` compiled it) in the helper; the event functions, the contact
-#: gradients of the saltation matrices and the starting modes here; the segment integrator, with
-#: the variational right-hand side inlined, then loads both.
+#: the variational right-hand side (with the complex-step physics under it) in the helper; the
+#: event functions, the contact gradients of the saltation matrices and the starting modes here;
+#: the segment integrator then loads both. A model file's ``orbit`` after its ``stability``, from
+#: an empty cache otherwise: the variational kernels in 14 s instead of 21 s.
 VARIATIONAL = Split(
-    helper=("stickslip.orbits.var_kernels.direction_residual", "stickslip.model.physics.rhs"),
+    helper=("stickslip.orbits.var_kernels.variational_rhs",),
     own=("stickslip.orbits.var_kernels.event_value", "stickslip.orbits.var_kernels._first_event",
          "stickslip.orbits.var_kernels.contact_gradients", "stickslip.integrate.contacts.initial_modes"),
     caller="stickslip.orbits.var_kernels.integrate_segment",
     signatures={
-        "stickslip.orbits.var_kernels.direction_residual": "z v i M f f | v v i M f f",
-        "stickslip.model.physics.rhs": "z v M z",
+        "stickslip.orbits.var_kernels.variational_rhs": "v v M i B v v z z v",
         "stickslip.orbits.var_kernels.event_value": "i i v f f v M",
         "stickslip.orbits.var_kernels._first_event": "I v v v v m f v M i v v v",
         "stickslip.orbits.var_kernels.contact_gradients": "v v i M i m m v z z z z",

@@ -146,7 +146,7 @@ def band_correction(s, cst, md, n2, Phi, out, z, gq):
                 out[n + i, col] += acc[i] * dtheta
 
 
-@inlined_kernel
+@kernel
 def variational_rhs(y, cst, md, n2, band, dy, s, z, dz, gq):
     """d/dt of y = [s, Φ]: ṡ = f(s), Φ̇ = J(s) Φ, in the modes of ``cst``.
 
@@ -261,8 +261,8 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
     n = y0.shape[0]
     nc = ev_kind.shape[0]
     y = y0.copy()
-    stages = np.empty((2, n))  # the stage states: rows 0 (stages 0–5) and 1 (stage 6, the step's end)
-    ynew = stages[1]
+    ynew = np.empty(n)
+    ytmp = np.empty(n)
     work = np.empty(n)
     Kst = np.empty((7, n))
     Q = np.empty((n, 4))
@@ -275,10 +275,10 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
         for i in range(n2):
             s[i] = y[i]
         g0[c] = event_value(ev_kind[c], c, s, ev_level[c], ev_e[c], cst, md)
+    variational_rhs(y, cst, md, n2, band, Kst[0], s, z, dz, gq)
     t = t0
     h = min(1e-4, t1 - t0)  # the controller grows it ×5 per step
     n_steps = 0
-    first_stage = 0  # stage 0 (the derivative at y) only before the first step: later steps reuse the last
     while t < t1:
         if n_steps >= max_steps:
             return 3, t, y, -1
@@ -286,16 +286,11 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
         h = min(h, t1 - t)
         if h <= 1e-15 * max(1.0, abs(t)):
             return 2, t, y, -1
-        # one call site of the inlined variational right-hand side (each site types and lowers its body)
-        for stage in range(first_stage, 7):
-            row = 1 if stage == 6 else 0
-            if stage == 0:
-                for i in range(n):
-                    stages[0, i] = y[i]
-            else:
-                DP.stage_state(y, Kst, h, np.int64(stage), stages[row])
-            variational_rhs(stages[row], cst, md, n2, band, Kst[stage], s, z, dz, gq)
-        first_stage = 1
+        for stage in range(1, 6):
+            DP.stage_state(y, Kst, h, stage, ytmp)
+            variational_rhs(ytmp, cst, md, n2, band, Kst[stage], s, z, dz, gq)
+        DP.stage_state(y, Kst, h, np.int64(6), ynew)
+        variational_rhs(ynew, cst, md, n2, band, Kst[6], s, z, dz, gq)
         total = 0.0
         for i in range(n):
             sc = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
