@@ -22,6 +22,7 @@ import argparse
 import io
 import json
 import multiprocessing
+import os
 import subprocess
 import sys
 import tarfile
@@ -76,6 +77,9 @@ def main() -> None:
             if ic is not None:
                 kw["ic"] = ic
             cases = [({}, args.t_end)]
+        # each worker compiles in its own process: a cold start's helper names kernels by the
+        # package's import name (``stickslip.…``), which is the working tree's, not the baseline's
+        os.environ["STICKSLIP_COMPILE_PROCESSES"] = "1"
         context = multiprocessing.get_context("spawn")
         workers = []
         for name in ("stickslip_baseline", "stickslip"):

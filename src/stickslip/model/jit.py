@@ -41,8 +41,9 @@ minute): numba gives each kernel that is not inlined a module of its own, into w
 the code of every kernel it calls, and LLVM optimises and emits all of that code again there.
 A thin kernel over a large one therefore costs the large one's optimisation once more: such
 kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
-``contacts.event_value``, ``transitions.settle``, the steady-sliding Newton's
-residual and Jacobian, the variational right-hand side's band correction), a compiled wrapper that
+``contacts.event_value``, ``transitions.settle``, the steady-sliding Newton (called at one site;
+``inlined_loop``, as it allocates), its residual and Jacobian, the variational right-hand side's
+band correction), a compiled wrapper that
 only allocates is Python instead (``event_loop.integrate_event``), and the stick solve
 (``forces.solve_stick_rows``) is one kernel called from five places rather than inlined into
 each. A kernel gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`),
