@@ -19,6 +19,9 @@ import os
 # one core: set before numpy/numba load their thread pools
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ[var] = "1"
+# compile in this process: a cold start's helper process names kernels by the import name
+# ``stickslip.…``, the working tree's, not the baseline's imported beside it
+os.environ["STICKSLIP_COMPILE_PROCESSES"] = "1"
 
 import argparse  # noqa: E402
 import importlib  # noqa: E402

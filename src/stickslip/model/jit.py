@@ -345,8 +345,22 @@ def _key_by_user_code(index_key):
 
 _wrap_caching("Cache", "_index_key", _key_by_user_code)
 
+def _shared_flag(name: str) -> threading.local:
+    """A thread-local kept on numba's caching module, so that every copy of this module in one
+    process reads and writes the same one: numba's cache key function is replaced once, by the
+    first copy (:func:`_wrap_caching`), and reads this flag for the kernels of every copy (a
+    benchmark imports a baseline revision of the package beside the working tree)."""
+    from numba.core import caching
+
+    flag = getattr(caching, name, None)
+    if flag is None:
+        flag = threading.local()
+        setattr(caching, name, flag)
+    return flag
+
+
 #: Whether the compilation under way on this thread makes a kernel without its Python entry.
-_ENTRY = threading.local()
+_ENTRY = _shared_flag("_stickslip_without_entry")
 
 
 class KernelDispatcher(CPUDispatcher):
