@@ -41,13 +41,12 @@ minute): numba gives each kernel that is not inlined a module of its own, into w
 the code of every kernel it calls, and LLVM optimises and emits all of that code again there.
 A thin kernel over a large one therefore costs the large one's optimisation once more: such
 kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
-``contacts.event_value``, ``transitions.settle``, the steady-sliding Newton (called at one site;
-``inlined_loop``, as it allocates), its residual and Jacobian, the variational right-hand side's
-band correction), a compiled wrapper that
-only allocates is Python instead (``event_loop.integrate_event``), and the stick solve
-(``forces.solve_stick_rows``) is one kernel called from five places rather than inlined into
-each. A kernel gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`),
-the physics and the starting modes that both the event loop and the analyses' Python call always
+``contacts.event_value``, ``transitions.settle``, the steady-sliding Newton (called at one
+site; ``inlined_loop``, as it allocates), its residual and Jacobian, the variational right-hand
+side's band correction), a compiled wrapper that only allocates is Python instead
+(``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is one
+kernel called from five places rather than inlined into each. A kernel gets numba's Python
+entry only when Python calls it (:class:`KernelDispatcher`), the physics and the starting modes that both the event loop and the analyses' Python call always
 (``api_kernel``: one version, compiled by ``simulate`` and loaded by ``stability`` and ``orbit``),
 and no kernel a C-callable wrapper. numba's inliner copies an inlined callee's scope once per
 inlined call here, not once per block, and translates an inlined callee once per function, not
@@ -344,6 +343,7 @@ def _key_by_user_code(index_key):
 
 
 _wrap_caching("Cache", "_index_key", _key_by_user_code)
+
 
 def _shared_flag(name: str) -> threading.local:
     """A thread-local kept on numba's caching module, so that every copy of this module in one
