@@ -46,9 +46,10 @@ site; ``inlined_loop``, as it allocates), its residual and Jacobian, the variati
 side's band correction), a compiled wrapper that only allocates is Python instead
 (``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is one
 kernel called from five places rather than inlined into each. A kernel gets numba's Python
-entry only when Python calls it (:class:`KernelDispatcher`), the physics and the starting modes that both the event loop and the analyses' Python call always
-(``api_kernel``: one version, compiled by ``simulate`` and loaded by ``stability`` and ``orbit``),
-and no kernel a C-callable wrapper. numba's inliner copies an inlined callee's scope once per
+entry only when Python calls it (:class:`KernelDispatcher`), the physics and the starting modes
+that both the event loop and the analyses' Python call always (``api_kernel``: one version,
+compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a C-callable
+wrapper. numba's inliner copies an inlined callee's scope once per
 inlined call here, not once per block, and translates an inlined callee once per function, not
 once per call site; numba's compiler flags hash and compare without reading every option
 (:mod:`.compile_speedups`, installed on import). A slice assignment from an
