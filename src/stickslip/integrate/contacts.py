@@ -31,7 +31,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
-from ..model.jit import api_kernel, inlined_kernel, kernel
+from ..model.jit import api_kernel, inlined_kernel, kernel, standalone
 from ..model.kinematics import model_sizes, rigid_kernel
 from ..model.impact import IMPACT_INCONSISTENT, impact, remove_gap_rate, restitution_of
 from ..model.normal import gap_and_rate, gap_with_rate, is_open, is_rigid, starts_open
@@ -187,6 +187,7 @@ def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
     return probed_crossing(-1.0, kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N)
 
 
+@standalone
 @kernel
 def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
     """:func:`first_crossing` with one more sample point at θ = ``probe`` ∈ (0, 1) (−1.0: none),
@@ -354,6 +355,7 @@ def arrival_speed(y, n, rtol, atol):
     return max(STICK_SPEED_TOL, 10.0 * (atol + rtol * qd))
 
 
+@standalone
 @kernel
 def try_stick(y, cst, c, md, speed_tol, F, N):
     """At a zero of contact ``c``'s slip velocity: project and test stick admissibility (Eq. 10).
@@ -445,6 +447,7 @@ def close_contact(y, cst, c, md, rtol, atol, F, N):
     return False
 
 
+@standalone
 @api_kernel
 def initial_modes(y, cst, md, rtol, atol, F, N):
     """Modes a state starts in: each contact sticks if its v = 0 (to STICK_SPEED_TOL) and the joint

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, offsets
-from ..model.jit import inlined_kernel, kernel
+from ..model.jit import inlined_kernel, kernel, standalone
 from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
 from . import contacts as E
@@ -60,6 +60,7 @@ MAX_HOMING_STEP = 1e-3
 HOMING_SHORTFALL = 1e-2
 
 
+@standalone
 @kernel
 def dp_step(y, k1, h, cst, md, Kst, ynew, ytmp):
     """One Dormand–Prince step from y with k1 = f(y); fills the stages Kst[0:7] and ynew.
@@ -108,6 +109,7 @@ def store_sample(idx, y, cst, md, F, N, v, out_s, out_mode, out_F):
         out_F[idx, i] = F[i]
 
 
+@standalone
 @kernel
 def write_samples(idx, tau_to, y0, Q, h, tau_step, t_base, cst, md, sample_times, out_s, out_mode, out_F,
                   work, F, N, v):

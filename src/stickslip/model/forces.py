@@ -25,7 +25,7 @@ import numpy as np
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
-from .jit import inlined_kernel, kernel
+from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, rigid_kernel
 from .linalg import solve_in_order, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
@@ -220,6 +220,7 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     return a00, a01, a11
 
 
+@standalone
 @kernel
 def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     """Stick multipliers of the sticking contacts and contact ``extra`` (F written for those), by
@@ -384,6 +385,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
     return smallest
 
 
+@standalone
 @kernel
 def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
     """Slip forces of the contacts inside the low-speed band (after those with the exact direction,
@@ -414,6 +416,7 @@ def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
         add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
 
 
+@standalone
 @kernel
 def general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     """:func:`general_forces_body` as a call (for the queries; :func:`~stickslip.model.physics.general_rhs`

@@ -45,9 +45,11 @@ kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
 site; ``inlined_loop``, as it allocates), its residual and Jacobian, the variational right-hand
 side's band correction), a compiled wrapper that only allocates is Python instead
 (``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is one
-kernel called from five places rather than inlined into each. A kernel gets numba's Python
-entry only when Python calls it (:class:`KernelDispatcher`), the physics and the starting modes
-that both the event loop and the analyses' Python call always (``api_kernel``: one version,
+kernel called from five places rather than inlined into each. The largest kernels are
+:func:`standalone` (:mod:`.linking`): their callers call their one compiled copy instead of
+linking a copy in. A kernel gets numba's Python entry only when Python calls it
+(:class:`KernelDispatcher`), the physics and the starting modes that both the event loop and
+the analyses' Python call always (``api_kernel``: one version,
 compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a C-callable
 wrapper. numba's inliner copies an inlined callee's scope once per
 inlined call here, not once per block, and translates an inlined callee once per function, not
@@ -77,9 +79,11 @@ from numba import njit
 from numba.core import sigutils
 from numba.core.registry import CPUDispatcher
 
-from . import compile_speedups
+from . import compile_speedups, linking
+from .linking import standalone
 
 compile_speedups.install()
+linking.install()
 
 
 def _wrap_caching(class_name: str, method: str, make) -> None:
@@ -422,8 +426,13 @@ class KernelDispatcher(CPUDispatcher):
             _ENTRY.without = outer
             self._compiler.targetoptions = self.targetoptions
 
+    #: Whether callers call this kernel's one compiled copy instead of linking it (:func:`linking.standalone`).
+    standalone = False
+
     def add_overload(self, cres):
         args = tuple(cres.signature.args)
+        if self.standalone:
+            linking.mark_library(self, cres, with_entry=not getattr(_ENTRY, "without", False))
         if getattr(_ENTRY, "without", False):
             self.overloads[args] = cres  # for kernels only: not in the table that Python calls go through
             return
@@ -475,5 +484,5 @@ inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)
 inlined_loop = njit(cache=True, inline="always", error_model="numpy", no_cfunc_wrapper=True)
 
-__all__ = ["kernel", "api_kernel", "inlined_kernel", "loop", "inlined_loop", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
+__all__ = ["kernel", "api_kernel", "inlined_kernel", "loop", "inlined_loop", "standalone", "KERNEL_OPTIONS", "KernelDispatcher", "track_user_code",
            "defined_in_package"]

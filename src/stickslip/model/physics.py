@@ -50,7 +50,7 @@ from .bundle import CST, H_BAND, offsets
 from .forces import (add_contact_force, general_forces, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
-from .jit import api_kernel, inlined_kernel, kernel
+from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
@@ -97,6 +97,7 @@ def write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds):
         ds[2 * n + 1] = damping
 
 
+@standalone
 @kernel
 def general_rhs(s, cst, md, ds):
     """:func:`rhs` for any mix of modes (the path of stick and of the low-speed band)."""
@@ -125,6 +126,7 @@ def rhs_body(s, cst, md, ds):
         general_rhs(s, cst, md, ds)
 
 
+@standalone
 @api_kernel
 def rhs(s, cst, md, ds):
     """State derivative ds/dt = [q̇, M⁻¹ (f0 − C q̇ − K q + Σ G_cᵀ F_c)] in the modes of ``cst``.
@@ -145,6 +147,7 @@ def export_contacts(nc, N, F, v, N_out, F_out, v_out):
             v_out[2 * c + i] = v[2 * c + i]
 
 
+@standalone
 @api_kernel
 def contact_forces(s, cst, md, F_out, N_out, v_out):
     """Each contact's friction force F (2 nc,) [N], normal force N (nc,) [N] and slip velocity
@@ -172,6 +175,7 @@ def rhs_and_forces(s, cst, md, ds, F_out, N_out, v_out):
     export_contacts(nc, N, F, v, N_out, F_out, v_out)
 
 
+@standalone
 @api_kernel
 def stick_forces(s, cst, extra, md, F_out, N_out):
     """Stick multipliers F (2 nc,) [N] of the sticking contacts and contact ``extra`` (≥ 0, or −1),
@@ -317,6 +321,7 @@ def slip_velocity_and_rate(s, ds, c, md):
     return v0, v1, a0, a1
 
 
+@standalone
 @kernel
 def band_direction(s, cst, c, md, speed):
     """Slip direction (e0, e1) of slipping contact ``c`` inside the low-speed band (|v| = ``speed``):
@@ -352,6 +357,7 @@ def slip_direction(s, cst, c, md, v0, v1):
     return band_direction(s, cst, c, md, speed)
 
 
+@standalone
 @api_kernel
 def project_velocities(s, cst, extra, md):
     """Project q̇ onto v_c = 0 for every sticking contact and contact ``extra`` (≥ 0; −1: none),

@@ -28,7 +28,7 @@ from ..integrate import dormand_prince as DP
 from ..model import csmath as csm
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
-from ..model.jit import api_kernel, inlined_kernel, kernel, loop
+from ..model.jit import api_kernel, inlined_kernel, kernel, loop, standalone
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, work_matrix, work_vectors
 
@@ -75,6 +75,7 @@ def event_value(kind, c, s, level, e0, cst, md):
     return 1.0
 
 
+@standalone
 @kernel
 def direction_residual(s, cst, c, md, ct, st):
     """(g, ∂g/∂θ, μN, k) of 2-D contact ``c`` slipping inside the low-speed band at the direction
@@ -146,6 +147,7 @@ def band_correction(s, cst, md, n2, Phi, out, z, gq):
                 out[n + i, col] += acc[i] * dtheta
 
 
+@standalone
 @kernel
 def variational_rhs(y, cst, md, n2, band, dy, s, z, dz, gq):
     """d/dt of y = [s, Φ]: ṡ = f(s), Φ̇ = J(s) Φ, in the modes of ``cst``.
@@ -178,6 +180,7 @@ def variational_rhs(y, cst, md, n2, band, dy, s, z, dz, gq):
         band_correction(s, cst, md, n2, Phi, out, z, gq)
 
 
+@standalone
 @kernel
 def _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, s):
     """(θ, contact) of the earliest event in the accepted step from ``y`` (θ ∈ (0, 1]), or (−1, −1).
@@ -328,6 +331,7 @@ def indicator_gradient(s, cst, c, md, n2, out, z):
         z[j] = s[j]
 
 
+@standalone
 @api_kernel
 def contact_gradients(s, cst, c, md, n2, Dv, DF, DN, z, F, N, v):
     """Complex-step gradients of contact ``c`` at the float state ``s`` in the modes of ``cst``:
