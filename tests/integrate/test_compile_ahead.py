@@ -33,11 +33,12 @@ def _available(split, name, md_type) -> bool:
 @pytest.mark.parametrize("model", ["two-plates", MODEL_FILE])
 def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     """Every kernel the two processes compile ahead, with the argument types written in the
-    split, is one the event loop calls (else the helper would compile in vain): once the loop is
-    compiled (here or, loaded from the cache, by another process) that version of each is in this
-    process or in the cache. A wrong code is not."""
+    split, is one the event loop or a run's results call (else the helper would compile in vain):
+    once they are compiled (here or, loaded from the cache, by another process) that version of
+    each is in this process or in the cache. A wrong code is not."""
     system = stickslip.load_model(model)
-    stickslip.simulate(system, 0.5)
+    run = stickslip.simulate(system, 0.5)
+    assert run.slip_velocity.shape[0] == run.normal_force.shape[0] == run.t.size  # the results' kernels
     md_type = numba.typeof(system.data)
     split = compile_ahead.EVENT_LOOP
     for name in split.helper + split.own:
@@ -103,6 +104,19 @@ def test_a_cold_start_in_two_processes_runs_alike_and_compiles_the_stick_solve_o
     assert cold["states"] == hashlib.sha256(np.ascontiguousarray(here.states).tobytes()).hexdigest()
     assert "try_stick" not in cold["compiled"] and "stick_forces" not in cold["compiled"]
     assert "rhs" in cold["compiled"] and "event_loop" in cold["outermost"]
+
+
+def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_data():
+    """Where the helper is not forked (not Linux) it is a new interpreter that reads the model data
+    pickled to a file; it ends with status 0 and the file is removed."""
+    system = stickslip.load_model("belt")
+    stickslip.simulate(system, 0.5)  # its kernels are here or cached: the helper loads them
+    helper = compile_ahead._spawned_helper(system.data, "stickslip.integrate.compile_ahead:EVENT_LOOP")
+    assert helper is not None and helper.path.exists()
+    helper.wait(300.0)
+    assert helper.process.returncode == 0
+    helper.end()
+    assert not helper.path.exists()
 
 
 def test_the_helper_is_off_on_request(monkeypatch):
