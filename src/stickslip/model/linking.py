@@ -8,15 +8,15 @@ optimises it once more: on a cold start most of LLVM's time went into code it ha
 optimised. A *standalone* kernel (:func:`standalone`) is not copied: its callers declare it and
 call the one compiled copy, which the JIT engine resolves by its symbol when it loads a caller.
 Only kernels that LLVM would not inline are made standalone (those that a caller's optimised
-module kept as a function of their own), so the callers' code is the code they had, less the copies:
-the same results bit for bit.
+module kept as a function of their own), so the callers' code is the code they had, less the
+copies: the same results bit for bit.
 
 numba's on-disk cache keeps each kernel's object code, which now refers to the standalone
 kernels it calls by their symbols. A cached caller is loaded only after each of those kernels is
 loaded (from the cache or compiled) under the very symbol the caller refers to: each cache entry
-records them (:func:`_record_dependencies`), and an entry whose kernels no longer carry those symbols
-(a callee compiled again by another process since) counts as a miss and is compiled again, never
-loaded with a dangling reference, which would end the process.
+records them (:func:`_record_dependencies`), and an entry whose callee is not there under that
+symbol (a version that kept numba's own numbering, :func:`_stable_symbols`) counts as a miss and
+is compiled again, never loaded with a dangling reference, which would end the process.
 """
 
 from __future__ import annotations
