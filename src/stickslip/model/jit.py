@@ -92,14 +92,10 @@ def _wrap_caching(class_name: str, method: str, make) -> None:
     try:
         from numba.core import caching
         owner = getattr(caching, class_name)
-        original = getattr(owner, method)
+        getattr(owner, method)
     except (ImportError, AttributeError):  # pragma: no cover - a numba that caches differently
         return
-    if getattr(original, "_stickslip_wrapped", False):
-        return
-    wrapped = make(original)
-    wrapped._stickslip_wrapped = True
-    setattr(owner, method, wrapped)
+    linking.wrap_once(owner, method, make)
 
 
 class _StandIn:

@@ -180,23 +180,25 @@ def _stale_is_a_miss(load):
     return wrapped
 
 
+def wrap_once(owner, name: str, make) -> None:
+    """Replace ``owner.<name>`` by ``make(original)``, once per process however many copies of the
+    package it imports (a classmethod stays one)."""
+    attribute = owner.__dict__.get(name)
+    method = isinstance(attribute, classmethod)
+    original = attribute.__func__ if method else getattr(owner, name)
+    if getattr(original, "_stickslip_wrapped", False):
+        return
+    wrapped = make(original)
+    wrapped._stickslip_wrapped = True
+    setattr(owner, name, classmethod(wrapped) if method else wrapped)
+
+
 def install() -> None:
-    """Install the wrappers of numba's linking and caching (once per process, however many copies
-    of the package it imports)."""
+    """Install the wrappers of numba's linking and caching (:func:`wrap_once`)."""
     from numba.core import caching, codegen, funcdesc
 
-    original = funcdesc.FunctionDescriptor.__dict__["_from_python_function"].__func__
-    if not getattr(original, "_stickslip_wrapped", False):
-        wrapped = _stable_symbols(original)
-        wrapped._stickslip_wrapped = True
-        funcdesc.FunctionDescriptor._from_python_function = classmethod(wrapped)
-    for owner, name, make in ((codegen.CPUCodeLibrary, "finalize", _record_dependencies),
-                              (caching.CompileResultCacheImpl, "reduce", _reduce_with_dependencies),
-                              (caching.CompileResultCacheImpl, "rebuild", _rebuild_after_dependencies),
-                              (caching.Cache, "_load_overload", _stale_is_a_miss)):
-        original = getattr(owner, name)
-        if getattr(original, "_stickslip_wrapped", False):
-            continue
-        wrapped = make(original)
-        wrapped._stickslip_wrapped = True
-        setattr(owner, name, wrapped)
+    wrap_once(funcdesc.FunctionDescriptor, "_from_python_function", _stable_symbols)
+    wrap_once(codegen.CPUCodeLibrary, "finalize", _record_dependencies)
+    wrap_once(caching.CompileResultCacheImpl, "reduce", _reduce_with_dependencies)
+    wrap_once(caching.CompileResultCacheImpl, "rebuild", _rebuild_after_dependencies)
+    wrap_once(caching.Cache, "_load_overload", _stale_is_a_miss)
