@@ -106,6 +106,76 @@ def test_a_cold_start_in_two_processes_runs_alike_and_compiles_the_stick_solve_o
     assert "rhs" in cold["compiled"] and "event_loop" in cold["outermost"]
 
 
+OPEN_AT_START = textwrap.dedent("""
+    import json, os
+    from numba.core import event
+    import stickslip
+    from stickslip.integrate.driver import SimulationError
+    from stickslip.integrate import runner
+    from stickslip.model import model_from_spec
+    started = []
+    start = runner.start_callees
+    runner.start_callees = lambda md: started.append(start(md)) or started[-1]
+    compiled = []
+    class Every(event.Listener):
+        def on_start(self, ev):
+            compiled.append(ev.data["dispatcher"].py_func.__name__)
+        def on_end(self, ev):
+            pass
+    spec = {"dofs": ["x"], "mass": [[1.0]], "damping": [[0.1]], "stiffness": [[1.0]],
+            "contact": [{"tangent": [[1.0]], "drive": [1.5], "normal_force": 1.0, "normal_gradient": [-2.0],
+                         "friction": {"law": "coulomb", "mu_k": 0.8, "delta_mu": 0.2}}]}
+    try:
+        with event.install_listener("numba:compile", Every()):
+            stickslip.simulate(model_from_spec(spec), 1.0, ic={"x": 0.6})
+        refused = False
+    except SimulationError:
+        refused = True
+    try:
+        os.waitpid(-1, os.WNOHANG)
+        children = True
+    except ChildProcessError:
+        children = False
+    print(json.dumps({"refused": refused, "children": children, "compiled": compiled,
+                      "helper": started[0] is not None}))
+""")
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="the helper process runs only with two or more cores")
+def test_a_cold_start_whose_contact_is_open_at_the_start_ends_its_helper(tmp_path):
+    """The helper starts before the check of the contacts' loads: where a contact is open at the
+    start, the run is refused without compiling the loop, and the helper is gone."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), STICKSLIP_COMPILE_PROCESSES="2")
+    out = subprocess.run([sys.executable, "-c", OPEN_AT_START], env=env, capture_output=True, text=True,
+                         check=True, timeout=600)
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    assert result["helper"] and result["refused"] and not result["children"]
+    assert "contact_lost" in result["compiled"] and "event_loop" not in result["compiled"]
+
+
+def test_a_cold_starts_meanwhile_work_runs_once_before_it_waits_for_the_helper():
+    """:func:`compile_ahead.meanwhile` work runs in the first cold start inside its block, after
+    this side's kernels and before the wait; an error in it is ignored; outside the block it is gone."""
+    calls = []
+
+    class Helper:
+        def wait(self, timeout):
+            calls.append("wait")
+
+        def end(self):
+            calls.append("end")
+
+    split = compile_ahead.Split(helper=(), own=(), caller=compile_ahead.EVENT_LOOP.caller, signatures={})
+    with compile_ahead.meanwhile(lambda: calls.append("work")), compile_ahead.meanwhile(lambda: 1 / 0):
+        for _ in range(2):
+            with compile_ahead.ColdStart(split, None, Helper()) as cold:
+                cold.finish()
+    assert calls == ["work", "wait", "end", "wait", "end"]
+    with compile_ahead.ColdStart(split, None, Helper()) as cold:
+        cold.finish()
+    assert calls[-2:] == ["wait", "end"] and calls.count("work") == 1
+
+
 def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_data():
     """Where the helper is not forked (not Linux) it is a new interpreter that reads the model data
     pickled to a file; it ends with status 0 and the file is removed."""

@@ -13,7 +13,22 @@ from ..files import write_output
 from ..integrate.interrupt import finish_first
 from ._kept import keeps, keeps_figure
 
-__all__ = ["draw_figure", "write_result"]
+__all__ = ["draw_figure", "write_result", "prepare_outputs"]
+
+
+def prepare_outputs(figure: bool) -> None:
+    """Import what writes a run's outputs: xarray (with the array types it looks for on its first
+    variable), the NetCDF writer and, with ``figure``, matplotlib's figure and Agg canvas. A command
+    runs it while a cold start's helper compiles (:func:`stickslip.integrate.compile_ahead.meanwhile`)."""
+    import h5netcdf  # noqa: F401
+    import numpy as np
+    import xarray
+
+    xarray.Variable("x", np.zeros(1))
+    if figure:
+        from ..plot._common import agg_figure
+
+        agg_figure((1.0, 1.0))
 
 
 def draw_figure(out: Path, draw: Callable[[Path], object], *, overwrite: bool, inputs: dict | None = None,

@@ -11,6 +11,7 @@ stops without drawing the figure.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from pathlib import Path
@@ -22,6 +23,7 @@ from rich.table import Table
 from rich.text import Text
 
 from ..attractors import run_summary, simulate_until_settled
+from ..integrate.compile_ahead import meanwhile
 from ..integrate.driver import simulate as run_simulation
 from ..files import netcdf_writer, write_output
 from ..integrate.interrupt import finish_first, on_ctrl_c, stop_if_interrupted
@@ -34,7 +36,7 @@ from ._app import (CLIError, app, build_system, check_finite, check_outputs, che
 from ._groups import grouped
 from ._kept import keeps, on_interrupt
 from ._options import Model, ModelChanges, NoPlot, Overwrite, Plates, SampleRate, Tolerances
-from ._outputs import draw_figure
+from ._outputs import draw_figure, prepare_outputs
 
 #: Most steps a run may need: ``--dt`` is the fixed step, or the largest step of ``event``. At about
 #: 0.5 µs a step (measured: 5e7 fixed steps in 23 s) this is hours of computing; a step that
@@ -226,7 +228,8 @@ def simulate(
                   + (f"; overridden: {', '.join(overridden)}" if overridden else ""))
     _warn_aliasing(system, settings["sample_rate"])
 
-    with on_ctrl_c(partial=True):  # Ctrl-C ends the run with the part done, which is written below
+    prepare = functools.partial(prepare_outputs, not no_plot) if write else lambda: None
+    with on_ctrl_c(partial=True), meanwhile(prepare):  # Ctrl-C ends the run with the part done, written below
         if duration is None:
             settled = simulate_until_settled(system, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
             traj, verdict = settled.trajectory, settled.attractor

@@ -18,10 +18,14 @@ Two splits:
   step's (the right-hand side, the Dormand–Prince step, the crossings' probe, the samples) here. On two
   cores, from an empty cache: the plates' ``simulate`` −17 %, a model file's −18 %. The two
   subtrees share ``general_forces``, which both compile: the split is as even as the loop's call
-  tree allows, and the loop's own body (a third of the time) compiles after both. The helper
-  also compiles the kernels that a run's results call after the loop (each contact's slip
-  velocity and normal force at the samples), which this process would compile after the run:
-  forked, it is done with them before this process is done with its subtree.
+  tree allows, and the loop's own body compiles after both. The helper also compiles the
+  kernels that a run's results call after the loop (each contact's slip velocity and normal
+  force at the samples) and the loop's small callees (the error norm, the dense-output
+  coefficients, the slip velocity's rate, the release after a transition), this process the cut
+  of a step at an event: what neither side compiles, the loop compiles alone. The helper starts
+  before the run checks that no contact is open at the start (:class:`ColdStart`: a refused run
+  ends it), and this process, done with its side, does the command's :func:`meanwhile` work
+  (the CLI imports what writes its outputs) while the helper finishes.
 * the variational equations of the orbit tools, declared beside them
   (:data:`stickslip.orbits.linear_flow.VARIATIONAL`).
 
@@ -52,7 +56,8 @@ import numba
 from numba import types
 from numba.core import event
 
-__all__ = ["Split", "EVENT_LOOP", "CODES", "compile_apart", "compile_callees", "enabled", "kernel_named"]
+__all__ = ["Split", "EVENT_LOOP", "CODES", "ColdStart", "start_apart", "compile_apart", "start_callees", "compile_callees",
+           "meanwhile", "enabled", "kernel_named"]
 
 #: Argument codes: v float64[::1], m float64[:, ::1], z complex128[::1], b int8[::1],
 #: I int64[::1], i int64, f float64, B bool, M the model data.
@@ -93,9 +98,14 @@ EVENT_LOOP = Split(
     helper=("stickslip.integrate.contacts.try_stick", "stickslip.integrate.contacts.release_most_overloaded",
             "stickslip.model.physics.contact_forces", "stickslip.model.physics.band_direction",
             "stickslip.integrate.contacts.initial_modes", "stickslip.integrate.result._slip_velocities",
-            "stickslip.integrate.result._normal_forces"),
+            "stickslip.integrate.result._normal_forces", "stickslip.integrate.transitions.settle",
+            "stickslip.integrate.event_loop.error_norm", "stickslip.model.physics.slip_velocity_and_rate",
+            "stickslip.integrate.dormand_prince.dense_coefficients", "stickslip.integrate.contacts.slip_event_possible",
+            "stickslip.integrate.contacts.time_to_zero_of", "stickslip.integrate.contacts.all_finite",
+            "stickslip.integrate.event_loop.homing_left"),
     own=("stickslip.model.physics.rhs", "stickslip.integrate.event_loop.dp_step",
-         "stickslip.integrate.contacts.probed_crossing", "stickslip.integrate.event_loop.write_samples"),
+         "stickslip.integrate.contacts.probed_crossing", "stickslip.integrate.event_loop.write_samples",
+         "stickslip.integrate.event_loop.cut_step"),
     caller="stickslip.integrate.event_loop.event_loop",
     signatures={
         "stickslip.integrate.contacts.try_stick": "v v i M f v v",
@@ -109,6 +119,15 @@ EVENT_LOOP = Split(
         "stickslip.integrate.event_loop.write_samples": "i f v m f f f v M v m b m v v v v",
         "stickslip.integrate.result._slip_velocities": "m M i",
         "stickslip.integrate.result._normal_forces": "m b M i",
+        "stickslip.integrate.transitions.settle": "v v M v v f v b b m i I",
+        "stickslip.integrate.event_loop.error_norm": "v v m f M f f",
+        "stickslip.model.physics.slip_velocity_and_rate": "v v i M",
+        "stickslip.integrate.dormand_prince.dense_coefficients": "m m",
+        "stickslip.integrate.contacts.slip_event_possible": "f f f f",
+        "stickslip.integrate.contacts.time_to_zero_of": "f f f f",
+        "stickslip.integrate.contacts.all_finite": "v",
+        "stickslip.integrate.event_loop.homing_left": "I",
+        "stickslip.integrate.event_loop.cut_step": "f i v m f f f v M v m b m v v v v",
     })
 
 _started: set = set()
@@ -134,32 +153,79 @@ def _compile(split: Split, names, md_type) -> None:
             kernel.compile(split.signature(name, md_type))
 
 
-def compile_apart(md, split: Split, split_name: str) -> bool:
-    """Compile ``split``'s kernels for the model data ``md`` in two processes where that is a cold
-    start (module docstring); returns whether a helper ran. Once per split, model class and process.
+class ColdStart:
+    """A split's helper at work (:func:`start_apart`): :meth:`finish` compiles this process's side
+    and waits for the helper; :meth:`end` stops a helper that is still running (use as a context
+    manager, so that an error or Ctrl-C on this side ends it)."""
+
+    def __init__(self, split: Split, md_type, helper):
+        self.split, self.md_type, self.helper = split, md_type, helper
+
+    def finish(self) -> None:
+        """Compile this process's kernels, run the :func:`meanwhile` work, then wait for the helper."""
+        caller = kernel_named(self.split.caller)
+        # one outermost compile event for the pair, so the time waited counts as compiling
+        with event.trigger_event("numba:compile", data={"dispatcher": caller, "args": (), "return_type": None}):
+            _compile(self.split, self.split.own, self.md_type)
+            while _meanwhile:
+                with contextlib.suppress(Exception):  # preparation only: the same work fails again where it is due
+                    _meanwhile.pop(0)()
+            self.helper.wait(HELPER_TIMEOUT_S)
+
+    def end(self) -> None:
+        self.helper.end()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.end()
+
+
+def start_apart(md, split: Split, split_name: str) -> ColdStart | None:
+    """Start the helper of ``split`` for the model data ``md`` where that is a cold start (module
+    docstring); None where it is not, or no helper can run. Once per split, model class and process.
 
     ``split_name`` is where a helper started as a new interpreter finds ``split``:
     ``"module:attribute"``.
     """
     md_type = numba.typeof(md)
     if (split_name, md_type) in _started or not enabled():
-        return False
+        return None
     _started.add((split_name, md_type))
     probe = split.helper[0]
     if kernel_named(probe).available(split.signature(probe, md_type)):
-        return False
+        return None
     helper = _forked_helper(split, md_type) if _FORK else _spawned_helper(md, split_name)
-    if helper is None:
+    return None if helper is None else ColdStart(split, md_type, helper)
+
+
+def compile_apart(md, split: Split, split_name: str) -> bool:
+    """Compile ``split``'s kernels for ``md`` in two processes where that is a cold start
+    (:func:`start_apart`, then :meth:`ColdStart.finish`); returns whether a helper ran."""
+    cold = start_apart(md, split, split_name)
+    if cold is None:
         return False
-    caller = kernel_named(split.caller)
-    try:
-        # one outermost compile event for the pair, so the time waited counts as compiling
-        with event.trigger_event("numba:compile", data={"dispatcher": caller, "args": (), "return_type": None}):
-            _compile(split, split.own, md_type)
-            helper.wait(HELPER_TIMEOUT_S)
-    finally:
-        helper.end()  # interrupted while waiting, or past the timeout: the helper ends with us
+    with cold:
+        cold.finish()
     return True
+
+
+_meanwhile: list = []
+
+
+@contextlib.contextmanager
+def meanwhile(work):
+    """Within the block, a cold start's :meth:`ColdStart.finish` calls ``work()`` once, in this
+    process, after compiling its own kernels and before waiting for the helper: work the command
+    does later anyway (the CLI imports what writes its outputs), which then costs no time where
+    the helper's side is the longer one. Errors of ``work`` are ignored there."""
+    _meanwhile.append(work)
+    try:
+        yield
+    finally:
+        with contextlib.suppress(ValueError):
+            _meanwhile.remove(work)
 
 
 #: Whether the helper is a forked copy of this process (Linux): it then starts at once, with the
@@ -255,6 +321,11 @@ def _spawned_helper(md, split_name: str) -> _SpawnedHelper | None:
         path.unlink(missing_ok=True)
         return None
     return _SpawnedHelper(process, path)
+
+
+def start_callees(md) -> ColdStart | None:
+    """:func:`start_apart` of the event loop's callees (:data:`EVENT_LOOP`)."""
+    return start_apart(md, EVENT_LOOP, f"{__name__}:EVENT_LOOP")
 
 
 def compile_callees(md) -> bool:

@@ -96,6 +96,16 @@ def error_norm(y, ynew, Kst, h, md, rtol, atol):
     return math.sqrt(total / count)
 
 
+@kernel
+def homing_left(homing):
+    """Whether any contact is in the middle of homing in on v = 0 (a loop: ``homing.sum()`` would
+    compile numpy's reduction with its axis checks)."""
+    for c in range(homing.shape[0]):
+        if homing[c] != 0:
+            return True
+    return False
+
+
 @inlined_kernel
 def store_sample(idx, y, cst, md, F, N, v, out_s, out_mode, out_F):
     """Write sample ``idx``: the state, the mode flags (bit c: contact c sticks) and each contact's
@@ -124,7 +134,7 @@ def write_samples(idx, tau_to, y0, Q, h, tau_step, t_base, cst, md, sample_times
     return idx
 
 
-@inlined_kernel
+@kernel
 def cut_step(theta, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F, work, F, N, v):
     """End the step at θ ∈ (0, 1] of its length ``h`` (an event's root): write the samples up to
     there and move ``y`` (the step's start) onto it. Returns (idx, local time of the cut)."""
@@ -503,7 +513,7 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             h_override = -1.0
         else:
             h *= factor
-            if tau_stop <= tau < tau_end and h_free < 0.0 and homing.sum() == 0:
+            if tau_stop <= tau < tau_end and h_free < 0.0 and not homing_left(homing):
                 status = CHUNK_END
                 break
     return status, tau, h, idx, n_tr, lost

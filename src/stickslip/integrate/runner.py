@@ -24,6 +24,8 @@ with room for all of them, which gives the same result.
 
 from __future__ import annotations
 
+import contextlib
+
 import dataclasses
 import time
 
@@ -33,7 +35,7 @@ from ..errors import SimulationError
 from ..model.bundle import contact_state
 from ..model.system_model import FrictionModel
 from . import contacts as E
-from .compile_ahead import compile_callees
+from .compile_ahead import start_callees
 from .event_loop import N_EXTRA, integrate_event
 from .interrupt import interruptible
 from .result import Transitions, mode_dtype
@@ -262,17 +264,23 @@ class EventStepper:
         self.h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
         self.steps_left = int(max_steps)
         self.stats = np.zeros(6, dtype=np.int64)
-        self.open_contact = int(E.contact_lost(self.y, md))
-        if self.open_contact < 0:
-            self._warm_up(system)
+        with contextlib.ExitStack() as stack:
+            # on a cold start the loop's callees compile in two processes (:mod:`.compile_ahead`):
+            # the helper starts before the check of the contacts' loads, which compiles meanwhile
+            cold = start_callees(md)
+            if cold is not None:
+                stack.enter_context(cold)
+            self.open_contact = int(E.contact_lost(self.y, md))
+            if self.open_contact < 0:
+                if cold is not None:
+                    cold.finish()
+                self._warm_up(system)
         prepared = time.perf_counter() - start
         self.prepare_s = prepared if prepared > COMPILE_REPORT_S else 0.0
 
     def _warm_up(self, system: FrictionModel) -> None:
         """Compile (or load from cache) the event loop for this kinematics class and set the modes
-        the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇).
-        On a cold start the loop's callees compile in two processes (:mod:`.compile_ahead`)."""
-        compile_callees(self.md)
+        the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇)."""
         tr = transition_room(0.0, self.ns, 1)
         y = integrate_event(self.y, self.cst, 0.0, 0.0, 0.0, self.md, self.rtol, self.atol, 1e-7, 1e-6, 10,
                             np.empty(0), 0, np.empty((1, self.ns)), np.empty(1, dtype=np.int8),

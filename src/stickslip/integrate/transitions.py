@@ -47,7 +47,7 @@ def record_transition(n_tr, t, kind, contact, y, tr_t, tr_kind, tr_contact, tr_s
             tr_s[n_tr, i] = y[i]
 
 
-@inlined_kernel
+@kernel
 def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
     """Release sticking contacts whose joint stick force exceeds the static limit (the most
     overloaded first) and record their breakaways at time ``t``; returns the transition count."""
