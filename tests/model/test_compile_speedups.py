@@ -17,6 +17,9 @@ def test_installed_with_the_compiled_layer():
     assert compile_speedups.installed()
     assert compile_speedups.install()  # a second install changes nothing
     assert isinstance(icc.copy, compile_speedups._SharedScopeCopy)
+    from numba.core.types.functions import BaseFunction
+
+    assert getattr(BaseFunction.get_call_type, "_stickslip_once", False)
 
 
 def _blocks(n_blocks: int):
@@ -131,3 +134,52 @@ def test_flags_equality_is_numbas():
     assert c == Flags() and Flags() == c
     c.boundscheck = not Flags.options["boundscheck"].default if Flags.options["boundscheck"].default is not None else True
     assert c != Flags()
+
+
+def test_a_builtin_call_is_typed_once_per_argument_types_and_records_its_implementation():
+    """The second typing of ``float64 * float64`` is the first's signature, answered without the
+    templates, and records the implementation key for lowering again, as numba does at every call."""
+    import operator
+
+    from numba.core import types
+    from numba.core.registry import cpu_target
+
+    ctx = cpu_target.typing_context
+    ctx.refresh()
+    fnty = ctx.resolve_value_type(operator.mul)
+    args = (types.float64, types.float64)
+    first = fnty.get_call_type(ctx, args, {})
+    key = fnty._impl_keys[first.args]
+    assert compile_speedups._call_types[fnty][(id(ctx), args, ())] == (first, key)
+    del fnty._impl_keys[first.args]
+    assert fnty.get_call_type(ctx, args, {}) is first
+    assert fnty._impl_keys[first.args] == key
+
+
+def test_a_rejected_builtin_call_fails_each_time_with_numbas_error():
+    import operator
+
+    import pytest
+    from numba.core import types
+    from numba.core.errors import TypingError
+    from numba.core.registry import cpu_target
+
+    ctx = cpu_target.typing_context
+    ctx.refresh()
+    fnty = ctx.resolve_value_type(operator.truediv)
+    for _ in range(2):
+        with pytest.raises(TypingError):
+            fnty.get_call_type(ctx, (types.unicode_type, types.float64), {})
+    assert (id(ctx), (types.unicode_type, types.float64), ()) not in compile_speedups._call_types.get(fnty, {})
+
+
+@njit
+def _repeated_products(x, y):
+    a = x * y
+    b = (x + 1.0) * y
+    c = x * (y - 2.0)
+    return a * b * c
+
+
+def test_a_function_of_repeated_builtin_calls_computes_what_python_computes():
+    assert _repeated_products(1.5, -0.25) == _repeated_products.py_func(1.5, -0.25)
