@@ -38,7 +38,8 @@ from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
-from .transitions import crossing_in_step, gap_crossing, jammed_contact, record_transition, settle, switch_gap
+from .transitions import (break_away, crossing_in_step, gap_crossing, jammed_contact, record_transition, settle,
+                          switch_gap)
 
 __all__ = ["integrate_event", "N_EXTRA"]
 
@@ -384,16 +385,7 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
             cut = True
             idx, tau = cut_step(theta_b, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
                                 work, F, N, vv)
-            P.project_velocities(y, cst, np.int64(-1), md)
-            P.stick_forces(y, cst, np.int64(-1), md, F, N)
-            ex, ey = E.breakaway_direction(F[2 * c_b], F[2 * c_b + 1], P.contact_dim(md.kin, m, n, c_b))
-            cst[CST * c_b] = P.MODE_SLIP_QUASI_STATIC
-            cst[CST * c_b + 1] = ex
-            cst[CST * c_b + 2] = ey
-            cst[CST * c_b + 3] = math.inf
-            stats[5] += 1
-            record_transition(n_tr, t_base + tau, E.TRANSITION_TO_SLIP, c_b, y, tr_t, tr_kind, tr_contact, tr_s)
-            n_tr = settle(y, cst, md, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr + 1, stats)
+            n_tr = break_away(y, cst, c_b, md, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
         else:
             # ---- accept the whole step
             if idx < n_samples and sample_times[idx] - t_base <= tau + h:

@@ -20,7 +20,8 @@ from . import contacts as E
 from . import dormand_prince as DP
 from .status import INCONSISTENT, SUCCESS
 
-__all__ = ["crossing_in_step", "record_transition", "settle", "switch_gap", "jammed_contact", "gap_crossing"]
+__all__ = ["crossing_in_step", "record_transition", "settle", "break_away", "switch_gap", "jammed_contact",
+           "gap_crossing"]
 
 
 @inlined_kernel
@@ -59,6 +60,27 @@ def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
         n_tr += 1
         stats[5] += 1
     return n_tr
+
+
+@kernel
+def break_away(y, cst, c, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+    """Sticking contact ``c`` breaks away at ``y`` (time ``t``, the root of its stick margin): the
+    velocities are projected onto the stick constraints, ``c`` slips quasi-statically along its
+    stick force's direction, and the breakaway and any release it causes (:func:`settle`) are
+    recorded; returns the transition count. A kernel of its own (a rare branch of the loop), so
+    that a cold start compiles it beside the loop instead of inside it."""
+    m = md.m
+    n = model_sizes(md.kin, m)[0]
+    P.project_velocities(y, cst, np.int64(-1), md)
+    P.stick_forces(y, cst, np.int64(-1), md, F, N)
+    ex, ey = E.breakaway_direction(F[2 * c], F[2 * c + 1], P.contact_dim(md.kin, m, n, c))
+    cst[CST * c] = P.MODE_SLIP_QUASI_STATIC
+    cst[CST * c + 1] = ex
+    cst[CST * c + 2] = ey
+    cst[CST * c + 3] = math.inf
+    stats[5] += 1
+    record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
+    return settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr + 1, stats)
 
 
 @unilateral_kernel(lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work:
