@@ -66,6 +66,21 @@ def test_the_variational_splits_signatures_are_the_ones_the_orbit_tools_compile(
                           numba.types.float32)  # any model data type but this one's: not compiled
 
 
+def test_the_steady_splits_signatures_are_the_ones_stability_compiles_for_a_model_file():
+    """As above for steady sliding's kernels: after a model file's stability, every kernel of the
+    split is there with the written argument types; for the plates, whose sizes are compile-time
+    constants, the split does not apply."""
+    from stickslip.stability.steady_split import STEADY
+
+    system = stickslip.load_model(MODEL_FILE)
+    stickslip.stability(system)
+    md_type = numba.typeof(system.data)
+    assert STEADY.applies(system.data)
+    for name in STEADY.helper + STEADY.own:
+        assert _available(STEADY, name, md_type), name
+    assert not STEADY.applies(stickslip.load_model("two-plates").data)
+
+
 COLD_RUN = textwrap.dedent("""
     import hashlib, json, sys
     import numpy as np

@@ -1,7 +1,7 @@
 """A line on stderr while numba compiles, and the compile time apart from the run's.
 
 A command's first call on a machine (or after stickslip or a model's kinematics changed) compiles
-the kernels of its model class: 20 s to a minute on two cores, during which nothing else would
+the kernels of its model class: 15 to 40 s on two cores, during which nothing else would
 appear. numba announces each compilation it starts (the ``numba:compile`` event; a kernel loaded
 from the on-disk cache is not one), so :func:`compile_notice` counts the seconds spent compiling
 while a command runs (:func:`compile_seconds`, which a command subtracts from its wall time and
@@ -22,7 +22,7 @@ __all__ = ["compile_notice", "compile_seconds", "COMPILING_LINE"]
 
 #: The line printed when the first kernel starts compiling.
 COMPILING_LINE = ("compiling kernels for this kind of model (once per machine: later runs load them from numba's "
-                  "cache; 20 s to a minute on 2 cores) ...")
+                  "cache; 15 to 40 s on 2 cores) ...")
 
 
 class _CompileClock(event.Listener):

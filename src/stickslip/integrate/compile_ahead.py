@@ -20,9 +20,10 @@ Two splits:
   subtrees share ``general_forces``, which both compile: the split is as even as the loop's call
   tree allows, and the loop's own body compiles after both. The helper also compiles the
   kernels that a run's results call after the loop (each contact's slip velocity and normal
-  force at the samples) and the loop's small callees (the error norm, the dense-output
-  coefficients, the slip velocity's rate, the release after a transition), this process the cut
-  of a step at an event: what neither side compiles, the loop compiles alone. The helper starts
+  force at the samples), the release of overloaded sticks after a transition, a breakaway, the
+  error norm and the slip velocity's rate; this process the cut of a step at an event and the
+  step's small helpers (the dense-output coefficients, the slip-event test): what neither side
+  compiles, the loop compiles alone, after both. The helper starts
   before the run checks that no contact is open at the start (:class:`ColdStart`: a refused run
   ends it), and this process, done with its side, does the command's :func:`meanwhile` work
   (the CLI imports what writes its outputs) while the helper finishes.
@@ -49,7 +50,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numba
@@ -59,10 +60,11 @@ from numba.core import event
 __all__ = ["Split", "EVENT_LOOP", "CODES", "ColdStart", "start_apart", "compile_apart", "start_callees", "compile_callees",
            "meanwhile", "enabled", "kernel_named"]
 
-#: Argument codes: v float64[::1], m float64[:, ::1], z complex128[::1], b int8[::1],
-#: I int64[::1], i int64, f float64, B bool, M the model data.
-CODES = {"v": types.float64[::1], "m": types.float64[:, ::1], "z": types.complex128[::1], "b": types.int8[::1],
-         "I": types.int64[::1], "i": types.int64, "f": types.float64, "B": types.boolean}
+#: Argument codes: v float64[::1], m float64[:, ::1], z complex128[::1], Z complex128[:, ::1],
+#: b int8[::1], I int64[::1], i int64, f float64, c complex128, B bool, M the model data.
+CODES = {"v": types.float64[::1], "m": types.float64[:, ::1], "z": types.complex128[::1],
+         "Z": types.complex128[:, ::1], "b": types.int8[::1], "I": types.int64[::1], "i": types.int64,
+         "f": types.float64, "c": types.complex128, "B": types.boolean}
 
 #: Seconds to wait for the helper before going on without it.
 HELPER_TIMEOUT_S = 600.0
@@ -81,12 +83,16 @@ class Split:
         The kernel that calls them, compiled after both (its compile event spans the pair).
     signatures : mapping of str to str
         Each kernel's argument codes (:data:`CODES`), separated by spaces.
+    applies : callable, optional
+        ``applies(md)``: whether the split's signatures are those the caller compiles for the
+        model data ``md`` (default: always).
     """
 
     helper: tuple
     own: tuple
     caller: str
     signatures: Mapping
+    applies: Callable | None = None
 
     def signature(self, name: str, md_type) -> tuple:
         """The argument types of kernel ``name`` for model data of numba type ``md_type``."""
@@ -191,7 +197,7 @@ def start_apart(md, split: Split, split_name: str) -> ColdStart | None:
     ``"module:attribute"``.
     """
     md_type = numba.typeof(md)
-    if (split_name, md_type) in _started or not enabled():
+    if (split_name, md_type) in _started or not enabled() or (split.applies is not None and not split.applies(md)):
         return None
     _started.add((split_name, md_type))
     probe = split.helper[0]

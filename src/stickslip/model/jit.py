@@ -41,13 +41,17 @@ minute): numba gives each kernel that is not inlined a module of its own, into w
 the code of every kernel it calls, and LLVM optimises and emits all of that code again there.
 A thin kernel over a large one therefore costs the large one's optimisation once more: such
 kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
-``contacts.event_value``, ``transitions.settle``, the steady-sliding Newton (called at one
+``contacts.event_value``, the steady-sliding Newton (called at one
 site; ``inlined_loop``, as it allocates), its residual and Jacobian, the variational right-hand
 side's band correction), a compiled wrapper that only allocates is Python instead
 (``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is one
 kernel called from five places rather than inlined into each. The largest kernels are
 :func:`standalone` (:mod:`.linking`): their callers call their one compiled copy instead of
-linking a copy in. A kernel gets numba's Python entry only when Python calls it
+linking a copy in. Since they are, a thin kernel over standalone ones costs little more than its
+own code, and the event loop's rare branches over them (``event_loop.cut_step``,
+``transitions.settle`` and ``break_away``) are kernels: typed once instead of at each of their
+sites, and compiled by a cold start's helper process beside the loop
+(:mod:`stickslip.integrate.compile_ahead`). A kernel gets numba's Python entry only when Python calls it
 (:class:`KernelDispatcher`), the physics and the starting modes that both the event loop and
 the analyses' Python call always (``api_kernel``: one version,
 compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a C-callable

@@ -355,6 +355,12 @@ def _gap_computed(kin):
     return lambda kin: False
 
 
+def sizes_at_run_time(kin) -> bool:
+    """Whether the kinematics object ``kin`` leaves all of a model's sizes (n, nc, diagonal) to its
+    data at run time, so that kernels take them as plain integers, not compile-time constants."""
+    return _SIZES.get(type(kin), (None, None, None)) == (None, None, None)
+
+
 def model_sizes(kin, m):  # pragma: no cover - resolved by numba (overload below)
     """(n, nc, diagonal) of a model: compile-time constants where its kinematics fixes them."""
     raise NotImplementedError

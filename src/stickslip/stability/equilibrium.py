@@ -155,6 +155,9 @@ def _solve_closed(system) -> tuple[np.ndarray, float, int]:
     if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:  # a contact at rest does not slide (e.g. Ω = 0)
         raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
     free = np.flatnonzero(system.free).astype(np.int64)
+    from .steady_split import compile_steady  # not at import: the integrators import this module
+
+    compile_steady(system.data)
     q, status, rel, iterations = steady.steady_sliding_point(system.data, free, MAX_ITER)
     if status == steady.NEWTON_NOT_SLIDING:
         raise EquilibriumError(_not_sliding_message(system, q))
