@@ -128,13 +128,13 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
     threading.Thread(target=poll, name="stickslip-watch-parent", daemon=True).start()
 
 
-#: The setting of how many processes a cold start compiles in (``integrate/compile_ahead.py``).
+#: The setting of how many processes a cold start compiles in (``model/compile_ahead.py``).
 COMPILE_PROCESSES_ENV = "STICKSLIP_COMPILE_PROCESSES"
 
 
 def _compile_alone() -> None:
     """In a pool or dask worker: the workers fill the cores, so a cold start in a worker compiles
-    there alone, without the helper process of ``integrate/compile_ahead.py``."""
+    there alone, without the helper process of ``model/compile_ahead.py``."""
     os.environ[COMPILE_PROCESSES_ENV] = "1"
 
 

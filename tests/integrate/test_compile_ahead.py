@@ -1,4 +1,4 @@
-"""A cold start compiles the event loop's callees in two processes (stickslip.integrate.compile_ahead)."""
+"""A cold start compiles independent kernels in two processes (stickslip.model.compile_ahead and its splits)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.integrate import compile_ahead
+from stickslip.integrate import loop_split
+from stickslip.model import compile_ahead
 from stickslip.model.jit import KernelDispatcher
 from stickslip.orbits.linear_flow import VARIATIONAL, flow_jacobian
 
@@ -40,7 +41,7 @@ def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     run = stickslip.simulate(system, 0.5)
     assert run.slip_velocity.shape[0] == run.normal_force.shape[0] == run.t.size  # the results' kernels
     md_type = numba.typeof(system.data)
-    split = compile_ahead.EVENT_LOOP
+    split = loop_split.EVENT_LOOP
     for name in split.helper + split.own:
         assert _available(split, name, md_type), name
     rhs = "stickslip.model.physics.rhs"
@@ -70,7 +71,7 @@ def test_the_steady_splits_signatures_are_the_ones_stability_compiles_for_a_mode
     """As above for steady sliding's kernels: after a model file's stability, every kernel of the
     split is there with the written argument types; for the plates, whose sizes are compile-time
     constants, the split does not apply."""
-    from stickslip.stability.steady_split import STEADY
+    from stickslip.stability.steady import STEADY
 
     system = stickslip.load_model(MODEL_FILE)
     stickslip.stability(system)
@@ -180,7 +181,7 @@ def test_a_cold_starts_meanwhile_work_runs_once_before_it_waits_for_the_helper()
         def end(self):
             calls.append("end")
 
-    split = compile_ahead.Split(helper=(), own=(), caller=compile_ahead.EVENT_LOOP.caller, signatures={})
+    split = compile_ahead.Split(helper=(), own=(), caller=loop_split.EVENT_LOOP.caller, signatures={})
     with compile_ahead.meanwhile(lambda: calls.append("work")), compile_ahead.meanwhile(lambda: 1 / 0):
         for _ in range(2):
             with compile_ahead.ColdStart(split, None, Helper()) as cold:
@@ -196,7 +197,7 @@ def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_d
     pickled to a file; it ends with status 0 and the file is removed."""
     system = stickslip.load_model("belt")
     stickslip.simulate(system, 0.5)  # its kernels are here or cached: the helper loads them
-    helper = compile_ahead._spawned_helper(system.data, "stickslip.integrate.compile_ahead:EVENT_LOOP")
+    helper = compile_ahead._spawned_helper(system.data, "stickslip.integrate.loop_split:EVENT_LOOP")
     assert helper is not None and helper.path.exists()
     helper.wait(300.0)
     assert helper.process.returncode == 0
@@ -207,7 +208,7 @@ def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_d
 def test_the_helper_is_off_on_request(monkeypatch):
     monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "1")
     assert not compile_ahead.enabled()
-    assert not compile_ahead.compile_callees(stickslip.load_model("belt").data)
+    assert not loop_split.compile_callees(stickslip.load_model("belt").data)
     monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "2")
     assert compile_ahead.enabled() == ((os.cpu_count() or 1) >= 2)
 

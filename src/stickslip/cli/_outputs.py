@@ -19,7 +19,7 @@ __all__ = ["draw_figure", "write_result", "prepare_outputs"]
 def prepare_outputs(figure: bool) -> None:
     """Import what writes a run's outputs: xarray (with the array types it looks for on its first
     variable), the NetCDF writer and, with ``figure``, matplotlib's figure and Agg canvas. A command
-    runs it while a cold start's helper compiles (:func:`stickslip.integrate.compile_ahead.meanwhile`)."""
+    runs it while a cold start's helper compiles (:func:`stickslip.model.compile_ahead.meanwhile`)."""
     import h5netcdf  # noqa: F401
     import numpy as np
     import xarray

@@ -23,12 +23,12 @@ from rich.table import Table
 from rich.text import Text
 
 from ..attractors import run_summary, simulate_until_settled
-from ..integrate.compile_ahead import meanwhile
 from ..integrate.driver import simulate as run_simulation
 from ..files import netcdf_writer, write_output
 from ..integrate.interrupt import finish_first, on_ctrl_c, stop_if_interrupted
 from ..integrate.result import load_trajectory
 from ..integrate.status import Status
+from ..model.compile_ahead import meanwhile
 from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
 from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, given,

@@ -35,7 +35,7 @@ from ..errors import SimulationError
 from ..model.bundle import contact_state
 from ..model.system_model import FrictionModel
 from . import contacts as E
-from .compile_ahead import start_callees
+from .loop_split import start_callees
 from .event_loop import N_EXTRA, integrate_event
 from .interrupt import interruptible
 from .result import Transitions, mode_dtype
@@ -265,7 +265,7 @@ class EventStepper:
         self.steps_left = int(max_steps)
         self.stats = np.zeros(6, dtype=np.int64)
         with contextlib.ExitStack() as stack:
-            # on a cold start the loop's callees compile in two processes (:mod:`.compile_ahead`):
+            # on a cold start the loop's callees compile in two processes (:mod:`.loop_split`):
             # the helper starts before the check of the contacts' loads, which compiles meanwhile
             cold = start_callees(md)
             if cold is not None:

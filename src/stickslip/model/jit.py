@@ -51,7 +51,7 @@ linking a copy in. Since they are, a thin kernel over standalone ones costs litt
 own code, and the event loop's rare branches over them (``event_loop.cut_step``,
 ``transitions.settle`` and ``break_away``) are kernels: typed once instead of at each of their
 sites, and compiled by a cold start's helper process beside the loop
-(:mod:`stickslip.integrate.compile_ahead`). A kernel gets numba's Python entry only when Python calls it
+(:mod:`stickslip.model.compile_ahead`). A kernel gets numba's Python entry only when Python calls it
 (:class:`KernelDispatcher`), the physics and the starting modes that both the event loop and
 the analyses' Python call always (``api_kernel``: one version,
 compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a C-callable
@@ -478,7 +478,7 @@ kernel = _kernel_decorator(**KERNEL_OPTIONS)
 #: compiled for the event loop is also the one ``stability`` or ``orbit`` calls, loaded from the
 #: cache (a Python entry costs ~45 ms; compiling the version again for Python cost a model file's
 #: ``orbit`` ~8 s). A kernel only Python calls is one too where a cold start compiles it ahead
-#: (``integrate/compile_ahead.py``): its version then has the entry its first call needs.
+#: (``model/compile_ahead.py``): its version then has the entry its first call needs.
 api_kernel = _kernel_decorator(always_entry=True, **KERNEL_OPTIONS)
 inlined_kernel = njit(cache=True, inline="always", **KERNEL_OPTIONS)
 loop = njit(cache=True, error_model="numpy", no_cfunc_wrapper=True)

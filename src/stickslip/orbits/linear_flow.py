@@ -25,7 +25,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import OrbitError
 from ..integrate import contacts as E
-from ..integrate.compile_ahead import Split, compile_apart
+from ..model.compile_ahead import Split, compile_apart
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from . import saltation as S
@@ -56,7 +56,7 @@ MATCH_TIME_TOL = 1e-6
 #: Step cap of one segment.
 MAX_SEGMENT_STEPS = 1_000_000
 
-#: A cold start's variational kernels in two processes (:mod:`stickslip.integrate.compile_ahead`):
+#: A cold start's variational kernels in two processes (:mod:`stickslip.model.compile_ahead`):
 #: the event functions, then the variational right-hand side (with the complex-step physics under
 #: it) in the helper; the complex-step version of the band direction's residual, the first event's
 #: search, the contact gradients of the saltation matrices and the starting modes here; the

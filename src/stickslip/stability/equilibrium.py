@@ -21,6 +21,7 @@ from scipy.linalg import null_space
 from scipy.optimize import root
 
 from ..errors import EquilibriumError, StickSlipError
+from ..model.compile_ahead import compile_apart
 from ..model.bundle import CST
 from ..model.library import resolve_system
 from ..model.parameters import Parameters
@@ -155,9 +156,7 @@ def _solve_closed(system) -> tuple[np.ndarray, float, int]:
     if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:  # a contact at rest does not slide (e.g. Ω = 0)
         raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
     free = np.flatnonzero(system.free).astype(np.int64)
-    from .steady_split import compile_steady  # not at import: the integrators import this module
-
-    compile_steady(system.data)
+    compile_apart(system.data, steady.STEADY, f"{steady.__name__}:STEADY")
     q, status, rel, iterations = steady.steady_sliding_point(system.data, free, MAX_ITER)
     if status == steady.NEWTON_NOT_SLIDING:
         raise EquilibriumError(_not_sliding_message(system, q))

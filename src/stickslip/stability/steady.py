@@ -21,11 +21,12 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import overload
 
+from ..model.compile_ahead import Split
 from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
 from ..model.derivatives import acceleration_jacobian, state_jacobian
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
 from ..model.frame_pointers import is_pointer_class
-from ..model.kinematics import model_sizes
+from ..model.kinematics import model_sizes, sizes_at_run_time
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
 __all__ = ["NEWTON_OK", "NEWTON_MAX_ITER", "NEWTON_SINGULAR", "NEWTON_NOT_FINITE", "NEWTON_NO_DESCENT",
@@ -227,6 +228,26 @@ def _newton_from(q, cst, md, free, max_iter):
     if rel <= NEWTON_TARGET:
         return NEWTON_OK, rel, max_iter
     return NEWTON_MAX_ITER, rel, max_iter
+
+
+#: A cold start's steady-sliding kernels in two processes (:mod:`stickslip.model.compile_ahead`),
+#: for kinematics whose sizes are run-time data (model files; fixed sizes are compile-time constants
+#: in these signatures): the complex-step stick solve (the deepest level of the chain under the
+#: Newton) in the helper; the friction coefficient, the frame's central-difference bias (complex)
+#: and the Newton's linear solve here; :func:`steady_sliding_point` then
+#: loads both.
+STEADY = Split(
+    helper=("stickslip.model.forces.solve_stick_rows",),
+    own=("stickslip.model.model_data.kinetic_coefficient", "stickslip.model.frames._frame_bias_central",
+         "stickslip.stability.steady._solve_inplace"),
+    caller="stickslip.stability.steady.steady_sliding_point",
+    signatures={
+        "stickslip.model.forces.solve_stick_rows": "z M i i B v i Z z z z Z",
+        "stickslip.model.model_data.kinetic_coefficient": "M i i c",
+        "stickslip.model.frames._frame_bias_central": "z i M Z z z",
+        "stickslip.stability.steady._solve_inplace": "m v",
+    },
+    applies=lambda md: sizes_at_run_time(md.kin))
 
 
 @loop

@@ -10,25 +10,13 @@ interpreter running :func:`helper_main`) that compiles its subtree into the shar
 the other subtree here meanwhile and waits for the helper. The same
 kernels are compiled either way, so the results are the same bit for bit.
 
-Two splits:
-
-* :data:`EVENT_LOOP` (``simulate`` and everything that runs the event loop): the stick solve's
-  subtree (:func:`~stickslip.integrate.contacts.try_stick`, the release of an overloaded stick,
-  the contact forces, the low-speed band's direction and the starting modes) in the helper, the
-  step's (the right-hand side, the Dormand–Prince step, the crossings' probe, the samples) here. On two
-  cores, from an empty cache: the plates' ``simulate`` −17 %, a model file's −18 %. The two
-  subtrees share ``general_forces``, which both compile: the split is as even as the loop's call
-  tree allows, and the loop's own body compiles after both. The helper also compiles the
-  kernels that a run's results call after the loop (each contact's slip velocity and normal
-  force at the samples), the release of overloaded sticks after a transition, a breakaway, the
-  error norm and the slip velocity's rate; this process the cut of a step at an event and the
-  step's small helpers (the dense-output coefficients, the slip-event test): what neither side
-  compiles, the loop compiles alone, after both. The helper starts
-  before the run checks that no contact is open at the start (:class:`ColdStart`: a refused run
-  ends it), and this process, done with its side, does the command's :func:`meanwhile` work
-  (the CLI imports what writes its outputs) while the helper finishes.
-* the variational equations of the orbit tools, declared beside them
-  (:data:`stickslip.orbits.linear_flow.VARIATIONAL`).
+Each split is declared beside the kernels it compiles: the event loop's callees
+(:data:`stickslip.integrate.loop_split.EVENT_LOOP`: ``simulate`` and everything that runs the
+event loop), the variational equations of the orbit tools
+(:data:`stickslip.orbits.linear_flow.VARIATIONAL`) and steady sliding's complex-step chain
+(:data:`stickslip.stability.steady.STEADY`). A split may start its helper before this process
+turns to its own side (:func:`start_apart`, :class:`ColdStart`), and a command may hand the split
+work it does later anyway (:func:`meanwhile`: the CLI imports what writes its outputs).
 
 The callees' argument types are written as short codes (:data:`CODES`: the callers' own call
 sites; the tests check that they are the signatures the callers compile). Where the helper cannot
@@ -57,8 +45,7 @@ import numba
 from numba import types
 from numba.core import event
 
-__all__ = ["Split", "EVENT_LOOP", "CODES", "ColdStart", "start_apart", "compile_apart", "start_callees", "compile_callees",
-           "meanwhile", "enabled", "kernel_named"]
+__all__ = ["Split", "CODES", "ColdStart", "start_apart", "compile_apart", "meanwhile", "enabled", "kernel_named"]
 
 #: Argument codes: v float64[::1], m float64[:, ::1], z complex128[::1], Z complex128[:, ::1],
 #: b int8[::1], I int64[::1], i int64, f float64, c complex128, B bool, M the model data.
@@ -98,44 +85,6 @@ class Split:
         """The argument types of kernel ``name`` for model data of numba type ``md_type``."""
         return tuple(md_type if code == "M" else CODES[code] for code in self.signatures[name].split())
 
-
-#: The event loop's callees: the stick solve's subtree in the helper, the step's here.
-EVENT_LOOP = Split(
-    helper=("stickslip.integrate.contacts.try_stick", "stickslip.integrate.contacts.release_most_overloaded",
-            "stickslip.model.physics.contact_forces", "stickslip.model.physics.band_direction",
-            "stickslip.integrate.contacts.initial_modes", "stickslip.integrate.result._slip_velocities",
-            "stickslip.integrate.result._normal_forces", "stickslip.integrate.transitions.settle",
-            "stickslip.integrate.transitions.break_away", "stickslip.model.physics.slip_velocity_and_rate",
-            "stickslip.integrate.event_loop.error_norm"),
-    own=("stickslip.model.physics.rhs", "stickslip.integrate.event_loop.dp_step",
-         "stickslip.integrate.contacts.probed_crossing", "stickslip.integrate.event_loop.write_samples",
-         "stickslip.integrate.event_loop.cut_step", "stickslip.integrate.dormand_prince.dense_coefficients", "stickslip.integrate.contacts.slip_event_possible",
-         "stickslip.integrate.contacts.time_to_zero_of", "stickslip.integrate.contacts.all_finite",
-         "stickslip.integrate.event_loop.homing_left"),
-    caller="stickslip.integrate.event_loop.event_loop",
-    signatures={
-        "stickslip.integrate.contacts.try_stick": "v v i M f v v",
-        "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
-        "stickslip.model.physics.contact_forces": "v v M v v v",
-        "stickslip.model.physics.band_direction": "v v i M f",
-        "stickslip.model.physics.rhs": "v v M v",
-        "stickslip.integrate.event_loop.dp_step": "v v f v M m v v",
-        "stickslip.integrate.contacts.probed_crossing": "f i i v m f f f v M v v v",
-        "stickslip.integrate.contacts.release_most_overloaded": "v v M v v",
-        "stickslip.integrate.event_loop.write_samples": "i f v m f f f v M v m b m v v v v",
-        "stickslip.integrate.result._slip_velocities": "m M i",
-        "stickslip.integrate.result._normal_forces": "m b M i",
-        "stickslip.integrate.transitions.settle": "v v M v v f v b b m i I",
-        "stickslip.integrate.transitions.break_away": "v v i M v v f v b b m i I",
-        "stickslip.integrate.event_loop.error_norm": "v v m f M f f",
-        "stickslip.model.physics.slip_velocity_and_rate": "v v i M",
-        "stickslip.integrate.dormand_prince.dense_coefficients": "m m",
-        "stickslip.integrate.contacts.slip_event_possible": "f f f f",
-        "stickslip.integrate.contacts.time_to_zero_of": "f f f f",
-        "stickslip.integrate.contacts.all_finite": "v",
-        "stickslip.integrate.event_loop.homing_left": "I",
-        "stickslip.integrate.event_loop.cut_step": "f i v m f f f v M v m b m v v v v",
-    })
 
 _started: set = set()
 
@@ -330,17 +279,7 @@ def _spawned_helper(md, split_name: str) -> _SpawnedHelper | None:
     return _SpawnedHelper(process, path)
 
 
-def start_callees(md) -> ColdStart | None:
-    """:func:`start_apart` of the event loop's callees (:data:`EVENT_LOOP`)."""
-    return start_apart(md, EVENT_LOOP, f"{__name__}:EVENT_LOOP")
-
-
-def compile_callees(md) -> bool:
-    """:func:`compile_apart` of the event loop's callees (:data:`EVENT_LOOP`)."""
-    return compile_apart(md, EVENT_LOOP, f"{__name__}:EVENT_LOOP")
-
-
-_HELPER = "import sys; from stickslip.integrate.compile_ahead import helper_main; sys.exit(helper_main(*sys.argv[1:]))"
+_HELPER = "import sys; from stickslip.model.compile_ahead import helper_main; sys.exit(helper_main(*sys.argv[1:]))"
 
 
 def helper_main(path: str, parent: str, split_name: str) -> int:
