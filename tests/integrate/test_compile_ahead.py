@@ -208,7 +208,7 @@ def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_d
 def test_the_helper_is_off_on_request(monkeypatch):
     monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "1")
     assert not compile_ahead.enabled()
-    assert not loop_split.compile_callees(stickslip.load_model("belt").data)
+    assert loop_split.start_callees(stickslip.load_model("belt").data) is None
     monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "2")
     assert compile_ahead.enabled() == ((os.cpu_count() or 1) >= 2)
 

@@ -18,9 +18,9 @@ it); this process, done with its side, does the command's
 
 from __future__ import annotations
 
-from ..model.compile_ahead import ColdStart, Split, compile_apart, start_apart
+from ..model.compile_ahead import ColdStart, Split, start_apart
 
-__all__ = ["EVENT_LOOP", "start_callees", "compile_callees"]
+__all__ = ["EVENT_LOOP", "start_callees"]
 
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.
 EVENT_LOOP = Split(
@@ -64,8 +64,3 @@ EVENT_LOOP = Split(
 def start_callees(md) -> ColdStart | None:
     """:func:`start_apart` of the event loop's callees (:data:`EVENT_LOOP`)."""
     return start_apart(md, EVENT_LOOP, f"{__name__}:EVENT_LOOP")
-
-
-def compile_callees(md) -> bool:
-    """:func:`compile_apart` of the event loop's callees (:data:`EVENT_LOOP`)."""
-    return compile_apart(md, EVENT_LOOP, f"{__name__}:EVENT_LOOP")

@@ -25,7 +25,6 @@ with room for all of them, which gives the same result.
 from __future__ import annotations
 
 import contextlib
-
 import dataclasses
 import time
 
@@ -35,9 +34,9 @@ from ..errors import SimulationError
 from ..model.bundle import contact_state
 from ..model.system_model import FrictionModel
 from . import contacts as E
-from .loop_split import start_callees
 from .event_loop import N_EXTRA, integrate_event
 from .interrupt import interruptible
+from .loop_split import start_callees
 from .result import Transitions, mode_dtype
 from .status import CHUNK_END, Status
 
@@ -264,12 +263,9 @@ class EventStepper:
         self.h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
         self.steps_left = int(max_steps)
         self.stats = np.zeros(6, dtype=np.int64)
-        with contextlib.ExitStack() as stack:
-            # on a cold start the loop's callees compile in two processes (:mod:`.loop_split`):
-            # the helper starts before the check of the contacts' loads, which compiles meanwhile
-            cold = start_callees(md)
-            if cold is not None:
-                stack.enter_context(cold)
+        # on a cold start the loop's callees compile in two processes (:mod:`.loop_split`): the
+        # helper starts before the check of the contacts' loads, which compiles meanwhile
+        with start_callees(md) or contextlib.nullcontext() as cold:
             self.open_contact = int(E.contact_lost(self.y, md))
             if self.open_contact < 0:
                 if cold is not None:
