@@ -1,7 +1,8 @@
 """Sphinx configuration of the stickslip documentation site.
 
-Build: ``sphinx-build -W -b html docs docs/_build/html`` (or ``make -C docs html``). The gallery
-runs every script in ``examples/`` and keeps its figures; ``-D plot_gallery=0`` skips running them.
+Build: ``sphinx-build -W -j auto -b html docs docs/_build/html`` (or ``make -C docs html``). The
+gallery runs every script in ``examples/`` (as many at once as ``-j`` allows) and keeps its
+figures; ``-D plot_gallery=0`` skips running them.
 """
 
 import re
@@ -68,6 +69,7 @@ sphinx_gallery_conf = {
     "show_memory": False,
     "line_numbers": False,
     "min_reported_time": 1,
+    "parallel": True,  # the examples run in parallel (joblib processes), as many as sphinx-build -j says
 }
 
 # -- HTML --------------------------------------------------------------------------------------

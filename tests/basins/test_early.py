@@ -13,7 +13,12 @@ from stickslip.model import model_from_spec
 from stickslip.model.library import load_model
 
 BELT = load_model("belt")
-CTX = make_context(BELT)
+
+
+@pytest.fixture(scope="module")
+def ctx():
+    """The belt's context, built once per module on the worker that runs these tests."""
+    return make_context(BELT)
 
 
 def long_run(model, s0, t_end=1500.0):
@@ -21,23 +26,23 @@ def long_run(model, s0, t_end=1500.0):
     return "periodic" if np.ptp(traj.states[traj.t >= t_end - 100.0, 0]) > 1e-3 else "equilibrium"
 
 
-def test_steady_sliding_itself_is_at_rest_at_once():
-    o = classify_state(CTX, BELT, CTX.equilibrium.copy(), [], Options())
+def test_steady_sliding_itself_is_at_rest_at_once(ctx):
+    o = classify_state(ctx, BELT, ctx.equilibrium.copy(), [], Options())
     assert (o.verdict, o.decided_by) == ("equilibrium", "at-rest")
-    assert o.t_decided < 2 * CTX.chunk * CTX.dt  # after the first chunk (its last step may pass its end)
+    assert o.t_decided < 2 * ctx.chunk * ctx.dt  # after the first chunk (its last step may pass its end)
 
 
 @pytest.mark.parametrize("amplitude", np.round(np.arange(1.30, 1.405, 0.01), 2))
-def test_early_verdicts_across_the_basin_boundary_equal_long_runs(amplitude):
+def test_early_verdicts_across_the_basin_boundary_equal_long_runs(amplitude, ctx):
     """Along x = x_e + a, x' = 0 the equilibrium's basin ends between a = 1.3 and 1.4: there the
     run passes close to the grazing of v = 0 and the linear test must wait (or refuse)."""
-    s0 = CTX.equilibrium + np.array([amplitude, 0.0])
-    o = classify_state(CTX, BELT, s0, [], Options(t_end=1000.0))
+    s0 = ctx.equilibrium + np.array([amplitude, 0.0])
+    o = classify_state(ctx, BELT, s0, [], Options(t_end=1000.0))
     assert o.verdict == long_run(BELT, s0)
 
 
-def test_the_linear_test_waits_longer_the_closer_the_boundary():
-    times = [classify_state(CTX, BELT, CTX.equilibrium + np.array([a, 0.0]), [], Options()).t_decided
+def test_the_linear_test_waits_longer_the_closer_the_boundary(ctx):
+    times = [classify_state(ctx, BELT, ctx.equilibrium + np.array([a, 0.0]), [], Options()).t_decided
              for a in (0.2, 0.8, 1.3)]
     assert times[0] < times[1] < times[2]
 
@@ -51,11 +56,11 @@ def test_unstable_steady_sliding_is_never_claimed():
     assert o.verdict == "periodic"  # the oscillation grows onto the stick-slip cycle
 
 
-def test_a_known_cycle_stops_runs_early_without_changing_verdicts():
-    states = box(BELT, {"x": (-2, 2), "dx": (-2, 2)}, n=40, seed=11).states(BELT, CTX.equilibrium[:1])
-    alone = [classify_state(CTX, BELT, s, [], Options()) for s in states]
+def test_a_known_cycle_stops_runs_early_without_changing_verdicts(ctx):
+    states = box(BELT, {"x": (-2, 2), "dx": (-2, 2)}, n=40, seed=11).states(BELT, ctx.equilibrium[:1])
+    alone = [classify_state(ctx, BELT, s, [], Options()) for s in states]
     cycle = next(o.cycle for o in alone if o.verdict == "periodic")
-    known = [classify_state(CTX, BELT, s, [cycle], Options()) for s in states]
+    known = [classify_state(ctx, BELT, s, [cycle], Options()) for s in states]
     assert [o.verdict for o in alone] == [o.verdict for o in known]
     assert {o.decided_by for o in known if o.verdict == "periodic"} == {"matched"}
     assert sum(o.t_decided for o in known) < sum(o.t_decided for o in alone)
@@ -116,8 +121,8 @@ def test_a_run_matches_only_after_enough_recurring_crossings():
     assert run_matches(c, _section([2.0], 2.0, MATCH_PERIODS, jitter=0.02), 1e-2)
 
 
-def test_outcome_rows_round_trip():
-    o = classify_state(CTX, BELT, np.array([2.0, 2.0]), [], Options())
+def test_outcome_rows_round_trip(ctx):
+    o = classify_state(ctx, BELT, np.array([2.0, 2.0]), [], Options())
     back = Outcome.from_row(o.to_row(), 1)
     assert (back.verdict, back.decided_by, back.t_decided, back.steps) == (o.verdict, o.decided_by, o.t_decided,
                                                                             o.steps)

@@ -17,8 +17,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-from scipy.linalg import null_space
-from scipy.optimize import root
 
 from ..errors import EquilibriumError, StickSlipError
 from ..model.compile_ahead import compile_apart
@@ -114,6 +112,8 @@ def rigid_constraint(system) -> tuple[np.ndarray, np.ndarray]:
             if c.unilateral and c.normal.law == "rigid"]
     W = np.array([w for w, _ in rows])
     g0 = np.array([g for _, g in rows])
+    from scipy.linalg import null_space  # imported on use: scipy takes ~0.3 s of every command's start
+
     free = np.flatnonzero(system.free)
     q_p = np.zeros(system.n)
     q_p[free] = -np.linalg.pinv(W[:, free]) @ g0
@@ -126,6 +126,8 @@ def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
     """:func:`solve_steady` with every contact sliding and the rigid ones closed (module docstring):
     scipy's hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0, the rigid normal forces
     the right-hand side's multipliers."""
+    from scipy.optimize import root  # imported on use, as in rigid_constraint
+
     if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:
         raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
     q_p, Z = rigid_constraint(system)

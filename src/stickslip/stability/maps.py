@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
-from scipy import optimize
 
 from .._version import __version__
 from ..errors import EquilibriumError, ModelError, ParameterError
@@ -308,6 +307,8 @@ def boundary_omegas(grid: MapGrid, i: int, values: np.ndarray):
     jumps : list of bool
         True where max Re λ jumps across zero instead of crossing it smoothly.
     """
+    from scipy import optimize  # imported on use: scipy takes ~0.3 s of every command's start
+
     roots, directions, jumps = [], [], []
     f = lambda w: grid.value_at(i, w)  # noqa: E731
     Y = grid.b
