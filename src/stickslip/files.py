@@ -48,7 +48,7 @@ from typing import Callable
 
 from filelock import FileLock, Timeout
 
-from . import _forked
+from . import _forked, _startup
 from ._loader import format_name, open_ours
 from .errors import DiskFullError, FileFormatError, LockError, OutputError, StickSlipError, WriteError
 
@@ -230,8 +230,11 @@ class AppendLog:
 
     Each record is written whole (``os.write`` until done), then ``fsync``-ed. If the write fails
     (a full disk) the file is cut back to its length before the record, so it never ends in half
-    a record written by this process, and :class:`WriteError` is raised. Records torn by a kill
-    inside a write are for the reader to drop (:mod:`stickslip.journal` checksums every record).
+    a record written by this process, and :class:`WriteError` is raised. A Ctrl-C during the
+    write and ``fsync`` is held until the record is durable and then raised, so the record of
+    finished work is kept (a second Ctrl-C stops at once and cuts the record). Records torn by a
+    kill inside a write are for the reader to drop (:mod:`stickslip.journal` checksums every
+    record).
 
     Parameters
     ----------
@@ -252,6 +255,7 @@ class AppendLog:
         """Write ``data`` at the end of the file and ``fsync`` it."""
         start = os.fstat(self._fd).st_size
         view = memoryview(data)
+        _startup.hold()
         try:
             with writing_errors(self.path, self.kept):
                 while view:
@@ -263,6 +267,10 @@ class AppendLog:
             except OSError:  # pragma: no cover - the reader drops a torn record anyway
                 pass
             raise
+        finally:
+            ctrl_c = _startup.release(raise_pending=False)
+        if ctrl_c:  # pressed during the write: the record is durable now, and the Ctrl-C acts
+            raise KeyboardInterrupt
 
     def close(self) -> None:
         if self._fd is not None:

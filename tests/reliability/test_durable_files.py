@@ -153,6 +153,27 @@ def test_append_cut_short_by_a_full_disk_leaves_only_whole_records(tmp_path, mon
     log.close()
 
 
+def test_ctrl_c_during_the_fsync_of_a_record_keeps_the_record(tmp_path, monkeypatch):
+    """A Ctrl-C pressed while a finished point's record is being made durable is taken after it:
+    the record stays and the interrupted run resumes from it."""
+    path = tmp_path / "log"
+    log = AppendLog(path)
+    log.append(b"first")
+    real_fsync = os.fsync
+
+    def fsync_then_ctrl_c(fd):
+        real_fsync(fd)
+        os.kill(os.getpid(), signal.SIGINT)  # the handler runs before this function returns
+
+    monkeypatch.setattr(files.os, "fsync", fsync_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        log.append(b"second")
+    monkeypatch.setattr(files.os, "fsync", real_fsync)
+    assert path.read_bytes() == b"firstsecond"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    log.close()
+
+
 # ----------------------------------------------------------------------------- the loader
 @pytest.fixture(scope="module")
 def sweep_file(tmp_path_factory):
