@@ -10,7 +10,9 @@ imports and start-up) replaces the default SIGINT handler by one that records th
 KeyboardInterrupt once, at the end of the import, with a one-line report of it in place of the
 traceback (``interrupted: nothing was written``; the process then ends as Python ends on an
 unhandled Ctrl-C, exit status 130 in a shell). The command line releases with
-``raise_pending=False`` and reports the request itself. A second Ctrl-C while held raises at
+``raise_pending=False`` and reports the request itself, as does
+:meth:`stickslip.files.AppendLog.append`, which holds Ctrl-C while a journal record is written
+and synced and raises it once the record is durable. A second Ctrl-C while held raises at
 once. Only the default handler is replaced, in the main thread: a process that ignores SIGINT,
 or installed its own handler, keeps it.
 

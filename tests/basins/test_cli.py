@@ -20,20 +20,20 @@ def run(*args):
 
 def test_json_has_n_fractions_standard_errors_and_attractors(tmp_path):
     out = tmp_path / "b.nc"
-    res = run("basins", *BELT_BOX, "--n", "300", "--executor", "serial", "--out", str(out), "--json")
+    res = run("basins", *BELT_BOX, "--n", "120", "--executor", "serial", "--out", str(out), "--json")
     assert res.exit_code == 0, res.output
     s = json.loads(res.stdout.strip().splitlines()[-1])
-    assert s["n"] == 300 and set(s["fractions"]) == {"equilibrium", "periodic"}
+    assert s["n"] == 120 and set(s["fractions"]) == {"equilibrium", "periodic"}
     assert sum(s["fractions"].values()) == pytest.approx(1.0)
     for name, p in s["fractions"].items():
-        assert s["standard_errors"][name] == pytest.approx(np.sqrt(p * (1 - p) / 300))
+        assert s["standard_errors"][name] == pytest.approx(np.sqrt(p * (1 - p) / 120))
     cycle = next(a for a in s["attractors"] if a["name"] == "periodic")
     assert cycle["period"] == pytest.approx(6.3163, rel=1e-4) and cycle["frequency"] == pytest.approx(1 / cycle["period"])
     assert set(cycle["state"]) == {"x", "dx"} and cycle["amplitude"] > 0
     assert out.with_suffix(".png").stat().st_size > 0
     # the library gives the same study the same answer
     belt = load_model("belt")
-    lib = basin_stability(belt, box(belt, {"x": (-2, 2), "dx": (-2, 2)}, n=300), executor="serial")
+    lib = basin_stability(belt, box(belt, {"x": (-2, 2), "dx": (-2, 2)}, n=120), executor="serial")
     assert np.array_equal(lib.labels(), np.array([load_basins(out)["attractor"].values[c]
                                                   for c in load_basins(out)["label"].values]))
 
