@@ -276,3 +276,12 @@ def test_ctrl_c_keeps_the_part_of_a_run_done(tmp_path):
     kept = load_trajectory(out)
     assert 0 < kept.t[-1] < 100000 and kept.status.startswith("interrupted at t = ")
     assert f"t = {kept.t[-1]:g} s" in lines[0]  # the line says what the file holds
+
+
+def test_the_command_line_starts_without_scipys_solvers():
+    """scipy's optimisers and integrators (0.3 s of a start) are imported by what uses them."""
+    code = ("import sys, stickslip.cli; "
+            "print(sorted(m for m in ('scipy.optimize', 'scipy.integrate') if m in sys.modules))")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "[]"

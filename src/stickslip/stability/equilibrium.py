@@ -108,12 +108,12 @@ def rigid_constraint(system) -> tuple[np.ndarray, np.ndarray]:
     """(q_p, Z): the least-norm point q_p (n,) of W_R q = −g0 and an orthonormal basis Z (n, k − m)
     of null(W_R) on the free DOFs (zero rows on locked ones), W_R (m, n) the rigid contacts' gap
     gradients, g0 their gaps."""
+    from scipy.linalg import null_space  # imported on use: scipy takes ~0.3 s of every command's start
+
     rows = [(np.asarray(c.gap_gradient, float), c.gap) for c in system.contacts
             if c.unilateral and c.normal.law == "rigid"]
     W = np.array([w for w, _ in rows])
     g0 = np.array([g for _, g in rows])
-    from scipy.linalg import null_space  # imported on use: scipy takes ~0.3 s of every command's start
-
     free = np.flatnonzero(system.free)
     q_p = np.zeros(system.n)
     q_p[free] = -np.linalg.pinv(W[:, free]) @ g0
