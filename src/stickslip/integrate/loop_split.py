@@ -32,9 +32,9 @@ EVENT_LOOP = Split(
             "stickslip.integrate.event_loop.error_norm"),
     own=("stickslip.model.physics.rhs", "stickslip.integrate.event_loop.dp_step",
          "stickslip.integrate.contacts.probed_crossing", "stickslip.integrate.event_loop.write_samples",
-         "stickslip.integrate.event_loop.cut_step", "stickslip.integrate.dormand_prince.dense_coefficients", "stickslip.integrate.contacts.slip_event_possible",
-         "stickslip.integrate.contacts.time_to_zero_of", "stickslip.integrate.contacts.all_finite",
-         "stickslip.integrate.event_loop.homing_left"),
+         "stickslip.integrate.event_loop.cut_step", "stickslip.integrate.dormand_prince.dense_coefficients",
+         "stickslip.integrate.contacts.slip_event_possible", "stickslip.integrate.contacts.time_to_zero_of",
+         "stickslip.integrate.contacts.all_finite", "stickslip.integrate.event_loop.homing_left"),
     caller="stickslip.integrate.event_loop.event_loop",
     signatures={
         "stickslip.integrate.contacts.try_stick": "v v i M f v v",

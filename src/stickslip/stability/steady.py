@@ -234,8 +234,7 @@ def _newton_from(q, cst, md, free, max_iter):
 #: for kinematics whose sizes are run-time data (model files; fixed sizes are compile-time constants
 #: in these signatures): the complex-step stick solve (the deepest level of the chain under the
 #: Newton) in the helper; the friction coefficient, the frame's central-difference bias (complex)
-#: and the Newton's linear solve here; :func:`steady_sliding_point` then
-#: loads both.
+#: and the Newton's linear solve here; :func:`steady_sliding_point` then loads both.
 STEADY = Split(
     helper=("stickslip.model.forces.solve_stick_rows",),
     own=("stickslip.model.model_data.kinetic_coefficient", "stickslip.model.frames._frame_bias_central",
