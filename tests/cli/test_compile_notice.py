@@ -1,9 +1,12 @@
 """The line the command line prints while numba compiles, and the compile time it reports."""
 
+import time
+
 import numpy as np
+import pytest
 from numba import njit
 
-from stickslip.cli._compiling import COMPILING_LINE, compile_notice, compile_seconds
+from stickslip.cli._compiling import COMPILING_LINE, compile_notice, compile_seconds, time_text, timed
 
 
 def test_one_line_as_compiling_starts_and_the_time_at_the_end():
@@ -55,3 +58,29 @@ def test_seconds_counted_inside_and_zero_outside():
         spent = compile_seconds() - before
     assert spent > 0.0
     assert compile_seconds() == 0.0
+
+
+def test_timed_puts_the_compiling_apart_from_the_wall_time():
+    @njit(cache=False)
+    def four_times(x):
+        return 4.0 * x
+
+    with compile_notice():
+        start = time.perf_counter()
+        with timed() as timing:
+            four_times(np.float64(1.0))  # compiles
+            time.sleep(0.2)  # the block's own work
+        elapsed = time.perf_counter() - start
+    assert timing.compile_s > 0.0 and timing.wall_s >= 0.2
+    assert timing.wall_s + timing.compile_s == pytest.approx(elapsed, abs=1e-3)
+
+    with compile_notice(), timed() as again:  # compiled already
+        four_times(np.float64(2.0))
+    assert again.compile_s == 0.0
+
+
+def test_time_text_says_the_wall_time_and_the_compiling_apart():
+    assert time_text(27.417, 25.04, "processes, 2 workers") == "27.42 s (processes, 2 workers; compiling 25.0 s apart)"
+    assert time_text(2.5, 0.0, "processes, 2 workers") == "2.50 s (processes, 2 workers)"
+    assert time_text(0.0123, 3.0) == "0.012 s (compiling 3.0 s apart)"
+    assert time_text(0.0123, 0.0) == "0.012 s"

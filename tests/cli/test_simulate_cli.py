@@ -14,7 +14,7 @@ runner = CliRunner()
 JSON_KEYS = {"settled", "attractor", "period_count", "fundamental_frequency_hz", "dominant_frequency_hz",
              "settle_time_s", "evidence", "status", "model", "parameters", "t_end_s", "steady_from_s",
              "stick_fraction", "n_transitions", "contacts", "coordinate", "phi_min", "phi_max", "steps", "wall_time_s",
-             "method", "confirmed_by"}
+             "method", "confirmed_by", "compile_time_s"}
 
 
 def run(*args):

@@ -83,18 +83,27 @@ def test_the_steady_splits_signatures_are_the_ones_stability_compiles_for_a_mode
 
 
 COLD_RUN = textwrap.dedent("""
-    import hashlib, json, sys
+    import hashlib, json, sys, time
     import numpy as np
     from numba.core import event
     import stickslip
-    outermost, depth = [], [0]
+    from stickslip.model.compile_ahead import meanwhile
+    outermost, depth, spans = [], [0], []
     class Outermost(event.Listener):
         def on_start(self, ev):
             if depth[0] == 0:
                 outermost.append(ev.data["dispatcher"].py_func.__name__)
+                spans.append([time.perf_counter(), None])
             depth[0] += 1
         def on_end(self, ev):
             depth[0] -= 1
+            if depth[0] == 0:
+                spans[-1][1] = time.perf_counter()
+    work = []
+    def prepare():
+        work.append(time.perf_counter())
+        time.sleep(0.3)
+        work.append(time.perf_counter())
     nested = []
     class Every(event.Listener):
         def on_start(self, ev):
@@ -102,16 +111,19 @@ COLD_RUN = textwrap.dedent("""
         def on_end(self, ev):
             pass
     with event.install_listener("numba:compile", Outermost()), event.install_listener("numba:compile", Every()):
-        tr = stickslip.simulate(None, 5.0)
+        with meanwhile(prepare):
+            tr = stickslip.simulate(None, 5.0)
     print(json.dumps({"states": hashlib.sha256(np.ascontiguousarray(tr.states).tobytes()).hexdigest(),
-                      "outermost": outermost, "compiled": nested}))
+                      "outermost": outermost, "compiled": nested, "spans": spans, "work": work}))
 """)
 
 
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="the helper process runs only with two or more cores")
 def test_a_cold_start_in_two_processes_runs_alike_and_compiles_the_stick_solve_once(tmp_path):
     """From an empty cache with the helper on: the same states bit for bit as a run in this
-    process, and this process loads the helper's kernels from the cache instead of compiling them."""
+    process, and this process loads the helper's kernels from the cache instead of compiling them.
+    The :func:`meanwhile` work runs between this process's compiling and the wait for the helper,
+    outside the compile events (which the command line counts as compiling, the wait included)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), STICKSLIP_COMPILE_PROCESSES="2")
     out = subprocess.run([sys.executable, "-c", COLD_RUN], env=env, capture_output=True, text=True, check=True,
                          timeout=900)
@@ -120,6 +132,10 @@ def test_a_cold_start_in_two_processes_runs_alike_and_compiles_the_stick_solve_o
     assert cold["states"] == hashlib.sha256(np.ascontiguousarray(here.states).tobytes()).hexdigest()
     assert "try_stick" not in cold["compiled"] and "stick_forces" not in cold["compiled"]
     assert "rhs" in cold["compiled"] and "event_loop" in cold["outermost"]
+    start, end = cold["work"]
+    assert end - start >= 0.3
+    assert all(stop <= start or begin >= end for begin, stop in cold["spans"]), (cold["spans"], cold["work"])
+    assert any(stop <= start for _, stop in cold["spans"]) and any(begin >= end for begin, _ in cold["spans"])
 
 
 OPEN_AT_START = textwrap.dedent("""

@@ -14,7 +14,7 @@ def test_stability_json():
     result = runner.invoke(app, ["stability", "--N", "50", "--omega", "12", "--json"])
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
-    assert set(data) >= {"equilibrium", "eigenvalues", "max_real_part", "stable", "compile_time_s"}
+    assert set(data) >= {"equilibrium", "eigenvalues", "max_real_part", "stable", "wall_time_s", "compile_time_s"}
     assert data["compile_time_s"] >= 0.0
     assert set(data["equilibrium"]) == {"x1", "y1", "x2", "y2", "phi", "psi"}
     assert len(data["eigenvalues"]) == 12 and len(data["eigenvalues"][0]) == 2

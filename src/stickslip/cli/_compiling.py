@@ -9,16 +9,25 @@ reports apart), and can print one line when the first compilation starts and, at
 long compiling took in all. The command line prints those two lines on stderr when stderr is a
 terminal (``--json`` output on stdout stays clean; a log of a script or a test's captured output
 keeps only the command's own lines).
+
+Every computing command reports its time the same way (:func:`timed`, :func:`time_text`): the wall
+time of its computation without the compiling, and the compiling apart. Its ``--json`` summary
+holds both, ``wall_time_s`` and ``compile_time_s``; its table or last line reads ``2.41 s
+(processes, 2 workers; compiling 25.0 s apart)``. Compiling is what numba compiles in this process
+and the time it waits for a cold start's helper process compiling the rest
+(:mod:`stickslip.model.compile_ahead`); workers of a sweep or basins inherit the kernels or load
+them from the cache.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import time
 
 from numba.core import event
 
-__all__ = ["compile_notice", "compile_seconds", "COMPILING_LINE"]
+__all__ = ["compile_notice", "compile_seconds", "COMPILING_LINE", "Timing", "timed", "time_text"]
 
 #: The line printed when the first kernel starts compiling.
 COMPILING_LINE = ("compiling kernels for this kind of model (once per machine: later runs load them from numba's "
@@ -75,3 +84,32 @@ def compile_notice(say=None):
         _clocks.remove(clock)
     if say is not None and clock.seconds > 0.0:  # not after an error or Ctrl-C: their line is the last
         say(f"compiled kernels in {clock.seconds:.1f} s (cached for later runs)")
+
+
+@dataclasses.dataclass
+class Timing:
+    """What :func:`timed` measured: ``wall_s`` [s], the block's wall time without its compiling;
+    ``compile_s`` [s], the compiling (:func:`compile_seconds`) within it."""
+
+    wall_s: float = 0.0
+    compile_s: float = 0.0
+
+
+@contextlib.contextmanager
+def timed():
+    """Measure the block: a :class:`Timing`, filled in when the block ends."""
+    timing = Timing()
+    start, compiling = time.perf_counter(), compile_seconds()
+    try:
+        yield timing
+    finally:
+        timing.compile_s = compile_seconds() - compiling
+        timing.wall_s = time.perf_counter() - start - timing.compile_s
+
+
+def time_text(wall_s: float, compile_s: float, detail: str = "") -> str:
+    """A command's time as its summary prints it: ``2.41 s (processes, 2 workers; compiling 25.0 s
+    apart)``, without the compiling part when nothing was compiled (milliseconds below 1 s)."""
+    notes = [note for note in (detail, f"compiling {compile_s:.1f} s apart" if compile_s > 0 else "") if note]
+    number = f"{wall_s:.3f}" if wall_s < 1 else f"{wall_s:.2f}"
+    return f"{number} s" + (f" ({'; '.join(notes)})" if notes else "")

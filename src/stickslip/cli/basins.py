@@ -22,6 +22,7 @@ from ..basins.engine import load_result
 from ..integrate.interrupt import stop_if_interrupted
 from ..plot.basins import save_basins_figure
 from ._app import CLIError, app, build_system, check_resumable_output, console, journal_of, parse_assignments
+from ._compiling import Timing, time_text, timed
 from ._groups import grouped
 from ._kept import keeps, on_interrupt
 from ._options import Model, SetItems, Study, Tolerances
@@ -92,17 +93,18 @@ def basins(
     keeps(out, _holds)
     on_interrupt(f"the states classified before are kept in {journal_of(out)}; run the same command again to resume",
                  journal_of(out))
-    result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, **parallel,
-                             progress=not (study.no_progress or as_json), overwrite=study.overwrite,
-                             rtol=tolerances.rtol, atol=tolerances.atol, match_rtol=match_rtol,
-                             confirm=not no_confirm, lyapunov=lyapunov)
+    with timed() as timing:
+        result = basin_stability(m, states, param=path, values=values, out=out, t_end=t_end, **parallel,
+                                 progress=not (study.no_progress or as_json), overwrite=study.overwrite,
+                                 rtol=tolerances.rtol, atol=tolerances.atol, match_rtol=match_rtol,
+                                 confirm=not no_confirm, lyapunov=lyapunov)
     stop_if_interrupted()  # the study took a Ctrl-C: it wrote what it had
     figure = draw_figure(out, lambda tmp: save_basins_figure(result, tmp), skip=study.no_plot,
                          overwrite=replace_figure, inputs=inputs)
     if as_json:
-        print(json.dumps(result.to_json()))
+        print(json.dumps({**result.to_json(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
     else:
-        _print_summary(result, out, figure)
+        _print_summary(result, out, figure, timing)
 
 
 def _holds(out: Path) -> str:
@@ -114,7 +116,7 @@ def _holds(out: Path) -> str:
     return f"{out} holds {done} of {total} states classified; run the same command again to resume"
 
 
-def _print_summary(result, out: Path, figure) -> None:
+def _print_summary(result, out: Path, figure, timing: Timing) -> None:
     ds = result.dataset
     timings = result.timings
     if "param" in ds.dims:
@@ -142,4 +144,5 @@ def _print_summary(result, out: Path, figure) -> None:
     console.print(table)
     computed = timings.get("states_computed", 0)
     console.print(f"states computed / resumed: {computed} / {timings.get('states_resumed', 0)}; "
-                  f"{timings.get('total_s', 0.0):.1f} s; wrote {out}" + ("" if figure is None else f", {figure}"))
+                  f"wall time {time_text(timing.wall_s, timing.compile_s)}; wrote {out}"
+                  + ("" if figure is None else f", {figure}"))

@@ -21,7 +21,7 @@ from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
 from ._app import (CLIError, app, check_below_one, check_finite, check_positive, check_resumable_output, console,
                    error_line, note_line, resumable_holds)
-from ._compiling import compile_seconds
+from ._compiling import time_text, timed
 from ._groups import grouped
 from ._kept import keeps, keeps_figure
 from ._options import (ContinuedPoint, JsonSummary, Model, ModelChanges, NoPlot, OrbitRtol, OrbitSearch, Restart,
@@ -122,18 +122,17 @@ def continue_command(
     progress = None if (no_progress or as_json) else (
         lambda i, v, T, st: console.print(f"  orbit {i:4d}: {param} = {v:.6g}, T = {T:.6g} s, "
                                           f"{'stable' if st else 'unstable'}"))
-    compiling0 = compile_seconds()
-    run = start_run(system, ic_start, t_end=search.search_time, rtol=rtol)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    compiling1 = compile_seconds()
-    try:
-        branch = continue_orbit(system, param, start=run, direction=1 if stop > start else -1, step=step,
-                                max_step=max_step, max_points=max_points, bounds=(min(start, stop), max(start, stop)),
-                                stop_on=tuple(stop_on), section=sec, rtol=rtol, tol=tol, callback=progress, out=out,
-                                on_resume=_note_resume, resume=not overwrite)
-    except SteadySlidingError as exc:
-        raise _steady_start(exc, system) from None
-    compiling, compiling_inside = compile_seconds() - compiling0, compile_seconds() - compiling1
+    with timed() as timing:
+        run = start_run(system, ic_start, t_end=search.search_time, rtol=rtol)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            branch = continue_orbit(system, param, start=run, direction=1 if stop > start else -1, step=step,
+                                    max_step=max_step, max_points=max_points,
+                                    bounds=(min(start, stop), max(start, stop)), stop_on=tuple(stop_on), section=sec,
+                                    rtol=rtol, tol=tol, callback=progress, out=out, on_resume=_note_resume,
+                                    resume=not overwrite)
+        except SteadySlidingError as exc:
+            raise _steady_start(exc, system) from None
     figure = None
     if not no_plot:
         keeps_figure(out)
@@ -145,9 +144,8 @@ def continue_command(
         "special": [{"kind": p.kind, "value": p.value, "located": p.located, "multipliers": _pairs(p.multipliers),
                      "multipliers_before": _pairs(p.multipliers_before),
                      "multipliers_after": _pairs(p.multipliers_after)} for p in branch.special],
-        # the continuation's own time, without the compiling inside it (the start run's is reported with it)
-        "total_s": branch.timings["total_s"] - compiling_inside,
-        "compile_time_s": compiling, "simulations": branch.timings["simulations"],
+        # the start run and the continuation, without the compiling inside them
+        "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s, "simulations": branch.timings["simulations"],
         "points_resumed": branch.timings.get("points_resumed", 0),
     }
     steady = branch.stop_reason.startswith("steady sliding")
@@ -173,8 +171,8 @@ def _print_summary(branch, summary: dict, param: str, out: Path) -> None:
         if p.kind in ("fold", "period-doubling", "neimark-sacker"):
             table.add_row("  multipliers", f"{_multipliers_text(p.multipliers_before)} → "
                                            f"{_multipliers_text(p.multipliers_after)}")
-    table.add_row("wall time", f"{summary['total_s']:.2f} s ({summary['simulations']} simulations"
-                  + (f"; compiling {summary['compile_time_s']:.1f} s apart)" if summary["compile_time_s"] > 0 else ")"))
+    table.add_row("wall time", time_text(summary["wall_time_s"], summary["compile_time_s"],
+                                         f"{summary['simulations']} simulations"))
     if summary["points_resumed"]:
         table.add_row("resumed", f"{summary['points_resumed']} orbits read back from {out} or its journal")
     table.add_row("wrote", str(out) + ("" if summary["figure"] is None else f", {summary['figure']}"))

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +24,7 @@ from ..orbits.problem import stick_summary
 from ..orbits.start import default_start
 from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
-from ._compiling import compile_seconds
+from ._compiling import time_text, timed
 from ._groups import grouped
 from ._options import (JsonSummary, Model, ModelChanges, OperatingPoint, OrbitRtol, OrbitSearch, Outputs, SlipBand,
                        StartIc, Tol)
@@ -103,12 +102,10 @@ def orbit_command(
     sec = resolve_section(parse_section(search.section), system)
     out, inputs = outputs.out, changes.inputs
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
-    t0, compiling0 = time.perf_counter(), compile_seconds()
-    run = start_run(system, start, t_end=search.search_time, rtol=rtol)
-    orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
-                           monodromy=monodromy)
-    compiling = compile_seconds() - compiling0
-    wall = time.perf_counter() - t0 - compiling
+    with timed() as timing:
+        run = start_run(system, start, t_end=search.search_time, rtol=rtol)
+        orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
+                               monodromy=monodromy)
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
     figure = write_result(outputs, lambda: netcdf_writer(orbit.to_xarray()), holds=f"the orbit is in {out}",
@@ -121,8 +118,8 @@ def orbit_command(
         "max_nontrivial_multiplier_abs": float(others.max()) if others.size else None,
         "trivial_multiplier_error": float(abs(orbit.trivial_multiplier - 1.0)),
         "stable": bool(orbit.stable), "monodromy": orbit.options.get("monodromy", monodromy),
-        "iterations": int(orbit.iterations), "residual": float(orbit.residual), "wall_time_s": wall,
-        "compile_time_s": compiling,
+        "iterations": int(orbit.iterations), "residual": float(orbit.residual),
+        "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s,
     }
     if as_json:
         print(json.dumps(summary))
@@ -137,8 +134,7 @@ def orbit_command(
     table.add_row("|μ_trivial − 1|", f"{summary['trivial_multiplier_error']:.2e} ({summary['monodromy']})")
     table.add_row("stability", Text("stable", style="green") if orbit.stable else Text("unstable", style="bold red"))
     table.add_row("Newton", f"{summary['iterations']} iterations, residual {summary['residual']:.2e}")
-    table.add_row("wall time", f"{wall:.2f} s (start run + shooting + multipliers"
-                  + (f"; compiling {compiling:.1f} s apart)" if compiling > 0 else ")"))
+    table.add_row("wall time", time_text(timing.wall_s, timing.compile_s, "start run + shooting + multipliers"))
     table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
     console.print(table)
 
@@ -172,11 +168,9 @@ def lyapunov_command(
     out, inputs = outputs.out, changes.inputs
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     start = default_start(system) if start is None else start
-    compiling0 = compile_seconds()
-    spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
-                                 method=method)
-    compiling = compile_seconds() - compiling0
-    wall = float(spectrum.wall_time) - compiling
+    with timed() as timing:
+        spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
+                                     method=method)
     figure = write_result(outputs, lambda: netcdf_writer(spectrum.to_xarray()), holds=f"the spectrum is in {out}",
                           inputs=inputs, draw=lambda tmp: save_lyapunov_spectrum_figure(spectrum, tmp))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
@@ -184,7 +178,8 @@ def lyapunov_command(
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,
         "method": method, "t_transient_s": float(t_transient), "t_average_s": float(t_average),
         "exponents": [_finite_or_none(x) for x in ordered], "largest": _finite_or_none(ordered[0]),
-        "stick_phases": int(spectrum.stick_phases), "wall_time_s": wall, "compile_time_s": compiling,
+        "stick_phases": int(spectrum.stick_phases), "wall_time_s": timing.wall_s,
+        "compile_time_s": timing.compile_s,
     }
     if as_json:
         print(json.dumps(summary))
@@ -198,6 +193,6 @@ def lyapunov_command(
         table.add_row(str(i), f"{lam:+.6g}", style="bold red" if lam > 0 else None)
     console.print(table)
     console.print(f"averaged over {t_average:g} s after a {t_transient:g} s transient from --ic {ic}; "
-                  f"{spectrum.stick_phases} stick phases; wall time {wall:.2f} s"
-                  + (f" (compiling {compiling:.1f} s apart)" if compiling > 0 else ""), soft_wrap=True)
+                  f"{spectrum.stick_phases} stick phases; wall time {time_text(timing.wall_s, timing.compile_s)}",
+                  soft_wrap=True)
     console.print(f"wrote {out}" + ("" if figure is None else f", {figure}"), soft_wrap=True)

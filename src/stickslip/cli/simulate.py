@@ -33,6 +33,7 @@ from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
 from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, given,
                    note_line, warning_line)
+from ._compiling import time_text, timed
 from ._groups import grouped
 from ._kept import keeps, on_interrupt
 from ._options import Model, ModelChanges, NoPlot, Overwrite, Plates, SampleRate, Tolerances
@@ -229,7 +230,8 @@ def simulate(
     _warn_aliasing(system, settings["sample_rate"])
 
     prepare = functools.partial(prepare_outputs, not no_plot) if write else lambda: None
-    with on_ctrl_c(partial=True), meanwhile(prepare):  # Ctrl-C ends the run with the part done, written below
+    # Ctrl-C ends the run with the part done, written below
+    with on_ctrl_c(partial=True), meanwhile(prepare), timed() as timing:
         if duration is None:
             settled = simulate_until_settled(system, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
             traj, verdict = settled.trajectory, settled.attractor
@@ -256,7 +258,7 @@ def simulate(
         error_line(f"the run stopped early: {traj.status}; " + (f"what it computed is in {out}" if keep else
                    "it kept too few samples to write" if write else "nothing was written (--json without --out)"))
         raise typer.Exit(1)
-    summary = run_summary(traj, verdict)
+    summary = {**run_summary(traj, verdict), "compile_time_s": timing.compile_s}
     if as_json:
         print(json.dumps(summary))
     else:
@@ -293,7 +295,7 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
         ("transitions in window", str(s.n_transitions)),
         (f"{symbol} min / max", f"{s.minimum:.6g} / {s.maximum:.6g}" + f" {system.units.get(observed, '')}".rstrip(" -")),
         ("steps (accepted + rejected)", f"{traj.stats.steps} ({traj.method})"),
-        ("wall time", f"{traj.stats.wall_time_s:.3f} s"),
+        ("wall time", time_text(traj.stats.wall_time_s, summary["compile_time_s"], "the integration")),
         ("wrote", wrote),
     ]
     for key, value in rows:
@@ -302,6 +304,3 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
     if not summary["settled"]:
         console.print("not settled in the window: no period is claimed (the dominant frequency is the highest "
                       "peak of the spectrum); run longer or use --t-end auto", style="dim")
-    if traj.stats.compile_time_s > 0:
-        console.print(f"first call: kernels compiled or loaded from cache in {traj.stats.compile_time_s:.1f} s "
-                      "(not included in the wall time)", style="dim")

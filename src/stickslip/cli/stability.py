@@ -21,7 +21,7 @@ from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ._app import CLIError, app, build_system, check_finite, check_outputs, console
-from ._compiling import compile_seconds
+from ._compiling import time_text, timed
 from ._groups import grouped
 from ._options import Friction, JsonSummary, MapModel, Model, ModelChanges, Outputs, Plates
 from ._outputs import write_result
@@ -38,10 +38,10 @@ def stability(
 ) -> None:
     """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
     system, _ = build_system(model, changes.config, changes.set_, **plates.named())
-    compiling0 = compile_seconds()
-    result = run_stability(system)
+    with timed() as timing:
+        result = run_stability(system)
     if as_json:
-        print(json.dumps({**result.summary(), "compile_time_s": compile_seconds() - compiling0}))
+        print(json.dumps({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
         return
     p = result.params
     title = f"steady sliding: model {result.model}"
@@ -63,6 +63,7 @@ def stability(
     console.print(modes)
     verdict = Text("stable", style="green") if result.stable else Text("unstable", style="bold red")
     console.print(Text.assemble(f"max real part {result.max_real_part:.6g} 1/s: steady sliding is ", verdict))
+    console.print(f"wall time {time_text(timing.wall_s, timing.compile_s)}", style="dim")
 
 
 def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
@@ -122,7 +123,8 @@ def stability_map(
                        "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
     out, inputs = outputs.out, changes.inputs
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
-    smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
+    with timed() as timing:
+        smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
     figure = write_result(outputs, lambda: netcdf_writer(smap.to_xarray()), holds=f"the map is in {out}",
                           inputs=inputs, draw=lambda tmp: save_stability_map_figure(smap, tmp))
     rows = []
@@ -137,7 +139,8 @@ def stability_map(
         })
     if as_json:
         print(json.dumps({"out": str(out), "figure": None if figure is None else str(figure), "axes": list(names),
-                          "family": smap.family_name, "members": rows, "timings": smap.timings}))
+                          "family": smap.family_name, "members": rows, "timings": smap.timings,
+                          "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
         return
     table = Table(title=f"stability map {values[0].size} × {values[1].size} ({names[0]} × {names[1]}), "
                         f"model {smap.model}")
@@ -148,7 +151,8 @@ def stability_map(
         table.add_row(r["member"], uf, f"{r['no_equilibrium_fraction']:.3f}", str(r["boundary_points"]))
     console.print(table)
     t = smap.timings
-    console.print(f"grid {t['grid_s']:.2f} s, boundary {t['boundary_s']:.2f} s; wrote {out}"
+    detail = f"grid {t['grid_s']:.2f} s, boundary {t['boundary_s']:.2f} s"
+    console.print(f"wall time {time_text(timing.wall_s, timing.compile_s, detail)}; wrote {out}"
                   + ("" if figure is None else f", {figure}"))
 
 

@@ -29,6 +29,7 @@ from ..sweep.bistability import REGION_NAMES
 from ..sweep.spec import columns_of
 from ._app import (CLIError, app, build_system, check_positive, check_resumable_output, config_values, console,
                    parse_assignments, resumable_holds)
+from ._compiling import Timing, time_text, timed
 from ._groups import grouped
 from ._kept import keeps
 from ._options import (BifurcationModel, BifurcationPlates, Friction, GridTEnd, JsonSummary, ModelChanges, NoPlot,
@@ -166,13 +167,16 @@ def _study(study: Study, what: str, inputs: dict, compute: Callable[[], object],
         What ``compute`` returned.
     figure : Path or None
         The figure written.
+    timing : Timing
+        The computation's wall time and its compiling apart.
     """
     replace_figure = check_resumable_output(study.out, not study.no_plot, study.overwrite, inputs)
     keeps(study.out, resumable_holds(what))
-    result = compute()
+    with timed() as timing:
+        result = compute()
     figure = draw_figure(study.out, lambda tmp: draw(result, tmp), skip=study.no_plot, overwrite=replace_figure,
                          inputs=inputs)
-    return result, figure
+    return result, figure, timing
 
 
 def _kind_counts(ds) -> dict:
@@ -182,12 +186,13 @@ def _kind_counts(ds) -> dict:
     return {names[c]: int(np.sum(code == c)) for c in (-1, 0, 1, 2, 3) if np.any(code == c)}
 
 
-def _report(title: str, out: Path, figure, timings: dict, ds, as_json: bool, extra: dict | None = None) -> None:
+def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as_json: bool,
+            extra: dict | None = None) -> None:
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure),
         "shape": {d: int(ds.sizes[d]) for d in ds["done"].dims},
         "points_computed": int(timings.get("points_computed", 0)), "points_resumed": int(timings.get("points_resumed", 0)),
-        "total_s": float(timings.get("total_s", float("nan"))), "kinds": _kind_counts(ds), **(extra or {}),
+        "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s, "kinds": _kind_counts(ds), **(extra or {}),
     }
     if as_json:
         print(json.dumps(summary))
@@ -197,7 +202,7 @@ def _report(title: str, out: Path, figure, timings: dict, ds, as_json: bool, ext
     table.add_row("points computed / resumed", f"{summary['points_computed']} / {summary['points_resumed']}")
     executor = timings.get("executor", "?")
     workers = "1 process" if executor == "serial" else f"{timings.get('workers', '?')} workers"
-    table.add_row("wall time", f"{summary['total_s']:.2f} s ({executor}, {workers})")
+    table.add_row("wall time", time_text(timing.wall_s, timing.compile_s, f"{executor}, {workers}"))
     table.add_row("steady states", ", ".join(f"{k} {v}" for k, v in summary["kinds"].items()))
     for key, value in (extra or {}).items():
         table.add_row(key.replace("_", " "), str(value))
@@ -245,11 +250,11 @@ def sweep_command(
     study = Study(parallel=parallel, out=out, overwrite=overwrite, no_plot=no_plot, no_progress=no_progress)
     options = _run_options(study, t_end, t_from, sample_rate, tolerances)
     options.update(_settle_options(settling))
-    result, figure = _study(study, "sweep", changes.inputs,
-                            lambda: run_sweep(values, target, out=out, model=variant, ic=ic, **options),
-                            lambda result, tmp: save_sweep_figure(result, tmp, var=plot_var))
+    result, figure, timing = _study(study, "sweep", changes.inputs,
+                                    lambda: run_sweep(values, target, out=out, model=variant, ic=ic, **options),
+                                    lambda result, tmp: save_sweep_figure(result, tmp, var=plot_var))
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
-            result.dataset, as_json)
+            timing, result.dataset, as_json)
 
 
 # ----------------------------------------------------------------------------- stickslip bifurcation
@@ -294,12 +299,12 @@ def bifurcation(
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
     options = _run_options(study, t_end, t_from, sample_rate, tolerances)
     options.update(_settle_options(settling))
-    result, figure = _study(study, "bifurcation diagram", changes.inputs,
-                            lambda: run_sweep(grid, target, out=study.out, model=models[0], ic=ic, n_peaks=n_peaks,
-                                              **options),
-                            save_bifurcation_figure)
-    _report(f"bifurcation diagram of {coordinate} against {param}", study.out, figure, result.timings, result.dataset,
-            as_json)
+    result, figure, timing = _study(study, "bifurcation diagram", changes.inputs,
+                                    lambda: run_sweep(grid, target, out=study.out, model=models[0], ic=ic,
+                                                      n_peaks=n_peaks, **options),
+                                    save_bifurcation_figure)
+    _report(f"bifurcation diagram of {coordinate} against {param}", study.out, figure, result.timings, timing,
+            result.dataset, as_json)
 
 
 #: Base values of the paper's bifurcation diagrams (Figs. 12–14): N = 50 N and Ω = 0.5 rad/s
@@ -355,9 +360,10 @@ def regions_command(
     if t_from is None and math.isfinite(t_end):
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
     options = _run_options(study, t_end, t_from, sample_rate, tolerances)
-    rmap, figure = _study(study, "region map", changes.inputs,
-                          lambda: run_regions(n_values, w_values, params, models=models, out=study.out, **options),
-                          save_regions_figure)
+    rmap, figure, timing = _study(study, "region map", changes.inputs,
+                                  lambda: run_regions(n_values, w_values, params, models=models, out=study.out,
+                                                      **options),
+                                  save_regions_figure)
 
     region = rmap.region
     counts = {REGION_NAMES[c]: int(np.sum(region == c)) for c in sorted(REGION_NAMES) if np.any(region == c)}
@@ -366,4 +372,5 @@ def regions_command(
     extra = {"regions": ", ".join(f"{k}: {v}" for k, v in counts.items())}
     if as_json:
         extra = {"regions": counts, "stick_slip_omega_max": edges}
-    _report("regions of steady states over (N, Ω)", study.out, figure, rmap.timings, rmap.dataset, as_json, extra)
+    _report("regions of steady states over (N, Ω)", study.out, figure, rmap.timings, timing, rmap.dataset,
+            as_json, extra)

@@ -119,13 +119,15 @@ class ColdStart:
 
     def finish(self) -> None:
         """Compile this process's kernels, run the :func:`meanwhile` work, then wait for the helper."""
-        caller = kernel_named(self.split.caller)
-        # one outermost compile event for the pair, so the time waited counts as compiling
-        with event.trigger_event("numba:compile", data={"dispatcher": caller, "args": (), "return_type": None}):
+        # outermost compile events around this process's side and the wait for the helper, so that
+        # the time waited counts as compiling and the meanwhile work does not
+        compiling = {"dispatcher": kernel_named(self.split.caller), "args": (), "return_type": None}
+        with event.trigger_event("numba:compile", data=compiling):
             _compile(self.split, self.split.own, self.md_type)
-            while _meanwhile:
-                with contextlib.suppress(Exception):  # preparation only: the same work fails again where it is due
-                    _meanwhile.pop(0)()
+        while _meanwhile:
+            with contextlib.suppress(Exception):  # preparation only: the same work fails again where it is due
+                _meanwhile.pop(0)()
+        with event.trigger_event("numba:compile", data=compiling):
             self.helper.wait(HELPER_TIMEOUT_S)
 
     def end(self) -> None:
