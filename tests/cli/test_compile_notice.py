@@ -5,6 +5,7 @@ import time
 import numpy as np
 import pytest
 from numba import njit
+from numba.core import event
 
 from stickslip.cli._compiling import COMPILING_LINE, compile_notice, compile_seconds, time_text, timed
 
@@ -84,3 +85,63 @@ def test_time_text_says_the_wall_time_and_the_compiling_apart():
     assert time_text(2.5, 0.0, "processes, 2 workers") == "2.50 s (processes, 2 workers)"
     assert time_text(0.0123, 3.0) == "0.012 s (compiling 3.0 s apart)"
     assert time_text(0.0123, 0.0) == "0.012 s"
+
+
+def _terminal():
+    """A rich console writing to a string as a terminal would."""
+    import io
+
+    from rich.console import Console
+
+    return Console(file=io.StringIO(), force_terminal=True, width=100)
+
+
+def test_a_spinner_counts_the_seconds_while_numba_compiles_and_leaves_nothing_on_screen():
+    @njit(cache=False)
+    def five_times(x):
+        return 5.0 * x
+
+    console = _terminal()
+    with compile_notice(console=console) as clock:
+        five_times(np.float64(1.0))
+        assert clock.spinner.live is None  # stopped when the compilation ended
+    written = console.file.getvalue()
+    assert "compiling ... 0 s" in written or "compiling ... 1 s" in written
+    assert written.endswith("\x1b[2K")  # transient: the spinner's line is erased
+
+
+def test_the_spinner_stops_on_an_interrupt_and_shows_beside_a_progress_bar():
+    from rich.progress import Progress
+
+    @njit(cache=False)
+    def six_times(x):
+        return 6.0 * x
+
+    @njit(cache=False)
+    def seven_times(x):
+        return 7.0 * x
+
+    console = _terminal()
+    try:
+        with compile_notice(console=console) as clock:
+            six_times(np.float64(1.0))
+            raise KeyboardInterrupt
+    except KeyboardInterrupt:
+        pass
+    assert clock.spinner.live is None
+
+    class Refresh(event.Listener):  # the bar redraws as the compilation starts (after the spinner started)
+        def on_start(self, ev):
+            bar.refresh()
+
+        def on_end(self, ev):
+            pass
+
+    console = _terminal()
+    with Progress(console=console) as bar, compile_notice(console=console) as clock:
+        bar.add_task("sweep", total=2)
+        with event.install_listener("numba:compile", Refresh()):
+            seven_times(np.float64(1.0))  # a study compiling its first point under its progress bar
+    assert clock.seconds > 0.0 and clock.spinner.live is None
+    written = console.file.getvalue()
+    assert "sweep" in written and "compiling ..." in written

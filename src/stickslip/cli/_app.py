@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
+import rich
 import typer
 from rich.console import Console
 from rich.markup import escape
@@ -251,8 +252,12 @@ def _use_replacement_characters() -> None:
 
 def _compile_notice():
     """Compile time counted for the command (:mod:`._compiling`), and a line while numba compiles
-    when stderr is a terminal."""
-    return compile_notice(note_line if getattr(sys.stderr, "isatty", lambda: False)() else None)
+    when stderr is a terminal, with a spinner below it where stdout is one too. The spinner is on
+    rich's global console, the console of the studies' progress bars, so that rich shows both
+    together instead of letting them overwrite each other; it is transient and leaves nothing in
+    the output."""
+    terminal = getattr(sys.stderr, "isatty", lambda: False)()
+    return compile_notice(note_line if terminal else None, rich.get_console() if terminal else None)
 
 
 def _check_environment() -> None:
