@@ -9,6 +9,10 @@ from .. import _startup
 
 _startup.hold()
 
+from ._xarray_dask import defer_dask_array  # noqa: E402
+
+defer_dask_array()  # before anything imports xarray: its first variable then skips importing dask.array
+
 from ._app import app  # noqa: E402
 
 from . import simulate  # noqa: E402,F401  (registers `stickslip simulate`)
