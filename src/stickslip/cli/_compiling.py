@@ -6,10 +6,11 @@ appear. numba announces each compilation it starts (the ``numba:compile`` event;
 from the on-disk cache is not one), so :func:`compile_notice` counts the seconds spent compiling
 while a command runs (:func:`compile_seconds`, which a command subtracts from its wall time and
 reports apart), and can print one line when the first compilation starts and, at the end, how
-long compiling took in all; on a terminal a spinner below that line counts the seconds while numba
-compiles (beside a study's progress bar where one is on screen). The command line prints those lines on
-stderr when stderr is a terminal (``--json`` output on stdout stays clean; a log of a script or a
-test's captured output keeps only the command's own lines).
+long compiling took in all, with a spinner below the first line that counts the seconds while
+numba compiles (beside a study's progress bar where one is on screen). The command line prints the
+two lines on stderr when stderr is a terminal, and the transient spinner where stdout is one too
+(``--json`` output on stdout stays clean; a log of a script or a test's captured output keeps only
+the command's own lines).
 
 Every computing command reports its time the same way (:func:`timed`, :func:`time_text`): the wall
 time of its computation without the compiling, and the compiling apart. Its ``--json`` summary
