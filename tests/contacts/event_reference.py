@@ -53,16 +53,18 @@ def event_driven(field, phi, slip_speed, stick_force, limit, t_eval, y0):
             contact.direction, margin.direction, events = -1.0, -1.0, [contact, margin]
         else:
             contact.direction, slip.direction, events = -1.0, -float(mode), [contact, slip]
+        # the samples ahead, interpolated by scipy in the steps that hold them (a segment between
+        # two close events may hold none); the segment ends at its event, or at the last sample
+        ahead = np.flatnonzero(t_eval >= t0)
         sol = solve_ivp(field(mode), (t0, t_eval[-1]), s, method="DOP853", rtol=1e-12, atol=1e-14,
-                        events=events, dense_output=True)
-        t1 = sol.t[-1]
-        sel = (t_eval >= t0) & (t_eval <= t1)
-        if sel.any():  # a segment between two close events may hold no sample
-            out[sel] = sol.sol(t_eval[sel]).T
-        t0, s = t1, sol.y[:, -1]
+                        events=events, t_eval=t_eval[ahead])
+        if len(sol.t):  # scipy leaves them lists when no sample fell in the segment
+            out[ahead[:len(sol.t)]] = sol.y.T
         if sol.status != 1:
             break
-        fired = events[[k for k, te in enumerate(sol.t_events) if te.size][0]]
+        k = next(k for k, te in enumerate(sol.t_events) if te.size)
+        t0, s = sol.t_events[k][0], sol.y_events[k][0]
+        fired, t1 = events[k], t0
         if fired is contact and mode != OPEN_MODE:
             if mode == STICK_MODE:
                 switches[SLIP].append(t1)

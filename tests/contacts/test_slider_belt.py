@@ -50,14 +50,15 @@ def equations(cc, V=V, CX=CX, ALPHA=ALPHA):
 
     def field(mode):
         def f(t, s):
-            x, y, dx, dy = s
+            x, y, dx, dy = s.tolist()  # Python floats: the same arithmetic, faster than numpy scalars
             spring_x, spring_y = -K11 * x - K12 * y, -K12 * x - K22 * y - P
             if mode == OPEN_MODE:
                 return [dx, dy, spring_x - CX * dx, spring_y - CY * dy]
+            pressed = P - KC * y - cc * dy  # lam(s)
             if mode == STICK_MODE:
-                return [dx, dy, 0.0, spring_y - CY * dy + lam(s)]
+                return [dx, dy, 0.0, spring_y - CY * dy + pressed]
             mu = MU_K + DELTA_MU * math.exp(-ALPHA * abs(dx - V))
-            return [dx, dy, spring_x - CX * dx - mode * mu * lam(s), spring_y - CY * dy + lam(s)]
+            return [dx, dy, spring_x - CX * dx - mode * mu * pressed, spring_y - CY * dy + pressed]
         return f
 
     return dict(field=field, phi=lambda s: min(P / KC - s[1], lam(s) / KC), slip_speed=lambda s: s[2] - V,

@@ -25,11 +25,6 @@ sliding decays at 0.0027 1/s (measured by continuation in V). A steeper fall (α
 whole picture to lower speeds where the friction's slope is spent, and cx = 0.1 doubles the decay:
 at V = 0.6 steady sliding decays at 0.0395 1/s and the cycle sticks, slips, separates and lands
 once per period (3.4759932; stick 0.0454 and flight 0.3895 of it).
-
-The reference cannot start a segment whose span holds no requested sample (scipy's dense output
-refuses an empty time array; segments of a few ms occur here between a slip reversal and a
-lift-off): :func:`_reference` lends it a dense output that answers an empty request with no
-samples, and changes nothing else.
 """
 
 from __future__ import annotations
