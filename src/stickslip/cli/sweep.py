@@ -132,16 +132,18 @@ def _plot_columns(system) -> tuple[str, ...]:
     return tuple(c[0] for c in columns_of(system))
 
 
-def _run_options(study: Study, t_end: float, t_from: float | None, sample_rate: float, tolerances: Tolerances) -> dict:
+def _run_options(study: Study, t_end: float, t_from: float | None, sample_rate: float, tolerances: Tolerances,
+                 as_json: bool) -> dict:
     """The run options of the sweep library from the command line.
 
     The run's length, rate and tolerances are checked here: the sweep does not refuse a tolerance
     (each of its runs would fail) and names neither the length nor the rate it refuses. It refuses
-    ``--t-from``, ``--workers`` and ``--cap`` itself, naming their values."""
+    ``--t-from``, ``--workers`` and ``--cap`` itself, naming their values. No progress bar with
+    ``--json``: stdout is then the one JSON line."""
     rtol, atol = tolerances.rtol, tolerances.atol
     check_positive({"--t-end": t_end, "--sample-rate": sample_rate, "--rtol": rtol, "--atol": atol})
-    return dict(study.parallel.options(), progress=not study.no_progress, overwrite=study.overwrite, t_end=t_end,
-                t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
+    return dict(study.parallel.options(), progress=not (study.no_progress or as_json), overwrite=study.overwrite,
+                t_end=t_end, t_from=t_from, sample_rate=sample_rate, rtol=rtol, atol=atol)
 
 
 def _study(study: Study, what: str, inputs: dict, compute: Callable[[], object],
@@ -248,7 +250,7 @@ def sweep_command(
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in columns if c != 'peaks')}")
     # the options of a Study, taken one by one because --plot stands among them
     study = Study(parallel=parallel, out=out, overwrite=overwrite, no_plot=no_plot, no_progress=no_progress)
-    options = _run_options(study, t_end, t_from, sample_rate, tolerances)
+    options = _run_options(study, t_end, t_from, sample_rate, tolerances, as_json)
     options.update(_settle_options(settling))
     result, figure, timing = _study(study, "sweep", changes.inputs,
                                     lambda: run_sweep(values, target, out=out, model=variant, ic=ic, **options),
@@ -297,7 +299,7 @@ def bifurcation(
     grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
-    options = _run_options(study, t_end, t_from, sample_rate, tolerances)
+    options = _run_options(study, t_end, t_from, sample_rate, tolerances, as_json)
     options.update(_settle_options(settling))
     result, figure, timing = _study(study, "bifurcation diagram", changes.inputs,
                                     lambda: run_sweep(grid, target, out=study.out, model=models[0], ic=ic,
@@ -359,7 +361,7 @@ def regions_command(
     models = parse_values("model", model, option="--model")
     if t_from is None and math.isfinite(t_end):
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
-    options = _run_options(study, t_end, t_from, sample_rate, tolerances)
+    options = _run_options(study, t_end, t_from, sample_rate, tolerances, as_json)
     rmap, figure, timing = _study(study, "region map", changes.inputs,
                                   lambda: run_regions(n_values, w_values, params, models=models, out=study.out,
                                                       **options),
