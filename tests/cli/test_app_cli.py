@@ -208,17 +208,23 @@ def _size(path) -> int:
 
 
 def _stickslip(*args) -> list:
-    return [sys.executable, "-c", "from stickslip.cli import app; app()", *args]
+    # faulthandler: a command that Ctrl-C did not end shows where it was (SIGABRT, _interrupt_when)
+    return [sys.executable, "-X", "faulthandler", "-c", "from stickslip.cli import app; app()", *args]
 
 
 def _interrupt_when(proc, ready, deadline_s=120.0) -> tuple:
-    """Send SIGINT to ``proc`` once ``ready()`` is true; its (returncode, stdout, stderr lines)."""
+    """Send SIGINT to ``proc`` once ``ready()`` is true; its (returncode, stdout, stderr lines).
+    A command still running 60 s later fails the test with the stacks of its threads."""
     deadline = time.monotonic() + deadline_s
     while not ready() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     proc.send_signal(signal.SIGINT)
     try:
         stdout, stderr = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGABRT)  # faulthandler prints every thread's stack, then the process ends
+        _, stderr = proc.communicate(timeout=60)
+        pytest.fail(f"Ctrl-C did not end the command within 60 s; where it was:\n{stderr[-6000:]}")
     finally:
         proc.kill()  # if Ctrl-C did not end it
     return proc.returncode, stdout, [ln for ln in stderr.splitlines() if ln.strip()]
