@@ -1,9 +1,9 @@
 """The line the command line prints while numba compiles, and the compile time it reports."""
 
+import re
 import time
 
 import numpy as np
-import pytest
 from numba import njit
 from numba.core import event
 
@@ -73,7 +73,8 @@ def test_timed_puts_the_compiling_apart_from_the_wall_time():
             time.sleep(0.2)  # the block's own work
         elapsed = time.perf_counter() - start
     assert timing.compile_s > 0.0 and timing.wall_s >= 0.2
-    assert timing.wall_s + timing.compile_s == pytest.approx(elapsed, abs=1e-3)
+    # together the block's time (measured around it here, so up to a scheduling delay longer)
+    assert elapsed - 0.05 <= timing.wall_s + timing.compile_s <= elapsed
 
     with compile_notice(), timed() as again:  # compiled already
         four_times(np.float64(2.0))
@@ -106,7 +107,7 @@ def test_a_spinner_counts_the_seconds_while_numba_compiles_and_leaves_nothing_on
         five_times(np.float64(1.0))
         assert clock.spinner.live is None  # stopped when the compilation ended
     written = console.file.getvalue()
-    assert "compiling ... 0 s" in written or "compiling ... 1 s" in written
+    assert re.search(r"compiling \.\.\. \d+ s", written)
     assert written.endswith("\x1b[2K")  # transient: the spinner's line is erased
 
 
