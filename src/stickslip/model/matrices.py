@@ -40,7 +40,7 @@ from ..errors import ModelError
 from .stack import MAX_DOFS
 
 __all__ = ["DENSE_DOFS", "is_sparse", "square_matrix", "contact_rows", "has_nonzero",
-           "dense_rows", "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite"]
+           "dense_rows", "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite", "is_checked"]
 
 #: Largest model kept dense: the compiled kernels' limit. Larger models keep their matrices sparse.
 DENSE_DOFS = MAX_DOFS
@@ -66,7 +66,11 @@ def is_sparse(value) -> bool:
 
 
 def _csr(value) -> sp.csr_matrix:
-    """``value`` as a canonical float64 CSR matrix (duplicates summed, indices sorted, no stored zeros)."""
+    """``value`` as a canonical float64 CSR matrix (duplicates summed, indices sorted, no stored
+    zeros); one that already is a canonical float64 CSR matrix is kept as it is (not copied: a
+    model's matrices are never changed in place, and a checked mass stays known as checked)."""
+    if type(value) is sp.csr_matrix and value.dtype == np.float64 and value.has_canonical_format:
+        return value
     out = sp.csr_matrix(value, dtype=float, copy=True)
     out.sum_duplicates()
     out.eliminate_zeros()
@@ -142,7 +146,8 @@ def mark_positive_definite(mass: sp.spmatrix) -> None:
     _CHECKED[id(mass)] = weakref.ref(mass, lambda _ref, key=id(mass): _CHECKED.pop(key, None))
 
 
-def _checked(mass) -> bool:
+def is_checked(mass) -> bool:
+    """Whether ``mass`` passed :func:`check_mass` (and is still that object)."""
     ref = _CHECKED.get(id(mass))
     return ref is not None and ref() is mass
 
@@ -159,7 +164,7 @@ def check_mass(mass, free: np.ndarray, where: str) -> None:
         One line: ``{where}: mass must be symmetric ...`` or ``... is not positive definite ...``.
     """
     if is_sparse(mass):
-        if _checked(mass):
+        if is_checked(mass):
             return
         low, high = _sparse_range(mass if free.all() else mass[free][:, free], where)
     else:

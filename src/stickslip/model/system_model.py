@@ -584,8 +584,10 @@ class FrictionModel:
             changes = {self.resolver(k): v for k, v in changes.items()}
         unknown = [k for k in changes if k not in self.parameters]
         if unknown:
-            raise ModelError(f"unknown parameter(s) {', '.join(unknown)} of model {self.name!r}; "
-                             f"valid names: {', '.join(self.parameters)}")
+            names = list(self.parameters)
+            shown = ", ".join(names[:24]) + (f", … ({len(names)} in all; 'stickslip models' lists them)"
+                                             if len(names) > 24 else "")
+            raise ModelError(f"unknown parameter(s) {', '.join(unknown)} of model {self.name!r}; valid names: {shown}")
         values = dict(self.parameters)
         values.update(changes)
         return self.builder(values)
