@@ -163,7 +163,8 @@ def _pick(names: list[str], name: str | None, where: str, kind: str):
     if name is None:
         if len(names) == 1:
             return names[0]
-        raise ModelFileError(f"{where} holds {len(names)} {kind}s ({', '.join(names[:8])}); name one, e.g. "
+        plural = kind[:-2] + "ices" if kind.endswith("ix") else kind + "s"
+        raise ModelFileError(f"{where} holds {len(names)} {plural} ({', '.join(names[:8])}); name one, e.g. "
                              f"\"{where.rsplit(': ', 1)[-1]}:{names[0] if names else 'NAME'}\"")
     if name not in names:
         raise ModelFileError(f"{where} holds no {kind} {name!r}; it holds {', '.join(names[:8]) or 'none'}")

@@ -77,6 +77,10 @@ def dof_names(value, labels=None) -> tuple[str, ...]:
     if isinstance(value, list):
         if not value or not all(isinstance(d, str) and d for d in value):
             raise ModelFileError(f"dofs must be a non-empty list of names, e.g. dofs = [\"x\", \"y\"], got {_short(value)}")
+        if len(set(value)) != len(value):
+            seen: set = set()
+            twice = next(d for d in value if d in seen or seen.add(d))
+            raise ModelFileError(f"dofs: {twice!r} is given twice; give each dof its own name")
         return tuple(value)
     if not isinstance(value, Mapping):
         raise ModelFileError(f"dofs must be a list of names or a table {{ count = N, prefix = \"u\" }}, got {_short(value)}")

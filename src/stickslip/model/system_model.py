@@ -316,9 +316,12 @@ class FrictionModel:
         check_text(self.description, f"model {self.name!r}: description")
         for i, dof in enumerate(self.dofs):
             check_name(dof, f"model {self.name!r}: dof {i}")
-        if len(set(self.dofs)) != n:
-            raise ModelError(f"model {self.name!r}: dof names must be unique, got {list(self.dofs)}")
         names = set(self.dofs)
+        if len(names) != n:
+            seen: set = set()
+            twice = next(d for d in self.dofs if d in seen or seen.add(d))
+            raise ModelError(f"model {self.name!r}: dof names must be unique, {twice!r} is given twice; give each dof "
+                             "its own name")
         for dof in self.dofs:
             if "d" + dof in names:
                 raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
