@@ -40,7 +40,7 @@ from ..errors import ModelError
 from .stack import MAX_DOFS
 
 __all__ = ["DENSE_DOFS", "is_sparse", "square_matrix", "contact_rows", "has_nonzero",
-           "dense_rows", "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite", "is_checked"]
+           "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite", "is_checked"]
 
 #: Largest model kept dense: the compiled kernels' limit. Larger models keep their matrices sparse.
 DENSE_DOFS = MAX_DOFS
@@ -118,14 +118,6 @@ def contact_rows(value, rows: int | None, n: int, dense: bool):
         return _csr(value)
     out = np.array(value, dtype=float)
     return _csr(out.reshape(1, -1) if rows == 1 or out.ndim == 1 else out)
-
-
-def dense_rows(value, n: int) -> np.ndarray:
-    """A contact's rows or vector as a dense array (vectors (n,), rows (dim, n)); zeros for None."""
-    if value is None:
-        return np.zeros(n)
-    return value.toarray().reshape(-1) if is_sparse(value) and value.shape[0] == 1 else (
-        value.toarray() if is_sparse(value) else np.asarray(value, dtype=float))
 
 
 def finite(value) -> bool:

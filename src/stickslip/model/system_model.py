@@ -94,6 +94,9 @@ def check_name(name: str, what: str) -> None:
         raise ModelError(f"{what} = {shown} is not a valid name; give a name of {NAME_RULE}")
 
 
+#: The dof names last checked by a FrictionModel (the same tuple is not checked again).
+_CHECKED_DOFS: list = [None]
+
 #: Normal laws a unilateral contact may state (:class:`NormalLaw`).
 UNILATERAL_LAWS = ("compliant", "rigid")
 
@@ -314,24 +317,15 @@ class FrictionModel:
             raise ModelError(f"model {self.name!r} has no degrees of freedom; list them in dofs")
         check_text(self.name, "the model's name")
         check_text(self.description, f"model {self.name!r}: description")
-        for i, dof in enumerate(self.dofs):
-            check_name(dof, f"model {self.name!r}: dof {i}")
-        names = set(self.dofs)
-        if len(names) != n:
-            seen: set = set()
-            twice = next(d for d in self.dofs if d in seen or seen.add(d))
-            raise ModelError(f"model {self.name!r}: dof names must be unique, {twice!r} is given twice; give each dof "
-                             "its own name")
-        for dof in self.dofs:
-            if "d" + dof in names:
-                raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
-                                 f"states are the dofs, then d + each dof); give one of them another name")
+        if not (isinstance(self.dofs, tuple) and self.dofs is _CHECKED_DOFS[0]):
+            self._check_dofs()
         dense = n <= DENSE_DOFS
         for key in ("mass", "damping", "stiffness"):
             object.__setattr__(self, key, square_matrix(getattr(self, key), n, dense, f"model {self.name!r}: {key}"))
         force = np.zeros(n) if self.force is None else np.array(self.force, dtype=float).reshape(-1)
         if force.shape != (n,) or not np.isfinite(force).all():
-            raise ModelError(f"model {self.name!r}: force must be {n} finite numbers, got {force.tolist()}")
+            shown = force.tolist() if force.size <= 8 else f"{force.size} numbers"
+            raise ModelError(f"model {self.name!r}: force must be {n} finite numbers, got {shown}")
         object.__setattr__(self, "force", force)
         free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
         object.__setattr__(self, "free", free)
@@ -347,6 +341,25 @@ class FrictionModel:
         if not (math.isfinite(self.slip_band) and self.slip_band > SPEED_FLOOR):
             raise ModelError(f"slip_band = {self.slip_band} must be a finite speed > {SPEED_FLOOR} m/s")
         self._check_starts()
+
+    def _check_dofs(self) -> None:
+        """Dof names valid, distinct, and none ``d`` + another (remembered for the tuple last checked:
+        a model file's rebuilds pass the same tuple, of up to 10^6 names)."""
+        n = len(self.dofs)
+        for i, dof in enumerate(self.dofs):
+            check_name(dof, f"model {self.name!r}: dof {i}")
+        names = set(self.dofs)
+        if len(names) != n:
+            seen: set = set()
+            twice = next(d for d in self.dofs if d in seen or seen.add(d))
+            raise ModelError(f"model {self.name!r}: dof names must be unique, {twice!r} is given twice; give each dof "
+                             "its own name")
+        for dof in self.dofs:
+            if "d" + dof in names:
+                raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
+                                 f"states are the dofs, then d + each dof); give one of them another name")
+        if isinstance(self.dofs, tuple):
+            _CHECKED_DOFS[0] = self.dofs
 
     def _check_starts(self) -> None:
         locked = ~np.concatenate([self.free, self.free])
