@@ -623,7 +623,8 @@ def regular_file_size(path, what: str, error: type[StickSlipError]) -> int:
         os.close(fd)
 
 
-def read_regular_file(path, limit: int, what: str, error: type[StickSlipError], fix: str = "give a smaller file") -> bytes:
+def read_regular_file(path, limit: int, what: str, error: type[StickSlipError],
+                      fix: str = "give a smaller file") -> bytes:
     """The bytes of the regular file ``path``, at most ``limit`` of them.
 
     Raises

@@ -126,7 +126,8 @@ def test_a_large_pad_stays_sparse_from_its_files(tmp_path):
     assert all(sp.issparse(c.tangent) and c.tangent.nnz == 1 for c in model.contacts)
     form = model.sparse_form()
     assert abs(form.stiffness - fe.stiffness).max() == 0.0
-    assert np.array_equal(form.tangent.indices, fe.tangent_dof) and np.array_equal(form.gap_gradient.indices, fe.normal_dof)
+    assert np.array_equal(form.tangent.indices, fe.tangent_dof)
+    assert np.array_equal(form.gap_gradient.indices, fe.normal_dof)
     assert model.replace(**{"contact_set.pad.friction.mu_k": 0.2}).mass is model.mass  # not read or copied again
 
 
@@ -193,7 +194,8 @@ def test_bad_matrix_files_are_refused_in_one_line(tmp_path):
         "nan.mtx": lambda p: scipy.io.mmwrite(str(p), sp.csr_matrix(np.diag([np.nan] + [1.0] * 15))),
         "text.mtx": lambda p: p.write_text("not a matrix\n"),
         "broken.npz": lambda p: p.write_bytes(b"PK\x03\x04 not a zip"),
-        "skew.mtx": lambda p: scipy.io.mmwrite(str(p), (M + sp.csr_matrix(([1e-3], ([0], [1])), shape=(16, 16))).tocoo()),
+        "skew.mtx": lambda p: scipy.io.mmwrite(str(p), (M + sp.csr_matrix(([1e-3], ([0], [1])), shape=(16, 16)))
+                                               .tocoo()),
         "indefinite.mtx": lambda p: scipy.io.mmwrite(str(p), (M - 1e-3 * sp.identity(16)).tocoo()),
     }
     words = {"rect.mtx": ("16×15", "must be 16×16"), "nan.mtx": ("non-finite",), "text.mtx": ("Abaqus",),
@@ -219,7 +221,8 @@ def test_bad_contact_sets_are_refused_in_one_line(tmp_path):
     pad = spec["contact_set"]["pad"]
     nodes = pad["nodes"]
     cases = [
-        ({**pad, "nodes": {**nodes, "1": {**nodes["1"], "tangent": "x9"}}}, ("contact_set.pad.nodes.1.tangent", "not a dof")),
+        ({**pad, "nodes": {**nodes, "1": {**nodes["1"], "tangent": "x9"}}},
+         ("contact_set.pad.nodes.1.tangent", "not a dof")),
         ({**pad, "nodes": {**nodes, "1": {**nodes["1"], "normal": "u99"}}}, ("nodes.1.normal", "not a dof")),
         ({k: v for k, v in pad.items() if k != "friction"}, ("contact_set.pad.friction is missing",)),
         ({k: v for k, v in pad.items() if k != "normal"}, ("nodes.1.normal is a unilateral contact's",)),

@@ -150,8 +150,9 @@ def test_nastran_op4_written_by_pynastran(tmp_path):
 def test_dofs_named_after_labels_align_the_other_matrices(tmp_path):
     """dofs = { from = "stiffness" }: the dofs are n<node>_<component> of the stiffness file; a mass
     file of the same nodes listed in another order is aligned by label."""
-    (tmp_path / "K.mtx").write_text("".join(f"{LABELS4[i][0]},{LABELS4[i][1]}, {LABELS4[j][0]},{LABELS4[j][1]}, "
-                                            f"{float(K4[i, j])!r}\n" for i in range(4) for j in range(i + 1) if K4[i, j]))
+    lines = [f"{LABELS4[i][0]},{LABELS4[i][1]}, {LABELS4[j][0]},{LABELS4[j][1]}, {float(K4[i, j])!r}\n"
+             for i in range(4) for j in range(i + 1) if K4[i, j]]
+    (tmp_path / "K.mtx").write_text("".join(lines))
     masses = {(2, 2): 4.0, (1, 1): 1.0, (2, 1): 3.0, (1, 2): 2.0}
     (tmp_path / "M.mtx").write_text("".join(f"{n},{d}, {n},{d}, {m}\n" for (n, d), m in masses.items()))
     (tmp_path / "nodes.csv").write_text("node,x,y\n1,0.0,0.0\n2,1.0,0.0\n")

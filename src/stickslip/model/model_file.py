@@ -38,7 +38,12 @@ its path: ``mass.0.0``, ``stiffness.x.y`` (indices or dof names), ``force.1``,
 ``contact.0.normal.stiffness``, ``slip_band``. An entry written as an expression is set through its
 parameters (a path into it is refused). Errors name the key and the fix in one line.
 
-The file is checked once, when it is read (keys, shapes, names, expressions), into a
+A model of finite-element size keeps its matrices in files, names its dofs by count, writes
+vectors and rows as sparse tables, its damping as Rayleigh's, its many contacts as contact sets,
+and carries its mesh's nodes (:mod:`stickslip.model.model_file_fe`; docs/models.md).
+
+The file is checked once, when it is read (keys, shapes, names, expressions; each entry by
+:class:`~stickslip.model.model_file_parser.Parser`; its matrix files and CSVs read), into a
 :class:`_Template`; each model — the file's, and each ``replace`` of it — is the template's
 entries evaluated at its parameter values, validated once by :class:`FrictionModel`.
 """
@@ -46,9 +51,7 @@ entries evaluated at its parameter values, validated once by :class:`FrictionMod
 from __future__ import annotations
 
 import dataclasses
-import json
 import keyword
-import reprlib
 import sys
 from pathlib import Path
 from typing import Any, Mapping
@@ -58,11 +61,12 @@ import scipy.sparse as sp
 
 from ..errors import ExpressionError, FrictionLawError, ModelError, ModelFileError
 from ..files import read_regular_file
-from .expressions import RESERVED, Expression, finite_number, grammar, parse_expression
+from .expressions import RESERVED, Expression
 from .friction import FrictionLaw
 from .matrices import is_checked, is_sparse, mark_positive_definite
-from .model_file_fe import (FILE_KEYS, SET_KEYS, ContactSet, FileMatrices, Triplets, contact_set, dof_index, dof_names,
-                            read_nodes, set_nodes)
+from .model_file_fe import ContactSet, FileMatrices, Triplets, dof_names, read_nodes
+from .model_file_parser import (CONTACT_KEYS, FRICTION_KEYS, NORMAL_KEYS, Parser, check_keys, entry_label,
+                                file_number, parse_entry, quote_text, show_value, with_defaults)
 from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, NormalLaw, check_name, check_text
 
 if sys.version_info >= (3, 11):
@@ -79,76 +83,17 @@ REQUIRED_TOP = ("dofs", "mass", "stiffness")
 #: Largest model file read [bytes]: a file of 64 dofs written out in full is about 100 kB, and
 #: larger models keep their matrices in matrix files beside it.
 MAX_MODEL_FILE_BYTES = 64 * 2**20
-CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "gap",
-                "gap_gradient", "normal", "friction")
-REQUIRED_CONTACT = ("tangent", "friction")
-FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v")
-NORMAL_KEYS = ("law", "stiffness", "damping", "restitution")
-#: The keys of a prescribed load and of a unilateral contact (a contact has the one or the other).
-PRESCRIBED_KEYS = ("normal_force", "normal_gradient", "normal_rate_gradient")
-UNILATERAL_KEYS = ("gap", "gap_gradient", "normal")
-
 #: Names a parameter cannot take: the model file's keys (``--set mass=2`` is the path of a 1×1
 #: mass), the functions and constant of expressions, and the names a sweep's grid gives other
 #: meanings (``model``, ``ic``; ``perturb_<state>`` is refused as a prefix).
 RESERVED_NAMES = frozenset(TOP_KEYS) | RESERVED | {"model", "ic"}
 
-#: Short reprs for messages: a value shown in an error stays on one short line, however deeply
-#: nested or long (levels, list items and characters shown).
-_SHORT = reprlib.Repr()
-_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxstring, _SHORT.maxother = 3, 6, 40, 40
-
-
-def _show(value) -> str:
-    return _SHORT.repr(value)
-
-
-def _quote(text: str) -> str:
-    """An expression as the file writes it, on one line (control characters escaped)."""
-    return json.dumps(text if len(text) <= 60 else text[:57] + "...", ensure_ascii=False)
-
-
-def _label(path: str) -> str:
-    """How errors name an entry: ``mass.0.1`` → ``mass[0][1]``, ``contact.0.drive.0`` → ``contact.0.drive[0]``."""
-    parts = path.split(".")
-    k = len(parts)
-    while k > 1 and parts[k - 1].isdigit():
-        k -= 1
-    return ".".join(parts[:k]) + "".join(f"[{p}]" for p in parts[k:])
-
-
-def _number(value, where: str, hint: str = "") -> float:
-    try:
-        return finite_number(value)
-    except ExpressionError as exc:
-        raise ModelFileError(f"{where} = {_show(value)} {exc}; give a finite number{hint}") from None
-
-
-def _check_keys(table: Mapping, known: tuple, where: str) -> None:
-    unknown = sorted(map(str, set(table) - set(known)))
-    if unknown:
-        raise ModelFileError(f"{where}unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(known)}")
-
-
-def _entry(value, path: str, names) -> float | Expression:
-    """A number of the file: a float, or an expression of the parameters ``names`` (a string)."""
-    label = _label(path)
-    if not isinstance(value, str):
-        return _number(value, label, " or an expression of [parameters] (a string)")
-    try:
-        check_text(value, label)
-    except ModelError as exc:
-        raise ModelFileError(str(exc)) from None
-    try:
-        return parse_expression(value, names)
-    except ExpressionError as exc:
-        raise ModelFileError(f"{label} = {_quote(value)} is not a valid expression: {exc}; {grammar(names)}") from None
-
 
 def _parameters(table) -> dict[str, float]:
     """The ``[parameters]`` table: valid names, finite numbers."""
     if not isinstance(table, Mapping):
-        raise ModelFileError(f"parameters = {_show(table)} must be a table of name = number, e.g. [parameters] V = 0.2")
+        raise ModelFileError(f"parameters = {show_value(table)} must be a table of name = number, e.g. [parameters] "
+                             "V = 0.2")
     out = {}
     for name, value in table.items():
         try:
@@ -159,9 +104,9 @@ def _parameters(table) -> dict[str, float]:
             raise ModelFileError(f"parameters: the name {name!r} is reserved (a key of model files, a function or "
                                  "constant of expressions, or a sweep's model, ic, perturb_*); choose another name")
         if isinstance(value, str):
-            raise ModelFileError(f"parameters.{name} = {_quote(value)} is not a number; give a number (expressions "
+            raise ModelFileError(f"parameters.{name} = {quote_text(value)} is not a number; give a number (expressions "
                                  "go in the model's entries, not in [parameters])")
-        out[name] = _number(value, f"parameters.{name}")
+        out[name] = file_number(value, f"parameters.{name}")
     return out
 
 
@@ -225,14 +170,15 @@ class _Template:
             current = self.slots[path]
             if isinstance(current, Expression):
                 uses = ", ".join(sorted(current.names)) or "none"
-                raise ModelFileError(f"--set {path}: {_label(path)} is the expression {_quote(current.text)} of "
+                raise ModelFileError(f"--set {path}: {entry_label(path)} is the expression "
+                                     f"{quote_text(current.text)} of "
                                      f"[parameters]; set the parameters it uses ({uses}) instead, or write a number "
                                      "in the file")
             slots = dict(slots) if slots is self.slots else slots
             if self.targets[path][1] == "law":
                 slots[path] = new
             else:
-                slots[path] = _entry(new, path, self.named)
+                slots[path] = parse_entry(new, path, self.named)
                 new = new if isinstance(new, str) else slots[path]
             edits[path] = new
         if not edits:
@@ -242,8 +188,8 @@ class _Template:
 
 def _parameter_value(value, name: str) -> float:
     if isinstance(value, str):
-        raise ModelFileError(f"parameter {name} = {_quote(value)} is not a number; give a number")
-    return _number(value, f"parameters.{name}")
+        raise ModelFileError(f"parameter {name} = {quote_text(value)} is not a number; give a number")
+    return file_number(value, f"parameters.{name}")
 
 
 def _edited(spec: dict, edits: Mapping[str, Any]) -> dict:
@@ -275,226 +221,6 @@ def _plain_copy(value):
     return value
 
 
-class _Parser:
-    """Checks the entries of a file and collects them as slots of a :class:`_Template`."""
-
-    def __init__(self, n: int, names, dofs=()) -> None:
-        self.n, self.names = n, names
-        self.index = {dof: i for i, dof in enumerate(dofs)}
-        self.slots: dict = {}
-        self.targets: dict = {}
-        self.shapes: dict = {"scalars": None}
-
-    def number(self, value, path: str, container: str, index) -> None:
-        self.slots[path] = _entry(value, path, self.names)
-        self.targets[path] = (container, index)
-
-    def vector(self, value, n: int, key: str, container: str, sparse: bool = False) -> None:
-        """n entries (a one-entry vector may be written as a number), or a sparse table of dof =
-        value (``sparse``: kept as a CSR row (1, n), else a dense vector)."""
-        if isinstance(value, Mapping) and n == self.n:
-            self.shapes[container] = ("sparse", 1, n) if sparse else (n,)
-            for dof, v in value.items():
-                i = dof_index(self.index, dof, f"{key}.{dof}")
-                self.number(v, f"{key}.{dof}", container, (0, i) if sparse else i)
-            return
-        if not isinstance(value, list):
-            if n == 1 and (isinstance(value, (int, float, str)) and not isinstance(value, bool)):
-                self.shapes[container] = (1,)
-                return self.number(value, key, container, 0)
-            table = " or a table of dof = number" if n == self.n else ""
-            raise ModelFileError(f"{key} must be a list of {n} number(s){table}, got {_show(value)}")
-        if len(value) != n:
-            raise ModelFileError(f"{key} must be a list of {n} number(s), got {_show(value)}")
-        self.shapes[container] = (n,)
-        for i, v in enumerate(value):
-            self.number(v, f"{key}.{i}", container, i)
-
-    def matrix(self, value, rows: int | None, key: str, container: str, flat: bool = False) -> int:
-        """A matrix of ``rows`` (None: any number of) rows of n entries, each row a list or (contact
-        rows) a sparse table of dof = number; returns the number of rows."""
-        n = self.n
-        if flat:  # a single row written flat
-            value = [value]
-        if rows is None and isinstance(value, list) and value and all(isinstance(r, Mapping) for r in value):
-            self.shapes[container] = ("sparse", len(value), n)
-            for i, row in enumerate(value):
-                for dof, v in row.items():
-                    j = dof_index(self.index, dof, f"{key}.{dof}" if flat else f"{key}.{i}.{dof}")
-                    self.number(v, f"{key}.{dof}" if flat else f"{key}.{i}.{dof}", container, (i, j))
-            return len(value)
-        if not isinstance(value, list) or not value or not all(isinstance(row, list) for row in value):
-            example = f"[[{', '.join(['1.0'] * n)}]]" if n <= 8 else "[{ u0 = 1.0 }] (rows as tables of dof = number)"
-            raise ModelFileError(f"{key} must be a list of rows, each a list of {n} numbers, e.g. "
-                                 f"{key.split('.')[-1]} = {example}")
-        if rows is not None and len(value) != rows:
-            raise ModelFileError(f"{key} must have {rows} row(s) (one per dof), got {len(value)}")
-        for i, row in enumerate(value):
-            if len(row) != n:
-                raise ModelFileError(f"{key} row {i} must have {n} number(s) (one per dof), got {len(row)}")
-        self.shapes[container] = (len(value), n)
-        for i, row in enumerate(value):
-            for j, v in enumerate(row):
-                self.number(v, f"{key}.{j}" if flat else f"{key}.{i}.{j}", container, (i, j))
-        return len(value)
-
-    def square(self, key: str, value, files: FileMatrices) -> None:
-        """``mass``, ``stiffness`` or ``damping``: a matrix file (its ``scale`` a slot), Rayleigh
-        damping (its two coefficients), or the matrix written out."""
-        if key in files.matrices:
-            self.number(files.tables[key]["scale"], f"{key}.scale", "scalars", f"{key}.scale")
-        elif key == "damping" and isinstance(value, Mapping) and "rayleigh" in value:
-            _check_keys(value, ("rayleigh",), "damping: ")
-            if not isinstance(value["rayleigh"], list) or len(value["rayleigh"]) != 2:
-                raise ModelFileError(f"damping.rayleigh = {_show(value['rayleigh'])} must be [alpha, beta]: C = alpha M "
-                                     "+ beta K")
-            self.vector(value["rayleigh"], 2, "damping.rayleigh", "rayleigh")
-        elif isinstance(value, Mapping):
-            raise ModelFileError(f"{key} = {_show(value)}: give a matrix (rows of numbers), a matrix file (\"{key[0].upper()}"
-                                 f".mtx\" or {{ file = ... }}, keys {', '.join(FILE_KEYS)})"
-                                 + (", or { rayleigh = [alpha, beta] }" if key == "damping" else ""))
-        else:
-            self.matrix(value, self.n, key, key)
-
-    def contact(self, c: int, table) -> str:
-        """Contact ``c``'s entries; returns its name."""
-        where = f"contact.{c}"
-        if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([[contact]])")
-        _check_keys(table, CONTACT_KEYS, f"{where}: ")
-        for key in REQUIRED_CONTACT:
-            if key not in table:
-                hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]",
-                        "friction": "add a [contact.friction] table with law, mu_k, delta_mu"}[key]
-                raise ModelFileError(f"{where}.{key} is missing; give {hint}")
-        self.normal_keys(where, table)
-        tangent = table["tangent"]
-        flat = isinstance(tangent, Mapping) or (isinstance(tangent, list) and bool(tangent)
-                                                and not isinstance(tangent[0], (list, Mapping)))
-        dim = self.matrix(tangent, None, f"{where}.tangent", f"{c}.tangent", flat=flat)
-        if dim not in (1, 2):
-            raise ModelFileError(f"{where}.tangent must have 1 row (1-D friction) or 2 rows (2-D), got {dim}")
-        self.shapes[f"{c}.drive"] = (dim,)
-        for key, value in table.items():
-            if key in ("drive", "normal_gradient", "normal_rate_gradient"):
-                self.vector(value, dim if key == "drive" else self.n, f"{where}.{key}", f"{c}.{key}", sparse=True)
-            elif key in ("normal_force", "gap"):
-                self.number(value, f"{where}.{key}", "scalars", f"{c}.{key}")
-            elif key == "gap_gradient":
-                self.vector(value, self.n, f"{where}.{key}", f"{c}.{key}", sparse=True)
-            elif key == "friction":
-                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb or exponential")
-            elif key == "normal":
-                self.normal_table(value, f"{where}.normal", f"{c}.normal")
-        name = table.get("name", f"contact{c}")
-        if not isinstance(name, str):
-            raise ModelFileError(f"{where}.name = {_show(name)} must be a string")
-        check_text(name, f"{where}.name")
-        return name
-
-    @staticmethod
-    def normal_keys(where: str, table) -> None:
-        """A contact has a prescribed load or a gap with a normal law: one of them, whole."""
-        prescribed = [k for k in PRESCRIBED_KEYS if k in table]
-        unilateral = [k for k in UNILATERAL_KEYS if k in table]
-        if prescribed and unilateral:
-            raise ModelFileError(f"{where}: {prescribed[0]} (a prescribed load) and {unilateral[0]} (a unilateral "
-                                 "contact) both given; give normal_force for a contact that is always pressed, or "
-                                 "gap_gradient with a [contact.normal] table for one that opens and closes")
-        if not prescribed and not unilateral:
-            raise ModelFileError(f"{where}.normal_force is missing; give normal_force = N0 > 0 [N] for a contact that "
-                                 "is always pressed, or gap_gradient with a [contact.normal] table for one that opens "
-                                 "and closes")
-        if prescribed and "normal_force" not in table:
-            raise ModelFileError(f"{where}.normal_force is missing; give N0 > 0 [N]")
-        for key in ("gap_gradient", "normal"):
-            if unilateral and key not in table:
-                hint = ("W of g = gap + W·q, one number per dof" if key == "gap_gradient" else
-                        'a [contact.normal] table, e.g. law = "compliant", stiffness = 40.0')
-                raise ModelFileError(f"{where}.{key} is missing for a unilateral contact; give {hint}")
-
-    def normal_table(self, table, where: str, container: str) -> None:
-        """A ``[contact.normal]`` table: a compliant law's stiffness, a rigid law's restitution, and
-        neither's numbers on the other (the file's keys checked, not only their values)."""
-        self.law_table(table, where, NORMAL_KEYS, container, "compliant or rigid")
-        law = table.get("law", "compliant")
-        if law == "rigid" and ("stiffness" in table or "damping" in table):
-            raise ModelFileError(f"{where}: a rigid contact has no stiffness or damping; give restitution = e in [0, 1], "
-                                 "or law = \"compliant\" for a contact spring")
-        if law == "compliant" and "restitution" in table:
-            raise ModelFileError(f"{where}: restitution is a rigid contact's; a compliant contact dissipates through its "
-                                 "damping (or give law = \"rigid\")")
-        if law == "compliant" and "stiffness" not in table:
-            raise ModelFileError(f"{where}.stiffness is missing; give the contact stiffness k > 0 [N/m], e.g. "
-                                 "stiffness = 40.0, or law = \"rigid\" for a contact without one")
-
-    def contact_set(self, name: str, table, base) -> tuple[ContactSet, dict]:
-        """``[contact_set.NAME]``: its structure, and its table as the frozen spec keeps it (nodes
-        inline, defaults written out); its numbers become slots."""
-        where = f"contact_set.{name}"
-        if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([contact_set.{name}])")
-        _check_keys(table, SET_KEYS, f"{where}: ")
-        if "friction" not in table:
-            raise ModelFileError(f"{where}.friction is missing; add a [{where}.friction] table with law, mu_k, delta_mu")
-        nodes = set_nodes(table, where, base)
-        cset = contact_set(name, table, nodes, self.index)
-        table = dict(_with_defaults({**table, "nodes": nodes}, gap="gap" not in cset.per_node))
-        if not cset.unilateral and "normal_force" not in table and "normal_force" not in cset.per_node:
-            raise ModelFileError(f"{where}.normal_force is missing; give normal_force = N0 > 0 [N] (for the set or per "
-                                 f"node) for contacts that are always pressed, or a normal column with a [{where}.normal] "
-                                 "table for contacts that open and close")
-        for key, value in table.items():
-            if key == "drive":
-                self.vector(value, cset.dim, f"{where}.drive", cset.container("drive"))
-            elif key in ("gap", "normal_force"):
-                self.number(value, f"{where}.{key}", "scalars", cset.container(key))
-            elif key == "friction":
-                self.law_table(value, f"{where}.friction", FRICTION_KEYS, cset.container("friction"),
-                               "coulomb or exponential")
-            elif key == "normal":
-                self.normal_table(value, f"{where}.normal", cset.container("normal"))
-        count = len(cset.nodes)
-        self.shapes[cset.container("node_drive")] = (count, cset.dim)
-        for key in ("gap", "normal_force"):
-            self.shapes[cset.container(f"node_{key}")] = (count,)
-        for k, (node, row) in enumerate(nodes.items()):
-            for key in sorted(cset.per_node & set(row)):
-                index = (k, 1 if key == "drive2" else 0) if key.startswith("drive") else k
-                container = "node_drive" if key.startswith("drive") else f"node_{key}"
-                self.number(row[key], f"{where}.nodes.{node}.{key}", cset.container(container), index)
-        return cset, table
-
-    def law_table(self, table, where: str, keys: tuple, container: str, laws: str) -> None:
-        """A law's table (``[contact.friction]``, ``[contact.normal]``): its law's name and numbers."""
-        if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([contact.{where.rsplit('.', 1)[1]}])")
-        _check_keys(table, keys, f"{where}: ")
-        self.shapes[container] = None
-        for key, value in table.items():
-            if key != "law":
-                self.number(value, f"{where}.{key}", container, key)
-            elif isinstance(value, str):
-                self.slots[f"{where}.law"] = value
-                self.targets[f"{where}.law"] = (container, "law")
-            else:
-                raise ModelFileError(f"{where}.law = {_show(value)} is not a law name; choose {laws}")
-
-
-def _with_defaults(table, gap: bool = True):
-    """A unilateral contact's (or contact set's) table with its optional numbers written out (gap 0
-    unless ``gap`` is False, contact damping 0 or a rigid contact's restitution 0), so that
-    ``--set`` reaches them like any entry (a copy; the caller's table is not changed)."""
-    if not (isinstance(table, Mapping) and isinstance(table.get("normal"), Mapping)):
-        return table
-    normal = {**table["normal"]}
-    if normal.get("law") == "rigid":
-        if "stiffness" not in normal and "damping" not in normal:  # a rigid law given either is refused
-            normal.setdefault("restitution", 0.0)
-    elif "restitution" not in normal:
-        normal.setdefault("damping", 0.0)
-    return {**table, **({"gap": table.get("gap", 0.0)} if gap else {}), "normal": normal}
-
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class _FEParts:
@@ -511,13 +237,13 @@ def _header(spec: Mapping[str, Any], dofs: tuple, default_name: str) -> tuple[di
     texts = {key: spec.get(key, default) for key, default in (("name", default_name), ("description", ""))}
     for key, text in texts.items():
         if not isinstance(text, str):
-            raise ModelFileError(f"{key} must be a string, got {_show(text)}")
+            raise ModelFileError(f"{key} must be a string, got {show_value(text)}")
         check_text(text, key)
     names = set(dofs)
     observe = spec.get("observe", dofs[0])
     if not isinstance(observe, str) or observe not in names:
         shown = ", ".join(dofs[:10]) + (", ..." if len(dofs) > 10 else "")
-        raise ModelFileError(f"observe = {_show(observe)} is not a dof; give one of {shown}")
+        raise ModelFileError(f"observe = {show_value(observe)} is not a dof; give one of {shown}")
     units = spec.get("units", {})
     if not isinstance(units, Mapping) or not all(isinstance(v, str) for v in units.values()):
         raise ModelFileError('units must be a table of dof = "unit", e.g. units = { x = "m" }')
@@ -533,7 +259,7 @@ def _dofs(spec: Mapping[str, Any], base) -> tuple[tuple, FileMatrices]:
     """The dof names and the matrix files (read once; the dofs may be named after their labels)."""
     if not isinstance(spec, Mapping):
         raise ModelFileError("a model file holds a table of keys (name, dofs, mass, ...)")
-    _check_keys(spec, TOP_KEYS, "")
+    check_keys(spec, TOP_KEYS, "")
     for key in REQUIRED_TOP:
         if key not in spec:
             hint = {"dofs": 'e.g. dofs = ["x"] or dofs = { count = 100, prefix = "u" }'}.get(
@@ -559,12 +285,12 @@ def _template(spec: Mapping[str, Any], source: str, default_name: str, base=None
         tables = [tables]
     if not isinstance(tables, list) or ("contact" in spec and not tables):
         raise ModelFileError("contact must be one or more [[contact]] tables")
-    tables = [_with_defaults(table) for table in tables]
+    tables = [with_defaults(table) for table in tables]
     sets = spec.get("contact_set", {})
     if not isinstance(sets, Mapping) or ("contact_set" in spec and not sets):
         raise ModelFileError("contact_set must hold one or more [contact_set.NAME] tables")
     n = len(dofs)
-    parser = _Parser(n, tuple(named), dofs)
+    parser = Parser(n, tuple(named), dofs)
     contact_names, plans, set_tables, nodes, frozen = [], [], {}, None, {}
     for key, value in spec.items():  # file order: the order of the parameters
         if key in ("mass", "damping", "stiffness"):
@@ -602,7 +328,7 @@ def _value(raw, path: str, named: Mapping[str, float]):
         return raw(named)
     except ExpressionError as exc:
         used = ", ".join(f"{k} = {named[k]:g}" for k in sorted(raw.names))
-        raise ModelFileError(f"{_label(path)} = {_quote(raw.text)} cannot be evaluated"
+        raise ModelFileError(f"{entry_label(path)} = {quote_text(raw.text)} cannot be evaluated"
                              f"{' with ' + used if used else ''}: {exc}; fix the expression or give other parameter "
                              "values") from None
 

@@ -76,14 +76,16 @@ def dof_names(value, labels=None) -> tuple[str, ...]:
     (node, component) ``labels`` of that matrix (read by the caller)."""
     if isinstance(value, list):
         if not value or not all(isinstance(d, str) and d for d in value):
-            raise ModelFileError(f"dofs must be a non-empty list of names, e.g. dofs = [\"x\", \"y\"], got {_short(value)}")
+            raise ModelFileError(f"dofs must be a non-empty list of names, e.g. dofs = [\"x\", \"y\"], got "
+                                 f"{_short(value)}")
         if len(set(value)) != len(value):
             seen: set = set()
             twice = next(d for d in value if d in seen or seen.add(d))
             raise ModelFileError(f"dofs: {twice!r} is given twice; give each dof its own name")
         return tuple(value)
     if not isinstance(value, Mapping):
-        raise ModelFileError(f"dofs must be a list of names or a table {{ count = N, prefix = \"u\" }}, got {_short(value)}")
+        raise ModelFileError(f"dofs must be a list of names or a table {{ count = N, prefix = \"u\" }}, got "
+                             f"{_short(value)}")
     unknown = sorted(set(value) - {"count", "prefix", "from"})
     if unknown or ("count" in value) == ("from" in value):
         raise ModelFileError("dofs as a table takes count (and prefix), or from (and prefix): e.g. dofs = { count = "
@@ -246,7 +248,8 @@ def read_csv(path: Path, what: str, required: tuple, known: tuple) -> tuple[list
     missing = [c for c in required if c not in columns]
     unknown = [c for c in columns if c not in known]
     if not rows or missing or unknown:
-        raise ModelFileError(f"{what} {path.name} needs a header line with the columns {', '.join(required)} (optional: "
+        raise ModelFileError(f"{what} {path.name} needs a header line with the columns {', '.join(required)} "
+                             "(optional: "
                              f"{', '.join(c for c in known if c not in required)}) and one row per entry"
                              + (f"; unknown column {unknown[0]!r}" if unknown else "")
                              + (f"; missing {', '.join(missing)}" if missing and rows else ""))
@@ -337,13 +340,15 @@ def set_nodes(table: Mapping, where: str, base: Path | None) -> dict:
     if isinstance(nodes, Mapping) and nodes:
         for key, row in nodes.items():
             if not isinstance(row, Mapping):
-                raise ModelFileError(f"{where}.nodes.{key} must be a table {{ tangent = \"u0\", normal = \"u1\", ... }}")
+                raise ModelFileError(f"{where}.nodes.{key} must be a table {{ tangent = \"u0\", normal = \"u1\", "
+                                     "... }")
             unknown = sorted(set(row) - set(SET_COLUMNS[1:]))
             if unknown:
                 raise ModelFileError(f"{where}.nodes.{key}: unknown key(s) {', '.join(unknown)}; valid keys are "
                                      f"{', '.join(SET_COLUMNS[1:])}")
         return {str(k): dict(v) for k, v in nodes.items()}
-    raise ModelFileError(f"{where}.nodes is missing; give nodes = \"contact_nodes.csv\" (columns node, tangent, normal, "
+    raise ModelFileError(f"{where}.nodes is missing; give nodes = \"contact_nodes.csv\" (columns node, tangent, "
+                         "normal, "
                          "gap, …) or a table of the nodes")
 
 
