@@ -11,7 +11,7 @@ from the file's suffix (``format`` overrides it):
 ``.npz``           ``scipy.sparse.save_npz``; with ``:NAME``, the array NAME of a ``numpy.savez`` file
 ``.mat``           MATLAB up to v7 (``scipy.io.loadmat``); ``:NAME`` the variable (needed when the file
                    holds several); v7.3 files are HDF5 and are refused with the fix
-``.op4``           Nastran OUTPUT4, ASCII or binary (pyNastran, the ``fe`` extra); ``:NAME`` the matrix
+``.op4``           Nastran OUTPUT4, ASCII or binary (pyNastran, installed apart: docs/models.md); ``:NAME`` the matrix
 ``.pch``, ``.dmig``  Nastran DMIG cards (a punch file of ``PARAM,EXTOUT,DMIGPCH``, or bulk data):
                    small, large (``DMIG*``) or free (comma) fields, real matrices (TIN 1, 2);
                    ``:NAME`` the matrix; IFO 6 (symmetric) gives one triangle, mirrored here
@@ -202,8 +202,8 @@ def _op4(data: bytes, name, where, path: Path, **_):
     try:
         from pyNastran.op4.op4 import read_op4  # noqa: PLC0415 - the optional `fe` extra
     except ImportError:
-        raise ModelFileError(f"{where}: reading Nastran OP4 needs pyNastran; install it with pip install "
-                             "'stickslip[fe]' (or pip install pyNastran)") from None
+        raise ModelFileError(f"{where}: reading Nastran OP4 needs pyNastran; install it with pip install cpylog "
+                             "docopt-ng colorama, then pip install --no-deps pyNastran") from None
     matrices = read_op4(str(path), debug=False, log=None)
     matrix = matrices[_pick(sorted(matrices), name, where, "matrix")]
     if getattr(matrix, "is_complex", False):
