@@ -37,7 +37,8 @@ from typer.core import TyperGroup
 from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
-from ..files import lock, read_regular_file, refuse_output
+from ..files import lock, refuse_output
+from ..inputs import read_regular_file
 from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.library.two_plates import is_plates

@@ -52,7 +52,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelFileError
-from ..files import read_regular_file, regular_file_size
+from ..inputs import read_regular_file, regular_file_size
 from ..memory import check_memory, format_bytes, matrix_file_bytes
 
 __all__ = ["MatrixData", "read_matrix", "split_reference", "FORMATS", "MAX_MATRIX_FILE_BYTES", "file_digest"]

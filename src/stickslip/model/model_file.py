@@ -60,7 +60,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ExpressionError, FrictionLawError, ModelError, ModelFileError
-from ..files import read_regular_file
+from ..inputs import read_regular_file
 from .expressions import RESERVED, Expression
 from .friction import FrictionLaw
 from .matrices import is_checked, is_sparse, mark_positive_definite

@@ -35,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError, ModelFileError
-from ..files import read_regular_file, regular_file_size
+from ..inputs import read_regular_file, regular_file_size
 from ..memory import check_memory, format_bytes
 from .fe_files import MatrixData, file_digest, read_matrix, split_reference
 from .sparse_form import COMPONENTS, NodeMap
