@@ -20,7 +20,6 @@ from __future__ import annotations
 import errno
 import math
 import os
-import re
 import sys
 import warnings
 from pathlib import Path
@@ -69,30 +68,20 @@ class CLIError(StickSlipError, ValueError):
     must not be replaced. The message names the option and the fix."""
 
 
-#: A run of this many digits or more in a message is a number typed or computed beyond any
-#: meaning (a 300-digit --n); it is shown with 3 significant digits. Paths keep theirs.
-_LONG_DIGITS = 16
-_LONG_NUMBER = re.compile(r"(?<![\w/.\\])(\d{%d,})(?![\w/\\]|\.\w)" % _LONG_DIGITS)
-
-
-def _short_number(match: re.Match) -> str:
-    """``1.23e+299`` for a long run of digits (not through float, which ends at 1e308)."""
-    digits = match.group(1).lstrip("0") or "0"
-    exponent = len(digits) - 1
-    mantissa = round(int(digits[:4]) / 10 ** (min(len(digits), 4) - 1), 2)
-    if mantissa >= 10:  # 9.999… rounds up to the next power of ten
-        mantissa, exponent = mantissa / 10, exponent + 1
-    return f"{mantissa:g}e+{exponent}"
-
-
-def shorten_numbers(text: str) -> str:
-    """``text`` with every number of :data:`_LONG_DIGITS` digits or more shown as ``1.23e+299``."""
-    return _LONG_NUMBER.sub(_short_number, text)
+def exact(value) -> str:
+    """A number given on the command line as the shortest text that reads back as it (``50``,
+    ``0.1``, ``1.0000001``, ``1e+300``): what a message quotes of an option's value (``:g`` would
+    round it to six digits)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def error_line(message: str) -> None:
-    """Print ``error: message`` as one line on stderr, exactly as written (long numbers shortened)."""
-    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(shorten_numbers(str(message)).split())))
+    """Print ``error: message`` as one line on stderr, exactly as written: what the user typed is
+    quoted as typed, however many digits it has."""
+    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(str(message).split())))
 
 
 def warning_line(message: str) -> None:
@@ -304,6 +293,10 @@ def parse_assignments(items: list[str] | None, option: str = "--set") -> dict:
             values[name] = float(text)
         except ValueError:
             values[name] = text
+            continue
+        if not math.isfinite(values[name]) and text.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
+            raise CLIError(f"{option} {item.strip()}: {text} is beyond the range of a float (about ±1.8e308); "
+                           "give a finite number")
     return values
 
 
@@ -432,7 +425,7 @@ def check_below_one(flags: dict) -> None:
     """Every ``{flag: value}`` (a relative tolerance) must be < 1: at 1 or more any guess passes."""
     for flag, value in flags.items():
         if value is not None and not value < 1.0:
-            raise CLIError(f"{flag} {value:g}: a relative tolerance must be < 1 (typical values 1e-6 … 1e-10)")
+            raise CLIError(f"{flag} {exact(value)}: a relative tolerance must be < 1 (typical values 1e-6 … 1e-10)")
 
 
 def executor_of(executor: str | None, scheduler: str | None) -> str:

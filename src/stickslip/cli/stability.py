@@ -14,6 +14,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..errors import StickSlipError
 from ..files import netcdf_writer
 from ..memory import check_memory, largest_count
 from ..plot.stability import save_stability_map_figure
@@ -85,6 +86,7 @@ def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
 @app.command("stability-map")
 @grouped
 def stability_map(
+    *,  # options only (typer reads them by name)
     n_min: float = typer.Option(2.0, "--N-min", help="Smallest normal load [N]."),
     n_max: float = typer.Option(200.0, "--N-max", help="Largest normal load [N]."),
     n_points: int = typer.Option(100, "--N-points", help="Number of N values."),
@@ -123,8 +125,14 @@ def stability_map(
                        "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
     out, inputs = outputs.out, changes.inputs
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
+    _check_axes(system, names, values, axis)
     with timed() as timing:
-        smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
+        try:
+            smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
+        except ValueError as exc:
+            if isinstance(exc, StickSlipError):
+                raise
+            raise _map_error(exc, names, axis, family) from None
     figure = write_result(outputs, lambda: netcdf_writer(smap.to_xarray()), holds=f"the map is in {out}",
                           inputs=inputs, draw=lambda tmp: save_stability_map_figure(smap, tmp))
     rows = []
@@ -154,6 +162,26 @@ def stability_map(
     detail = f"grid {t['grid_s']:.2f} s, boundary {t['boundary_s']:.2f} s"
     console.print(f"wall time {time_text(timing.wall_s, timing.compile_s, detail)}; wrote {out}"
                   + ("" if figure is None else f", {figure}"))
+
+
+def _check_axes(system, names: tuple[str, str], values: list, axis: list[str] | None) -> None:
+    """Refuse, naming ``--axis``, a parameter the model lacks or a value it refuses (before the map)."""
+    for name, vals, item in zip(names, values, axis or ()):
+        try:
+            for v in vals:
+                system.replace(**{name: float(v)})
+        except StickSlipError as exc:
+            raise CLIError(f"--axis {item.strip()}: {exc}") from None
+
+
+def _map_error(exc: ValueError, names: tuple[str, str], axis: list[str] | None, family: str | None) -> CLIError:
+    """The library's refusal of the map as one line naming the option it is about (an axis value
+    without steady sliding, a family the model cannot have)."""
+    text = str(exc)
+    for name, item in zip(names, axis or ()):
+        if text.startswith(f"{name} "):
+            return CLIError(f"--axis {item.strip()}: {text}")
+    return CLIError(f"--family {family}: {text}" if family is not None else text)
 
 
 def _map_axes(axis: list[str] | None, n_range: tuple, omega_range: tuple) -> tuple[tuple[str, str], list]:

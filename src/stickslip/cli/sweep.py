@@ -54,8 +54,9 @@ def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
         With a one-line message naming the fix.
     """
     text = text.strip()
-    given = f"{option} {name}={text}" if option == "--grid" else f"{option} {text}"
-    prefix = f"{option} {name}=" if option == "--grid" else f"{option} "
+    named = option in ("--grid", "--axis")  # options given as NAME=VALUES
+    given = f"{option} {name}={text}" if named else f"{option} {text}"
+    prefix = f"{option} {name}=" if named else f"{option} "
     example = f"{prefix}10:130:13 or {prefix}30,50,70"
     if not text:
         raise CLIError(f"{given} has no values; e.g. {example}")
@@ -208,6 +209,7 @@ def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as
 @app.command("sweep")
 @grouped
 def sweep_command(
+    *,  # options only (typer reads them by name)
     grid: Optional[List[str]] = typer.Option(None, "--grid", help="Swept dimension NAME=start:stop:count or NAME=v1,v2,... "
                                              "(repeatable; order = dimension order). NAME: a parameter (plates: N, "
                                              "Omega, delta_mu, alpha, mu_k, k_px, ...; other models: a path such as "
@@ -254,6 +256,7 @@ def sweep_command(
 @app.command("bifurcation")
 @grouped
 def bifurcation(
+    *,  # options only (typer reads them by name)
     param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter "
                                                   "of the plates; for another model a path such as contact.0.drive."),
     range_: str = typer.Option("10:130:121", "--range", help="Its values: start:stop:count or v1,v2,..."),

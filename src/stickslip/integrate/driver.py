@@ -190,15 +190,28 @@ def simulate(
     if out.interrupted and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
         forget_ctrl_c()  # acted on here
         raise KeyboardInterrupt
-    code, record, n_kept = out.status, out.record, out.record.n
-    if n_kept == 0:
-        raise SimulationError(f"the run ended before its first sample ({code.message(out.t_reached, out.lost)})")
-
-    ic_text = ic if isinstance(ic, str) else ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path)
-                                              else "states" if isinstance(ic, Mapping) else "explicit")
-    options = {"rtol": rtol, "atol": atol, "dt": dt, "sample_rate": sample_rate, "ic": ic_text,
+    if out.record.n == 0:
+        raise SimulationError(f"the run ended before its first sample ({out.status.message(out.t_reached, out.lost)})")
+    options = {"rtol": rtol, "atol": atol, "dt": dt, "sample_rate": sample_rate, "ic": _ic_text(ic),
                "perturbation": None if perturbation is None else np.asarray(perturbation, dtype=float).tolist(),
                "t0": t0, "t_end": t_end, "slip_band": system.slip_band}
+    return _trajectory(out, system, method, sample_times, options, steady_from, wall)
+
+
+def _ic_text(ic) -> str:
+    """How a run's options name its initial condition."""
+    if isinstance(ic, str):
+        return ic
+    return ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path)
+            else "states" if isinstance(ic, Mapping) else "explicit")
+
+
+def _trajectory(out, system, method: str, sample_times: np.ndarray, options: dict, steady_from: float | None,
+                wall: float) -> Trajectory:
+    """The :class:`Trajectory` of a runner's output ``out`` (its samples up to the time reached;
+    ``steady_from`` default: the last half of them)."""
+    code, record, n_kept = out.status, out.record, out.record.n
+    t0 = options["t0"]
     t_samples = sample_times[:n_kept]  # the samples up to the time reached: a prefix, so views
     if steady_from is None:
         steady_from = t0 + 0.5 * (t_samples[-1] - t0)

@@ -364,9 +364,8 @@ class Trajectory(Plottable):
     def steady_state(self, t_from: float) -> SteadyState:
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
-        tr = self.transitions
         impacts = (self.impacts.time, self.impacts.speed_before) if self.system.rigid else None
-        return summarize(self.t, self.states, self.mode, tr.time, tr.kind, tr.contact, self.system.n_contacts, t_from,
+        return summarize(self.t, self.states, self.mode, self.transitions, t_from, n_contacts=self.system.n_contacts,
                          coordinate=i, rate=i + self.system.n, name=self.system.dofs[i],
                          unilateral=self.system.unilateral, impacts=impacts)
 

@@ -206,48 +206,8 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, model=None, *, out=None,
     journal = Journal(out, spec, overwrite=overwrite)
     info: dict = {"executor": executor, "workers": workers}
     try:
-        todo = np.flatnonzero(~journal.done_mask())
-        info["points_resumed"] = int(spec.size - todo.size)
-        info["points_computed"] = int(todo.size)
-        bar = _progress_bar() if progress else None
-        task = None
-        if bar is not None:
-            bar.start()
-            task = bar.add_task(f"sweep {'×'.join(map(str, spec.shape))}", total=spec.size,
-                                completed=spec.size - todo.size, rate="")
-        compute_start = time.perf_counter()
-        n_done = 0
-        last_snapshot = time.perf_counter()
-
-        def record(idx, rows):
-            nonlocal n_done, last_snapshot
-            journal.append(idx, rows)
-            n_done += len(idx)
-            if bar is not None:
-                rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
-                bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
-            if time.perf_counter() - last_snapshot > snapshot_interval:
-                assemble(journal, out, extra_attrs=_settle_attrs(spec))
-                last_snapshot = time.perf_counter()
-
-        if todo.size:
-            # the first point runs here: it compiles/loads the kernels and times a point
-            t = time.perf_counter()
-            record(*evaluate_batch(spec, todo[:1]))
-            t_point = time.perf_counter() - t
-            rest = todo[1:]
-            size = _auto_batch(t_point, rest.size, workers, executor) if batch_size == "auto" else int(batch_size)
-            if size < 1:
-                raise SweepError(f"batch_size must be >= 1 or 'auto', got {batch_size!r}")
-            batches = [rest[i : i + size] for i in range(0, rest.size, size)]
-            info.update(batch_size=size, batches=len(batches), first_point_s=t_point)
-            if batches:
-                for idx, rows in map_unordered(functools.partial(evaluate_batch, spec), batches, executor=executor,
-                                               workers=workers, address=address, warm=warm_up, info=info):
-                    record(idx, rows)
-        info["compute_s"] = time.perf_counter() - compute_start
-        if bar is not None:
-            bar.stop()
+        _compute(journal, out, info, batch_size=batch_size, address=address, progress=progress,
+                 snapshot_interval=snapshot_interval)
         assemble(journal, out, extra_attrs={"executor": executor, **_settle_attrs(spec)})
         if not keep_journal:
             journal.remove()
@@ -265,3 +225,52 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, model=None, *, out=None,
         tmpdir.cleanup()
     return result
 
+
+def _compute(journal: Journal, out: Path, info: dict, *, batch_size, address, progress: bool,
+             snapshot_interval: float) -> None:
+    """Compute the points of ``journal``'s sweep that it does not hold, journaling each batch as it
+    arrives (with ``info``'s executor and workers; its counts and times are added to ``info``) and
+    writing a snapshot of ``out`` every ``snapshot_interval`` seconds."""
+    spec, executor, workers = journal.spec, info["executor"], info["workers"]
+    todo = np.flatnonzero(~journal.done_mask())
+    info["points_resumed"] = int(spec.size - todo.size)
+    info["points_computed"] = int(todo.size)
+    bar = _progress_bar() if progress else None
+    task = None
+    if bar is not None:
+        bar.start()
+        task = bar.add_task(f"sweep {'×'.join(map(str, spec.shape))}", total=spec.size,
+                            completed=spec.size - todo.size, rate="")
+    compute_start = time.perf_counter()
+    n_done = 0
+    last_snapshot = time.perf_counter()
+
+    def record(idx, rows):
+        nonlocal n_done, last_snapshot
+        journal.append(idx, rows)
+        n_done += len(idx)
+        if bar is not None:
+            rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
+            bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
+        if time.perf_counter() - last_snapshot > snapshot_interval:
+            assemble(journal, out, extra_attrs=_settle_attrs(spec))
+            last_snapshot = time.perf_counter()
+
+    if todo.size:
+        # the first point runs here: it compiles/loads the kernels and times a point
+        t = time.perf_counter()
+        record(*evaluate_batch(spec, todo[:1]))
+        t_point = time.perf_counter() - t
+        rest = todo[1:]
+        size = _auto_batch(t_point, rest.size, workers, executor) if batch_size == "auto" else int(batch_size)
+        if size < 1:
+            raise SweepError(f"batch_size must be >= 1 or 'auto', got {batch_size!r}")
+        batches = [rest[i : i + size] for i in range(0, rest.size, size)]
+        info.update(batch_size=size, batches=len(batches), first_point_s=t_point)
+        if batches:
+            for idx, rows in map_unordered(functools.partial(evaluate_batch, spec), batches, executor=executor,
+                                           workers=workers, address=address, warm=warm_up, info=info):
+                record(idx, rows)
+    info["compute_s"] = time.perf_counter() - compute_start
+    if bar is not None:
+        bar.stop()
