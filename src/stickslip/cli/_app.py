@@ -382,7 +382,7 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
     assigned = parse_assignments(assignments)
     setters = {item.partition("=")[0].strip(): [f"--set {item.strip()}"] for item in assignments or []}
     for name, value in named.items():
-        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {value:g}")
+        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {exact(value)}")
     for name, sweeper in (swept or {}).items():
         setters.setdefault(name, []).insert(0, sweeper)
     for name, options in setters.items():
