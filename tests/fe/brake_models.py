@@ -93,8 +93,10 @@ def elasticity_matrices(nodes, elements, E, nu, rho, thickness=1.0, chunk=4096):
             B[:, :, dim + s, i::dim] = dNdx[:, :, :, j]
             B[:, :, dim + s, j::dim] = dNdx[:, :, :, i]
         w = detJ * (thickness if dim == 2 else 1.0)
-        Ke = np.einsum("egsi,st,egtj,eg->eij", B, D, B, w)
-        Ms = rho * np.einsum("ga,gb,eg->eab", Nv, Nv, w)
+        DB = np.matmul(D, B).reshape(el.shape[0], -1, nen * dim)  # (e, g·s, j)
+        Bw = (B * w[:, :, None, None]).reshape(DB.shape)
+        Ke = np.matmul(Bw.transpose(0, 2, 1), DB)
+        Ms = rho * np.einsum("ga,gb,eg->eab", Nv, Nv, w, optimize=True)
         Me = np.einsum("eab,ij->eaibj", Ms, np.eye(dim)).reshape(Ke.shape)
         dofs = (el[:, :, None] * dim + np.arange(dim)).reshape(el.shape[0], -1)
         rows.append(np.repeat(dofs, nen * dim, axis=1).ravel())
@@ -209,17 +211,16 @@ def pad_on_belt_2d(nx=6, ny=3, *, width=0.04, height=0.012, E=5e9, nu=0.25, rho=
     return dense_model(form) if dense else form
 
 
-def pad_on_strip_2d(strip=(120, 5), pad=(30, 8), *, length=0.3, depth=0.01, pad_width=0.075, pad_height=0.02,
+def pad_on_strip_2d(strip=(120, 5), pad=(30, 8), *, length=0.3, depth=0.02, pad_height=0.02,
                     E_strip=2.1e11, E_pad=5e9, rho_strip=7800.0, rho_pad=2500.0, nu=0.3, thickness=0.02,
-                    pressure=2e6, kc=2e9, cc=0.0, mu=0.3, speed=1.0, alpha=0.0, beta=0.0):
+                    pressure=2e6, kc=5e8, cc=0.0, mu=0.3, speed=1.0, alpha=0.0, beta=0.0):
     """A plane-stress pad pressed on a flexible strip clamped at both ends; node pairs between the
     pad's bottom and the strip's top (the pad centred) on compliant contacts, the strip moving
-    under the pad at ``speed`` [m/s]."""
+    under the pad at ``speed`` [m/s]; the pad's elements are as long as the strip's."""
     sx, sy = strip
     px, py = pad
     dx = length / sx
-    if abs(pad_width / px - dx) > 1e-12 * dx:
-        raise ValueError("pad elements must be as long as the strip's (pad_width / pad[0] = length / strip[0])")
+    pad_width = px * dx
     asm = _Assembly(2)
     s_nodes, s_el, s_index = _grid((sx, sy), (length, depth))
     base_s = asm.body(s_nodes, s_el, E_strip, nu, rho_strip, thickness)
@@ -258,12 +259,12 @@ def pad_on_surface_3d(shape=(2, 1, 1), *, size=(0.02, 0.01, 0.01), E=5e9, nu=0.2
 
 def pad_on_disc_3d(disc=(8, 96, 2), pad=(4, 12, 2), *, radii=(0.06, 0.15), disc_thickness=0.012,
                    pad_thickness=0.01, E_disc=1.25e11, E_pad=5e9, rho_disc=7200.0, rho_pad=2500.0, nu=0.3,
-                   pressure=1e6, kc=None, cc=0.0, mu=0.4, omega=10.0, alpha=0.0, beta=0.0):
+                   pressure=1e6, kc=None, cc=0.0, mu=0.3, omega=10.0, alpha=0.0, beta=0.0):
     """A pad on an annular disc clamped at its hub: disc = (radial, circumferential, through-thickness)
     elements, pad = (radial, circumferential, through-thickness) elements on the disc's outer rim.
 
     The pad's nodes on its face coincide with the disc's top nodes; each pair is a compliant
-    contact (stiffness ``kc`` [N/m], default 10 × the pad's axial stiffness per contact) with 2-D
+    contact (stiffness ``kc`` [N/m], default the pad's axial stiffness per contact) with 2-D
     friction, its tangent rows the circumferential and radial directions, its drive the disc's
     surface speed Ω r [m/s] at ``omega`` [rad/s]. The pad's back is held in its plane and pressed
     by ``pressure`` [Pa]. DOFs: 3 × (nodes) less the hub's and the pad back's in-plane ones.
@@ -303,7 +304,7 @@ def pad_on_disc_3d(disc=(8, 96, 2), pad=(4, 12, 2), *, radii=(0.06, 0.15), disc_
     area = 0.5 * (ro**2 - r[r0] ** 2) * (pth[-1] - pth[0])
     force = [(asm.dof(n, 2), -pressure * area / back.size) for n in back]
     if kc is None:
-        kc = 10.0 * E_pad * area / pad_thickness / ((pr + 1) * (pt + 1))
+        kc = E_pad * area / pad_thickness / ((pr + 1) * (pt + 1))
     rows = []
     for a in range(pr + 1):
         for b in range(pt + 1):

@@ -33,7 +33,7 @@ from ..model.friction import _USER_LAWS
 from ..model.system_model import DEFAULT_SLIP_BAND
 from .sparse_input import normal_rows, sparse_form
 
-__all__ = ["SlidingState", "friction_slopes", "sparse_steady_sliding"]
+__all__ = ["SlidingState", "friction_slopes", "sparse_steady_sliding", "factorize"]
 
 #: Complex step of the user friction laws' slope dμ/d|v| (exact to round-off: no subtraction).
 _STEP = 1e-30
@@ -70,6 +70,10 @@ class SlidingState:
         Each contact's sliding speed |w| [m/s].
     residual : float
         Relative force residual of the steady state, by the friction forces themselves (not K_t).
+    stiffness_lu : SuperLU
+        The LU factors of ``stiffness`` (the solve of the steady state; the shift-invert at 0 reuses them).
+    friction_stiffness : csr_matrix (k, k)
+        K_f, the friction's unsymmetric part of K_t (K_t − K_f is the frictionless stiffness).
     """
 
     form: object
@@ -81,11 +85,32 @@ class SlidingState:
     normal_force: np.ndarray
     speed: np.ndarray
     residual: float
+    stiffness_lu: object = None
+    friction_stiffness: sp.csr_matrix = None
 
     @property
     def n(self) -> int:
         """Number of free DOFs."""
         return int(self.free.size)
+
+
+def factorize(A, *, pivot: float = 0.1):
+    """Sparse LU of a square matrix with the structure of a finite-element matrix (SuperLU).
+
+    The minimum-degree ordering of Aᵀ + A with pivots preferred on the diagonal keeps the fill of
+    a structurally symmetric matrix low: 51 M entries for K_t of a 99,260-DOF pad on a disc, 8 s,
+    against 2.5 times the fill and the time with scipy's default column ordering.
+    ``pivot`` = 0 takes every pivot on the diagonal (the inertia count of a symmetric matrix).
+
+    Raises
+    ------
+    RuntimeError
+        SuperLU's "Factor is exactly singular".
+    """
+    from scipy.sparse.linalg import splu  # imported on use: scipy's sparse solvers cost start-up time
+
+    return splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=pivot,
+                options={"SymmetricMode": True})
 
 
 def _directions(form):
@@ -112,11 +137,12 @@ def _directions(form):
     return slopes[:, 0], slopes[:, 1], speed, E, rows
 
 
-def _stiffness(form, normal, mu, E) -> sp.csr_matrix:
-    """K_t = K + Wᵀ diag(k) W + Gᵀ E diag(μ) n_q (n, n)."""
+def _stiffness(form, normal, mu, E) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """K_t = K + Wᵀ diag(k) W + K_f and the friction's part K_f = Gᵀ E diag(μ) n_q (n, n)."""
     G = sp.csr_matrix(form.tangent)
     K = sp.csr_matrix(form.stiffness) + normal.W.T @ sp.diags(normal.k) @ normal.W
-    return sp.csr_matrix(K + G.T @ (E @ sp.diags(mu) @ normal.n_q))
+    K_f = sp.csr_matrix(G.T @ (E @ sp.diags(mu) @ normal.n_q))
+    return sp.csr_matrix(K + K_f), K_f
 
 
 def _damping(form, normal, mu, slope, speed, E, rows, N) -> sp.csr_matrix:
@@ -163,21 +189,20 @@ def sparse_steady_sliding(model) -> SlidingState:
     ModelError
         For a rigid contact or kinematics that are not constant.
     """
-    from scipy.sparse.linalg import splu  # imported on use: scipy's sparse solvers cost start-up time
-
     form = sparse_form(model)
     normal = normal_rows(form)
     mu, slope, speed, E, rows = _directions(form)
     free = np.flatnonzero(np.asarray(form.free, bool))
     n = int(form.stiffness.shape[0])
     G = sp.csr_matrix(form.tangent)
-    K_t = _stiffness(form, normal, mu, E)
+    K_t, K_f = _stiffness(form, normal, mu, E)
     # f0 − Σ μ N0 Gᵀ e (+ the compliant contacts' −k g0 Wᵀ, inside N0 through λ = N0 + n·q)
     b = np.asarray(form.force, float) + G.T @ (E @ (-mu * normal.N0)) + normal.W.T @ normal.N0
-    Kf = sp.csc_matrix(K_t[free][:, free])
+    K_free = sp.csc_matrix(K_t[free][:, free])
     q = np.zeros(n)
     try:
-        q[free] = splu(Kf).solve(b[free])
+        lu = factorize(K_free)
+        q[free] = lu.solve(b[free])
     except RuntimeError:  # SuperLU: "Factor is exactly singular"
         raise EquilibriumError("no steady sliding: the stiffness of steady sliding K_t is singular on the free DOFs "
                                "(a free part held by nothing: fix it, or add contact stiffness)") from None
@@ -190,8 +215,9 @@ def sparse_steady_sliding(model) -> SlidingState:
     residual = _force_residual(form, normal, q, N, mu, E, free)
     C_t = _damping(form, normal, mu, slope, speed, E, rows, N)
     return SlidingState(form=form, q=q, free=free, mass=sp.csr_matrix(form.mass[free][:, free]),
-                        damping=sp.csr_matrix(C_t[free][:, free]), stiffness=sp.csr_matrix(Kf),
-                        normal_force=N, speed=speed, residual=residual)
+                        damping=sp.csr_matrix(C_t[free][:, free]), stiffness=sp.csr_matrix(K_free),
+                        normal_force=N, speed=speed, residual=residual, stiffness_lu=lu,
+                        friction_stiffness=sp.csr_matrix(K_f[free][:, free]))
 
 
 def _force_residual(form, normal, q, N, mu, E, free) -> float:
