@@ -25,6 +25,10 @@ made is lost and no reader ever sees half a file:
 :class:`AppendLog`
     A journal file that grows by records, each written whole and ``fsync``-ed before the call
     returns; a record torn by a full disk is cut off again at once.
+:func:`read_regular_file`
+    Read an input whole, bounded: only a regular file (a folder, a pipe or a device such as
+    ``/dev/zero``, also behind a symbolic link, is refused before a byte is read, and a pipe is
+    opened without waiting for a writer), and only up to a size limit.
 :func:`open_ours`
     Open a NetCDF file written by stickslip and check its kind and format version, with one
     :class:`FileFormatError` line for a missing, foreign, truncated or newer file.
@@ -39,6 +43,7 @@ import os
 import re
 import secrets
 import socket
+import stat
 import sys
 import threading
 import time
@@ -55,7 +60,7 @@ from .errors import DiskFullError, FileFormatError, LockError, OutputError, Stic
 __all__ = ["FileFormatError", "LockError", "WriteError", "DiskFullError", "OutputError", "OutputLock", "lock",
            "lock_path", "atomic_write", "atomic_write_text", "write_output", "refuse_output", "same_file",
            "temporary_path", "clean_temporaries", "AppendLog", "fsync_dir", "open_ours", "format_name",
-           "writing_errors", "netcdf_writer", "save_netcdf"]
+           "writing_errors", "netcdf_writer", "save_netcdf", "read_regular_file", "regular_file_size"]
 
 
 #: ``errno`` values of a full disk, an exhausted quota and a file over ``RLIMIT_FSIZE`` (Python
@@ -591,3 +596,61 @@ def save_netcdf(ds, path, *, overwrite: bool = False, kept: str | None = None) -
     """
     return write_output(path, netcdf_writer(ds), overwrite=overwrite, flag="path", kept=kept,
                         overwrite_hint="overwrite=True")
+
+
+def _open_regular(path, what: str, error: type[StickSlipError]) -> int:
+    """A descriptor of ``path`` opened for reading, refused unless it is a regular file (opened
+    non-blocking, so that a pipe without a writer does not hang the open; checked on the opened
+    file itself, so that nothing can swap it between the check and the read)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise error(f"{what} {path} does not exist; give the path of an existing file") from None
+    except OSError as exc:
+        raise error(f"{what} {path} cannot be read ({exc.strerror}); give a readable file") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise error(f"{what} {path} is not a regular file (a folder, a pipe or a device); give the path of a file")
+    return fd
+
+
+def regular_file_size(path, what: str, error: type[StickSlipError]) -> int:
+    """The size [bytes] of the regular file ``path`` (refused as :func:`read_regular_file` refuses)."""
+    fd = _open_regular(path, what, error)
+    try:
+        return os.fstat(fd).st_size
+    finally:
+        os.close(fd)
+
+
+def read_regular_file(path, limit: int, what: str, error: type[StickSlipError],
+                      fix: str = "give a smaller file") -> bytes:
+    """The bytes of the regular file ``path``, at most ``limit`` of them.
+
+    Raises
+    ------
+    error
+        One line naming ``what`` and ``path``: it does not exist, cannot be read, is not a regular
+        file (a folder, a pipe, a device), or holds more than ``limit`` bytes (also when it grows
+        past the limit while being read).
+    """
+    fd = _open_regular(path, what, error)
+    too_large = error(f"{what} {path} is larger than {limit:,} bytes, the most such a file may be; {fix}")
+    try:
+        size = os.fstat(fd).st_size
+        if size > limit:
+            raise too_large
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            data = fh.read(size + 1)  # one byte more than stated: a file that grows is read on
+            while 0 < len(data) <= limit:
+                more = fh.read(min(2**20, limit + 1 - len(data)))
+                if not more:
+                    break
+                data += more
+    except OSError as exc:
+        raise error(f"{what} {path} cannot be read ({exc.strerror}); give a readable file") from None
+    finally:
+        os.close(fd)
+    if len(data) > limit:
+        raise too_large
+    return data

@@ -37,7 +37,7 @@ from typer.core import TyperGroup
 from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
-from ..files import lock, refuse_output
+from ..files import lock, read_regular_file, refuse_output
 from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.library.two_plates import is_plates
@@ -310,12 +310,33 @@ def parse_assignments(items: list[str] | None, option: str = "--set") -> dict:
 PARAMETER_FLAGS = {"N": "--N", "Omega": "--omega", "mu_k": "--mu-k", "delta_mu": "--delta-mu", "alpha": "--alpha"}
 
 
+#: Largest ``--config`` file read [bytes]: it holds a table of parameters.
+MAX_CONFIG_BYTES = 2**20
+
+
+def _config_table(config) -> dict:
+    """The TOML of a ``--config`` file, read bounded (a regular file of at most
+    :data:`MAX_CONFIG_BYTES`: a folder, a pipe or a device is refused before it is read)."""
+    data = read_regular_file(config, MAX_CONFIG_BYTES, "--config", CLIError,
+                             "give a TOML file with a [parameters] table")
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
+    except RecursionError:
+        raise CLIError(f"--config {config}: a value is nested too deeply to read; give a [parameters] table of "
+                       "name = number") from None
+
+
 def config_values(config) -> dict:
     """``{name: value}`` of the parameters a --config TOML file sets (validated; names it does
     not set are left out)."""
-    loaded = Parameters.load_toml(config)
-    data = tomllib.loads(Path(config).read_text())
-    return {name: getattr(loaded, name) for name in data.get("parameters", data)}
+    data = _config_table(config)
+    table = data.get("parameters", data)
+    if not isinstance(table, dict):
+        raise CLIError(f"--config {config}: [parameters] must be a table of name = value")
+    loaded = Parameters.from_dict(table)
+    return {name: getattr(loaded, name) for name in table}
 
 
 def build_system(model: str, config, assignments, *, base=None, swept: dict | None = None, **named):
@@ -381,10 +402,10 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
 
 def _config_parameters(config) -> dict:
     """The ``[parameters]`` table of a ``--config`` TOML file for a model's named parameters."""
-    try:
-        return dict(tomllib.loads(Path(config).read_text()).get("parameters", {}))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
+    table = _config_table(config).get("parameters", {})
+    if not isinstance(table, dict):
+        raise CLIError(f"--config {config}: [parameters] must be a table of name = value")
+    return dict(table)
 
 
 def check_nc_path(out, flag: str = "--out") -> None:

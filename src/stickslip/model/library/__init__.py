@@ -73,8 +73,8 @@ def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
     path = HERE / (text.replace("-", "_") + ".toml")
     if "/" not in text and not text.endswith(".toml") and path.is_file():
         return load_model_file(path, source=f"library:{text}")
-    if text.endswith(".toml") or Path(text).is_file():
-        return load_model_file(text)
+    if text.endswith(".toml") or Path(text).exists() or Path(text).is_symlink():
+        return load_model_file(text)  # refuses what is not a regular file (a folder, a pipe, a device)
     raise ModelError(f"unknown model {text!r}; choose one of {', '.join(library())}, a plates variant "
                      f"({', '.join(MODELS)}) or a model file (.toml)")
 
