@@ -23,9 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from .._version import __version__
+from ..analysis.outcome import OUTCOMES, outcome_code, outcome_flags
 from ..attractors import jsonable
 from .cycles import find_cycle, run_matches
-from .early import DECIDED, OUTCOMES, Outcome
+from .early import DECIDED, Outcome
 from .spec import BasinSpec
 from .store import FORMAT
 
@@ -116,7 +117,7 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
     for p, ((labels, dec, refs), outs) in enumerate(zip(labelled, per_param)):
         for i, o in outs:
             label[p, i] = code[labels[i]]
-            verdict[p, i] = OUTCOMES.index(o.verdict)
+            verdict[p, i] = outcome_code(o.verdict)
             decided[p, i] = DECIDED.index(dec[i])
             t_decided[p, i], steps[p, i], wall[p, i] = o.t_decided, o.steps, o.wall_time
             if not np.isfinite(rep[p, label[p, i], 0]):
@@ -151,9 +152,8 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
     data = {
         "label": v(label, ("state",), {"long_name": "attractor reached from each initial state (-1: not classified)",
                                         **flags}),
-        "verdict": v(verdict, ("state",), {"long_name": "verdict of each state's run (-1: not classified)",
-                                            "flag_values": np.arange(len(OUTCOMES), dtype=np.int8),
-                                            "flag_meanings": " ".join(OUTCOMES)}),
+        "verdict": v(verdict, ("state",), {"long_name": "outcome of each state's run (-1: not classified)",
+                                            **outcome_flags()}),
         "decided_by": v(decided, ("state",), {"long_name": "how the verdict was reached (-1: not classified)",
                                                "flag_values": np.arange(len(DECIDED), dtype=np.int8),
                                                "flag_meanings": " ".join(DECIDED)}),

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..memory import check_memory, format_bytes, largest_count, sample_bytes
-from ..model.library import resolve_system
+from ..model.library import resolve_model
 from ..model.library.two_plates import is_plates
 from .fixed_step import run_fixed_step
 from .initial import check_rigid_start, initial_state
@@ -96,10 +96,9 @@ RUNNERS = {"event": run_event, "aeom": functools.partial(run_fixed_step, "aeom")
 
 
 def simulate(
-    system=None,
+    model=None,
     t_end: float = 100.0,
     *,
-    model=None,
     method: str = "event",
     ic="zero",
     perturbation=None,
@@ -116,14 +115,14 @@ def simulate(
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str, optional
-        The model: a :class:`FrictionModel`, a library name (``belt``, ...) or model file path, or
-        the two plates' :class:`Parameters`; default the plates with Table 1 at N = 50 N, Ω = 5 rad/s.
+    model : FrictionModel, Parameters, str, optional
+        The model: a :class:`FrictionModel` (the plates in a variant: ``two_plates(params,
+        "rotation")``, Models 1–4 being ``full``, ``x``, ``y``, ``rotation``), a library name
+        (``belt``, ...), a variant of the plates by name or a model file path, or the two plates'
+        :class:`Parameters` (all DOFs free); default the plates with Table 1 at N = 50 N,
+        Ω = 5 rad/s (:func:`stickslip.model.library.resolve_model`).
     t_end : float
         Final time [s].
-    model : str, iterable of DOF names, or FrictionModel, optional
-        The plates' variant: ``full`` (Model 1, default), ``x`` (2), ``y`` (3), ``rotation`` (4), or
-        the DOFs to free; a library name or model file here is the same as ``system``.
     method : str
         ``event`` (adaptive, exact transitions; default); ``aeom`` or ``naeom`` (the paper's fixed-step
         methods, two plates only).
@@ -163,7 +162,7 @@ def simulate(
         raise SimulationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if slip_band is not None:
         slip_band = _check_positive("slip_band", slip_band, "give a speed in m/s, e.g. 1e-6")
-    system = resolve_system(system, model, slip_band)
+    system = resolve_model(model, slip_band)
     t0 = float(t0)
     if not math.isfinite(t0):
         raise SimulationError("t0 must be finite")

@@ -194,7 +194,7 @@ def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return J, -M @ J[k:, :k], -M @ J[k:, k:]
 
 
-def stability(params=None, model="full") -> StabilityResult:
+def stability(model=None) -> StabilityResult:
     """Linear stability of steady sliding (paper Sect. 4.1) of any friction model.
 
     Finds the steady-sliding equilibrium (Eq. 14 for the plates), linearises the slip equations
@@ -203,13 +203,10 @@ def stability(params=None, model="full") -> StabilityResult:
 
     Parameters
     ----------
-    params : Parameters, FrictionModel or str, optional
-        The plates' parameters (default Table 1), or any model (a FrictionModel, a library name
-        or a model file path).
-    model : str, iterable of DOF names or Variant
-        The plates' variant: ``full`` (Model 1), ``x`` (2), ``y`` (3), ``rotation`` (4), or the DOFs
-        to free (or a library name / model file, as ``params``). The Jacobian is reduced to the
-        free DOFs.
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it: any model (a FrictionModel, a library
+        name or a model file path) or the plates' parameters (default Table 1; in a variant:
+        ``two_plates(params, "rotation")``, Model 4). The Jacobian is reduced to the free DOFs.
 
     Returns
     -------
@@ -222,7 +219,7 @@ def stability(params=None, model="full") -> StabilityResult:
         simulator's low-speed band, where its slip direction is not v/|v|, or a Jacobian that
         overflows (values far outside physical size).
     """
-    return model_stability(model_of(params, model))
+    return model_stability(model_of(model))
 
 
 def model_stability(system) -> StabilityResult:

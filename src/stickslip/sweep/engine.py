@@ -11,7 +11,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from ..analysis.classify import KINDS
+from ..analysis.outcome import outcome_names
 from ..errors import SweepError
 from ..integrate.driver import check_samples
 from ..journal import finished_output, output_path
@@ -61,11 +61,10 @@ class SweepResult:
         """The result as an ``xarray.Dataset``."""
         return self.dataset
 
-    def kinds(self) -> np.ndarray:
-        """Steady-state kind names over the grid (``failed`` for −1)."""
-        code = self.dataset["kind"].values
-        names = np.array(KINDS + ("failed",), dtype=object)
-        return names[np.where(np.isfinite(code), code, -1).astype(int)]
+    def outcomes(self) -> np.ndarray:
+        """What each point's run settles to, by name (:data:`~stickslip.analysis.outcome.OUTCOMES`) over
+        the grid; whether it sticks is the ``stick_fraction`` variable beside it."""
+        return outcome_names(self.dataset["attractor"].values)
 
 
 #: Most points per automatic batch: a batch's rows are held in memory until journaled, so this
@@ -131,7 +130,7 @@ def _progress_bar():
                     transient=False)
 
 
-def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
+def sweep(grid: Mapping[str, Sequence] | SweepSpec, model=None, *, out=None,
           executor: str = "processes", workers: int | None = None, address: str | None = None,
           batch_size: int | str = "auto", progress: bool = False, overwrite: bool = False,
           snapshot_interval: float = 60.0, keep_journal: bool = False, t_end: float = 200.0,
@@ -146,9 +145,10 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
         model its parameter paths, e.g. ``contact.0.drive``), ``model`` (the plates' variants),
         ``ic`` (named initial conditions, :data:`~stickslip.sweep.spec.NAMED_ICS`) or
         ``perturb_<state>``.
-    params : Parameters, FrictionModel or str, optional
-        The plates' base parameters (default Table 1 with N = 50 N, Ω = 5 rad/s), or any model
-        stated as a model file (a FrictionModel read from one, a library name or a path).
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it: the plates' base parameters (default
+        Table 1 with N = 50 N, Ω = 5 rad/s; in a variant: ``two_plates(params, "rotation")``), or
+        any model stated as a model file (a FrictionModel read from one, a library name or a path).
     out : path, optional
         NetCDF output (``.nc``). Finished points are journaled beside it (``OUT.nc.journal``) as
         they arrive; a sweep killed and restarted with the same arguments recomputes nothing it
@@ -173,7 +173,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     t_end, t_from : float
         Run length and start of the steady window of every point [s] (default t_end/2).
     **options
-        ``model``, ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
+        ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
         ``n_peaks``, ``method``, ``settle`` (extend every run until it has settled; then
         ``t_end`` is the first run's length), ``cap`` [s] (longest run when settling),
         ``confirm``: see :class:`~stickslip.sweep.spec.SweepSpec`.
@@ -193,7 +193,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
         If the disk is full (the journal keeps every finished point: run again to resume).
     """
     t_start = time.perf_counter()
-    spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
+    spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, model, t_end=t_end, t_from=t_from, **options)
     check_executor(executor)
     workers = check_workers(workers, address=address)
     _check_memory(spec, 0 if address else 1 if executor == "serial" else workers)
