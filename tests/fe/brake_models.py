@@ -21,13 +21,13 @@ dense solvers' checks).
 from __future__ import annotations
 
 import itertools
-import types
 
 import numpy as np
 import scipy.sparse as sp
 
 from stickslip.model import FrictionModel
 from stickslip.model.friction import FrictionLaw
+from stickslip.model.sparse_form import NodeMap, SparseForm
 from stickslip.model.system_model import Contact, NormalLaw
 
 __all__ = ["elasticity_matrices", "pad_on_belt_2d", "pad_on_strip_2d", "pad_on_surface_3d", "pad_on_disc_3d",
@@ -180,17 +180,19 @@ class _Assembly:
         nc, R, k = len(contact_rows), len(drive), keep.size
         friction = law or FrictionLaw("coulomb", mu_k=mu, delta_mu=0.0)
         nodes = np.vstack(self.nodes)
-        return types.SimpleNamespace(
-            dofs=tuple(f"u{i}" for i in range(k)), mass=M, damping=C, stiffness=K, force=f[keep],
+        coordinates = np.hstack([nodes, np.zeros((nodes.shape[0], 3 - self.dim))])
+        return SparseForm(
+            name=name, dofs=tuple(f"u{i}" for i in range(k)), mass=M, damping=C, stiffness=K, force=f[keep],
             free=np.ones(k, bool), tangent=sp.csr_matrix((tv, (tr, tc)), shape=(R, k)),
             row_start=np.asarray(row_start, np.int64), drive=np.asarray(drive, float), normal_force=np.zeros(nc),
             normal_gradient=sp.csr_matrix((nc, k)), normal_rate_gradient=sp.csr_matrix((nc, k)),
             unilateral=np.ones(nc, bool), normal_law=np.array(["compliant"] * nc), gap=np.zeros(nc),
             gap_gradient=sp.csr_matrix((gv, (gr, gc)), shape=(nc, k)), contact_stiffness=np.full(nc, kc),
             contact_damping=np.full(nc, cc), restitution=np.zeros(nc), friction=(friction,) * nc,
-            contact_names=tuple(f"c{c}" for c in range(nc)), nodes=nodes, units={}, slip_band=5e-4, name=name,
-            dof_node=(keep // self.dim), dof_axis=(keep % self.dim),
-        )
+            contact_names=tuple(f"c{c}" for c in range(nc)),
+            nodes=NodeMap(ids=np.arange(nodes.shape[0]), coordinates=coordinates, node=keep // self.dim,
+                          component=keep % self.dim),
+            units={}, slip_band=5e-4)
 
 
 def pad_on_belt_2d(nx=6, ny=3, *, width=0.04, height=0.012, E=5e9, nu=0.25, rho=2500.0, thickness=0.01,

@@ -174,36 +174,34 @@ class BandStability:
                  "summary": json.dumps(self.summary())}
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def write_vtk(self, path, shapes: str = "unstable") -> None:
+    def write_vtk(self, path, shapes: str = "unstable", file_format: str | None = None) -> None:
         """The mode shapes as point data on the model's nodes (meshio; the ``fe`` extra), one real
-        and one imaginary displacement field per mode, for ParaView.
+        and one imaginary displacement field per mode, for ParaView (``file_format``: meshio's, e.g.
+        ``vtu``; default from the suffix).
 
         Raises
         ------
         BandError
-            When the model gives no node coordinates or no node of each DOF.
+            When the model gives no node coordinates, or meshio is not installed.
         """
         nodes = getattr(self.form, "nodes", None)
-        node_of, axis_of = getattr(self.form, "dof_node", None), getattr(self.form, "dof_axis", None)
-        if nodes is None or node_of is None or axis_of is None:
-            raise BandError(f"model {self.model!r} gives no node coordinates with a node and an axis for each DOF; "
-                            "write the shapes to NetCDF instead")
+        if nodes is None:
+            raise BandError(f"model {self.model!r} gives no node coordinates; write the shapes to NetCDF instead "
+                            "(--out), or give the model its nodes (docs/models.md)")
         try:
             import meshio
         except ImportError:
             raise BandError("writing VTK needs meshio: pip install 'stickslip[fe]'") from None
-        nodes = np.asarray(nodes, float)
-        points = nodes if nodes.shape[1] == 3 else np.hstack([nodes, np.zeros((nodes.shape[0], 3 - nodes.shape[1]))])
+        points = np.asarray(nodes.coordinates, float)
         keep = self.unstable if shapes == "unstable" else np.flatnonzero(self.eigenvalues.imag >= 0.0)
         fields = {}
         for j in keep:
-            u = np.zeros((points.shape[0], 3), complex)
-            u[node_of, axis_of] = self.mode_shapes[j]
+            u = nodes.displacement(self.mode_shapes[j])
             f = self.eigenvalues[j].imag / (2 * math.pi)
             fields[f"mode{j}_{f:.6g}Hz_real"] = u.real
             fields[f"mode{j}_{f:.6g}Hz_imag"] = u.imag
         cells = [("vertex", np.arange(points.shape[0]).reshape(-1, 1))]
-        meshio.write(str(path), meshio.Mesh(points, cells, point_data=fields))
+        meshio.write(str(path), meshio.Mesh(points, cells, point_data=fields), file_format=file_format)
 
 
 def _shapes(state: SlidingState, X: np.ndarray) -> np.ndarray:
@@ -273,7 +271,7 @@ def band_stability(model, max_frequency: float, *, method: str = "direct", cutof
                         f"{_lowest(state):.6g} rad/s: give a larger --max-frequency")
     form = state.form
     return BandStability(
-        model=getattr(form, "name", "model"), dofs=tuple(form.dofs), free=state.free, equilibrium=state.q,
+        model=form.name, dofs=tuple(form.dofs), free=state.free, equilibrium=state.q,
         residual=state.residual, eigenvalues=band.eigenvalues[inside],
         mode_shapes=_shapes(state, band.vectors[:, inside]), backward_error=band.backward_error[inside],
         max_frequency=float(max_frequency), radius=band.radius, method=method,

@@ -29,26 +29,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import EquilibriumError
-from ..model.friction import _USER_LAWS
-from ..model.system_model import DEFAULT_SLIP_BAND
 from .sparse_input import normal_rows, sparse_form
 
-__all__ = ["SlidingState", "friction_slopes", "sparse_steady_sliding", "factorize"]
-
-#: Complex step of the user friction laws' slope dμ/d|v| (exact to round-off: no subtraction).
-_STEP = 1e-30
-
-
-def friction_slopes(law, speed: float) -> tuple[float, float]:
-    """(μ, dμ/d|v|) of a :class:`~stickslip.model.friction.FrictionLaw` at the slip speed ``speed`` [m/s]."""
-    if law.law == "coulomb":
-        return law.mu_k, 0.0
-    if law.law == "user":
-        mu = _USER_LAWS[type(law.user)](law.user, complex(speed, _STEP))
-        return float(mu.real), float(mu.imag / _STEP)
-    decay = law.delta_mu * math.exp(-law.alpha * speed)
-    return law.mu_k + decay + law.mu_v * speed, -law.alpha * decay + law.mu_v
-
+__all__ = ["SlidingState", "sparse_steady_sliding", "factorize"]
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class SlidingState:
@@ -120,7 +103,7 @@ def _directions(form):
     w = np.asarray(form.drive, float)
     nc = start.size - 1
     speed = np.sqrt(np.add.reduceat(w * w, start[:-1])) if w.size else np.zeros(0)
-    band = getattr(form, "slip_band", DEFAULT_SLIP_BAND)
+    band = form.slip_band
     dims = np.diff(start)
     names = form.contact_names
     for c in range(nc):
@@ -133,8 +116,9 @@ def _directions(form):
                                    "the drive")
     rows = np.repeat(np.arange(nc), dims)
     E = sp.csr_matrix((-w / speed[rows], (np.arange(w.size), rows)), shape=(w.size, nc))
-    slopes = np.array([friction_slopes(form.friction[c], float(speed[c])) for c in range(nc)]).reshape(nc, 2)
-    return slopes[:, 0], slopes[:, 1], speed, E, rows
+    mu = np.array([float(form.mu(c, speed[c])) for c in range(nc)])
+    slope = np.array([float(form.dmu(c, speed[c])) for c in range(nc)])
+    return mu, slope, speed, E, rows
 
 
 def _stiffness(form, normal, mu, E) -> tuple[sp.csr_matrix, sp.csr_matrix]:
