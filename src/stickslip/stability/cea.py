@@ -38,7 +38,7 @@ import scipy.sparse as sp
 from ..errors import EquilibriumError
 from .sparse_sliding import SlidingState, factorize
 
-__all__ = ["BandEigen", "band_eigen", "dense_eigen", "backward_errors", "frictionless_count", "REAL_MARGIN",
+__all__ = ["BandEigen", "band_eigen", "dense_eigen", "backward_errors", "frictionless_count", "modes_below", "REAL_MARGIN",
            "DENSE_STATES", "REFINE_BELOW", "sorted_eigen"]
 
 #: Half-width of the band's strip at its top, as a fraction of ω_max: every eigenvalue of
@@ -244,14 +244,19 @@ def _refine(state: SlidingState, lam: np.ndarray, X: np.ndarray, eta: np.ndarray
 
 
 def frictionless_count(state: SlidingState, omega: float) -> int | None:
-    """Number of modes of (K_s, M) below ``omega`` [rad/s], K_s the symmetric part of K_t − K_f,
-    by Sylvester's law of inertia: the negative pivots of an LU of K_s − ω² M with diagonal pivots
+    """Number of modes of (K_s, M) below ``omega`` [rad/s], K_s the symmetric part of K_t − K_f
+    (:func:`modes_below`)."""
+    return modes_below(_frictionless_stiffness(state), state.mass, omega)
+
+
+def modes_below(K, M, omega: float) -> int | None:
+    """Number of eigenvalues of the symmetric pencil (K, M) below ω² (M positive definite), by
+    Sylvester's law of inertia: the negative pivots of an LU of K − ω² M with diagonal pivots
     (None where SuperLU had to pivot off the diagonal)."""
-    Ks = _frictionless_stiffness(state)
     try:
-        lu = factorize(Ks - omega**2 * state.mass, pivot=0.0)
+        lu = factorize(K - omega**2 * M, pivot=0.0)
     except RuntimeError:  # ω² is an eigenvalue: count it with those below
-        lu = factorize(Ks - (omega * (1 + 1e-12)) ** 2 * state.mass, pivot=0.0)
+        lu = factorize(K - (omega * (1 + 1e-12)) ** 2 * M, pivot=0.0)
     if not np.array_equal(lu.perm_r, lu.perm_c):
         return None
     return int(np.count_nonzero(lu.U.diagonal() < 0.0))

@@ -22,10 +22,10 @@ import math
 import numpy as np
 
 from ..errors import EquilibriumError
-from .cea import BandEigen, _frictionless_stiffness, band_eigen, frictionless_count
+from .cea import BandEigen, _frictionless_stiffness, band_eigen, modes_below
 from .sparse_sliding import SlidingState, factorize
 
-__all__ = ["ModalBasis", "ModalReport", "real_modes", "projected_eigen", "modal_cea", "CUTOFF_FACTOR"]
+__all__ = ["ModalBasis", "ModalReport", "real_modes", "lowest_modes", "projected_eigen", "modal_cea", "CUTOFF_FACTOR"]
 
 #: Default cutoff of the real modes as a multiple of the band's top (the rule of thumb of modal
 #: CEA: modes up to 1.5–2 times the highest frequency of interest).
@@ -82,7 +82,21 @@ class ModalReport:
 
 
 def real_modes(state: SlidingState, cutoff: float) -> ModalBasis:
-    """Every real mode of (K_s, M) below ``cutoff`` [rad/s] (shift-invert Lanczos at 0).
+    """Every real mode of (K_s, M) below ``cutoff`` [rad/s] (:func:`lowest_modes`).
+
+    Raises
+    ------
+    EquilibriumError
+        When there is no mode below the cutoff or Lanczos does not return the counted modes.
+    """
+    omega, V, count = lowest_modes(_frictionless_stiffness(state), state.mass, cutoff)
+    return ModalBasis(frequencies=omega, vectors=V, cutoff=cutoff, count=count)
+
+
+def lowest_modes(K, M, cutoff: float) -> tuple[np.ndarray, np.ndarray, int | None]:
+    """Every mode of the symmetric pencil (K, M) below ``cutoff`` [rad/s]: angular frequencies (m,)
+    ascending, M-orthonormal vectors (k, m) and Sylvester's count (checked against what Lanczos
+    returns; shift-invert at 0, the LU of K with diagonal pivots).
 
     Raises
     ------
@@ -91,21 +105,20 @@ def real_modes(state: SlidingState, cutoff: float) -> ModalBasis:
     """
     from scipy.sparse.linalg import LinearOperator, eigsh
 
-    Ks = _frictionless_stiffness(state)
-    count = frictionless_count(state, cutoff)
+    count = modes_below(K, M, cutoff)
     if count == 0:
         raise EquilibriumError(f"no real mode below the cutoff {cutoff:.6g} rad/s; give a larger cutoff")
     k = count if count is not None else 20
-    n = state.n
-    lu = factorize(Ks, pivot=0.0)
+    n = K.shape[0]
+    lu = factorize(K, pivot=0.0)
     op = LinearOperator((n, n), matvec=lambda x: lu.solve(np.asarray(x).reshape(-1)), dtype=float)
     while True:
         if k >= n - 1:  # a small model: every mode
             from scipy.linalg import eigh
 
-            w2, V = eigh(Ks.toarray(), state.mass.toarray())
+            w2, V = eigh(K.toarray(), M.toarray())
         else:
-            w2, V = eigsh(Ks, k=k, M=state.mass, sigma=0.0, OPinv=op, which="LM")
+            w2, V = eigsh(K, k=k, M=M, sigma=0.0, OPinv=op, which="LM")
         order = np.argsort(w2)
         w2, V = w2[order], V[:, order]
         below = w2 < cutoff**2
@@ -115,8 +128,7 @@ def real_modes(state: SlidingState, cutoff: float) -> ModalBasis:
     if count is not None and int(np.count_nonzero(below)) != count:
         raise EquilibriumError(f"Lanczos found {int(np.count_nonzero(below))} real modes below {cutoff:.6g} rad/s, "
                                f"Sylvester's inertia counts {count}; give another cutoff")
-    return ModalBasis(frequencies=np.sqrt(np.maximum(w2[below], 0.0)), vectors=V[:, below], cutoff=cutoff,
-                      count=count)
+    return np.sqrt(np.maximum(w2[below], 0.0)), V[:, below], count
 
 
 def projected_eigen(state: SlidingState, basis: ModalBasis, modes: int | None = None):
