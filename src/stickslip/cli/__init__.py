@@ -26,6 +26,7 @@ from . import basins  # noqa: E402,F401  (registers `stickslip basins`)
 from . import models  # noqa: E402,F401  (registers `stickslip models`)
 from . import warmup  # noqa: E402,F401  (registers `stickslip warmup`)
 from . import reduce  # noqa: E402,F401  (registers `stickslip reduce`)
+from . import mode_coupling  # noqa: E402,F401  (registers `stickslip mode-coupling`)
 
 _startup.release()  # a Ctrl-C held during these imports is raised here, reported in one line
 
