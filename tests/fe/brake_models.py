@@ -322,7 +322,6 @@ def pad_on_disc_3d(disc=(8, 96, 2), pad=(4, 12, 2), *, radii=(0.06, 0.15), disc_
 
 def dense_model(form) -> FrictionModel:
     """The :class:`FrictionModel` of a small sparse form (the same numbers, dense)."""
-    n = form.stiffness.shape[0]
     G, W = form.tangent.toarray(), form.gap_gradient.toarray()
     contacts = []
     for c in range(form.row_start.size - 1):

@@ -15,6 +15,7 @@ from ..model.derivatives import state_jacobian_from_python
 from ..model.library.two_plates import plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.physics import MODE_SLIP_EXACT
+from ..model.sparse_form import SparseForm
 from ..model.variants import DOF_NAMES
 from .band import BandError, band_stability
 from .equilibrium import model_of, point_text, rigid_constraint, solve_steady
@@ -234,7 +235,7 @@ def stability(model=None, *, max_frequency: float | None = None, method: str | N
     BandError
         A sparse model without ``max_frequency``, or a band that holds no eigenvalue.
     """
-    system = model_of(model)
+    system = model if isinstance(model, SparseForm) else model_of(model)
     if max_frequency is None and method is None and cutoff is None and not is_sparse_model(system):
         return model_stability(system)
     if max_frequency is None:

@@ -112,7 +112,7 @@ def _upper(model, mu: float, max_frequency: float, method: str) -> np.ndarray:
     return lam[lam.imag >= 0.0]
 
 
-def _onsets(form, mu, branches, max_frequency, method) -> list[dict]:
+def _onsets(form, mu, branches, max_frequency, method, xtol) -> list[dict]:
     """Each upward crossing of Re λ = 0 by a branch, refined by Brent's method on max Re λ nearby."""
     from scipy.optimize import brentq
 
@@ -131,7 +131,7 @@ def _onsets(form, mu, branches, max_frequency, method) -> list[dict]:
                 return near.real / abs(near) - GROWTH_TOL
 
             lo, hi = float(mu[i]), float(mu[i + 1])
-            critical = brentq(rate, lo, hi, xtol=ONSET_XTOL) if rate(lo) < 0.0 < rate(hi) else hi
+            critical = brentq(rate, lo, hi, xtol=xtol) if rate(lo) < 0.0 < rate(hi) else hi
             lam = _upper(form, critical, max_frequency, method)
             at = lam[np.argmin(np.abs(lam - target))]
             others = branches[i + 1].imag.copy()
@@ -141,7 +141,8 @@ def _onsets(form, mu, branches, max_frequency, method) -> list[dict]:
     return out
 
 
-def mode_coupling(model, mu, max_frequency: float, *, method: str = "direct") -> ModeCoupling:
+def mode_coupling(model, mu, max_frequency: float, *, method: str = "direct", xtol: float = ONSET_XTOL
+                  ) -> ModeCoupling:
     """The band's eigenvalues against the friction coefficient (module docstring).
 
     Parameters
@@ -154,6 +155,8 @@ def mode_coupling(model, mu, max_frequency: float, *, method: str = "direct") ->
         The band's top [rad/s].
     method : {"direct", "modal", "dense"}
         The CEA of each point (:func:`~stickslip.stability.band.band_stability`).
+    xtol : float
+        Absolute tolerance of the onsets' μ (each step of the root finding is one CEA).
 
     Raises
     ------
@@ -168,4 +171,4 @@ def mode_coupling(model, mu, max_frequency: float, *, method: str = "direct") ->
     form = sparse_form(model)
     branches = _track([_upper(form, m, max_frequency, method) for m in mu])
     return ModeCoupling(model=form.name, mu=mu, eigenvalues=branches, max_frequency=float(max_frequency),
-                        onsets=_onsets(form, mu, branches, max_frequency, method))
+                        onsets=_onsets(form, mu, branches, max_frequency, method, xtol))
