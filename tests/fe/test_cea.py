@@ -19,8 +19,8 @@ from .brake_models import pad_on_strip_2d
 
 @pytest.fixture(scope="module")
 def strip():
-    """A pad on a flexible strip (779 DOFs, 21 contacts) past its flutter onset, light stiffness damping."""
-    return pad_on_strip_2d(strip=(60, 4), pad=(20, 4), mu=0.6, beta=2e-7)
+    """A pad on a flexible strip (495 DOFs, 17 contacts) past its flutter onset, light stiffness damping."""
+    return pad_on_strip_2d(strip=(48, 3), pad=(16, 3), mu=0.6, beta=2e-7)
 
 
 @pytest.fixture(scope="module")
@@ -31,6 +31,11 @@ def strip_dense(strip):
 
 def _nearest_errors(found, reference):
     return np.array([np.min(np.abs(reference - x)) / abs(x) for x in found])
+
+
+def _band(lam, omega):
+    """The band of the sparse path: |Im λ| ≤ ω_max inside the disc |λ| ≤ ω_max √(1 + 0.25²)."""
+    return lam[(np.abs(lam.imag) <= omega) & (np.abs(lam) <= omega * math.sqrt(1 + 0.25**2))]
 
 
 def _same(a, b, rtol=1e-9):
@@ -54,8 +59,8 @@ def test_direct_matches_dense_to_1e_8(strip, strip_dense):
     state, lam = strip_dense
     omega = 2 * np.pi * 30e3
     result = band_stability(strip, omega)
-    assert result.method == "direct" and state.n == 779
-    reference = lam[np.abs(lam.imag) <= omega]
+    assert result.method == "direct" and state.n == 495
+    reference = _band(lam, omega)
     # the same eigenvalues: each found one is a dense one, and as many
     assert result.eigenvalues.size == reference.size > 20
     assert np.max(_nearest_errors(result.eigenvalues, reference)) < 1e-8
@@ -77,7 +82,7 @@ def test_modal_refined_and_converging(strip, strip_dense):
     assert rows[-1]["modes"] == modal.modal.modes == frictionless_count(sparse_steady_sliding(strip), 2 * omega)
     errors = [row["max_relative_error"] for row in rows]
     assert errors[-1] < 0.05 * errors[0]  # approximations approach the full eigenvalues as modes are added
-    assert rows[-1]["found"] == modal.eigenvalues.size - 2  # all but one pair within 1e-2 with modes to 2 ω_max
+    assert rows[0]["found"] < rows[-1]["found"] <= modal.eigenvalues.size  # more of the band within 1e-2
     # a higher cutoff, more modes: closer (the stiff contacts need the high modes; docs/fe.md)
     wider = band_stability(strip, omega, method="modal", cutoff=8 * omega)
     assert wider.modal.convergence[-1]["max_relative_error"] < 0.2 * errors[-1]
@@ -116,4 +121,5 @@ def test_dense_method_of_band(strip, strip_dense):
     _, lam = strip_dense
     omega = 2 * math.pi * 30e3
     dense = band_stability(strip, omega, method="dense")
+    assert dense.eigenvalues.size == _band(lam, omega).size
     assert np.max(_nearest_errors(dense.eigenvalues, lam)) < 1e-13

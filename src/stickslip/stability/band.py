@@ -24,7 +24,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import StickSlipError
 from ..memory import check_memory, format_bytes
-from .cea import BandEigen, backward_errors, band_eigen, dense_eigen, frictionless_count, sorted_eigen
+from .cea import REAL_MARGIN, BandEigen, backward_errors, band_eigen, dense_eigen, frictionless_count, sorted_eigen
 from .modal_cea import ModalReport, modal_cea
 from .sparse_sliding import SlidingState, sparse_steady_sliding
 
@@ -59,7 +59,9 @@ class BandStability:
     residual : float
         Relative force residual of the steady state.
     eigenvalues : ndarray (m,) complex
-        Every eigenvalue with |Im λ| ≤ ``max_frequency``, by real part descending, then Im descending [1/s].
+        Every eigenvalue of the band: |Im λ| ≤ ``max_frequency`` inside the disc |λ| ≤ ``radius``
+        (heavily damped eigenvalues beyond it are not part of the band), by real part descending,
+        then Im descending [1/s].
     mode_shapes : ndarray (m, n) complex
         Displacements of each eigenvector on every dof (0 on locked ones), largest entry 1.
     backward_error : ndarray (m,)
@@ -217,20 +219,24 @@ def _shapes(state: SlidingState, X: np.ndarray) -> np.ndarray:
 
 
 def _dense_band(state: SlidingState, max_frequency: float) -> BandEigen:
+    """Every eigenvalue densely, kept in the disc the sparse methods search (the same band)."""
     n = state.n
     check_memory(dense_bytes(n), f"the dense eigenvalues of {n} DOFs",
                  lambda memory: f"use --method direct (the sparse path; the dense one fits up to "
                                 f"{int(math.sqrt(memory / 32.0) / 2)} DOFs in {format_bytes(memory)})")
     lam, X = dense_eigen(state)
-    inside = np.abs(lam.imag) <= max_frequency
+    radius = max_frequency * math.sqrt(1.0 + REAL_MARGIN**2)
+    inside = np.abs(lam) <= radius
     lam, X = sorted_eigen(lam[inside], X[:, inside])
-    return BandEigen(eigenvalues=lam, vectors=X, radius=math.inf, backward_error=backward_errors(state, lam, X),
-                     method="dense")
+    return BandEigen(eigenvalues=lam, vectors=X, radius=radius, backward_error=backward_errors(state, lam, X),
+                     method="dense", frictionless_count=frictionless_count(state, radius))
 
 
 def band_stability(model, max_frequency: float, *, method: str = "direct", cutoff: float | None = None
                    ) -> BandStability:
-    """Steady sliding and every eigenvalue of its linearisation with |Im λ| ≤ ``max_frequency``.
+    """Steady sliding and every eigenvalue of its linearisation in the band: |Im λ| ≤ ``max_frequency``
+    inside the disc |λ| ≤ ``max_frequency`` √(1 + 0.25²) that the methods search completely
+    (:mod:`~stickslip.stability.cea`).
 
     Parameters
     ----------
