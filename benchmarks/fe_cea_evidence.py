@@ -9,7 +9,7 @@ Coulomb friction μ = 0.3; light stiffness damping β = 1e-6 s): 1,955 DOFs.
    (|Im λ| ≤ ω_max inside the disc |λ| ≤ R that the sparse path searches), against the sparse
    direct CEA of the band (shift-invert Arnoldi): the same count, and the largest relative
    distance from each sparse eigenvalue to the nearest dense one and back.
-2. Modal CEA with cutoffs of 1.5, 2, 4 and 8 ω_max: the projection's eigenvalues on the first m
+2. Modal CEA with cutoffs of 1.5, 2 and 4 ω_max: the projection's eigenvalues on the first m
    real modes against the full sparse ones (each full eigenvalue from its nearest approximation).
 
     python benchmarks/fe_cea_evidence.py      (a few minutes: the dense eigenvalues of 3,910 states)
@@ -66,7 +66,7 @@ def main() -> None:
           f"{direct.eigenvalues.size} | {out['sparse_to_dense']:.1e} | {out['dense_to_sparse']:.1e} | {dense_s:.0f} | "
           f"{direct_s:.1f} |\n")
     print("| cutoff / ω_max | modes | highest mode / ω_max | max relative error | within 1e-2 |\n|---|---|---|---|---|")
-    for factor in (1.5, 2.0, 4.0, 8.0):
+    for factor in (1.5, 2.0, 4.0):
         result = band_stability(model, OMEGA, method="modal", cutoff=factor * OMEGA)
         assert nearest(result.eigenvalues, direct.eigenvalues) < 1e-8  # the refined eigenvalues are the full ones
         for row in result.modal.convergence:
