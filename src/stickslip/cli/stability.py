@@ -21,7 +21,9 @@ from ..plot.stability import save_stability_map_figure
 from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
+from ..stability.sparse_input import is_sparse_model
 from ._app import CLIError, app, build_system, check_finite, check_outputs, console
+from ._band import Band, report_band
 from ._compiling import time_text, timed
 from ._groups import grouped
 from ._options import Friction, JsonSummary, MapModel, Model, ModelChanges, Outputs, Plates
@@ -35,12 +37,26 @@ def stability(
     plates: Plates = Plates(),
     model: Model = "full",
     changes: ModelChanges = ModelChanges(),
+    band: Band = Band(),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
-    """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
+    """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model; for sparse
+    (finite-element) models every eigenvalue of a band (complex eigenvalue analysis, --max-frequency)."""
     system, _ = build_system(model, changes.config, changes.set_, **plates.named())
+    sparse = band.asked or is_sparse_model(system)
+    if sparse:
+        band.check(changes.inputs)
+        if band.max_frequency is None:
+            raise CLIError(f"model {system.name!r} has {system.n} dofs: give --max-frequency, the top of the band whose "
+                           "eigenvalues are computed [rad/s]")
     with timed() as timing:
-        result = run_stability(system)
+        if sparse:
+            result = run_stability(system, max_frequency=band.max_frequency, method=band.method, cutoff=band.cutoff)
+        else:
+            result = run_stability(system)
+    if sparse:
+        report_band(result, timing, band.write(result, changes.inputs), as_json)
+        return
     if as_json:
         print(json.dumps({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
         return
