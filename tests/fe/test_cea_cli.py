@@ -56,6 +56,13 @@ def test_modal_method_table(pad):
     result = run("--model", str(pad), "--max-frequency", "4e5", "--method", "modal")
     assert result.exit_code == 0, result.output
     assert "modal CEA" in result.output and "max real part in the band" in result.output
+    summary = json.loads(run("--model", str(pad), "--max-frequency", "4e5", "--method", "modal", "--json").output)
+    alone = json.loads(run("--model", str(pad), "--max-frequency", "4e5", "--method", "modal", "--json",
+                           "--no-residual-vectors").output)
+    assert summary["modal"]["residual_vectors"] > 0 and alone["modal"]["residual_vectors"] == 0
+    np.testing.assert_allclose(summary["eigenvalues"], alone["eigenvalues"], rtol=1e-9)  # both refined on the full model
+    last, last_alone = summary["modal"]["convergence"][-1], alone["modal"]["convergence"][-1]
+    assert last["modes_only_error"] == pytest.approx(last_alone["max_relative_error"], rel=1e-9)
 
 
 def test_refusals(pad, tmp_path):
@@ -64,6 +71,7 @@ def test_refusals(pad, tmp_path):
     refused(run("--model", str(pad), "--max-frequency", "-1"), "--max-frequency -1 must be")
     refused(run("--model", str(pad), "--max-frequency", "4e5", "--method", "qz"), "--method qz: choose one of")
     refused(run("--model", str(pad), "--max-frequency", "4e5", "--cutoff", "1e6"), "give --method modal")
+    refused(run("--model", str(pad), "--max-frequency", "4e5", "--no-residual-vectors"), "belongs to --method modal")
     out = tmp_path / "exists.nc"
     out.write_text("mine")
     refused(run("--model", str(pad), "--max-frequency", "4e5", "--out", str(out)), "--overwrite")

@@ -27,6 +27,9 @@ Method = Annotated[Optional[str], typer.Option(
     "--cutoff, refined on the full model) or dense (every eigenvalue; a few thousand DOFs).")]
 Cutoff = Annotated[Optional[float], typer.Option(
     "--cutoff", help="--method modal: the real modes' cutoff [rad/s] (default 2 × --max-frequency).")]
+NoResidual = Annotated[bool, typer.Option(
+    "--no-residual-vectors", help="--method modal: project on the real modes alone, without the residual vectors "
+    "(the static response to the contact forces) that make the projection converge.")]
 ShapesOut = Annotated[Optional[Path], typer.Option(
     "--out", help="Sparse path: NetCDF of the band's eigenvalues and the unstable modes' shapes.")]
 Vtk = Annotated[Optional[Path], typer.Option(
@@ -44,6 +47,7 @@ class Band:
     max_frequency: MaxFrequency = None
     method: Method = None
     cutoff: Cutoff = None
+    no_residual_vectors: NoResidual = False
     out: ShapesOut = None
     vtk: Vtk = None
     all_shapes: AllShapes = False
@@ -52,7 +56,8 @@ class Band:
     @property
     def asked(self) -> bool:
         """Whether an option of the sparse path was given."""
-        return any(v is not None for v in (self.max_frequency, self.method, self.cutoff, self.out, self.vtk))
+        return self.no_residual_vectors or any(v is not None for v in (self.max_frequency, self.method, self.cutoff,
+                                                                        self.out, self.vtk))
 
     def check(self, inputs: dict) -> None:
         """Refuse values and outputs before any work."""
@@ -62,8 +67,10 @@ class Band:
                 raise CLIError(f"{flag} {value:g} must be an angular frequency > 0 [rad/s]")
         if self.method is not None:
             check_choice("--method", self.method, ("direct", "modal", "dense"))
-        if self.cutoff is not None and self.method != "modal":
-            raise CLIError("--cutoff is the real modes' cutoff of --method modal; give --method modal too")
+        for flag, given in (("--cutoff", self.cutoff is not None), ("--no-residual-vectors", self.no_residual_vectors)):
+            if given and self.method != "modal":
+                raise CLIError(f"{flag} belongs to --method modal (the real modes' projection); give --method modal "
+                               "too")
         if self.cutoff is not None and self.max_frequency is not None and self.cutoff < self.max_frequency:
             raise CLIError(f"--cutoff {self.cutoff:g} is below --max-frequency {self.max_frequency:g}; give a cutoff "
                            "above the band (1.5 to 2 times it)")
@@ -106,13 +113,18 @@ def report_band(result, timing, written: list[Path], as_json: bool) -> None:
                       f"{row['angular_frequency'] / (2 * math.pi):.6g}", f"{row['backward_error']:.1e}", style=style)
     console.print(modes)
     if result.modal is not None:
-        conv = Table(title=f"modal CEA: {result.modal.modes} real modes below {result.modal.cutoff:.6g} rad/s; the "
-                           "approximations' distance from the full eigenvalues as modes are added")
-        for head in ("modes", "highest mode [rad/s]", "max relative error", "within 1e-2"):
+        modal = result.modal
+        conv = Table(title=f"modal CEA: {modal.modes} real modes below {modal.cutoff:.6g} rad/s and "
+                           f"{modal.residual_vectors} residual vectors; the approximations' largest distance from the "
+                           "full eigenvalues as modes are added (relative; the band's eigenvalues within 1e-2)")
+        for head in ("modes", "highest mode [rad/s]", "residual vectors", "with them", "within 1e-2", "modes alone",
+                     "within 1e-2 "):
             conv.add_column(head, justify="right")
-        for row in result.modal.convergence:
-            conv.add_row(str(row["modes"]), f"{row['highest_mode']:.6g}", f"{row['max_relative_error']:.2e}",
-                         str(row["found"]))
+        for row in modal.convergence:
+            conv.add_row(str(row["modes"]), f"{row['highest_mode']:.6g}", str(row["residual_vectors"]),
+                         f"{row['max_relative_error']:.2e}" if row["residual_vectors"] else "-",
+                         str(row["found"]) if row["residual_vectors"] else "-", f"{row['modes_only_error']:.2e}",
+                         str(row["modes_only_found"]))
         console.print(conv)
     count = result.frictionless_count
     console.print(f"{len(result.dofs)} dofs, {len(result.contact_names)} contacts; every eigenvalue with |λ| ≤ "

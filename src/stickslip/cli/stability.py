@@ -51,7 +51,8 @@ def stability(
                            "eigenvalues are computed [rad/s]")
     with timed() as timing:
         if sparse:
-            result = run_stability(system, max_frequency=band.max_frequency, method=band.method, cutoff=band.cutoff)
+            result = run_stability(system, max_frequency=band.max_frequency, method=band.method, cutoff=band.cutoff,
+                                   residual=not band.no_residual_vectors)
         else:
             result = run_stability(system)
     if sparse:

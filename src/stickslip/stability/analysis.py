@@ -198,7 +198,7 @@ def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
 
 
 def stability(model=None, *, max_frequency: float | None = None, method: str | None = None,
-              cutoff: float | None = None):
+              cutoff: float | None = None, residual: bool = True):
     """Linear stability of steady sliding (paper Sect. 4.1) of any friction model.
 
     Finds the steady-sliding equilibrium (Eq. 14 for the plates), linearises the slip equations
@@ -221,6 +221,8 @@ def stability(model=None, *, max_frequency: float | None = None, method: str | N
         The sparse path's method (default ``direct``).
     cutoff : float, optional
         The real modes' cutoff of ``modal`` [rad/s] (default 2 ω_max).
+    residual : bool
+        ``modal``: the residual vectors of the contact rows beside the modes (default).
 
     Returns
     -------
@@ -241,7 +243,7 @@ def stability(model=None, *, max_frequency: float | None = None, method: str | N
     if max_frequency is None:
         raise BandError(f"model {system.name!r} has {system.n} dofs: give max_frequency (--max-frequency), the top "
                         "of the band whose eigenvalues its sparse analysis computes [rad/s]")
-    return band_stability(system, max_frequency, method=method or "direct", cutoff=cutoff)
+    return band_stability(system, max_frequency, method=method or "direct", cutoff=cutoff, residual=residual)
 
 
 def model_stability(system) -> StabilityResult:

@@ -4,8 +4,9 @@
 every eigenvalue of its linearisation with |Im λ| ≤ ω_max, by one of
 
 ``direct``  shift-invert Arnoldi on the full first-order pencil (:func:`~.cea.band_eigen`);
-``modal``   the projection on the real modes below a cutoff, refined on the full pencil
-            (:func:`~.modal_cea.modal_cea`), with the convergence as modes are added;
+``modal``   the projection on the real modes below a cutoff and the residual vectors of the
+            contact rows, refined on the full pencil (:func:`~.modal_cea.modal_cea`), with the
+            convergence as modes are added;
 ``dense``   every eigenvalue by LAPACK (a few thousand DOFs at most: checked against memory).
 
 Every eigenvalue reported is one of the full model (with its backward error on the full pencil);
@@ -146,7 +147,8 @@ class BandStability:
         if len(self.dofs) <= 64:
             out["equilibrium"] = {d: float(v) for d, v in zip(self.dofs, self.equilibrium)}
         if self.modal is not None:
-            out["modal"] = {"modes": self.modal.modes, "cutoff": self.modal.cutoff,
+            out["modal"] = {"modes": self.modal.modes, "residual_vectors": self.modal.residual_vectors,
+                            "cutoff": self.modal.cutoff,
                             "max_approximation_error": float(np.max(self.modal.errors, initial=0.0)),
                             "convergence": self.modal.convergence}
         return out
@@ -232,8 +234,8 @@ def _dense_band(state: SlidingState, max_frequency: float) -> BandEigen:
                      method="dense", frictionless_count=frictionless_count(state, radius))
 
 
-def band_stability(model, max_frequency: float, *, method: str = "direct", cutoff: float | None = None
-                   ) -> BandStability:
+def band_stability(model, max_frequency: float, *, method: str = "direct", cutoff: float | None = None,
+                   residual: bool = True) -> BandStability:
     """Steady sliding and every eigenvalue of its linearisation in the band: |Im λ| ≤ ``max_frequency``
     inside the disc |λ| ≤ ``max_frequency`` √(1 + 0.25²) that the methods search completely
     (:mod:`~stickslip.stability.cea`).
@@ -248,6 +250,10 @@ def band_stability(model, max_frequency: float, *, method: str = "direct", cutof
         Module docstring.
     cutoff : float, optional
         Cutoff of the real modes of ``modal`` [rad/s] (default 2 ω_max).
+    residual : bool
+        ``modal``: enrich the modes with the residual vectors of the contact rows (the static
+        response to the contact forces; without them the projection stalls where stiff contacts
+        put motion into high modes: docs/fe.md).
 
     Raises
     ------
@@ -268,7 +274,7 @@ def band_stability(model, max_frequency: float, *, method: str = "direct", cutof
     if method == "dense":
         band = _dense_band(state, max_frequency)
     elif method == "modal":
-        band, report = modal_cea(state, max_frequency, cutoff=cutoff)
+        band, report = modal_cea(state, max_frequency, cutoff=cutoff, residual=residual)
     else:
         band = band_eigen(state, max_frequency)
     inside = np.abs(band.eigenvalues.imag) <= max_frequency

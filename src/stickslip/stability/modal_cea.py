@@ -1,17 +1,32 @@
-"""Modal CEA: the linearisation projected on the real modes of the frictionless structure.
+"""Modal CEA: the linearisation projected on the real modes of the frictionless structure, enriched
+with the static response to the contact forces (residual vectors).
 
 The field's everyday analysis of brake squeal (Nastran SOL 107, Abaqus *COMPLEX FREQUENCY,
 ANSYS QRDAMP): the real modes Φ of (K_s, M) below a cutoff ω_c, with K_s the stiffness without
 friction (symmetrised), by shift-invert Lanczos (ARPACK's ``eigsh`` at 0), then the small complex
-problem of the projected system Φᵀ M Φ = I, Φᵀ C_t Φ, Φᵀ K_t Φ. The number of modes below ω_c
-is known beforehand by Sylvester's law of inertia (:func:`~.cea.frictionless_count`), so the
-basis holds every mode below the cutoff, checked.
+problem of the projected system. The number of modes below ω_c is known beforehand by
+Sylvester's law of inertia (:func:`~.cea.frictionless_count`), so the basis holds every mode
+below the cutoff, checked.
+
+Stiff contact springs put part of the motion of the coupled modes into modes far above any
+practical cutoff, and a projection on modes alone stalls (1e-2 relative on the pad on a strip of
+docs/fe.md, up to 4 ω_max). The friction forces and the contact springs act through the contact
+rows only: K_t − K_s = Gᵀ(…) and C_t − C = Gᵀ(…) + Wᵀ(…), so (K symmetric) every eigenvector x satisfies
+
+    (λ² M + λ C + K_s) x ∈ span(P),   P = [Gᵀ, Wᵀ, nᵀ, n_vᵀ]   (the contact rows' patterns)
+
+and its part in the truncated modes is, to O(|λ|²/ω_c²), the static response K_s⁻¹ P y. The
+*residual vectors* (Nastran's RESVEC, Abaqus' residual modes) are these static responses, M-
+orthogonalised against the kept modes; with them the projection converges to the full model's
+eigenvalues as modes are added (:func:`residual_vectors`). They are computed with the LU factors
+of K_t that steady sliding made: span(K_t⁻¹ P) = span(K_s⁻¹ P), because K_t − K_s = K_f maps into
+span(P) (one pair of triangular solves per contact row).
 
 A projection is an approximation; its eigenvalues are never reported as the model's:
 :func:`modal_cea` refines them on the full pencil (:func:`~.cea.band_eigen`, started from the
 modal approximations) and reports the full eigenvalues with each approximation's distance from
 them, and the convergence as modes are added (the eigenvalues of the projection on the first m
-modes for growing m).
+modes, with and without the residual vectors, for growing m).
 """
 
 from __future__ import annotations
@@ -20,16 +35,23 @@ import dataclasses
 import math
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import EquilibriumError
+from ..memory import check_memory, format_bytes
 from .cea import BandEigen, _frictionless_stiffness, band_eigen, modes_below
 from .sparse_sliding import SlidingState, factorize
 
-__all__ = ["ModalBasis", "ModalReport", "real_modes", "lowest_modes", "projected_eigen", "modal_cea", "CUTOFF_FACTOR"]
+__all__ = ["ModalBasis", "ModalReport", "real_modes", "lowest_modes", "residual_vectors", "projected_eigen",
+           "modal_cea", "CUTOFF_FACTOR"]
 
 #: Default cutoff of the real modes as a multiple of the band's top (the rule of thumb of modal
 #: CEA: modes up to 1.5–2 times the highest frequency of interest).
 CUTOFF_FACTOR = 2.0
+
+#: A residual vector is dropped when its M-norm after the orthogonalisation against the modes and
+#: the other residual vectors is below this fraction of the largest (it adds nothing to the span).
+RANK_TOLERANCE = 1e-10
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -62,19 +84,24 @@ class ModalReport:
     ----------
     modes : int
         Real modes in the basis.
+    residual_vectors : int
+        Residual vectors beside the modes (0 without them).
     cutoff : float
         ω_c [rad/s].
     approximations : ndarray (p,) complex
-        The projection's eigenvalues in the band, with all modes.
+        The projection's eigenvalues in the band, with all modes (and the residual vectors).
     errors : ndarray (p,)
         |λ̃ − λ| / |λ| of each approximation from the nearest full eigenvalue.
     convergence : list of dict
-        One row per basis size: ``modes``, ``highest_mode`` [rad/s], ``max_relative_error`` over the
-        band's full eigenvalues (each from its nearest approximation), ``found`` (eigenvalues of
-        the band within 1e-2 relative).
+        One row per number of modes: ``modes``, ``highest_mode`` [rad/s], ``residual_vectors``,
+        ``max_relative_error`` over the band's full eigenvalues (each from its nearest
+        approximation) of the basis (modes and residual vectors), ``found`` (eigenvalues of the
+        band within 1e-2 relative), and ``modes_only_error``, ``modes_only_found``: the same of
+        the modes alone.
     """
 
     modes: int
+    residual_vectors: int
     cutoff: float
     approximations: np.ndarray
     errors: np.ndarray
@@ -131,19 +158,74 @@ def lowest_modes(K, M, cutoff: float) -> tuple[np.ndarray, np.ndarray, int | Non
     return np.sqrt(np.maximum(w2[below], 0.0)), V[:, below], count
 
 
-def projected_eigen(state: SlidingState, basis: ModalBasis, modes: int | None = None):
-    """Eigenvalues (2m,) and physical displacement vectors (k, 2m) of the projection on the first
-    ``modes`` real modes."""
-    Phi = basis.vectors[:, :modes]
-    m = Phi.shape[1]
-    K = Phi.T @ (state.stiffness @ Phi)
-    C = Phi.T @ (state.damping @ Phi)
-    J = np.zeros((2 * m, 2 * m))
-    J[:m, m:] = np.eye(m)
-    J[m:, :m] = -K
-    J[m:, m:] = -C
+def contact_patterns(state: SlidingState) -> sp.csr_matrix:
+    """P (p, k): the contact rows that carry the friction and contact forces on the free DOFs — the
+    tangent rows G, the gap gradients W and the normal force's gradients n, n_v (module
+    docstring) — each row that touches a free DOF once."""
+    form = state.form
+    rows = sp.vstack([sp.csr_matrix(A) for A in (form.tangent, form.gap_gradient, form.normal_gradient,
+                                                   form.normal_rate_gradient)], format="csr")[:, state.free]
+    rows = sp.csr_matrix(rows[np.flatnonzero(np.diff(rows.indptr) > 0)])
+    rows.sum_duplicates()
+    return rows
+
+
+def residual_vectors(state: SlidingState, modes: np.ndarray, static: np.ndarray | None = None) -> np.ndarray:
+    """The residual vectors of a modal basis (module docstring): the static responses K_t⁻¹ Pᵀ to
+    the contact patterns (``static``, computed here when not given), M-orthogonalised against
+    ``modes`` (k, m) and among themselves (M-orthonormal; directions already in the span dropped).
+
+    Returns
+    -------
+    ndarray (k, r)
+        r ≤ p vectors with Yᵀ M Y = I and Φᵀ M Y = 0.
+    """
+    M = state.mass
+    Y = static_responses(state) if static is None else static.copy()
+    for _ in range(2):  # twice is enough (Gram–Schmidt against the modes, Φᵀ M Φ = I)
+        Y -= modes @ (modes.T @ (M @ Y))
+    norm = np.sqrt(np.maximum(np.einsum("ij,ij->j", Y, M @ Y), 0.0))
+    keep = norm > RANK_TOLERANCE * max(float(norm.max(initial=0.0)), 1e-300)
+    Y = Y[:, keep] / norm[keep]
+    if not Y.shape[1]:
+        return Y
+    w, U = np.linalg.eigh(Y.T @ (M @ Y))
+    keep = w > RANK_TOLERANCE * w[-1]
+    return Y @ (U[:, keep] / np.sqrt(w[keep]))
+
+
+def static_responses(state: SlidingState) -> np.ndarray:
+    """K_t⁻¹ Pᵀ (k, p): the static response to each contact pattern (:func:`contact_patterns`),
+    with the LU factors of steady sliding.
+
+    Raises
+    ------
+    MemoryLimitError
+        When the p vectors of k numbers (and their orthogonalisation) do not fit in memory.
+    """
+    P = contact_patterns(state)
+    check_memory(8.0 * 4 * state.n * P.shape[0], f"the {P.shape[0]} residual vectors of the contact rows "
+                 f"({state.n} DOFs)",
+                 lambda memory: f"use --method direct, or --no-residual-vectors (the vectors take 32 bytes per DOF "
+                                f"and contact row; {format_bytes(memory)} available)")
+    dense = P.T.toarray()
+    return np.column_stack([state.stiffness_lu.solve(np.ascontiguousarray(dense[:, j])) for j in range(P.shape[0])]) \
+        if P.shape[0] else np.zeros((state.n, 0))
+
+
+def projected_eigen(state: SlidingState, basis, modes: int | None = None):
+    """Eigenvalues (2r,) and physical displacement vectors (k, 2r) of the projection on ``basis``:
+    a :class:`ModalBasis` (its first ``modes`` modes) or an M-orthonormal (k, r) array."""
+    V = basis.vectors[:, :modes] if isinstance(basis, ModalBasis) else basis
+    r = V.shape[1]
+    K = V.T @ (state.stiffness @ V)
+    C = V.T @ (state.damping @ V)
+    J = np.zeros((2 * r, 2 * r))
+    J[:r, r:] = np.eye(r)
+    J[r:, :r] = -K
+    J[r:, r:] = -C
     lam, Z = np.linalg.eig(J)
-    return lam, Phi @ Z[:m]
+    return lam, V @ Z[:r]
 
 
 def _errors(full: np.ndarray, approx: np.ndarray) -> np.ndarray:
@@ -153,7 +235,22 @@ def _errors(full: np.ndarray, approx: np.ndarray) -> np.ndarray:
     return np.min(np.abs(full[:, None] - approx[None, :]), axis=1) / np.abs(full)
 
 
-def modal_cea(state: SlidingState, max_frequency: float, *, cutoff: float | None = None,
+def _row(state, basis: ModalBasis, size: int, static, full) -> dict:
+    """One row of the convergence table: the first ``size`` modes, alone and with the residual vectors."""
+    Phi = basis.vectors[:, :size]
+    alone = _errors(full, projected_eigen(state, Phi)[0])
+    row = {"modes": size, "highest_mode": float(basis.frequencies[size - 1]), "residual_vectors": 0,
+           "max_relative_error": float(np.max(alone, initial=0.0)), "found": int(np.sum(alone < 1e-2)),
+           "modes_only_error": float(np.max(alone, initial=0.0)), "modes_only_found": int(np.sum(alone < 1e-2))}
+    if static is not None:
+        Y = residual_vectors(state, Phi, static)
+        err = _errors(full, projected_eigen(state, np.hstack([Phi, Y]))[0])
+        row.update(residual_vectors=int(Y.shape[1]), max_relative_error=float(np.max(err, initial=0.0)),
+                   found=int(np.sum(err < 1e-2)))
+    return row
+
+
+def modal_cea(state: SlidingState, max_frequency: float, *, cutoff: float | None = None, residual: bool = True,
               steps: int = 6) -> tuple[BandEigen, ModalReport]:
     """Modal CEA of the band |Im λ| ≤ ``max_frequency`` [rad/s], refined on the full pencil.
 
@@ -161,33 +258,39 @@ def modal_cea(state: SlidingState, max_frequency: float, *, cutoff: float | None
     ----------
     cutoff : float, optional
         ω_c of the real modes [rad/s] (default :data:`CUTOFF_FACTOR` × ``max_frequency``).
+    residual : bool
+        Enrich the modes with the residual vectors of the contact rows (module docstring).
     steps : int
-        Basis sizes of the convergence table (evenly spaced up to all modes).
+        Numbers of modes of the convergence table (evenly spaced up to all modes).
 
     Returns
     -------
     band : BandEigen
         The full model's eigenvalues (as :func:`~.cea.band_eigen`).
     report : ModalReport
+
+    Raises
+    ------
+    EquilibriumError
+        A cutoff below the band, or no real mode below it.
+    MemoryLimitError
+        When the residual vectors do not fit in memory.
     """
     cutoff = CUTOFF_FACTOR * max_frequency if cutoff is None else cutoff
     if cutoff < max_frequency:
         raise EquilibriumError(f"the cutoff {cutoff:.6g} rad/s is below the band's top {max_frequency:.6g} rad/s; "
                                "give a cutoff above it (1.5 to 2 times)")
     basis = real_modes(state, cutoff)
-    lam, Y = projected_eigen(state, basis)
+    static = static_responses(state) if residual else None
+    V = basis.vectors if static is None else np.hstack([basis.vectors, residual_vectors(state, basis.vectors, static)])
+    lam, Y = projected_eigen(state, V)
     in_band = np.abs(lam.imag) <= max_frequency
     v0 = np.concatenate([Y[:, in_band].sum(axis=1), (Y[:, in_band] * lam[in_band]).sum(axis=1)]).real
     band = band_eigen(state, max_frequency, k=int(in_band.sum()) + 6, v0=v0 if np.any(v0) else None)
     full = band.eigenvalues[np.abs(band.eigenvalues.imag) <= max_frequency]
     m = basis.vectors.shape[1]
     sizes = sorted({max(1, int(round(m * (j + 1) / steps))) for j in range(steps)})
-    rows = []
-    for size in sizes:
-        approx, _ = projected_eigen(state, basis, size)
-        err = _errors(full, approx)
-        rows.append({"modes": size, "highest_mode": float(basis.frequencies[size - 1]),
-                     "max_relative_error": float(np.max(err, initial=0.0)), "found": int(np.sum(err < 1e-2))})
-    report = ModalReport(modes=m, cutoff=cutoff, approximations=lam[in_band],
+    rows = [_row(state, basis, size, static, full) for size in sizes]
+    report = ModalReport(modes=m, residual_vectors=V.shape[1] - m, cutoff=cutoff, approximations=lam[in_band],
                          errors=_errors(lam[in_band], band.eigenvalues), convergence=rows)
     return band, report
