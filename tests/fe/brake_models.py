@@ -135,7 +135,7 @@ class _Assembly:
     """Bodies side by side in one coordinate vector, DOFs removed where held, contacts collected."""
 
     def __init__(self, dim):
-        self.dim, self.K, self.M, self.nodes, self.offset = dim, [], [], [], 0
+        self.dim, self.K, self.M, self.nodes, self.offset, self.elements = dim, [], [], [], 0, []
         self.fixed, self.force, self.contacts = [], [], []
 
     def body(self, nodes, elements, E, nu, rho, thickness=1.0):
@@ -144,6 +144,7 @@ class _Assembly:
         self.K.append(K)
         self.M.append(M)
         self.nodes.append(nodes)
+        self.elements.append(np.asarray(elements) + base)
         self.offset += nodes.shape[0]
         return base
 
@@ -191,7 +192,8 @@ class _Assembly:
             contact_damping=np.full(nc, cc), restitution=np.zeros(nc), friction=(friction,) * nc,
             contact_names=tuple(f"c{c}" for c in range(nc)),
             nodes=NodeMap(ids=np.arange(nodes.shape[0]), coordinates=coordinates, node=keep // self.dim,
-                          component=keep % self.dim),
+                          component=keep % self.dim,
+                          cells=(("quad" if self.dim == 2 else "hexahedron", np.vstack(self.elements)),)),
             units={}, slip_band=5e-4)
 
 

@@ -70,6 +70,8 @@ class FEModel:
         The mesh: each node's x, y, z, its id, and each dof's node (index) and component (0 x, 1 y).
     force : dict of int → float
         Nonzero entries of f0 by dof index.
+    elements : ndarray (elements, 4) of int or None
+        The quadrilaterals' corner nodes (indices into ``ids``, counter-clockwise), where the mesh has them.
     """
 
     name: str
@@ -90,6 +92,7 @@ class FEModel:
     dof_component: np.ndarray
     force: dict = dataclasses.field(default_factory=dict)
     chain: tuple[int, float, float] | None = None
+    elements: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -165,6 +168,14 @@ class FEModel:
                                  *(names.get((k, comp), "") for comp in columns)])
         return "nodes.csv"
 
+    def _write_elements(self, folder: Path) -> str:
+        with open(folder / "elements.csv", "w", newline="") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(["element", "type", "n1", "n2", "n3", "n4"])
+            for k, corners in enumerate(self.elements, start=1):
+                writer.writerow([k, "quad", *(int(self.ids[c]) for c in corners)])
+        return "elements.csv"
+
     def _write_matrix(self, folder: Path, stem: str, matrix: sp.csr_matrix, fmt: str) -> str:
         if fmt == "mtx":
             scipy.io.mmwrite(str(folder / f"{stem}.mtx"), matrix.tocoo(), precision=17)
@@ -177,11 +188,13 @@ class FEModel:
             return f"{stem}.mat:{stem}"
         raise ValueError(f"unknown matrix format {fmt!r}")
 
-    def write(self, folder, *, matrix_format: str = "mtx", contacts: str = "set", nodes: bool = True) -> Path:
+    def write(self, folder, *, matrix_format: str = "mtx", contacts: str = "set", nodes: bool = True,
+              elements: bool = False) -> Path:
         """Write the matrix files, CSVs and ``model.toml`` into ``folder``; returns the model file's path.
 
         ``contacts``: ``"set"`` (a ``[contact_set.pad]`` with a CSV of its nodes), ``"set-inline"``
         (its nodes as a TOML table), ``"tables"`` (one ``[[contact]]`` each, sparse rows).
+        ``elements``: the nodes with an ``elements.csv`` (``nodes = { file, elements }``).
         """
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
@@ -196,6 +209,8 @@ class FEModel:
             spec["force"] = {self.dof(i): v for i, v in self.force.items()}
         if nodes:
             spec["nodes"] = self._write_nodes(folder)
+            if elements:
+                spec["nodes"] = {"file": spec["nodes"], "elements": self._write_elements(folder)}
         if contacts == "tables":
             spec["contact"] = self._contact_tables()
         else:
@@ -290,7 +305,7 @@ def pad_on_belt(nx: int = 10, ny: int = 4, *, length: float = 0.1, height: float
     return FEModel(name=name, mass=M, stiffness=K, rayleigh=rayleigh, damping=None, tangent_dof=2 * bottom,
                    normal_dof=2 * bottom + 1, gap=np.full(cols, -preload), drive=speed, node_ids=bottom + 1,
                    contact=contact, friction=friction, coordinates=coordinates, ids=nodes + 1,
-                   dof_node=np.arange(n) // 2, dof_component=np.arange(n) % 2)
+                   dof_node=np.arange(n) // 2, dof_component=np.arange(n) % 2, elements=corner_nodes)
 
 
 def bar_chain(n: int = 8, *, mass: float = 1.0, stiffness: float = 100.0, damping: float = 0.0,

@@ -15,7 +15,9 @@ What :mod:`stickslip.model.model_file` takes from here:
 * :class:`ContactSet` — ``[contact_set.NAME]``: many alike contacts from a CSV (or a table) of
   contact nodes, sharing their laws;
 * :func:`read_nodes` — ``nodes = "nodes.csv"``: the mesh's coordinates and each dof's node
-  (:class:`~stickslip.model.sparse_form.NodeMap`).
+  (:class:`~stickslip.model.sparse_form.NodeMap`); ``nodes = { file = "nodes.csv", elements =
+  "elements.csv" }`` adds the elements (type and node ids), so that mode shapes are drawn on the
+  mesh.
 
 A model file is read once: files and CSVs are read into the checked template, and the frozen spec
 (``model.spec``, written into results) holds each file as an absolute path with its SHA-256 and each
@@ -38,10 +40,10 @@ from ..errors import ModelError, ModelFileError
 from ..inputs import read_regular_file, regular_file_size
 from ..memory import check_memory, format_bytes
 from .fe_files import MatrixData, file_digest, read_matrix, split_reference
-from .sparse_form import COMPONENTS, NodeMap
+from .sparse_form import CELL_NODES, COMPONENTS, NodeMap
 from .system_model import check_name, check_text
 
-__all__ = ["dof_names", "FileMatrices", "ContactSet", "read_nodes", "is_file_reference", "Triplets", "FILE_KEYS",
+__all__ = ["dof_names", "FileMatrices", "ContactSet", "read_nodes", "read_elements", "ELEMENT_COLUMNS", "is_file_reference", "Triplets", "FILE_KEYS",
            "SET_KEYS", "MAX_TABLE_BYTES", "MAX_DOF_COUNT", "dof_index", "set_nodes", "contact_set", "file_table"]
 
 #: Keys of a matrix file's table.
@@ -52,6 +54,9 @@ SET_KEYS = ("nodes", "drive", "gap", "normal_force", "normal_sign", "normal", "f
 SET_COLUMNS = ("node", "name", "tangent", "tangent2", "normal", "gap", "drive", "drive2", "normal_force")
 #: Columns of a ``nodes`` CSV (``node``, ``x``, ``y`` required).
 NODE_COLUMNS = ("node", "x", "y", "z") + tuple(f"dof_{c}" for c in COMPONENTS)
+#: Columns of an ``elements`` CSV: ``type`` and the element's node ids ``n1`` … (VTK's order; as many
+#: as its type has, the rest empty); ``element``, the element's id, is optional.
+ELEMENT_COLUMNS = ("element", "type") + tuple(f"n{k}" for k in range(1, max(CELL_NODES.values()) + 1))
 #: Largest CSV of nodes or contact nodes read [bytes].
 MAX_TABLE_BYTES = 2**30
 #: Python objects per byte of a CSV while parsed (strings and lists of the rows).
@@ -267,18 +272,19 @@ def _csv_number(text: str, where: str) -> float:
 
 
 def read_nodes(table, base: Path | None, names: Mapping[str, int], labels) -> tuple[NodeMap, dict]:
-    """``nodes = "nodes.csv"``: its :class:`NodeMap` and the canonical table of the file."""
-    ref = file_table(table, "nodes", base)
+    """``nodes = "nodes.csv"`` or ``{ file = "nodes.csv", elements = "elements.csv" }``: its
+    :class:`NodeMap` and the canonical table of the files (absolute paths and SHA-256)."""
+    elements = table.get("elements") if isinstance(table, Mapping) else None
+    ref = file_table({k: v for k, v in table.items() if k != "elements"} if isinstance(table, Mapping) else table,
+                     "nodes", base)
     unknown = sorted(set(ref) - {"file", "sha256", "scale"})
     if unknown:
-        raise ModelFileError(f"nodes: unknown key(s) {', '.join(unknown)}; give nodes = \"nodes.csv\"")
+        raise ModelFileError(f"nodes: unknown key(s) {', '.join(unknown)}; give nodes = \"nodes.csv\" or nodes = "
+                             "{ file = \"nodes.csv\", elements = \"elements.csv\" }")
     ref.pop("scale", None)
     path = Path(ref["file"])
     rows, digest = read_csv(path, "nodes file", ("node", "x", "y"), NODE_COLUMNS)
-    if ref.get("sha256", digest).lower() != digest:
-        raise ModelFileError(f"nodes: {path.name} is not the file the model was made with (its SHA-256 differs); give "
-                             "that file, or remove nodes.sha256")
-    ref["sha256"] = digest
+    _same_file(ref, digest, "nodes", path)
     ids = [int(_csv_number(r["node"], f"nodes: {path.name} node")) for r in rows]
     xyz = [[_csv_number(r.get(c) or "0", f"nodes: {path.name} node {i} {c}") for c in "xyz"] for i, r in zip(ids, rows)]
     n = len(names)
@@ -294,10 +300,55 @@ def read_nodes(table, base: Path | None, names: Mapping[str, int], labels) -> tu
         for i, (node_id, comp) in enumerate(labels):
             if node_id in position and 1 <= comp <= len(COMPONENTS):
                 node[i], component[i] = position[node_id], comp - 1
+    cells = ()
+    if elements is not None:
+        cells, ref["elements"] = read_elements(elements, base, position)
     try:
-        return NodeMap(ids=ids, coordinates=xyz, node=node, component=component), ref
+        return NodeMap(ids=ids, coordinates=xyz, node=node, component=component, cells=cells), ref
     except ModelError as exc:
         raise ModelFileError(f"{path.name}: {exc}") from None
+
+
+def _same_file(ref: dict, digest: str, key: str, path: Path) -> None:
+    """Refuse a file whose SHA-256 differs from the one its table records; record it otherwise."""
+    if ref.get("sha256", digest).lower() != digest:
+        raise ModelFileError(f"{key}: {path.name} is not the file the model was made with (its SHA-256 differs); give "
+                             f"that file, or remove {key}.sha256")
+    ref["sha256"] = digest
+
+
+def read_elements(value, base: Path | None, position: Mapping[int, int]) -> tuple[tuple, dict]:
+    """``nodes.elements = "elements.csv"``: the elements as :attr:`NodeMap.cells` blocks (node ids
+    turned into indices of the nodes file, one block per type in the order of first appearance)
+    and the file's canonical table."""
+    ref = file_table(value, "nodes.elements", base)
+    ref.pop("scale", None)
+    unknown = sorted(set(ref) - {"file", "sha256"})
+    if unknown:
+        raise ModelFileError(f"nodes.elements: unknown key(s) {', '.join(unknown)}; give elements = \"elements.csv\"")
+    path = Path(ref["file"])
+    rows, digest = read_csv(path, "elements file", ("type", "n1"), ELEMENT_COLUMNS)
+    _same_file(ref, digest, "nodes.elements", path)
+    blocks: dict = {}
+    for k, row in enumerate(rows, start=2):  # line numbers of the file (its header is line 1)
+        kind = row["type"].lower()
+        if kind not in CELL_NODES:
+            raise ModelFileError(f"nodes.elements: {path.name} line {k}: type {row['type']!r} is not an element type; "
+                                 f"give one of {', '.join(CELL_NODES)}")
+        count = CELL_NODES[kind]
+        given = [row.get(f"n{j}", "") for j in range(1, len(ELEMENT_COLUMNS) - 1)]
+        if any(not text for text in given[:count]) or any(text for text in given[count:]):
+            raise ModelFileError(f"nodes.elements: {path.name} line {k}: a {kind} element has {count} nodes: give "
+                                 f"n1 … n{count} and leave the other columns empty")
+        indices = []
+        for text in given[:count]:
+            node_id = int(_csv_number(text, f"nodes.elements: {path.name} line {k} node"))
+            if node_id not in position:
+                raise ModelFileError(f"nodes.elements: {path.name} line {k}: node {node_id} is not in the nodes file; "
+                                     "give the ids of the nodes file's nodes")
+            indices.append(position[node_id])
+        blocks.setdefault(kind, []).append(indices)
+    return tuple((kind, np.array(block, dtype=np.int64)) for kind, block in blocks.items()), ref
 
 
 # ----------------------------------------------------------------------------- contact sets

@@ -54,10 +54,17 @@ from ..errors import ModelError
 from .friction import _USER_LAWS, FrictionLaw
 from .matrices import is_sparse
 
-__all__ = ["SparseForm", "NodeMap", "sparse_form", "friction_value", "friction_slope", "COMPONENTS"]
+__all__ = ["SparseForm", "NodeMap", "sparse_form", "friction_value", "friction_slope", "COMPONENTS", "CELL_NODES"]
 
 #: Component codes of :attr:`NodeMap.component`: translations along x, y, z, then rotations about them.
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
+
+#: Element (cell) types of :attr:`NodeMap.cells` and their numbers of nodes: VTK's cells by meshio's
+#: names, their nodes in VTK's order (corners counter-clockwise, bottom face before top face; the
+#: mid-side nodes of the quadratic ones after the corners).
+CELL_NODES = {"vertex": 1, "line": 2, "triangle": 3, "quad": 4, "tetra": 4, "pyramid": 5, "wedge": 6,
+              "hexahedron": 8, "line3": 3, "triangle6": 6, "quad8": 8, "tetra10": 10, "wedge15": 15,
+              "hexahedron20": 20}
 
 #: Complex step of a user law's derivative (exact to round-off for a complex-safe law).
 _STEP = 1e-20
@@ -98,18 +105,24 @@ class NodeMap:
     component : ndarray (n,) of int
         What each dof is at its node: 0, 1, 2 the displacement along x, y, z, 3, 4, 5 the rotation
         about them (:data:`COMPONENTS`); −1 for a dof on no node.
+    cells : tuple of (str, ndarray (ne, k) of int)
+        The mesh's elements, one block per type (:data:`CELL_NODES`: ``"quad"``, ``"hexahedron"``,
+        …): each row the indices into :attr:`ids` of an element's k nodes; empty without elements
+        (mode shapes are then drawn on the nodes alone).
     """
 
     ids: np.ndarray
     coordinates: np.ndarray
     node: np.ndarray
     component: np.ndarray
+    cells: tuple = ()
 
     def __post_init__(self) -> None:
         for key, dtype in (("ids", np.int64), ("coordinates", float), ("node", np.int64), ("component", np.int64)):
             value = np.array(getattr(self, key), dtype=dtype)
             value.setflags(write=False)
             object.__setattr__(self, key, value)
+        object.__setattr__(self, "cells", tuple(_cell_block(kind, rows, len(self.ids)) for kind, rows in self.cells))
         nn, n = len(self.ids), len(self.node)
         if self.coordinates.shape != (nn, 3) or self.component.shape != (n,):
             raise ModelError(f"nodes: {nn} node ids need {nn} × 3 coordinates and each of the {n} dofs a component; "
@@ -204,6 +217,22 @@ class SparseForm:
         n_q = (self.normal_gradient - sp.diags(k) @ self.gap_gradient).tocsr()
         n_v = (self.normal_rate_gradient - sp.diags(c) @ self.gap_gradient).tocsr()
         return N0, n_q, n_v
+
+
+def _cell_block(kind, rows, nn: int) -> tuple[str, np.ndarray]:
+    """One block of :attr:`NodeMap.cells`, checked: a known type, its number of nodes per row, and
+    node indices of the mesh."""
+    if kind not in CELL_NODES:
+        raise ModelError(f"nodes: element type {kind!r} is not one of {', '.join(CELL_NODES)} (VTK's cells by "
+                         "meshio's names)")
+    rows = np.array(rows, dtype=np.int64)
+    k = CELL_NODES[kind]
+    if rows.ndim != 2 or rows.shape[1] != k:
+        raise ModelError(f"nodes: {kind} elements have {k} nodes each; got rows of shape {rows.shape}")
+    if rows.size and (rows.min() < 0 or rows.max() >= nn):
+        raise ModelError(f"nodes: an element's node index must lie in [0, {nn}) (the mesh's nodes)")
+    rows.setflags(write=False)
+    return kind, rows
 
 
 def _csr(value, shape: tuple[int, int]) -> sp.csr_matrix:

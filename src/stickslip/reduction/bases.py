@@ -179,7 +179,8 @@ def _reduced_form(form: SparseForm, b, i, Psi, Phi, method) -> SparseForm:
     if form.nodes is not None:
         nodes = NodeMap(ids=form.nodes.ids, coordinates=form.nodes.coordinates,
                         node=np.concatenate([form.nodes.node[b], -np.ones(m, int)]),
-                        component=np.concatenate([form.nodes.component[b], -np.ones(m, int)]))
+                        component=np.concatenate([form.nodes.component[b], -np.ones(m, int)]),
+                        cells=form.nodes.cells)
     return SparseForm(
         name=f"{form.name}-{method}", dofs=names, mass=_sym(project(form.mass)), damping=project(form.damping),
         stiffness=project(form.stiffness), force=T.T @ np.asarray(form.force, float), free=np.ones(nb + m, bool),

@@ -179,9 +179,11 @@ class BandStability:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def write_vtk(self, path, shapes: str = "unstable", file_format: str | None = None) -> None:
-        """The mode shapes as point data on the model's nodes (meshio; the ``fe`` extra), one real
+        """The mode shapes as point data on the model's mesh (meshio; the ``fe`` extra), one real
         and one imaginary displacement field per mode, for ParaView (``file_format``: meshio's, e.g.
-        ``vtu``; default from the suffix).
+        ``vtu``; default from the suffix). The cells are the model's elements where its nodes come
+        with them (``nodes.elements``, :class:`~stickslip.model.sparse_form.NodeMap`), else one
+        vertex per node.
 
         Raises
         ------
@@ -204,7 +206,7 @@ class BandStability:
             f = self.eigenvalues[j].imag / (2 * math.pi)
             fields[f"mode{j}_{f:.6g}Hz_real"] = u.real
             fields[f"mode{j}_{f:.6g}Hz_imag"] = u.imag
-        cells = [("vertex", np.arange(points.shape[0]).reshape(-1, 1))]
+        cells = list(nodes.cells) or [("vertex", np.arange(points.shape[0]).reshape(-1, 1))]
         meshio.write(str(path), meshio.Mesh(points, cells, point_data=fields), file_format=file_format)
 
 
