@@ -67,7 +67,8 @@ pad = SparseForm(
     gap_gradient=normal, contact_stiffness=np.full(nc, 1e8), contact_damping=np.zeros(nc), restitution=np.zeros(nc),
     friction=(FrictionLaw("coulomb", mu_k=0.3, delta_mu=0.0),) * nc, contact_names=tuple(f"c{c}" for c in range(nc)),
     nodes=NodeMap(ids=np.arange(mesh.p.shape[1]), coordinates=np.vstack([mesh.p, np.zeros(mesh.p.shape[1])]).T,
-                  node=node[keep], component=component[keep]),
+                  node=node[keep], component=component[keep],
+                  cells=(("quad", mesh.t.T[:, ::-1]),)),  # the elements, corners counter-clockwise as VTK's
     slip_band=5e-4)
 
 # %%
@@ -83,7 +84,8 @@ coupling.plot(hz=True)
 
 # %%
 # At μ = 0.45, past the first onset: the band's eigenvalues (every one of the full model, with its
-# backward error on the full pencil) and the shape of the unstable mode.
+# backward error on the full pencil) and the shape of the unstable mode on the mesh
+# (``result.write_vtk("modes.vtu")`` writes it for ParaView).
 result = stability(with_friction(pad, 0.45), max_frequency=1.6e5)
 for row in result.modes():
     print(f"{row['growth_rate']:10.2f} 1/s  {row['angular_frequency'] / (2 * np.pi):8.1f} Hz  "

@@ -6,8 +6,10 @@ import csv
 import dataclasses
 import math
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.collections import LineCollection
 from typer.testing import CliRunner
 
 from stickslip.cli import app
@@ -15,6 +17,7 @@ from stickslip.errors import ModelError, ModelFileError
 from stickslip.model.library import load_model
 from stickslip.model.model_file import model_from_spec
 from stickslip.model.sparse_form import NodeMap
+from stickslip.plot.fe import cell_edges, plot_mode_shape
 from stickslip.stability.band import band_stability
 
 from .brake_models import pad_on_belt_2d, pad_on_surface_3d
@@ -96,6 +99,18 @@ def test_nodes_without_elements_are_vertices(tmp_path):
     result.write_vtk(tmp_path / "points.vtu", "all")
     mesh = meshio.read(tmp_path / "points.vtu")
     assert [b.type for b in mesh.cells] == ["vertex"] and len(mesh.cells[0].data) == len(form.nodes.ids)
+
+
+def test_edges_and_the_mesh_in_the_mode_shape_figure():
+    assert cell_edges([("quad", np.array([[0, 1, 4, 3], [1, 2, 5, 4]]))]).tolist() == [
+        [0, 1], [0, 3], [1, 2], [1, 4], [2, 5], [3, 4], [4, 5]]
+    assert len(cell_edges([("hexahedron", np.arange(8)[None])])) == 12
+    assert len(cell_edges([("tetra", np.arange(4)[None]), ("triangle", np.array([[0, 1, 2]]))])) == 6
+    form = pad_on_belt_2d(4, 2, mu=0.3)
+    fig = plot_mode_shape(band_stability(form, 5e6))
+    meshes = [c for c in fig.axes[0].collections if isinstance(c, LineCollection)]
+    assert [len(c.get_segments()) for c in meshes] == [4 * 3 + 5 * 2] * 2  # undeformed and displaced
+    plt.close(fig)
 
 
 def _write(folder, pad_file, text):

@@ -6,7 +6,28 @@ import math
 
 import numpy as np
 
-__all__ = ["plot_mode_coupling", "plot_mode_shape"]
+__all__ = ["plot_mode_coupling", "plot_mode_shape", "cell_edges"]
+
+#: The edges of each element type (pairs of its corner nodes, VTK's order; mid-side nodes left out).
+_EDGES = {
+    "line": [(0, 1)], "line3": [(0, 1)],
+    "triangle": [(0, 1), (1, 2), (2, 0)], "triangle6": [(0, 1), (1, 2), (2, 0)],
+    "quad": [(0, 1), (1, 2), (2, 3), (3, 0)], "quad8": [(0, 1), (1, 2), (2, 3), (3, 0)],
+    "tetra": [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)],
+    "pyramid": [(0, 1), (1, 2), (2, 3), (3, 0), (0, 4), (1, 4), (2, 4), (3, 4)],
+    "wedge": [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 3), (0, 3), (1, 4), (2, 5)],
+    "hexahedron": [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)],
+}
+_EDGES["tetra10"], _EDGES["wedge15"], _EDGES["hexahedron20"] = _EDGES["tetra"], _EDGES["wedge"], _EDGES["hexahedron"]
+
+
+def cell_edges(cells) -> np.ndarray:
+    """The distinct edges (e, 2) of a mesh's elements (:attr:`~stickslip.model.sparse_form.NodeMap.cells`)
+    as pairs of node indices."""
+    pairs = [block[:, list(edge)] for kind, block in cells for edge in _EDGES.get(kind, [])]
+    if not pairs:
+        return np.zeros((0, 2), dtype=np.int64)
+    return np.unique(np.sort(np.vstack(pairs), axis=1), axis=0)
 
 
 def plot_mode_coupling(result, *, hz: bool = False, ax=None):
@@ -49,9 +70,11 @@ def plot_mode_coupling(result, *, hz: bool = False, ax=None):
 
 def plot_mode_shape(result, mode: int | None = None, *, scale: float = 0.1, ax=None):
     """The real part of a mode's shape on the model's nodes (x, y; displaced by ``scale`` × the
-    model's size), the undeformed nodes grey. ``mode``: an index of ``result.eigenvalues``
+    model's size), the undeformed nodes grey; where the model gives its elements, their edges
+    too (the mesh, undeformed and displaced). ``mode``: an index of ``result.eigenvalues``
     (default the most unstable)."""
     import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
 
     nodes = result.form.nodes
     if nodes is None:
@@ -69,6 +92,11 @@ def plot_mode_shape(result, mode: int | None = None, *, scale: float = 0.1, ax=N
     else:
         fig = ax.figure
     moved = xyz[on, :2] + scale * size / amp * u[on, :2]
+    edges = cell_edges(nodes.cells)
+    if edges.size:
+        displaced = xyz[:, :2] + scale * size / amp * u[:, :2]
+        ax.add_collection(LineCollection(xyz[edges, :2], colors="0.85", linewidths=0.6))
+        ax.add_collection(LineCollection(displaced[edges], colors="0.45", linewidths=0.6))
     ax.plot(xyz[on, 0], xyz[on, 1], ".", color="0.8", ms=3)
     ax.scatter(moved[:, 0], moved[:, 1], c=np.linalg.norm(u[on], axis=1), s=6, cmap="viridis")
     lam = result.eigenvalues[j]
