@@ -100,7 +100,8 @@ def write_docs(part: str, table: str) -> None:
     text = path.read_text()
     pattern = re.compile(rf"(<!-- fe_cea_evidence:{part} -->\n).*?(<!-- /fe_cea_evidence:{part} -->)", re.DOTALL)
     if not pattern.search(text):
-        raise SystemExit(f"docs/fe.md has no markers <!-- fe_cea_evidence:{part} --> … <!-- /fe_cea_evidence:{part} -->")
+        raise SystemExit(f"docs/fe.md has no markers <!-- fe_cea_evidence:{part} --> … "
+                         f"<!-- /fe_cea_evidence:{part} -->")
     path.write_text(pattern.sub(lambda m: m.group(1) + table + m.group(2), text))
 
 

@@ -60,7 +60,8 @@ def test_modal_method_table(pad):
     alone = json.loads(run("--model", str(pad), "--max-frequency", "4e5", "--method", "modal", "--json",
                            "--no-residual-vectors").output)
     assert summary["modal"]["residual_vectors"] > 0 and alone["modal"]["residual_vectors"] == 0
-    np.testing.assert_allclose(summary["eigenvalues"], alone["eigenvalues"], rtol=1e-9)  # both refined on the full model
+    # both refined on the full model
+    np.testing.assert_allclose(summary["eigenvalues"], alone["eigenvalues"], rtol=1e-9)
     last, last_alone = summary["modal"]["convergence"][-1], alone["modal"]["convergence"][-1]
     assert last["modes_only_error"] == pytest.approx(last_alone["max_relative_error"], rel=1e-9)
 

@@ -151,7 +151,7 @@ def test_the_spec_records_the_elements_file(pad, tmp_path):
 
 
 def test_node_map_refuses_bad_cells():
-    base = dict(ids=[1, 2, 3], coordinates=np.zeros((3, 3)), node=[0], component=[0])
+    base = {"ids": [1, 2, 3], "coordinates": np.zeros((3, 3)), "node": [0], "component": [0]}
     with pytest.raises(ModelError, match="quad elements have 4 nodes each"):
         NodeMap(**base, cells=[("quad", [[0, 1, 2]])])
     with pytest.raises(ModelError, match=r"node index must lie in \[0, 3\)"):

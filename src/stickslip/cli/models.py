@@ -79,7 +79,8 @@ def parameter_rows(parameters) -> list[tuple[str, str]]:
             shown = f"{low:g}" if low == high else f"{low:g} … {high:g}"
         else:
             distinct = sorted({_shown(v) for v in values})
-            shown = ", ".join(distinct) if len(distinct) <= 3 else f"{len(distinct)} values: {', '.join(distinct[:2])}, …"
+            shown = ", ".join(distinct) if len(distinct) <= 3 else \
+                f"{len(distinct)} values: {', '.join(distinct[:2])}, …"
         rows.append((f"{pattern} ({len(members)} paths)", shown))
     return rows
 

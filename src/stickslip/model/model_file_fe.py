@@ -43,7 +43,8 @@ from .fe_files import MatrixData, file_digest, read_matrix, split_reference
 from .sparse_form import CELL_NODES, COMPONENTS, NodeMap
 from .system_model import check_name, check_text
 
-__all__ = ["dof_names", "FileMatrices", "ContactSet", "read_nodes", "read_elements", "ELEMENT_COLUMNS", "is_file_reference", "Triplets", "FILE_KEYS",
+__all__ = ["dof_names", "FileMatrices", "ContactSet", "read_nodes", "read_elements", "ELEMENT_COLUMNS",
+           "is_file_reference", "Triplets", "FILE_KEYS",
            "SET_KEYS", "MAX_TABLE_BYTES", "MAX_DOF_COUNT", "dof_index", "set_nodes", "contact_set", "file_table"]
 
 #: Keys of a matrix file's table.

@@ -208,24 +208,73 @@ def static_responses(state: SlidingState) -> np.ndarray:
                  f"({state.n} DOFs)",
                  lambda memory: f"use --method direct, or --no-residual-vectors (the vectors take 32 bytes per DOF "
                                 f"and contact row; {format_bytes(memory)} available)")
-    dense = P.T.toarray()
-    return np.column_stack([state.stiffness_lu.solve(np.ascontiguousarray(dense[:, j])) for j in range(P.shape[0])]) \
-        if P.shape[0] else np.zeros((state.n, 0))
+    if not P.shape[0]:
+        return np.zeros((state.n, 0))
+    return state.stiffness_lu.solve(np.asfortranarray(P.T.toarray()))
 
 
 def projected_eigen(state: SlidingState, basis, modes: int | None = None):
     """Eigenvalues (2r,) and physical displacement vectors (k, 2r) of the projection on ``basis``:
     a :class:`ModalBasis` (its first ``modes`` modes) or an M-orthonormal (k, r) array."""
     V = basis.vectors[:, :modes] if isinstance(basis, ModalBasis) else basis
-    r = V.shape[1]
-    K = V.T @ (state.stiffness @ V)
-    C = V.T @ (state.damping @ V)
+    lam, Z = _companion_eigen(V.T @ (state.stiffness @ V), V.T @ (state.damping @ V))
+    return lam, V @ Z
+
+
+def _companion_eigen(K: np.ndarray, C: np.ndarray, vectors: bool = True):
+    """Eigenvalues (2r,) and displacement parts (r, 2r) of λ² I + λ C + K (r × r); the eigenvalues
+    alone without ``vectors``."""
+    r = K.shape[0]
     J = np.zeros((2 * r, 2 * r))
     J[:r, r:] = np.eye(r)
     J[r:, :r] = -K
     J[r:, r:] = -C
+    if not vectors:
+        return np.linalg.eigvals(J)
     lam, Z = np.linalg.eig(J)
-    return lam, V @ Z[:r]
+    return lam, Z[:r]
+
+
+class _Projection:
+    """The linearisation projected once on B = [Φ, Q] (M-orthonormal: every mode, and the residual
+    vectors against all of them) and the bases of the convergence table inside it.
+
+    The first m modes and the residual vectors span [Φ_m, Y] with Y = K_t⁻¹ Pᵀ = Φ X + Q R: in
+    B's coordinates, the unit columns of the m modes and an orthonormal basis of the columns of
+    [X_{m+1…}; R] — exact coordinates, so nothing cancels however much of Y the modes hold.
+    """
+
+    def __init__(self, state: SlidingState, Phi: np.ndarray, static: np.ndarray | None) -> None:
+        self.m = Phi.shape[1]
+        if static is None:
+            Q, self.X, self.R = np.zeros((Phi.shape[0], 0)), None, None
+        else:
+            Q = residual_vectors(state, Phi, static)
+            MY = state.mass @ static
+            self.X, self.R = Phi.T @ MY, Q.T @ MY
+        self.B = np.hstack([Phi, Q])
+        self.K = self.B.T @ (state.stiffness @ self.B)
+        self.C = self.B.T @ (state.damping @ self.B)
+
+    def coordinates(self, modes: int, residual: bool) -> np.ndarray:
+        """T (dim B, r): the orthonormal coordinates of the first ``modes`` modes and, with
+        ``residual``, of the residual vectors."""
+        size = self.B.shape[1]
+        T = np.eye(size)[:, :modes]
+        if not residual or self.R is None or not self.R.size:
+            return T
+        W = np.vstack([self.X[modes:], self.R])
+        W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)
+        U, sigma, _ = np.linalg.svd(W, full_matrices=False)
+        U = U[:, sigma > RANK_TOLERANCE * max(float(sigma[0]), 1e-300)] if sigma.size else U[:, :0]
+        extra = np.zeros((size, U.shape[1]))
+        extra[modes:] = U
+        return np.hstack([T, extra])
+
+    def eigen(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The projection's eigenvalues (2r,) on the sub-basis T and their physical vectors (k, 2r)."""
+        lam, Z = _companion_eigen(T.T @ self.K @ T, T.T @ self.C @ T)
+        return lam, self.B @ (T @ Z)
 
 
 def _errors(full: np.ndarray, approx: np.ndarray) -> np.ndarray:
@@ -235,17 +284,17 @@ def _errors(full: np.ndarray, approx: np.ndarray) -> np.ndarray:
     return np.min(np.abs(full[:, None] - approx[None, :]), axis=1) / np.abs(full)
 
 
-def _row(state, basis: ModalBasis, size: int, static, full) -> dict:
+def _row(projection: _Projection, frequencies: np.ndarray, size: int, full: np.ndarray) -> dict:
     """One row of the convergence table: the first ``size`` modes, alone and with the residual vectors."""
-    Phi = basis.vectors[:, :size]
-    alone = _errors(full, projected_eigen(state, Phi)[0])
-    row = {"modes": size, "highest_mode": float(basis.frequencies[size - 1]), "residual_vectors": 0,
+    T = projection.coordinates(size, False)
+    alone = _errors(full, _companion_eigen(T.T @ projection.K @ T, T.T @ projection.C @ T, vectors=False))
+    row = {"modes": size, "highest_mode": float(frequencies[size - 1]), "residual_vectors": 0,
            "max_relative_error": float(np.max(alone, initial=0.0)), "found": int(np.sum(alone < 1e-2)),
            "modes_only_error": float(np.max(alone, initial=0.0)), "modes_only_found": int(np.sum(alone < 1e-2))}
-    if static is not None:
-        Y = residual_vectors(state, Phi, static)
-        err = _errors(full, projected_eigen(state, np.hstack([Phi, Y]))[0])
-        row.update(residual_vectors=int(Y.shape[1]), max_relative_error=float(np.max(err, initial=0.0)),
+    if projection.R is not None:
+        T = projection.coordinates(size, True)
+        err = _errors(full, _companion_eigen(T.T @ projection.K @ T, T.T @ projection.C @ T, vectors=False))
+        row.update(residual_vectors=int(T.shape[1] - size), max_relative_error=float(np.max(err, initial=0.0)),
                    found=int(np.sum(err < 1e-2)))
     return row
 
@@ -281,16 +330,16 @@ def modal_cea(state: SlidingState, max_frequency: float, *, cutoff: float | None
         raise EquilibriumError(f"the cutoff {cutoff:.6g} rad/s is below the band's top {max_frequency:.6g} rad/s; "
                                "give a cutoff above it (1.5 to 2 times)")
     basis = real_modes(state, cutoff)
-    static = static_responses(state) if residual else None
-    V = basis.vectors if static is None else np.hstack([basis.vectors, residual_vectors(state, basis.vectors, static)])
-    lam, Y = projected_eigen(state, V)
+    projection = _Projection(state, basis.vectors, static_responses(state) if residual else None)
+    m = basis.vectors.shape[1]
+    T = projection.coordinates(m, residual)
+    lam, Y = projection.eigen(T)
     in_band = np.abs(lam.imag) <= max_frequency
     v0 = np.concatenate([Y[:, in_band].sum(axis=1), (Y[:, in_band] * lam[in_band]).sum(axis=1)]).real
     band = band_eigen(state, max_frequency, k=int(in_band.sum()) + 6, v0=v0 if np.any(v0) else None)
     full = band.eigenvalues[np.abs(band.eigenvalues.imag) <= max_frequency]
-    m = basis.vectors.shape[1]
     sizes = sorted({max(1, int(round(m * (j + 1) / steps))) for j in range(steps)})
-    rows = [_row(state, basis, size, static, full) for size in sizes]
-    report = ModalReport(modes=m, residual_vectors=V.shape[1] - m, cutoff=cutoff, approximations=lam[in_band],
+    rows = [_row(projection, basis.frequencies, size, full) for size in sizes]
+    report = ModalReport(modes=m, residual_vectors=T.shape[1] - m, cutoff=cutoff, approximations=lam[in_band],
                          errors=_errors(lam[in_band], band.eigenvalues), convergence=rows)
     return band, report
