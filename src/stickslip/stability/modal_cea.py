@@ -42,8 +42,8 @@ from ..memory import check_memory, format_bytes
 from .cea import BandEigen, _frictionless_stiffness, band_eigen, modes_below
 from .sparse_sliding import SlidingState, factorize
 
-__all__ = ["ModalBasis", "ModalReport", "real_modes", "lowest_modes", "residual_vectors", "projected_eigen",
-           "modal_cea", "CUTOFF_FACTOR"]
+__all__ = ["ModalBasis", "ModalReport", "real_modes", "lowest_modes", "contact_patterns", "static_responses",
+           "residual_vectors", "modal_cea", "CUTOFF_FACTOR"]
 
 #: Default cutoff of the real modes as a multiple of the band's top (the rule of thumb of modal
 #: CEA: modes up to 1.5–2 times the highest frequency of interest).
@@ -211,14 +211,6 @@ def static_responses(state: SlidingState) -> np.ndarray:
     if not P.shape[0]:
         return np.zeros((state.n, 0))
     return state.stiffness_lu.solve(np.asfortranarray(P.T.toarray()))
-
-
-def projected_eigen(state: SlidingState, basis, modes: int | None = None):
-    """Eigenvalues (2r,) and physical displacement vectors (k, 2r) of the projection on ``basis``:
-    a :class:`ModalBasis` (its first ``modes`` modes) or an M-orthonormal (k, r) array."""
-    V = basis.vectors[:, :modes] if isinstance(basis, ModalBasis) else basis
-    lam, Z = _companion_eigen(V.T @ (state.stiffness @ V), V.T @ (state.damping @ V))
-    return lam, V @ Z
 
 
 def _companion_eigen(K: np.ndarray, C: np.ndarray, vectors: bool = True):
