@@ -110,9 +110,9 @@ class Parser:
                 self.shapes[container] = (1,)
                 return self.number(value, key, container, 0)
             table = " or a table of dof = number" if n == self.n else ""
-            raise ModelFileError(f"{key} must be a list of {n} file_number(s){table}, got {show_value(value)}")
+            raise ModelFileError(f"{key} must be a list of {n} number(s){table}, got {show_value(value)}")
         if len(value) != n:
-            raise ModelFileError(f"{key} must be a list of {n} file_number(s), got {show_value(value)}")
+            raise ModelFileError(f"{key} must be a list of {n} number(s), got {show_value(value)}")
         self.shapes[container] = (n,)
         for i, v in enumerate(value):
             self.number(v, f"{key}.{i}", container, i)
@@ -138,7 +138,7 @@ class Parser:
             raise ModelFileError(f"{key} must have {rows} row(s) (one per dof), got {len(value)}")
         for i, row in enumerate(value):
             if len(row) != n:
-                raise ModelFileError(f"{key} row {i} must have {n} file_number(s) (one per dof), got {len(row)}")
+                raise ModelFileError(f"{key} row {i} must have {n} number(s) (one per dof), got {len(row)}")
         self.shapes[container] = (len(value), n)
         for i, row in enumerate(value):
             for j, v in enumerate(row):
