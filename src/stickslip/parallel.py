@@ -133,15 +133,15 @@ COMPILE_PROCESSES_ENV = "STICKSLIP_COMPILE_PROCESSES"
 
 
 def compile_processes() -> int:
-    """How many processes a cold start may compile in: ``STICKSLIP_COMPILE_PROCESSES`` (default 2;
-    1 compiles in this process alone).
+    """How many processes a cold start may compile in: ``STICKSLIP_COMPILE_PROCESSES`` (default 2,
+    also where it is empty; 1 compiles in this process alone).
 
     Raises
     ------
     WorkersError
         One line, where the setting is not a positive integer.
     """
-    text = os.environ.get(COMPILE_PROCESSES_ENV, "2").strip()
+    text = os.environ.get(COMPILE_PROCESSES_ENV, "").strip() or "2"
     try:
         value = int(text)
     except ValueError:

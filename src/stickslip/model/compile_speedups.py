@@ -12,8 +12,9 @@ variable of the function, so each block's copy copies the whole scope again: O(b
 variables) per inlined call site. The per-block copies of one inlined call get a memo that holds
 the scope's copy already, so the blocks of a copied callee share one scope, as the blocks of any
 numba IR share theirs (the inliner reads the callee's scope once and then moves every block into
-the caller's scope). Outside an inlined call, and for anything but a block, ``copy.deepcopy``
-behaves as before.
+the caller's scope). numba before 0.59 copies each statement again, after its block: those
+copies take the same memo, so their variables refer to that one scope copy too (as the block's
+copy of them does). Outside an inlined call ``copy.deepcopy`` behaves as before.
 
 **The hash of compiler flags without reading them** (``flags-hash``). Every typing request of an
 overload looks up its implementation by a key that holds the compiler flags (a
@@ -75,11 +76,13 @@ class _SharedScopeCopy:
     @staticmethod
     def deepcopy(x, memo=None):
         scopes = getattr(_state, "scopes", None)
-        if memo is None and scopes is not None and isinstance(x, _Block):
-            scope = x.scope
-            if id(scope) not in scopes:
-                scopes[id(scope)] = (scope, copy.deepcopy(scope))  # the original kept alive: ids stay unique
-            memo = {id(scope): scopes[id(scope)][1]}
+        if memo is None and scopes is not None:
+            if isinstance(x, _Block):
+                scope = x.scope
+                if id(scope) not in scopes:
+                    scopes[id(scope)] = (scope, copy.deepcopy(scope))  # the original kept alive: ids stay unique
+            # a block's copy, or (numba < 0.59) a statement copied after its block: this call's scope copies
+            memo = {key: scope_copy for key, (_, scope_copy) in scopes.items()}
         return copy.deepcopy(x, memo)
 
 

@@ -2,68 +2,62 @@
 
 ``kernel``: numba ``njit`` with an on-disk cache and *without* the numba runtime (NRT). Kernels
 only read and write the arrays they are given and never allocate, so they need no reference
-counting; compiled without NRT their calls carry no atomic incref/decref per array argument,
-which halves the cost of the right-hand side (measured 189 → 84 ns per call, N = 50 N,
-Ω = 5 rad/s). Functions that allocate (the integrator loops) use ``loop`` (plain cached
-``njit``); they allocate only on entry and never reassign an array variable inside their main
-loop, since numba reference-counts loop-carried arrays on every iteration
-(``fixed_step.record_transition``).
+counting; compiled without NRT their calls carry no atomic incref/decref per array argument.
+Functions that allocate (the integrator loops) use ``loop`` (plain cached ``njit``); they
+allocate only on entry and never reassign an array variable inside their main loop, since numba
+reference-counts loop-carried arrays on every iteration (``fixed_step.record_transition``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
 kernels on the innermost path (``forces.slip_force``, ``forces.add_contact_force``,
-``forces.rotated``) and for the right-hand side's body ``physics.rhs_body`` at exactly one call
-site per integrator step,
-inside the loop over its stages (a call passes each array as 7 words, ~40 per rhs; inlined:
-−1.5…6 % per fixed-step run). Each inlined copy of the rhs costs ~2.3 s of cold compile: three
-copies (one per RK4 stage) took it +5…9 s for about the speed of one copy in a loop. Inlining
-larger step functions (``fixed_step.rk4_slip_step``) into the loop made runs 1.5× *slower*, and
-inlining every kernel took the cold compile from 15 s to 295 s. The small predicates, offsets
-and formulas that kernels call at tens of sites (``bundle.offsets``, ``contact_offsets``,
-``gap_offset``, ``normal.is_open``, ``is_rigid``, ``is_unilateral``, ``gap_and_rate``,
-``gap_with_rate``, ``contact_indicator``, ``model_data.is_stick``, ``static_limit``,
-``kinetic_coefficient``, ``frames.frame_velocity``, ``friction.static_coefficient``,
-``linalg.solve_psd_2x2``, ``forces.exact_direction``) are plain kernels instead: numba types an
-inlined body again at every call site (and at every site of every inlined caller), a kernel
-once, and LLVM still inlines the small function into its caller's module. A cold ``simulate`` of
-the plates in one process: 25.0–25.5 s against 27.7–34.9 s for the first nine, 21.8–22.5 s
-against 22.9–23.6 s for the rest; the same states bit for bit and the same speed
-(``benchmarks/ab.py``: event 1000 s 0.983–1.009 and 0.989, AEOM 0.983 and 1.001, the belt 0.983).
-``model_data.apply_inverse_mass`` and ``base_force``, loops on the right-hand side's path, stay
-inlined: as kernels the plates' event runs took 1.016× as long.
+``forces.rotated``), for the right-hand side's body ``physics.rhs_body`` at exactly one call
+site per integrator step, inside the loop over its stages (a call passes each array as 7 words),
+and for the loops on the right-hand side's path (``model_data.apply_inverse_mass``,
+``base_force``). Every inlined copy is typed and compiled again, so larger step functions stay
+kernels. The small predicates, offsets and formulas that kernels call at tens of sites
+(``bundle.offsets``, ``contact_offsets``, ``gap_offset``, ``normal.is_open``, ``is_rigid``,
+``is_unilateral``, ``gap_and_rate``, ``gap_with_rate``, ``contact_indicator``,
+``model_data.is_stick``, ``static_limit``, ``kinetic_coefficient``, ``frames.frame_velocity``,
+``friction.static_coefficient``, ``linalg.solve_psd_2x2``, ``forces.exact_direction``) are plain
+kernels: numba types an inlined body again at every call site (and at every site of every
+inlined caller), a kernel once, and LLVM still inlines the small function into its caller's
+module.
 
 ``error_model="numpy"`` everywhere: a float division by zero gives inf/nan as in numpy instead
-of raising ZeroDivisionError, so divisions carry no zero test and branch to an exception
-(measured −2 % per fixed-step run). Every kernel guards its divisions where zero can occur
-(speed floors, rank tests), and the integrators check that the state stays finite.
+of raising ZeroDivisionError, so divisions carry no zero test and branch to an exception. Every
+kernel guards its divisions where zero can occur (speed floors, rank tests), and the integrators
+check that the state stays finite.
 
-Compile time (a cold start compiles every kernel a command needs; on two cores that was a
-minute): numba gives each kernel that is not inlined a module of its own, into which it links
-the code of every kernel it calls, and LLVM optimises and emits all of that code again there.
-A thin kernel over a large one therefore costs the large one's optimisation once more: such
-kernels are ``inlined_kernel`` (``physics.stick_margin``, ``slip_direction``,
-``contacts.event_value``, the steady-sliding Newton (called at one
-site; ``inlined_loop``, as it allocates), its residual and Jacobian, the variational right-hand
-side's band correction), a compiled wrapper that only allocates is Python instead
-(``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is one
-kernel called from five places rather than inlined into each. The largest kernels are
+Compile time (a cold start compiles every kernel a command needs): numba gives each kernel that
+is not inlined a module of its own, into which it links the code of every kernel it calls, and
+LLVM optimises and emits all of that code again there. A thin kernel over a large one therefore
+costs the large one's optimisation once more: such kernels are ``inlined_kernel``
+(``physics.stick_margin``, ``slip_direction``, ``contacts.event_value``, the steady-sliding
+Newton (called at one site; ``inlined_loop``, as it allocates), its residual and Jacobian, the
+variational right-hand side's band correction), a compiled wrapper that only allocates is Python
+instead (``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is
+one kernel called from five places rather than inlined into each. The largest kernels are
 :func:`standalone` (:mod:`.linking`): their callers call their one compiled copy instead of
-linking a copy in. Since they are, a thin kernel over standalone ones costs little more than its
-own code, and the event loop's rare branches over them (``event_loop.cut_step``,
-``transitions.settle`` and ``break_away``) are kernels: typed once instead of at each of their
-sites, and compiled by a cold start's helper process beside the loop
-(:mod:`stickslip.model.compile_ahead`). A kernel gets numba's Python entry only when Python calls it
-(:class:`KernelDispatcher`), the physics and the starting modes that both the event loop and
-the analyses' Python call always (``api_kernel``: one version,
-compiled by ``simulate`` and loaded by ``stability`` and ``orbit``), and no kernel a C-callable
-wrapper. numba's inliner copies an inlined callee's scope once per
-inlined call here, not once per block, and translates an inlined callee once per function, not
-once per call site; numba's compiler flags hash and compare without reading every option
-(:mod:`.compile_speedups`, installed on import). A slice assignment from an
-array inside compiled code (``a[:n] = b[:n]``) makes numba compile its shape-mismatch error
-message (string formatting, ~10 s of a cold start); use element loops. Literal arguments
-(``f(x, 0)``, ``f(x, True)``) compile a second version of the callee for the literal type; pass
-``np.int64(0)`` / ``np.bool_(True)`` or a variable, and start a counter that is passed to a
-kernel as ``np.int64(0)`` (numba types the call for the literal first).
+linking a copy in. So a thin kernel over standalone ones costs little more than its own code,
+and the event loop's rare branches over them (``event_loop.cut_step``, ``transitions.settle`` and
+``break_away``) are kernels: typed once instead of at each of their sites, and compiled by a
+cold start's helper process beside the loop (:mod:`stickslip.model.compile_ahead`). A kernel
+gets numba's Python entry only when Python calls it (:class:`KernelDispatcher`), the physics and
+the starting modes that both the event loop and the analyses' Python call always
+(``api_kernel``: one version, compiled by ``simulate`` and loaded by ``stability`` and
+``orbit``), and no kernel a C-callable wrapper. :mod:`.compile_speedups` makes numba's front end
+faster where a cold compile spends its time.
+
+Those changes to numba are patches installed by :mod:`.numba_patches` when this module is
+imported, each only where numba has what it relies on; :mod:`.kernel_cache` keeps the kernels'
+disk cache correct (stamped with the whole compiled layer) and survivable (checksummed). Without
+that patch (``STICKSLIP_NUMBA_PATCHES=0``, an untested numba) the kernels are declared uncached.
+
+Pitfalls: a slice assignment from an array inside compiled code (``a[:n] = b[:n]``) makes numba
+compile its shape-mismatch error message (string formatting, seconds of a cold start); use
+element loops. Literal arguments (``f(x, 0)``, ``f(x, True)``) compile a second version of the
+callee for the literal type; pass ``np.int64(0)`` / ``np.bool_(True)`` or a variable, and start
+a counter that is passed to a kernel as ``np.int64(0)`` (numba types the call for the literal
+first).
 """
 
 from __future__ import annotations
