@@ -172,3 +172,18 @@ def test_only_the_package_kernels_cache_files_take_the_checksummed_format():
 
     assert kernel_cache._ours(physics.rhs._cache._cache_file)
     assert not kernel_cache._ours(types.SimpleNamespace(_source_stamp=(1.0, 2)))
+
+
+def test_index_keys_carry_the_patches_that_change_what_an_entry_holds():
+    """A process with other patches (the standalone kernels off, say) looks its kernels up under
+    other keys, so it never loads an entry in a payload format it does not read."""
+    from numba.core.registry import cpu_target
+
+    from stickslip.model import physics
+
+    assert kernel_cache.patch_tag() == ("stickslip", "python-entry", "standalone-linking")
+    from numba import types as nbtypes
+
+    sig = (nbtypes.float64[::1],)
+    key = physics.rhs._cache._index_key(sig, cpu_target.target_context.codegen())
+    assert key[0] == sig and kernel_cache.patch_tag() in key
