@@ -20,10 +20,12 @@ work it does later anyway (:func:`meanwhile`: the CLI imports what writes its ou
 
 The callees' argument types are written as short codes (:data:`CODES`: the callers' own call
 sites; the tests check that they are the signatures the callers compile). Where the helper cannot
-run (one core, a model class its process cannot import, a failure) this process compiles
-everything itself: the helper only ever adds kernels to the cache.
-``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test suite does, its workers already fill the
-cores; so do the workers of sweeps and basins).
+run (one core, a model class its process cannot import, a failure, kernels not cached on disk:
+:func:`.kernel_cache.caching`) this process compiles everything itself: the helper only ever adds
+kernels to the cache. ``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test suite does, its
+workers already fill the cores; so do the workers of sweeps and basins). The helper is a fork
+where numba's compiler lock and compile listeners are as the patch ``fork-helper`` of
+:mod:`.numba_patches` expects (:data:`FORK_PATCH`), else a new interpreter.
 """
 
 from __future__ import annotations
