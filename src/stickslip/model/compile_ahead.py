@@ -196,7 +196,7 @@ def meanwhile(work):
 
 #: Whether the helper is a forked copy of this process (Linux): it then starts at once, with the
 #: package imported and the model's data in memory. Elsewhere it is a new interpreter, which
-#: imports the package and reads the pickled data first (1.2–1.5 s on the 2-core machine).
+#: imports the package and reads the pickled data first.
 _FORK = hasattr(os, "fork") and sys.platform.startswith("linux")
 
 
