@@ -42,6 +42,7 @@ from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.library.two_plates import is_plates
 from ..model.parameters import Parameters
+from ..parallel import compile_processes
 from ._compiling import compile_notice
 from ._kept import forget_outputs, on_disk, on_interrupt
 
@@ -256,6 +257,7 @@ def _check_environment() -> None:
         raise CLIError(f"NUMBA_DISABLE_JIT={os.environ['NUMBA_DISABLE_JIT']}: stickslip's kernels must be compiled "
                        "(interpreted, a run would take hours and some kernels cannot run at all); unset "
                        "NUMBA_DISABLE_JIT or set it to 0")
+    compile_processes()  # a setting that is not a positive integer: one line, exit 2
     for note in _startup.notes:
         warning_line(note)
 
