@@ -89,7 +89,7 @@ from pathlib import Path
 
 import numba
 
-__all__ = ["TESTED", "ENV", "Patch", "install", "active", "status", "notice", "has", "source_has"]
+__all__ = ["TESTED", "ENV", "Patch", "install", "active", "status", "notice", "has", "source_has", "end_run"]
 
 #: numba versions (major.minor) the test suite passed on with the patches installed, and stock.
 TESTED = ("0.57", "0.58", "0.59", "0.60", "0.61", "0.62", "0.63", "0.64", "0.65", "0.66", "0.67", "0.68")
@@ -280,11 +280,22 @@ def _forget_markers(run: str, root: int) -> None:
             path.unlink()
 
 
+#: The run this process is the root of (its id and process id), where it is one.
+_ROOT: dict[str, object] = {}
+
+
 def _start_run() -> None:
     """Make this process the root of a run where it was started by none (its markers removed at exit)."""
     if not os.environ.get(RUN_ENV):
-        run = _run_id()
-        atexit.register(_forget_markers, run, os.getpid())
+        _ROOT.update(run=_run_id(), pid=os.getpid())
+        atexit.register(end_run)
+
+
+def end_run() -> None:
+    """Remove the markers of the run this process is the root of: at exit, or before a process ends
+    without running its exit handlers (``os._exit``)."""
+    if _ROOT:
+        _forget_markers(_ROOT["run"], _ROOT["pid"])
 
 
 _start_run()
