@@ -7,7 +7,6 @@ Parse → library call (:func:`stickslip.orbits.periodic_orbit`,
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import (JsonSummary, Model, ModelChanges, OperatingPoint, OrbitRtol, OrbitSearch, Outputs, SlipBand,
                        StartIc, Tol)
 from ._outputs import write_result
@@ -122,7 +122,7 @@ def orbit_command(
         "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s,
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     table = Table(title=f"stickslip orbit ({model_label(orbit)})", show_header=False)
     table.add_row("period", f"{summary['period_s']:.10g} s ({summary['frequency_hz']:.8g} Hz)")
@@ -182,7 +182,7 @@ def lyapunov_command(
         "compile_time_s": timing.compile_s,
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     console.print(f"stickslip lyapunov: {model_label(spectrum)}, {method}",
                   soft_wrap=True)

@@ -350,13 +350,18 @@ def lyapunov_spectrum(
     method: str = "variational",
     chunk: float = 1.0,
     d0: float = DEFAULT_D0,
+    seed: int = 0,
 ) -> LyapunovSpectrum:
     """All Lyapunov exponents of the attractor reached from ``ic`` (Benettin–Shimada–Nagashima).
 
     The variational equations with saltation matrices (:func:`.linear_flow.propagate`) carry
     an orthonormal frame (in the σ-scaled norm) along the ``event`` integrator's trajectory; it
     is re-orthonormalised by QR after every jump and at least every :data:`QR_INTERVAL`
-    seconds, and λ_i = Σ ln |R_ii| / t.
+    seconds, and λ_i = Σ ln |R_ii| / t. Both methods start from a random orthonormal frame
+    (:func:`generic_frame`): a frame of the coordinate directions is not generic where a
+    coordinate subspace is invariant (a DOF that the others drive but that never acts back on
+    them, e.g. the tangential motion of an impact oscillator): the column inside it then leaves
+    it only through round-off, and its exponent carries ln(1e-16) over the averaging time.
 
     Parameters
     ----------
@@ -382,6 +387,8 @@ def lyapunov_spectrum(
         by stick come out at ln(integration noise / d0) per chunk instead of −∞).
     chunk, d0 : float
         Chunk length [s] and scaled separation [-] of ``finite-difference``.
+    seed : int
+        Seed of the random initial frame.
 
     Returns
     -------
@@ -398,15 +405,17 @@ def lyapunov_spectrum(
     interval, option = (chunk, "chunk") if method == "finite-difference" else (record, "record")
     problem, s_ref = _after_transient(model, ic, perturbation, t_transient, rtol, atol, slip_band, t_average,
                                       interval, option)
+    frame = generic_frame(problem.free.size, seed)
     if method == "finite-difference":
-        return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
+        return _fd_spectrum(problem, s_ref, frame, t_transient, t_average, chunk, d0,
+                            dict(perturbation=perturbation, seed=seed), t_start)
     if method != "variational":
         raise OrbitError(f"unknown method {method!r}; use 'variational' or 'finite-difference'")
     end, transitions = problem.flow(s_ref, t_average)
     free, sigma = problem.free, problem.sigma
 
     k = free.size
-    D = _initial_frame(problem, s_ref)
+    D = _initial_frame(problem, s_ref, frame)
     log_sum = np.zeros(k)
     times, sums = [0.0], [np.zeros(k)]
 
@@ -424,30 +433,38 @@ def lyapunov_spectrum(
               max_interval=QR_INTERVAL)
     time = np.array(times[1:])
     return _spectrum(problem, np.array(sums[1:]) / time[:, None], time, t_transient, stick_count(transitions), t_start,
-                     dict(perturbation=perturbation, record=record, qr_interval=QR_INTERVAL, method="variational"))
+                     dict(perturbation=perturbation, seed=seed, record=record, qr_interval=QR_INTERVAL,
+                          method="variational"))
 
 
 #: Step [σ] of the differences that project the initial frame of the variational spectrum.
 FRAME_STEP = 1e-6
 
 
-def _initial_frame(problem, s_ref: np.ndarray) -> np.ndarray:
-    """The variations (2n, 2 n_free) the variational spectrum starts from: σ-scaled unit vectors
-    of the free states; where a contact sticks or a rigid contact is closed at ``s_ref``, projected
-    as perturbed states are (:meth:`.problem.ShootingProblem.perturbed`, by differences of
-    :data:`FRAME_STEP`), so the directions those constraints forbid collapse at once (exponents
-    −∞, large negative numbers from round-off) instead of staying frozen (exponent 0) until an
-    event collapses them."""
+def generic_frame(k: int, seed: int) -> np.ndarray:
+    """A random orthonormal frame (k, k) (QR of a standard normal matrix, seeded): no column lies
+    in a coordinate subspace, which a flow may leave invariant."""
+    Q, _ = _qr(np.random.default_rng(seed).standard_normal((k, k)))
+    return Q
+
+
+def _initial_frame(problem, s_ref: np.ndarray, frame: np.ndarray) -> np.ndarray:
+    """The variations (2n, 2 n_free) the variational spectrum starts from: the orthonormal
+    ``frame`` (k, k) of the σ-scaled free states; where a contact sticks or a rigid contact is
+    closed at ``s_ref``, projected as perturbed states are
+    (:meth:`.problem.ShootingProblem.perturbed`, by differences of :data:`FRAME_STEP`), so the
+    directions those constraints forbid collapse at once (exponents −∞, large negative numbers
+    from round-off) instead of staying frozen (exponent 0) until an event collapses them."""
     free, sigma = problem.free, problem.sigma
     k = free.size
     D = np.zeros((2 * problem.system.n, k))
-    D[free, np.arange(k)] = sigma
+    D[free] = frame * sigma[:, None]
     system = problem.system
     stuck = np.any(resting_contacts(system, s_ref)[::CST] == MODE_STICK)
     closed = system.rigid and any(g[0] <= tol[0] for _, g, _, tol in rigid_gaps(system, s_ref))
     if stuck or closed:
         for j in range(k):
-            D[:, j] = (problem.perturbed(s_ref, np.eye(k)[j], FRAME_STEP) - s_ref) / FRAME_STEP
+            D[:, j] = (problem.perturbed(s_ref, frame[:, j], FRAME_STEP) - s_ref) / FRAME_STEP
     return D
 
 
@@ -468,7 +485,7 @@ def _spectrum(problem, estimate, time, t_transient, stick_phases, t_start, optio
     )
 
 
-def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start) -> LyapunovSpectrum:
+def _fd_spectrum(problem, s_ref, frame, t_transient, t_average, chunk, d0, options, t_start) -> LyapunovSpectrum:
     """Benettin with 2 n_free perturbed trajectories and QR after every chunk (see
     :func:`lyapunov_spectrum`, ``method="finite-difference"``)."""
     n_chunks = int(round(t_average / chunk))
@@ -476,7 +493,7 @@ def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
     free, sigma = problem.free, problem.sigma
     k = free.size
-    Q = np.eye(k)
+    Q = frame
     log_sum = np.zeros(k)
     sums = np.empty((n_chunks, k))
     sticks = 0
@@ -493,4 +510,4 @@ def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation
         s_ref = s_new
     time = chunk * np.arange(1, n_chunks + 1)
     return _spectrum(problem, sums / time[:, None], time, t_transient, sticks, t_start,
-                     dict(perturbation=perturbation, method="finite-difference", chunk=chunk, d0=d0))
+                     dict(options, method="finite-difference", chunk=chunk, d0=d0))
