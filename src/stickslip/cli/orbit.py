@@ -15,6 +15,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..errors import SteadySlidingOrbitError
 from ..files import netcdf_writer
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import start_run
@@ -104,8 +105,14 @@ def orbit_command(
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     with timed() as timing:
         run = start_run(system, start, t_end=search.search_time, rtol=rtol)
-        orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
-                               monodromy=monodromy)
+        try:
+            orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol,
+                                   tol=tol, monodromy=monodromy)
+        except SteadySlidingOrbitError:
+            x = system.dofs[system.observed_index]
+            raise CLIError(f"shooting from the start run (--ic {search.ic or 'default'}) converged onto steady sliding, "
+                           f"the equilibrium, not a cycle; start from a state on the cycle, e.g. --ic {x}=...,d{x}=..., "
+                           "or give a longer --search-time") from None
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
     figure = write_result(outputs, lambda: netcdf_writer(orbit.to_xarray()), holds=f"the orbit is in {out}",
