@@ -434,7 +434,8 @@ def lyapunov_spectrum(
         end, transitions = problem.flow(s_ref, t_frame)
         D, _, _ = propagate(problem.system, s_ref, t_frame, transitions, end, D, scale=sigma, after=turn,
                             max_interval=QR_INTERVAL)
-        s_ref = end
+        # projected again where the averaging starts: QR made the collapsed columns whole again
+        s_ref, D = end, _initial_frame(problem, end, D[free] / sigma[:, None])
     end, transitions = problem.flow(s_ref, t_average)
     log_sum = np.zeros(k)
     times, sums = [0.0], [np.zeros(k)]
