@@ -87,7 +87,7 @@ def orbit_command(
     outputs: Outputs = Outputs(out=Path("orbit.nc")),
     as_json: JsonSummary = False,
 ) -> None:
-    """Find a periodic orbit by Newton shooting on the φ-maximum section, with its Floquet multipliers.
+    """Find a periodic orbit by Newton shooting on a Poincaré section (default: the maximum of the model's observed coordinate, the plates' φ), with its Floquet multipliers.
 
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
