@@ -194,3 +194,12 @@ def test_orbit_that_converges_onto_steady_sliding_is_refused_in_one_line(tmp_pat
     assert res.stdout == "" and len(res.stderr.strip().splitlines()) == 1
     assert "converged onto steady sliding" in res.stderr and "--search-time" in res.stderr
     assert not out.exists()
+
+
+def test_a_negative_return_time_suggests_another_section():
+    from stickslip.errors import OrbitError
+    from stickslip.model.library import load_model
+    from stickslip.orbits.section import flow
+
+    with pytest.raises(OrbitError, match=r"T = -0\.836 s is not positive.*--section on the command line"):
+        flow(load_model("impact-oscillator"), np.zeros(4), -0.836, rtol=1e-10, atol=1e-13)
