@@ -178,3 +178,28 @@ def test_model_file_bad_input_is_one_line_and_exit_2(tmp_path, cmd, args, messag
     res = runner.invoke(app, [cmd, *args, "--out", str(tmp_path / "o.nc"), "--search-time", "1"]
                         if cmd == "orbit" else [cmd, *args, "--out", str(tmp_path / "o.nc")])
     _one_error_line(res, message)
+
+
+def test_orbit_that_converges_onto_steady_sliding_is_refused_in_one_line(tmp_path):
+    """The two-mass belt from rest: shooting from the 59.9 s start run's crossings converges onto
+    steady sliding (tests/orbits/test_special_points.py shows independently that a run from such a
+    state barely moves); it is refused as such, exit 2, nothing written."""
+    from pathlib import Path
+
+    model = Path(__file__).parents[1] / "orbits" / "two_mass_belt.toml"
+    out = tmp_path / "o.nc"
+    res = runner.invoke(app, ["orbit", "--model", str(model), "--ic", "zero", "--search-time", "59.9",
+                              "--period-multiplicity", "2", "--no-plot", "--json", "--out", str(out)])
+    assert res.exit_code == 2, res.output
+    assert res.stdout == "" and len(res.stderr.strip().splitlines()) == 1
+    assert "converged onto steady sliding" in res.stderr and "--search-time" in res.stderr
+    assert not out.exists()
+
+
+def test_a_negative_return_time_suggests_another_section():
+    from stickslip.errors import OrbitError
+    from stickslip.model.library import load_model
+    from stickslip.orbits.section import flow
+
+    with pytest.raises(OrbitError, match=r"T = -0\.836 s is not positive.*--section on the command line"):
+        flow(load_model("impact-oscillator"), np.zeros(4), -0.836, rtol=1e-10, atol=1e-13)

@@ -53,7 +53,10 @@ class SteadyState:
         Impacts of rigid contacts in the window (None for a model without rigid contacts).
     max_impact_speed : float or None
         Largest normal speed |ġ⁻| at those impacts [m/s] (0 without impacts; None for a model
-        without rigid contacts).
+        without rigid contacts; NaN where the states of some of the window's impacts were not
+        kept: :attr:`max_impact_speed_reason` then says so).
+    max_impact_speed_reason : str
+        Why :attr:`max_impact_speed` is undefined (empty where it is defined).
     """
 
     t_from: float
@@ -72,6 +75,7 @@ class SteadyState:
     contact_open_fractions: tuple = ()
     impacts: int | None = None
     max_impact_speed: float | None = None
+    max_impact_speed_reason: str = ""
 
     @property
     def frequency_hz(self) -> float:
@@ -86,6 +90,8 @@ class SteadyState:
             del d["open_fraction"], d["contact_open_fractions"]
         if self.impacts is None:  # no rigid contacts: no impacts
             del d["impacts"], d["max_impact_speed"]
+        if not self.max_impact_speed_reason:
+            del d["max_impact_speed_reason"]
         d[f"{self.coordinate}_min"] = d.pop("minimum")
         d[f"{self.coordinate}_max"] = d.pop("maximum")
         return d
@@ -166,10 +172,18 @@ def summarize(t, states, mode, transitions, t_from, *, n_contacts: int, coordina
 
 
 def _impacts_in(impacts, t0: float, t1: float) -> dict:
-    """``impacts`` and ``max_impact_speed`` of the impacts in (t0, t1] (nothing without rigid contacts)."""
+    """``impacts`` and ``max_impact_speed`` of the impacts in (t0, t1] (nothing without rigid
+    contacts). An impact whose state before was not kept has speed NaN: the maximum is then
+    unknown (NaN, with the reason), not the maximum of the others."""
     if impacts is None:
         return {}
     times, speeds = (np.asarray(a, dtype=float) for a in impacts)
     inside = (times > t0) & (times <= t1)
+    unknown = int(np.isnan(speeds[inside]).sum())
+    if unknown:
+        return {"impacts": int(inside.sum()), "max_impact_speed": math.nan,
+                "max_impact_speed_reason": f"the states of {unknown} of the window's {int(inside.sum())} impacts "
+                                           "were not kept (a run keeps the states of its most recent transitions "
+                                           "only); move the steady window later or run shorter"}
     return {"impacts": int(inside.sum()),
             "max_impact_speed": float(np.abs(speeds[inside]).max()) if inside.any() else 0.0}

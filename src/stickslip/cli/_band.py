@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,6 +14,7 @@ from rich.text import Text
 from ..files import netcdf_writer, write_output
 from ._app import CLIError, check_choice, check_finite, check_nc_path, check_output, console
 from ._compiling import time_text
+from ._json import print_json
 
 __all__ = ["Band", "report_band"]
 
@@ -100,8 +100,8 @@ class Band:
 def report_band(result, timing, written: list[Path], as_json: bool) -> None:
     """Print the band's eigenvalues: a JSON line, or the tables."""
     if as_json:
-        print(json.dumps({**result.summary(), "written": [str(p) for p in written], "wall_time_s": timing.wall_s,
-                          "compile_time_s": timing.compile_s}))
+        print_json({**result.summary(), "written": [str(p) for p in written], "wall_time_s": timing.wall_s,
+                     "compile_time_s": timing.compile_s})
         return
     modes = Table(title=f"steady sliding of model {result.model}: eigenvalues with |Im λ| ≤ {result.max_frequency:.6g} "
                         f"rad/s ({result.method}; one per conjugate pair), by growth rate")

@@ -7,7 +7,6 @@ Parse → library call (:func:`stickslip.orbits.periodic_orbit`,
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..errors import SteadySlidingOrbitError
 from ..files import netcdf_writer
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
 from ..orbits.continuation import start_run
@@ -26,6 +26,7 @@ from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import (JsonSummary, Model, ModelChanges, OperatingPoint, OrbitRtol, OrbitSearch, Outputs, SlipBand,
                        StartIc, Tol)
 from ._outputs import write_result
@@ -86,7 +87,7 @@ def orbit_command(
     outputs: Outputs = Outputs(out=Path("orbit.nc")),
     as_json: JsonSummary = False,
 ) -> None:
-    """Find a periodic orbit by Newton shooting on the φ-maximum section, with its Floquet multipliers.
+    """Find a periodic orbit by Newton shooting on a Poincaré section (default: the maximum of the model's observed coordinate, the plates' φ), with its Floquet multipliers.
 
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
@@ -104,8 +105,14 @@ def orbit_command(
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     with timed() as timing:
         run = start_run(system, start, t_end=search.search_time, rtol=rtol)
-        orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
-                               monodromy=monodromy)
+        try:
+            orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol,
+                                   tol=tol, monodromy=monodromy)
+        except SteadySlidingOrbitError:
+            x = system.dofs[system.observed_index]
+            raise CLIError(f"shooting from the start run (--ic {search.ic or 'default'}) converged onto steady sliding, "
+                           f"the equilibrium, not a cycle; start from a state on the cycle, e.g. --ic {x}=...,d{x}=..., "
+                           "or give a longer --search-time") from None
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
     figure = write_result(outputs, lambda: netcdf_writer(orbit.to_xarray()), holds=f"the orbit is in {out}",
@@ -122,7 +129,7 @@ def orbit_command(
         "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s,
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     table = Table(title=f"stickslip orbit ({model_label(orbit)})", show_header=False)
     table.add_row("period", f"{summary['period_s']:.10g} s ({summary['frequency_hz']:.8g} Hz)")
@@ -182,7 +189,7 @@ def lyapunov_command(
         "compile_time_s": timing.compile_s,
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     console.print(f"stickslip lyapunov: {model_label(spectrum)}, {method}",
                   soft_wrap=True)

@@ -5,7 +5,6 @@ Parse → library call → print/write; no physics here.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import List, Optional
 
@@ -26,6 +25,7 @@ from ._app import CLIError, app, build_system, check_finite, check_outputs, cons
 from ._band import Band, report_band
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import Friction, JsonSummary, MapModel, Model, ModelChanges, Outputs, Plates
 from ._outputs import write_result
 from .sweep import _VALUE_BYTES, parse_values
@@ -59,7 +59,7 @@ def stability(
         report_band(result, timing, band.write(result, changes.inputs), as_json)
         return
     if as_json:
-        print(json.dumps({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
+        print_json({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s})
         return
     p = result.params
     title = f"steady sliding: model {result.model}"
@@ -163,9 +163,9 @@ def stability_map(
             "boundary_points": int(np.sum(np.isfinite(smap.boundary[f]))),
         })
     if as_json:
-        print(json.dumps({"out": str(out), "figure": None if figure is None else str(figure), "axes": list(names),
-                          "family": smap.family_name, "members": rows, "timings": smap.timings,
-                          "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
+        print_json({"out": str(out), "figure": None if figure is None else str(figure), "axes": list(names),
+                     "family": smap.family_name, "members": rows, "timings": smap.timings,
+                     "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s})
         return
     table = Table(title=f"stability map {values[0].size} × {values[1].size} ({names[0]} × {names[1]}), "
                         f"model {smap.model}")
