@@ -23,7 +23,7 @@ __all__ = ["Parser", "CONTACT_KEYS", "REQUIRED_CONTACT", "FRICTION_KEYS", "NORMA
 CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "gap",
                 "gap_gradient", "normal", "friction")
 REQUIRED_CONTACT = ("tangent", "friction")
-FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v")
+FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v", "v_s")
 NORMAL_KEYS = ("law", "stiffness", "damping", "restitution")
 #: The keys of a prescribed load and of a unilateral contact (a contact has the one or the other).
 PRESCRIBED_KEYS = ("normal_force", "normal_gradient", "normal_rate_gradient")
