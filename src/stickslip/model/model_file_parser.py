@@ -192,7 +192,7 @@ class Parser:
             elif key == "gap_gradient":
                 self.vector(value, self.n, f"{where}.{key}", f"{c}.{key}", sparse=True)
             elif key == "friction":
-                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb or exponential")
+                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb, exponential or stribeck")
             elif key == "normal":
                 self.normal_table(value, f"{where}.normal", f"{c}.normal")
         name = table.get("name", f"contact{c}")
@@ -264,7 +264,7 @@ class Parser:
                 self.number(value, f"{where}.{key}", "scalars", cset.container(key))
             elif key == "friction":
                 self.law_table(value, f"{where}.friction", FRICTION_KEYS, cset.container("friction"),
-                               "coulomb or exponential")
+                               "coulomb, exponential or stribeck")
             elif key == "normal":
                 self.normal_table(value, f"{where}.normal", cset.container("normal"))
         count = len(cset.nodes)
