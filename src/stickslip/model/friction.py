@@ -30,7 +30,7 @@ path) and call it like hand-written code. The function must be complex-safe: use
 :mod:`stickslip.model.csmath` (``exp``, ``sqrt``, ``sin``, ``cos``) and arithmetic, no ``abs`` or
 ``math.*`` on the speed, branches on ``speed.real`` only. All contacts of a model that use a user
 law share one instance. :mod:`stickslip.model.library.laws` holds a Stribeck law written this way
-(its μ is :func:`stribeck_coefficient`, the built-in law's).
+(the built-in ``stribeck`` law's curve, as a user law).
 """
 
 from __future__ import annotations

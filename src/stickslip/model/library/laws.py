@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-from ..friction import register_friction_law, stribeck_coefficient
+from .. import csmath as csm
+from ..friction import register_friction_law
 from ..jit import kernel
 
 __all__ = ["Stribeck", "stribeck"]
@@ -33,7 +34,8 @@ class Stribeck(NamedTuple):
 @kernel
 def stribeck(law, speed):
     """μ(|v|) [-] of :class:`Stribeck` at slip speed ``speed`` [m/s] (float or complex)."""
-    return stribeck_coefficient(law.mu_c, law.mu_s - law.mu_c, law.v_s, law.mu_v, speed)
+    ratio = speed / law.v_s
+    return law.mu_c + (law.mu_s - law.mu_c) * csm.exp(-ratio * ratio) + law.mu_v * speed
 
 
 register_friction_law(Stribeck, stribeck)
