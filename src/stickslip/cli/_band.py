@@ -130,8 +130,16 @@ def report_band(result, timing, written: list[Path], as_json: bool) -> None:
     console.print(f"{len(result.dofs)} dofs, {len(result.contact_names)} contacts; every eigenvalue with |λ| ≤ "
                   f"{result.radius:.6g} rad/s found"
                   + ("" if count is None else f" (the frictionless structure has {count} modes there)"), style="dim")
-    verdict = Text("stable", style="green") if result.stable else Text("unstable", style="bold red")
     console.print(Text.assemble(f"max real part in the band {result.max_real_part:.6g} 1/s: steady sliding is ",
-                                verdict))
+                                verdict_words(result)))
     tail = "" if not written else "; wrote " + ", ".join(str(p) for p in written)
     console.print(f"wall time {time_text(timing.wall_s, timing.compile_s)}{tail}", style="dim")
+
+
+def verdict_words(result) -> Text:
+    """The verdict of a stability result (dense or band) in colour: stable, unstable, or marginal
+    with what that means (a real part 0 within the eigenvalue solver's accuracy)."""
+    if result.verdict == "marginal":
+        return Text(f"marginal: Re λ = 0 within the eigenvalue solver's accuracy ({result.tolerance:.2g} 1/s), a "
+                    "centre the linearisation neither damps nor grows", style="yellow")
+    return Text(result.verdict, style="green" if result.verdict == "stable" else "bold red")
