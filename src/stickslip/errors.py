@@ -18,7 +18,8 @@ them without importing the module that raises it.
 ``EquilibriumError``     no steady sliding found
 ``SimulationError``      invalid simulation options, or a run that could not finish
 ``OrbitError``           a periodic orbit or Lyapunov exponent that could not be computed
-                         (``ContinuationError``: a branch that could not start or go on;
+                         (``SteadySlidingOrbitError``: shooting that converged onto steady
+                         sliding; ``ContinuationError``: a branch that could not start or go on;
                          ``SteadySlidingError``: one whose start is steady sliding)
 ``SweepError``           an invalid sweep, or an output of another sweep
 ``WorkersError``         a worker count outside 1 … the CPUs available
@@ -36,7 +37,8 @@ them without importing the module that raises it.
 from __future__ import annotations
 
 __all__ = ["StickSlipError", "ModelError", "ModelFileError", "ParameterError", "FrictionLawError", "VariantError",
-           "KinematicsError", "ExpressionError", "EquilibriumError", "SimulationError", "OrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
+           "KinematicsError", "ExpressionError", "EquilibriumError", "SimulationError", "OrbitError",
+           "SteadySlidingOrbitError", "ContinuationError", "SteadySlidingError", "SweepError",
            "WorkersError", "SchedulerError", "BasinError", "FileFormatError", "LockError", "WriteError", "DiskFullError",
            "OutputError", "JournalError", "MemoryLimitError"]
 
@@ -84,6 +86,11 @@ class SimulationError(StickSlipError, ValueError):
 
 class OrbitError(StickSlipError, RuntimeError):
     """A periodic orbit or Lyapunov exponent could not be computed (the message says why)."""
+
+
+class SteadySlidingOrbitError(OrbitError):
+    """Shooting converged onto steady sliding (the equilibrium solves the shooting equations for
+    any period), not a cycle."""
 
 
 class ContinuationError(OrbitError):

@@ -107,7 +107,7 @@ def test_bad_model_input_is_one_line(args, words, tmp_path, monkeypatch):
 @pytest.mark.parametrize("edit, words", [
     (("mass = [[1.0]]", "mass = [[-1.0]]"), "mass"),
     (("mass = [[1.0]]", ""), "mass"),
-    (('law = "exponential"', 'law = "stribeck"'), "stribeck"),
+    (('law = "exponential"', 'law = "dahl"'), "dahl"),
     (("normal_force = 1.0", "normal_force = 0.0"), "normal_force"),
     (("damping = [[0.1]]", "damping = [[0.1, 0.2]]"), "damping"),
     (("mu_k = 0.5", 'mu_k = "half"'), "mu_k"),

@@ -25,7 +25,7 @@ ORBIT_KEYS = {"out", "figure", "model", "period_s", "frequency_hz", "stick_phase
               "max_nontrivial_multiplier_abs", "trivial_multiplier_error", "stable", "monodromy", "iterations",
               "residual", "wall_time_s", "compile_time_s"}
 LYAPUNOV_KEYS = {"out", "figure", "model", "method", "t_transient_s", "t_average_s", "exponents", "largest",
-                 "stick_phases", "wall_time_s", "compile_time_s"}
+                 "stick_phases", "wall_time_s", "compile_time_s", "seed", "t_frame_s"}
 
 
 def _one_error_line(res, message):
@@ -62,6 +62,10 @@ def test_orbit_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
     (["--rtol", "nan"], "rtol = nan must be a finite number > 0"),
     (["--slip-band", "-1"], "slip_band = -1.0 must be a finite speed > 1e-13 m/s"),
     (["--method", "qr"], "--method qr: choose one of variational, finite-difference"),
+    (["--seed", "-1"], "--seed -1: give an integer >= 0"),
+    (["--seed", "two"], "--seed"),
+    (["--t-frame", "-1"], "--t-frame -1.0: give a finite time >= 0 [s]"),
+    (["--t-frame", "nan"], "--t-frame nan: give a finite time >= 0 [s]"),
     (["--out", "l.csv"], "--out l.csv: give a path ending in .nc"),
     (["--model", "xyz"], "unknown model 'xyz'"),
     (["--config", "missing.toml"], "missing.toml"),
@@ -165,6 +169,15 @@ def test_orbit_and_lyapunov_of_a_model_file(tmp_path):
     ex = json.loads(res.output)["exponents"]
     ref = lyapunov_spectrum("belt", {"x": 0.0, "dx": 1.5}, t_transient=20.0, t_average=60.0)
     assert np.allclose(ex, ref.exponents, rtol=1e-12)
+    res = runner.invoke(app, ["lyapunov", "--model", "belt", "--ic", "x=0,dx=1.5", "--t-transient", "20",
+                              "--t-average", "60", "--seed", "7", "--t-frame", "0", "--out", str(ly), "--overwrite",
+                              "--json", "--no-plot"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.output)
+    assert summary["seed"] == 7 and summary["t_frame_s"] == 0.0
+    ref = lyapunov_spectrum("belt", {"x": 0.0, "dx": 1.5}, t_transient=20.0, t_average=60.0, seed=7, t_frame=0.0)
+    assert np.allclose(summary["exponents"], sorted(ref.exponents, reverse=True), rtol=1e-12)
+    assert not np.allclose(summary["exponents"], ex, rtol=1e-12)  # another frame, another finite-time estimate
 
 
 @pytest.mark.parametrize("cmd, args, message", [
@@ -178,3 +191,28 @@ def test_model_file_bad_input_is_one_line_and_exit_2(tmp_path, cmd, args, messag
     res = runner.invoke(app, [cmd, *args, "--out", str(tmp_path / "o.nc"), "--search-time", "1"]
                         if cmd == "orbit" else [cmd, *args, "--out", str(tmp_path / "o.nc")])
     _one_error_line(res, message)
+
+
+def test_orbit_that_converges_onto_steady_sliding_is_refused_in_one_line(tmp_path):
+    """The two-mass belt from rest: shooting from the 59.9 s start run's crossings converges onto
+    steady sliding (tests/orbits/test_special_points.py shows independently that a run from such a
+    state barely moves); it is refused as such, exit 2, nothing written."""
+    from pathlib import Path
+
+    model = Path(__file__).parents[1] / "orbits" / "two_mass_belt.toml"
+    out = tmp_path / "o.nc"
+    res = runner.invoke(app, ["orbit", "--model", str(model), "--ic", "zero", "--search-time", "59.9",
+                              "--period-multiplicity", "2", "--no-plot", "--json", "--out", str(out)])
+    assert res.exit_code == 2, res.output
+    assert res.stdout == "" and len(res.stderr.strip().splitlines()) == 1
+    assert "converged onto steady sliding" in res.stderr and "--search-time" in res.stderr
+    assert not out.exists()
+
+
+def test_a_negative_return_time_suggests_another_section():
+    from stickslip.errors import OrbitError
+    from stickslip.model.library import load_model
+    from stickslip.orbits.section import flow
+
+    with pytest.raises(OrbitError, match=r"T = -0\.836 s is not positive.*--section on the command line"):
+        flow(load_model("impact-oscillator"), np.zeros(4), -0.836, rtol=1e-10, atol=1e-13)

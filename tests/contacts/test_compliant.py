@@ -57,6 +57,21 @@ def test_undamped_stop_gives_the_piecewise_linear_period():
     assert traj.steady.open_fraction == pytest.approx(math.pi / (math.pi + math.pi / 2), abs=0.02)
 
 
+def test_the_open_fraction_of_a_periodic_run_is_the_cycle_s():
+    """Periodic in y (flights of π, contacts of π/√(1+k)): the summary takes its fractions over the
+    whole periods that end the window, so the open fraction is the cycle's π / (π + π/2) = 2/3
+    (measured 5e-13 off); over the 60-s window itself, which holds 12.7 periods, it is not."""
+    traj = stickslip.simulate(bouncer(3.0), 120.0, ic={"y": -0.5}, rtol=1e-11, atol=1e-13)
+    steady = traj.steady
+    assert steady.periodic and 1.0 / steady.fundamental_frequency_hz == pytest.approx(1.5 * math.pi, rel=1e-9)
+    assert steady.open_fraction == pytest.approx(2.0 / 3.0, abs=1e-9)
+    assert steady.contact_open_fractions[0] == steady.open_fraction
+    close, opened = events(traj)
+    flights = [(a, close[close > a][0] if np.any(close > a) else traj.t[-1]) for a in opened]
+    window = sum(max(0.0, min(b, steady.t_to) - max(a, steady.t_from)) for a, b in flights)
+    assert abs(window / (steady.t_to - steady.t_from) - 2.0 / 3.0) > 1e-3  # the part period's bias
+
+
 def damped_cycle(k, c, v0):
     """One contact phase and flight of the damped stop, by hand: closing at y = 0 with ẏ = v0 > 0,
     y = (v0/ωd) e^(−a t) sin ωd t (a = c/2, ωd = √(1 + k − a²)) until λ = k y + c ẏ = 0, i.e.

@@ -97,8 +97,8 @@ def test_the_lift_off_cycle_period_amplitude_and_open_fraction(runs):
 
 def test_a_sweep_over_mu_reports_the_open_fraction_and_openings(runs):
     """A sweep of hoffmann over μ: below the onset (μ = 0.5) the contact never opens; at μ = 1.3
-    the point's run is the one above, and its open fraction and openings over the last 100 s
-    are the reference's flights cut to that window (pressed models keep their columns as before)."""
+    the point's run is the one above, and its open fraction over the whole periods that end the
+    last 100 s is the reference's flights cut to them (pressed models keep their columns as before)."""
     traj, ref, switches = runs
     model = stickslip.load_model("hoffmann").replace(**{"damping.x.x": C, "damping.y.y": C})
     result = stickslip.sweep({"contact.0.friction.mu_k": [0.5, MU], "perturb_x": [0.01]}, model, executor="serial",
@@ -107,10 +107,14 @@ def test_a_sweep_over_mu_reports_the_open_fraction_and_openings(runs):
     closed, lifting = ds.sel({"contact.0.friction.mu_k": 0.5}), ds.sel({"contact.0.friction.mu_k": MU})
     assert float(closed["open_fraction"]) == 0.0 and float(closed["openings"]) == 0.0
     t0, t1 = T_END - 100.0, traj.t[-1]
+    steady = traj.steady_state(t0)  # periodic: the fractions are over the whole periods ending at t1
+    assert steady.periodic
+    period = 1.0 / steady.fundamental_frequency_hz
+    whole = t1 - (t1 - steady.t_from) // period * period
     opens, closes = switches[OPEN], switches[CLOSE]
     flights = [(a, closes[closes > a][0] if np.any(closes > a) else t1) for a in opens]
-    open_time = sum(max(0.0, min(b, t1) - max(a, t0)) for a, b in flights)
-    assert float(lifting["open_fraction"]) == pytest.approx(open_time / (t1 - t0), abs=1e-5)
+    open_time = sum(max(0.0, min(b, t1) - max(a, whole)) for a, b in flights)
+    assert float(lifting["open_fraction"]) == pytest.approx(open_time / (t1 - whole), abs=1e-5)
     assert float(lifting["openings"]) == np.sum((opens > t0) & (opens <= t1)) > 0
     belt = stickslip.sweep({"contact.0.drive": [1.0]}, "belt", executor="serial", t_end=2.0)
     assert "open_fraction" not in belt.dataset and "openings" not in belt.dataset

@@ -72,3 +72,37 @@ def test_stability_map_of_the_constrained_eigenproblem_matches_the_hand_solution
         found = smap.boundary[0, i][np.isfinite(smap.boundary[0, i])]
         np.testing.assert_allclose(found, [root], atol=1e-8)
         assert smap.boundary_direction[0, i, 0] == -1  # stable above the boundary: μ' → 0 as V grows
+
+
+def painleve(mu, kx=1.0, tangent=(1.0, 1.0)):
+    """W = [0, 1] and G = [1, 1] (M = I), sliding forward (e = +1): the normal force's equation has
+    the pivot D = W·(W − μ G e) = 1 − μ, which is ≤ 0 for μ ≥ 1 (Painlevé)."""
+    from stickslip.model.model_file import model_from_spec
+
+    return model_from_spec({
+        "name": "painleve", "dofs": ["x", "y"], "mass": [[1.0, 0.0], [0.0, 1.0]],
+        "damping": [[0.0, 0.0], [0.0, 0.0]], "stiffness": [[kx, 0.0], [0.0, 1.0]], "force": [0.0, -1.0],
+        "contact": [{"tangent": [list(tangent)], "drive": [-1.0], "gap": 0.0, "gap_gradient": [0.0, 1.0],
+                     "normal": {"law": "rigid", "restitution": 0.0},
+                     "friction": {"law": "coulomb", "mu_k": mu, "delta_mu": 0.0}}]})
+
+
+@pytest.mark.parametrize("mu", [1.0, 1.5])
+@pytest.mark.parametrize("kx", [0.0, 1.0])
+def test_a_painleve_contact_is_named_as_the_paradox_not_a_fold(mu, kx):
+    with pytest.raises(EquilibriumError) as caught:
+        model_stability(painleve(mu, kx))
+    text = str(caught.value)
+    assert "Painlevé paradox" in text and "no consistent value, or two" in text
+    assert "fold" not in text and "Newton" not in text and "\n" not in text
+    assert "≤ 0" in text
+
+
+def test_a_rigid_slider_without_stiffness_along_the_contact_is_not_a_fold():
+    """D = 1 − 0.5 > 0 (no Painlevé), but x has no spring: nothing balances the friction along x."""
+    with pytest.raises(EquilibriumError) as caught:
+        model_stability(painleve(0.5, kx=0.0))
+    text = str(caught.value)
+    assert "no position with the rigid contacts closed balances the forces" in text
+    assert "fold" not in text and "Newton" not in text and "Painlevé" not in text
+

@@ -123,7 +123,7 @@ def test_mass_not_symmetric_positive_definite(tmp_path, mass):
     refused(write(tmp_path, spec), "mass")
 
 
-@pytest.mark.parametrize("law", ["stribeck", "Coulomb", ""])
+@pytest.mark.parametrize("law", ["dahl", "Coulomb", ""])
 def test_unknown_law(tmp_path, law):
     spec = copy.deepcopy(BASES[0])
     spec["contact"][0]["friction"]["law"] = law
@@ -185,7 +185,7 @@ def test_file_errors_name_the_file(tmp_path):
 def test_set_paths_are_checked():
     model = load_model("popp-stelter")
     for path, value, named in [("mass.9.0", 1.0, "mass.9.0"), ("bogus", 1.0, "bogus"), ("mass", 1.0, "mass"),
-                               ("contact.0.friction.law", "stribeck", "law"), ("mass.0.0", "abc", "mass[0][0]"),
+                               ("contact.0.friction.law", "dahl", "law"), ("mass.0.0", "abc", "mass[0][0]"),
                                ("contact.1.normal_force", 0.0, "normal_force"), ("mass.x1.x1", -2.0, "mass")]:
         with pytest.raises(ModelError) as info:
             model.replace(**{path: value})

@@ -15,6 +15,7 @@ import pytest
 from numba import typeof
 
 from stickslip.model import physics
+from stickslip.model.kernel_cache import patch_tag
 
 MODULE = """
 from typing import NamedTuple
@@ -73,7 +74,8 @@ def test_a_signature_without_user_code_keeps_numbas_key():
     class Plain(NamedTuple):  # no frame registered: the package's kernels keep their cache
         a: float
 
-    assert len(_index_key(Plain(1.0))) == 3  # (signature, machine, code hashes): numba's own
+    key = _index_key(Plain(1.0))  # (signature, machine, code hashes): numba's own, and the patches' tag
+    assert len(key) == 4 and key[3] == patch_tag()
 
 
 @pytest.mark.slow

@@ -17,7 +17,9 @@ import pytest
 
 from stickslip import simulate
 from stickslip.model.library import load_model
+from stickslip.errors import SteadySlidingOrbitError
 from stickslip.orbits import periodic_orbit
+from stickslip.orbits import layout
 from stickslip.orbits import special_points as S
 from stickslip.orbits.continuation import (Branch, SteadySlidingError, circle_crossings, continue_orbit, load_branch,
                                            start_orbit_from_run, start_run)
@@ -119,7 +121,7 @@ def test_slip_branch_that_shrinks_onto_the_equilibrium_ends_there(monkeypatch, t
     that stop reason and no special point after its last orbit (the period doubling at v0 = 1/3 is
     kept); written and resumed, the file holds the same branch."""
     install(monkeypatch, transitions=SLIP)
-    monkeypatch.setattr(S, "ORBIT_MIN_SIZE", 0.1)
+    monkeypatch.setattr(layout, "ORBIT_MIN_SIZE", 0.1)
 
     def equilibrium(system):
         s = np.zeros(12)
@@ -127,7 +129,7 @@ def test_slip_branch_that_shrinks_onto_the_equilibrium_ends_there(monkeypatch, t
         s[5] = SIGMA[1] * 0.1 * system.parameters["alpha"] / 5.0
         return s
 
-    monkeypatch.setattr(S, "equilibrium_state", equilibrium)
+    monkeypatch.setattr(layout, "equilibrium_state", equilibrium)
     opts = dict(start=constructed_orbit(stick_phases=0), param="alpha", step=0.05, max_step=0.2, max_points=200,
                 bounds=(4.0, 20.0), amplitude=False)
     b = continue_orbit(**opts)
@@ -160,7 +162,9 @@ def test_start_on_steady_sliding_is_refused_as_such(tmp_path):
     continuation refuses it as steady sliding at drive 0.2, and writes nothing."""
     belt = load_model(TWO_MASS)
     run = start_run(belt, "zero", t_end=60.0)
-    orbit = start_orbit_from_run(run)
+    with pytest.raises(SteadySlidingOrbitError, match="shooting converged onto steady sliding"):
+        start_orbit_from_run(run)
+    orbit = start_orbit_from_run(run, steady_sliding="keep")
     # independent of the shooting: a run from its state barely moves (a cycle's x1 spans ~0.05 m); it
     # is the unstable equilibrium (multipliers ~3.3 a period), so its 1e-12 m offset grows to ~3e-8 m in 5 s
     traj = simulate(belt, 5.0, ic=orbit.state, sample_rate=200.0)

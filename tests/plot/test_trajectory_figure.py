@@ -91,3 +91,24 @@ def test_stick_limit_follows_a_normal_force_that_depends_on_the_state():
     shown = traj.t >= traj.t[-1] - 10.0
     assert limit == pytest.approx(mu_s * (1.0 + traj.states[shown, 1]), rel=1e-12)
     assert np.ptp(limit) > 0.01
+
+
+def test_the_stick_limit_is_named_by_the_contact_s_normal_force():
+    """μs N for a pressed contact; μs λ for a unilateral one (its contact force), and for a rigid
+    one λ is named as the multiplier it is; the limit drawn is μs × that normal force."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from stickslip import load_model
+    from stickslip.plot.trajectory import friction_lines, stick_limit_label
+
+    friction = np.array([[0.3, 0.0], [-0.2, 0.0], [0.0, 0.0]])
+    normal = np.array([[1.0], [2.0], [0.0]])
+    for name, words in (("belt", "μs N"), ("sprag-slip", "μs λ"), ("impact-oscillator", "μs λ (multiplier)")):
+        model = load_model(name)
+        assert stick_limit_label(model.contacts[0]) == words
+        [drawn] = friction_lines(SimpleNamespace(system=model, friction=friction, normal_force=normal))
+        assert drawn["label"] == "|F|" and drawn["limit_label"] == words
+        assert drawn["force"] == pytest.approx([0.3, 0.2, 0.0], abs=0)
+        assert drawn["limit"] == pytest.approx(model.contacts[0].friction.mu_s * normal[:, 0], abs=0)

@@ -34,9 +34,12 @@ class SteadyState:
     period_multiplicity : int
         Section crossings (peaks) per period (0 when not periodic).
     stick_fraction : float
-        Fraction of the window in which some contact sticks [-].
+        Fraction of the window in which some contact sticks [-]. When the motion is periodic, of
+        the whole periods that end the window (the largest number of periods that fits it), so
+        that it is the orbit's own fraction rather than one biased by a part period.
     contact_stick_fractions : tuple of float
-        Fraction of the window in which each contact sticks [-], in the model's contact order.
+        Fraction of the window (whole periods when periodic) in which each contact sticks [-], in
+        the model's contact order.
     n_transitions : int
         Stick↔slip transitions inside the window.
     coordinate : str
@@ -44,16 +47,19 @@ class SteadyState:
     minimum, maximum : float
         Extremes of the coordinate in the window [its unit] (from the uniform samples).
     open_fraction : float or None
-        Fraction of the window in which some unilateral contact is open [-] (None for a model
-        whose contacts are all pressed).
+        Fraction of the window (whole periods when periodic, as ``stick_fraction``) in which some
+        unilateral contact is open [-] (None for a model whose contacts are all pressed).
     contact_open_fractions : tuple of float
-        Fraction of the window in which each contact is open [-] (empty for a model whose contacts
-        are all pressed).
+        Fraction of the window (whole periods when periodic) in which each contact is open [-]
+        (empty for a model whose contacts are all pressed).
     impacts : int or None
         Impacts of rigid contacts in the window (None for a model without rigid contacts).
     max_impact_speed : float or None
         Largest normal speed |ġ⁻| at those impacts [m/s] (0 without impacts; None for a model
-        without rigid contacts).
+        without rigid contacts; NaN where the states of some of the window's impacts were not
+        kept: :attr:`max_impact_speed_reason` then says so).
+    max_impact_speed_reason : str
+        Why :attr:`max_impact_speed` is undefined (empty where it is defined).
     """
 
     t_from: float
@@ -72,6 +78,7 @@ class SteadyState:
     contact_open_fractions: tuple = ()
     impacts: int | None = None
     max_impact_speed: float | None = None
+    max_impact_speed_reason: str = ""
 
     @property
     def frequency_hz(self) -> float:
@@ -86,6 +93,8 @@ class SteadyState:
             del d["open_fraction"], d["contact_open_fractions"]
         if self.impacts is None:  # no rigid contacts: no impacts
             del d["impacts"], d["max_impact_speed"]
+        if not self.max_impact_speed_reason:
+            del d["max_impact_speed_reason"]
         d[f"{self.coordinate}_min"] = d.pop("minimum")
         d[f"{self.coordinate}_max"] = d.pop("maximum")
         return d
@@ -144,8 +153,21 @@ def summarize(t, states, mode, transitions, t_from, *, n_contacts: int, coordina
     at_rest = per.amplitude < REST_AMPLITUDE
     periodic = per.periodic and not at_rest
     contacts = np.asarray(transitions.contact)
-    stick, each = stick_time(t0, t1, mode0, tt, kinds, contacts, n_contacts)
-    opened, each_open = open_time(t0, t1, mode0, tt, kinds, contacts, n_contacts) if unilateral else (None, ())
+    # the fractions: over whole periods ending at t1 when periodic (a part period biases them)
+    f0 = t1 - (t1 - t0) // per.period_s * per.period_s if periodic else t0
+    j = int(np.searchsorted(ts, f0, side="right")) - 1  # the last sample at or before f0
+
+    def phase(time_in):
+        """Time in a phase within [f0, t1]: within [ts[j], t1] less within [ts[j], f0] (the mode
+        is known at samples)."""
+        after = time_in(float(ts[j]), t1, int(mode[sel][j]), tt, kinds, contacts, n_contacts)
+        before = time_in(float(ts[j]), f0, int(mode[sel][j]), tt, kinds, contacts, n_contacts)
+        return after[0] - before[0], np.asarray(after[1], float) - np.asarray(before[1], float)
+
+    stick, each = phase(stick_time) if periodic else stick_time(t0, t1, mode0, tt, kinds, contacts, n_contacts)
+    opened, each_open = (None, ()) if not unilateral else (
+        phase(open_time) if periodic else open_time(t0, t1, mode0, tt, kinds, contacts, n_contacts))
+    span = t1 - f0
     return SteadyState(
         t_from=t0,
         t_to=t1,
@@ -153,23 +175,31 @@ def summarize(t, states, mode, transitions, t_from, *, n_contacts: int, coordina
         dominant_frequency_hz=math.nan if at_rest else spectral_peak(ts, phi),
         periodic=bool(periodic),
         period_multiplicity=int(per.multiplicity) if periodic else 0,
-        stick_fraction=stick / (t1 - t0),
-        contact_stick_fractions=tuple(float(x) / (t1 - t0) for x in each),
+        stick_fraction=stick / span,
+        contact_stick_fractions=tuple(float(x) / span for x in each),
         n_transitions=int(window.sum()),
         coordinate=name,
         minimum=float(phi.min()),
         maximum=float(phi.max()),
-        open_fraction=None if opened is None else opened / (t1 - t0),
-        contact_open_fractions=tuple(float(x) / (t1 - t0) for x in each_open),
+        open_fraction=None if opened is None else opened / span,
+        contact_open_fractions=tuple(float(x) / span for x in each_open),
         **_impacts_in(impacts, t0, t1),
     )
 
 
 def _impacts_in(impacts, t0: float, t1: float) -> dict:
-    """``impacts`` and ``max_impact_speed`` of the impacts in (t0, t1] (nothing without rigid contacts)."""
+    """``impacts`` and ``max_impact_speed`` of the impacts in (t0, t1] (nothing without rigid
+    contacts). An impact whose state before was not kept has speed NaN: the maximum is then
+    unknown (NaN, with the reason), not the maximum of the others."""
     if impacts is None:
         return {}
     times, speeds = (np.asarray(a, dtype=float) for a in impacts)
     inside = (times > t0) & (times <= t1)
+    unknown = int(np.isnan(speeds[inside]).sum())
+    if unknown:
+        return {"impacts": int(inside.sum()), "max_impact_speed": math.nan,
+                "max_impact_speed_reason": f"the states of {unknown} of the window's {int(inside.sum())} impacts "
+                                           "were not kept (a run keeps the states of its most recent transitions "
+                                           "only); move the steady window later or run shorter"}
     return {"impacts": int(inside.sum()),
             "max_impact_speed": float(np.abs(speeds[inside]).max()) if inside.any() else 0.0}

@@ -30,7 +30,8 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
         ``n_transitions``, ``contacts`` (by name: each contact's ``stick_fraction`` and
         ``n_transitions`` stick↔slip in the window); with unilateral contacts also
         ``open_fraction`` (some contact open) and, by contact, ``open_fraction`` and ``openings``;
-        with rigid contacts ``impacts`` and ``max_impact_speed`` [m/s] in the window;
+        with rigid contacts ``impacts`` and ``max_impact_speed`` [m/s] in the window (NaN, with
+        ``max_impact_speed_reason``, where it is unknown);
         ``coordinate`` (the model's observed dof) and its extremes ``<coordinate>_min``,
         ``<coordinate>_max`` in the window (the plates: ``phi_min``, ``phi_max``); ``steps``, ``wall_time_s``, ``method``; ``settle``
         (the cap and steps of :func:`~.settle.simulate_until_settled`) when the run was extended
@@ -49,6 +50,8 @@ def run_summary(traj: Trajectory, verdict: Attractor | None = None) -> dict:
     if s.impacts is not None:
         out["impacts"] = s.impacts
         out["max_impact_speed"] = s.max_impact_speed
+        if s.max_impact_speed_reason:
+            out["max_impact_speed_reason"] = s.max_impact_speed_reason
     if "settle" in traj.options:
         out["settle"] = traj.options["settle"]
     return out

@@ -6,7 +6,8 @@
 =================  ======================================================================
 ``equilibrium``    at rest, or a slip-only oscillation decaying in every free coordinate
                    (:func:`~stickslip.analysis.classify.classify_response`), where steady
-                   sliding is linearly stable (:func:`stickslip.stability`)
+                   sliding is linearly stable (:func:`stickslip.stability`; a marginal centre,
+                   Re λ = 0 within the solver's accuracy, leaves the run unsettled)
 ``periodic``       the maxima of the coordinate repeat with k crossings per period and the
                    window shows no drift (:mod:`stickslip.analysis.period`); for k ≥ 2 only
                    when the shot k-periodic orbit confirms it (:func:`.confirm.confirm_period`)
@@ -40,6 +41,7 @@ from ..analysis.outcome import is_stick_slip, outcome_code
 from ..errors import StickSlipError
 from ..integrate.status import Status
 from ..stability import stability
+from ..stability.verdict import verdict_text
 from .confirm import (LYAPUNOV_START_S, ORBIT_PERIODS, QUASI_RATE, QUASI_SPAN_S, confirm_period, lyapunov_sign,
                       span_change)
 
@@ -191,8 +193,10 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
         stab = cache["stability"]
         if stab.get("stable"):
             return verdict("equilibrium", stability=stab)
-        seen = "at rest" if c.signal == "at-rest" else "a slip-only oscillation decays"
-        why = stab.get("reason") or f"steady sliding is linearly unstable (max Re λ = {stab['max_real_part']:.3g} 1/s)"
+        seen = "at rest" if c.signal == "at-rest" else (
+            f"a slip-only oscillation's amplitude fell in the window (last quarter / first "
+            f"{evidence.get('amplitude_ratio', math.nan):.4g})")
+        why = stab.get("reason") or f"steady sliding is {verdict_text(stab['max_real_part'], stab['tolerance'])}"
         return verdict("unsettled", stability=stab, reason=f"{seen}, but {why}")
     if c.signal == "periodic":
         k, period = c.multiplicity, c.period_s
@@ -266,4 +270,5 @@ def _equilibrium_stability(traj) -> dict:
         res = stability(traj.system)
     except (StickSlipError, ArithmeticError, np.linalg.LinAlgError) as exc:
         return {"stable": False, "reason": f"the equilibrium's stability could not be computed ({exc})"}
-    return {"stable": bool(res.stable), "max_real_part": float(res.max_real_part)}
+    return {"stable": bool(res.stable), "verdict": res.verdict, "max_real_part": float(res.max_real_part),
+            "tolerance": res.tolerance}

@@ -41,6 +41,7 @@ from ..inputs import read_regular_file
 from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.library.two_plates import is_plates
+from ..model.numba_patches import end_run
 from ..model.parameters import Parameters
 from ..parallel import compile_processes
 from ._compiling import compile_notice
@@ -119,6 +120,22 @@ def report_interrupt() -> None:
     if not _reported[0]:
         _reported[0] = True
         err_console.print(Text(f"interrupted: {on_disk()}"))
+
+
+def _end_interrupted() -> None:
+    """End the process now, exit status 130, after a Ctrl-C was reported. What the command keeps is
+    written and closed by then. Ending through the interpreter's shutdown instead would finalise what
+    the interrupt left half built (numba's compiler objects, when it came during a compilation: the
+    process could crash at exit) and could deliver a Ctrl-C that a finaliser had swallowed
+    (:mod:`stickslip._startup` delivers it again a moment later) a second time, ending the process
+    by the signal after its one line."""
+    end_run()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(130)
 
 
 def _interrupted_by_ctrl_c(exc: BaseException) -> bool:
@@ -223,6 +240,10 @@ class _Typer(typer.Typer):
         _startup.hold()
         try:
             return super().__call__(*args, **kwargs)
+        except SystemExit as exc:
+            if exc.code == 130:  # the command line's own process, after a Ctrl-C
+                _end_interrupted()
+            raise
         finally:
             _startup.release(raise_pending=False)  # main has released it, unless it never ran
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,6 +14,7 @@ from rich.text import Text
 from ..files import netcdf_writer, write_output
 from ._app import CLIError, check_choice, check_finite, check_nc_path, check_output, console
 from ._compiling import time_text
+from ._json import print_json
 
 __all__ = ["Band", "report_band"]
 
@@ -100,8 +100,8 @@ class Band:
 def report_band(result, timing, written: list[Path], as_json: bool) -> None:
     """Print the band's eigenvalues: a JSON line, or the tables."""
     if as_json:
-        print(json.dumps({**result.summary(), "written": [str(p) for p in written], "wall_time_s": timing.wall_s,
-                          "compile_time_s": timing.compile_s}))
+        print_json({**result.summary(), "written": [str(p) for p in written], "wall_time_s": timing.wall_s,
+                     "compile_time_s": timing.compile_s})
         return
     modes = Table(title=f"steady sliding of model {result.model}: eigenvalues with |Im λ| ≤ {result.max_frequency:.6g} "
                         f"rad/s ({result.method}; one per conjugate pair), by growth rate")
@@ -130,8 +130,16 @@ def report_band(result, timing, written: list[Path], as_json: bool) -> None:
     console.print(f"{len(result.dofs)} dofs, {len(result.contact_names)} contacts; every eigenvalue with |λ| ≤ "
                   f"{result.radius:.6g} rad/s found"
                   + ("" if count is None else f" (the frictionless structure has {count} modes there)"), style="dim")
-    verdict = Text("stable", style="green") if result.stable else Text("unstable", style="bold red")
     console.print(Text.assemble(f"max real part in the band {result.max_real_part:.6g} 1/s: steady sliding is ",
-                                verdict))
+                                verdict_words(result)))
     tail = "" if not written else "; wrote " + ", ".join(str(p) for p in written)
     console.print(f"wall time {time_text(timing.wall_s, timing.compile_s)}{tail}", style="dim")
+
+
+def verdict_words(result) -> Text:
+    """The verdict of a stability result (dense or band) in colour: stable, unstable, or marginal
+    with what that means (a real part 0 within the eigenvalue solver's accuracy)."""
+    if result.verdict == "marginal":
+        return Text(f"marginal: Re λ = 0 within the eigenvalue solver's accuracy ({result.tolerance:.2g} 1/s), a "
+                    "centre the linearisation neither damps nor grows", style="yellow")
+    return Text(result.verdict, style="green" if result.verdict == "stable" else "bold red")

@@ -8,7 +8,6 @@ with one line saying how many states the output holds (the journal keeps them fo
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import List, Optional
 
@@ -24,6 +23,7 @@ from ..plot.basins import save_basins_figure
 from ._app import CLIError, app, build_system, check_resumable_output, console, journal_of, parse_assignments
 from ._compiling import Timing, time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._kept import keeps, on_interrupt
 from ._options import Model, SetItems, Study, Tolerances
 from ._outputs import draw_figure
@@ -103,7 +103,7 @@ def basins(
     figure = draw_figure(out, lambda tmp: save_basins_figure(result, tmp), skip=study.no_plot,
                          overwrite=replace_figure, inputs=inputs)
     if as_json:
-        print(json.dumps({**result.to_json(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
+        print_json({**result.to_json(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s})
     else:
         _print_summary(result, out, figure, timing)
 

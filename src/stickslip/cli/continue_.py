@@ -6,7 +6,6 @@ figure; no physics here.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import List, Optional
@@ -23,6 +22,7 @@ from ._app import (CLIError, app, check_below_one, check_finite, check_positive,
                    error_line, exact, note_line, resumable_holds)
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._kept import keeps, keeps_figure
 from ._options import (ContinuedPoint, JsonSummary, Model, ModelChanges, NoPlot, OrbitRtol, OrbitSearch, Restart,
                        ResumableOut, SlipBand, Tol)
@@ -151,7 +151,7 @@ def continue_command(
     }
     steady = branch.stop_reason.startswith("steady sliding")
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
     else:
         _print_summary(branch, summary, param, out)
     if steady:  # the orbits before it are a result, but the branch did not end where it should

@@ -4,7 +4,6 @@ coalescences marked (computing in :mod:`stickslip.stability.mode_coupling`, figu
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +17,7 @@ from ..stability.mode_coupling import mode_coupling as run_mode_coupling
 from ._app import CLIError, app, build_system, check_choice, check_finite, check_outputs, console
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import JsonSummary, Model, ModelChanges, Outputs
 from ._outputs import write_result
 from .sweep import parse_values
@@ -52,9 +52,9 @@ def mode_coupling(
     figure = write_result(outputs, lambda: netcdf_writer(result.to_xarray()), holds=f"the diagram is in {out}",
                           inputs=inputs, draw=lambda tmp: save_figure(plot_mode_coupling(result), tmp))
     if as_json:
-        print(json.dumps({"out": str(out), "figure": None if figure is None else str(figure), "onsets": result.onsets,
-                          "critical_mu": result.critical_mu, "wall_time_s": timing.wall_s,
-                          "compile_time_s": timing.compile_s}))
+        print_json({"out": str(out), "figure": None if figure is None else str(figure), "onsets": result.onsets,
+                     "critical_mu": result.critical_mu, "wall_time_s": timing.wall_s,
+                     "compile_time_s": timing.compile_s})
         return
     table = Table(title=f"mode coupling of model {result.model}: onsets of instability (Re λ through 0) in "
                         f"{values[0]:g} ≤ μ ≤ {values[-1]:g}")

@@ -8,7 +8,6 @@ nodes.12.gap``, ``force.u21``) one row with the range of their values. ``--json`
 
 from __future__ import annotations
 
-import json
 import re
 from typing import Optional
 
@@ -18,6 +17,7 @@ from rich.text import Text
 
 from ..model.library import library, load_model, plates_variant, two_plates
 from ._app import app, console
+from ._json import print_json
 
 #: Lists longer than this are shown as their count, head and tail.
 LIST_LIMIT = 12
@@ -96,7 +96,7 @@ def models(
     if model is None:
         names = library()
         if as_json:
-            print(json.dumps(names))
+            print_json(names)
             return
         table = Table(title="stickslip model library (--model NAME; or a model file, --model FILE.toml)")
         table.add_column("name")
@@ -112,11 +112,11 @@ def models(
     if as_json:
         counts = {"dofs": system.n, "states": len(system.state_names), "contacts": len(system.contacts),
                   "parameters": len(system.parameters)}
-        print(json.dumps(system.describe() | {
+        print_json(system.describe() | {
             "states": list(system.state_names), "counts": counts,
             # every natural frequency needs the dense M⁻¹K: a sparse model's lowest modes come from
             # its sparse form (stickslip stability --max-frequency, docs/fe.md)
-            "natural_frequencies_hz": system.natural_frequencies().tolist() if dense else None}))
+            "natural_frequencies_hz": system.natural_frequencies().tolist() if dense else None})
         return
     _show(system)
 

@@ -7,7 +7,6 @@ Parse → library call (:func:`stickslip.orbits.periodic_orbit`,
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -16,8 +15,10 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..errors import SteadySlidingOrbitError
 from ..files import netcdf_writer
 from ..orbits import lyapunov_spectrum, periodic_orbit, resolve_section
+from ..orbits.lyapunov import FRAME_TIME
 from ..orbits.continuation import start_run
 from ..orbits.problem import METHODS as MONODROMY_METHODS
 from ..orbits.problem import stick_summary
@@ -26,6 +27,7 @@ from ..plot.orbits import save_lyapunov_spectrum_figure, save_orbit_figure
 from ._app import CLIError, app, build_system, check_below_one, check_choice, check_outputs, check_positive, console
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import (JsonSummary, Model, ModelChanges, OperatingPoint, OrbitRtol, OrbitSearch, Outputs, SlipBand,
                        StartIc, Tol)
 from ._outputs import write_result
@@ -86,7 +88,7 @@ def orbit_command(
     outputs: Outputs = Outputs(out=Path("orbit.nc")),
     as_json: JsonSummary = False,
 ) -> None:
-    """Find a periodic orbit by Newton shooting on the φ-maximum section, with its Floquet multipliers.
+    """Find a periodic orbit by Newton shooting on a Poincaré section (default: the maximum of the model's observed coordinate, the plates' φ), with its Floquet multipliers.
 
     A run of --search-time seconds from --ic gives the guess (its last section crossings); Newton shooting converges it to --tol, and the monodromy matrix of the orbit gives the Floquet multipliers. Writes the orbit (section state, period, multipliers, monodromy) to --out and, beside it, φ over one period with the stick phases shaded and the multipliers with the unit circle.
     """
@@ -104,8 +106,14 @@ def orbit_command(
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     with timed() as timing:
         run = start_run(system, start, t_end=search.search_time, rtol=rtol)
-        orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol, tol=tol,
-                               monodromy=monodromy)
+        try:
+            orbit = periodic_orbit(None, run, section=sec, period_multiplicity=period_multiplicity, rtol=rtol,
+                                   tol=tol, monodromy=monodromy)
+        except SteadySlidingOrbitError:
+            x = system.dofs[system.observed_index]
+            raise CLIError(f"shooting from the start run (--ic {search.ic or 'default'}) converged onto steady sliding, "
+                           f"the equilibrium, not a cycle; start from a state on the cycle, e.g. --ic {x}=...,d{x}=..., "
+                           "or give a longer --search-time") from None
     one_period = orbit.trajectory(1.0)
     stick = stick_summary(one_period, orbit.period)
     figure = write_result(outputs, lambda: netcdf_writer(orbit.to_xarray()), holds=f"the orbit is in {out}",
@@ -122,7 +130,7 @@ def orbit_command(
         "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s,
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     table = Table(title=f"stickslip orbit ({model_label(orbit)})", show_header=False)
     table.add_row("period", f"{summary['period_s']:.10g} s ({summary['frequency_hz']:.8g} Hz)")
@@ -150,6 +158,10 @@ def lyapunov_command(
     method: str = typer.Option("variational", "--method", help="variational (saltation matrices) | "
                                "finite-difference (perturbed trajectories; works where the variational one refuses)."),
     rtol: OrbitRtol = 1e-10,
+    seed: int = typer.Option(0, "--seed", help="Seed of the random orthonormal frame the spectrum starts from "
+                             "(an integer >= 0)."),
+    t_frame: float = typer.Option(FRAME_TIME, "--t-frame", help="Time [s] after the transient in which the frame "
+                                  "turns before the averaging, nothing counted (>= 0; 0 averages from the start)."),
     slip_band: SlipBand = None,
     changes: ModelChanges = ModelChanges(),
     outputs: Outputs = Outputs(out=Path("lyapunov.nc")),
@@ -157,32 +169,37 @@ def lyapunov_command(
 ) -> None:
     """Lyapunov spectrum (Benettin–Shimada–Nagashima) of the attractor reached from --ic.
 
-    Runs --t-transient seconds from --ic, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
+    Runs --t-transient seconds from --ic, lets a random orthonormal frame (--seed) turn for --t-frame seconds, then averages over --t-average seconds. Writes the exponents and their running estimates to --out and, beside it, the convergence of each exponent over time. Directions collapsed by stick come out as large negative numbers (−∞ in exact arithmetic) and are left out of the figure.
     """
     start = parse_start(ic)
     # the command line's checks: the library refuses a method only after the transient run, and a
     # non-finite time in other words (t_end - t0 of a run, a memory estimate)
     check_positive({"--t-transient": t_transient, "--t-average": t_average})
     check_choice("--method", method, _LYAPUNOV_METHODS)
+    if seed < 0:
+        raise CLIError(f"--seed {seed}: give an integer >= 0")
+    if not (math.isfinite(t_frame) and t_frame >= 0.0):
+        raise CLIError(f"--t-frame {t_frame}: give a finite time >= 0 [s] (0 averages from the start)")
     system = model_system(model, changes, slip_band, **point.named())
     out, inputs = outputs.out, changes.inputs
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
     start = default_start(system) if start is None else start
     with timed() as timing:
         spectrum = lyapunov_spectrum(system, start, t_transient=t_transient, t_average=t_average, rtol=rtol,
-                                     method=method)
+                                     method=method, seed=seed, t_frame=t_frame)
     figure = write_result(outputs, lambda: netcdf_writer(spectrum.to_xarray()), holds=f"the spectrum is in {out}",
                           inputs=inputs, draw=lambda tmp: save_lyapunov_spectrum_figure(spectrum, tmp))
     ordered = spectrum.exponents  # λ1 ≥ … ≥ λk
     summary = {
         "out": str(out), "figure": None if figure is None else str(figure), "model": spectrum.model,
         "method": method, "t_transient_s": float(t_transient), "t_average_s": float(t_average),
+        "seed": seed, "t_frame_s": float(t_frame),
         "exponents": [_finite_or_none(x) for x in ordered], "largest": _finite_or_none(ordered[0]),
         "stick_phases": int(spectrum.stick_phases), "wall_time_s": timing.wall_s,
         "compile_time_s": timing.compile_s,
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     console.print(f"stickslip lyapunov: {model_label(spectrum)}, {method}",
                   soft_wrap=True)
@@ -192,7 +209,8 @@ def lyapunov_command(
     for i, lam in enumerate(ordered, start=1):
         table.add_row(str(i), f"{lam:+.6g}", style="bold red" if lam > 0 else None)
     console.print(table)
-    console.print(f"averaged over {t_average:g} s after a {t_transient:g} s transient from --ic {ic}; "
+    console.print(f"averaged over {t_average:g} s after a {t_transient:g} s transient from --ic {ic} and "
+                  f"{t_frame:g} s of the frame's turning (seed {seed}); "
                   f"{spectrum.stick_phases} stick phases; wall time {time_text(timing.wall_s, timing.compile_s)}",
                   soft_wrap=True)
     console.print(f"wrote {out}" + ("" if figure is None else f", {figure}"), soft_wrap=True)

@@ -3,7 +3,6 @@ and how far its steady-sliding eigenvalues are from the full model's. No physics
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Optional
 
@@ -15,6 +14,7 @@ from ..reduction.model_writer import output_paths
 from ._app import CLIError, app, build_system, check_choice, check_finite, check_output, console
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import Model, ModelChanges
 
 
@@ -70,7 +70,7 @@ def reduce(
                "check": None if report is None else report.summary(), "wall_time_s": timing.wall_s,
                "compile_time_s": timing.compile_s}
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     console.print(f"{method}: {system.n} dofs → {reduced.form.n} ({reduced.boundary.size} contact and loaded dofs "
                   f"kept, {reduced.frequencies.size} modes up to {reduced.frequencies[-1]:.6g} rad/s); wrote {out}")

@@ -12,7 +12,6 @@ stops without drawing the figure.
 from __future__ import annotations
 
 import functools
-import json
 import math
 from pathlib import Path
 from typing import Optional
@@ -35,6 +34,7 @@ from ._app import (CLIError, app, build_system, check_finite, check_outputs, che
                    given, note_line, warning_line)
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._kept import keeps, on_interrupt
 from ._options import Model, ModelChanges, NoPlot, Overwrite, Plates, SampleRate, Tolerances
 from ._outputs import draw_figure, prepare_outputs
@@ -262,7 +262,7 @@ def simulate(
         raise typer.Exit(1)
     summary = {**run_summary(traj, verdict), "compile_time_s": timing.compile_s}
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
     else:
         _print_summary(traj, summary, out if write else None, figure)
 
@@ -292,7 +292,8 @@ def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:
         (f"dominant frequency of {symbol}", "–" if dominant is None else f"{dominant:.6g} Hz"),
         ("stick fraction", f"{s.stick_fraction:.4f}"),
         *([("open fraction", f"{s.open_fraction:.4f}")] if s.open_fraction is not None else []),
-        *([("impacts", f"{s.impacts}"), ("max impact speed", f"{s.max_impact_speed:.4g}")]
+        *([("impacts", f"{s.impacts}"), ("max impact speed", f"unknown: {s.max_impact_speed_reason}"
+                                          if s.max_impact_speed_reason else f"{s.max_impact_speed:.4g}")]
           if s.impacts is not None else []),
         ("transitions in window", str(s.n_transitions)),
         (f"{symbol} min / max", f"{s.minimum:.6g} / {s.maximum:.6g}" + f" {system.units.get(observed, '')}".rstrip(" -")),

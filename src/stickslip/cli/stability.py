@@ -5,7 +5,6 @@ Parse → library call → print/write; no physics here.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import List, Optional
 
@@ -22,10 +21,12 @@ from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
 from ..stability.sparse_input import is_sparse_model
+from ..stability.verdict import stability_verdict
 from ._app import CLIError, app, build_system, check_finite, check_outputs, console
-from ._band import Band, report_band
+from ._band import Band, report_band, verdict_words
 from ._compiling import time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._options import Friction, JsonSummary, MapModel, Model, ModelChanges, Outputs, Plates
 from ._outputs import write_result
 from .sweep import _VALUE_BYTES, parse_values
@@ -38,7 +39,8 @@ def stability(
     model: Model = "full",
     changes: ModelChanges = ModelChanges(),
     band: Band = Band(),
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, "
+                                 "stable, verdict (stable | marginal | unstable), marginal_tolerance."),
 ) -> None:
     """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model; for sparse
     (finite-element) models every eigenvalue of a band (complex eigenvalue analysis, --max-frequency)."""
@@ -59,7 +61,7 @@ def stability(
         report_band(result, timing, band.write(result, changes.inputs), as_json)
         return
     if as_json:
-        print(json.dumps({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
+        print_json({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s})
         return
     p = result.params
     title = f"steady sliding: model {result.model}"
@@ -75,12 +77,13 @@ def stability(
         modes.add_column(head, justify="right" if head != "dominant DOF" else "left")
     for number, row in enumerate(result.modes(), start=1):  # 1, 2, … (row["index"] counts both of each pair)
         shape = ", ".join(f"{abs(c):.3g}" for c in row["shape"].values())
-        style = "bold red" if row["growth_rate"] > 0 else None
+        style = {"unstable": "bold red", "marginal": "yellow"}.get(stability_verdict(row["growth_rate"],
+                                                                                       result.tolerance))
         modes.add_row(str(number), f"{row['growth_rate']:.6g}", f"{row['frequency_hz']:.6g}",
                       row["dominant_dof"], shape, style=style)
     console.print(modes)
-    verdict = Text("stable", style="green") if result.stable else Text("unstable", style="bold red")
-    console.print(Text.assemble(f"max real part {result.max_real_part:.6g} 1/s: steady sliding is ", verdict))
+    console.print(Text.assemble(f"max real part {result.max_real_part:.6g} 1/s: steady sliding is ",
+                                verdict_words(result)))
     console.print(f"wall time {time_text(timing.wall_s, timing.compile_s)}", style="dim")
 
 
@@ -163,9 +166,9 @@ def stability_map(
             "boundary_points": int(np.sum(np.isfinite(smap.boundary[f]))),
         })
     if as_json:
-        print(json.dumps({"out": str(out), "figure": None if figure is None else str(figure), "axes": list(names),
-                          "family": smap.family_name, "members": rows, "timings": smap.timings,
-                          "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
+        print_json({"out": str(out), "figure": None if figure is None else str(figure), "axes": list(names),
+                     "family": smap.family_name, "members": rows, "timings": smap.timings,
+                     "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s})
         return
     table = Table(title=f"stability map {values[0].size} × {values[1].size} ({names[0]} × {names[1]}), "
                         f"model {smap.model}")

@@ -7,7 +7,6 @@ missing (nothing, if the output is complete).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Callable, List, Optional
@@ -30,6 +29,7 @@ from ._app import (CLIError, app, build_system, check_positive, check_resumable_
                    parse_assignments, resumable_holds)
 from ._compiling import Timing, time_text, timed
 from ._groups import grouped
+from ._json import print_json
 from ._kept import keeps
 from ._options import (BifurcationModel, BifurcationPlates, Friction, GridTEnd, JsonSummary, ModelChanges, NoPlot,
                        NoProgress, Parallel, RegionsTEnd, RegionsTFrom, Restart, ResumableOut, SampleRate, Settling,
@@ -190,7 +190,7 @@ def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as
         **(extra or {}),
     }
     if as_json:
-        print(json.dumps(summary))
+        print_json(summary)
         return
     table = Table(title=title, show_header=False)
     table.add_row("grid", " × ".join(f"{d} {n}" for d, n in summary["shape"].items()))

@@ -11,7 +11,6 @@ to matter, and says how long each took. A second warmup loads everything from th
 
 from __future__ import annotations
 
-import json
 import time
 from typing import List, Optional
 
@@ -25,6 +24,7 @@ from ..model.library.two_plates import is_plates
 from ..orbits import flow_jacobian
 from ..stability import stability
 from ._app import CLIError, app, build_system, console, note_line
+from ._json import print_json
 
 #: The library models whose kernel sets cover the built-in kinds of model: the plates, a model
 #: file with pressed contacts, a model file with a contact that opens.
@@ -78,7 +78,7 @@ def warmup(
             report.append({"model": name, "stage": stage, "seconds": round(time.perf_counter() - start, 2),
                            "outcome": outcome})
     if as_json:
-        print(json.dumps(report))
+        print_json(report)
         return
     table = Table(title="kernels compiled, or loaded from the cache")
     for column in ("model", "stage", "seconds", "outcome"):

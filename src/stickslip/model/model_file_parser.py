@@ -23,7 +23,7 @@ __all__ = ["Parser", "CONTACT_KEYS", "REQUIRED_CONTACT", "FRICTION_KEYS", "NORMA
 CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "gap",
                 "gap_gradient", "normal", "friction")
 REQUIRED_CONTACT = ("tangent", "friction")
-FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v")
+FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v", "v_s")
 NORMAL_KEYS = ("law", "stiffness", "damping", "restitution")
 #: The keys of a prescribed load and of a unilateral contact (a contact has the one or the other).
 PRESCRIBED_KEYS = ("normal_force", "normal_gradient", "normal_rate_gradient")
@@ -192,7 +192,7 @@ class Parser:
             elif key == "gap_gradient":
                 self.vector(value, self.n, f"{where}.{key}", f"{c}.{key}", sparse=True)
             elif key == "friction":
-                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb or exponential")
+                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb, exponential or stribeck")
             elif key == "normal":
                 self.normal_table(value, f"{where}.normal", f"{c}.normal")
         name = table.get("name", f"contact{c}")
@@ -264,7 +264,7 @@ class Parser:
                 self.number(value, f"{where}.{key}", "scalars", cset.container(key))
             elif key == "friction":
                 self.law_table(value, f"{where}.friction", FRICTION_KEYS, cset.container("friction"),
-                               "coulomb or exponential")
+                               "coulomb, exponential or stribeck")
             elif key == "normal":
                 self.normal_table(value, f"{where}.normal", cset.container("normal"))
         count = len(cset.nodes)

@@ -89,7 +89,7 @@ from pathlib import Path
 
 import numba
 
-__all__ = ["TESTED", "ENV", "Patch", "install", "active", "status", "notice", "has", "source_has"]
+__all__ = ["TESTED", "ENV", "Patch", "install", "active", "status", "notice", "has", "source_has", "end_run"]
 
 #: numba versions (major.minor) the test suite passed on with the patches installed, and stock.
 TESTED = ("0.57", "0.58", "0.59", "0.60", "0.61", "0.62", "0.63", "0.64", "0.65", "0.66", "0.67", "0.68")
@@ -123,20 +123,17 @@ class Patch:
 _STATUS: dict = {}
 
 
-def _patches() -> list[Patch]:
-    from . import compile_ahead, compile_speedups, kernel_cache, linking
-    from .jit import python_entry_patch
-
-    return [*compile_speedups.PATCHES, python_entry_patch(), linking.PATCH, kernel_cache.PATCH,
-            compile_ahead.FORK_PATCH]
-
-
-def install() -> dict:
+def install(patches: Callable[[], list[Patch]] | None = None) -> dict:
     """Apply every patch whose check passes, on a numba of :data:`TESTED` and unless
-    ``STICKSLIP_NUMBA_PATCHES=0``; once per process. Returns :func:`status`."""
+    ``STICKSLIP_NUMBA_PATCHES=0``; once per process. Returns :func:`status`.
+
+    ``patches`` lists them: :mod:`.jit` gives it as it is imported, before it declares kernels (the
+    modules that define patches import this one, so it does not import them); without it, this
+    imports :mod:`.jit`, which installs them.
+    """
     if _STATUS:
         return _STATUS
-    if f"{__package__}.jit" not in sys.modules:  # it installs them as it is imported, before it declares kernels
+    if patches is None:
         importlib.import_module(f"{__package__}.jit")
         return _STATUS
     version = numba.__version__
@@ -149,7 +146,7 @@ def install() -> dict:
                             f"({TESTED[0]}-{TESTED[-1]}); install numba>={TESTED[0]},<{_next_minor(TESTED[-1])}"
     else:
         applied, skipped = [], {}
-        for patch in _patches():
+        for patch in patches():
             try:
                 problem = patch.check()
             except Exception as exc:  # noqa: BLE001 - a check that fails is a patch that does not fit
@@ -280,11 +277,22 @@ def _forget_markers(run: str, root: int) -> None:
             path.unlink()
 
 
+#: The run this process is the root of (its id and process id), where it is one.
+_ROOT: dict[str, object] = {}
+
+
 def _start_run() -> None:
     """Make this process the root of a run where it was started by none (its markers removed at exit)."""
     if not os.environ.get(RUN_ENV):
-        run = _run_id()
-        atexit.register(_forget_markers, run, os.getpid())
+        _ROOT.update(run=_run_id(), pid=os.getpid())
+        atexit.register(end_run)
+
+
+def end_run() -> None:
+    """Remove the markers of the run this process is the root of: at exit, or before a process ends
+    without running its exit handlers (``os._exit``)."""
+    if _ROOT:
+        _forget_markers(_ROOT["run"], _ROOT["pid"])
 
 
 _start_run()

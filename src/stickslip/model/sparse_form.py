@@ -78,7 +78,8 @@ def friction_value(law: FrictionLaw, speed) -> np.ndarray:
 def friction_slope(law: FrictionLaw, speed) -> np.ndarray:
     """dμ/d|v| [s/m] of ``law`` at slip speeds ``speed`` [m/s] (any shape; the right derivative at 0).
 
-    ``coulomb``: 0; ``exponential``: −α Δμ exp(−α |v|) + μv; a user law: the complex step of its
+    ``coulomb``: 0; ``exponential``: −α Δμ exp(−α |v|) + μv; ``stribeck``: −2 (|v|/v_s²) Δμ
+    exp(−(|v|/v_s)²) + μv; a user law: the complex step of its
     function (a user law is complex-safe by contract, :mod:`stickslip.model.friction`).
     """
     speed = np.abs(np.asarray(speed, dtype=float))
@@ -86,6 +87,9 @@ def friction_slope(law: FrictionLaw, speed) -> np.ndarray:
         return np.zeros_like(speed)
     if law.law == "exponential":
         return -law.alpha * law.delta_mu * np.exp(-law.alpha * speed) + law.mu_v
+    if law.law == "stribeck":
+        ratio = speed / law.v_s
+        return -2.0 * ratio / law.v_s * law.delta_mu * np.exp(-ratio * ratio) + law.mu_v
     mu = _USER_LAWS[type(law.user)].py_func
     return np.vectorize(lambda v: float(np.imag(mu(law.user, complex(v, _STEP)))) / _STEP, otypes=[float])(speed)
 

@@ -11,13 +11,23 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import EquilibriumError
 from ..integrate.contacts import STICK_SPEED_TOL
 from ..integrate.initial import refused_rigid_starts, rigid_gaps
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
 from ..stability.equilibrium import steady_sliding
 
-__all__ = ["free_states", "equilibrium_state", "stick_projected", "resting_contacts", "rigid_admissible"]
+__all__ = ["free_states", "equilibrium_state", "ORBIT_MIN_SIZE", "distance_from_steady_sliding", "is_steady_sliding",
+           "stick_projected", "resting_contacts", "rigid_admissible"]
+
+#: A solution of the shooting equations without stick phases whose state on the section lies closer
+#: than this to the steady-sliding state (‖(s − s_eq)/σ‖ over the free states, σ the orbit's scales)
+#: is the equilibrium, not an orbit: the finite differences of its Jacobian (steps of
+#: DEFAULT_FD_STEP = 1e-5 σ) would straddle such a cycle, so nothing the shooting computes can tell
+#: it from steady sliding. Measured: 1e-12 on the steady sliding the two-mass belt's start converged
+#: onto, against ≥ 2.8e-3 on the Model 4 slip cycle down to its Hopf point (0.69 at its start).
+ORBIT_MIN_SIZE = 1e-5
 
 
 def free_states(system) -> np.ndarray:
@@ -31,6 +41,30 @@ def equilibrium_state(system) -> np.ndarray:
     s = np.zeros(2 * system.n)
     s[:system.n] = steady_sliding(system)
     return s
+
+
+def distance_from_steady_sliding(system, state: np.ndarray, free: np.ndarray, sigma: np.ndarray) -> float:
+    """‖(s − s_eq)/σ‖ on the ``free`` states (σ their scales): the size of a cycle about the
+    steady-sliding state of ``system``.
+
+    Raises
+    ------
+    EquilibriumError
+        Where ``system`` has no steady sliding.
+    """
+    return float(np.linalg.norm((np.asarray(state) - equilibrium_state(system))[free] / sigma))
+
+
+def is_steady_sliding(system, state: np.ndarray, free: np.ndarray, sigma: np.ndarray, stick_phases: int) -> bool:
+    """Whether a solution of the shooting equations is steady sliding (which solves them for any
+    period), not a cycle: it has no stick phase and lies within :data:`ORBIT_MIN_SIZE` of the
+    steady-sliding state (a model without steady sliding has no such solution)."""
+    if stick_phases > 0:
+        return False
+    try:
+        return distance_from_steady_sliding(system, state, free, sigma) < ORBIT_MIN_SIZE
+    except EquilibriumError:
+        return False
 
 
 def resting_contacts(system, s: np.ndarray) -> np.ndarray:

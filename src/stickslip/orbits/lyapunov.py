@@ -330,6 +330,9 @@ def _largest_first(estimate: np.ndarray) -> np.ndarray:
     return estimate[:, np.argsort(-estimate[-1], kind="stable")]
 
 
+#: Time [s] in which the spectrum's random initial frame turns before the averaging (t_frame).
+FRAME_TIME = 10.0
+
 #: Longest smooth piece between QR re-orthonormalisations [s]: growth rates of the paper's
 #: cases are ≤ ~10 1/s (the fastest decaying modes, e.g. 3 1/s for N = 50 N), so the columns
 #: stay within e^10 of each other and well conditioned; QR also follows every jump.
@@ -350,13 +353,19 @@ def lyapunov_spectrum(
     method: str = "variational",
     chunk: float = 1.0,
     d0: float = DEFAULT_D0,
+    seed: int = 0,
+    t_frame: float = FRAME_TIME,
 ) -> LyapunovSpectrum:
     """All Lyapunov exponents of the attractor reached from ``ic`` (Benettin–Shimada–Nagashima).
 
     The variational equations with saltation matrices (:func:`.linear_flow.propagate`) carry
     an orthonormal frame (in the σ-scaled norm) along the ``event`` integrator's trajectory; it
     is re-orthonormalised by QR after every jump and at least every :data:`QR_INTERVAL`
-    seconds, and λ_i = Σ ln |R_ii| / t.
+    seconds, and λ_i = Σ ln |R_ii| / t. Both methods start from a random orthonormal frame
+    (:func:`generic_frame`), turned for ``t_frame`` seconds before the averaging: a frame of the coordinate directions is not generic where a
+    coordinate subspace is invariant (a DOF that the others drive but that never acts back on
+    them, e.g. the tangential motion of an impact oscillator): the column inside it then leaves
+    it only through round-off, and its exponent carries ln(1e-16) over the averaging time.
 
     Parameters
     ----------
@@ -382,6 +391,13 @@ def lyapunov_spectrum(
         by stick come out at ln(integration noise / d0) per chunk instead of −∞).
     chunk, d0 : float
         Chunk length [s] and scaled separation [-] of ``finite-difference``.
+    seed : int
+        Seed of the random initial frame.
+    t_frame : float
+        Time [s] after the transient in which the frame turns (re-orthonormalised as in the
+        average) before the averaging starts, nothing counted (``finite-difference``: whole
+        chunks): from a random frame the exponents' error then falls as 1/t from the settled
+        frame's small constant instead of the random one's (≥ 0).
 
     Returns
     -------
@@ -395,18 +411,32 @@ def lyapunov_spectrum(
     t_start = _time.perf_counter()
     if t_average <= 0.0:
         raise OrbitError(f"t_average = {t_average} s must be > 0")
+    if not t_frame >= 0.0:
+        raise OrbitError(f"t_frame = {t_frame} s must be >= 0")
     interval, option = (chunk, "chunk") if method == "finite-difference" else (record, "record")
     problem, s_ref = _after_transient(model, ic, perturbation, t_transient, rtol, atol, slip_band, t_average,
                                       interval, option)
+    frame = generic_frame(problem.free.size, seed)
     if method == "finite-difference":
-        return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)
+        return _fd_spectrum(problem, s_ref, frame, t_transient, t_average, t_frame, chunk, d0,
+                            dict(perturbation=perturbation, seed=seed, t_frame=t_frame), t_start)
     if method != "variational":
         raise OrbitError(f"unknown method {method!r}; use 'variational' or 'finite-difference'")
-    end, transitions = problem.flow(s_ref, t_average)
     free, sigma = problem.free, problem.sigma
-
     k = free.size
-    D = _initial_frame(problem, s_ref)
+    D = _initial_frame(problem, s_ref, frame)
+    if t_frame > 0.0:  # the frame turns towards the growing directions; nothing is counted
+        def turn(t, P):
+            out = np.zeros((2 * problem.system.n, k))
+            out[free] = _qr(P[free] / sigma[:, None])[0] * sigma[:, None]
+            return out
+
+        end, transitions = problem.flow(s_ref, t_frame)
+        D, _, _ = propagate(problem.system, s_ref, t_frame, transitions, end, D, scale=sigma, after=turn,
+                            max_interval=QR_INTERVAL)
+        # projected again where the averaging starts: QR made the collapsed columns whole again
+        s_ref, D = end, _initial_frame(problem, end, D[free] / sigma[:, None])
+    end, transitions = problem.flow(s_ref, t_average)
     log_sum = np.zeros(k)
     times, sums = [0.0], [np.zeros(k)]
 
@@ -424,30 +454,38 @@ def lyapunov_spectrum(
               max_interval=QR_INTERVAL)
     time = np.array(times[1:])
     return _spectrum(problem, np.array(sums[1:]) / time[:, None], time, t_transient, stick_count(transitions), t_start,
-                     dict(perturbation=perturbation, record=record, qr_interval=QR_INTERVAL, method="variational"))
+                     dict(perturbation=perturbation, seed=seed, t_frame=t_frame, record=record,
+                          qr_interval=QR_INTERVAL, method="variational"))
 
 
 #: Step [σ] of the differences that project the initial frame of the variational spectrum.
 FRAME_STEP = 1e-6
 
 
-def _initial_frame(problem, s_ref: np.ndarray) -> np.ndarray:
-    """The variations (2n, 2 n_free) the variational spectrum starts from: σ-scaled unit vectors
-    of the free states; where a contact sticks or a rigid contact is closed at ``s_ref``, projected
-    as perturbed states are (:meth:`.problem.ShootingProblem.perturbed`, by differences of
-    :data:`FRAME_STEP`), so the directions those constraints forbid collapse at once (exponents
-    −∞, large negative numbers from round-off) instead of staying frozen (exponent 0) until an
-    event collapses them."""
+def generic_frame(k: int, seed: int) -> np.ndarray:
+    """A random orthonormal frame (k, k) (QR of a standard normal matrix, seeded): no column lies
+    in a coordinate subspace, which a flow may leave invariant."""
+    Q, _ = _qr(np.random.default_rng(seed).standard_normal((k, k)))
+    return Q
+
+
+def _initial_frame(problem, s_ref: np.ndarray, frame: np.ndarray) -> np.ndarray:
+    """The variations (2n, 2 n_free) the variational spectrum starts from: the orthonormal
+    ``frame`` (k, k) of the σ-scaled free states; where a contact sticks or a rigid contact is
+    closed at ``s_ref``, projected as perturbed states are
+    (:meth:`.problem.ShootingProblem.perturbed`, by differences of :data:`FRAME_STEP`), so the
+    directions those constraints forbid collapse at once (exponents −∞, large negative numbers
+    from round-off) instead of staying frozen (exponent 0) until an event collapses them."""
     free, sigma = problem.free, problem.sigma
     k = free.size
     D = np.zeros((2 * problem.system.n, k))
-    D[free, np.arange(k)] = sigma
+    D[free] = frame * sigma[:, None]
     system = problem.system
     stuck = np.any(resting_contacts(system, s_ref)[::CST] == MODE_STICK)
     closed = system.rigid and any(g[0] <= tol[0] for _, g, _, tol in rigid_gaps(system, s_ref))
     if stuck or closed:
         for j in range(k):
-            D[:, j] = (problem.perturbed(s_ref, np.eye(k)[j], FRAME_STEP) - s_ref) / FRAME_STEP
+            D[:, j] = (problem.perturbed(s_ref, frame[:, j], FRAME_STEP) - s_ref) / FRAME_STEP
     return D
 
 
@@ -468,29 +506,38 @@ def _spectrum(problem, estimate, time, t_transient, stick_phases, t_start, optio
     )
 
 
-def _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start) -> LyapunovSpectrum:
+def _fd_chunk(problem, s_ref, Q, chunk, d0):
+    """One chunk of the finite-difference spectrum from ``s_ref`` with the frame ``Q`` (k, k):
+    the new reference state, the new frame, ln |R_ii| and the chunk's stick phases."""
+    free, sigma = problem.free, problem.sigma
+    starts = [problem.perturbed(s_ref, Q[:, j], d0) for j in range(free.size)]
+    s_new, tr = problem.flow(s_ref, chunk)
+    # columns Φ P Q_j: the chunk's flow after the projection onto v_c = 0 that a stuck
+    # reference implies (part of the physical map: stick collapses those directions)
+    A = np.column_stack([(problem.flow(sp, chunk)[0][free] - s_new[free]) / sigma for sp in starts]) / d0
+    Q, log_r = _qr(A)
+    return s_new, Q, log_r, stick_count(tr)
+
+
+def _fd_spectrum(problem, s_ref, frame, t_transient, t_average, t_frame, chunk, d0, options,
+                 t_start) -> LyapunovSpectrum:
     """Benettin with 2 n_free perturbed trajectories and QR after every chunk (see
-    :func:`lyapunov_spectrum`, ``method="finite-difference"``)."""
+    :func:`lyapunov_spectrum`, ``method="finite-difference"``), after ``t_frame`` seconds (whole
+    chunks, rounded up) in which the frame turns and nothing is counted."""
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
-    free, sigma = problem.free, problem.sigma
-    k = free.size
-    Q = np.eye(k)
-    log_sum = np.zeros(k)
-    sums = np.empty((n_chunks, k))
+    Q = frame
+    for _ in range(math.ceil(t_frame / chunk - 1e-9)):
+        s_ref, Q, _, _ = _fd_chunk(problem, s_ref, Q, chunk, d0)
+    log_sum = np.zeros(problem.free.size)
+    sums = np.empty((n_chunks, problem.free.size))
     sticks = 0
     for i in range(n_chunks):
-        starts = [problem.perturbed(s_ref, Q[:, j], d0) for j in range(k)]
-        s_new, tr = problem.flow(s_ref, chunk)
-        sticks += stick_count(tr)
-        # columns Φ P Q_j: the chunk's flow after the projection onto v_c = 0 that a stuck
-        # reference implies (part of the physical map: stick collapses those directions)
-        A = np.column_stack([(problem.flow(sp, chunk)[0][free] - s_new[free]) / sigma for sp in starts]) / d0
-        Q, log_r = _qr(A)
+        s_ref, Q, log_r, stuck = _fd_chunk(problem, s_ref, Q, chunk, d0)
+        sticks += stuck
         log_sum += log_r
         sums[i] = log_sum
-        s_ref = s_new
     time = chunk * np.arange(1, n_chunks + 1)
     return _spectrum(problem, sums / time[:, None], time, t_transient, sticks, t_start,
-                     dict(perturbation=perturbation, method="finite-difference", chunk=chunk, d0=d0))
+                     dict(options, method="finite-difference", chunk=chunk, d0=d0))

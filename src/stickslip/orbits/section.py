@@ -125,7 +125,9 @@ def flow(system, s0: np.ndarray, T: float, *, rtol: float, atol: float, max_step
         If T ≤ 0 or the run did not finish.
     """
     if not np.isfinite(T) or T <= 0.0:
-        raise OrbitError(f"return time T = {T} s is not positive; the Newton iteration left the orbit")
+        raise OrbitError(f"return time T = {T} s is not positive; the Newton iteration left the orbit: choose another "
+                         "Poincaré section (section=, --section on the command line), one the cycle crosses once "
+                         "per period in a smooth phase, e.g. the highest point of a flight ('y_max' for a gap y)")
     rate = 1.0 / T
     T_exact = 1.0 / rate  # the last sample time the driver will compute, so it lands on t_end
     cap = {} if max_steps is None else {"max_steps": int(max_steps)}

@@ -27,14 +27,14 @@ import warnings
 import numpy as np
 
 from .._version import __version__
-from ..errors import OrbitError, SimulationError
+from ..errors import OrbitError, SimulationError, SteadySlidingOrbitError
 from ..integrate.driver import simulate
 from ..integrate.initial import initial_state, rigid_gaps
 from ..integrate.result import Trajectory
 from ..model.library import two_plates
 from ..model.parameters import Parameters
 from ..model.system_model import DEFAULT_SLIP_BAND, FrictionModel
-from .layout import free_states
+from .layout import free_states, is_steady_sliding
 from .models import ModelResult, model_attrs, resolve
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
                       check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
@@ -204,6 +204,7 @@ def periodic_orbit(
     slip_band: float | None = None,
     monodromy: str = "saltation",
     newton_jacobian: str = "saltation",
+    steady_sliding: str = "refuse",
 ) -> PeriodicOrbit:
     """Find a periodic orbit by Newton shooting on a Poincaré section.
 
@@ -258,6 +259,8 @@ def periodic_orbit(
     OrbitError
         If no crossings are found, the section is crossed in stick, or Newton does not reach
         ``tol`` within ``max_iter`` iterations (the message gives the residual history).
+    SteadySlidingOrbitError
+        If Newton converged onto steady sliding (an OrbitError), with ``steady_sliding="refuse"``.
     """
     system = _orbit_model(model, guess, slip_band)
     k = int(period_multiplicity)
@@ -265,6 +268,8 @@ def periodic_orbit(
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")
     check_method(monodromy)
     check_method(newton_jacobian, "newton_jacobian")
+    if steady_sliding not in ("refuse", "keep"):
+        raise OrbitError(f"steady_sliding = {steady_sliding!r}: use 'refuse' or 'keep'")
     atol = 1e-3 * rtol if atol is None else float(atol)
     sec = resolve_section(section, system)
     check_section(sec, system)
@@ -285,6 +290,11 @@ def periodic_orbit(
     problem = ShootingProblem.build(system, sigma=scales(ptp, free_states(system)), section=sec, fd_step=fd_step,
                                     **opts)
     orbit = problem.newton(s0, T, tol=tol, max_iter=max_iter, method=newton_jacobian)
+    stick_phases = stick_count(orbit.transitions)
+    if steady_sliding == "refuse" and is_steady_sliding(system, orbit.state, problem.free, problem.sigma, stick_phases):
+        raise SteadySlidingOrbitError(
+            f"shooting converged onto steady sliding (no stick phase, {orbit.period:.6g} s being any period of the "
+            "equilibrium), not a cycle: start from a state on the cycle or from a run that has reached it")
     method = monodromy
     if method == "saltation":
         try:
@@ -296,7 +306,7 @@ def periodic_orbit(
     if method == "finite-difference":
         M, _ = problem.monodromy(orbit.state, orbit.period, method)
     return PeriodicOrbit(
-        state=orbit.state, period=orbit.period, multiplicity=k, stick_phases=stick_count(orbit.transitions),
+        state=orbit.state, period=orbit.period, multiplicity=k, stick_phases=stick_phases,
         residual=orbit.history[-1], iterations=orbit.iterations, residual_history=np.array(orbit.history),
         multipliers=sorted_eigenvalues(M), monodromy=M, free_states=tuple(system.state_names[j] for j in problem.free),
         scale=problem.sigma, system=system, section=sec,

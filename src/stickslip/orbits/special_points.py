@@ -53,10 +53,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import EquilibriumError, OrbitError, SimulationError
+from ..errors import OrbitError, SimulationError
 from . import branch_store as store
 from .arclength import Point, Problem, point_at, step_from
-from .layout import equilibrium_state
+from .layout import ORBIT_MIN_SIZE, distance_from_steady_sliding, is_steady_sliding
 from .problem import nontrivial
 
 __all__ = ["SpecialPoint", "SPECIAL_KINDS", "HOPF_RATIO", "MIN_STICK_FRACTION", "ORBIT_MIN_SIZE", "REAL_RTOL",
@@ -72,13 +72,6 @@ SPECIAL_KINDS = ("fold", "period-doubling", "neimark-sacker", "stick-phases", "g
 #: of the start at the located turning point, against ≥ 0.3 on the rest of those branches.
 HOPF_RATIO = 0.1
 
-#: A point without stick phases whose state on the section lies closer than this to the
-#: steady-sliding state (‖(s − s_eq)/σ‖ over the free states, σ the start orbit's scales) is the
-#: equilibrium, not an orbit: the finite differences of its Jacobian (steps of DEFAULT_FD_STEP =
-#: 1e-5 σ) would straddle such a cycle, so nothing the shooting computes can tell it from steady
-#: sliding. Measured: 1e-12 on the steady sliding the two-mass belt's start converged onto, against
-#: ≥ 2.8e-3 on the Model 4 slip cycle down to its Hopf point (0.69 at its start).
-ORBIT_MIN_SIZE = 1e-5
 
 #: A multiplier is real when |Im μ| ≤ REAL_RTOL |μ|: LAPACK returns the real eigenvalues of a real
 #: matrix with Im = 0 exactly and the others in conjugate pairs, so this only absorbs round-off.
@@ -249,20 +242,14 @@ def circle_crossings(before: np.ndarray, after: np.ndarray) -> set:
 def distance_from_equilibrium(problem: Problem, state: np.ndarray, lam: float) -> float:
     """‖(s − s_eq)/σ‖ on the free states: the size of a slip cycle about the equilibrium of Eq. (14)."""
     sp = problem.shooting
-    s_eq = equilibrium_state(problem.system_at(lam))
-    return float(np.linalg.norm((state - s_eq)[sp.free] / sp.sigma))
+    return distance_from_steady_sliding(problem.system_at(lam), state, sp.free, sp.sigma)
 
 
 def is_orbit(problem: Problem, state: np.ndarray, lam: float, stick_phases: int) -> bool:
-    """Whether a solution of the shooting equations is an orbit: it has a stick phase, or its state
-    on the section lies at least :data:`ORBIT_MIN_SIZE` from the steady-sliding state (a model
-    without steady sliding at ``lam`` has no such solution)."""
-    if stick_phases > 0:
-        return True
-    try:
-        return distance_from_equilibrium(problem, state, lam) >= ORBIT_MIN_SIZE
-    except EquilibriumError:
-        return True
+    """Whether a solution of the shooting equations at ``lam`` is an orbit, not steady sliding
+    (:func:`.layout.is_steady_sliding`)."""
+    sp = problem.shooting
+    return not is_steady_sliding(problem.system_at(lam), state, sp.free, sp.sigma, stick_phases)
 
 
 def steady_stop(param: str, value: float) -> str:

@@ -13,7 +13,7 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import ContinuationError, OrbitError, SimulationError
+from ..errors import ContinuationError, OrbitError, SimulationError, SteadySlidingOrbitError
 from ..integrate.driver import check_samples, simulate
 from ..integrate.result import Trajectory
 from ..model.system_model import FrictionModel
@@ -81,12 +81,13 @@ def crossings_per_stick(run: Trajectory, section="max") -> int:
 
 
 def start_orbit_from_run(run: Trajectory, *, section="max", rtol: float = 1e-10, atol: float | None = None,
-                         slip_band: float | None = None) -> PeriodicOrbit:
+                         slip_band: float | None = None, steady_sliding: str = "refuse") -> PeriodicOrbit:
     """Shoot the stick-slip orbit a run has settled on, with one stick onset per period.
 
     The period multiplicity is :func:`crossings_per_stick`. Where some section crossings lie in
     stick, the run is cut back one sample period at a time (up to one orbit period) until the
     first crossing used by :func:`~stickslip.orbits.periodic_orbit` lies in slip.
+    ``steady_sliding`` as :func:`~stickslip.orbits.periodic_orbit` takes it.
 
     Raises
     ------
@@ -104,7 +105,9 @@ def start_orbit_from_run(run: Trajectory, *, section="max", rtol: float = 1e-10,
         part = dataclasses.replace(run, t=run.t[:m], states=run.states[:m], mode=run.mode[:m])
         try:
             return periodic_orbit(None, part, section=section, rtol=rtol, atol=atol, period_multiplicity=k,
-                                  slip_band=slip_band)
+                                  slip_band=slip_band, steady_sliding=steady_sliding)
+        except SteadySlidingOrbitError:
+            raise
         except OrbitError as exc:
             error = exc
             if "crossed in stick" not in str(exc):
@@ -148,8 +151,9 @@ def start_orbit(system: FrictionModel, param, start, section, rtol, atol) -> Per
     try:
         if isinstance(start, Trajectory):  # one stick onset per period (several φ maxima at low N)
             run = start if start.system is system else dataclasses.replace(start, system=system)
-            return start_orbit_from_run(run, section=section, rtol=rtol, atol=atol)
-        return periodic_orbit(system, start, section=section, rtol=rtol, atol=atol)
+            return start_orbit_from_run(run, section=section, rtol=rtol, atol=atol, steady_sliding="keep")
+        # the continuation refuses a start on steady sliding itself, naming the parameter's value
+        return periodic_orbit(system, start, section=section, rtol=rtol, atol=atol, steady_sliding="keep")
     except (OrbitError, SimulationError) as exc:
         raise ContinuationError(f"no periodic orbit to start from at {param} = {parameter_value(system, param):g}: "
                                 f"{exc}") from exc

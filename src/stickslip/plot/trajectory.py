@@ -1,4 +1,5 @@
-"""Overview figure of one trajectory: coordinates with stick shaded, |F| against μs N per contact, the
+"""Overview figure of one trajectory: coordinates with stick shaded, |F| against its stick limit (μs N,
+or μs λ for a unilateral contact) per contact, the
 phase plot and spectrum of the observed coordinate (the plates: φ, ψ and the φ spectrum)."""
 
 from __future__ import annotations
@@ -10,7 +11,8 @@ import numpy as np
 from ..analysis.signal import spectrum
 from ._common import param_text, save_figure, symbol
 
-__all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals", "shade_contacts", "shown_coordinates"]
+__all__ = ["plot_trajectory", "save_trajectory_figure", "stick_intervals", "shade_contacts", "shown_coordinates",
+           "stick_limit_label", "friction_lines"]
 
 
 def stick_intervals(t: np.ndarray, mode: np.ndarray) -> list[tuple[float, float]]:
@@ -50,6 +52,31 @@ def shade_contacts(ax, t, mode, system, t_lo, t_hi, labels: bool = True) -> None
             label = ("open" if nc == 1 else f"{name} open") if labels else None
             _shade_stick(ax, stick_intervals(t, (mode >> (nc + c)) & 1), t_lo, t_hi, label=label, color="0.5",
                          hatch="//")
+
+
+def stick_limit_label(contact) -> str:
+    """The legend's name of a contact's stick limit μs × normal force: ``μs N`` for a pressed
+    contact (N its prescribed load), ``μs λ`` for a unilateral one, whose normal force is its
+    contact force λ (a compliant law's, 0 while open), and ``μs λ (multiplier)`` for a rigid one,
+    whose λ is the multiplier that keeps it closed."""
+    if not contact.unilateral:
+        return "μs N"
+    return "μs λ (multiplier)" if contact.normal.law == "rigid" else "μs λ"
+
+
+def friction_lines(traj) -> list[dict]:
+    """What the friction panel draws, per contact: ``label`` and ``force`` (k,) of |F| [N], and
+    ``limit_label`` and ``limit`` (k,) of the stick limit μs × normal force [N]
+    (:func:`stick_limit_label`); with several contacts each label ends with the contact's name."""
+    system = traj.system
+    nc = system.n_contacts
+    lines = []
+    for c, contact in enumerate(system.contacts):
+        tag = "" if nc == 1 else f" {contact.name or c}"
+        lines.append({"label": f"|F|{tag}", "force": np.hypot(traj.friction[:, 2 * c], traj.friction[:, 2 * c + 1]),
+                      "limit_label": stick_limit_label(contact) + tag,
+                      "limit": contact.friction.mu_s * traj.normal_force[:, c]})
+    return lines
 
 
 def plot_trajectory(traj, *, window: float | None = None, fig=None):
@@ -101,12 +128,11 @@ def plot_trajectory(traj, *, window: float | None = None, fig=None):
     ax_phi.legend(ncol=3, **above)
 
     nc = system.n_contacts
-    for c, contact in enumerate(system.contacts):
-        tag = "" if nc == 1 else f" {contact.name or c}"
-        F = np.hypot(traj.friction[:, 2 * c], traj.friction[:, 2 * c + 1])
-        line, = ax_F.plot(t[show], F[show], lw=1.0, color="tab:green" if nc == 1 else None, label=f"|F|{tag}")
-        ax_F.plot(t[show], contact.friction.mu_s * traj.normal_force[show, c], color="k" if nc == 1 else line.get_color(),
-                  ls="--", lw=0.8, label=f"μs N{tag}")
+    for drawn in friction_lines(traj):
+        line, = ax_F.plot(t[show], drawn["force"][show], lw=1.0, color="tab:green" if nc == 1 else None,
+                          label=drawn["label"])
+        ax_F.plot(t[show], drawn["limit"][show], color="k" if nc == 1 else line.get_color(), ls="--", lw=0.8,
+                  label=drawn["limit_label"])
     shade_contacts(ax_F, t, traj.mode, system, t_lo, t_hi, labels=False)
     ax_F.set_xlabel("t [s]")
     ax_F.set_ylabel("friction force [N]")

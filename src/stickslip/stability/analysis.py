@@ -20,6 +20,7 @@ from ..model.variants import DOF_NAMES
 from .band import BandError, band_stability
 from .equilibrium import model_of, point_text, rigid_constraint, solve_steady
 from .sparse_input import is_sparse_model
+from .verdict import MARGINAL_RTOL, stability_verdict
 
 __all__ = ["StabilityResult", "stability", "linearization", "model_stability"]
 
@@ -89,9 +90,20 @@ class StabilityResult:
         return float(self.eigenvalues.real[0])
 
     @property
+    def tolerance(self) -> float:
+        """Real parts within ±tolerance count as 0 [1/s]: :data:`MARGINAL_RTOL` × ‖J‖₂."""
+        return MARGINAL_RTOL * float(np.linalg.norm(self.jacobian, 2)) if self.jacobian.size else 0.0
+
+    @property
+    def verdict(self) -> str:
+        """``stable``, ``marginal`` or ``unstable`` (:func:`stability_verdict`)."""
+        return stability_verdict(self.max_real_part, self.tolerance)
+
+    @property
     def stable(self) -> bool:
-        """True when every eigenvalue has a negative real part (asymptotically stable sliding)."""
-        return self.max_real_part < 0.0
+        """True when every eigenvalue has a real part below −:attr:`tolerance` (asymptotically
+        stable sliding); a centre (Re λ = 0 within the tolerance) is marginal, not stable."""
+        return self.verdict == "stable"
 
     @property
     def equilibrium_dict(self) -> dict[str, float]:
@@ -120,13 +132,16 @@ class StabilityResult:
 
     def summary(self) -> dict:
         """JSON-ready summary: equilibrium (names → values), eigenvalues [[re, im], ...],
-        max_real_part, stable."""
+        max_real_part, stable, verdict (stable | marginal | unstable) and the tolerance within
+        which a real part counts as 0 (``marginal_tolerance`` [1/s])."""
         return {
             "model": self.model,
             "equilibrium": self.equilibrium_dict,
             "eigenvalues": [[float(v.real), float(v.imag)] for v in self.eigenvalues],
             "max_real_part": self.max_real_part,
             "stable": bool(self.stable),
+            "verdict": self.verdict,
+            "marginal_tolerance": self.tolerance,
         }
 
     def to_xarray(self):
@@ -162,6 +177,8 @@ class StabilityResult:
             "max_real_part": self.max_real_part,
             "max_real_part_units": "1/s",
             "stable": int(self.stable),
+            "verdict": self.verdict,
+            "marginal_tolerance": self.tolerance,
             "equilibrium_residual": self.residual,
             "parameters": json.dumps(self.params.to_dict() if self.params is not None else dict(self.system.parameters)),
         }

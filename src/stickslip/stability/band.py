@@ -28,6 +28,7 @@ from ..memory import check_memory, format_bytes
 from .cea import REAL_MARGIN, BandEigen, backward_errors, band_eigen, dense_eigen, frictionless_count, sorted_eigen
 from .modal_cea import ModalReport, modal_cea
 from .sparse_sliding import SlidingState, sparse_steady_sliding
+from .verdict import MARGINAL_RTOL, stability_verdict
 
 __all__ = ["BandStability", "BandError", "band_stability", "METHODS", "dense_bytes"]
 
@@ -106,9 +107,22 @@ class BandStability:
         return float(self.eigenvalues.real[0])
 
     @property
+    def tolerance(self) -> float:
+        """Real parts within ±tolerance count as 0 [1/s]: the largest |λ| of the band (the scale of
+        the eigenproblem solved) times :data:`~.verdict.MARGINAL_RTOL` or the largest backward
+        error of the band's eigenvalues, whichever is larger."""
+        scale = float(np.max(np.abs(self.eigenvalues), initial=0.0))
+        return scale * max(MARGINAL_RTOL, float(np.max(self.backward_error, initial=0.0)))
+
+    @property
+    def verdict(self) -> str:
+        """``stable``, ``marginal`` or ``unstable`` (:func:`~.verdict.stability_verdict`)."""
+        return stability_verdict(self.max_real_part, self.tolerance)
+
+    @property
     def stable(self) -> bool:
-        """True when every eigenvalue of the band has a negative real part."""
-        return self.max_real_part < 0.0
+        """True when every eigenvalue of the band has a real part below −:attr:`tolerance`."""
+        return self.verdict == "stable"
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -118,7 +132,7 @@ class BandStability:
     @property
     def unstable(self) -> np.ndarray:
         """Indices of the unstable eigenvalues with Im λ ≥ 0 (one per conjugate pair)."""
-        return np.flatnonzero((self.eigenvalues.real > 0.0) & (self.eigenvalues.imag >= 0.0))
+        return np.flatnonzero((self.eigenvalues.real > self.tolerance) & (self.eigenvalues.imag >= 0.0))
 
     def modes(self) -> list[dict]:
         """One dict per mode (the member with Im λ ≥ 0 of each pair): eigenvalue, growth rate,
@@ -135,6 +149,8 @@ class BandStability:
             "eigenvalues": [[float(v.real), float(v.imag)] for v in self.eigenvalues],
             "max_real_part": self.max_real_part,
             "stable": bool(self.stable),
+            "verdict": self.verdict,
+            "marginal_tolerance": self.tolerance,
             "method": self.method,
             "max_frequency": self.max_frequency,
             "searched_radius": self.radius,

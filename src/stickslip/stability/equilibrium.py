@@ -142,14 +142,24 @@ def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
         return Z.T @ ds[n:]
     sol = root(acceleration, np.zeros(Z.shape[1]), method="hybr", options={"xtol": 1e-14})
     q = q_p + Z @ sol.x
-    s = np.zeros(2 * n)
-    s[:n] = q
-    if rigid_pivot(s, cst, system.data) <= 0.0:
-        raise EquilibriumError(f"no steady sliding at {system.point_text()}: a sliding rigid contact has no "
-                               "consistent normal force there (Painlevé); lower the friction coefficient")
+    for at in (q, q_p):  # where the solve ended, else (a state not finite) on the constraint at r = 0
+        s = np.zeros(2 * n)
+        s[:n] = at
+        pivot = rigid_pivot(s, cst, system.data)
+        if np.isfinite(pivot):
+            break
+    if pivot <= 0.0:
+        raise EquilibriumError(f"no steady sliding at {system.point_text()}: the Painlevé paradox — while a rigid "
+                               "contact slides, the normal force that keeps it closed has no consistent value, or two "
+                               f"(the relative pivot of its normal-force equation is {pivot:.3g} ≤ 0: friction turns "
+                               "the normal acceleration against the normal force); lower the friction coefficient")
     rel = steady_residual(system, q)
     if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
-        raise EquilibriumError(_failure_message(system, q, steady.NEWTON_MAX_ITER, rel))
+        raise EquilibriumError(f"no steady-sliding equilibrium found for {point_text(system)}: no position with the "
+                               f"rigid contacts closed balances the forces (relative residual {rel:.2e} > "
+                               f"{RESIDUAL_TOL:g} where the root finder stopped: {sol.message.rstrip('.')}); steady "
+                               "sliding may not exist at these parameters (is there a free direction along the contact "
+                               "without stiffness against the friction?)")
     return q, float(rel), int(sol.nfev)
 
 

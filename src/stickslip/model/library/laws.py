@@ -5,7 +5,9 @@
     μ(v) = μc + (μs − μc) exp(−(v / v_s)²) + μv v,
 
 μ(0) = μs the static coefficient (Armstrong-Hélouvry, Dupont and Canudas de Wit 1994, Eq. 3 with
-δ = 2). Use it as ``FrictionLaw.from_user(Stribeck(mu_c, mu_s, v_s, mu_v))``.
+δ = 2). Use it as ``FrictionLaw.from_user(Stribeck(mu_c, mu_s, v_s, mu_v))``. Model files state the
+same law as the built-in ``law = "stribeck"`` (:mod:`stickslip.model.friction`), which each contact
+may have with its own numbers.
 """
 
 from __future__ import annotations
