@@ -27,7 +27,7 @@ from ..errors import OrbitError
 from ..integrate import contacts as E
 from ..model.compile_ahead import Split, compile_apart
 from ..model import physics as P
-from ..model.bundle import CST, contact_state
+from ..model.bundle import CST, H_N, H_NC, contact_state
 from . import saltation as S
 from . import var_kernels as V
 from .layout import free_states
@@ -56,6 +56,28 @@ MATCH_TIME_TOL = 1e-6
 #: Step cap of one segment.
 MAX_SEGMENT_STEPS = 1_000_000
 
+
+def _variational_calls(md) -> dict:
+    """The arguments with which the segment integrator and the saltation matrices call the kernels
+    of :data:`VARIATIONAL`, for the model data ``md``."""
+    n, nc = int(md.m[H_N]), int(md.m[H_NC])
+    n2 = 2 * n
+    y = np.zeros(n2 + n2 * n2)
+    s = np.zeros(n2)
+    z = np.zeros(n2, dtype=complex)
+    cst = contact_state(md.m)
+    F, N = np.zeros(2 * nc), np.zeros(nc)
+    kind, level = np.zeros(nc, dtype=np.int64), np.zeros(nc)
+    return {V.event_value: (V.EV_NONE, 0, s, 0.0, 0.0, cst, md),
+            V.variational_rhs: (y, cst, md, n2, False, y, s, z, z, s),
+            V.direction_residual: (z, cst, 0, md, 0.0, 0.0),
+            V._first_event: (kind, level, level, y, y, np.zeros((y.size, 4)), 0.0, cst, md, n2, level, y, s),
+            V.contact_gradients: (s, cst, 0, md, n2, np.zeros((2, n2)), np.zeros((2, n2)), s, z,
+                                  np.zeros(2 * nc, dtype=complex), np.zeros(nc, dtype=complex),
+                                  np.zeros(2 * nc, dtype=complex)),
+            E.initial_modes: (s, cst, md, 0.0, 0.0, F, N)}
+
+
 #: A cold start's variational kernels in two processes (:mod:`stickslip.model.compile_ahead`):
 #: the event functions, then the variational right-hand side (with the complex-step physics under
 #: it) in the helper; the complex-step version of the band direction's residual, the first event's
@@ -66,18 +88,11 @@ MAX_SEGMENT_STEPS = 1_000_000
 #: instead of 4.6 s; with the event functions in the helper (which the first event's search here
 #: then loads) 2.9–3.0 s against 3.1–3.2 s.
 VARIATIONAL = Split(
-    helper=("stickslip.orbits.var_kernels.event_value", "stickslip.orbits.var_kernels.variational_rhs"),
-    own=("stickslip.orbits.var_kernels.direction_residual", "stickslip.orbits.var_kernels._first_event",
-         "stickslip.orbits.var_kernels.contact_gradients", "stickslip.integrate.contacts.initial_modes"),
-    caller="stickslip.orbits.var_kernels.integrate_segment",
-    signatures={
-        "stickslip.orbits.var_kernels.variational_rhs": "v v M i B v v z z v",
-        "stickslip.orbits.var_kernels.direction_residual": "z v i M f f",
-        "stickslip.orbits.var_kernels.event_value": "i i v f f v M",
-        "stickslip.orbits.var_kernels._first_event": "I v v v v m f v M i v v v",
-        "stickslip.orbits.var_kernels.contact_gradients": "v v i M i m m v z z z z",
-        "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
-    })
+    helper=(V.event_value, V.variational_rhs),
+    own=(V.direction_residual, V._first_event, V.contact_gradients, E.initial_modes),
+    caller=V.integrate_segment,
+    calls=_variational_calls)
+
 
 #: Kind of the recorded transition each event kind ends in (+1 slip → stick, −1 stick → slip).
 _RECORDED_KIND = {V.EV_MARGIN: E.TRANSITION_TO_SLIP, V.EV_ZERO: E.TRANSITION_TO_STICK,

@@ -21,12 +21,15 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import overload
 
+from ..model.bundle import C_DIM, C_N0, CST, H_BAND, H_DIAGONAL, H_N, H_NC, ModelData, contact_offsets, offsets
 from ..model.compile_ahead import Split
-from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
 from ..model.derivatives import acceleration_jacobian, state_jacobian
-from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
+from ..model.forces import solve_stick_rows
 from ..model.frame_pointers import is_pointer_class
+from ..model.frames import _frame_bias_central
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
 from ..model.kinematics import model_sizes, sizes_at_run_time
+from ..model.model_data import kinetic_coefficient
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
 __all__ = ["NEWTON_OK", "NEWTON_MAX_ITER", "NEWTON_SINGULAR", "NEWTON_NOT_FINITE", "NEWTON_NO_DESCENT",
@@ -230,25 +233,6 @@ def _newton_from(q, cst, md, free, max_iter):
     return NEWTON_MAX_ITER, rel, max_iter
 
 
-#: A cold start's steady-sliding kernels in two processes (:mod:`stickslip.model.compile_ahead`),
-#: for kinematics whose sizes are run-time data (model files; fixed sizes are compile-time constants
-#: in these signatures): the complex-step stick solve (the deepest level of the chain under the
-#: Newton) in the helper; the friction coefficient, the frame's central-difference bias (complex)
-#: and the Newton's linear solve here; :func:`steady_sliding_point` then loads both.
-STEADY = Split(
-    helper=("stickslip.model.forces.solve_stick_rows",),
-    own=("stickslip.model.model_data.kinetic_coefficient", "stickslip.model.frames._frame_bias_central",
-         "stickslip.stability.steady._solve_inplace"),
-    caller="stickslip.stability.steady.steady_sliding_point",
-    signatures={
-        "stickslip.model.forces.solve_stick_rows": "z M i i B v i Z z z z Z",
-        "stickslip.model.model_data.kinetic_coefficient": "M i i c",
-        "stickslip.model.frames._frame_bias_central": "z i M Z z z",
-        "stickslip.stability.steady._solve_inplace": "m v",
-    },
-    applies=lambda md: sizes_at_run_time(md.kin))
-
-
 @loop
 def steady_sliding_point(md, free, max_iter):
     """Steady sliding of the model ``md``: Newton from q = 0, load continuation as a fallback.
@@ -337,6 +321,31 @@ def _steady_sliding(md, free, max_iter):
             if speed == 0.0 or (m[o + C_DIM] == 2.0 and speed <= m[H_BAND]):
                 return q, NEWTON_NOT_SLIDING, rel, iterations
     return q, status, rel, iterations
+
+
+def _steady_calls(md) -> dict:
+    """The arguments with which steady sliding's Newton calls the kernels of :data:`STEADY`, for
+    the model data ``md`` (complex-step physics: complex states and work arrays)."""
+    m = md.m
+    n, nc, diagonal = int(m[H_N]), int(m[H_NC]), bool(m[H_DIAGONAL] != 0.0)
+    s = np.zeros(2 * n, dtype=complex)
+    cst = np.zeros(CST * nc)
+    G = np.zeros((2 * nc, n), dtype=complex)
+    rows = np.zeros(2 * nc, dtype=complex)
+    return {solve_stick_rows: (s, md, n, nc, diagonal, cst, -1, G, rows, np.zeros(n, dtype=complex), rows,
+                               np.zeros((2 * nc, 2 * nc), dtype=complex)),
+            kinetic_coefficient: (md, n, 0, 0j),
+            _frame_bias_central: (s, 0, md, G[0:2], rows[0:2], rows[0:2]),
+            _solve_inplace: (np.zeros((n, n)), np.zeros(n))}
+
+
+#: A cold start's steady-sliding kernels in two processes (:mod:`stickslip.model.compile_ahead`),
+#: for kinematics whose sizes are run-time data (model files; fixed sizes are compile-time constants
+#: in these signatures): the complex-step stick solve (the deepest level of the chain under the
+#: Newton) in the helper; the friction coefficient, the frame's central-difference bias (complex)
+#: and the Newton's linear solve here; :func:`steady_sliding_point` then loads both.
+STEADY = Split(helper=(solve_stick_rows,), own=(kinetic_coefficient, _frame_bias_central, _solve_inplace),
+               caller=steady_sliding_point, calls=_steady_calls, applies=lambda md: sizes_at_run_time(md.kin))
 
 
 @loop
