@@ -28,44 +28,45 @@ from . import dormand_prince as DP
 from . import event_loop as L
 from . import result as R
 from . import transitions as T
+from .bundles import Samples, transition_log
 
 __all__ = ["EVENT_LOOP", "start_callees"]
 
 
 def _loop_calls(md) -> dict:
     """The arguments with which the event loop (and a run's results after it) call the kernels of
-    :data:`EVENT_LOOP`, for the model data ``md``."""
+    :data:`EVENT_LOOP`, for the model data ``md``: the bundles :func:`.event_loop.integrate_event`
+    and :class:`.runner.Record` build."""
     n, nc = int(md.m[H_N]), int(md.m[H_NC])
     ns = 2 * n + L.N_EXTRA
-    y = np.zeros(ns)
     cst = contact_state(md.m)
-    F, N, v = np.zeros(2 * nc), np.zeros(nc), np.zeros(2 * nc)
-    stages, dense = np.zeros((7, ns)), np.zeros((ns, 4))
-    times, states, forces = np.zeros(1), np.zeros((1, ns)), np.zeros((1, 2 * nc))
+    start, step, slips, scratch, stats = L.loop_arrays(np.zeros(ns), nc)
+    y, F, N = step.y, scratch.F, scratch.N
     modes = np.zeros(1, dtype=R.mode_dtype(nc, bool(md.m[H_UNILATERAL])))
-    tr = (np.zeros(1), np.zeros(1, dtype=np.int8), np.zeros(1, dtype=np.int8), np.zeros((1, ns)))
+    samples = Samples(np.zeros(1), np.zeros((1, ns)), modes, np.zeros((1, 2 * nc)))
+    log = transition_log(1, ns)
     i, f = np.int64(0), 0.0
     return {E.try_stick: (y, cst, i, md, f, F, N),
             E.release_most_overloaded: (y, cst, md, F, N),
-            P.contact_forces: (y, cst, md, F, N, v),
+            P.contact_forces: (y, cst, md, F, N, scratch.v),
             P.band_direction: (y, cst, i, md, f),
             E.initial_modes: (y, cst, md, f, f, F, N),
-            R._slip_velocities: (states, md, i),
-            R._normal_forces: (states, modes, md, i),
-            T.settle: (y, cst, md, F, N, f, *tr, i, np.zeros(6, dtype=np.int64)),
-            T.break_away: (y, cst, i, md, F, N, f, *tr, i, np.zeros(6, dtype=np.int64)),
+            R._slip_velocities: (samples.states, md, i),
+            R._normal_forces: (samples.states, samples.modes, md, i),
+            T.settle: (y, cst, md, scratch, f, log, i, stats),
+            T.break_away: (y, cst, i, md, scratch, f, log, i, stats),
             P.slip_velocity_and_rate: (y, y, i, md),
-            L.error_norm: (y, y, stages, f, md, f, f),
+            L.error_norm: (y, y, step.stages, f, md, f, f),
             P.rhs: (y, cst, md, y),
-            L.dp_step: (y, y, f, cst, md, stages, y, y),
-            E.probed_crossing: (f, i, i, y, dense, f, f, f, cst, md, y, F, N),
-            L.write_samples: (i, f, y, dense, f, f, f, cst, md, times, states, modes, forces, y, F, N, v),
-            L.cut_step: (f, i, y, dense, f, f, f, cst, md, times, states, modes, forces, y, F, N, v),
-            DP.dense_coefficients: (stages, dense),
+            L.dp_step: (y, y, f, cst, md, step.stages, y, y),
+            E.probed_crossing: (f, i, i, y, step.dense, f, f, f, cst, md, scratch),
+            L.write_samples: (i, f, f, f, f, y, step.dense, cst, md, samples, scratch),
+            L.cut_step: (f, i, f, f, f, step, cst, md, samples, scratch),
+            DP.dense_coefficients: (step.stages, step.dense),
             E.slip_event_possible: (f, f, f, f),
             E.time_to_zero_of: (f, f, f, f),
             E.all_finite: (y,),
-            L.homing_left: (np.zeros(nc, dtype=np.int64),)}
+            L.homing_left: (slips.homing,)}
 
 
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.

@@ -150,20 +150,28 @@ def solve_stick_step(y, h, Fx, Fy, md, ynew, ytmp, K, stats):
 
 
 @kernel
-def naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, K, Q, F, N, stats):
-    """A NAEOM stick step from ``y`` at time ``t`` [s] of length ``h`` [s], breakaway bisected.
+def naeom_stick_branch(step, t, h, stick, md, scratch, stats):
+    """A NAEOM stick step from ``step.y`` at time ``t`` [s] of length ``h`` [s], breakaway bisected.
 
-    ``hist`` (7,) is the force history of the current stick phase, updated here: the number of
-    steps so far, then (mid-step time, Fx, Fy) of the last two steps. The start value of the
-    force solve is its linear extrapolation (O(Δt²)), or the exact stick multiplier at the first
-    step of a stick phase (``stick``: the contact state in stick).
+    ``step.history`` (7,) is the force history of the current stick phase, updated here: the
+    number of steps so far, then (mid-step time, Fx, Fy) of the last two steps. The start value of
+    the force solve is its linear extrapolation (O(Δt²)), or the exact stick multiplier at the
+    first step of a stick phase (``stick``: the contact state in stick).
 
     Returns (h_taken, transition, Fx, Fy, solved): the step length taken [s], 0 or
     ``events.TRANSITION_TO_SLIP``, the solved force [N], and False if a solve failed
-    (:data:`MAX_NEWTON`). ``ynew`` holds the step end. Breakaway is bisected on re-solved steps,
-    the first trials around the root on the step's interpolant (``events.bisection_point``);
-    ``K`` (4, n), ``Q`` (n, 3), ``F`` (2,), ``N`` (1,) are work arrays.
+    (:data:`MAX_NEWTON`). ``step.ynew`` holds the step end. Breakaway is bisected on re-solved
+    steps, the first trials around the root on the step's interpolant (``events.bisection_point``);
+    ``step.Kn`` (4, n), ``step.dense`` (n, 3) and ``scratch`` (:class:`~.bundles.Scratch`) are
+    work arrays.
     """
+    y = step.y
+    hist = step.history
+    ynew = step.ynew
+    ytmp = step.ytmp
+    K = step.Kn
+    F = scratch.F
+    N = scratch.N
     n_hist = hist[0]
     tm = t + 0.5 * h
     if n_hist >= 2:
@@ -182,7 +190,7 @@ def naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, K, Q, F, N, stats):
         # the step's Hermite interpolant under the solved force gives the first trials
         derivative_under_force(y, Fx, Fy, md, K[0])
         derivative_under_force(ynew, Fx, Fy, md, K[1])
-        estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, K[1], h, stick, md, Q, ytmp, F, N)
+        estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, K[1], h, stick, md, step.dense, scratch)
         a, b, at, c = E.first_trial(estimate, h)
         while c >= 0.0:
             Fx, Fy, it = solve_stick_step(y, c * h, Fx, Fy, md, ynew, ytmp, K, stats)
