@@ -18,6 +18,8 @@ map.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba.extending import overload
 
@@ -34,7 +36,7 @@ from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
 __all__ = ["NEWTON_OK", "NEWTON_MAX_ITER", "NEWTON_SINGULAR", "NEWTON_NOT_FINITE", "NEWTON_NO_DESCENT",
            "NEWTON_NOT_SLIDING", "NEWTON_TARGET", "CONTINUATION_ACCEPT", "steady_sliding_point",
-           "steady_jacobian", "jacobian_points", "kinematics_from", "kinematics_values"]
+           "steady_jacobian", "AxisTables", "jacobian_points", "kinematics_from", "kinematics_values"]
 
 NEWTON_OK = 0
 NEWTON_MAX_ITER = 1
@@ -379,16 +381,45 @@ def steady_jacobian(md, free, max_iter, tol, J):
     return True
 
 
-@loop
-def jacobian_points(m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib, kin0, law, free, max_iter, tol, out):
-    """:func:`steady_jacobian` at points assembled from two axis tables, into ``out`` (P, 2k, 2k).
+class AxisTables(NamedTuple):
+    """The points of a grid over two parameters, as two tables of model numbers (:func:`jacobian_points`).
 
     Point p has the data array ``m_a[ia[p]]`` with the entries flagged in ``mask_b`` taken from
-    ``m_b[ib[p]]``, and kinematics ``kinematics_from(kin0, kv)`` with kv = ``kv_a[ia[p]]`` and the
-    fields flagged in ``kmask_b`` from ``kv_b[ib[p]]``, and the user friction law ``law`` of the
-    model (:class:`~stickslip.model.friction.NoUserLaw` if none). A map whose two parameters touch disjoint
-    entries is thus nA + nB tables instead of nA × nB models. NaN where no steady sliding exists.
+    ``m_b[ib[p]]``, and the kinematics fields ``kv_a[ia[p]]`` with those flagged in ``kmask_b``
+    from ``kv_b[ib[p]]``. A map whose two parameters touch disjoint entries is thus nA + nB rows
+    instead of nA × nB models.
+
+    Attributes
+    ----------
+    m_a, m_b : ndarray (nA, L), (nB, L)
+        Data arrays along each axis.
+    mask_b : ndarray (L,) bool
+        Entries of ``m`` taken from ``m_b``.
+    kv_a, kv_b : ndarray (nA, nf), (nB, nf)
+        Kinematics fields along each axis (:func:`kinematics_values`).
+    kmask_b : ndarray (nf,) bool
+        Fields taken from ``kv_b``.
+    ia, ib : ndarray (P,) int64
+        Each point's rows.
     """
+
+    m_a: np.ndarray
+    m_b: np.ndarray
+    mask_b: np.ndarray
+    kv_a: np.ndarray
+    kv_b: np.ndarray
+    kmask_b: np.ndarray
+    ia: np.ndarray
+    ib: np.ndarray
+
+
+@loop
+def jacobian_points(tables, kin0, law, free, max_iter, tol, out):
+    """:func:`steady_jacobian` at the points of the :class:`AxisTables` ``tables``, into ``out``
+    (P, 2k, 2k); the kinematics of a point are ``kinematics_from(kin0, kv)``, its user friction law
+    ``law`` (:class:`~stickslip.model.friction.NoUserLaw` if none). NaN where no steady sliding
+    exists."""
+    m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib = tables
     mw = np.empty(m_a.shape[1])
     kv = np.empty(kv_a.shape[1])
     for p in range(ia.shape[0]):
