@@ -26,20 +26,17 @@ each slipping contact (:class:`~.slip_watch.SlipWatch`), the samples, the transi
 work arrays (:mod:`.bundles`), the chunk's request (:class:`Controls`) and its progress (a
 :data:`PROGRESS` record on the loop's stack):
 
-==========================  ======================================================================
-:func:`take_step`           a step of the size proposed, under the error control
-:func:`lost_contact`        a prescribed normal force through zero inside it (the run ends there,
-                            :func:`end_at_lost_contact`)
-:func:`.slip_roots`         departures that overshoot the low-speed band, slip → stick roots
-:func:`retake`              the step re-taken shorter for either
-:func:`.gap_crossing`       a unilateral contact that opens or closes inside the step
-:func:`breakaway_root`      the first breakaway inside it
-:func:`cut_at_gap`,         the step cut at the earlier of the two, the transition applied there
-:func:`cut_at_breakaway`
-:func:`accept_step`         otherwise the whole step: its samples, the state advanced
-:func:`.arrivals`           the slipping contacts: band departures, homing onto v = 0, stick entry
-:func:`next_step_size`      the next step's size; the chunk's end
-==========================  ======================================================================
+* :func:`take_step`: a step of the size proposed, under the error control;
+* :func:`lost_contact`: a prescribed normal force through zero inside it (the run ends there,
+  :func:`end_at_lost_contact`);
+* :func:`.slip_roots`: departures that overshoot the low-speed band, slip → stick roots;
+  :func:`retake`: the step re-taken shorter for either;
+* :func:`.gap_crossing`: a unilateral contact that opens or closes inside the step;
+  :func:`breakaway_root`: the first breakaway inside it; :func:`cut_at_gap`,
+  :func:`cut_at_breakaway`: the step cut at the earlier root, the transition applied there;
+* otherwise :func:`accept_step`: the whole step, its samples, the state advanced;
+  :func:`.arrivals`: the slipping contacts' band departures, homing onto v = 0 and stick entry;
+* :func:`next_step_size`: the next step's size, and whether the chunk ends.
 
 State layout: the 2n physical states, then the accumulated work of friction and of damping [J],
 integrated with the same steps as quadratures.
@@ -64,7 +61,7 @@ from .slip_watch import MAX_RETAKES, arrivals, slip_roots, slip_watch
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
 from .transitions import break_away, crossing_in_step, gap_crossing, jammed_contact, switch_gap
 
-__all__ = ["integrate_event", "event_loop", "loop_arrays", "Controls", "PROGRESS", "N_EXTRA"]
+__all__ = ["integrate_event", "event_loop", "loop_arrays", "Controls", "controls", "PROGRESS", "N_EXTRA"]
 
 N_EXTRA = 2  # work of friction, work of damping
 

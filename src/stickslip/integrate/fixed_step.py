@@ -161,8 +161,7 @@ def slip_step_with_event(step, h, rx, ry, cst, md, scratch, stats):
     Plain halving from the whole step: unlike breakaway (``events.bisection_point``), the root
     on the step's interpolant is a poor guide here (measured off by 1e-4 to 0.2 of the step at
     Δt = 1e-3 s: near v_r = 0 the slip direction relaxes faster than the step resolves, and the
-    re-taken RK4 steps of different lengths do not follow one smooth path). Starting from it
-    saved 2 % of the re-steps at Δt = 1e-3 s and 26 % at 1e-4 s (0.2 % of that run): not kept.
+    re-taken RK4 steps of different lengths do not follow one smooth path).
 
     ``(rx, ry)``: unit reference direction, (0, 0) for none (right after breakaway, v_r = 0).
     Returns (h_taken, crossed, v1x, v1y, F1x, F1y): the step length actually taken [s], whether
@@ -171,14 +170,8 @@ def slip_step_with_event(step, h, rx, ry, cst, md, scratch, stats):
     ``step.fnew`` = f(ynew) hold the step end; ``scratch`` holds work arrays. ``stats`` is updated
     (rhs calls at index 2, re-taken steps at 3).
     """
-    y = step.y
-    K = step.K
-    ynew = step.ynew
-    fnew = step.fnew
-    ytmp = step.ytmp
-    F = scratch.F
-    N = scratch.N
-    v = scratch.v
+    y, K, ynew, fnew, ytmp = step.y, step.K, step.ynew, step.fnew, step.ytmp
+    F, N, v = scratch.F, scratch.N, scratch.v
     stats[2] += rk4_slip_step(y, K, h, cst, md, ynew, ytmp)
     F1x, F1y, v1x, v1y, _ = derivative_and_contact(ynew, cst, md, fnew, F, N, v)
     stats[2] += 1

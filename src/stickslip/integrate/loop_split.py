@@ -3,17 +3,17 @@
 :data:`EVENT_LOOP`: the stick solve's subtree (:func:`~stickslip.integrate.contacts.try_stick`,
 the release of an overloaded stick, the contact forces, the low-speed band's direction and the
 starting modes) in the helper, the step's (the right-hand side, the Dormand–Prince step, the
-crossings' probe, the samples) here. On two cores, from an empty cache: the plates' ``simulate``
-−17 %, a model file's −18 %. The two subtrees share ``general_forces``, which both compile: the
-split is as even as the loop's call tree allows, and the loop's own body compiles after both.
-The helper also compiles the kernels that a run's results call after the loop (each contact's
-slip velocity and normal force at the samples), the release of overloaded sticks after a
-transition, a breakaway, the error norm and the slip velocity's rate; this process the cut of a
+crossings' probe, the samples) here. The two subtrees share ``general_forces``, which both
+compile: the split is as even as the loop's call tree allows, and the loop's own body compiles
+after both. The helper also compiles the kernels that a run's results call after the loop (each
+contact's slip velocity and normal force at the samples), the release of overloaded sticks after
+a transition, a breakaway, the error norm and the slip velocity's rate; this process the cut of a
 step at an event and the step's small helpers (the dense-output coefficients, the slip-event
-test): what neither side compiles, the loop compiles alone, after both. The run starts the helper
-(:func:`start_callees`) before it checks that no contact is open at the start (a refused run ends
-it); this process, done with its side, does the command's
-:func:`~stickslip.model.compile_ahead.meanwhile` work while the helper finishes.
+test): what neither side compiles, the loop compiles alone, after both. The kernels are named by
+reference and their argument types derived from the bundles a run builds
+(:func:`_loop_calls`). The run starts the helper (:func:`start_callees`) before it checks that no
+contact is open at the start (a refused run ends it); this process, done with its side, does the
+command's :func:`~stickslip.model.compile_ahead.meanwhile` work while the helper finishes.
 """
 
 from __future__ import annotations

@@ -136,8 +136,8 @@ def aeom_stick_step(y, K, h, stick, md, ynew, ytmp):
 
     The stages call ``physics.general_rhs``, the right-hand side's path for stick, which
     ``physics.rhs_body`` calls after its fast path (every contact sliding) declines: inlining
-    ``rhs_body`` here, as the slip step does, would add its cold compile (3.8 s measured) for
-    nothing, and calling ``physics.rhs`` would add a call per stage (+5 % per run measured).
+    ``rhs_body`` here, as the slip step does, would add its cold compile for nothing, and calling
+    ``physics.rhs`` would add a call per stage.
     """
     u0, w0, a0, b0 = _trapezoid_base(y, md)
     for stage in range(3):
@@ -166,14 +166,8 @@ def aeom_stick_branch(step, h, stick, md, scratch, stats):
     hold the step end; ``stats`` counts rhs calls (index 2) and re-taken steps (index 3);
     ``scratch`` (:class:`~.bundles.Scratch`) and ``step.dense`` are work arrays.
     """
-    y = step.y
-    K = step.K
-    ynew = step.ynew
-    fnew = step.fnew
-    ytmp = step.ytmp
-    F = scratch.F
-    N = scratch.N
-    v = scratch.v
+    y, K, ynew, fnew, ytmp = step.y, step.K, step.ynew, step.fnew, step.ytmp
+    F, N, v = scratch.F, scratch.N, scratch.v
     calls = aeom_stick_step(y, K, h, stick, md, ynew, ytmp)
     Fx, Fy, _, _, normal = derivative_and_contact(ynew, stick, md, fnew, F, N, v)
     stats[2] += calls + 1

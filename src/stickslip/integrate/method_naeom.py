@@ -165,13 +165,8 @@ def naeom_stick_branch(step, t, h, stick, md, scratch, stats):
     ``step.Kn`` (4, n), ``step.dense`` (n, 3) and ``scratch`` (:class:`~.bundles.Scratch`) are
     work arrays.
     """
-    y = step.y
-    hist = step.history
-    ynew = step.ynew
-    ytmp = step.ytmp
-    K = step.Kn
-    F = scratch.F
-    N = scratch.N
+    y, hist, ynew, ytmp, K = step.y, step.history, step.ynew, step.ytmp, step.Kn
+    F, N = scratch.F, scratch.N
     n_hist = hist[0]
     tm = t + 0.5 * h
     if n_hist >= 2:

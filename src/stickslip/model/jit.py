@@ -4,10 +4,11 @@
 only read and write the arrays they are given and never allocate, so they need no reference
 counting; compiled without NRT their calls carry no atomic incref/decref per array argument,
 which halves the cost of the right-hand side (measured 189 → 84 ns per call, N = 50 N,
-Ω = 5 rad/s). Functions that allocate (the integrator loops) use ``loop`` (plain cached
-``njit``); they allocate only on entry and never reassign an array variable inside their main
-loop, since numba reference-counts loop-carried arrays on every iteration
-(``fixed_step.record_transition``).
+Ω = 5 rad/s). Functions that allocate (the orbit tools' segment integrator, steady sliding) use
+``loop`` (plain cached ``njit``); they allocate only on entry and never reassign an array variable
+inside their main loop, since numba reference-counts loop-carried arrays on every iteration
+(``transitions.record_transition``). The simulators' loops are kernels whose arrays their Python
+callers allocate (``integrate/bundles.py``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
 kernels on the innermost path (``forces.slip_force``, ``forces.add_contact_force``,

@@ -82,12 +82,8 @@ def _variational_calls(md) -> dict:
 #: A cold start's variational kernels in two processes (:mod:`stickslip.model.compile_ahead`):
 #: the event functions, then the variational right-hand side (with the complex-step physics under
 #: it) in the helper; the complex-step version of the band direction's residual, the first event's
-#: search, the contact gradients of the saltation matrices and the starting modes here; the
-#: segment integrator then loads both. A model file's ``orbit`` after its ``stability``, from an
-#: empty cache otherwise: the variational kernels in 14 s instead of 21 s; with the residual here
-#: (the helper, the longer side before, then mostly finds it in the cache) the two sides 3.9–4.0 s
-#: instead of 4.6 s; with the event functions in the helper (which the first event's search here
-#: then loads) 2.9–3.0 s against 3.1–3.2 s.
+#: search (which loads the helper's event functions), the contact gradients of the saltation
+#: matrices and the starting modes here; the segment integrator then loads both.
 VARIATIONAL = Split(
     helper=(V.event_value, V.variational_rhs),
     own=(V.direction_residual, V._first_event, V.contact_gradients, E.initial_modes),
