@@ -16,7 +16,10 @@ The loops' arrays are allocated by their Python callers (:func:`scratch`, :func:
 A loop's scalar state (its time, step size, counters, status) is a numpy record
 (``np.dtype(..., align=True)``) passed in a one-element array; :func:`on_stack` copies it onto the
 loop's own stack, where the compiler keeps its fields in registers as it would local variables,
-and the loop writes it back when it returns.
+and the loop writes it back when it returns (:func:`store_record`). Both copy the record's bytes
+with one ``memcpy``: an aggregate load or store of the record (numba's ``array[0] = record``, or
+a zero-fill of the copy) would have LLVM split it into single bytes, each field then reassembled
+from them at every use.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ import numpy as np
 from numba.core import cgutils, types
 from numba.extending import intrinsic
 
-__all__ = ["Samples", "TransitionLog", "Scratch", "scratch", "transition_log", "on_stack"]
+__all__ = ["Samples", "TransitionLog", "Scratch", "scratch", "transition_log", "on_stack", "store_record"]
 
 
 class Samples(NamedTuple):
@@ -113,9 +116,26 @@ def on_stack(typingctx, record):
         return None
 
     def codegen(context, builder, signature, args):
-        copy = cgutils.alloca_once(builder, context.data_model_manager[record].get_data_type())
+        with builder.goto_entry_block():  # not cgutils.alloca_once: its zero-fill, a store of the
+            # whole byte array, would have LLVM split the record into bytes
+            copy = builder.alloca(context.data_model_manager[record].get_data_type())
         copy.align = 16  # the record's fields are aligned (align=True)
         cgutils.raw_memcpy(builder, copy, args[0], context.get_constant(types.intp, 1), record.size)
         return copy
 
     return record(record), codegen
+
+
+@intrinsic
+def store_record(typingctx, array, record):
+    """Copy the numpy record ``record`` into the first element of the record array ``array`` (one
+    ``memcpy``; module docstring)."""
+    if not isinstance(record, types.Record) or not isinstance(array, types.Array) or array.dtype != record:
+        return None
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(array)(context, builder, args[0]).data
+        cgutils.raw_memcpy(builder, data, args[1], context.get_constant(types.intp, 1), record.size)
+        return context.get_dummy_value()
+
+    return types.none(array, record), codegen

@@ -56,7 +56,7 @@ from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
-from .bundles import on_stack, scratch
+from .bundles import on_stack, scratch, store_record
 from .slip_watch import MAX_RETAKES, arrivals, slip_roots, slip_watch
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
 from .transitions import break_away, crossing_in_step, gap_crossing, jammed_contact, switch_gap
@@ -472,7 +472,7 @@ def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, sta
     progress.lost = jammed_contact(step.y, cst, md)
     if progress.lost >= 0:
         progress.status = INCONSISTENT
-        start[0] = progress
+        store_record(start, progress)
         return
     progress.h = min(progress.h, controls.h_max)
     progress.n_steps = 0
@@ -519,7 +519,7 @@ def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, sta
         if next_step_size(progress, controls, slips.homing):
             progress.status = CHUNK_END
             break
-    start[0] = progress
+    store_record(start, progress)
 
 
 def loop_arrays(y0: np.ndarray, nc: int, h_init: float = 0.0, idx0: int = 0, n_tr0: int = 0):

@@ -37,7 +37,7 @@ from ..model.jit import inlined_kernel, kernel
 from ..model.system_model import FrictionModel
 from . import events as E
 from . import rk4
-from .bundles import Samples, on_stack, scratch
+from .bundles import Samples, on_stack, scratch, store_record
 from .event_loop import N_EXTRA
 from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
@@ -440,7 +440,7 @@ def fixed_loop(controls, md, start, step, cst, stick, scratch, samples, log, sta
         if not E.all_finite(step.y):
             progress.status = STATUS_NOT_FINITE
             break
-    start[0] = progress
+    store_record(start, progress)
 
 
 def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, samples, log):
