@@ -36,12 +36,12 @@ def store_sample(idx, y, mode, Fx, Fy, samples):
 
 
 @kernel
-def write_samples(idx, t, h, step, F1x, F1y, mode, fixed_force, cst, md, samples, scratch):
+def write_samples(idx, t, h, step, dense, force1, mode, fixed_force, cst, md, samples, scratch):
     """Write the samples with t < ts ≤ t + h (to END_SAMPLE_TOL) from the Hermite interpolant of
     the step ``step`` (a :class:`~.fixed_step.FixedStep`: from y0 = ``step.y``, f0 = ``step.K[0]``
-    to y1 = ``step.ynew``, f1 = ``step.fnew``; coefficients into ``step.dense``).
+    to y1 = ``step.ynew``, f1 = ``step.fnew``; its coefficients into ``dense``).
 
-    ``(F1x, F1y)`` is the friction force at the step end y1 [N]. A sample at the step end
+    ``force1`` = (F1x, F1y) is the friction force at the step end y1 [N]. A sample at the step end
     (θ = 1 to :data:`END_SAMPLE_TOL` on either side; every sample when the sample period is a
     multiple of Δt) is y1 with that force, and needs neither the interpolant nor a force
     evaluation. The tolerance also covers the far side: sample times and grid points are
@@ -51,11 +51,12 @@ def write_samples(idx, t, h, step, F1x, F1y, mode, fixed_force, cst, md, samples
     in stick), else the contact force in the modes of ``cst`` at the sample
     (``physics.contact_forces``). Returns the next sample index.
     """
+    F1x, F1y = force1
     times = samples.times
     n_samples = times.shape[0]
     y0 = step.y
     y1 = step.ynew
-    Q = step.dense
+    Q = dense
     work = scratch.state
     t_to = t + h
     t_last = t_to + END_SAMPLE_TOL * h

@@ -41,7 +41,7 @@ from .bundles import Samples, on_stack, scratch, store_record
 from .event_loop import N_EXTRA
 from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
-from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
+from .method_naeom import MAX_NEWTON, VR_TOL, ForceStep, naeom_stick_branch
 from .runner import Chunk, Record, RunOutput, ToTheEnd, run_chunks, stats_dict, transition_room
 from .status import MAX_STEPS as STATUS_MAX_STEPS
 from .status import NOT_FINITE as STATUS_NOT_FINITE
@@ -52,7 +52,8 @@ from .status import Status
 from .step_physics import derivative_and_contact, derivative_under_force, stick_force
 from .transitions import record_transition
 
-__all__ = ["integrate_fixed_step", "fixed_loop", "run_fixed_step", "FixedStepper", "FixedStep", "FixedControls",
+__all__ = ["integrate_fixed_step", "fixed_loop", "run_fixed_step", "FixedStepper", "FixedStep", "StickArrays",
+           "FixedControls",
            "FIXED_PROGRESS", "check_step", "step_band", "step_data", "STABILITY_LIMIT", "METHOD_AEOM", "METHOD_NAEOM"]
 
 #: Stick solver codes of :func:`integrate_fixed_step`.
@@ -68,7 +69,7 @@ METHOD_CODES = {"aeom": METHOD_AEOM, "naeom": METHOD_NAEOM}
 STABILITY_LIMIT = 2.0
 
 class FixedStep(NamedTuple):
-    """The arrays of one fixed step of a state of n entries.
+    """The arrays of one RK4 step of a state of n entries.
 
     Attributes
     ----------
@@ -80,12 +81,6 @@ class FixedStep(NamedTuple):
         The state at the step's end and its derivative.
     ytmp : ndarray (n,)
         The state of the stage being evaluated.
-    dense : ndarray (n, 3)
-        The step's cubic Hermite interpolant (``events.hermite_coefficients``).
-    Kn : ndarray (4, n)
-        Stages of NAEOM's constant-force steps in stick.
-    history : ndarray (7,)
-        NAEOM's force history of the stick phase (:func:`.method_naeom.naeom_stick_branch`).
     """
 
     y: np.ndarray
@@ -93,6 +88,22 @@ class FixedStep(NamedTuple):
     ynew: np.ndarray
     fnew: np.ndarray
     ytmp: np.ndarray
+
+
+class StickArrays(NamedTuple):
+    """What the stick steps add to a :class:`FixedStep` (n states).
+
+    Attributes
+    ----------
+    dense : ndarray (n, 3)
+        The step's cubic Hermite interpolant (``events.hermite_coefficients``): samples inside the
+        step, the first trials of breakaway's bisection.
+    Kn : ndarray (4, n)
+        Stages of NAEOM's constant-force steps.
+    history : ndarray (7,)
+        NAEOM's force history of the stick phase (:func:`.method_naeom.naeom_stick_branch`).
+    """
+
     dense: np.ndarray
     Kn: np.ndarray
     history: np.ndarray
@@ -150,7 +161,7 @@ def rk4_slip_step(y, K, h, cst, md, ynew, ytmp):
 
 
 @kernel
-def slip_step_with_event(step, h, rx, ry, cst, md, scratch, stats):
+def slip_step_with_event(step, h, rx, ry, cst, md, F, N, v, stats):
     """A slip step with the slip → stick event located by bisection on re-stepping.
 
     The event function is the projection of v_r on the reference direction (rx, ry)
@@ -167,11 +178,10 @@ def slip_step_with_event(step, h, rx, ry, cst, md, scratch, stats):
     Returns (h_taken, crossed, v1x, v1y, F1x, F1y): the step length actually taken [s], whether
     it ends at a zero of the slip velocity, and v_r [m/s] and the friction force [N] at the step
     end. ``step`` is a :class:`FixedStep` from ``step.y`` with K[0] = f(y); ``step.ynew``,
-    ``step.fnew`` = f(ynew) hold the step end; ``scratch`` holds work arrays. ``stats`` is updated
-    (rhs calls at index 2, re-taken steps at 3).
+    ``step.fnew`` = f(ynew) hold the step end; ``F``, ``N``, ``v`` are work arrays. ``stats`` is
+    updated (rhs calls at index 2, re-taken steps at 3).
     """
     y, K, ynew, fnew, ytmp = step.y, step.K, step.ynew, step.fnew, step.ytmp
-    F, N, v = scratch.F, scratch.N, scratch.v
     stats[2] += rk4_slip_step(y, K, h, cst, md, ynew, ytmp)
     F1x, F1y, v1x, v1y, _ = derivative_and_contact(ynew, cst, md, fnew, F, N, v)
     stats[2] += 1
@@ -278,25 +288,29 @@ def grid_step(progress, controls):
 
 
 @inlined_kernel
-def take_fixed_step(progress, method, step, cst, stick, md, scratch, stats):
+def take_fixed_step(progress, method, step, extra, cst, stick, md, scratch, stats):
     """One step in the current mode: a slip step with the slip → stick event, or the method's stick
     step with breakaway (each located by bisection on re-stepping; ``progress.h`` becomes the
-    length taken). False where NAEOM's stick-force solve failed."""
+    length taken). False where NAEOM's stick-force solve failed. Each step kernel is given the
+    arrays it uses only: a kernel called at every step takes its arguments word by word."""
     progress.transition = 0
     progress.crossed = False
     if progress.mode == P.MODE_SLIP:
         rx, ry = event_direction(progress.vx, progress.vy, progress.rx, progress.ry, md.m[H_BAND])
         progress.rx = rx
         progress.ry = ry
-        h, crossed, vx, vy, Fx, Fy = slip_step_with_event(step, progress.h, rx, ry, cst, md, scratch, stats)
+        h, crossed, vx, vy, Fx, Fy = slip_step_with_event(step, progress.h, rx, ry, cst, md, scratch.F, scratch.N,
+                                                          scratch.v, stats)
         progress.crossed = crossed
         progress.vx = vx
         progress.vy = vy
     elif method == METHOD_AEOM:
-        h, transition, Fx, Fy = aeom_stick_branch(step, progress.h, stick, md, scratch, stats)
+        h, transition, Fx, Fy = aeom_stick_branch(step, progress.h, stick, md, extra.dense, scratch, stats)
         progress.transition = transition
     else:
-        h, transition, Fx, Fy, solved = naeom_stick_branch(step, progress.t, progress.h, stick, md, scratch, stats)
+        forced = ForceStep(step.y, step.ynew, step.ytmp, extra.Kn, extra.history)
+        h, transition, Fx, Fy, solved = naeom_stick_branch(forced, progress.t, progress.h, stick, md, extra.dense,
+                                                           scratch, stats)
         if not solved:
             progress.status = STATUS_SOLVE_FAILED
             return False
@@ -308,7 +322,7 @@ def take_fixed_step(progress, method, step, cst, stick, md, scratch, stats):
 
 
 @inlined_kernel
-def step_samples(progress, method, step, cst, md, samples, scratch, stats):
+def step_samples(progress, method, step, dense, cst, md, samples, scratch, stats):
     """The samples of the step (the friction force at its end (Fx, Fy)), before a transition
     changes ``cst``: at its end alone where that is all (:func:`.fixed_samples.end_sample_only`),
     else from its cubic Hermite interpolant (for NAEOM in stick, under its constant force)."""
@@ -324,12 +338,13 @@ def step_samples(progress, method, step, cst, md, samples, scratch, stats):
             derivative_under_force(step.ynew, Fx, Fy, md, step.fnew)
             stats[2] += 2
             fixed_force = np.bool_(True)
-        idx = write_samples(idx, progress.t, progress.h, step, Fx, Fy, mode, fixed_force, cst, md, samples, scratch)
+        idx = write_samples(idx, progress.t, progress.h, step, dense, (Fx, Fy), mode, fixed_force, cst, md, samples,
+                            scratch)
     progress.idx = idx
 
 
 @inlined_kernel
-def end_of_step(progress, step, cst, stick, md, scratch):
+def end_of_step(progress, step, history, cst, stick, md, scratch):
     """At the step's end: in slip, the slip direction there, and at a located zero of the slip
     velocity the stick test (:func:`after_slip_root`); after a breakaway, the direction slip
     departs in."""
@@ -340,7 +355,7 @@ def end_of_step(progress, step, cst, stick, md, scratch):
         cst[2] = ey
         if progress.crossed and after_slip_root(ynew, cst, stick, md, scratch.F, scratch.N):
             progress.transition = E.TRANSITION_TO_STICK
-            step.history[0] = 0.0
+            history[0] = 0.0
     elif progress.transition == E.TRANSITION_TO_SLIP:
         Fx, Fy, _ = stick_force(ynew, stick, md, scratch.F, scratch.N)
         cst[1], cst[2] = E.breakaway_direction(Fx, Fy, np.int64(2))
@@ -401,7 +416,7 @@ def begin(progress, controls, step, cst, stick, md, samples, scratch, stats):
 
 
 @kernel
-def fixed_loop(controls, md, start, step, cst, stick, scratch, samples, log, stats):
+def fixed_loop(controls, md, start, step, extra, cst, stick, scratch, samples, log, stats):
     """The loop of :func:`integrate_fixed_step`: the model ``md`` (the plates) from ``step.y``
     (2n + 2 entries, advanced in place) over [t0, t_end] with the fixed step ``dt``.
 
@@ -412,6 +427,7 @@ def fixed_loop(controls, md, start, step, cst, stick, scratch, samples, log, sta
     start : ndarray (1,) of :data:`FIXED_PROGRESS`
         The loop's progress at its end.
     step : FixedStep
+    extra : StickArrays
     cst, stick : ndarray (CST,)
         The contact's state in its current mode (mode, slip direction ex, ey, τ), and the same in
         stick (the stick multiplier, the projection, breakaway).
@@ -430,10 +446,10 @@ def fixed_loop(controls, md, start, step, cst, stick, scratch, samples, log, sta
     while progress.t < controls.t_end:
         if not grid_step(progress, controls):
             break
-        if not take_fixed_step(progress, controls.method, step, cst, stick, md, scratch, stats):
+        if not take_fixed_step(progress, controls.method, step, extra, cst, stick, md, scratch, stats):
             break
-        step_samples(progress, controls.method, step, cst, md, samples, scratch, stats)
-        end_of_step(progress, step, cst, stick, md, scratch)
+        step_samples(progress, controls.method, step, extra.dense, cst, md, samples, scratch, stats)
+        end_of_step(progress, step, extra.history, cst, stick, md, scratch)
         advance(progress, step, stats)
         if progress.transition != 0:
             switch_mode(progress, step, cst, md, scratch, log, stats)
@@ -465,14 +481,14 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, samples, log)
         As :func:`fixed_loop`'s.
     """
     n = y0.shape[0]
-    step = FixedStep(y0.copy(), np.empty((4, n)), np.empty(n), np.empty(n), np.empty(n), np.empty((n, 3)),
-                     np.empty((4, n)), np.zeros(7))
+    step = FixedStep(y0.copy(), np.empty((4, n)), np.empty(n), np.empty(n), np.empty(n))
+    extra = StickArrays(np.empty((n, 3)), np.empty((4, n)), np.zeros(7))
     cst = np.empty(CST)
     stick = np.array([P.MODE_STICK, 0.0, 0.0, math.inf])
     stats = np.zeros(8, dtype=np.int64)
     start = np.zeros(1, dtype=FIXED_PROGRESS)
-    fixed_loop(FixedControls(int(method), float(t0), float(t_end), float(dt), int(max_steps)), md, start, step, cst,
-               stick, scratch(n, 1), samples, log, stats)
+    fixed_loop(FixedControls(int(method), float(t0), float(t_end), float(dt), int(max_steps)), md, start, step, extra,
+               cst, stick, scratch(n, 1), samples, log, stats)
     p = start[0]
     return int(p["status"]), float(p["t"]), step.y, int(p["n_tr"]), stats
 

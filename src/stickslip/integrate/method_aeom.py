@@ -153,7 +153,7 @@ def aeom_stick_step(y, K, h, stick, md, ynew, ytmp):
 
 
 @kernel
-def aeom_stick_branch(step, h, stick, md, scratch, stats):
+def aeom_stick_branch(step, h, stick, md, dense, scratch, stats):
     """An AEOM stick step of length ``h`` [s] with breakaway located by bisection on re-stepping.
 
     If the stick force at the step end violates Eq. (10), θ ∈ (0, 1] is bisected, each trial
@@ -164,7 +164,7 @@ def aeom_stick_branch(step, h, stick, md, scratch, stats):
     (h_taken, transition, Fx, Fy): the step length taken [s], 0 or ``events.TRANSITION_TO_SLIP``
     and the stick force at the step end [N]. ``step.ynew`` and ``step.fnew`` = f(ynew) (stick)
     hold the step end; ``stats`` counts rhs calls (index 2) and re-taken steps (index 3);
-    ``scratch`` (:class:`~.bundles.Scratch`) and ``step.dense`` are work arrays.
+    ``dense`` (n, 3) and ``scratch`` (:class:`~.bundles.Scratch`) are work arrays.
     """
     y, K, ynew, fnew, ytmp = step.y, step.K, step.ynew, step.fnew, step.ytmp
     F, N, v = scratch.F, scratch.N, scratch.v
@@ -174,7 +174,7 @@ def aeom_stick_branch(step, h, stick, md, scratch, stats):
     limit = P.static_limit(md.m, model_sizes(md.kin, md.m)[0], np.int64(0), normal)
     if limit - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
         return h, 0, Fx, Fy
-    estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, fnew, h, stick, md, step.dense, scratch)
+    estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, fnew, h, stick, md, dense, scratch)
     a, b, at, c = E.first_trial(estimate, h)
     while c >= 0.0:
         stats[2] += aeom_stick_step(y, K, c * h, stick, md, ynew, ytmp)
