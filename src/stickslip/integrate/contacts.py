@@ -96,6 +96,7 @@ EVENT_CHECKS = 4
 MAX_SETTLE = 64
 
 
+@standalone
 @kernel
 def dense_state(y0, Q, h, theta, out):
     """Evaluate ``out = y0 + h Σ_j Q[:, j] θ^(j+1)`` (Horner)."""

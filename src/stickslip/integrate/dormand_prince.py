@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..model.jit import kernel
+from ..model.jit import kernel, standalone
 
 A21 = 1 / 5
 A31, A32 = 3 / 40, 9 / 40
@@ -108,6 +108,7 @@ def local_error(Kst, h, i):
                 + E7 * Kst[6, i])
 
 
+@standalone
 @kernel
 def dense_coefficients(Kst, Q):
     """Q (n, 4) = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ (``events.dense_state``)."""

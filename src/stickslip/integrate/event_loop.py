@@ -27,15 +27,15 @@ work arrays (:mod:`.bundles`), the chunk's request (:class:`Controls`) and its p
 :data:`PROGRESS` record on the loop's stack):
 
 * :func:`take_step`: a step of the size proposed, under the error control;
-* :func:`lost_contact`: a prescribed normal force through zero inside it (the run ends there,
-  :func:`end_at_lost_contact`);
+* :func:`lost_contact`: a prescribed normal force through zero inside it (the run ends there);
 * :func:`.slip_roots`: departures that overshoot the low-speed band, slip → stick roots;
   :func:`retake`: the step re-taken shorter for either;
 * :func:`.gap_crossing`: a unilateral contact that opens or closes inside the step;
   :func:`breakaway_root`: the first breakaway inside it; :func:`cut_at_gap`,
   :func:`cut_at_breakaway`: the step cut at the earlier root, the transition applied there;
 * otherwise :func:`accept_step`: the whole step, its samples, the state advanced;
-  :func:`.arrivals`: the slipping contacts' band departures, homing onto v = 0 and stick entry;
+  :func:`.arrivals`: the slipping contacts' band departures, homing onto v = 0 and stick entry,
+  and the derivative again where a mode changed;
 * :func:`next_step_size`: the next step's size, and whether the chunk ends.
 
 State layout: the 2n physical states, then the accumulated work of friction and of damping [J],
@@ -280,10 +280,12 @@ def first_samples(idx, t_base, y, cst, md, samples, scratch):
 
 # ----------------------------------------------------------------------------- events inside the step
 @inlined_kernel
-def lost_contact(step, h, cst, md, scratch):
-    """(θ, contact, q_ready): the first prescribed normal force through zero inside the step (θ =
-    −1.0, contact −1: none) and whether the step's dense-output coefficients are formed."""
+def lost_contact(progress, t_base, step, cst, md, samples, scratch, stats):
+    """A prescribed normal force through zero inside the step: the run ends at the first root
+    (the step cut there, ``progress.status`` CONTACT_LOST). Returns (whether it ends, whether the
+    step's dense-output coefficients are formed)."""
     n, nc, _ = model_sizes(md.kin, md.m)
+    h = progress.h
     theta_lost = -1.0
     lost = np.int64(-1)
     q_ready = False
@@ -294,18 +296,15 @@ def lost_contact(step, h, cst, md, scratch):
             if theta_lost < 0.0 or th < theta_lost:
                 theta_lost = th
                 lost = c
-    return theta_lost, lost, q_ready
-
-
-@inlined_kernel
-def end_at_lost_contact(progress, theta, c, t_base, step, cst, md, samples, scratch, stats):
-    """Contact ``c``'s normal force reaches zero at θ inside the step: the run ends there."""
-    idx, tau = cut_step(theta, progress.idx, progress.tau, progress.h, t_base, step, cst, md, samples, scratch)
-    progress.idx = idx
-    progress.tau = tau
-    stats[0] += 1
-    progress.status = CONTACT_LOST
-    progress.lost = c
+    if theta_lost > 0.0:
+        idx, tau = cut_step(theta_lost, progress.idx, progress.tau, h, t_base, step, cst, md, samples, scratch)
+        progress.idx = idx
+        progress.tau = tau
+        stats[0] += 1
+        progress.status = CONTACT_LOST
+        progress.lost = lost
+        return True, q_ready
+    return False, q_ready
 
 
 @inlined_kernel
@@ -327,6 +326,7 @@ def breakaway_root(any_stick, step, q_ready, h, cst, md, scratch):
     return theta_b, c_b, q_ready
 
 
+@standalone
 @kernel
 def cut_step(theta, idx, tau, h, t_base, step, cst, md, samples, scratch):
     """End the step of length ``h`` from local time ``tau`` at θ ∈ (0, 1] (an event's root): write
@@ -414,21 +414,6 @@ def accept_step(progress, t_base, step, slips, cst, md, samples, scratch, q_read
     progress.slips_ready = True
 
 
-@inlined_kernel
-def after_arrivals(progress, homing, changed, step, cst, md, stats):
-    """After an accepted step: the derivative again where a mode changed or the velocities were
-    projected; the error controller's step resumed after a homing episode (the homing steps
-    were short by construction, not by the error estimate)."""
-    if changed:
-        P.rhs(step.y, cst, md, step.k1)
-        stats[2] += 1
-        progress.slips_ready = False
-    if not homing and progress.h_free > 0.0 and progress.h_override < 0.0:
-        progress.h_override = max(progress.h * progress.factor, progress.h_free)
-        progress.h_free = -1.0
-    progress.retakes = 0
-
-
 # ----------------------------------------------------------------------------- the loop
 @kernel
 def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, stats, start_modes):
@@ -487,28 +472,26 @@ def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, sta
             break
         if taken == RETRY:
             continue
-        theta_lost, c_lost, q_ready = lost_contact(step, progress.h, cst, md, scratch)
-        if theta_lost > 0.0:
-            end_at_lost_contact(progress, theta_lost, c_lost, controls.t_base, step, cst, md, samples, scratch, stats)
+        ended, q_ready = lost_contact(progress, controls.t_base, step, cst, md, samples, scratch, stats)
+        if ended:
             break
         shrink, theta_slip, any_stick, q_ready = slip_roots(progress, step, slips, cst, md, scratch, q_ready)
         if retake(progress, shrink, theta_slip, stats):
             continue
         theta_g, c_g, q_ready = gap_crossing(step, q_ready, progress.h, cst, md, scratch)
         theta_b, c_b, q_ready = breakaway_root(any_stick, step, q_ready, progress.h, cst, md, scratch)
-        if theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b):
+        cut = theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b)
+        if cut:
             if not cut_at_gap(progress, theta_g, c_g, controls, step, cst, md, samples, scratch, log, stats):
                 break
-            new_piece(progress, step, cst, md, stats)
         elif theta_b > 0.0:
+            cut = True
             cut_at_breakaway(progress, theta_b, c_b, controls, step, cst, md, samples, scratch, log, stats)
-            new_piece(progress, step, cst, md, stats)
         else:
             accept_step(progress, controls.t_base, step, slips, cst, md, samples, scratch, q_ready, stats)
-            if any_stick:
-                P.project_velocities(step.y, cst, np.int64(-1), md)  # remove constraint drift
-            homing, changed = arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip, stats)
-            after_arrivals(progress, homing, changed or any_stick, step, cst, md, stats)
+            arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip, any_stick, stats)
+        if cut:
+            new_piece(progress, step, cst, md, stats)
         if not E.all_finite(step.y):
             progress.status = NOT_FINITE
             break

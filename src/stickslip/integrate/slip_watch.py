@@ -8,9 +8,10 @@ each inlined into the loop (one call site each):
     a quasi-static departure that overshoots the low-speed band (the step is re-taken shorter);
     the first slip → stick root of an approach inside the step (the step is re-taken to end there).
 :func:`arrivals`
-    After a step is accepted: each slipping contact's direction; a departure that leaves the band
-    (or turns back inside it) continues with the exact direction; an approach whose extrapolated
-    zero lies within the next step is homed onto it; one that has arrived sticks, or reverses.
+    After a step is accepted: drift removed from the sticking contacts; each slipping contact's
+    direction; a departure that leaves the band (or turns back inside it) continues with the exact
+    direction; an approach whose extrapolated zero lies within the next step is homed onto it; one
+    that has arrived sticks, or reverses.
 
 What the loop keeps of each contact between steps is a :class:`SlipWatch`; its scalar state (step
 size, re-takes, the step size before a homing episode) is the loop's progress record
@@ -70,20 +71,6 @@ class SlipWatch(NamedTuple):
 def slip_watch(nc: int) -> SlipWatch:
     """A :class:`SlipWatch` for ``nc`` contacts, none homing."""
     return SlipWatch(np.empty(4 * nc), np.empty(4 * nc), np.zeros(nc, dtype=np.int64))
-
-
-@inlined_kernel
-def slips_at_start(step, cst, md, slips):
-    """Each contact's slip velocity and its rate at the step's start ``step.y`` into ``slips.start``
-    (sticking contacts left out)."""
-    start = slips.start
-    for c in range(model_sizes(md.kin, md.m)[1]):
-        if np.int64(cst[CST * c]) != P.MODE_STICK:
-            vx, vy, ax, ay = P.slip_velocity_and_rate(step.y, step.k1, c, md)
-            start[4 * c] = vx
-            start[4 * c + 1] = vy
-            start[4 * c + 2] = ax
-            start[4 * c + 3] = ay
 
 
 @inlined_kernel
@@ -152,30 +139,20 @@ def slip_roots(progress, step, slips, cst, md, scratch, q_ready):
                 f_c = max(DP.MIN_FACTOR, math.sqrt(band / speed1))
                 shrink = f_c if shrink < 0.0 else min(shrink, f_c)
         if mode == P.MODE_SLIP_EXACT:
-            if not progress.slips_ready:
-                slips_at_start(step, cst, md, slips)
+            if not progress.slips_ready:  # the values at the step's start (sticking contacts left out)
+                start = slips.start
+                for c2 in range(nc):
+                    if np.int64(cst[CST * c2]) != P.MODE_STICK:
+                        vx, vy, ax, ay = P.slip_velocity_and_rate(step.y, step.k1, c2, md)
+                        start[4 * c2] = vx
+                        start[4 * c2 + 1] = vy
+                        start[4 * c2 + 2] = ax
+                        start[4 * c2 + 3] = ay
                 progress.slips_ready = True
             th, q_ready = approach_root(c, h, step, slips, cst, md, scratch, q_ready)
             if th > 0.0 and (theta_slip < 0.0 or th < theta_slip):
                 theta_slip = th
     return shrink, theta_slip, any_stick, q_ready
-
-
-@inlined_kernel
-def left_band(c, slips, band, cst):
-    """Contact ``c`` slipping quasi-statically: whether it has departed (|v| above the low-speed
-    ``band``) or |v| falls again inside the band (an approach, which may end in stick or a
-    reversal), either way watched with the exact direction from the next step on (the force law
-    changes between steps, never inside one)."""
-    end = slips.end
-    v1x = end[4 * c]
-    v1y = end[4 * c + 1]
-    speed = math.sqrt(v1x * v1x + v1y * v1y)
-    left = speed > band or v1x * end[4 * c + 2] + v1y * end[4 * c + 3] < 0.0
-    if left:
-        cst[CST * c] = P.MODE_SLIP_EXACT
-    cst[CST * c + 3] = math.inf
-    return left
 
 
 @inlined_kernel
@@ -245,32 +222,44 @@ def arrive(progress, c, t, y, cst, md, v_arrive, scratch, log, stats):
 
 
 @inlined_kernel
-def arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip, stats):
-    """The slipping contacts after an accepted step (``step.y``, local time ``progress.tau``):
-    each one's slip direction, then :func:`left_band` for a quasi-static one, :func:`approach`
-    and :func:`arrive` for the others. ``theta_slip``: the step ended at a located root.
+def arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip, any_stick, stats):
+    """The contacts after an accepted step (``step.y``, local time ``progress.tau``).
 
-    Returns (homing, changed): whether some contact homes onto v = 0 with the next step, and
-    whether some mode changed.
+    The velocities are projected onto the sticking contacts' constraints (``any_stick``: drift
+    removed); each slipping contact gets its slip direction there; a quasi-static one that has
+    departed (|v| above the low-speed band) or whose |v| falls again inside the band (an
+    approach, which may end in stick or a reversal) is watched with the exact direction from the
+    next step on (the force law changes between steps, never inside one); the others
+    :func:`approach` v = 0 and :func:`arrive`. Then the derivative again where a mode changed or
+    the velocities were projected, and the error controller's step resumed after a homing
+    episode (the homing steps were short by construction, not by the error estimate).
+    ``theta_slip``: the step ended at a located root.
     """
     m = md.m
     n, nc, _ = model_sizes(md.kin, m)
     y = step.y
     end = slips.end
+    band = m[H_BAND]
+    changed = any_stick
+    if any_stick:
+        P.project_velocities(y, cst, np.int64(-1), md)
     v_arrive = E.arrival_speed(y, n, controls.rtol, controls.atol)
     t = controls.t_base + progress.tau
     homing = False
-    changed = False
     for c in range(nc):
         mode = np.int64(cst[CST * c])
         if mode == P.MODE_STICK or mode == P.MODE_OPEN:
             continue
-        ex, ey = P.slip_direction(y, cst, c, md, end[4 * c], end[4 * c + 1])
+        v1x = end[4 * c]
+        v1y = end[4 * c + 1]
+        ex, ey = P.slip_direction(y, cst, c, md, v1x, v1y)
         cst[CST * c + 1] = ex
         cst[CST * c + 2] = ey
         if mode == P.MODE_SLIP_QUASI_STATIC:
-            if left_band(c, slips, m[H_BAND], cst):
+            if math.sqrt(v1x * v1x + v1y * v1y) > band or v1x * end[4 * c + 2] + v1y * end[4 * c + 3] < 0.0:
+                cst[CST * c] = P.MODE_SLIP_EXACT
                 changed = True
+            cst[CST * c + 3] = math.inf
             continue
         homes, near = approach(progress, c, mode, slips, theta_slip, v_arrive, cst, md)
         if homes:
@@ -279,4 +268,11 @@ def arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip,
             slips.homing[c] = 0
             if arrive(progress, c, t, y, cst, md, v_arrive, scratch, log, stats):
                 changed = True
-    return homing, changed
+    if changed:
+        P.rhs(y, cst, md, step.k1)
+        stats[2] += 1
+        progress.slips_ready = False
+    if not homing and progress.h_free > 0.0 and progress.h_override < 0.0:
+        progress.h_override = max(progress.h * progress.factor, progress.h_free)
+        progress.h_free = -1.0
+    progress.retakes = 0

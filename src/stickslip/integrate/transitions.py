@@ -13,7 +13,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import CST
-from ..model.jit import inlined_kernel, kernel
+from ..model.jit import inlined_kernel, kernel, standalone
 from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from ..model.normal import is_unilateral
 from . import contacts as E
@@ -36,6 +36,7 @@ def crossing_in_step(kind, c, step, q_ready, h, cst, md, scratch):
     return 1.0 if th <= 0.0 else th
 
 
+@standalone
 @kernel
 def record_transition(log, n_tr, t, kind, contact, y):
     """Write transition ``n_tr`` (time [s], kind, contact, state) into the :class:`~.bundles.TransitionLog`
@@ -51,6 +52,7 @@ def record_transition(log, n_tr, t, kind, contact, y):
             states[n_tr, i] = y[i]
 
 
+@standalone
 @kernel
 def settle(y, cst, md, scratch, t, log, n_tr, stats):
     """Release sticking contacts whose joint stick force exceeds the static limit (the most
@@ -66,6 +68,7 @@ def settle(y, cst, md, scratch, t, log, n_tr, stats):
     return n_tr
 
 
+@standalone
 @kernel
 def break_away(y, cst, c, md, scratch, t, log, n_tr, stats):
     """Sticking contact ``c`` breaks away at ``y`` (time ``t``, the root of its stick margin): the

@@ -300,6 +300,7 @@ def normal_force(s, c, md):
     return contact_frame(md.kin, s, c, md.m, G2, w2)
 
 
+@standalone
 @kernel
 def slip_velocity_and_rate(s, ds, c, md):
     """(v0, v1, a0, a1): slip velocity of contact ``c`` [m/s] and its rate dv/dt = G q̈ + h [m/s²]
