@@ -87,11 +87,15 @@ def main():
         import stickslip
         import stickslip_baseline as base
         import stickslip_baseline.orbits as base_orbits
+        from stickslip.model.library import two_plates
         from stickslip.orbits import monodromy, periodic_orbit
+        from stickslip_baseline.model.library import two_plates as base_two_plates
 
         for label, values, ic, variant, search in PLATES:
-            o_new = periodic_orbit(stickslip.Parameters(**values), ic, model=variant, search_time=search)
-            o_old = base_orbits.periodic_orbit(base.Parameters(**values), ic, model=variant, search_time=search)
+            # a model as the first argument: the same call before and after `model` named it alone
+            o_new = periodic_orbit(two_plates(stickslip.Parameters(**values), variant), ic, search_time=search)
+            o_old = base_orbits.periodic_orbit(base_two_plates(base.Parameters(**values), variant), ic,
+                                               search_time=search)
             monodromy(o_new), base_orbits.monodromy(o_old)  # compile / load the caches, not timed
             t_new, t_old, ratios = [], [], []
             for i in range(args.pairs):

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stickslip import OUTCOMES
 from stickslip.sweep import sweep
 from stickslip.sweep.spec import TIMING_COLUMNS
 
@@ -48,7 +49,7 @@ def fig8(workers: int, every: int, t_end: float) -> dict:
     out = {"machine": platform.processor() or platform.machine(), "cpus": os.cpu_count(), "workers": workers,
            "t_end": t_end, "grid_measured": [int(N.size), int(Om.size), 2], "runs_measured": runs,
            "wall_measured_s": wall, "sum_point_s": work, "mean_point_s": work / runs,
-           "max_point_s": float(ds["wall_time"].max()), "failed": int((ds["kind"] == -1).sum()),
+           "max_point_s": float(ds["wall_time"].max()), "failed": int((ds["attractor"] == OUTCOMES.index("failed")).sum()),
            "runs_full": runs_full, "timings": {k: v for k, v in rm.timings.items() if isinstance(v, (int, float, str))}}
     if runs == runs_full:
         out["wall_full_s"] = wall

@@ -21,7 +21,7 @@ from stickslip.plot.sweep import plot_bifurcation
 with tempfile.TemporaryDirectory() as tmp:
     res = stickslip.sweep({"N": np.linspace(10, 130, 21)}, stickslip.Parameters(Omega=0.5),
                           out=Path(tmp) / "bifurcation.nc", t_end=200.0, executor="serial")
-    print(res.kinds())
+    print(res.outcomes())
 
 # %%
 # The peaks show the diagram's structure: one branch at low N, two and more above ≈ 75 N. Over

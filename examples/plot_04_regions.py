@@ -18,7 +18,7 @@ import stickslip
 from stickslip.plot.regions import plot_regions
 
 with tempfile.TemporaryDirectory() as tmp:
-    rmap = stickslip.regions(N=np.linspace(20, 120, 5), Omega=np.linspace(1, 13, 5), models=["full"],
+    rmap = stickslip.regions(N=np.linspace(20, 120, 5), Omega=np.linspace(1, 13, 5), variants=["full"],
                              out=Path(tmp) / "regions.nc", t_end=60.0, t_from=40.0, executor="serial")
 print(rmap.region)  # (model, N, Ω): 1 = I, 2 = II, 3 = III, 0 = other
 

@@ -14,12 +14,13 @@ its stick phase vanishes.
 import matplotlib.pyplot as plt
 
 import stickslip
+from stickslip.model.library import two_plates
 from stickslip.orbits.continuation import start_run
 from stickslip.plot.continuation import plot_branch
 
 band = 1e-5  # a narrower low-speed band of the 2-D slip direction than the default
-p = stickslip.Parameters(N=50.0, Omega=3.0)
-start = stickslip.periodic_orbit(p, start_run(p, "far", model="rotation", t_end=30.0, slip_band=band), slip_band=band)
+model = two_plates(stickslip.Parameters(N=50.0, Omega=3.0), "rotation")  # Model 4
+start = stickslip.periodic_orbit(model, start_run(model, "far", t_end=30.0, slip_band=band), slip_band=band)
 branch = stickslip.continue_orbit(start=start, param="Omega", step=0.05, max_step=1.0, max_points=200,
                                   bounds=(3.0, 20.0), amplitude=False)
 print(f"{len(branch)} orbits, Ω from {branch.values[0]:.3f} to {branch.values[-1]:.4f} rad/s; stop: {branch.stop_reason}")

@@ -27,7 +27,7 @@ with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_
                           executor="dask", address=cluster.scheduler_address, out=Path(tmp) / "belt.nc")
     ds = res.to_xarray().load()
 print(dict(ds.sizes), list(ds.data_vars)[:8], "...")
-print(res.kinds())
+print(res.outcomes())
 
 # %%
 # The amplitude of the observed coordinate x and the fraction of time stuck, against the belt speed.

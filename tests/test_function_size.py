@@ -11,24 +11,6 @@ PACKAGE = Path(__file__).resolve().parents[1] / "src" / "stickslip"
 MAX_LINES = 120
 MAX_POSITIONAL = 12
 
-#: Functions still over a limit, as "module path:qualified name"; each is being split on another
-#: branch, and this list shrinks to empty as those land. A function that comes within the limits
-#: must leave the list (the test says so), and none may join it.
-NOT_YET = {
-    "analysis/steady.py:summarize",
-    "basins/result.py:assemble",
-    "cli/basins.py:basins",
-    "cli/continue_.py:continue_command",
-    "cli/simulate.py:simulate",
-    "cli/stability.py:stability_map",
-    "cli/sweep.py:sweep_command",
-    "cli/sweep.py:bifurcation",
-    "integrate/driver.py:simulate",
-    "orbits/shooting.py:periodic_orbit",
-    "sweep/engine.py:sweep",
-}
-
-
 def _functions(tree: ast.AST, prefix: str = ""):
     """(qualified name, node) of every function and method in ``tree``, nested ones included."""
     for node in ast.iter_child_nodes(tree):
@@ -56,14 +38,8 @@ def _census(package: Path = PACKAGE) -> dict:
 
 def test_no_function_is_longer_than_120_lines_or_takes_more_than_12_positional_parameters():
     over = _census()
-    new = {name: size for name, size in over.items() if name not in NOT_YET}
-    assert not new, "over the limits (lines, positional parameters): " + ", ".join(
-        f"{name} {size}" for name, size in sorted(new.items()))
-
-
-def test_the_list_of_functions_not_yet_split_holds_only_functions_over_a_limit():
-    within = NOT_YET - set(_census())
-    assert not within, f"within the limits now, remove from NOT_YET: {sorted(within)}"
+    assert not over, "over the limits (lines, positional parameters): " + ", ".join(
+        f"{name} {size}" for name, size in sorted(over.items()))
 
 
 def test_the_census_sees_a_long_function_and_a_long_signature(tmp_path):

@@ -4,6 +4,7 @@
 ``FrictionModel``           a friction-contact model (``Contact``, ``FrictionLaw``): every tool takes one
 ``load_model``              a library model by name (``belt``, ``hoffmann``, ...) or a model file (TOML)
 ``Parameters``              the two plates' parameters (paper Table 1), validated, TOML I/O
+``two_plates``              the two plates as a model: ``two_plates(params, "rotation")`` (Models 1–4)
 ``simulate``                run a simulation, returns a ``Trajectory``
 ``attractor``               what a run settles to, honestly (``simulate_until_settled``: run until it does;
                             ``run_summary``: verdict, window and cost as one dict)
@@ -13,7 +14,8 @@
 ``equilibrium``             steady-sliding equilibrium (Eq. 14)
 ``stability``               linear stability of steady sliding (Eq. 15), returns ``StabilityResult``
 ``stability_map``           (N, Ω) stability map with boundary by root finding (Figs. 3, 4)
-``classify``                steady state: equilibrium / periodic slip / periodic stick-slip / not periodic
+``classify``                the signal's verdict on a window: equilibrium / periodic / unsettled, stick fraction
+``OUTCOMES``                what a run settles to, the one vocabulary of runs, sweeps and basin studies
 ``find_peaks``              peaks of φ located as events (φ̇ = 0, φ̈ < 0)
 ``intensity``               intensity index I of Eq. (16)
 ``sweep``                   parameter grids → resumable NetCDF of reductions (serial, processes, dask)
@@ -27,6 +29,10 @@
 ``fold_curve``              end of the stick-slip branch (edge of Region II) over N
 ``MODELS``                  the paper's Models 1–4 as free DOFs
 ==========================  ==============================================================
+
+Every function that runs a model takes it as one argument, ``model``: a ``FrictionModel``, a
+library name or model file path, or the plates' ``Parameters`` (the plates in a variant:
+``two_plates(params, "rotation")``).
 
 The simulation core is imported at once; stability, sweeps and orbit tools are imported on
 first use (PEP 562), so ``import stickslip`` stays fast.
@@ -42,7 +48,7 @@ _startup.hold()
 
 #: Public names imported on first access, by the module that defines them.
 _LAZY = {
-    **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model"], ".model"),
+    **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model", "two_plates"], ".model"),
     **dict.fromkeys(["basin_stability", "BasinResult"], ".basins"),
     **dict.fromkeys(["attractor", "simulate_until_settled", "Attractor", "SettledRun", "run_summary"], ".attractors"),
     **dict.fromkeys(["StabilityMap", "StabilityResult", "load_stability_map", "stability", "stability_map"],
@@ -74,7 +80,7 @@ class _Package(types.ModuleType):
 sys.modules[__name__].__class__ = _Package  # before the imports below, which import stickslip.stability
 
 from ._version import __version__  # noqa: E402
-from .analysis import Classification, classify, find_peaks, intensity  # noqa: E402
+from .analysis import OUTCOMES, Classification, classify, find_peaks, intensity  # noqa: E402
 from .errors import FileFormatError, ParameterError, SimulationError, StickSlipError, VariantError  # noqa: E402
 from .integrate.driver import simulate  # noqa: E402
 from .integrate.result import Trajectory, load_trajectory  # noqa: E402
@@ -110,14 +116,14 @@ def __dir__():
 
 __all__ = [
     "__version__", "StickSlipError",
-    "FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model",
+    "FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model", "two_plates",
     "basin_stability", "BasinResult", "attractor", "simulate_until_settled", "Attractor", "SettledRun", "run_summary",
     "Parameters", "ParameterError",
     "simulate", "SimulationError",
     "Trajectory", "load_trajectory", "FileFormatError",
     "equilibrium", "EquilibriumError",
     "stability", "StabilityResult", "stability_map", "StabilityMap", "load_stability_map",
-    "classify", "Classification", "find_peaks", "intensity",
+    "classify", "Classification", "find_peaks", "intensity", "OUTCOMES",
     "sweep", "SweepResult", "SweepError", "load_sweep", "regions", "RegionMap", "load_region_map",
     "periodic_orbit", "PeriodicOrbit", "monodromy", "Monodromy", "flow_jacobian", "FlowJacobian", "OrbitError",
     "lyapunov_exponent", "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum",

@@ -30,7 +30,8 @@ from typing import Callable
 from .errors import MemoryLimitError
 
 __all__ = ["available_memory", "check_memory", "largest_count", "sample_bytes", "state_bytes", "param_bytes",
-           "grid_point_bytes", "map_point_bytes", "average_bytes", "format_bytes"]
+           "grid_point_bytes", "map_point_bytes", "average_bytes", "format_bytes", "model_data_bytes",
+           "largest_dense_dofs", "matrix_file_bytes"]
 
 #: Control-group memory limits (v2, then v1) that cap what the kernel gives this process.
 _CGROUP_LIMITS = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
@@ -195,3 +196,40 @@ _AVERAGE_FIXED, _AVERAGE_PER_EXPONENT = 160, 32
 def average_bytes(exponents: int) -> float:
     """Peak bytes per running estimate of a Lyapunov average of ``exponents`` exponents."""
     return float(_AVERAGE_FIXED + _AVERAGE_PER_EXPONENT * int(exponents))
+
+
+# ----------------------------------------------------------------------------- per model
+#: Dense n × n float64 arrays alive at the peak of packing a model for the compiled kernels
+#: (``FrictionModel.data``, ``model/bundle.pack``): M⁻¹, M, C, K in the packed array (4), the
+#: dense M, C, K it copies them from (3), and the inverse's result and LAPACK's work copy (2).
+_DENSE_COPIES = 9
+
+
+def model_data_bytes(n_dofs: int, n_contacts: int) -> float:
+    """Peak bytes of packing a model of ``n_dofs`` coordinates and ``n_contacts`` contacts for the
+    compiled kernels: :data:`_DENSE_COPIES` dense n × n arrays, and per contact its block (the
+    tangent rows, drive, three gradients and the law: 5n + 16 numbers)."""
+    n, nc = int(n_dofs), int(n_contacts)
+    return 8.0 * (_DENSE_COPIES * n * n + nc * (5 * n + 16) + 2 * n + 8)
+
+
+def largest_dense_dofs(memory: float, n_contacts: int = 0) -> int:
+    """The most coordinates whose packed model (:func:`model_data_bytes`) fits in ``memory`` bytes."""
+    n = int(math.isqrt(max(int(memory // (8 * _DENSE_COPIES)), 0)))
+    while n > 0 and model_data_bytes(n, n_contacts) > memory:
+        n -= 1
+    return n
+
+
+#: Bytes held while a matrix file is parsed, per byte of the file: the file's bytes, read once
+#: (and hashed), and the parsed triplets and their compressed-row copy, which take about as many
+#: bytes as the text they came from (a Matrix Market entry ``i j value`` is 20–30 characters for
+#: 16 bytes of index and value, twice while converted).
+_MATRIX_FILE_COPIES = 3
+
+
+def matrix_file_bytes(file_bytes: float, unpacked_bytes: float | None = None) -> float:
+    """Peak bytes of reading a matrix file of ``file_bytes`` bytes; ``unpacked_bytes``, where
+    known, is what its compressed arrays take unpacked (a ``.npz``'s members)."""
+    body = file_bytes if unpacked_bytes is None else max(file_bytes, unpacked_bytes)
+    return float(file_bytes + (_MATRIX_FILE_COPIES - 1) * body)

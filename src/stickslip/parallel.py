@@ -39,7 +39,7 @@ from typing import Callable, Iterable, Iterator
 from .errors import SchedulerError, SweepError, WorkersError
 
 __all__ = ["EXECUTORS", "default_workers", "check_workers", "check_executor", "watch_parent", "worker_pool",
-           "connect", "local_cluster", "map_unordered", "POLL_S"]
+           "connect", "local_cluster", "map_unordered", "POLL_S", "compile_processes"]
 
 EXECUTORS = ("serial", "processes", "dask")
 
@@ -130,6 +130,26 @@ def watch_parent(parent: int | None = None, interval: float = PARENT_POLL_S) -> 
 
 #: The setting of how many processes a cold start compiles in (``model/compile_ahead.py``).
 COMPILE_PROCESSES_ENV = "STICKSLIP_COMPILE_PROCESSES"
+
+
+def compile_processes() -> int:
+    """How many processes a cold start may compile in: ``STICKSLIP_COMPILE_PROCESSES`` (default 2,
+    also where it is empty; 1 compiles in this process alone).
+
+    Raises
+    ------
+    WorkersError
+        One line, where the setting is not a positive integer.
+    """
+    text = os.environ.get(COMPILE_PROCESSES_ENV, "").strip() or "2"
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise WorkersError(f"{COMPILE_PROCESSES_ENV}={os.environ[COMPILE_PROCESSES_ENV]!r} is not a positive integer; "
+                           f"set it to 1 (compile in one process) or 2 (a cold start compiles in two), or unset it")
+    return value
 
 
 def _compile_alone() -> None:

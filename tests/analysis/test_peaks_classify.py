@@ -52,29 +52,29 @@ def test_classify_constructed_signals():
     w = 2 * np.pi
     # pure sine: periodic, one peak per period, slip (no stick)
     c = classify_response(t, np.sin(w * t), w * np.cos(w * t))
-    assert (c.kind, c.multiplicity) == ("periodic-slip", 1)
+    assert (c.outcome, c.multiplicity, c.is_stick_slip) == ("periodic", 1, False)
     assert c.frequency_hz == pytest.approx(1.0, rel=1e-6)  # period from event times, O(h^4)
     assert c.fft_frequency_hz == pytest.approx(1.0, rel=1e-3)  # spectral peak, Hann, 100 s record
     # period 2 (two peaks per period of 1 s), flagged as sticking
     x = np.sin(2 * w * t) + 0.3 * np.sin(w * t)
     dx = 2 * w * np.cos(2 * w * t) + 0.3 * w * np.cos(w * t)
     c = classify_response(t, x, dx, stick_fraction=0.2)
-    assert (c.kind, c.multiplicity) == ("periodic-stick-slip", 2)
+    assert (c.outcome, c.multiplicity, c.is_stick_slip) == ("periodic", 2, True)
     assert c.period_s == pytest.approx(1.0, rel=1e-6)
     # quasi-periodic: two incommensurate frequencies
     x = np.sin(w * t) + 0.5 * np.sin(math.sqrt(2) * w * t)
     dx = w * np.cos(w * t) + 0.5 * math.sqrt(2) * w * np.cos(math.sqrt(2) * w * t)
     c = classify_response(t, x, dx, stick_fraction=0.1)
-    assert c.kind == "non-periodic" and c.multiplicity == 0
+    assert c.outcome == "unsettled" and c.multiplicity == 0 and c.is_stick_slip
     # decaying oscillation without stick: converging to the equilibrium
     x = np.exp(-0.05 * t) * np.sin(w * t)
     dx = np.exp(-0.05 * t) * (w * np.cos(w * t) - 0.05 * np.sin(w * t))
-    assert classify_response(t, x, dx).kind == "equilibrium"
+    assert classify_response(t, x, dx).outcome == "equilibrium"
     # ... unless another DOF grows (an unstable mode that φ barely shows)
     grow = np.exp(0.05 * t) * np.sin(3 * w * t)
-    assert classify_response(t, x, dx, others=grow[:, None]).kind == "non-periodic"
+    assert classify_response(t, x, dx, others=grow[:, None]).outcome == "unsettled"
     # at rest
-    assert classify_response(t, np.full_like(t, 0.02), np.zeros_like(t)).kind == "equilibrium"
+    assert classify_response(t, np.full_like(t, 0.02), np.zeros_like(t)).outcome == "equilibrium"
 
 
 def test_intensity_of_an_analytic_signal():
@@ -105,7 +105,7 @@ def _run(omega, ic, t_end=60.0):
 def test_stable_equilibrium_at_omega_12():
     for ic in ("far", "near"):
         c = _run(12.0, ic)
-        assert c.kind == "equilibrium" and c.stick_fraction == 0.0
+        assert c.outcome == "equilibrium" and c.stick_fraction == 0.0
 
 
 def test_stick_slip_at_omega_5():
@@ -116,4 +116,4 @@ def test_stick_slip_at_omega_5():
 def test_coexistence_at_omega_8_5():
     far, near = _run(8.5, "far"), _run(8.5, "near")
     assert far.is_stick_slip and far.stick_fraction > 0.05
-    assert near.kind == "equilibrium"
+    assert near.outcome == "equilibrium"

@@ -10,13 +10,14 @@ import stickslip
 from stickslip.analysis import classify, classify_response, detect_period, fundamental_frequency
 from stickslip.analysis.classify import STATIONARY_MIN_PEAKS
 from stickslip.analysis.period import MIN_PERIODS, SETTLE_RTOL
+from stickslip.model.library import two_plates
 
 W = 2 * np.pi * 0.5  # 0.5 Hz fundamental: period 2 s
 
 
 def _agree(c, s):
     """Classification c and steady summary s make the same periodicity decision."""
-    assert c.kind.startswith("periodic") == s.periodic
+    assert (c.outcome == "periodic") == s.periodic
     assert c.multiplicity == s.period_multiplicity
     if s.periodic:
         assert s.fundamental_frequency_hz == 1.0 / c.period_s
@@ -57,20 +58,20 @@ def test_constructed_signals_agree(kind, periodic, k):
     per = detect_period(t, x, dx)
     assert (per.periodic, per.multiplicity) == (periodic, k)
     assert (is_periodic, mult) == (periodic, k)
-    assert c.kind.startswith("periodic") == periodic and c.multiplicity == k
+    assert (c.outcome == "periodic") == periodic and c.multiplicity == k
     if periodic:
-        assert c.settled and c.attractor == "periodic"
+        assert c.settled and c.signal == "periodic"
         assert per.period_s == pytest.approx(2.0, rel=1e-6)      # 1 / 0.5 Hz
         assert f == 1.0 / c.period_s == pytest.approx(0.5, rel=1e-6)
     else:
-        assert not c.settled and c.attractor == "stationary"     # stationary, not periodic
+        assert not c.settled and c.signal == "stationary"        # stationary, not periodic
         assert c.evidence["peaks"] >= STATIONARY_MIN_PEAKS
 
 
 def test_no_period_is_claimed_from_too_few_peaks():
     t, x, dx = _signal("quasi", t_end=100.0)                     # 70 peaks: k up to 16 cannot all be tried
     c = classify_response(t, x, dx)
-    assert c.evidence["peaks"] < STATIONARY_MIN_PEAKS and c.attractor == "unsettled"
+    assert c.evidence["peaks"] < STATIONARY_MIN_PEAKS and c.signal == "drifting"
 
 
 def test_too_few_periods_is_not_periodic():
@@ -99,7 +100,7 @@ def test_transient_with_multipliers_near_minus_one_is_not_period_two():
     assert np.max(np.abs(p[2:] - p[:-2])) < 1e-3 * amp < np.max(np.abs(p[1:] - p[:-1]))  # the old trap
     assert not per.periodic and per.multiplicity == 0
     c = classify_response(t, x, dx, stick_fraction=0.5)
-    assert c.kind == "non-periodic" and not c.settled and c.attractor == "unsettled"
+    assert c.outcome == "unsettled" and not c.settled and c.signal == "drifting"
 
 
 def test_slow_monotone_drift_below_the_tolerance_is_not_settled():
@@ -117,12 +118,11 @@ def test_slow_monotone_drift_below_the_tolerance_is_not_settled():
 
 # ------------------------------------------------------------------ simulated known cases
 def _traj(N, omega, ic, t_end, model="full"):
-    from stickslip.model.library import two_plates
     from stickslip.sweep.spec import initial_condition
 
     p = stickslip.Parameters(N=N, Omega=omega)
     s0, pert = initial_condition(ic, two_plates(p, model))
-    traj = stickslip.simulate(p, t_end, ic=s0, perturbation=pert, sample_rate=200.0, model=model)
+    traj = stickslip.simulate(two_plates(p, model), t_end, ic=s0, perturbation=pert, sample_rate=200.0)
     assert traj.status == "success", traj.status
     return traj
 
@@ -153,9 +153,9 @@ def test_classify_and_steady_summary_agree(N, omega, ic, t_end, expect):
     if expect == "stick-slip":
         assert c.is_stick_slip
     elif expect == "decaying":
-        assert c.kind == "equilibrium" and c.attractor == "decaying"
+        assert c.outcome == "equilibrium" and c.signal == "decaying"
     else:
-        assert c.kind == "non-periodic" and c.attractor == "unsettled"
+        assert c.outcome == "unsettled" and c.signal == "drifting"
 
 
 def test_settled_window_is_periodic_in_both():
@@ -164,4 +164,4 @@ def test_settled_window_is_periodic_in_both():
     c = classify(traj, 600.0)
     s = traj.steady_state(600.0)
     _agree(c, s)
-    assert c.kind == "periodic-stick-slip" and c.multiplicity == 1 and c.settled
+    assert c.outcome == "periodic" and c.is_stick_slip and c.multiplicity == 1 and c.settled

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.attractors import ATTRACTORS, simulate_until_settled
+from stickslip import OUTCOMES
+from stickslip.attractors import simulate_until_settled
 from stickslip.sweep import load_sweep, sweep
 
 
@@ -14,7 +15,7 @@ def test_settling_sweep_records_verdicts_settle_times_and_the_cap(tmp_path):
     r = sweep({"N": [50.0, 110.0]}, base, out=out, executor="serial", settle=True, cap=1500.0)
     ds = load_sweep(out)
     assert ds.attrs["settle"] == 1 and ds.attrs["cap"] == 1500.0
-    assert [ATTRACTORS[int(c)] for c in ds["attractor"].values] == ["periodic", "periodic"]
+    assert [OUTCOMES[int(c)] for c in ds["attractor"].values] == ["periodic", "periodic"]
     assert ds["period_count"].values.tolist() == [1.0, 2.0] and np.all(ds["settled"].values == 1)
     st = ds["settle_time"].values
     assert np.all((st > 200.0) & (st <= 1500.0)) and np.array_equal(st, ds["t_reached"].values)
@@ -22,17 +23,17 @@ def test_settling_sweep_records_verdicts_settle_times_and_the_cap(tmp_path):
     assert ds["fundamental_frequency"].values[0] == pytest.approx(1.53810, rel=1e-4)
     direct = simulate_until_settled(base.replace(N=110.0), sample_rate=200.0, keep="window")
     assert ds["fundamental_frequency"].values[1] == direct.attractor.fundamental_frequency_hz
-    assert r.kinds().tolist() == ["periodic-stick-slip", "periodic-stick-slip"]
+    assert r.outcomes().tolist() == ["periodic", "periodic"] and np.all(ds["stick_fraction"].values > 0)
 
 
 def test_fixed_length_sweep_says_unsettled():
     r = sweep({"N": [50.0, 70.0]}, stickslip.Parameters(Omega=0.5), executor="serial")
     ds = r.dataset
     assert ds.attrs["settle"] == 0 and "cap" not in ds.attrs
-    assert [ATTRACTORS[int(c)] for c in ds["attractor"].values] == ["unsettled", "unsettled"]
+    assert [OUTCOMES[int(c)] for c in ds["attractor"].values] == ["unsettled", "unsettled"]
     assert np.all(np.isnan(ds["fundamental_frequency"].values)) and np.all(np.isnan(ds["settle_time"].values))
     assert np.all(np.isfinite(ds["dominant_frequency"].values))
-    assert r.kinds().tolist() == ["non-periodic", "non-periodic"]
+    assert r.outcomes().tolist() == ["unsettled", "unsettled"]
 
 
 def test_cap_below_the_first_run_is_refused():

@@ -10,6 +10,8 @@ import pytest
 import stickslip
 from stickslip.attractors.confirm import QUASI_SPAN_S, lyapunov_sign
 from stickslip.attractors import attractor, run_summary, simulate_until_settled
+from stickslip.integrate.status import Status
+from stickslip.model.library import two_plates
 from stickslip.stability import stability
 
 #: Detuned stiffnesses (docs/orbits.md, "A chaotic case") with Table 1 damping: the period-1
@@ -62,7 +64,6 @@ def test_paper_defaults():
 
 
 def test_stable_steady_sliding_is_an_equilibrium():
-    from stickslip.model.library import two_plates
     from stickslip.sweep.spec import initial_condition
 
     p = stickslip.Parameters(N=50.0, Omega=12.0)                 # Fig. 7(e)
@@ -86,7 +87,7 @@ def test_at_rest_on_an_unstable_equilibrium_is_not_settled():
     assert not stability(p).stable
     run = stickslip.simulate(p, 20.0, ic="equilibrium", sample_rate=100.0)
     a = attractor(run)
-    assert a.classification.attractor == "equilibrium"            # the signal is at rest
+    assert a.classification.signal == "at-rest"                   # the signal is at rest
     assert a.attractor == "unsettled" and "unstable" in a.evidence["reason"]
 
 
@@ -111,7 +112,7 @@ def test_period_two_past_a_period_doubling_is_confirmed():
     a = run2.attractor
     assert (a.attractor, a.period_count) == ("periodic", 2)
     assert a.evidence["shooting"]["confirmed"] and a.evidence["shooting"]["stick_phases"] == 2
-    unstable1 = stickslip.periodic_orbit(q, orbit1.state, model="full", section=section, search_time=5.0)
+    unstable1 = stickslip.periodic_orbit(q, orbit1.state, section=section, search_time=5.0)
     assert not unstable1.stable and np.min(unstable1.multipliers.real) < -1.0
     assert a.period_s == pytest.approx(2.0 * unstable1.period, rel=1e-2)
 
@@ -141,15 +142,28 @@ def test_no_period_k_claim_without_confirmation():
     p = stickslip.Parameters(N=110.0, Omega=0.5)
     run = simulate_until_settled(p, sample_rate=200.0)
     a = attractor(run.trajectory, confirm=False)
-    assert a.classification.attractor == "periodic" and a.classification.multiplicity == 2
+    assert a.classification.signal == "periodic" and a.classification.multiplicity == 2
     assert a.attractor == "unsettled" and a.period_count is None and "confirm" in a.evidence["reason"]
 
 
 def test_a_run_that_blew_up_is_unbounded():
     run = stickslip.simulate(stickslip.Parameters(), 1.0, sample_rate=100.0)
-    broken = dataclasses.replace(run, status="state became non-finite at t = 0.5 s")
+    broken = dataclasses.replace(run, status="state became non-finite at t = 0.5 s", status_code=Status.NOT_FINITE)
     a = attractor(broken)
     assert (a.attractor, a.settled, a.period_count) == ("unbounded", True, None)
+
+
+def test_a_run_that_stopped_is_named_by_how_it_stopped():
+    # a step cap the run cannot finish within: the outcome is ``failed``, not a transient
+    run = stickslip.simulate(stickslip.Parameters(), 1.0, sample_rate=100.0, max_steps=50)
+    assert run.status_code == Status.MAX_STEPS
+    a = attractor(run)
+    assert (a.attractor, a.settled, a.code) == ("failed", False, stickslip.OUTCOMES.index("failed"))
+    assert "max_steps" in a.evidence["reason"]
+    lost = dataclasses.replace(run, status="contact lost at t = 0.5 s", status_code=Status.CONTACT_LOST)
+    assert attractor(lost).attractor == "contact-lost"
+    cut = dataclasses.replace(run, status="interrupted at t = 0.5 s (partial run)", status_code=Status.INTERRUPTED)
+    assert attractor(cut).attractor == "unsettled"  # only cut short: nothing is known of where it goes
 
 
 def test_lyapunov_sign_needs_both_separations_to_agree(monkeypatch):
@@ -186,13 +200,13 @@ def test_slow_approach_with_zero_exponent_is_not_a_torus():
 def test_quasiperiodic_slip_oscillation_of_model_3():
     # Model 3 (y), N = 35 N, Ω = 0.5 rad/s: a slip-only oscillation at 2.246 Hz modulated at 0.139 Hz
     p = stickslip.Parameters(N=35.0, Omega=0.5)
-    run = simulate_until_settled(p, model="y", sample_rate=200.0)
+    run = simulate_until_settled(two_plates(p, "y"), sample_rate=200.0)
     a = run.attractor
     assert a.attractor == "quasiperiodic" and a.period_count is None and a.fundamental_frequency_hz is None
     assert a.evidence["span"]["span_s"] == QUASI_SPAN_S
     # independent: over a 4000 s run the maxima of φ never repeat (thousands of distinct values)
     # while their set does not move (same extremes in the second and fourth 1000 s)
-    plain = stickslip.simulate(p, 4000.0, model="y", sample_rate=200.0)
+    plain = stickslip.simulate(two_plates(p, "y"), 4000.0, sample_rate=200.0)
     pk = stickslip.find_peaks(plain.t, plain.states[:, 4], plain.states[:, 10])
     late = pk.value[pk.time > 1000.0]
     amp = float(np.ptp(plain.states[plain.t > 1000.0, 4]))
@@ -225,8 +239,8 @@ def test_extended_run_is_one_uniform_record():
 def test_window_mode_keeps_the_last_span_and_reaches_the_same_verdict():
     # Model 3, N = 41 N, Ω = 0.5 rad/s still drifts at 1300 s
     p = stickslip.Parameters(N=41.0, Omega=0.5)
-    full = simulate_until_settled(p, model="y", sample_rate=100.0, cap=1300.0)
-    window = simulate_until_settled(p, model="y", sample_rate=100.0, cap=1300.0, keep="window")
+    full = simulate_until_settled(two_plates(p, "y"), sample_rate=100.0, cap=1300.0)
+    window = simulate_until_settled(two_plates(p, "y"), sample_rate=100.0, cap=1300.0, keep="window")
     assert full.trajectory.t[0] == 0.0 and window.trajectory.t[0] == pytest.approx(1300.0 - QUASI_SPAN_S, abs=0.01)
     assert window.trajectory.t[-1] == full.trajectory.t[-1] == 1300.0 and not full.attractor.settled
     assert window.attractor.evidence == full.attractor.evidence

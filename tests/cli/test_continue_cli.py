@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 from stickslip import Parameters
 from stickslip.cli import app
+from stickslip.model.library import two_plates
 from stickslip.orbits.continuation import continue_orbit, load_branch, start_run
 
 runner = CliRunner()
@@ -70,9 +71,9 @@ def test_continue_writes_the_library_branch_and_a_figure(tmp_path):
     values = ds["value"].values
     assert values[0] == 3.0 and np.all(np.diff(values) > 0) and values[-1] <= 3.3
 
-    p = Parameters(N=50.0, Omega=3.0)
-    b = continue_orbit(p, "Omega", start=start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND), max_points=4,
-                       bounds=(3.0, 3.3), model="rotation", slip_band=BAND)
+    rotation = two_plates(Parameters(N=50.0, Omega=3.0), "rotation")
+    b = continue_orbit(rotation, "Omega", start=start_run(rotation, "far", t_end=30.0, slip_band=BAND), max_points=4,
+                       bounds=(3.0, 3.3), slip_band=BAND)
     assert ds.attrs["options"] and '"slip_band": 1e-05' in ds.attrs["options"]
     assert np.array_equal(b.values, values)
     assert np.array_equal(b.periods, ds["period"].values)
@@ -92,15 +93,15 @@ def test_same_command_resumes_and_other_settings_are_refused(tmp_path):
     resumed by the command: one note line, then the branch of an uninterrupted run; the same
     command again reads the finished file; another --max-points with the same --out exits 2."""
     out = tmp_path / "branch.nc"
-    p = Parameters(N=50.0, Omega=3.0)
-    opts = dict(max_points=4, bounds=(3.0, 3.3), model="rotation", slip_band=BAND)
+    rotation = two_plates(Parameters(N=50.0, Omega=3.0), "rotation")
+    opts = dict(max_points=4, bounds=(3.0, 3.3), slip_band=BAND)
 
     def stop_after_two(i, *_):
         if i == 2:
             raise _Interrupt
 
     with pytest.raises(_Interrupt):
-        continue_orbit(p, "Omega", start=start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND),
+        continue_orbit(rotation, "Omega", start=start_run(rotation, "far", t_end=30.0, slip_band=BAND),
                        out=out, callback=stop_after_two, **opts)
     assert not out.exists()
     res = runner.invoke(app, _ARGS + ["--out", str(out)])
@@ -108,7 +109,7 @@ def test_same_command_resumes_and_other_settings_are_refused(tmp_path):
     assert res.stderr.strip() == "resuming from 3 points"
     summary = json.loads(res.stdout.strip().splitlines()[-1])
     assert summary["points"] == 4 and summary["points_resumed"] == 3
-    b = continue_orbit(p, "Omega", start=start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND), **opts)
+    b = continue_orbit(rotation, "Omega", start=start_run(rotation, "far", t_end=30.0, slip_band=BAND), **opts)
     ds = load_branch(out)
     assert np.array_equal(b.values, ds["value"].values) and np.array_equal(b.periods, ds["period"].values)
     assert np.array_equal(b.states, ds["state_on_section"].values)

@@ -89,7 +89,7 @@ def test_orbit_writes_the_library_orbit_and_a_figure(tmp_path):
     assert out.with_suffix(".png").stat().st_size > 10_000  # a drawn figure, not an empty canvas
 
     p = Parameters(N=50.0, Omega=5.0)
-    orbit = periodic_orbit(p, start_run(p, "far", model="full", t_end=SEARCH), monodromy="saltation")
+    orbit = periodic_orbit(p, start_run(p, "far", t_end=SEARCH), monodromy="saltation")
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert ds.attrs["period"] == orbit.period
         assert ds.attrs["iterations"] == orbit.iterations and ds.attrs["model"] == "full"
@@ -123,7 +123,7 @@ def test_lyapunov_writes_the_library_spectrum_and_a_figure(method, tmp_path):
 
     p = Parameters(N=50.0, Omega=5.0)
     state, pert = initial_condition("far", two_plates(p, "full"))
-    S = lyapunov_spectrum(p, state, model="full", t_transient=5.0, t_average=10.0, perturbation=pert, method=method)
+    S = lyapunov_spectrum(p, state, t_transient=5.0, t_average=10.0, perturbation=pert, method=method)
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert np.array_equal(ds["exponent"].values, S.exponents)
         assert np.array_equal(ds["estimate"].values, S.estimate)

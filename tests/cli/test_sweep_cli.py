@@ -9,7 +9,8 @@ from typer.testing import CliRunner
 
 import stickslip
 from stickslip import Parameters
-from stickslip.analysis import classify, kind_code
+from stickslip.analysis import classify
+from stickslip.attractors import attractor
 from stickslip.cli import app
 from stickslip.sweep import load_region_map, load_sweep
 from stickslip.sweep.bistability import classify_regions
@@ -35,20 +36,21 @@ def summary(res) -> dict:
 
 
 def direct(params, model="full", ic="zero"):
-    """The sweep point recomputed by `stickslip.simulate` + `classify` (what the sweep must store)."""
+    """The sweep point recomputed by `stickslip.simulate` + `classify` and `attractor` (what the
+    sweep must store)."""
     ic_arg, pert = initial_condition(ic, two_plates(params, model))
-    traj = stickslip.simulate(params, T_END, model=model, ic=ic_arg, perturbation=pert, **SIM)
-    return traj, classify(traj, T_FROM)
+    traj = stickslip.simulate(two_plates(params, model), T_END, ic=ic_arg, perturbation=pert, **SIM)
+    return attractor(traj), classify(traj, T_FROM)
 
 
-def assert_point_matches(point, c):
+def assert_point_matches(point, verdict, c):
     """Stored reductions of one grid point equal the direct run's: same code, same options, so
     identical floating-point results (no tolerance)."""
-    assert point["kind"].item() == kind_code(c.kind)
+    assert point["attractor"].item() == verdict.code
     assert point["stick_fraction"].item() == c.stick_fraction
     assert point["amplitude"].item() == c.amplitude
     # the column's definition: 1/period when periodic, else the mean rate of the peaks
-    expected = c.frequency_hz if c.kind.startswith("periodic") else c.peak_rate_hz
+    expected = c.frequency_hz if c.outcome == "periodic" else c.peak_rate_hz
     assert np.array_equal(point["frequency"].item(), expected, equal_nan=True)
     peaks = point["peaks"].values
     last = c.peaks.value[-peaks.size:]
@@ -70,9 +72,9 @@ def test_sweep_writes_netcdf_and_png_with_the_direct_runs_data(swept):
     assert out.with_suffix(".png").stat().st_size > 10_000  # a drawn figure, not an empty canvas
     ds = load_sweep(out)
     assert ds.attrs["complete"] == 1 and ds.attrs["t_end"] == T_END and ds.attrs["t_from"] == T_FROM
-    _, c = direct(Parameters(N=50.0, Omega=0.5))
+    verdict, c = direct(Parameters(N=50.0, Omega=0.5))
     assert c.stick_fraction > 0  # the point is a stick-slip oscillation, not a trivial rest
-    assert_point_matches(ds.sel(N=50.0, Omega=0.5), c)
+    assert_point_matches(ds.sel(N=50.0, Omega=0.5), verdict, c)
 
 
 def test_resuming_a_finished_sweep_recomputes_nothing(swept):
@@ -104,7 +106,7 @@ def test_bifurcation_uses_the_paper_base_values_and_agrees_with_sweep(swept, tmp
     ds = load_sweep(out)
     assert ds.attrs["param_Omega"] == 0.5  # Figs. 12(a), 13, 14: Ω = 0.5 rad/s unless swept
     sw = load_sweep(swept[0]).sel(Omega=0.5)
-    for name in ("kind", "peaks", "frequency", "stick_fraction"):
+    for name in ("attractor", "peaks", "frequency", "stick_fraction"):
         assert ds[name].equals(sw[name].drop_vars("Omega")), name
 
 
@@ -115,8 +117,8 @@ def test_bifurcation_over_omega_and_models(tmp_path):
     assert s["shape"] == {"model": 2, "Omega": 2}
     ds = load_sweep(out)
     assert ds.attrs["param_N"] == 50.0  # Fig. 12(b): N = 50 N
-    _, c = direct(Parameters(N=50.0, Omega=1.0), model="rotation")
-    assert_point_matches(ds.sel(model="rotation", Omega=1.0), c)
+    verdict, c = direct(Parameters(N=50.0, Omega=1.0), model="rotation")
+    assert_point_matches(ds.sel(model="rotation", Omega=1.0), verdict, c)
 
 
 def test_regions_of_known_cases_and_direct_run(tmp_path):
@@ -131,9 +133,9 @@ def test_regions_of_known_cases_and_direct_run(tmp_path):
     rm = load_region_map(out)
     ds = rm.dataset
     assert rm.region[0, 0].tolist() == [2, 3]
-    kind = ds["kind"].transpose("model", "N", "Omega", "ic").values
+    outcome = ds["attractor"].transpose("model", "N", "Omega", "ic").values
     sf = ds["stick_fraction"].transpose("model", "N", "Omega", "ic").values
-    assert np.array_equal(classify_regions(kind, sf), rm.region)
+    assert np.array_equal(classify_regions(outcome, sf), rm.region)
     assert (ds.attrs["t_end"], ds.attrs["t_from"]) == (60.0, 30.0) and list(ds["ic"].values) == ["far", "near"]
 
 
@@ -203,7 +205,7 @@ def test_bifurcation_takes_omega_from_a_config_file(tmp_path):
     assert not out.with_suffix(".png").exists()
 
 
-@pytest.mark.parametrize("var", ["kind", "frequency", "intensity_r_phi"])
+@pytest.mark.parametrize("var", ["attractor", "frequency", "intensity_r_phi"])
 def test_sweep_figures_of_other_reductions(swept, tmp_path, var):
     from stickslip.plot.sweep import save_sweep_figure
 

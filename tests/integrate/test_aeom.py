@@ -117,7 +117,7 @@ def test_variants_no_nan_and_vr_zero_in_stick(model):
     params = Parameters(Omega=0.5)
     ic = np.zeros(12)
     ic[11] = -params.Omega
-    traj = stickslip.simulate(params, 6.0, model=model, method="aeom", dt=1e-4, sample_rate=1e4, ic=ic)
+    traj = stickslip.simulate(two_plates(params, model), 6.0, method="aeom", dt=1e-4, sample_rate=1e4, ic=ic)
     assert traj.status == "success"
     assert np.all(np.isfinite(traj.states))
     assert traj.mode[0] == 1 and traj.stats.stick_to_slip > 0

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from stickslip import Parameters, simulate
+from stickslip.model.library import two_plates
 
 
 def closed_form(P):
@@ -30,7 +31,7 @@ def test_stick_and_slip_durations(Omega, mu_k, delta_mu):
     period = t_stick + t_slip
     ic = np.zeros(12)
     ic[10] = Omega  # start stuck to the belt at φ = 0
-    traj = simulate(P, 12 * period, model="phi", ic=ic, rtol=1e-11, atol=1e-13, sample_rate=200)
+    traj = simulate(two_plates(P, "phi"), 12 * period, ic=ic, rtol=1e-11, atol=1e-13, sample_rate=200)
     assert traj.status == "success"
     tt, kind = traj.transitions.time, traj.transitions.kind
     assert len(tt) >= 10
@@ -48,7 +49,7 @@ def test_stick_is_exact_on_the_belt():
     P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
     ic = np.zeros(12)
     ic[10] = P.Omega
-    traj = simulate(P, 5.0, model="phi", ic=ic, sample_rate=2000)
+    traj = simulate(two_plates(P, "phi"), 5.0, ic=ic, sample_rate=2000)
     stick = traj.mode == 1
     assert stick.any()
     assert np.allclose(traj.states[stick, 10], P.Omega, rtol=0, atol=1e-10)
@@ -64,7 +65,7 @@ def test_run_that_starts_sliding_just_short_of_stick():
     P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
     ic = np.zeros(12)
     ic[4], ic[10] = 0.00946034184785673, 0.49777818470226337  # v_r = r (φ̇ − Ω) ≈ −4.4e-4 m/s
-    traj = simulate(P, 1.0, model="phi", ic=ic, rtol=1e-10, atol=1e-13, max_steps=100_000)
+    traj = simulate(two_plates(P, "phi"), 1.0, ic=ic, rtol=1e-10, atol=1e-13, max_steps=100_000)
     assert traj.status == "success"
     t_stick, t_slip = closed_form(P)
     tt = traj.transitions.time

@@ -241,3 +241,19 @@ def test_pool_workers_compile_alone(monkeypatch):
     monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", "2")
     with worker_pool(1) as pool:
         assert pool.submit(_compile_processes_setting).result(timeout=120) == "1"
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "two", "1.5"])
+def test_a_compile_processes_setting_that_is_no_positive_integer_is_one_line_and_exit_2(monkeypatch, value):
+    from typer.testing import CliRunner
+
+    from stickslip.cli import app
+    from stickslip.errors import WorkersError
+
+    monkeypatch.setenv("STICKSLIP_COMPILE_PROCESSES", value)
+    with pytest.raises(WorkersError, match="STICKSLIP_COMPILE_PROCESSES=.* is not a positive integer"):
+        compile_ahead.enabled()
+    result = CliRunner().invoke(app, ["models"])
+    assert result.exit_code == 2
+    (line,) = result.output.strip().splitlines()
+    assert line.startswith("error: STICKSLIP_COMPILE_PROCESSES=") and "set it to 1" in line

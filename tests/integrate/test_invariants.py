@@ -71,7 +71,7 @@ def test_slip_to_stick_lands_on_zero_velocity(stick_slip_run):
 
 
 def test_rotation_model_rank_one_stick_has_no_nan():
-    tr = simulate(Parameters(Omega=0.5), 20.0, model="rotation")
+    tr = simulate(two_plates(Parameters(Omega=0.5), "rotation"), 20.0)
     assert tr.status == "success"
     assert np.isfinite(tr.states).all() and np.isfinite(tr.friction).all()
     assert tr.stats.slip_to_stick > 0

@@ -90,7 +90,7 @@ def test_variants(model):
     params = Parameters(Omega=0.5)
     ic = np.zeros(12)
     ic[11] = -params.Omega  # start in stick (see test_aeom)
-    traj = stickslip.simulate(params, 6.0, model=model, method="naeom", dt=1e-4, sample_rate=1e4, ic=ic)
+    traj = stickslip.simulate(two_plates(params, model), 6.0, method="naeom", dt=1e-4, sample_rate=1e4, ic=ic)
     assert traj.status == "success" and np.all(np.isfinite(traj.states))
     assert traj.mode[0] == 1 and traj.stats.stick_to_slip > 0
     vr = traj.relative_velocity[traj.mode == 1]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from stickslip import MODELS, Parameters, simulate
-from stickslip.model import resolve_variant
+from stickslip.model import resolve_variant, two_plates
 
 RNG = np.random.default_rng(20261122)
 IC_SCALE = np.array([0.002] * 4 + [0.3, 0.05] + [0.3] * 6)  # m, rad, m/s, rad/s
@@ -17,7 +17,7 @@ CASES = [
 @pytest.mark.parametrize("N, Omega, model, law, ic", CASES)
 def test_random_cases_finish(N, Omega, model, law, ic):
     mask = np.tile(resolve_variant(model).mask, 2)
-    traj = simulate(Parameters(N=N, Omega=Omega, friction_law=law), 40.0, model=model,
+    traj = simulate(two_plates(Parameters(N=N, Omega=Omega, friction_law=law), model), 40.0,
                     ic=np.where(mask, ic, 0.0), sample_rate=100, max_steps=2_000_000)
     assert traj.status == "success", traj.status
     assert np.isfinite(traj.states).all() and np.isfinite(traj.friction).all()
@@ -33,7 +33,7 @@ def test_near_singular_contact_metric_model_3():
     # response as a band 500x narrower (which resolves the slip direction down to 1e-6 m/s)
     ic = np.zeros(12)
     ic[7] = 0.6  # ẏ1 [m/s]
-    runs = [simulate(Parameters(N=70, Omega=3), 20.0, model="y", ic=ic, sample_rate=100, max_steps=500_000,
+    runs = [simulate(two_plates(Parameters(N=70, Omega=3), "y"), 20.0, ic=ic, sample_rate=100, max_steps=500_000,
                      rtol=1e-10, atol=1e-12, slip_band=band) for band in (5e-4, 1e-6)]
     for traj in runs:
         assert traj.status == "success", traj.status

@@ -14,12 +14,18 @@ from stickslip.model import compile_speedups
 
 
 def test_installed_with_the_compiled_layer():
-    assert compile_speedups.installed()
-    assert compile_speedups.install()  # a second install changes nothing
-    assert isinstance(icc.copy, compile_speedups._SharedScopeCopy)
+    from numba.core.targetconfig import TargetConfig
     from numba.core.types.functions import BaseFunction
 
+    from stickslip.model import numba_patches
+
+    assert {patch.name for patch in compile_speedups.PATCHES} <= numba_patches.status()["active"]
+    assert numba_patches.install() is numba_patches.status()  # a second install changes nothing
+    assert isinstance(icc.copy, compile_speedups._SharedScopeCopy)
+    assert getattr(icc.InlineWorker.inline_ir, "_stickslip_shared_scope", False)
+    assert getattr(icc.InlineWorker.inline_function, "_stickslip_once", False)
     assert getattr(BaseFunction.get_call_type, "_stickslip_once", False)
+    assert TargetConfig.__hash__ is compile_speedups._flags_hash
 
 
 def _blocks(n_blocks: int):

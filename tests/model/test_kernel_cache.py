@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import errno
+import pickle
+import tempfile
+import types
 import warnings
+from pathlib import Path
 
 import pytest
 from numba.core.caching import Cache, CacheImpl
 
-from stickslip.model import jit
+from stickslip.model import jit, kernel_cache, numba_patches
 
 
 def test_every_kernel_of_the_package_is_stamped_with_the_compiled_layer():
@@ -23,14 +27,18 @@ def test_every_kernel_of_the_package_is_stamped_with_the_compiled_layer():
 
 
 def test_the_digest_covers_the_modules_that_define_or_specialise_kernels():
-    text = (jit._PACKAGE / "model" / "normal.py").read_bytes()
-    assert jit._COMPILED.search(text)  # the unilateral contacts' kernels count
-    assert not jit._COMPILED.search((jit._PACKAGE / "errors.py").read_bytes())
+    text = (kernel_cache._PACKAGE / "model" / "normal.py").read_bytes()
+    assert kernel_cache._COMPILED.search(text)  # the unilateral contacts' kernels count
+    assert not kernel_cache._COMPILED.search((kernel_cache._PACKAGE / "errors.py").read_bytes())
+    for module in kernel_cache._MACHINERY:  # what shapes a cache entry counts, kernels or not
+        assert (kernel_cache._PACKAGE / module).is_file()
 
 
-def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeypatch):
+def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeypatch, tmp_path):
     """A full disk or a file-size limit while numba saves a kernel (seen under ulimit -f with an
-    empty cache): the kernel runs uncached; the process warns once."""
+    empty cache): the kernel runs uncached; the run warns once."""
+    monkeypatch.setenv(numba_patches.RUN_ENV, f"test-{tmp_path.name}")  # a run that has not warned
+    monkeypatch.setattr(numba_patches, "_SAID", set())
     full = OSError(errno.EFBIG, "File too large")
 
     class Stub:
@@ -50,7 +58,14 @@ def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeyp
         saved(stub, None, None)
         saved(stub, None, None)
     messages = [str(w.message) for w in caught]
-    assert len(messages) <= 1 and all("could not be cached (File too large)" in m for m in messages)
+    assert len(messages) == 1 and "could not be cached (File too large)" in messages[0]
+    monkeypatch.setattr(numba_patches, "_SAID", set())  # another process of the run: it is not said again
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        saved(stub, None, None)
+    assert caught == []
+    for marker in Path(tempfile.gettempdir()).glob(f"stickslip-*-test-{tmp_path.name}-*"):
+        marker.unlink()
     with pytest.raises(TypeError):  # anything but an OSError still surfaces
         Stub._save_overload = lambda self, sig, data: (_ for _ in ()).throw(TypeError("bug"))
         saved(stub, None, None)
@@ -60,11 +75,8 @@ def test_an_index_naming_a_class_this_process_cannot_import_keeps_its_entries(tm
     """A cache index whose keys name a class from a module that is gone (a user's script, a test
     folder) still loads: that entry with a stand-in, the others as they were; saved again, the
     stand-in is written as the original name, so a process that can import it gets it back."""
-    import pickle
     import sys
-    import types
 
-    from numba.core.caching import IndexDataCacheFile
     from numba.core.serialize import dumps as numba_dumps
 
     module = types.ModuleType("gone_kinematics")
@@ -75,10 +87,10 @@ def test_an_index_naming_a_class_this_process_cannot_import_keeps_its_entries(tm
     monkeypatch.delitem(sys.modules, "gone_kinematics")
     path = tmp_path / "kernel.nbi"
     with open(path, "wb") as f:
-        pickle.dump("v1", f, protocol=-1)
-        f.write(data)
+        pickle.dump(f"v1+{kernel_cache.FORMAT}", f, protocol=-1)
+        f.write(kernel_cache._sealed(data))
     fake = types.SimpleNamespace(_index_path=str(path), _version="v1", _source_stamp="stamp")
-    loaded = IndexDataCacheFile._load_index(fake)
+    loaded = kernel_cache._load_index(fake)
     assert sorted(loaded.values()) == ["kernel-1.nbc", "kernel-2.nbc"]
     stand_in = next(key[1] for key, value in loaded.items() if value == "kernel-1.nbc")
     assert "gone_kinematics.Arm" in repr(stand_in) and stand_in is not int
@@ -87,4 +99,91 @@ def test_an_index_naming_a_class_this_process_cannot_import_keeps_its_entries(tm
     restored = pickle.loads(again)
     assert ("sig", module.Arm) in restored and restored[("sig", int)] == "kernel-2.nbc"
     fake._source_stamp = "another"  # a stale index is empty, as numba has it
-    assert IndexDataCacheFile._load_index(fake) == {}
+    assert kernel_cache._load_index(fake) == {}
+
+
+class _Files(types.SimpleNamespace):
+    """numba's ``IndexDataCacheFile`` as far as the checksummed reads and writes use it."""
+
+    def _dump(self, obj):
+        return pickle.dumps(obj, protocol=-1)
+
+    def _data_path(self, name):
+        return str(Path(self._cache_path) / name)
+
+    def _open_for_write(self, path):
+        return open(path, "wb")
+
+
+def _said(monkeypatch, tmp_path) -> list:
+    monkeypatch.setenv(numba_patches.RUN_ENV, f"test-{tmp_path.name}")
+    monkeypatch.setattr(numba_patches, "_SAID", set())
+    lines = []
+    monkeypatch.setattr(kernel_cache, "notice", lambda key, line, say=None: lines.append((key, line)))
+    return lines
+
+
+@pytest.mark.parametrize("damage", ["truncate", "flip", "garble", "empty"])
+def test_a_damaged_index_or_data_file_is_a_miss_said_once(tmp_path, monkeypatch, damage):
+    """Whatever happened to a cache file after it was written (cut short by a full disk, a flipped
+    bit, garbage), reading it gives a miss, never an unpickling error or damaged object code, and
+    one line says so."""
+    lines = _said(monkeypatch, tmp_path)
+    files = _Files(_cache_path=str(tmp_path), _index_path=str(tmp_path / "k.nbi"), _version="v1",
+                   _source_stamp=("stamp", "digest"))
+    overloads = {("sig",): "k.1.nbc"}
+    data = ("object code " * 200).encode()
+    kernel_cache._save_index(files, overloads)
+    kernel_cache._save_data(files, "k.1.nbc", data)
+    assert kernel_cache._load_index(files) == overloads and kernel_cache._load_data(files, "k.1.nbc") == data
+    assert lines == []
+    for path in (tmp_path / "k.nbi", tmp_path / "k.1.nbc"):
+        blob = bytearray(path.read_bytes())
+        if damage == "truncate":
+            blob = blob[:len(blob) // 2]
+        elif damage == "flip":
+            blob[len(blob) * 2 // 3] ^= 0x04
+        elif damage == "garble":
+            blob[-30:-10] = b"g" * 20
+        else:
+            blob = b""
+        path.write_bytes(bytes(blob))
+    assert kernel_cache._load_index(files) == {}
+    assert kernel_cache._load_data(files, "k.1.nbc") is None
+    assert [key for key, _ in lines] == ["damaged-cache", "damaged-cache"]  # notice() says it once per run
+    assert "k.nbi" in lines[0][1] and "compiled again" in lines[0][1]
+
+
+def test_an_index_of_numba_without_the_patch_is_not_read_as_ours(tmp_path, monkeypatch):
+    """numba's own index format (another process, the patch off) is another version's: empty, unsaid."""
+    lines = _said(monkeypatch, tmp_path)
+    path = tmp_path / "k.nbi"
+    with open(path, "wb") as f:
+        pickle.dump("v1", f, protocol=-1)
+        f.write(pickle.dumps((("stamp", "digest"), {("sig",): "k.1.nbc"})))
+    files = _Files(_cache_path=str(tmp_path), _index_path=str(path), _version="v1", _source_stamp=("stamp", "digest"))
+    assert kernel_cache._load_index(files) == {} and lines == []
+
+
+def test_only_the_package_kernels_cache_files_take_the_checksummed_format():
+    """A user's own cached numba functions keep numba's format (their caches stay readable by
+    numba without stickslip)."""
+    from stickslip.model import physics
+
+    assert kernel_cache._ours(physics.rhs._cache._cache_file)
+    assert not kernel_cache._ours(types.SimpleNamespace(_source_stamp=(1.0, 2)))
+
+
+def test_index_keys_carry_the_patches_that_change_what_an_entry_holds():
+    """A process with other patches (the standalone kernels off, say) looks its kernels up under
+    other keys, so it never loads an entry in a payload format it does not read."""
+    from numba.core.registry import cpu_target
+
+    from stickslip.model import physics
+
+    assert kernel_cache.patch_tag() == ("stickslip", "python-entry", "standalone-linking")
+    from numba import types as nbtypes
+
+    sig = (nbtypes.float64[::1],)
+    key = physics.rhs._cache._index_key(sig, cpu_target.target_context.codegen())
+    assert key[0] == sig and kernel_cache.patch_tag() in key

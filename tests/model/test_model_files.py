@@ -138,7 +138,7 @@ def test_normal_force_must_be_positive(tmp_path, normal_force):
     refused(write(tmp_path, spec), "contact.1.normal_force", "> 0")
 
 
-@pytest.mark.parametrize("where, key", [(None, k) for k in ("dofs", "mass", "damping", "stiffness", "contact")]
+@pytest.mark.parametrize("where, key", [(None, k) for k in ("dofs", "mass", "stiffness", "contact")]
                          + [(("contact", 0), k) for k in ("tangent", "normal_force", "friction")]
                          + [(("contact", 0, "friction"), k) for k in ("mu_k", "delta_mu", "alpha")])
 def test_missing_key(tmp_path, where, key):
@@ -147,6 +147,13 @@ def test_missing_key(tmp_path, where, key):
     del node[key]
     message = refused(write(tmp_path, spec), key)
     assert "missing" in message
+
+
+def test_damping_left_out_is_zero():
+    spec = copy.deepcopy(BASES[1])
+    del spec["damping"]
+    model = model_from_spec(spec)
+    assert np.array_equal(model.damping, np.zeros((model.n, model.n)))
 
 
 @pytest.mark.parametrize("value", ["one", "1.0 +", True, [1.0], {"a": 1.0}, math.nan, math.inf])
@@ -421,3 +428,18 @@ def test_units_name_dofs_and_parameters_and_refuse_anything_else():
     spec["units"]["v"] = "m/s"
     with pytest.raises(ModelFileError, match="units: 'v' is neither a dof nor a named parameter"):
         model_from_spec(spec)
+
+
+@pytest.mark.parametrize("normal, words", [
+    ({"law": "rigid", "damping": 0.0}, ("contact.0.normal", "rigid contact has no stiffness or damping")),
+    ({"law": "rigid", "stiffness": 10.0, "restitution": 0.5}, ("rigid contact has no stiffness or damping",)),
+    ({}, ("contact.0.normal.stiffness is missing",)),
+    ({"law": "compliant", "damping": 0.1}, ("contact.0.normal.stiffness is missing",)),
+    ({"stiffness": 40.0, "restitution": 0.0}, ("restitution is a rigid contact's",)),
+])
+def test_a_normal_table_states_its_own_laws_numbers(tmp_path, normal, words):
+    """docs/contacts.md: a rigid contact's table refuses stiffness and damping (given at all, not only
+    nonzero), a compliant one's needs its stiffness and refuses a restitution."""
+    spec = copy.deepcopy(dict(load_model("impact-oscillator").spec))
+    spec["contact"][0]["normal"] = normal
+    refused(write(tmp_path, spec), *words)

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from stickslip import Parameters, simulate
+from stickslip.model.library import two_plates
 from stickslip.orbits import periodic_orbit
 from stickslip.orbits import region_edge
 from stickslip.orbits import continuation as C
@@ -90,7 +91,7 @@ def test_belt_branch_follows_the_analytic_stick_slip_orbits():
     P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
     ic = np.zeros(12)
     ic[10] = P.Omega  # stuck to the belt at φ = 0
-    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0)
     b = continue_orbit(start=orbit, param="Omega", step=0.05, max_step=0.2, max_points=8, bounds=(0.5, 2.0),
                        amplitude=False)
     assert len(b) == 8 and b.values[-1] > 0.7  # it moved along the branch
@@ -116,7 +117,7 @@ def rotation_branch():
     """Model 4, N = 50 N: the stick-slip orbit from the ``far`` start at Ω = 3 rad/s, continued up
     in Ω until it ends (stick phase vanishing at Ω ≈ 6.06 rad/s; ~2 s)."""
     p = Parameters(N=50.0, Omega=3.0)
-    orbit = periodic_orbit(p, start_run(p, "far", model="rotation", t_end=30.0, slip_band=BAND), slip_band=BAND)
+    orbit = periodic_orbit(p, start_run(two_plates(p, "rotation"), "far", t_end=30.0, slip_band=BAND), slip_band=BAND)
     return continue_orbit(start=orbit, param="Omega", step=0.05, max_step=1.0, max_points=200, bounds=(3.0, 20.0),
                           amplitude=False)
 
@@ -130,7 +131,7 @@ def test_branch_passes_through_an_orbit_found_independently(rotation_branch):
     # the `far` start reaches the equilibrium here (Region "III" of brute force, docs/continuation.md),
     # so the independent guess is a 20 s run from the branch state with φ displaced by 1e-3 rad
     # (~40 % of the orbit's φ range): shooting then starts from its own crossings, scales and period
-    guess = simulate(p, 20.0, model="rotation", ic=b.states[i], perturbation=1e-3, sample_rate=2000.0,
+    guess = simulate(two_plates(p, "rotation"), 20.0, ic=b.states[i], perturbation=1e-3, sample_rate=2000.0,
                      rtol=1e-10, atol=1e-13, slip_band=BAND)
     ref = periodic_orbit(p, guess, slip_band=BAND)
     assert ref.stick_phases == b.stick_phases[i] == 1
@@ -146,7 +147,7 @@ def test_branch_passes_through_an_orbit_found_independently(rotation_branch):
 
 def _sticks_after(p, state, t_end=200.0, window=100.0):
     """Brute force: does a run from ``state`` still stick in its last ``window`` seconds?"""
-    traj = simulate(p, t_end, model="rotation", ic=state, sample_rate=100.0, slip_band=BAND)
+    traj = simulate(two_plates(p, "rotation"), t_end, ic=state, sample_rate=100.0, slip_band=BAND)
     assert traj.status == "success"
     return bool(traj.mode[traj.t >= t_end - window].any())
 
@@ -217,7 +218,7 @@ def _omega_c_rotation(N=50.0):
     from stickslip.stability import stability
 
     lo, hi = 0.5, 6.0
-    growth = lambda W: stability(Parameters(N=N, Omega=W), "rotation").max_real_part
+    growth = lambda W: stability(two_plates(Parameters(N=N, Omega=W), "rotation")).max_real_part
     assert growth(lo) > 0 > growth(hi)
     for _ in range(40):
         mid = 0.5 * (lo + hi)
@@ -237,7 +238,7 @@ def test_unstable_slip_cycle_joins_the_hopf_point_and_the_end_of_the_stick_slip_
     orbit's stick phase vanishes, with the same amplitude (the two cycles merge there)."""
     b = rotation_branch
     i = int(np.argmin(np.abs(b.values - 5.0)))
-    cycle = C.unstable_cycle(b.orbit_params(i), b.states[i], model="rotation", slip_band=BAND)
+    cycle = C.unstable_cycle(two_plates(b.orbit_params(i), "rotation"), b.states[i], slip_band=BAND)
     assert cycle.stick_phases == 0
     assert int(np.sum(np.abs(cycle.nontrivial_multipliers) > 1.0)) == 1  # a saddle: one unstable direction
     up = continue_orbit(start=cycle, param="Omega", step=0.05, max_step=1.0, max_points=100, bounds=(b.values[i], 20.0),
@@ -363,13 +364,13 @@ def test_finished_output_is_returned_and_other_settings_are_refused(constructed,
 _BELT_CHILD = textwrap.dedent("""
     import sys, time
     import numpy as np
-    from stickslip import Parameters
+    from stickslip import Parameters, two_plates
     from stickslip.orbits import periodic_orbit
     from stickslip.orbits.continuation import continue_orbit
     P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
     ic = np.zeros(12)
     ic[10] = P.Omega
-    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0)
     # the pause after each journaled point only leaves the parent time to kill between points
     continue_orbit(start=orbit, param="Omega", out=sys.argv[1], callback=lambda *a: time.sleep(0.3), **{opts!r})
 """)
@@ -397,7 +398,7 @@ def test_killed_belt_branch_resumes_to_the_uninterrupted_branch(tmp_path):
     P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
     ic = np.zeros(12)
     ic[10] = P.Omega
-    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0)
     seen = []
     resumed = continue_orbit(start=orbit, param="Omega", out=out, on_resume=seen.append, **opts)
     assert 4 <= seen[0] < 10 and resumed.timings["points_resumed"] == seen[0]

@@ -169,7 +169,7 @@ def test_an_interrupted_run_resumes_and_outputs_without_open_phases_are_refused(
     open phases: emulated by leaving them out as it did) is refused in one line."""
     system = _hoffmann(0.1)
     run = start_run(system, {"x": 0.01}, t_end=300.0)
-    opts = dict(system=system, param=DRIVE, start=run, bounds=(0.1, 0.12), amplitude=False)
+    opts = dict(model=system, param=DRIVE, start=run, bounds=(0.1, 0.12), amplitude=False)
     full = continue_orbit(**opts)
     out = tmp_path / "b.nc"
     with pytest.raises(_Interrupt):

@@ -4,13 +4,14 @@ import numpy as np
 import pytest
 
 from stickslip import Parameters
+from stickslip.model.library import two_plates
 from stickslip.orbits import LyapunovResult, OrbitError, lyapunov_exponent, periodic_orbit
 from stickslip.plot.orbits import plot_lyapunov_convergence
 
 
 @pytest.fixture(scope="module")
 def orbit():
-    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0)
+    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", search_time=30.0)
 
 
 def test_periodic_orbit_exponent_vanishes(orbit):
@@ -40,7 +41,7 @@ def test_belt_orbit_exponent_vanishes():
     P = Parameters(Omega=0.5)
     ic = np.zeros(12)
     ic[10] = 0.5
-    o = periodic_orbit(P, ic, model="phi", search_time=10.0)
+    o = periodic_orbit(two_plates(P, "phi"), ic, search_time=10.0)
     L = lyapunov_exponent(ic=o, t_transient=1.0, t_average=100.0, chunk=1.0)
     assert abs(L.exponent) < 0.01           # measured −0.0029 1/s
     assert np.max(np.abs(np.cumsum(L.log_growth))) < 1.0   # measured 0.35
@@ -60,7 +61,7 @@ def test_belt_spectrum_periodic_orbit():
     P = Parameters(Omega=0.5)
     ic = np.zeros(12)
     ic[10] = 0.5
-    o = periodic_orbit(P, ic, model="phi", search_time=10.0)
+    o = periodic_orbit(two_plates(P, "phi"), ic, search_time=10.0)
     L = lyapunov_spectrum(ic=o, t_transient=1.0, t_average=50.0)
     assert isinstance(L, LyapunovSpectrum) and L.exponents.size == 2
     assert abs(L.largest) < 0.01                # measured 2.8e-3 after 50 s (~1/t)
@@ -135,6 +136,6 @@ def test_chaotic_case_has_a_positive_exponent():
     c = 0.01
     P = Parameters(k_px=300.0, k_py=200.0, k_dx=2500.0, k_dy=3500.0, k_pphi=80.0, N=100.0, Omega=1.0,
                    c_px=c, c_py=c, c_dx=c, c_dy=c, c_pphi=c, c_dpsi=c)
-    L = lyapunov_exponent(P, "equilibrium", model="full", t_transient=300.0, t_average=300.0)
+    L = lyapunov_exponent(P, "equilibrium", t_transient=300.0, t_average=300.0)
     assert L.exponent > 0.05
     assert L.exponent > 3.0 * L.standard_error

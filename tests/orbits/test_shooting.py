@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from stickslip import Parameters, simulate
+from stickslip.model.library import two_plates
 from stickslip.orbits import OrbitError, PeriodicOrbit, periodic_orbit
 from stickslip.orbits.section import section_crossings
 
@@ -27,7 +28,7 @@ def test_belt_stick_slip_orbit_analytic():
     # start stuck to the belt at φ = 0 (from rest at φ = 0 the oscillation never reaches the belt)
     ic = np.zeros(12)
     ic[10] = P.Omega
-    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0)
     assert isinstance(orbit, PeriodicOrbit)
     # the flow map is integrated at rtol 1e-10; 1e-9 relative leaves room for the event location
     assert orbit.period == pytest.approx(period, rel=1e-9)
@@ -50,7 +51,7 @@ def test_belt_pure_slip_orbit_analytic():
     phi_k = P.mu_k * P.N * P.r / P.k_pphi
     ic = np.zeros(12)
     ic[4] = phi_k + 0.01  # amplitude 0.01 rad: max φ̇ = 0.14 rad/s < Ω = 5 rad/s, no stick
-    orbit = periodic_orbit(P, ic, model="phi", search_time=1.0)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=1.0)
     assert orbit.stick_phases == 0
     assert orbit.period == pytest.approx(2 * math.pi / omega, rel=1e-9)   # integration at rtol 1e-10
     assert orbit.state[4] == pytest.approx(phi_k + 0.01, rel=1e-8)
@@ -61,7 +62,7 @@ def test_period_multiplicity_two_doubles_the_period():
     P, period, _ = belt()
     ic = np.zeros(12)
     ic[10] = P.Omega
-    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0, period_multiplicity=2)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0, period_multiplicity=2)
     assert orbit.period == pytest.approx(2 * period, rel=1e-9)
     assert orbit.stick_phases == 2
 
@@ -73,7 +74,7 @@ def test_level_section():
     level = P.mu_k * P.N * P.r / P.k_pphi + 1.2 * D
     ic = np.zeros(12)
     ic[10] = P.Omega
-    orbit = periodic_orbit(P, ic, model="phi", search_time=3.0, section=("phi", level))
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0, section=("phi", level))
     assert orbit.state[4] == level and orbit.state[10] > 0
     assert orbit.period == pytest.approx(period, rel=1e-9)
 
@@ -81,7 +82,7 @@ def test_level_section():
 @pytest.fixture(scope="module")
 def full_orbit():
     """Model 1 at N = 50 N, Ω = 0.5 rad/s (Fig. 10(b)): a stick-slip orbit."""
-    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0)
+    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", search_time=30.0)
 
 
 def test_full_model_orbit(full_orbit):
@@ -103,7 +104,7 @@ def test_long_simulation_settles_on_the_shooting_orbit(full_orbit):
     states of the run agree with the orbit's to the decayed perturbation."""
     o = full_orbit
     t_end = 600.0
-    traj = simulate(o.params, t_end, model="full", ic=o.state, perturbation=1e-4, rtol=1e-10,
+    traj = simulate(o.params, t_end, ic=o.state, perturbation=1e-4, rtol=1e-10,
                     atol=1e-13, sample_rate=2000)
     times, idx = section_crossings(o.system, o.section, traj.t, traj.states, traj.mode)
     last = traj.states[idx[-1]]   # sample before the last crossing; compare peak value and period
@@ -118,14 +119,14 @@ def test_long_simulation_settles_on_the_shooting_orbit(full_orbit):
 def test_bad_inputs():
     P, _, _ = belt()
     with pytest.raises(OrbitError, match="section"):
-        periodic_orbit(P, np.zeros(12), model="phi", section="nonsense")
+        periodic_orbit(two_plates(P, "phi"), np.zeros(12), section="nonsense")
     with pytest.raises(OrbitError, match="locked"):
-        periodic_orbit(P, np.zeros(12), model="phi", section=("x1", 0.0))
+        periodic_orbit(two_plates(P, "phi"), np.zeros(12), section=("x1", 0.0))
     with pytest.raises(OrbitError, match="crosses section"):
         # a run at the stable equilibrium of Model 1 at Ω = 8 rad/s never crosses φ̇ = 0
-        periodic_orbit(Parameters(N=40.0, Omega=6.0), "equilibrium", model="full", search_time=1.0)
+        periodic_orbit(Parameters(N=40.0, Omega=6.0), "equilibrium", search_time=1.0)
     with pytest.raises(OrbitError, match="did not converge"):
-        periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0, max_iter=1)
+        periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", search_time=30.0, max_iter=1)
 
 
 def test_to_xarray(full_orbit):

@@ -51,7 +51,7 @@ def test_band_jacobian_turns_with_the_quasi_static_direction(band):
     orbit's ranges); the complex step alone (band=False) misses the turn and is refused here."""
     from stickslip import simulate
 
-    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0,
+    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", search_time=30.0,
                        monodromy="finite-difference")
     system = o.system
     traj = simulate(system, 0.634, ic=o.state, rtol=1e-10, atol=1e-13, sample_rate=1 / 0.634)
@@ -114,7 +114,7 @@ def belt_coulomb():
     P = Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb")
     ic = np.zeros(12)
     ic[10] = P.Omega
-    return P, periodic_orbit(P, ic, model="phi", search_time=3.0)
+    return P, periodic_orbit(two_plates(P, "phi"), ic, search_time=3.0)
 
 
 def test_belt_coulomb_monodromy_closed_form():
@@ -146,7 +146,7 @@ def test_belt_exponential_law_rank_one_collapse():
     P = Parameters(Omega=0.5)
     ic = np.zeros(12)
     ic[10] = P.Omega
-    orbit = periodic_orbit(P, ic, model="phi", search_time=10.0)
+    orbit = periodic_orbit(two_plates(P, "phi"), ic, search_time=10.0)
     m = monodromy(orbit)
     M = m.matrix
     scale = np.abs(M).max()
@@ -159,7 +159,7 @@ def test_belt_exponential_law_rank_one_collapse():
 @pytest.fixture(scope="module")
 def orbit50():
     """Model 1, N = 50 N, Ω = 0.5 rad/s (Fig. 10(b)), FD monodromy as the reference."""
-    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0,
+    return periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", search_time=30.0,
                           monodromy="finite-difference")
 
 
@@ -182,7 +182,7 @@ def test_model1_saltation_matches_finite_differences(orbit50):
 
 def test_model1_second_case_n40():
     """Model 1, N = 40 N, Ω = 0.5 rad/s: the default (saltation) orbit against FD."""
-    o = periodic_orbit(Parameters(N=40.0, Omega=0.5), "equilibrium", model="full", search_time=30.0)
+    o = periodic_orbit(Parameters(N=40.0, Omega=0.5), "equilibrium", search_time=30.0)
     assert o.options["monodromy"] == "saltation" and o.stick_phases == 1
     fd = monodromy(o, "finite-difference")
     assert matched_distance(o.multipliers, fd.multipliers) < 1e-5
@@ -227,9 +227,9 @@ def test_newton_with_the_saltation_jacobian_converges_to_the_same_orbit(orbit50)
     residual of ~1e-9 σ (measured: the saltation Newton's last one, 1.1e-9), whose period is then
     only good to ~1e-9 relative."""
     kw = dict(search_time=30.0, monodromy="finite-difference", tol=1e-11)
-    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", newton_jacobian="finite-difference",
+    o = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", newton_jacobian="finite-difference",
                        **kw)
-    s = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", **kw)
+    s = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", **kw)
     assert s.options["newton_jacobian"] == "saltation"
     assert o.options["newton_jacobian"] == "finite-difference"
     assert o.period == pytest.approx(s.period, rel=1e-10)

@@ -8,9 +8,9 @@ from types import SimpleNamespace
 
 import numpy as np
 
-#: The steady-state kinds of a sweep file, as written by stickslip.sweep (code: meaning).
-KIND_FLAGS = {"flag_values": "-1 0 1 2 3",
-              "flag_meanings": "failed equilibrium periodic-slip periodic-stick-slip non-periodic"}
+from stickslip.analysis.outcome import outcome_code
+from stickslip.sweep.spec import ATTRACTOR_ATTRS
+
 UNITS = {"N": "N", "Omega": "rad/s", "delta_mu": "1", "frequency": "Hz", "period": "s", "amplitude": "rad",
          "stick_fraction": "1", "phi_mean": "rad", "peaks": "rad", "intensity_r_phi": "m s-1/2"}
 PARAMS = {"N": 50.0, "Omega": 0.5, "mu_k": 0.2, "delta_mu": 0.1, "alpha": 5.0}
@@ -27,14 +27,19 @@ def make_sweep(coords: dict, t_from=100.0, t_end=200.0, model="full", **variable
     for name, values in variables.items():
         values = np.asarray(values, dtype=float)
         attrs = {"units": UNITS[name]} if name in UNITS else {}
-        if name == "kind":
-            attrs = dict(KIND_FLAGS, long_name="steady-state kind")
+        if name == "attractor":
+            attrs = dict(ATTRACTOR_ATTRS)
         attrs.setdefault("long_name", name)
         data[name] = (dims + (["peak"] if name == "peaks" else []), values, attrs)
     ds = xr.Dataset(data, coords={d: (d, np.asarray(v), {"units": UNITS[d]} if d in UNITS else {})
                                   for d, v in coords.items()})
     ds.attrs.update(parameters=json.dumps(PARAMS), t_from=t_from, t_end=t_end, model=model)
     return ds
+
+
+def outcome_codes(names):
+    """The outcome codes (float array of the same shape) of outcome names."""
+    return np.vectorize(outcome_code, otypes=[float])(np.asarray(names, dtype=object))
 
 
 def make_stability_map(N, Omega, omega_c, *, missing=None, upper=None, labels=("Δμ = 0.1",), family="delta_mu"):

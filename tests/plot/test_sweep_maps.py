@@ -9,7 +9,7 @@ from matplotlib.colors import to_rgba
 
 from stickslip.plot.sweep import plot_reduction, save_sweep_figure
 
-from .figdata import capture_saved_figures, legend_entries, make_sweep, mesh_edges, top_cell_colours
+from .figdata import capture_saved_figures, legend_entries, make_sweep, mesh_edges, outcome_codes, top_cell_colours
 
 N3 = [10.0, 20.0, 30.0]
 
@@ -24,12 +24,13 @@ def _close_figures():
     plt.close("all")
 
 
-def _map(omega, frequency, kind=None, var="frequency"):
-    """Heat map over (N, Ω) of a sweep whose every point is periodic stick-slip unless ``kind`` says otherwise."""
+def _map(omega, frequency, outcomes=None, var="frequency", stick_fraction=0.2):
+    """Heat map over (N, Ω) of a sweep whose every point is periodic stick-slip unless ``outcomes``
+    (names) and ``stick_fraction`` say otherwise."""
     shape = (len(N3), len(omega))
-    kind = np.full(shape, 2.0) if kind is None else np.asarray(kind, float)
-    ds = make_sweep({"N": N3, "Omega": omega}, kind=kind, frequency=frequency,
-                    stick_fraction=np.full(shape, 0.2))
+    codes = np.full(shape, 1.0) if outcomes is None else outcome_codes(outcomes)
+    ds = make_sweep({"N": N3, "Omega": omega}, attractor=codes, frequency=frequency,
+                    stick_fraction=np.broadcast_to(stick_fraction, shape))
     return plot_reduction(ds, var)
 
 
@@ -75,14 +76,15 @@ def test_unsorted_grid_puts_each_value_in_the_cell_around_its_own_coordinate():
 def test_equilibria_have_their_own_colour_and_legend_entry_not_a_frequency():
     """The sweep stores the decay frequency of a transient at an equilibrium (2.25 Hz); the map
     must not draw it as an oscillation at 2.25 Hz."""
-    kind = np.array([[2, 2, 0], [3, 2, 0], [2, 0, 0]], float)  # (N, Ω)
-    freq = np.where(kind == 0, 2.25, np.array([[1.0, 1.1, 0], [1.2, 1.3, 0], [1.4, 0, 0]]))
-    ax = _map([0.5, 5.0, 8.5], freq, kind)
+    outcomes = np.array([["periodic", "periodic", "equilibrium"], ["chaotic", "periodic", "equilibrium"],
+                         ["periodic", "equilibrium", "equilibrium"]], dtype=object)  # (N, Ω)
+    freq = np.where(outcomes == "equilibrium", 2.25, np.array([[1.0, 1.1, 0], [1.2, 1.3, 0], [1.4, 0, 0]]))
+    ax = _map([0.5, 5.0, 8.5], freq, outcomes)
     entries = legend_entries(ax)
     eq_label = next(label for label in entries if "equilibrium" in label)
     eq_colour = entries[eq_label].get_facecolor()
     cells = top_cell_colours(ax)  # (Ω, N)
-    eq_cells = kind.T == 0
+    eq_cells = outcomes.T == "equilibrium"
     np.testing.assert_allclose(cells[eq_cells], np.tile(eq_colour, (eq_cells.sum(), 1)))
     scale = next(m for m in _meshes(ax) if m.colorbar is not None)
     assert scale.norm.vmax == pytest.approx(1.4)  # 2.25 Hz is not on the colour scale
@@ -91,9 +93,10 @@ def test_equilibria_have_their_own_colour_and_legend_entry_not_a_frequency():
 
 
 def test_failed_runs_and_missing_values_are_named_in_the_legend():
-    kind = np.array([[2, -1, 2], [2, 2, 2], [2, 2, 2]], float)
+    outcomes = np.full((3, 3), "periodic", dtype=object)
+    outcomes[0, 1] = "failed"
     freq = np.array([[1.0, np.nan, 1.2], [1.1, np.nan, 1.3], [1.2, 1.4, 1.5]])  # NaN at a failure and at (20 N, 5 rad/s)
-    ax = _map([0.5, 5.0, 8.5], freq, kind)
+    ax = _map([0.5, 5.0, 8.5], freq, outcomes)
     entries = legend_entries(ax)
     cells = top_cell_colours(ax)
     failed = next(label for label in entries if "failed" in label)
@@ -103,22 +106,26 @@ def test_failed_runs_and_missing_values_are_named_in_the_legend():
     np.testing.assert_allclose(cells[1, 1], entries[other[0]].get_facecolor())
 
 
-def test_unknown_kind_codes_get_their_own_colour_from_the_file():
-    """A kind written by a newer sweep (code 4, 'unsettled') is not drawn in another kind's colour."""
-    kind = np.array([[2, 4, 0], [2, 4, 0], [1, 3, -1]], float)
-    ds = make_sweep({"N": N3, "Omega": [0.5, 5.0, 8.5]}, kind=kind)
-    ds["kind"].attrs.update(flag_values="-1 0 1 2 3 4",
-                            flag_meanings="failed equilibrium periodic-slip periodic-stick-slip non-periodic unsettled")
-    ax = plot_reduction(ds, "kind")
+def test_every_outcome_and_the_stick_character_of_a_periodic_point_get_their_own_colour():
+    """The map of ``attractor`` draws each outcome in a colour of its own, a periodic point with
+    stick apart from one without, each named in the legend."""
+    outcomes = np.array([["periodic", "unsettled", "equilibrium"], ["periodic", "chaotic", "quasiperiodic"],
+                         ["unbounded", "contact-lost", "failed"]], dtype=object)
+    stick = np.array([[0.2, 0.2, 0.0], [0.0, 0.2, 0.2], [0.0, 0.0, 0.0]])
+    ax = _map([0.5, 5.0, 8.5], np.ones((3, 3)), outcomes, var="attractor", stick_fraction=stick)
     entries = legend_entries(ax)
-    assert "unsettled" in entries
     colours = {label: tuple(h.get_facecolor()) for label, h in entries.items()}
-    assert len(set(colours.values())) == len(colours) == 6
-    np.testing.assert_allclose(top_cell_colours(ax)[1, 0], colours["unsettled"])
+    assert len(set(colours.values())) == len(colours) == 9
+    cells = top_cell_colours(ax)  # (Ω, N)
+    np.testing.assert_allclose(cells[0, 0], colours["periodic stick-slip"])
+    np.testing.assert_allclose(cells[0, 1], colours["periodic slip"])
+    np.testing.assert_allclose(cells[1, 0], colours["unsettled"])
+    np.testing.assert_allclose(cells[2, 2], colours["failed"])
 
 
 def test_frequency_against_one_parameter_leaves_equilibria_off_the_curve():
-    ds = make_sweep({"N": [10.0, 20.0, 30.0, 40.0]}, kind=[2, 2, 0, 0], frequency=[1.0, 1.1, 2.25, 2.25])
+    ds = make_sweep({"N": [10.0, 20.0, 30.0, 40.0]}, attractor=[1, 1, 0, 0], frequency=[1.0, 1.1, 2.25, 2.25],
+                    stick_fraction=[0.2, 0.2, 0.0, 0.0])
     ax = plot_reduction(ds, "frequency")
     ys = np.concatenate([np.asarray(line.get_ydata(), float) for line in ax.get_lines()
                          if line.get_transform() == ax.transData])
@@ -136,7 +143,8 @@ def test_dimensionless_quantity_says_so_on_its_colour_bar():
 
 def test_sweep_figure_title_gives_fixed_parameters_with_units(tmp_path, monkeypatch):
     saved = capture_saved_figures(monkeypatch)
-    ds = make_sweep({"N": N3, "Omega": [0.5, 5.0, 8.5]}, kind=np.full((3, 3), 2.0), frequency=np.ones((3, 3)))
+    ds = make_sweep({"N": N3, "Omega": [0.5, 5.0, 8.5]}, attractor=np.full((3, 3), 1.0), frequency=np.ones((3, 3)),
+                    stick_fraction=np.full((3, 3), 0.2))
     save_sweep_figure(ds, tmp_path / "s.png", var="frequency")
     title = saved[0].get_suptitle()
     assert "α = 5 s/m" in title and "steady window 100–200 s" in title
@@ -144,6 +152,7 @@ def test_sweep_figure_title_gives_fixed_parameters_with_units(tmp_path, monkeypa
 
 def test_title_names_the_value_of_a_grid_dimension_of_length_one(tmp_path, monkeypatch):
     saved = capture_saved_figures(monkeypatch)
-    ds = make_sweep({"N": N3, "Omega": [8.5]}, kind=np.full((3, 1), 2.0), frequency=np.ones((3, 1)))
+    ds = make_sweep({"N": N3, "Omega": [8.5]}, attractor=np.full((3, 1), 1.0), frequency=np.ones((3, 1)),
+                    stick_fraction=np.full((3, 1), 0.2))
     save_sweep_figure(ds, tmp_path / "s.png", var="frequency")
     assert "Ω = 8.5 rad/s" in saved[0].get_suptitle()

@@ -100,7 +100,7 @@ def _belt(name: str, out, *extra) -> list:
 
 
 #: What must agree between the clean run and the resumed one (machine timings aside).
-COMPARED = {"simulate": ("x", "dx", "mode"), "sweep": ("done", "kind", "frequency", "peaks"),
+COMPARED = {"simulate": ("x", "dx", "mode"), "sweep": ("done", "attractor", "frequency", "peaks"),
             "basins": ("label", "fraction", "count")}
 
 

@@ -1,7 +1,7 @@
 """Faults an adversarial user found, each one line (or working) instead of a traceback or a
 wrong result: seeds out of range, an ASCII console, numba's environment variables, a run file
-continued with another model, a CSV with a byte-order mark, numbers of hundreds of digits in a
-message, and the numbering of the stability table."""
+continued with another model, a CSV with a byte-order mark, numbers of hundreds of digits quoted
+as typed, and the numbering of the stability table."""
 
 import os
 import subprocess
@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from stickslip.basins import from_csv
 from stickslip.cli import app
-from stickslip.cli._app import shorten_numbers
+from stickslip.cli._app import exact
 from stickslip.model.library import load_model
 
 runner = CliRunner()
@@ -33,12 +33,11 @@ def stickslip(*args, **env) -> subprocess.CompletedProcess:
                           text=True, timeout=300, env=dict(os.environ, **env))
 
 
-@pytest.mark.parametrize("seed, shown", [("-1", "-1"), ("99999999999999999999999", "1e+23"),
-                                         (str(2**63), "9.22e+18")])
-def test_a_seed_out_of_range_is_refused_before_anything_is_computed(seed, shown, tmp_path):
+@pytest.mark.parametrize("seed", ["-1", "99999999999999999999999", str(2**63)])
+def test_a_seed_out_of_range_is_refused_before_anything_is_computed(seed, tmp_path):
     """(-1 was a ValueError traceback; 10^23 computed every state, then failed writing, every time.)"""
     line = one_line(runner.invoke(app, [*BOXED, "--seed", seed, "--out", str(tmp_path / "b.nc")]))
-    assert line == f"error: --seed {shown}: give an integer 0 … 2^63 − 1"
+    assert line == f"error: --seed {seed}: give an integer 0 … 2^63 − 1"  # as typed, every digit
     assert not list(tmp_path.iterdir())
 
 
@@ -103,19 +102,49 @@ def test_a_csv_with_a_byte_order_mark_is_read(tmp_path):
     assert np.array_equal(from_csv(belt, path).table, [[0.5, 1.0], [-1.0, 0.0]])
 
 
-def test_numbers_of_hundreds_of_digits_are_shortened_in_error_lines(tmp_path):
+def test_numbers_of_hundreds_of_digits_are_quoted_as_typed(tmp_path):
     line = one_line(runner.invoke(app, [*BOXED, "--n", "9" * 300, "--out", str(tmp_path / "b.nc")]))
-    assert line == "error: --n 1e+300: give the number of random states, 1 … 10000000"
+    assert line == f"error: --n {'9' * 300}: give the number of random states, 1 … 10000000"
 
 
-@pytest.mark.parametrize("text, shown", [
-    ("1" * 300, "1.11e+299"), ("-" + "3" + "0" * 40, "-3e+40"), ("1234567890123456", "1.23e+15"),
-    ("123456789012345", "123456789012345"),  # 15 digits: a number one may mean
-    ("/data/12345678901234567890/r.nc", "/data/12345678901234567890/r.nc"),  # paths keep their digits
-    ("run_12345678901234567890.nc", "run_12345678901234567890.nc"),
+def test_a_set_value_beyond_a_float_is_refused_quoting_what_was_typed(tmp_path):
+    digits = "12" * 200  # 400 digits: no float holds it
+    line = one_line(runner.invoke(app, ["simulate", "--set", f"N={digits}", "--t-end", "1", "--json"]))
+    assert line == (f"error: --set N={digits}: {digits} is beyond the range of a float (about ±1.8e308); "
+                    "give a finite number")
+
+
+def test_a_set_value_named_in_a_conflict_is_quoted_as_typed():
+    digits = "1" + "2" * 56  # a float holds it, but not its digits
+    line = one_line(runner.invoke(app, ["simulate", "--set", f"N={digits}", "--N", "5", "--t-end", "1", "--json"]))
+    assert line == f"error: --set N={digits} and --N 5 both set N; give one of them"
+    line = one_line(runner.invoke(app, ["simulate", "--set", digits, "--t-end", "1", "--json"]))
+    assert line == f"error: --set expects NAME=VALUE, got '{digits}'; e.g. --set k_px=400"
+
+
+@pytest.mark.parametrize("value, shown", [
+    (50.0, "50"), (0.1, "0.1"), (1.0000001, "1.0000001"), (1e300, "1e+300"), (-2.5e-7, "-2.5e-07"), (12, "12"),
 ])
-def test_long_numbers_are_shown_with_three_digits(text, shown):
-    assert shorten_numbers(f"got {text}.") == f"got {shown}."
+def test_an_options_value_is_quoted_to_its_last_digit(value, shown):
+    assert exact(value) == shown
+    assert float(shown) == value
+
+
+def test_a_relative_tolerance_is_refused_with_the_value_given():
+    """(``:g`` showed --rtol 1.0000001 as 1, the very value the message says is too large.)"""
+    line = one_line(runner.invoke(app, ["orbit", "--tol", "1.0000001"]))
+    assert line.startswith("error: --tol 1.0000001: a relative tolerance must be < 1")
+
+
+@pytest.mark.parametrize("axes, start", [
+    (["N=-1:2:3", "Omega=1:2:3"], "error: --axis N=-1:2:3: parameter N = -1.0 must be > 0"),
+    (["N=1:2:3", "Omega=-1:1:3"], "error: --axis Omega=-1:1:3: Omega = 0 has no steady sliding"),
+    (["foo=1:2:3", "N=1:2:3"], "error: --axis foo=1:2:3: unknown parameter(s) foo of model 'two-plates'"),
+    (["N=1,2,x", "Omega=1:2:3"], "error: --axis N=1,2,x: give numbers separated by commas"),
+])
+def test_stability_map_axis_errors_name_the_axis(tmp_path, axes, start):
+    args = ["stability-map", *[a for axis in axes for a in ("--axis", axis)], "--no-plot", "--out", str(tmp_path / "m.nc")]
+    assert one_line(runner.invoke(app, args)).startswith(start)
 
 
 def test_lyapunov_with_a_huge_transient_names_its_own_option(tmp_path):

@@ -3,7 +3,7 @@
 import numpy as np
 
 import stickslip
-from stickslip.model import resolve_variant
+from stickslip.model import resolve_variant, two_plates
 from stickslip.stability import stability
 
 
@@ -17,7 +17,7 @@ def measured_growth_rate(params, t_end, amplitude, *, model="full", sample_rate=
 
     Returns (measured rate, predicted max real part, trajectory).
     """
-    res = stability(params, model)
+    res = stability(two_plates(params, model))
     free = resolve_variant(model).free_indices
     idx = np.concatenate([free, 6 + free])
     lam, V = np.linalg.eig(res.jacobian)
@@ -25,7 +25,7 @@ def measured_growth_rate(params, t_end, amplitude, *, model="full", sample_rate=
     v = V[:, j] / V[np.argmax(np.abs(V[:, j])), j]
     pert = np.zeros(12)
     pert[idx] = amplitude * v.real
-    traj = stickslip.simulate(params, t_end, model=model, ic="equilibrium", perturbation=pert,
+    traj = stickslip.simulate(two_plates(params, model), t_end, ic="equilibrium", perturbation=pert,
                               rtol=1e-11, atol=1e-15, sample_rate=sample_rate)
     assert traj.status == "success"
     assert not np.any(traj.mode), "the run must stay in slip for a linear growth measurement"

@@ -6,7 +6,7 @@ from plates import plate_arrays
 
 import stickslip
 from stickslip import Parameters
-from stickslip.model import MODELS
+from stickslip.model import MODELS, two_plates
 from stickslip.stability import EquilibriumError, equilibrium, equilibrium_residual, stability
 from stickslip.stability.equilibrium import RESIDUAL_TOL, solve_steady
 
@@ -16,7 +16,7 @@ from stickslip.stability.equilibrium import RESIDUAL_TOL, solve_steady
 def test_residual_is_below_tolerance(model, N, Omega):
     P = Parameters(N=N, Omega=Omega)
     system = plate_arrays(P, model)
-    q = equilibrium(P, model)
+    q = equilibrium(two_plates(P, model))
     res = equilibrium_residual(system.model, q)  # the simulator's kernel, not the differentiated copy
     Kq = system.stiff * q
     # brief: relative residual ≤ 1e-10 (Newton reaches round-off, ~1e-16)
@@ -78,7 +78,7 @@ def test_bad_params_type():
     with pytest.raises(TypeError, match="Parameters"):
         equilibrium({"N": 50})
     with pytest.raises(stickslip.StickSlipError, match="unknown model 'nonsense'"):
-        equilibrium(Parameters(), model="nonsense")
+        equilibrium("nonsense")
 
 
 def test_continuation_finds_the_equilibrium_near_the_fold():

@@ -8,7 +8,7 @@ from appendix import appendix_matrices
 from plates import plate_arrays
 
 from stickslip import Parameters
-from stickslip.model import MODELS
+from stickslip.model import MODELS, two_plates
 from stickslip.model.bundle import CST
 from stickslip.model.derivatives import state_jacobian
 from stickslip.model.physics import MODE_SLIP, MODE_SLIP_EXACT, rhs, slip_velocity
@@ -117,7 +117,7 @@ def central_difference_jacobian(s, system, h=1e-6):
 @pytest.mark.parametrize("model", list(MODELS))
 def test_jacobian_matches_central_differences(model):
     system = plate_arrays(Parameters(N=60.0, Omega=2.5), model)
-    q = equilibrium(system.params, model)
+    q = equilibrium(two_plates(system.params, model))
     states = [np.concatenate([q, np.zeros(6)])] + [slip_state(system) for _ in range(5)]
     for s in states:
         J = generic_jacobian(s, system)
@@ -133,7 +133,7 @@ def test_jacobian_matches_central_differences(model):
 
 def test_reduced_jacobian_is_the_free_block_of_the_full_one():
     system = plate_arrays(Parameters(), "x")
-    q = equilibrium(system.params, "x")
+    q = equilibrium(two_plates(system.params, "x"))
     free = system.variant.free_indices
     idx = np.concatenate([free, 6 + free])
     full = generic_jacobian(np.concatenate([q, np.zeros(6)]), system)

@@ -146,7 +146,7 @@ def test_reduced_model_boundary_is_the_closed_form(N):
     # exactly when c = 2a, i.e. Omega_c = ln(2 N r^2 alpha dmu / c) / (alpha r)
     P = Parameters()
     expected = math.log(2 * N * P.r**2 * P.alpha * P.delta_mu / P.c_pphi) / (P.alpha * P.r)
-    m = stability_map(P, [N], np.linspace(0.2, 20.0, 30), model="rotation")
+    m = stability_map(two_plates(P, "rotation"), [N], np.linspace(0.2, 20.0, 30))
     # brentq to BOUNDARY_XTOL; 1e-9 allows for the round-off of max Re λ near the root
     assert m.boundary[0, 0, 0] == pytest.approx(expected, rel=1e-9)
     assert np.isnan(m.boundary[0, 0, 1:]).all()

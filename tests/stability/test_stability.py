@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from stickslip import Parameters
-from stickslip.model import MODELS
+from stickslip.model import MODELS, two_plates
 from stickslip.stability import EquilibriumError, StabilityResult, stability
 
 from conftest import measured_growth_rate
@@ -32,7 +32,7 @@ def uncoupled_eigenvalues(P, dofs):
 def test_without_friction_eigenvalues_are_the_uncoupled_oscillators(model):
     # mu_k = delta_mu = 0: no friction, nothing couples the six oscillators of Eq. (1)
     P = Parameters(mu_k=0.0, delta_mu=0.0, c_px=0.3, c_dy=2.0)  # distinct damping: no ties
-    res = stability(P, model)
+    res = stability(two_plates(P, model))
     expected = uncoupled_eigenvalues(P, res.dofs)
     # eigenvalues of a 12×12 matrix with entries up to k/m = 300: LAPACK round-off ~1e-13
     np.testing.assert_allclose(res.eigenvalues, expected, rtol=1e-12, atol=1e-12)
@@ -44,7 +44,7 @@ def test_constant_friction_does_not_couple_the_reduced_model(mu_k):
     # Model 4 with delta_mu = 0: F = mu_k N along e_n1 whatever the rotation, a constant torque
     # on phi and psi, so the linearisation is again two isolated oscillators
     P = Parameters(mu_k=mu_k, delta_mu=0.0, N=80.0)
-    res = stability(P, "rotation")
+    res = stability(two_plates(P, "rotation"))
     expected = uncoupled_eigenvalues(P, ("phi", "psi"))
     np.testing.assert_allclose(res.eigenvalues, expected, rtol=1e-12, atol=1e-12)
     # and the equilibrium is the static deflection by that torque, r mu_k N / k
@@ -74,13 +74,13 @@ def test_result_is_typed_and_sorted():
 
 @pytest.mark.parametrize("model, size", [("full", 12), ("x", 8), ("y", 8), ("rotation", 4), ("phi", 2)])
 def test_jacobian_is_reduced_to_the_free_dofs(model, size):
-    res = stability(Parameters(), model)
+    res = stability(two_plates(Parameters(), model))
     assert res.jacobian.shape == (size, size)
     assert len(res.dofs) == size // 2
 
 
 def test_to_xarray(tmp_path):
-    res = stability(Parameters(N=70.0), "rotation")
+    res = stability(two_plates(Parameters(N=70.0), "rotation"))
     ds = res.to_xarray()
     assert ds["eigenvalue_real"].attrs["units"] == "1/s"
     assert ds.attrs["param_N"] == 70.0 and ds.attrs["param_N_units"] == "N"
@@ -109,7 +109,7 @@ def test_growth_rate_matches_simulation(N, Omega):
 
 def test_growth_rate_matches_simulation_reduced_model():
     P = Parameters(N=100.0, Omega=1.5)
-    predicted = stability(P, "rotation").max_real_part
+    predicted = stability(two_plates(P, "rotation")).max_real_part
     assert predicted > 0
     measured, predicted, _ = measured_growth_rate(P, math.log(100.0) / predicted, 1e-6, model="rotation")
     assert measured == pytest.approx(predicted, rel=0.05)

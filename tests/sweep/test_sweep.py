@@ -37,14 +37,14 @@ def serial(tmp_path_factory):
 
 def test_dataset_layout(serial):
     ds = serial.to_xarray()
-    assert tuple(ds["kind"].dims) == ("N", "Omega")
+    assert tuple(ds["attractor"].dims) == ("N", "Omega")
     assert ds["peaks"].dims == ("N", "Omega", "peak")
     assert ds["N"].attrs["units"] == "N" and ds["Omega"].attrs["units"] == "rad/s"
     assert ds["frequency"].attrs["units"] == "Hz"
-    assert ds.attrs["format"] == "stickslip-sweep-1" and ds.attrs["complete"] == 1
+    assert ds.attrs["format"] == "stickslip-sweep-2" and ds.attrs["complete"] == 1
     assert ds.attrs["param_mu_k"] == 0.2
     assert np.all(ds["done"] == 1) and np.all(ds["t_reached"] == OPTS["t_end"])
-    assert set(serial.kinds().ravel()) <= {"equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic"}
+    assert set(serial.outcomes().ravel()) <= {"equilibrium", "periodic", "quasiperiodic", "chaotic", "unsettled"}
     # stick-slip at Ω = 0.5 rad/s for every N (Fig. 12(a))
     assert np.all(ds["stick_fraction"].sel(Omega=0.5) > 0)
 
@@ -207,16 +207,16 @@ def test_assembly_in_slabs_places_out_of_order_rows(tmp_path, monkeypatch):
     store.assemble(journal, tmp_path / "j.nc")
     ds = load_sweep(tmp_path / "j.nc")
     names = [c[0] for c in spec.columns]
-    kind_col = 0
+    attractor_col = 0
     peaks_col = sum(c[1] for c in spec.columns[: names.index("peaks")])
     for i in range(spec.size):
         n, w = divmod(i, 5)
         if i == 7:
-            assert ds["done"].values[n, w] == 0 and np.isnan(ds["kind"].values[n, w])
+            assert ds["done"].values[n, w] == 0 and np.isnan(ds["attractor"].values[n, w])
             assert np.all(np.isnan(ds["peaks"].values[n, w]))
         else:
             assert ds["done"].values[n, w] == 1
-            assert ds["kind"].values[n, w] == rows[i, kind_col]
+            assert ds["attractor"].values[n, w] == rows[i, attractor_col]
             assert np.array_equal(ds["peaks"].values[n, w], rows[i, peaks_col : peaks_col + 3])
     assert not (journal.dir / "ordered.f64").exists()   # scratch file removed
 
@@ -226,7 +226,7 @@ def test_large_sweeps_are_returned_lazily(tmp_path, monkeypatch):
 
     monkeypatch.setattr(store, "LOAD_LIMIT_POINTS", 2)
     lazy = sweep({"N": [30.0, 50.0, 70.0]}, out=tmp_path / "lazy.nc", executor="serial", t_end=2.0)
-    var = lazy.dataset["kind"].variable
+    var = lazy.dataset["attractor"].variable
     assert not isinstance(var._data, np.ndarray)        # backed by the file, not read yet
     loaded = load_sweep(tmp_path / "lazy.nc")
     _assert_same(loaded, lazy.dataset)

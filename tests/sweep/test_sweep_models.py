@@ -8,6 +8,7 @@ import pytest
 
 import stickslip
 from stickslip.analysis.intensity import intensity
+from stickslip.analysis.outcome import STOPPED, outcome_names
 from stickslip.model.library import load_model
 from stickslip.stability.equilibrium import steady_sliding
 from stickslip.sweep import load_sweep, sweep
@@ -48,14 +49,14 @@ def test_belt_sweep_sticks_below_the_stability_boundary_only(belt_sweep):
     ds = belt_sweep.to_xarray()
     stick = ds["stick_fraction"].values
     assert stick[0] > 0.0 and stick[1] == 0.0 and stick[2] == 0.0
-    assert list(ds["kind"].values[1:]) == [0.0, 0.0]  # equilibrium (steady sliding)
+    assert list(ds["attractor"].values[1:]) == [0.0, 0.0]  # equilibrium (steady sliding)
 
 
 def test_belt_sweep_resumes_without_recomputing(belt_sweep):
     again = sweep({"contact.0.drive": DRIVES}, "belt", out=belt_sweep.path, executor="serial", **RUN)
     assert again.timings["points_computed"] == 0 and again.timings["points_resumed"] == len(DRIVES)
     back = load_sweep(belt_sweep.path)
-    np.testing.assert_array_equal(back["kind"].values, belt_sweep.to_xarray()["kind"].values)
+    np.testing.assert_array_equal(back["attractor"].values, belt_sweep.to_xarray()["attractor"].values)
 
 
 def test_hoffmann_sweep_over_mu_k_runs(tmp_path):
@@ -63,7 +64,7 @@ def test_hoffmann_sweep_over_mu_k_runs(tmp_path):
                 t_end=20.0, sample_rate=50.0, ic="near")
     ds = res.to_xarray()
     assert ds["done"].dims == ("contact.0.friction.mu_k",) and int(ds.attrs["complete"]) == 1
-    assert np.all(ds["kind"].values >= 0)
+    assert not np.any(np.isin(outcome_names(ds["attractor"].values), STOPPED))
 
 
 def test_plates_specs_read_as_before():

@@ -26,14 +26,14 @@ def main():
     t = time.perf_counter()
     runs, labels = [], []
     for seed, d0 in [(0, 1e-7), (1, 1e-7), (0, 1e-6), (0, 1e-8)]:
-        L = lyapunov_exponent(PARAMS, "equilibrium", model="full", t_transient=300.0, t_average=2000.0,
+        L = lyapunov_exponent(PARAMS, "equilibrium", t_transient=300.0, t_average=2000.0,
                               seed=seed, d0=d0)
         runs.append(L)
         labels.append(f"seed {seed}, d0 = {d0:g}")
         print(f"seed {seed} d0 {d0:g}: λ = {L.exponent:.4f} ± {L.standard_error:.4f} 1/s, "
               f"running {[round(float(L.estimate[i]), 4) for i in (99, 499, 999, 1999)]}")
     # the attractor: peak-to-peak of φ and stick fraction in 100 s windows after the transient
-    tr = simulate(PARAMS, 1300.0, model="full", ic="equilibrium", perturbation=1e-3, rtol=1e-10, atol=1e-13,
+    tr = simulate(PARAMS, 1300.0, ic="equilibrium", perturbation=1e-3, rtol=1e-10, atol=1e-13,
                   sample_rate=50.0)
     for k in range(3, 13):
         m = (tr.t >= 100 * k) & (tr.t < 100 * (k + 1))
@@ -42,7 +42,7 @@ def main():
     fig = plot_lyapunov_convergence(runs, labels=labels)
     fig.axes[0].set_title("Model 1, detuned stiffnesses, damping 0.01, N = 100 N, Ω = 1 rad/s", fontsize=9)
     fig.savefig(OUT / "lyapunov_chaos.png", dpi=130)
-    S = lyapunov_spectrum(PARAMS, "equilibrium", model="full", t_transient=300.0, t_average=2000.0,
+    S = lyapunov_spectrum(PARAMS, "equilibrium", t_transient=300.0, t_average=2000.0,
                           method="finite-difference")
     lam = np.sort(S.exponents)[::-1]
     print(f"spectrum (FD, {S.wall_time:.0f} s): {np.array2string(lam, precision=4)}; {S.stick_phases} stick phases")

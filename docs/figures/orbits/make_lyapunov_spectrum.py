@@ -28,7 +28,7 @@ def report(label, spec, orbit):
 def main():
     # Fig. 10(b): N = 50 N, on its shooting orbit
     t = time.perf_counter()
-    o50 = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", model="full", search_time=30.0)
+    o50 = periodic_orbit(Parameters(N=50.0, Omega=0.5), "equilibrium", search_time=30.0)
     s50 = lyapunov_spectrum(ic=o50, t_transient=1.0, t_average=400.0, record=2.0)
     f50 = report("N = 50 N", s50, o50)
     fig = plot_lyapunov_spectrum(s50, reference=f50)
@@ -37,11 +37,11 @@ def main():
 
     # Fig. 10(f): N = 120 N, from the perturbed equilibrium (the paper's "non-periodic" case)
     P = Parameters(N=120.0, Omega=0.5)
-    s120 = lyapunov_spectrum(P, "equilibrium", model="full", t_transient=100.0, t_average=1000.0, record=5.0)
-    late = simulate(P, 4000.0, model="full", ic="equilibrium", perturbation=1e-3, rtol=1e-10, atol=1e-13,
+    s120 = lyapunov_spectrum(P, "equilibrium", t_transient=100.0, t_average=1000.0, record=5.0)
+    late = simulate(P, 4000.0, ic="equilibrium", perturbation=1e-3, rtol=1e-10, atol=1e-13,
                     sample_rate=1.0)
     # a section crossed once per period, in slip (φ has two maxima per period, one of them in stick)
-    o120 = periodic_orbit(P, late.final_state, model="full", search_time=30.0,
+    o120 = periodic_orbit(P, late.final_state, search_time=30.0,
                           section=Section(0, -0.04, 1, "x1=-0.04 up"))
     f120 = report("N = 120 N", s120, o120)
     fig = plot_lyapunov_spectrum(s120, reference=f120)

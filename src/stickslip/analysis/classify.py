@@ -1,33 +1,35 @@
 """Classification of a response window from the signal alone: at rest, periodic, decaying,
 stationary or still drifting.
 
-The decision uses the window t ≥ t_from (the transient before it is discarded):
+The decision uses the window t ≥ t_from (the transient before it is discarded); the outcome is
+named in the one vocabulary of :mod:`.outcome`, the signal's own finding in ``signal``:
 
-1. **At rest** – peak-to-peak x below :data:`~stickslip.analysis.signal.REST_AMPLITUDE`:
-   ``equilibrium``, settled.
-2. **Settled period** – :func:`~stickslip.analysis.period.detect_period` (the one period rule,
-   shared with ``Trajectory.steady``): the peaks repeat with multiplicity k and the window shows
-   no drift and no decaying return differences. ``periodic-stick-slip`` if any stick occurs in
-   the window, else ``periodic-slip``.
-3. **Decay** – no settled period, no stick, and the peak-to-peak amplitude in the last quarter
-   of the window below :data:`DECAY_RATIO` times that of the first quarter, in x and in every
-   other given response: ``equilibrium`` (converging to steady sliding). The signal cannot
-   tell a decay onto the equilibrium from one onto a small slip limit cycle or a mode growing
-   unseen below it, so this is not settled here: :mod:`stickslip.attractors` confirms it
-   with the linear stability of the equilibrium. A slip-only response that grows in any
+1. **At rest** (``at-rest``) – peak-to-peak x below
+   :data:`~stickslip.analysis.signal.REST_AMPLITUDE`: ``equilibrium``, settled.
+2. **Settled period** (``periodic``) – :func:`~stickslip.analysis.period.detect_period` (the
+   one period rule, shared with ``Trajectory.steady``): the peaks repeat with multiplicity k and
+   the window shows no drift and no decaying return differences: ``periodic``, settled; a
+   stick-slip orbit when any stick occurs in the window (``stick_fraction`` > 0), else a
+   pure-slip orbit.
+3. **Decay** (``decaying``) – no settled period, no stick, and the peak-to-peak amplitude in the
+   last quarter of the window below :data:`DECAY_RATIO` times that of the first quarter, in x
+   and in every other given response: ``equilibrium`` (converging to steady sliding). The signal
+   cannot tell a decay onto the equilibrium from one onto a small slip limit cycle or a mode
+   growing unseen below it, so this is not settled here: :mod:`stickslip.attractors` confirms
+   it with the linear stability of the equilibrium. A slip-only response that grows in any
    response is not an equilibrium.
-4. Otherwise ``non-periodic``: **stationary** when the window holds enough peaks for every
+4. Otherwise ``unsettled``: **stationary** when the window holds enough peaks for every
    multiplicity to have been tried (:data:`STATIONARY_MIN_PEAKS`), the return differences of
    the best multiplicity seen are far from a match (spread ≥ :data:`STATIONARY_MIN_SPREAD`),
    and they show neither decay (:func:`~stickslip.analysis.period.decay_ratio` at most
    :data:`~stickslip.analysis.period.DECAY_FACTOR`) nor trend (their drift is no larger than
    their spread): no sign of a transient, a candidate for chaos or a torus that only the
-   dynamics can confirm (:mod:`stickslip.attractors`); else **unsettled**. The range of
+   dynamics can confirm (:mod:`stickslip.attractors`); else **drifting**. The range of
    the peaks is not required to repeat between the window halves: a chaotic attractor's
    100-s windows differ in range by 3–25 % (docs/settling.md).
 
-``settled`` is True only for cases 1 and 2. ``attractor`` names what the signal shows:
-``equilibrium`` (at rest), ``periodic``, ``decaying``, ``stationary`` or ``unsettled``.
+``settled`` is True only for cases 1 and 2. ``signal`` names what the signal shows
+(:data:`SIGNALS`): ``at-rest``, ``periodic``, ``decaying``, ``stationary`` or ``drifting``.
 """
 
 from __future__ import annotations
@@ -37,15 +39,16 @@ import math
 
 import numpy as np
 
+from .outcome import is_stick_slip, outcome_code
 from .peaks import Peaks
 from .period import DECAY_FACTOR, MAX_MULTIPLICITY, MIN_PERIODS, SETTLE_RTOL, decay_ratio, detect_period
 from .signal import REST_AMPLITUDE, spectral_peak, stick_time
 
-__all__ = ["KINDS", "Classification", "classify_response", "classify", "kind_code",
-           "SETTLE_RTOL", "MAX_MULTIPLICITY", "MIN_PERIODS", "STATIONARY_MIN_PEAKS"]
+__all__ = ["SIGNALS", "Classification", "classify_response", "classify", "SETTLE_RTOL", "MAX_MULTIPLICITY",
+           "MIN_PERIODS", "STATIONARY_MIN_PEAKS"]
 
-#: Steady-state kinds; their index is the integer code stored in sweeps (−1: the run failed).
-KINDS = ("equilibrium", "periodic-slip", "periodic-stick-slip", "non-periodic")
+#: What the signal of a window shows (module docstring): the evidence behind its outcome.
+SIGNALS = ("at-rest", "periodic", "decaying", "stationary", "drifting")
 
 #: A slip-only, non-periodic oscillation whose last-quarter amplitude is below this fraction of
 #: the first quarter's is decaying onto the equilibrium (a settled slip limit cycle is caught as
@@ -64,14 +67,9 @@ STATIONARY_RTOL = 1e-2
 
 #: Peaks a window needs before "no period" is a finding rather than a lack of data: every
 #: multiplicity up to :data:`~stickslip.analysis.period.MAX_MULTIPLICITY` then fits
-#: :data:`~stickslip.analysis.period.MIN_PERIODS` periods plus one (a 2.5 s window with 9 peaks
-#: was called stationary, and then chaotic, because only k = 1 could be tried in it).
+#: :data:`~stickslip.analysis.period.MIN_PERIODS` periods plus one (with fewer, a short window
+#: in which only k = 1 can be tried would pass as stationary, a candidate for chaos).
 STATIONARY_MIN_PEAKS = (MIN_PERIODS + 1) * MAX_MULTIPLICITY
-
-
-def kind_code(kind: str) -> int:
-    """Integer code of a kind (index in :data:`KINDS`); −1 for ``failed``."""
-    return KINDS.index(kind) if kind in KINDS else -1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -80,8 +78,9 @@ class Classification:
 
     Parameters
     ----------
-    kind : str
-        One of :data:`KINDS`.
+    outcome : str
+        ``equilibrium``, ``periodic`` or ``unsettled`` (of :data:`~.outcome.OUTCOMES`; the signal
+        alone names no other).
     multiplicity : int
         Peaks per period of a settled periodic response; 0 otherwise.
     period_s : float
@@ -92,7 +91,7 @@ class Classification:
     fft_frequency_hz : float
         Highest peak of the Hann-windowed amplitude spectrum of x [Hz]; NaN at rest.
     stick_fraction : float
-        Fraction of the window in stick [-].
+        Fraction of the window in stick [-]: the stick character beside the outcome.
     settled : bool
         Whether the window shows the attractor itself, not a transient (module docstring).
     amplitude : float
@@ -103,9 +102,8 @@ class Classification:
         Mean rate of the peaks in the window [Hz]; NaN with fewer than two.
     t_from, t_to : float
         The window [s].
-    attractor : str
-        ``equilibrium`` (at rest), ``periodic``, ``decaying``, ``stationary`` or ``unsettled``
-        (module docstring).
+    signal : str
+        What the signal shows, one of :data:`SIGNALS` (module docstring).
     evidence : dict
         What was measured: ``multiplicity``, ``period_s``, ``spread``, ``drift``,
         ``separation`` of the settled or best return map
@@ -116,7 +114,7 @@ class Classification:
         differences).
     """
 
-    kind: str
+    outcome: str
     multiplicity: int
     period_s: float
     frequency_hz: float
@@ -127,19 +125,19 @@ class Classification:
     peaks: Peaks = dataclasses.field(repr=False)
     t_from: float
     t_to: float
-    attractor: str = "unsettled"
+    signal: str = "drifting"
     evidence: dict = dataclasses.field(default_factory=dict, repr=False)
     peak_rate_hz: float = math.nan
 
     @property
     def code(self) -> int:
-        """Integer code (:func:`kind_code`)."""
-        return kind_code(self.kind)
+        """Integer code of the outcome (:func:`~.outcome.outcome_code`)."""
+        return outcome_code(self.outcome)
 
     @property
     def is_stick_slip(self) -> bool:
         """Stick-slip oscillation (periodic or not) with stick in the window."""
-        return self.kind != "equilibrium" and self.stick_fraction > 0.0
+        return is_stick_slip(self.outcome, self.stick_fraction)
 
     def to_dict(self) -> dict:
         """Flat dict without the peak arrays."""
@@ -208,17 +206,16 @@ def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | 
                 peak_rate_hz=float(rate))
     evidence = per.evidence.to_dict()
     if amp < REST_AMPLITUDE:  # at rest: no rate of peaks either
-        return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, attractor="equilibrium",
+        return Classification("equilibrium", 0, math.nan, math.nan, math.nan, settled=True, signal="at-rest",
                               evidence=evidence, **{**base, "peak_rate_hz": math.nan})
     fft_f = spectral_peak(t, x)
     if per.periodic:
-        kind = "periodic-stick-slip" if stick_fraction > 0.0 else "periodic-slip"
-        return Classification(kind, per.multiplicity, per.period_s, 1.0 / per.period_s, fft_f, settled=True,
-                              attractor="periodic", evidence=evidence, **base)
+        return Classification("periodic", per.multiplicity, per.period_s, 1.0 / per.period_s, fft_f, settled=True,
+                              signal="periodic", evidence=evidence, **base)
     quarters = [_quarters(t, x, t0, t1)] + ([] if others is None else [_quarters(t, y, t0, t1) for y in others.T])
     evidence["amplitude_ratio"] = float(quarters[0][-1] / quarters[0][0]) if quarters[0][0] > 0 else math.nan
     if stick_fraction == 0.0 and all(_decaying(q) for q in quarters):
-        return Classification("equilibrium", 0, math.nan, math.nan, fft_f, settled=False, attractor="decaying",
+        return Classification("equilibrium", 0, math.nan, math.nan, fft_f, settled=False, signal="decaying",
                               evidence=evidence, **base)
     mid = 0.5 * (t0 + t1)
     evidence["range_change"] = range_change(pk.value[pk.time < mid], pk.value[pk.time >= mid], amp)
@@ -228,8 +225,8 @@ def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | 
     evidence["peaks"] = len(pk)
     stationary = (best.spread >= STATIONARY_MIN_SPREAD and evidence["return_decay"] <= DECAY_FACTOR
                   and not best.drift > best.spread and len(pk) >= STATIONARY_MIN_PEAKS)
-    return Classification("non-periodic", 0, math.nan, math.nan, fft_f, settled=False,
-                          attractor="stationary" if stationary else "unsettled", evidence=evidence, **base)
+    return Classification("unsettled", 0, math.nan, math.nan, fft_f, settled=False,
+                          signal="stationary" if stationary else "drifting", evidence=evidence, **base)
 
 
 def classify(traj, t_from: float | None = None, dof: str | None = None) -> Classification:

@@ -119,13 +119,14 @@ def fundamental_frequency(t, phi, dphi):
     return spectral_peak(t, phi), False, 0
 
 
-def summarize(t, states, mode, transition_times, transition_kinds, transition_contacts, n_contacts: int,
-              t_from, coordinate: int, rate: int, name: str, unilateral: bool = False,
-              impacts=None) -> SteadyState:
+def summarize(t, states, mode, transitions, t_from, *, n_contacts: int, coordinate: int, rate: int, name: str,
+              unilateral: bool = False, impacts=None) -> SteadyState:
     """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
     state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``, of a model
     with ``n_contacts`` contacts (``unilateral``: some of them open and close; ``impacts``: the
-    instants [s] and normal speeds ġ⁻ [m/s] of its rigid contacts' impacts, None without them)."""
+    instants [s] and normal speeds ġ⁻ [m/s] of its rigid contacts' impacts, None without them).
+    ``transitions`` has the run's transitions as arrays ``time``, ``kind`` and ``contact`` (a
+    :class:`stickslip.integrate.result.Transitions`)."""
     t = np.asarray(t)
     sel = t >= t_from
     if sel.sum() < 2:
@@ -136,13 +137,13 @@ def summarize(t, states, mode, transition_times, transition_kinds, transition_co
     t0, t1 = float(ts[0]), float(ts[-1])
     # mode just after t0: the sample's mode unless a transition sits exactly on t0
     mode0 = int(mode[sel][0])
-    tt = np.asarray(transition_times)
-    kinds = np.asarray(transition_kinds)
+    tt = np.asarray(transitions.time)
+    kinds = np.asarray(transitions.kind)
     window = (tt > t0) & (tt <= t1) & ((kinds == STICK) | (kinds == SLIP))
     per = detect_period(ts, phi, dphi)
     at_rest = per.amplitude < REST_AMPLITUDE
     periodic = per.periodic and not at_rest
-    contacts = np.asarray(transition_contacts)
+    contacts = np.asarray(transitions.contact)
     stick, each = stick_time(t0, t1, mode0, tt, kinds, contacts, n_contacts)
     opened, each_open = open_time(t0, t1, mode0, tt, kinds, contacts, n_contacts) if unilateral else (None, ())
     return SteadyState(

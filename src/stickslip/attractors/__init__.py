@@ -11,8 +11,8 @@
 from .confirm import confirm_period, lyapunov_sign, span_change
 from .settle import DEFAULT_CAP_S, DEFAULT_STEP_S, DEFAULT_T_MIN_S, DEFAULT_WINDOW_S, SettledRun, simulate_until_settled
 from .summary import run_summary
-from .verdict import ATTRACTORS, Attractor, attractor, attractor_code, jsonable, undersampled
+from .verdict import Attractor, attractor, jsonable, stopped_outcome, undersampled
 
-__all__ = ["ATTRACTORS", "Attractor", "attractor", "attractor_code", "jsonable", "undersampled", "SettledRun",
+__all__ = ["Attractor", "attractor", "stopped_outcome", "jsonable", "undersampled", "SettledRun",
            "simulate_until_settled", "run_summary", "confirm_period", "lyapunov_sign", "span_change",
            "DEFAULT_CAP_S", "DEFAULT_STEP_S", "DEFAULT_T_MIN_S", "DEFAULT_WINDOW_S"]

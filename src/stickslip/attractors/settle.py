@@ -58,7 +58,7 @@ class SettledRun:
         return run_summary(self.trajectory, self.attractor)
 
 
-def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: float = DEFAULT_T_MIN_S,
+def simulate_until_settled(model=None, *, cap: float = DEFAULT_CAP_S, t_min: float = DEFAULT_T_MIN_S,
                            window: float = DEFAULT_WINDOW_S, step: float = DEFAULT_STEP_S, dof: str | None = None,
                            keep: str = "all", confirm: bool = True, lyapunov: bool = True, t0: float = 0.0,
                            **simulate_options) -> SettledRun:
@@ -66,8 +66,8 @@ def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: fl
 
     Parameters
     ----------
-    params : FrictionModel, Parameters or str, optional
-        The model, as the first argument of :func:`stickslip.simulate`.
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it.
     cap : float
         Longest run [s] (measured from ``t0``).
     t_min : float
@@ -86,7 +86,7 @@ def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: fl
     t0 : float
         Initial time [s].
     **simulate_options
-        ``model``, ``ic``, ``perturbation``, ``method``, ``rtol``, ``atol``, ``dt``,
+        ``ic``, ``perturbation``, ``method``, ``rtol``, ``atol``, ``dt``,
         ``sample_rate``, ``max_steps``, ``slip_band`` of :func:`stickslip.simulate`.
 
     Returns
@@ -106,7 +106,7 @@ def simulate_until_settled(params=None, *, cap: float = DEFAULT_CAP_S, t_min: fl
                               "give cap, t_min, window and step instead of t_end and steady_from")
     t0 = float(t0)
     end = t0 + min(t_min, cap)
-    traj = simulate(params, end, t0=t0, **simulate_options)
+    traj = simulate(model, end, t0=t0, **simulate_options)
     if keep == "all":  # the extensions keep every sample up to the cap: refused now if they would not fit
         check_samples(traj.system, cap, traj.options["sample_rate"], run="the run up to the cap (cap, --cap)")
     simulate_options.pop("ic", None)

@@ -1,6 +1,7 @@
 """What a run settles to: the verdict on a trajectory's window, from the evidence.
 
-:func:`attractor` gives
+:func:`attractor` names it in the one vocabulary of outcomes
+(:data:`~stickslip.analysis.outcome.OUTCOMES`):
 
 =================  ======================================================================
 ``equilibrium``    at rest, or a slip-only oscillation decaying in every free coordinate
@@ -14,12 +15,17 @@
 ``quasiperiodic``  stationary, not periodic, largest exponent zero for both, and the
                    crossings unchanged over 1000 s (:func:`.confirm.span_change`)
 ``unbounded``      the state became non-finite
-``unsettled``      anything else: a transient, an unconfirmed claim, a failed run, or samples
-                   too sparse to resolve the motion (:func:`undersampled`)
+``contact-lost``   the run stopped where a pressed contact's normal force reached 0
+``failed``         the run stopped otherwise before its end (step size underflow, step cap,
+                   no consistent contact force)
+``unsettled``      anything else: a transient, an unconfirmed claim, a run cut short (Ctrl-C),
+                   or samples too sparse to resolve the motion (:func:`undersampled`)
 =================  ======================================================================
 
-``settled`` is True for every verdict but ``unsettled``. The evidence (spreads, drifts,
-shooting and Lyapunov results, the reason a claim was not made) comes with the verdict.
+``settled`` is True for every verdict but ``unsettled`` and ``failed``. Whether the motion
+sticks is the window's stick fraction beside the verdict (:attr:`Attractor.is_stick_slip`).
+The evidence (spreads, drifts, shooting and Lyapunov results, the reason a claim was not made)
+comes with the verdict.
 """
 
 from __future__ import annotations
@@ -30,19 +36,22 @@ import math
 import numpy as np
 
 from ..analysis.classify import STATIONARY_MIN_PEAKS, STATIONARY_RTOL, Classification, classify
+from ..analysis.outcome import is_stick_slip, outcome_code
 from ..errors import StickSlipError
+from ..integrate.status import Status
 from ..stability import stability
 from .confirm import (LYAPUNOV_START_S, ORBIT_PERIODS, QUASI_RATE, QUASI_SPAN_S, confirm_period, lyapunov_sign,
                       span_change)
 
-__all__ = ["ATTRACTORS", "Attractor", "attractor", "attractor_code", "jsonable", "undersampled"]
+__all__ = ["Attractor", "attractor", "stopped_outcome", "jsonable", "undersampled"]
 
-#: Verdicts; their index is the integer code stored in sweeps (−1: the run failed).
-ATTRACTORS = ("equilibrium", "periodic", "quasiperiodic", "chaotic", "unbounded", "unsettled")
 
-def attractor_code(name: str) -> int:
-    """Integer code of a verdict (index in :data:`ATTRACTORS`)."""
-    return ATTRACTORS.index(name)
+def stopped_outcome(status: Status) -> str:
+    """The outcome of a run that ended with ``status`` before its end time: ``unbounded``
+    (non-finite state), ``contact-lost``, ``unsettled`` (interrupted: only cut short) or
+    ``failed``."""
+    return {Status.NOT_FINITE: "unbounded", Status.CONTACT_LOST: "contact-lost",
+            Status.INTERRUPTED: "unsettled"}.get(Status(status), "failed")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -52,9 +61,10 @@ class Attractor:
     Parameters
     ----------
     attractor : str
-        One of :data:`ATTRACTORS`.
+        The outcome, one of :data:`~stickslip.analysis.outcome.OUTCOMES`.
     settled : bool
-        Whether the evidence shows the attractor itself (every verdict but ``unsettled``).
+        Whether the evidence shows what the run settles to (every verdict but ``unsettled`` and
+        ``failed``).
     period_count : int or None
         Maxima of the coordinate per period of a settled periodic orbit; None otherwise.
     period_s : float
@@ -91,17 +101,18 @@ class Attractor:
 
     @property
     def code(self) -> int:
-        """Integer code (:func:`attractor_code`)."""
-        return attractor_code(self.attractor)
+        """Integer code of the outcome (:func:`~stickslip.analysis.outcome.outcome_code`)."""
+        return outcome_code(self.attractor)
 
     @property
-    def kind(self) -> str:
-        """The steady-state kind (:data:`~stickslip.analysis.classify.KINDS`) that this verdict implies."""
-        if self.attractor == "equilibrium":
-            return "equilibrium"
-        if self.attractor == "periodic":
-            return "periodic-stick-slip" if self.classification.stick_fraction > 0.0 else "periodic-slip"
-        return "non-periodic"
+    def stick_fraction(self) -> float:
+        """Fraction of the window in stick [-] (NaN when the run stopped early)."""
+        return self.classification.stick_fraction if self.classification is not None else math.nan
+
+    @property
+    def is_stick_slip(self) -> bool:
+        """Whether the run is a stick-slip oscillation (it moves and sticks in its window)."""
+        return is_stick_slip(self.attractor, self.stick_fraction)
 
     def to_dict(self) -> dict:
         """JSON-ready dict of the verdict (without the classification)."""
@@ -157,9 +168,10 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
     cache = {} if cache is None else cache
     end = float(traj.t[-1])
     if traj.status != "success":
-        name = "unbounded" if traj.status.startswith("state became non-finite") else "unsettled"
-        return Attractor(name, name == "unbounded", None, math.nan, None, None, end if name == "unbounded" else None,
-                         None, {"reason": f"the run stopped early: {traj.status}"})
+        name = stopped_outcome(traj.status_code)
+        settled = name not in ("unsettled", "failed")
+        return Attractor(name, settled, None, math.nan, None, None, end if settled else None, None,
+                         {"reason": f"the run stopped early: {traj.status}"})
     c = classify(traj, t_from, dof)
     evidence = dict(c.evidence)
     dominant = _finite(c.fft_frequency_hz)
@@ -173,16 +185,16 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
 
     if sparse:
         return verdict("unsettled", reason=sparse)
-    if c.attractor in ("equilibrium", "decaying"):
+    if c.signal in ("at-rest", "decaying"):
         if "stability" not in cache:
             cache["stability"] = _equilibrium_stability(traj)
         stab = cache["stability"]
         if stab.get("stable"):
             return verdict("equilibrium", stability=stab)
-        seen = "at rest" if c.attractor == "equilibrium" else "a slip-only oscillation decays"
+        seen = "at rest" if c.signal == "at-rest" else "a slip-only oscillation decays"
         why = stab.get("reason") or f"steady sliding is linearly unstable (max Re λ = {stab['max_real_part']:.3g} 1/s)"
         return verdict("unsettled", stability=stab, reason=f"{seen}, but {why}")
-    if c.attractor == "periodic":
+    if c.signal == "periodic":
         k, period = c.multiplicity, c.period_s
         if k == 1:
             return verdict("periodic", 1, period)
@@ -197,7 +209,7 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
                            confirmed_by=f"the shot orbit and its own run of {ORBIT_PERIODS} periods "
                                         f"({ORBIT_PERIODS * shot['period_s']:.4g} s) past the run")
         return verdict("unsettled", shooting=shot, reason=f"period of {k} maxima not confirmed: {shot['reason']}")
-    if c.attractor == "stationary":
+    if c.signal == "stationary":
         if not lyapunov:
             return verdict("unsettled", reason="stationary but not periodic; no Lyapunov exponent computed")
         if "lyapunov" not in cache:

@@ -14,7 +14,7 @@ stability, the linear flow), :mod:`.cycles` (phase-independent features and matc
 """
 
 from ..errors import BasinError
-from .early import DECIDED, OUTCOMES, Options
+from .early import DECIDED, Options
 from .engine import basin_stability, load_result
 from .result import BasinResult
 from .spec import parse_param
@@ -22,4 +22,4 @@ from .states import StateSpec, box, from_csv, grid, parse_range
 from .store import load_basins
 
 __all__ = ["basin_stability", "load_result", "load_basins", "BasinResult", "BasinError", "StateSpec", "box", "grid",
-           "from_csv", "parse_range", "parse_param", "Options", "OUTCOMES", "DECIDED"]
+           "from_csv", "parse_range", "parse_param", "Options", "DECIDED"]

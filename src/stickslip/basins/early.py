@@ -35,21 +35,18 @@ import time
 
 import numpy as np
 
+from ..analysis.outcome import OUTCOMES, outcome_code
 from ..analysis.peaks import Peaks
 from ..analysis.period import MIN_PERIODS, return_map
-from ..attractors import attractor
+from ..attractors import attractor, stopped_outcome
 from ..integrate.result import Stats, Trajectory, Transitions
 from ..integrate.runner import Chunk, EventStepper, Record, StopCondition, run_chunks
-from ..integrate.status import CHUNK_END, CONTACT_LOST, NOT_FINITE, SUCCESS
+from ..integrate.status import CHUNK_END, SUCCESS
 from .context import Context
 from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
 
-__all__ = ["Options", "Outcome", "classify_state", "EarlyStop", "OUTCOMES", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
+__all__ = ["Options", "Outcome", "classify_state", "EarlyStop", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
            "RULE_PERIODS", "row_width", "DEFAULT_MAX_STEPS"]
-
-#: Verdicts of one state: the attractor verdicts (:data:`stickslip.attractors.ATTRACTORS`),
-#: then a run that lost a contact, and one the integrator could not finish.
-OUTCOMES = ("equilibrium", "periodic", "quasiperiodic", "chaotic", "unbounded", "unsettled", "contact-lost", "failed")
 
 #: How the verdict was reached (``matched-at-end``: set when the study is assembled, for a run
 #: unsettled at t_end whose last crossings recur on a cycle found from another state).
@@ -117,7 +114,7 @@ class Outcome:
     Attributes
     ----------
     verdict : str
-        One of :data:`OUTCOMES`.
+        The outcome, one of :data:`~stickslip.analysis.outcome.OUTCOMES`.
     decided_by : str
         One of :data:`DECIDED`.
     t_decided : float
@@ -148,7 +145,7 @@ class Outcome:
         n2 = self.state.size
         row = np.full(row_width(n2 // 2), np.nan)
         c = self.cycle
-        row[:len(_HEAD)] = (OUTCOMES.index(self.verdict), DECIDED.index(self.decided_by), self.t_decided,
+        row[:len(_HEAD)] = (outcome_code(self.verdict), DECIDED.index(self.decided_by), self.t_decided,
                             math.nan if c is None else c.period, 0 if c is None else c.multiplicity,
                             math.nan if c is None else c.amplitude, math.nan if c is None else c.stick_fraction,
                             math.nan if c is None or c.open_fraction is None else c.open_fraction,
@@ -280,8 +277,7 @@ class EarlyStop(StopCondition):
                            time.perf_counter() - self.start)
 
         if chunk.status not in (CHUNK_END, SUCCESS):
-            return outcome({NOT_FINITE: "unbounded", CONTACT_LOST: "contact-lost"}.get(chunk.status, "failed"),
-                           "stopped")
+            return outcome(stopped_outcome(chunk.status), "stopped")
         # 1. steady sliding reached: the last m samples against the linear flow
         a, b = target - m - window_first, target - window_first
         if ctx.stable and a >= 0 and b < tw.size:

@@ -23,9 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from .._version import __version__
+from ..analysis.outcome import OUTCOMES, outcome_code, outcome_flags
 from ..attractors import jsonable
 from .cycles import find_cycle, run_matches
-from .early import DECIDED, OUTCOMES, Outcome
+from .early import DECIDED, Outcome
 from .spec import BasinSpec
 from .store import FORMAT
 
@@ -92,86 +93,104 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
     """
     import xarray as xr
 
-    P, N, n = spec.n_params, spec.n_states, spec.n_dofs
-    per_param = [[] for _ in range(P)]
+    N = spec.n_states
+    per_param = [[] for _ in range(spec.n_params)]
     for flat, row in sorted(zip(indices.tolist(), rows), key=lambda x: x[0]):
-        per_param[flat // N].append((flat % N, Outcome.from_row(row, n)))
+        per_param[flat // N].append((flat % N, Outcome.from_row(row, spec.n_dofs)))
     labelled = [_label_one(spec, outs) for outs in per_param]
     n_cycles = max((len(refs) for _, _, refs in labelled), default=0)
     present = {v for labels, _, _ in labelled for v in labels.values()}
     names = (["equilibrium"] if "equilibrium" in present else []) + [cycle_name(r) for r in range(n_cycles)]
     names += [v for v in OUTCOMES[2:] if v in present]
-    L, code = len(names), {name: i for i, name in enumerate(names)}
+    arrays = _tables(spec, models, per_param, labelled, names)
+    coords = {"state": ("state", np.arange(N)), "attractor": ("attractor", np.array(names, dtype=object)),
+              "state_name": ("state_name", np.array(spec.state_names, dtype=object))}
+    if spec.param:
+        coords["param"] = ("param", np.array(spec.values), {"long_name": spec.param, "path": spec.param})
+    done = arrays["label"] >= 0
+    return xr.Dataset(_variables(spec, models, initial, arrays, names), coords=coords,
+                      attrs={**_attributes(spec, done), **(attrs or {})})
 
-    label = np.full((P, N), -1, dtype=np.int16)
-    verdict = np.full((P, N), -1, dtype=np.int8)
-    decided = np.full((P, N), -1, dtype=np.int8)
-    t_decided = np.full((P, N), np.nan)
-    steps = np.full((P, N), -1, dtype=np.int64)
-    wall = np.full((P, N), np.nan)
-    table = {key: np.full((P, L), np.nan) for key in ("period", "amplitude", "stick_fraction", "open_fraction")}
-    multiplicity = np.zeros((P, L), dtype=np.int16)
-    count = np.zeros((P, L), dtype=np.int64)
-    rep = np.full((P, L, 2 * n), np.nan)
+
+def _tables(spec: BasinSpec, models: list[dict], per_param: list, labelled: list, names: list[str]) -> dict:
+    """Per state (P, N): ``label``, ``verdict``, ``decided``, ``t_decided``, ``steps``, ``wall``; per
+    attractor (P, L): ``count``, ``multiplicity``, ``period``, ``amplitude``, ``stick_fraction``,
+    ``open_fraction`` and ``rep`` (P, L, 2n), the states on the attractors."""
+    P, N, n, L = spec.n_params, spec.n_states, spec.n_dofs, len(names)
+    code = {name: i for i, name in enumerate(names)}
+    out = dict(label=np.full((P, N), -1, dtype=np.int16), verdict=np.full((P, N), -1, dtype=np.int8),
+               decided=np.full((P, N), -1, dtype=np.int8), t_decided=np.full((P, N), np.nan),
+               steps=np.full((P, N), -1, dtype=np.int64), wall=np.full((P, N), np.nan),
+               multiplicity=np.zeros((P, L), dtype=np.int16), count=np.zeros((P, L), dtype=np.int64),
+               rep=np.full((P, L, 2 * n), np.nan),
+               **{key: np.full((P, L), np.nan) for key in ("period", "amplitude", "stick_fraction", "open_fraction")})
+    label, rep = out["label"], out["rep"]
     for p, ((labels, dec, refs), outs) in enumerate(zip(labelled, per_param)):
         for i, o in outs:
             label[p, i] = code[labels[i]]
-            verdict[p, i] = OUTCOMES.index(o.verdict)
-            decided[p, i] = DECIDED.index(dec[i])
-            t_decided[p, i], steps[p, i], wall[p, i] = o.t_decided, o.steps, o.wall_time
+            out["verdict"][p, i] = outcome_code(o.verdict)
+            out["decided"][p, i] = DECIDED.index(dec[i])
+            out["t_decided"][p, i], out["steps"][p, i], out["wall"][p, i] = o.t_decided, o.steps, o.wall_time
             if not np.isfinite(rep[p, label[p, i], 0]):
                 rep[p, label[p, i]] = o.state  # the first state of each label, for verdicts without a cycle
-        count[p] = np.bincount(label[p][label[p] >= 0], minlength=L)
+        out["count"][p] = np.bincount(label[p][label[p] >= 0], minlength=L)
         for r, c in enumerate(refs):
             a = code[cycle_name(r)]
-            table["period"][p, a], table["amplitude"][p, a], table["stick_fraction"][p, a] = \
+            out["period"][p, a], out["amplitude"][p, a], out["stick_fraction"][p, a] = \
                 c.period, c.amplitude, c.stick_fraction
-            table["open_fraction"][p, a] = np.nan if c.open_fraction is None else c.open_fraction
-            multiplicity[p, a] = c.multiplicity
+            out["open_fraction"][p, a] = np.nan if c.open_fraction is None else c.open_fraction
+            out["multiplicity"][p, a] = c.multiplicity
             rep[p, a] = c.state
         eq = models[p]["equilibrium"]
         if "equilibrium" in code and eq is not None:
             a = code["equilibrium"]
-            table["amplitude"][p, a], table["stick_fraction"][p, a], table["open_fraction"][p, a] = 0.0, 0.0, 0.0
+            out["amplitude"][p, a], out["stick_fraction"][p, a], out["open_fraction"][p, a] = 0.0, 0.0, 0.0
             rep[p, a] = eq
-    done = label >= 0
+    return out
+
+
+def _variables(spec: BasinSpec, models: list[dict], initial: np.ndarray, arrays: dict, names: list[str]) -> dict:
+    """The dataset's variables from :func:`_tables` (the ``param`` dimension only when a parameter is varied)."""
+    n = spec.n_dofs
+    done = arrays["label"] >= 0
     n_done = done.sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fraction = count / n_done[:, None]
+        fraction = arrays["count"] / n_done[:, None]
         se = np.sqrt(fraction * (1.0 - fraction) / n_done[:, None])
-
     lead = ("param",) if spec.param else ()
 
     def v(array, dims, a):
         return (lead + dims, array if spec.param else array[0], a)
 
-    flags = dict(flag_values=np.arange(L, dtype=np.int16), flag_meanings=" ".join(names))
+    flags = dict(flag_values=np.arange(len(names), dtype=np.int16), flag_meanings=" ".join(names))
     eq_states = np.array([m["equilibrium"] if m["equilibrium"] is not None else np.full(2 * n, np.nan)
                           for m in models])
     data = {
-        "label": v(label, ("state",), {"long_name": "attractor reached from each initial state (-1: not classified)",
-                                        **flags}),
-        "verdict": v(verdict, ("state",), {"long_name": "verdict of each state's run (-1: not classified)",
-                                            "flag_values": np.arange(len(OUTCOMES), dtype=np.int8),
-                                            "flag_meanings": " ".join(OUTCOMES)}),
-        "decided_by": v(decided, ("state",), {"long_name": "how the verdict was reached (-1: not classified)",
-                                               "flag_values": np.arange(len(DECIDED), dtype=np.int8),
-                                               "flag_meanings": " ".join(DECIDED)}),
-        "t_decided": v(t_decided, ("state",), {"units": "s", "long_name": "simulated time at which the verdict was reached"}),
-        "steps": v(steps, ("state",), {"long_name": "integration steps of the state's run"}),
-        "wall_time": v(wall, ("state",), {"units": "s", "long_name": "wall time of the state's run (machine-dependent)"}),
+        "label": v(arrays["label"], ("state",),
+                   {"long_name": "attractor reached from each initial state (-1: not classified)", **flags}),
+        "verdict": v(arrays["verdict"], ("state",), {"long_name": "outcome of each state's run (-1: not classified)",
+                                                     **outcome_flags()}),
+        "decided_by": v(arrays["decided"], ("state",), {"long_name": "how the verdict was reached (-1: not classified)",
+                                                        "flag_values": np.arange(len(DECIDED), dtype=np.int8),
+                                                        "flag_meanings": " ".join(DECIDED)}),
+        "t_decided": v(arrays["t_decided"], ("state",),
+                       {"units": "s", "long_name": "simulated time at which the verdict was reached"}),
+        "steps": v(arrays["steps"], ("state",), {"long_name": "integration steps of the state's run"}),
+        "wall_time": v(arrays["wall"], ("state",),
+                       {"units": "s", "long_name": "wall time of the state's run (machine-dependent)"}),
         "initial_state": v(initial, ("state", "state_name"), {"long_name": "initial state"}),
         "done": v(done.astype(np.int8), ("state",), {"long_name": "state classified (1) or pending (0)"}),
-        "count": v(count, ("attractor",), {"long_name": "states that reach the attractor"}),
+        "count": v(arrays["count"], ("attractor",), {"long_name": "states that reach the attractor"}),
         "fraction": v(fraction, ("attractor",), {"long_name": "basin stability: fraction of the classified states"}),
         "standard_error": v(se, ("attractor",), {"long_name": "standard error sqrt(p (1 - p) / n) of the fraction"}),
-        "period": v(table["period"], ("attractor",), {"units": "s", "long_name": "period of a cycle"}),
-        "frequency": v(1.0 / table["period"], ("attractor",), {"units": "Hz", "long_name": "1 / period of a cycle"}),
-        "amplitude": v(table["amplitude"], ("attractor",),
+        "period": v(arrays["period"], ("attractor",), {"units": "s", "long_name": "period of a cycle"}),
+        "frequency": v(1.0 / arrays["period"], ("attractor",), {"units": "Hz", "long_name": "1 / period of a cycle"}),
+        "amplitude": v(arrays["amplitude"], ("attractor",),
                        {"long_name": "peak-to-peak amplitude of the observed coordinate on the attractor"}),
-        "multiplicity": v(multiplicity, ("attractor",), {"long_name": "maxima of the observed coordinate per period"}),
-        "stick_fraction": v(table["stick_fraction"], ("attractor",), {"long_name": "fraction of a period in stick"}),
-        "representative_state": v(rep, ("attractor", "state_name"),
+        "multiplicity": v(arrays["multiplicity"], ("attractor",),
+                          {"long_name": "maxima of the observed coordinate per period"}),
+        "stick_fraction": v(arrays["stick_fraction"], ("attractor",), {"long_name": "fraction of a period in stick"}),
+        "representative_state": v(arrays["rep"], ("attractor", "state_name"),
                                   {"long_name": "a state on the attractor (for verdicts without one: the final "
                                                 "state of the first run given that label)"}),
         "steady_sliding": v(eq_states, ("state_name",), {"long_name": "steady-sliding state (q_e, 0)"}),
@@ -183,26 +202,25 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
                                    {"units": "s", "long_name": "T_c: chunks and samples are sized by it"}),
     }
     if any(m.get("unilateral") for m in models):
-        data["open_fraction"] = v(table["open_fraction"], ("attractor",),
+        data["open_fraction"] = v(arrays["open_fraction"], ("attractor",),
                                   {"long_name": "fraction of a period with some contact open"})
-    coords = {"state": ("state", np.arange(N)), "attractor": ("attractor", np.array(names, dtype=object)),
-              "state_name": ("state_name", np.array(spec.state_names, dtype=object))}
-    if spec.param:
-        coords["param"] = ("param", np.array(spec.values), {"long_name": spec.param, "path": spec.param})
+    return data
+
+
+def _attributes(spec: BasinSpec, done: np.ndarray) -> dict:
+    """The dataset's attributes: format, model, spec and digest, the states' sampler, the options."""
     st = spec.states
     model_desc = json.loads(spec.model_key)
-    out_attrs = {
+    return {
         "format": FORMAT, "stickslip_version": __version__,
         "title": f"stickslip basin stability of model {model_desc.get('name')}",
         "model": model_desc.get("name", ""), "model_description": spec.model_key, "spec": spec.to_json(),
         "digest": spec.digest, "param": spec.param or "", "sampler": st.kind,
         "box": json.dumps({name: [lo, hi] for name, lo, hi in zip(st.names, st.lows, st.highs)}),
         "grid_counts": json.dumps(list(st.counts)), "seed": st.seed, "base": st.base, "ics_file": st.source,
-        "n_states": N, "states_done": int(done.sum()), "complete": int(done.all()),
+        "n_states": spec.n_states, "states_done": int(done.sum()), "complete": int(done.all()),
         **{k: (int(val) if isinstance(val, bool) else val) for k, val in dataclasses.asdict(spec.options).items()},
     }
-    out_attrs.update(attrs or {})
-    return xr.Dataset(data, coords=coords, attrs=out_attrs)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -176,7 +176,17 @@ def parse_range(text: str, option: str = "--box") -> tuple[str, float, float]:
         lo, hi = float(parts[0]), float(parts[1])
     except ValueError:
         raise BasinError(f"{option} {text}: LO and HI must be numbers; e.g. {example}") from None
+    _check_bounds(option, name, lo, hi, text.strip())
     return name, lo, hi
+
+
+def _check_bounds(option: str, name: str, lo: float, hi: float, given: str) -> None:
+    """Refuse bounds that are not finite or not ordered, quoting them as ``given`` (as the user wrote them)."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise BasinError(f"{option} {given}: LO and HI must be finite numbers")
+    if lo >= hi:
+        raise BasinError(f"{option} {given}: LO must be < HI; e.g. {option} {name}={min(lo, hi) - 1:g}:"
+                         f"{max(lo, hi) + 1:g}")
 
 
 def _check_state(model, name: str, option: str) -> None:
@@ -199,19 +209,15 @@ def _box(model, ranges: Mapping[str, Sequence[float]] | Sequence, option: str = 
     for item in items:
         if len(item) != 3:
             raise BasinError(f"{option}: give each range as NAME=LO:HI (name, low, high), got {item!r}")
-        name, lo, hi = str(item[0]), item[1], item[2]
+        name, given_lo, given_hi = str(item[0]), item[1], item[2]
         _check_state(model, name, option)
         if name in names:
             raise BasinError(f"{option} {name} is given twice; give each state once")
         try:
-            lo, hi = float(lo), float(hi)
+            lo, hi = float(given_lo), float(given_hi)
         except (TypeError, ValueError):
-            raise BasinError(f"{option} {name}={lo}:{hi}: LO and HI must be numbers") from None
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            raise BasinError(f"{option} {name}={lo:g}:{hi:g}: LO and HI must be finite numbers")
-        if lo >= hi:
-            raise BasinError(f"{option} {name}={lo:g}:{hi:g}: LO must be < HI; e.g. {option} {name}={min(lo, hi) - 1:g}:"
-                             f"{max(lo, hi) + 1:g}")
+            raise BasinError(f"{option} {name}={given_lo}:{given_hi}: LO and HI must be numbers") from None
+        _check_bounds(option, name, lo, hi, f"{name}={given_lo}:{given_hi}")
         names.append(name)
         lows.append(lo)
         highs.append(hi)

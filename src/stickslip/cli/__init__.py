@@ -25,6 +25,8 @@ from . import orbit  # noqa: E402,F401  (registers `stickslip orbit`, `lyapunov`
 from . import basins  # noqa: E402,F401  (registers `stickslip basins`)
 from . import models  # noqa: E402,F401  (registers `stickslip models`)
 from . import warmup  # noqa: E402,F401  (registers `stickslip warmup`)
+from . import reduce  # noqa: E402,F401  (registers `stickslip reduce`)
+from . import mode_coupling  # noqa: E402,F401  (registers `stickslip mode-coupling`)
 
 _startup.release()  # a Ctrl-C held during these imports is raised here, reported in one line
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 import errno
 import math
 import os
-import re
 import sys
 import warnings
 from pathlib import Path
@@ -38,10 +37,12 @@ from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
 from ..files import lock, refuse_output
+from ..inputs import read_regular_file
 from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
 from ..model.library import load_model, plates_variant, two_plates
 from ..model.library.two_plates import is_plates
 from ..model.parameters import Parameters
+from ..parallel import compile_processes
 from ._compiling import compile_notice
 from ._kept import forget_outputs, on_disk, on_interrupt
 
@@ -68,30 +69,20 @@ class CLIError(StickSlipError, ValueError):
     must not be replaced. The message names the option and the fix."""
 
 
-#: A run of this many digits or more in a message is a number typed or computed beyond any
-#: meaning (a 300-digit --n); it is shown with 3 significant digits. Paths keep theirs.
-_LONG_DIGITS = 16
-_LONG_NUMBER = re.compile(r"(?<![\w/.\\])(\d{%d,})(?![\w/\\]|\.\w)" % _LONG_DIGITS)
-
-
-def _short_number(match: re.Match) -> str:
-    """``1.23e+299`` for a long run of digits (not through float, which ends at 1e308)."""
-    digits = match.group(1).lstrip("0") or "0"
-    exponent = len(digits) - 1
-    mantissa = round(int(digits[:4]) / 10 ** (min(len(digits), 4) - 1), 2)
-    if mantissa >= 10:  # 9.999… rounds up to the next power of ten
-        mantissa, exponent = mantissa / 10, exponent + 1
-    return f"{mantissa:g}e+{exponent}"
-
-
-def shorten_numbers(text: str) -> str:
-    """``text`` with every number of :data:`_LONG_DIGITS` digits or more shown as ``1.23e+299``."""
-    return _LONG_NUMBER.sub(_short_number, text)
+def exact(value) -> str:
+    """A number given on the command line as the shortest text that reads back as it (``50``,
+    ``0.1``, ``1.0000001``, ``1e+300``): what a message quotes of an option's value (``:g`` would
+    round it to six digits)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def error_line(message: str) -> None:
-    """Print ``error: message`` as one line on stderr, exactly as written (long numbers shortened)."""
-    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(shorten_numbers(str(message)).split())))
+    """Print ``error: message`` as one line on stderr, exactly as written: what the user typed is
+    quoted as typed, however many digits it has."""
+    err_console.print(Text.assemble(("error:", "bold red"), " ", " ".join(str(message).split())))
 
 
 def warning_line(message: str) -> None:
@@ -266,6 +257,7 @@ def _check_environment() -> None:
         raise CLIError(f"NUMBA_DISABLE_JIT={os.environ['NUMBA_DISABLE_JIT']}: stickslip's kernels must be compiled "
                        "(interpreted, a run would take hours and some kernels cannot run at all); unset "
                        "NUMBA_DISABLE_JIT or set it to 0")
+    compile_processes()  # a setting that is not a positive integer: one line, exit 2
     for note in _startup.notes:
         warning_line(note)
 
@@ -303,6 +295,10 @@ def parse_assignments(items: list[str] | None, option: str = "--set") -> dict:
             values[name] = float(text)
         except ValueError:
             values[name] = text
+            continue
+        if not math.isfinite(values[name]) and text.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
+            raise CLIError(f"{option} {item.strip()}: {text} is beyond the range of a float (about ±1.8e308); "
+                           "give a finite number")
     return values
 
 
@@ -310,12 +306,33 @@ def parse_assignments(items: list[str] | None, option: str = "--set") -> dict:
 PARAMETER_FLAGS = {"N": "--N", "Omega": "--omega", "mu_k": "--mu-k", "delta_mu": "--delta-mu", "alpha": "--alpha"}
 
 
+#: Largest ``--config`` file read [bytes]: it holds a table of parameters.
+MAX_CONFIG_BYTES = 2**20
+
+
+def _config_table(config) -> dict:
+    """The TOML of a ``--config`` file, read bounded (a regular file of at most
+    :data:`MAX_CONFIG_BYTES`: a folder, a pipe or a device is refused before it is read)."""
+    data = read_regular_file(config, MAX_CONFIG_BYTES, "--config", CLIError,
+                             "give a TOML file with a [parameters] table")
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
+    except RecursionError:
+        raise CLIError(f"--config {config}: a value is nested too deeply to read; give a [parameters] table of "
+                       "name = number") from None
+
+
 def config_values(config) -> dict:
     """``{name: value}`` of the parameters a --config TOML file sets (validated; names it does
     not set are left out)."""
-    loaded = Parameters.load_toml(config)
-    data = tomllib.loads(Path(config).read_text())
-    return {name: getattr(loaded, name) for name in data.get("parameters", data)}
+    data = _config_table(config)
+    table = data.get("parameters", data)
+    if not isinstance(table, dict):
+        raise CLIError(f"--config {config}: [parameters] must be a table of name = value")
+    loaded = Parameters.from_dict(table)
+    return {name: getattr(loaded, name) for name in table}
 
 
 def build_system(model: str, config, assignments, *, base=None, swept: dict | None = None, **named):
@@ -367,7 +384,7 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
     assigned = parse_assignments(assignments)
     setters = {item.partition("=")[0].strip(): [f"--set {item.strip()}"] for item in assignments or []}
     for name, value in named.items():
-        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {value:g}")
+        setters.setdefault(name, []).append(f"{PARAMETER_FLAGS.get(name, '--' + name)} {exact(value)}")
     for name, sweeper in (swept or {}).items():
         setters.setdefault(name, []).insert(0, sweeper)
     for name, options in setters.items():
@@ -381,10 +398,10 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
 
 def _config_parameters(config) -> dict:
     """The ``[parameters]`` table of a ``--config`` TOML file for a model's named parameters."""
-    try:
-        return dict(tomllib.loads(Path(config).read_text()).get("parameters", {}))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise CLIError(f"--config {config} is not valid TOML ({exc}); fix the syntax") from None
+    table = _config_table(config).get("parameters", {})
+    if not isinstance(table, dict):
+        raise CLIError(f"--config {config}: [parameters] must be a table of name = value")
+    return dict(table)
 
 
 def check_nc_path(out, flag: str = "--out") -> None:
@@ -410,7 +427,7 @@ def check_below_one(flags: dict) -> None:
     """Every ``{flag: value}`` (a relative tolerance) must be < 1: at 1 or more any guess passes."""
     for flag, value in flags.items():
         if value is not None and not value < 1.0:
-            raise CLIError(f"{flag} {value:g}: a relative tolerance must be < 1 (typical values 1e-6 … 1e-10)")
+            raise CLIError(f"{flag} {exact(value)}: a relative tolerance must be < 1 (typical values 1e-6 … 1e-10)")
 
 
 def executor_of(executor: str | None, scheduler: str | None) -> str:

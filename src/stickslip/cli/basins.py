@@ -57,6 +57,7 @@ def _states(model, box, n, seed, grid, ics, base, state):
 @app.command()
 @grouped
 def basins(
+    *,  # options only (typer reads them by name)
     model: Model = "two-plates",
     set_: SetItems = None,
     box: Optional[List[str]] = typer.Option(None, "--box", help=_BOX_HELP),

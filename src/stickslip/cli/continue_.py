@@ -20,7 +20,7 @@ from ..orbits.continuation import SPECIAL_KINDS, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
 from ..plot.continuation import save_branch_figure
 from ._app import (CLIError, app, check_below_one, check_finite, check_positive, check_resumable_output, console,
-                   error_line, note_line, resumable_holds)
+                   error_line, exact, note_line, resumable_holds)
 from ._compiling import time_text, timed
 from ._groups import grouped
 from ._kept import keeps, keeps_figure
@@ -38,13 +38,13 @@ def _check(start: float, stop: float, max_points: int, step: float, max_step: fl
     tolerance unbounded, and sees --from and --to only as the bounds and direction made of them."""
     check_finite({"--from": start, "--to": stop})
     if start == stop:
-        raise CLIError(f"--from and --to are both {start:g}; give the end of the range to continue to")
+        raise CLIError(f"--from and --to are both {exact(start)}; give the end of the range to continue to")
     if max_points < 2:
         raise CLIError(f"--max-points must be >= 2, got {max_points}")
     check_positive({"--step": step, "--max-step": max_step, "--search-time": search_time, "--tol": tol})
     check_below_one({"--tol": tol})
     if step > max_step:
-        raise CLIError(f"--step {step:g} is larger than --max-step {max_step:g}")
+        raise CLIError(f"--step {exact(step)} is larger than --max-step {exact(max_step)}")
     bad = [k for k in stop_on if k not in SPECIAL_KINDS]
     if bad:
         raise CLIError(f"--stop-on {', '.join(bad)}: choose from {', '.join(SPECIAL_KINDS)}")
@@ -78,6 +78,7 @@ def _pairs(mu) -> list:
 @app.command("continue")
 @grouped
 def continue_command(
+    *,  # options only (typer reads them by name)
     param: str = typer.Option("Omega", "--param", help="Parameter to vary: any numeric parameter of the model, the "
                               "plates' N, Omega, delta_mu, alpha, mu_k, k_px, ... or a model file's path such as "
                               "contact.0.drive ('stickslip models NAME' lists them)."),

@@ -31,8 +31,8 @@ from ..integrate.status import Status
 from ..model.compile_ahead import meanwhile
 from ..model.library import load_model, plates_variant
 from ..plot.trajectory import save_trajectory_figure
-from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, given,
-                   note_line, warning_line)
+from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, exact,
+                   given, note_line, warning_line)
 from ._compiling import time_text, timed
 from ._groups import grouped
 from ._kept import keeps, on_interrupt
@@ -116,8 +116,8 @@ def _check_window(steady_from: float | None, t0: float, t_end: float, sample_rat
     """The steady-state window (default: the last half) must lie in the run and hold
     :data:`WINDOW_SAMPLES` samples."""
     if steady_from is not None and not t0 <= steady_from < t_end:
-        raise CLIError(f"--steady-from {steady_from:g} s is outside the run, which goes from {t0:g} to {t_end:g} s; "
-                       f"give a time in that range")
+        raise CLIError(f"--steady-from {exact(steady_from)} s is outside the run, which goes from {t0:g} to "
+                       f"{t_end:g} s; give a time in that range")
     start = t0 + 0.5 * (t_end - t0) if steady_from is None else steady_from
     if not (sample_rate > 0 and math.isfinite((t_end - t0) * sample_rate)):
         return  # a rate of 0 or less, or samples beyond counting: the run refuses them itself
@@ -151,8 +151,9 @@ def _check_steps(duration: float, dt: float | None, time_flag: str = "--t-end") 
     """A step of ``dt`` must cover ``duration`` within :data:`MAX_RUN_STEPS` steps (a step or a
     length that is not a finite number > 0 is the run's to refuse)."""
     if dt is not None and 0 < dt < math.inf and 0 < duration < math.inf and not duration / dt <= MAX_RUN_STEPS:
-        raise CLIError(f"--dt {dt:g} s takes at least {duration / dt:.3g} steps for {time_flag} {duration:g} s, more "
-                       f"than the {MAX_RUN_STEPS:.0e} (hours of computing) a run may take from the command line; give "
+        raise CLIError(f"--dt {exact(dt)} s takes at least {duration / dt:.3g} steps for {time_flag} "
+                       f"{exact(duration)} s, more than the {MAX_RUN_STEPS:.0e} (hours of computing) a run may take "
+                       "from the command line; give "
                        f"--dt {duration / MAX_RUN_STEPS:.3g} or more, or a shorter {time_flag}")
 
 
@@ -175,6 +176,7 @@ def _model_label(system) -> str:
 @app.command()
 @grouped
 def simulate(
+    *,  # options only (typer reads them by name)
     ctx: typer.Context,
     plates: Plates = Plates(),
     model: Model = "full",

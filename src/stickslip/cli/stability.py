@@ -14,13 +14,16 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
+from ..errors import StickSlipError
 from ..files import netcdf_writer
 from ..memory import check_memory, largest_count
 from ..plot.stability import save_stability_map_figure
 from ..stability.analysis import stability as run_stability
 from ..stability.maps import parse_family
 from ..stability.maps import stability_map as run_map
+from ..stability.sparse_input import is_sparse_model
 from ._app import CLIError, app, build_system, check_finite, check_outputs, console
+from ._band import Band, report_band
 from ._compiling import time_text, timed
 from ._groups import grouped
 from ._options import Friction, JsonSummary, MapModel, Model, ModelChanges, Outputs, Plates
@@ -34,12 +37,27 @@ def stability(
     plates: Plates = Plates(),
     model: Model = "full",
     changes: ModelChanges = ModelChanges(),
+    band: Band = Band(),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object: equilibrium, eigenvalues, max_real_part, stable."),
 ) -> None:
-    """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model."""
+    """Equilibrium of steady sliding (plates: Eq. 14) and its eigenvalues (Eq. 15), for any model; for sparse
+    (finite-element) models every eigenvalue of a band (complex eigenvalue analysis, --max-frequency)."""
     system, _ = build_system(model, changes.config, changes.set_, **plates.named())
+    sparse = band.asked or is_sparse_model(system)
+    if sparse:
+        band.check(changes.inputs)
+        if band.max_frequency is None:
+            raise CLIError(f"model {system.name!r} has {system.n} dofs: give --max-frequency, the top of the band whose "
+                           "eigenvalues are computed [rad/s]")
     with timed() as timing:
-        result = run_stability(system)
+        if sparse:
+            result = run_stability(system, max_frequency=band.max_frequency, method=band.method, cutoff=band.cutoff,
+                                   residual=not band.no_residual_vectors)
+        else:
+            result = run_stability(system)
+    if sparse:
+        report_band(result, timing, band.write(result, changes.inputs), as_json)
+        return
     if as_json:
         print(json.dumps({**result.summary(), "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s}))
         return
@@ -85,6 +103,7 @@ def _check_axis(name: str, lo: float, hi: float, n: int) -> None:
 @app.command("stability-map")
 @grouped
 def stability_map(
+    *,  # options only (typer reads them by name)
     n_min: float = typer.Option(2.0, "--N-min", help="Smallest normal load [N]."),
     n_max: float = typer.Option(200.0, "--N-max", help="Largest normal load [N]."),
     n_points: int = typer.Option(100, "--N-points", help="Number of N values."),
@@ -123,8 +142,14 @@ def stability_map(
                        "--axis contact.0.normal_force=0.5:2:31 --axis contact.0.drive=0.2:3:57")
     out, inputs = outputs.out, changes.inputs
     check_outputs(out, not outputs.no_plot, outputs.overwrite, inputs=inputs)
+    _check_axes(system, names, values, axis)
     with timed() as timing:
-        smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
+        try:
+            smap = run_map(system, values[0], values[1], family=members, boundary=not no_boundary, axes=names)
+        except ValueError as exc:
+            if isinstance(exc, StickSlipError):
+                raise
+            raise _map_error(exc, names, axis, family) from None
     figure = write_result(outputs, lambda: netcdf_writer(smap.to_xarray()), holds=f"the map is in {out}",
                           inputs=inputs, draw=lambda tmp: save_stability_map_figure(smap, tmp))
     rows = []
@@ -154,6 +179,26 @@ def stability_map(
     detail = f"grid {t['grid_s']:.2f} s, boundary {t['boundary_s']:.2f} s"
     console.print(f"wall time {time_text(timing.wall_s, timing.compile_s, detail)}; wrote {out}"
                   + ("" if figure is None else f", {figure}"))
+
+
+def _check_axes(system, names: tuple[str, str], values: list, axis: list[str] | None) -> None:
+    """Refuse, naming ``--axis``, a parameter the model lacks or a value it refuses (before the map)."""
+    for name, vals, item in zip(names, values, axis or ()):
+        try:
+            for v in vals:
+                system.replace(**{name: float(v)})
+        except StickSlipError as exc:
+            raise CLIError(f"--axis {item.strip()}: {exc}") from None
+
+
+def _map_error(exc: ValueError, names: tuple[str, str], axis: list[str] | None, family: str | None) -> CLIError:
+    """The library's refusal of the map as one line naming the option it is about (an axis value
+    without steady sliding, a family the model cannot have)."""
+    text = str(exc)
+    for name, item in zip(names, axis or ()):
+        if text.startswith(f"{name} "):
+            return CLIError(f"--axis {item.strip()}: {text}")
+    return CLIError(f"--family {family}: {text}" if family is not None else text)
 
 
 def _map_axes(axis: list[str] | None, n_range: tuple, omega_range: tuple) -> tuple[tuple[str, str], list]:

@@ -16,11 +16,10 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from ..analysis.classify import KINDS
+from ..analysis.outcome import OUTCOMES, is_stick_slip, outcome_names
 from ..memory import check_memory, largest_count
-from ..model.library import plates_variant
+from ..model.library import plates_variant, two_plates
 from ..model.library.two_plates import plates_parameters
-from ..model.parameters import Parameters
 from ..plot.regions import save_regions_figure
 from ..plot.sweep import save_bifurcation_figure, save_sweep_figure
 from ..sweep import regions as run_regions
@@ -55,8 +54,9 @@ def parse_values(name: str, text: str, *, option: str = "--grid") -> list:
         With a one-line message naming the fix.
     """
     text = text.strip()
-    given = f"{option} {name}={text}" if option == "--grid" else f"{option} {text}"
-    prefix = f"{option} {name}=" if option == "--grid" else f"{option} "
+    named = option in ("--grid", "--axis")  # options given as NAME=VALUES
+    given = f"{option} {name}={text}" if named else f"{option} {text}"
+    prefix = f"{option} {name}=" if named else f"{option} "
     example = f"{prefix}10:130:13 or {prefix}30,50,70"
     if not text:
         raise CLIError(f"{given} has no values; e.g. {example}")
@@ -118,15 +118,6 @@ def _settle_options(settling: Settling) -> dict:
     return {"settle": True, "cap": settling.cap}
 
 
-def _sweep_target(system) -> tuple:
-    """(params, model) for the sweep library: the plates' Parameters and variant, or the model itself."""
-    if system.name != "two-plates":
-        return system, None
-    values = dict(system.parameters)
-    variant = values.pop("variant", "full")
-    return Parameters.from_dict(values), variant
-
-
 def _plot_columns(system) -> tuple[str, ...]:
     """The reductions a sweep of ``system`` keeps (those ``--plot`` may draw)."""
     return tuple(c[0] for c in columns_of(system))
@@ -181,11 +172,12 @@ def _study(study: Study, what: str, inputs: dict, compute: Callable[[], object],
     return result, figure, timing
 
 
-def _kind_counts(ds) -> dict:
-    code = ds["kind"].values
-    code = np.where(np.isfinite(code), code, -1).astype(int)
-    names = list(KINDS) + ["failed"]
-    return {names[c]: int(np.sum(code == c)) for c in (-1, 0, 1, 2, 3) if np.any(code == c)}
+def _outcome_counts(ds) -> dict:
+    """Points per outcome (:data:`~stickslip.analysis.outcome.OUTCOMES`, in their order), and how many
+    of them are stick-slip oscillations."""
+    names = outcome_names(ds["attractor"].values)
+    counts = {name: int(np.sum(names == name)) for name in OUTCOMES if np.any(names == name)}
+    return {**counts, "stick-slip": int(np.sum(is_stick_slip(names, ds["stick_fraction"].values)))}
 
 
 def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as_json: bool,
@@ -194,7 +186,8 @@ def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as
         "out": str(out), "figure": None if figure is None else str(figure),
         "shape": {d: int(ds.sizes[d]) for d in ds["done"].dims},
         "points_computed": int(timings.get("points_computed", 0)), "points_resumed": int(timings.get("points_resumed", 0)),
-        "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s, "kinds": _kind_counts(ds), **(extra or {}),
+        "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s, "outcomes": _outcome_counts(ds),
+        **(extra or {}),
     }
     if as_json:
         print(json.dumps(summary))
@@ -205,7 +198,7 @@ def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as
     executor = timings.get("executor", "?")
     workers = "1 process" if executor == "serial" else f"{timings.get('workers', '?')} workers"
     table.add_row("wall time", time_text(timing.wall_s, timing.compile_s, f"{executor}, {workers}"))
-    table.add_row("steady states", ", ".join(f"{k} {v}" for k, v in summary["kinds"].items()))
+    table.add_row("outcomes", ", ".join(f"{k} {v}" for k, v in summary["outcomes"].items()))
     for key, value in (extra or {}).items():
         table.add_row(key.replace("_", " "), str(value))
     table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))
@@ -216,6 +209,7 @@ def _report(title: str, out: Path, figure, timings: dict, timing: Timing, ds, as
 @app.command("sweep")
 @grouped
 def sweep_command(
+    *,  # options only (typer reads them by name)
     grid: Optional[List[str]] = typer.Option(None, "--grid", help="Swept dimension NAME=start:stop:count or NAME=v1,v2,... "
                                              "(repeatable; order = dimension order). NAME: a parameter (plates: N, "
                                              "Omega, delta_mu, alpha, mu_k, k_px, ...; other models: a path such as "
@@ -231,7 +225,7 @@ def sweep_command(
     parallel: Parallel = Parallel(),
     out: ResumableOut = Path("sweep.nc"),
     plot_var: str = typer.Option("frequency", "--plot", help="Reduction drawn in the figure: frequency, amplitude, "
-                                                            "stick_fraction, kind, intensity_r_phi, ..."),
+                                                            "stick_fraction, attractor, intensity_r_phi, ..."),
     overwrite: Restart = False,
     no_plot: NoPlot = False,
     no_progress: NoProgress = False,
@@ -244,7 +238,6 @@ def sweep_command(
     """
     values = parse_grid(grid)
     system, _ = build_system(model, changes.config, changes.set_, swept={k: f"--grid {k}" for k in values})
-    target, variant = _sweep_target(system)
     columns = _plot_columns(system)
     if plot_var not in columns or plot_var == "peaks":
         raise CLIError(f"--plot {plot_var}: choose one of {', '.join(c for c in columns if c != 'peaks')}")
@@ -253,7 +246,7 @@ def sweep_command(
     options = _run_options(study, t_end, t_from, sample_rate, tolerances, as_json)
     options.update(_settle_options(settling))
     result, figure, timing = _study(study, "sweep", changes.inputs,
-                                    lambda: run_sweep(values, target, out=out, model=variant, ic=ic, **options),
+                                    lambda: run_sweep(values, system, out=out, ic=ic, **options),
                                     lambda result, tmp: save_sweep_figure(result, tmp, var=plot_var))
     _report(f"stickslip sweep ({result.spec.model}, ic {result.spec.ic})", out, figure, result.timings,
             timing, result.dataset, as_json)
@@ -263,6 +256,7 @@ def sweep_command(
 @app.command("bifurcation")
 @grouped
 def bifurcation(
+    *,  # options only (typer reads them by name)
     param: str = typer.Option("N", "--param", help="Control parameter: N, Omega, delta_mu, alpha, mu_k or any parameter "
                                                   "of the plates; for another model a path such as contact.0.drive."),
     range_: str = typer.Option("10:130:121", "--range", help="Its values: start:stop:count or v1,v2,..."),
@@ -295,15 +289,15 @@ def bifurcation(
         coordinate = target.dofs[target.observed_index]
         models = [None]
     else:
-        target = _bifurcation_parameters(changes.config, changes.set_, named, param)
+        target = two_plates(_bifurcation_parameters(changes.config, changes.set_, named, param),
+                            plates_variant(models[0]))
     grid = ({"model": models} if len(models) > 1 else {}) | {param: values}
     if n_peaks < 1:
         raise CLIError(f"--peaks must be >= 1, got {n_peaks}")
     options = _run_options(study, t_end, t_from, sample_rate, tolerances, as_json)
     options.update(_settle_options(settling))
     result, figure, timing = _study(study, "bifurcation diagram", changes.inputs,
-                                    lambda: run_sweep(grid, target, out=study.out, model=models[0], ic=ic,
-                                                      n_peaks=n_peaks, **options),
+                                    lambda: run_sweep(grid, target, out=study.out, ic=ic, n_peaks=n_peaks, **options),
                                     save_bifurcation_figure)
     _report(f"bifurcation diagram of {coordinate} against {param}", study.out, figure, result.timings, timing,
             result.dataset, as_json)
@@ -355,7 +349,6 @@ def regions_command(
     """
     system, _ = build_system("full", changes.config, changes.set_, swept={"N": "--N", "Omega": "--omega"},
                              **friction.named())
-    params = plates_parameters(system)
     n_values = parse_values("N", N, option="--N")
     w_values = parse_values("Omega", omega, option="--omega")
     models = parse_values("model", model, option="--model")
@@ -363,7 +356,7 @@ def regions_command(
         t_from = t_end - min(REGIONS_WINDOW_S, 0.5 * t_end)
     options = _run_options(study, t_end, t_from, sample_rate, tolerances, as_json)
     rmap, figure, timing = _study(study, "region map", changes.inputs,
-                                  lambda: run_regions(n_values, w_values, params, models=models, out=study.out,
+                                  lambda: run_regions(n_values, w_values, system, variants=models, out=study.out,
                                                       **options),
                                   save_regions_figure)
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..memory import check_memory, format_bytes, largest_count, sample_bytes
-from ..model.library import resolve_system
+from ..model.library import resolve_model
 from ..model.library.two_plates import is_plates
 from .fixed_step import run_fixed_step
 from .initial import check_rigid_start, initial_state
@@ -96,10 +96,9 @@ RUNNERS = {"event": run_event, "aeom": functools.partial(run_fixed_step, "aeom")
 
 
 def simulate(
-    system=None,
+    model=None,
     t_end: float = 100.0,
     *,
-    model=None,
     method: str = "event",
     ic="zero",
     perturbation=None,
@@ -116,14 +115,14 @@ def simulate(
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str, optional
-        The model: a :class:`FrictionModel`, a library name (``belt``, ...) or model file path, or
-        the two plates' :class:`Parameters`; default the plates with Table 1 at N = 50 N, Ω = 5 rad/s.
+    model : FrictionModel, Parameters, str, optional
+        The model: a :class:`FrictionModel` (the plates in a variant: ``two_plates(params,
+        "rotation")``, Models 1–4 being ``full``, ``x``, ``y``, ``rotation``), a library name
+        (``belt``, ...), a variant of the plates by name or a model file path, or the two plates'
+        :class:`Parameters` (all DOFs free); default the plates with Table 1 at N = 50 N,
+        Ω = 5 rad/s (:func:`stickslip.model.library.resolve_model`).
     t_end : float
         Final time [s].
-    model : str, iterable of DOF names, or FrictionModel, optional
-        The plates' variant: ``full`` (Model 1, default), ``x`` (2), ``y`` (3), ``rotation`` (4), or
-        the DOFs to free; a library name or model file here is the same as ``system``.
     method : str
         ``event`` (adaptive, exact transitions; default); ``aeom`` or ``naeom`` (the paper's fixed-step
         methods, two plates only).
@@ -163,7 +162,7 @@ def simulate(
         raise SimulationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if slip_band is not None:
         slip_band = _check_positive("slip_band", slip_band, "give a speed in m/s, e.g. 1e-6")
-    system = resolve_system(system, model, slip_band)
+    system = resolve_model(model, slip_band)
     t0 = float(t0)
     if not math.isfinite(t0):
         raise SimulationError("t0 must be finite")
@@ -191,15 +190,28 @@ def simulate(
     if out.interrupted and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
         forget_ctrl_c()  # acted on here
         raise KeyboardInterrupt
-    code, record, n_kept = out.status, out.record, out.record.n
-    if n_kept == 0:
-        raise SimulationError(f"the run ended before its first sample ({code.message(out.t_reached, out.lost)})")
-
-    ic_text = ic if isinstance(ic, str) else ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path)
-                                              else "states" if isinstance(ic, Mapping) else "explicit")
-    options = {"rtol": rtol, "atol": atol, "dt": dt, "sample_rate": sample_rate, "ic": ic_text,
+    if out.record.n == 0:
+        raise SimulationError(f"the run ended before its first sample ({out.status.message(out.t_reached, out.lost)})")
+    options = {"rtol": rtol, "atol": atol, "dt": dt, "sample_rate": sample_rate, "ic": _ic_text(ic),
                "perturbation": None if perturbation is None else np.asarray(perturbation, dtype=float).tolist(),
                "t0": t0, "t_end": t_end, "slip_band": system.slip_band}
+    return _trajectory(out, system, method, sample_times, options, steady_from, wall)
+
+
+def _ic_text(ic) -> str:
+    """How a run's options name its initial condition."""
+    if isinstance(ic, str):
+        return ic
+    return ("trajectory" if isinstance(ic, Trajectory) else str(Path(ic)) if isinstance(ic, Path)
+            else "states" if isinstance(ic, Mapping) else "explicit")
+
+
+def _trajectory(out, system, method: str, sample_times: np.ndarray, options: dict, steady_from: float | None,
+                wall: float) -> Trajectory:
+    """The :class:`Trajectory` of a runner's output ``out`` (its samples up to the time reached;
+    ``steady_from`` default: the last half of them)."""
+    code, record, n_kept = out.status, out.record, out.record.n
+    t0 = options["t0"]
     t_samples = sample_times[:n_kept]  # the samples up to the time reached: a prefix, so views
     if steady_from is None:
         steady_from = t0 + 0.5 * (t_samples[-1] - t0)

@@ -364,9 +364,8 @@ class Trajectory(Plottable):
     def steady_state(self, t_from: float) -> SteadyState:
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
-        tr = self.transitions
         impacts = (self.impacts.time, self.impacts.speed_before) if self.system.rigid else None
-        return summarize(self.t, self.states, self.mode, tr.time, tr.kind, tr.contact, self.system.n_contacts, t_from,
+        return summarize(self.t, self.states, self.mode, self.transitions, t_from, n_contacts=self.system.n_contacts,
                          coordinate=i, rate=i + self.system.n, name=self.system.dofs[i],
                          unilateral=self.system.unilateral, impacts=impacts)
 
@@ -484,10 +483,10 @@ class Trajectory(Plottable):
         return save_netcdf(self.to_xarray(), path, overwrite=overwrite)
 
     @classmethod
-    def from_xarray(cls, ds, system: FrictionModel | None = None) -> "Trajectory":
+    def from_xarray(cls, ds, model: FrictionModel | None = None) -> "Trajectory":
         """Rebuild a trajectory from :meth:`to_xarray` output (or a format-1 plates file).
 
-        ``system`` overrides the model written in the file (needed for models defined in Python
+        ``model`` overrides the model written in the file (needed for models defined in Python
         without a rule to rebuild them).
         """
         if ds.attrs.get("format") == format_name("trajectory", 1):
@@ -495,7 +494,7 @@ class Trajectory(Plottable):
         if ds.attrs.get("format") != FORMAT:
             raise FileFormatError(f"dataset is not a stickslip trajectory (format attribute {ds.attrs.get('format')!r}, "
                                   f"expected {FORMAT!r}); give a file written by `stickslip simulate`")
-        system = system or system_from_description(json.loads(ds.attrs["system"]))
+        system = model or system_from_description(json.loads(ds.attrs["system"]))
         states = np.stack([ds[name].values for name in system.state_names], axis=1)
         nc = system.n_contacts
         code = Status(int(ds.attrs.get("status_code", 0)))
@@ -531,14 +530,14 @@ class Trajectory(Plottable):
         )
 
 
-def load_trajectory(path: str | Path, system: FrictionModel | None = None) -> Trajectory:
+def load_trajectory(path: str | Path, model: FrictionModel | None = None) -> Trajectory:
     """Read a trajectory written by :meth:`Trajectory.to_netcdf`.
 
     Parameters
     ----------
     path : str or Path
         The NetCDF file (``stickslip simulate --out``).
-    system : FrictionModel, optional
+    model : FrictionModel, optional
         The model, for runs of a model defined in Python (files and library models are rebuilt
         from the file itself).
 
@@ -553,4 +552,4 @@ def load_trajectory(path: str | Path, system: FrictionModel | None = None) -> Tr
         of a newer format.
     """
     ds = open_ours(path, "trajectory", what="a run.nc written by `stickslip simulate`", versions=READ_VERSIONS)
-    return Trajectory.from_xarray(ds, system)
+    return Trajectory.from_xarray(ds, model)

@@ -61,7 +61,7 @@ def _rhs_factory(P: Parameters, free: np.ndarray, eps: float):
     return rhs
 
 
-def simulate_smoothed(params: Parameters, t_end: float, *, eps: float, model="full", y0=None,
+def simulate_smoothed(params: Parameters, t_end: float, *, eps: float, variant="full", y0=None,
                       sample_rate: float = 1000.0, method: str = "LSODA", rtol: float = 1e-8,
                       atol: float = 1e-10):
     """Integrate the smoothed-friction model with ``scipy.integrate.solve_ivp``.
@@ -73,8 +73,8 @@ def simulate_smoothed(params: Parameters, t_end: float, *, eps: float, model="fu
         Final time [s] (starts at 0).
     eps : float
         Regularisation speed ε [m/s] of v/√(v² + ε²).
-    model : str
-        Variant (locked DOFs held at zero).
+    variant : str
+        The plates' variant (locked DOFs held at zero).
     y0 : array-like (12,), optional
         Initial state, default at rest and undeformed.
     sample_rate : float
@@ -93,7 +93,7 @@ def simulate_smoothed(params: Parameters, t_end: float, *, eps: float, model="fu
 
     if not (eps > 0 and math.isfinite(eps)):
         raise ValueError(f"eps = {eps} must be a finite speed > 0 [m/s]")
-    free6 = resolve_variant(model).mask
+    free6 = resolve_variant(variant).mask
     y0 = np.zeros(12) if y0 is None else np.asarray(y0, dtype=float)
     t_eval = np.arange(int(math.floor(t_end * sample_rate + 1e-9)) + 1) / sample_rate
     start = time.perf_counter()

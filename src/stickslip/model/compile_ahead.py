@@ -21,11 +21,13 @@ work it does later anyway (:func:`meanwhile`: the CLI imports what writes its ou
 A split names its kernels by reference and derives their argument types: ``calls(md)`` gives
 each kernel's arguments as its caller passes them, from the bundles a run builds for the model
 data ``md``, and their numba types are the signature (the tests check that they are the
-signatures the callers compile). Where the helper cannot
-run (one core, a model class its process cannot import, a failure) this process compiles
-everything itself: the helper only ever adds kernels to the cache.
+signatures the callers compile). Where the helper cannot run (one core, a model class its process
+cannot import, a failure, kernels not cached on disk: :func:`.kernel_cache.caching`) this process
+compiles everything itself: the helper only ever adds kernels to the cache.
 ``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test suite does, its workers already fill the
-cores; so do the workers of sweeps and basins).
+cores; so do the workers of sweeps and basins). The helper is a fork where numba's compiler lock
+and compile listeners are as the patch ``fork-helper`` of :mod:`.numba_patches` expects
+(:data:`FORK_PATCH`), else a new interpreter.
 """
 
 from __future__ import annotations
@@ -46,6 +48,9 @@ from typing import Any
 
 import numba
 from numba.core import event
+
+from .kernel_cache import caching
+from .numba_patches import Patch, active, first_problem, has
 
 __all__ = ["Split", "ColdStart", "start_apart", "compile_apart", "meanwhile", "enabled"]
 
@@ -89,10 +94,13 @@ _started: set = set()
 
 
 def enabled() -> bool:
-    """Whether a cold start may use a helper process (two or more cores, not turned off)."""
-    from ..parallel import COMPILE_PROCESSES_ENV  # not at import: `import stickslip` does not load it
+    """Whether a cold start may use a helper process: two or more cores, not turned off
+    (``STICKSLIP_COMPILE_PROCESSES=1``; a value that is not a positive integer raises
+    :class:`~stickslip.errors.WorkersError`), and the kernels cached on disk, where the helper puts
+    what it compiles (:func:`.kernel_cache.caching`)."""
+    from ..parallel import compile_processes  # not at import: `import stickslip` does not load it
 
-    return os.environ.get(COMPILE_PROCESSES_ENV, "2").strip() != "1" and (os.cpu_count() or 1) >= 2
+    return compile_processes() >= 2 and (os.cpu_count() or 1) >= 2 and caching()
 
 
 def _compile(kernels, signatures) -> None:
@@ -147,7 +155,7 @@ def start_apart(md, split: Split, split_name: str) -> ColdStart | None:
     probe = split.helper[0]
     if probe.available(signatures[probe]):
         return None
-    helper = _forked_helper(split, signatures) if _FORK else _spawned_helper(md, split_name)
+    helper = _forked_helper(split, signatures) if _FORK and active("fork-helper") else _spawned_helper(md, split_name)
     return None if helper is None else ColdStart(split, signatures, helper)
 
 
@@ -181,7 +189,7 @@ def meanwhile(work):
 
 #: Whether the helper is a forked copy of this process (Linux): it then starts at once, with the
 #: package imported and the model's data in memory. Elsewhere it is a new interpreter, which
-#: imports the package and reads the pickled data first (1.2–1.5 s on the 2-core machine).
+#: imports the package and reads the pickled data first.
 _FORK = hasattr(os, "fork") and sys.platform.startswith("linux")
 
 
@@ -226,14 +234,27 @@ def _forked_helper(split: Split, signatures) -> _ForkedHelper | None:
         return _ForkedHelper(pid)
     status = 1
     try:
-        registered = getattr(event, "_registered", None)
-        if registered is not None:  # this process's compile listeners (a command's notice) stay silent
-            registered.clear()
+        event._registered.clear()  # this process's compile listeners (a command's notice) stay silent
         watch_parent(parent)
         _compile(split.helper, signatures)
         status = 0
     finally:
         os._exit(status)
+
+
+def _check_fork() -> str | None:
+    from numba.core import compiler_lock
+
+    lock = getattr(compiler_lock, "global_compiler_lock", None)
+    return first_problem(
+        has(compiler_lock, "global_compiler_lock"),
+        None if hasattr(lock, "__enter__") and hasattr(lock, "__exit__") else "numba's compiler lock is no context manager",
+        None if isinstance(getattr(event, "_registered", None), dict) else "numba.core.event has no _registered dict")
+
+
+#: Forking the helper with numba's compiler lock held and its listeners cleared in the child, as a
+#: patch of :mod:`.numba_patches` (without it the helper is a new interpreter).
+FORK_PATCH = Patch("fork-helper", _check_fork, lambda: None)
 
 
 class _SpawnedHelper:

@@ -1,60 +1,54 @@
 """Four exact speed-ups of numba's compiler front end, where a cold compile spends its time.
 
-**One copy of a callee's variable scope per inlined call, instead of one per block.** numba
-inlines a function's IR (``inline="always"`` kernels, and overloads that inline) by deep-copying
-the callee's blocks one at a time, each with a fresh memo. Every variable of a block refers to the
-function's one :class:`numba.core.ir.Scope`, which holds every variable of the function, so each
-block's copy copies the whole scope again: O(blocks × variables) per inlined call site. The
-kernels here inline large bodies into one another (the physics into the event loop and its
-steps), and this copying was a quarter of a cold compile (``simulate`` of the plates: 43.5 s →
-33.2 s on two cores, the same results bit for bit). Numba's inliner is kept as it is; the
-per-block copies of one inlined call get a memo that holds the scope's copy already, so the
-blocks of a copied callee share one scope, as the blocks of any numba IR share theirs (the
-inliner reads the callee's scope once and then moves every block into the caller's scope).
-Outside an inlined call, and for anything but a block, ``copy.deepcopy`` behaves as before.
+Each is a patch of :mod:`.numba_patches` (:data:`PATCHES`), installed there after its check; none
+changes the code numba emits. Their measured gains are in CHANGELOG.md, and
+``docs/numba-upstream.md`` offers them to numba.
 
-**The hash of compiler flags without reading them.** Every typing request of an overload looks up
-its implementation by a key that holds the compiler flags (a ``TargetConfig``), and
-``TargetConfig.__hash__`` builds the dict of every option's value and hashes its sorted *keys*:
-the option names, the same for every instance of a class. Tens of thousands of failed ``getitem``
-overload attempts per cold compile each paid that dict (−5 %: 31.4 s → 29.7 s). The hash is now
-that of the class's sorted option names, computed once per class: the same number, so every
-dict keyed by flags behaves as before. Equality, which such a lookup then tests, built both
-dicts of values; it now answers at once where the two are one object or of one class with the
-same options set to the same values (equal then, as before), and compares the values as before
+**One copy of a callee's variable scope per inlined call, instead of one per block**
+(``inline-scope-copy``). numba inlines a function's IR (``inline="always"`` kernels, and overloads
+that inline) by deep-copying the callee's blocks one at a time, each with a fresh memo. Every
+variable of a block refers to the function's one :class:`numba.core.ir.Scope`, which holds every
+variable of the function, so each block's copy copies the whole scope again: O(blocks ×
+variables) per inlined call site. The per-block copies of one inlined call get a memo that holds
+the scope's copy already, so the blocks of a copied callee share one scope, as the blocks of any
+numba IR share theirs (the inliner reads the callee's scope once and then moves every block into
+the caller's scope). numba before 0.59 copies each statement again, after its block: those
+copies take the same memo, so their variables refer to that one scope copy too (as the block's
+copy of them does). Outside an inlined call ``copy.deepcopy`` behaves as before.
+
+**The hash of compiler flags without reading them** (``flags-hash``). Every typing request of an
+overload looks up its implementation by a key that holds the compiler flags (a
+``TargetConfig``), and ``TargetConfig.__hash__`` builds the dict of every option's value and
+hashes its sorted *keys*: the option names, the same for every instance of a class. The hash is
+now that of the class's sorted option names, computed once per class: the same number, so every
+dict keyed by flags behaves as before. Equality, which such a lookup then tests, built both dicts
+of values; it now answers at once where the two are one object or of one class with the same
+options set to the same values (equal then, as before), and compares the values as before
 otherwise.
 
-**A callee's untyped IR made once per function, not once per inlined call.** To inline a call,
-numba's ``InlineWorker.inline_function`` runs the untyped pipeline (bytecode → IR, the untyped
-passes, and the inlining of the callee's own inlined callees) on the callee's Python function,
-then copies that IR into the caller (``inline_ir`` copies it first thing, and mutates only the
-copy). The IR depends on the function and on the compiler setup, not on the call site or the
-argument types, so the kernels' small inlined helpers (a contact's offsets, its stick flag, the
-friction row), inlined at tens of call sites each, were translated tens of times: now each is
-translated once per process and compiler setup (the typing context, the target context's class,
-the pipeline's class, the caller's ``locals`` and its flags apart from ``enable_ssa``, which the
-pipeline sets itself, and ``no_cpython_wrapper``, which only lowering reads), and every call site
-gets its copy as before (``simulate`` of the plates from an empty cache: −10 %, the same results
-bit for bit). As with numba's own cache of inlined overloads, a global that a callee reads is
-taken when the callee is first inlined in the process.
+**A callee's untyped IR made once per function, not once per inlined call** (``inline-ir-once``).
+To inline a call, numba's ``InlineWorker.inline_function`` runs the untyped pipeline (bytecode →
+IR, the untyped passes, and the inlining of the callee's own inlined callees) on the callee's
+Python function, then copies that IR into the caller (``inline_ir`` copies it first thing, and
+mutates only the copy). The IR depends on the function and on the compiler setup, not on the call
+site or the argument types, so each callee is translated once per process and compiler setup (the
+typing context, the target context's class, the pipeline's class, the caller's ``locals`` and its
+flags apart from ``enable_ssa``, which the pipeline sets itself, and ``no_cpython_wrapper``, which
+only lowering reads), and every call site gets its copy as before. As with numba's own cache of
+inlined overloads, a global that a callee reads is taken when the callee is first inlined in the
+process.
 
-**A builtin function's call typed once per argument types, not once per call site.** numba types
-each call of a builtin function or operator (``a * b``, ``x[i]``, ``math.sqrt``, an ``@overload``)
-by trying the function's typing templates in order until one accepts the argument types, at
-every call site: a cold ``simulate`` of the plates typed about 11 000 such calls, all but about
-360 with argument types typed before, and the templates tried first for scalars are numpy's array
-operators, which search the ufunc loops each time. A template's answer depends on the typing
-context, the function type (its templates, part of its key: a registration that adds templates
-makes a new type) and the argument types only, so :func:`_call_type_once` keeps each accepted
-signature per function type, context and argument types and answers a repeated call from it,
-recording the implementation key for the signature's arguments as numba does at every call (the
-last call's template decides which implementation lowering takes, as before). A call the
-templates reject is tried again each time, as before, so its error is numba's own
-(``simulate`` of the plates in one process from an empty cache: −20 %, 20.1–21.1 s → 16.3–16.5 s,
-the same states bit for bit).
-
-:func:`install` makes these changes when the compiled layer is imported; with a numba laid out
-otherwise it leaves that part alone.
+**A builtin function's call typed once per argument types, not once per call site**
+(``call-type-once``). numba types each call of a builtin function or operator (``a * b``,
+``x[i]``, ``math.sqrt``, an ``@overload``) by trying the function's typing templates in order
+until one accepts the argument types, at every call site; the templates tried first for scalars
+are numpy's array operators, which search the ufunc loops each time. A template's answer depends
+on the typing context, the function type (its templates, part of its key: a registration that
+adds templates makes a new type) and the argument types only, so :func:`_call_type_once` keeps
+each accepted signature per function type, context and argument types and answers a repeated
+call from it, recording the implementation key for the signature's arguments as numba does at
+every call (the last call's template decides which implementation lowering takes, as before). A
+call the templates reject is tried again each time, as before, so its error is numba's own.
 """
 
 from __future__ import annotations
@@ -65,7 +59,9 @@ import threading
 import weakref
 from collections.abc import Mapping
 
-__all__ = ["install", "installed"]
+from .numba_patches import Patch, first_problem, has, source_has
+
+__all__ = ["PATCHES"]
 
 _state = threading.local()
 
@@ -80,11 +76,13 @@ class _SharedScopeCopy:
     @staticmethod
     def deepcopy(x, memo=None):
         scopes = getattr(_state, "scopes", None)
-        if memo is None and scopes is not None and isinstance(x, _Block):
-            scope = x.scope
-            if id(scope) not in scopes:
-                scopes[id(scope)] = (scope, copy.deepcopy(scope))  # the original kept alive: ids stay unique
-            memo = {id(scope): scopes[id(scope)][1]}
+        if memo is None and scopes is not None:
+            if isinstance(x, _Block):
+                scope = x.scope
+                if id(scope) not in scopes:
+                    scopes[id(scope)] = (scope, copy.deepcopy(scope))  # the original kept alive: ids stay unique
+            # a block's copy, or (numba < 0.59) a statement copied after its block: this call's scope copies
+            memo = {key: scope_copy for key, (_, scope_copy) in scopes.items()}
         return copy.deepcopy(x, memo)
 
 
@@ -136,18 +134,6 @@ def _untyped_ir_once(inline_function):
     return wrapper
 
 
-def installed() -> bool:
-    """Whether numba's inliner copies one scope per inlined call (:func:`install` took effect)."""
-    try:
-        from numba.core import inline_closurecall as icc
-    except ImportError:  # pragma: no cover - numba always has it in the supported versions
-        return False
-    worker = getattr(icc, "InlineWorker", None)
-    return isinstance(getattr(icc, "copy", None), _SharedScopeCopy) and \
-        getattr(getattr(worker, "inline_ir", None), "_stickslip_shared_scope", False) and \
-        getattr(getattr(worker, "inline_function", None), "_stickslip_once", False)
-
-
 @functools.lru_cache(maxsize=None)
 def _option_names_hash(cls) -> int:
     return hash(tuple(sorted(cls.options)))
@@ -172,20 +158,6 @@ def _flags_equal(original):
 
     __eq__._stickslip_fast = True
     return __eq__
-
-
-def _install_flags_hash() -> None:
-    try:
-        from numba.core.targetconfig import TargetConfig
-    except ImportError:  # pragma: no cover
-        return
-    if not isinstance(getattr(TargetConfig, "options", None), Mapping):  # pragma: no cover - another layout
-        return
-    if TargetConfig.__hash__ is not _flags_hash:
-        TargetConfig.__hash__ = _flags_hash
-    if not getattr(TargetConfig.__eq__, "_stickslip_fast", False) and isinstance(getattr(TargetConfig(), "_values", None), dict):
-        TargetConfig.__eq__ = _flags_equal(TargetConfig.__eq__)
-        TargetConfig.__hash__ = _flags_hash  # assigning __eq__ in a class body would unset it; here it stays
 
 
 #: Accepted calls: function type → {(id of the typing context, argument types, keyword types):
@@ -216,55 +188,92 @@ def _call_type_once(get_call_type):
     return wrapper
 
 
-def _install_call_type_once() -> None:
-    try:
-        from numba.core.types.functions import BaseFunction
-    except ImportError:  # pragma: no cover
-        return
-    original = getattr(BaseFunction, "get_call_type", None)
-    if original is None or getattr(original, "_stickslip_once", False):
-        return
-    import inspect
+def _inliner():
+    from numba.core import inline_closurecall, ir
 
-    try:
-        source = inspect.getsource(original)
-    except (OSError, TypeError):  # pragma: no cover
-        return
-    if "self._impl_keys[sig.args] = temp.get_impl_key(sig)" in source:  # the layout this stands in for
-        BaseFunction.get_call_type = _call_type_once(original)
+    return inline_closurecall, ir
 
 
-def _inliner_as_expected(worker) -> bool:
-    """Whether numba's ``inline_function`` is the one :func:`_untyped_ir_once` stands in for: it
-    runs the untyped passes on the function and inlines the IR they give (checked by its code)."""
-    import inspect
+def _check_scope_copy() -> str | None:
+    icc, ir = _inliner()
+    return first_problem(
+        has(icc, "InlineWorker"),
+        lambda: has(icc.InlineWorker, "inline_ir",
+                    ("self", "caller_ir", "block", "i", "callee_ir", "callee_freevars", "arg_typs")),
+        lambda: source_has(icc.InlineWorker.inline_ir, "copy.deepcopy(the_ir.blocks[block_label])", "callee_scopes"),
+        None if getattr(icc, "copy", None) is copy else "numba.core.inline_closurecall.copy is not the copy module",
+        lambda: has(ir.Block, "__init__", ("self", "scope", "loc")))
 
-    try:
-        source = inspect.getsource(worker.inline_function)
-    except (OSError, TypeError):  # pragma: no cover
-        return False
-    return "self.run_untyped_passes(function)" in source and "self.inline_ir(" in source
 
-
-def install() -> bool:
-    """Make numba's inliner copy a callee's scope once per inlined call and translate a callee
-    once per function, numba's flags hash once per class and a builtin call's typing happen once
-    per argument types; returns :func:`installed` (the
-    inliner's part)."""
+def _apply_scope_copy() -> None:
     global _Block
-    _install_flags_hash()
-    _install_call_type_once()
-    try:
-        from numba.core import inline_closurecall as icc
-        from numba.core import ir
-    except ImportError:  # pragma: no cover
-        return False
-    worker = getattr(icc, "InlineWorker", None)
-    if installed() or worker is None or not hasattr(worker, "inline_ir") or getattr(icc, "copy", None) is not copy \
-            or not _inliner_as_expected(worker):
-        return installed()
+    icc, ir = _inliner()
     _Block = ir.Block
-    worker.inline_ir = _one_scope_copy_per_call(worker.inline_ir)
-    worker.inline_function = _untyped_ir_once(worker.inline_function)
+    icc.InlineWorker.inline_ir = _one_scope_copy_per_call(icc.InlineWorker.inline_ir)
     icc.copy = _SharedScopeCopy()
-    return True
+
+
+def _check_ir_once() -> str | None:
+    icc, _ = _inliner()
+    from numba.core.targetconfig import TargetConfig
+
+    def worker(name, params):
+        return lambda: has(icc.InlineWorker, name, params)
+
+    return first_problem(
+        has(icc, "InlineWorker"),
+        worker("inline_function", ("self", "caller_ir", "block", "i", "function", "arg_typs")),
+        worker("run_untyped_passes", ("self", "func", "enable_ssa")),
+        worker("inline_ir", ("self", "caller_ir", "block", "i", "callee_ir", "callee_freevars", "arg_typs")),
+        lambda: source_has(icc.InlineWorker.inline_function, "self.run_untyped_passes(function)", "self.inline_ir("),
+        lambda: source_has(icc.InlineWorker.__init__, "self.typingctx", "self.targetctx", "self.locals",
+                           "self.pipeline", "self.flags"),
+        has(TargetConfig, "values"))
+
+
+def _apply_ir_once() -> None:
+    icc, _ = _inliner()
+    icc.InlineWorker.inline_function = _untyped_ir_once(icc.InlineWorker.inline_function)
+
+
+def _check_flags_hash() -> str | None:
+    from numba.core.compiler import Flags
+    from numba.core.targetconfig import TargetConfig
+
+    problem = first_problem(
+        None if isinstance(getattr(TargetConfig, "options", None), Mapping) else "TargetConfig.options is no mapping",
+        lambda: source_has(TargetConfig.__hash__, "sorted(self.values())"),
+        lambda: source_has(TargetConfig.__eq__, "self.values() == other.values()"),
+        lambda: None if isinstance(getattr(Flags(), "_values", None), dict) else "TargetConfig has no _values dict")
+    if problem is None and TargetConfig.__hash__(Flags()) != _option_names_hash(Flags):
+        problem = "TargetConfig.__hash__ is not the hash of the option names"
+    return problem
+
+
+def _apply_flags_hash() -> None:
+    from numba.core.targetconfig import TargetConfig
+
+    TargetConfig.__eq__ = _flags_equal(TargetConfig.__eq__)
+    TargetConfig.__hash__ = _flags_hash  # assigning __eq__ in a class body would unset it; here it stays
+
+
+def _check_call_type_once() -> str | None:
+    from numba.core.types.functions import BaseFunction
+
+    return first_problem(
+        has(BaseFunction, "get_call_type", ("self", "context", "args", "kws")),
+        lambda: source_has(BaseFunction.get_call_type, "self._impl_keys[sig.args] = temp.get_impl_key(sig)"),
+        lambda: source_has(BaseFunction.__init__, "self._impl_keys = {}"))
+
+
+def _apply_call_type_once() -> None:
+    from numba.core.types.functions import BaseFunction
+
+    BaseFunction.get_call_type = _call_type_once(BaseFunction.get_call_type)
+
+
+#: The four speed-ups as patches of :mod:`.numba_patches`: each independent of the others.
+PATCHES = [Patch("inline-scope-copy", _check_scope_copy, _apply_scope_copy),
+           Patch("inline-ir-once", _check_ir_once, _apply_ir_once),
+           Patch("flags-hash", _check_flags_hash, _apply_flags_hash),
+           Patch("call-type-once", _check_call_type_once, _apply_call_type_once)]

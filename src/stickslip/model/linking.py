@@ -17,6 +17,10 @@ loaded (from the cache or compiled) under the very symbol the caller refers to: 
 records them (:func:`_record_dependencies`), and an entry whose callee is not there under that
 symbol (a version that kept numba's own numbering, :func:`_stable_symbols`) counts as a miss and
 is compiled again, never loaded with a dangling reference, which would end the process.
+
+These wrappers of numba are one patch of :mod:`.numba_patches`, ``standalone-linking``
+(:data:`PATCH`): all of them or none. Without it, :func:`standalone` marks a kernel that numba
+then links into its callers as it does any other.
 """
 
 from __future__ import annotations
@@ -24,7 +28,9 @@ from __future__ import annotations
 import hashlib
 import importlib
 
-__all__ = ["install", "standalone"]
+from .numba_patches import Patch, first_problem, has, source_has
+
+__all__ = ["PATCH", "standalone", "wrap_once"]
 
 #: The marker of a cache entry that records its standalone dependencies.
 _FORMAT = "stickslip-standalone-1"
@@ -109,7 +115,9 @@ def _record_dependencies(finalize):
             else:
                 symbol, origin = own
                 dependencies[symbol] = origin
-                self._reload_init.update(library._reload_init)
+                inherited = getattr(self, "_reload_init", None)  # numba >= 0.63: what a caller inherits
+                if inherited is not None:
+                    inherited.update(getattr(library, "_reload_init", ()))
         self._linking_libraries = linked
         self._stickslip_dependencies = dependencies
         return finalize(self)
@@ -193,7 +201,27 @@ def wrap_once(owner, name: str, make) -> None:
     setattr(owner, name, classmethod(wrapped) if method else wrapped)
 
 
-def install() -> None:
+def _check() -> str | None:
+    from numba.core import caching, codegen, compiler, funcdesc
+
+    library = codegen.CPUCodeLibrary
+    cache_impl = caching.CompileResultCacheImpl
+    return first_problem(
+        has(funcdesc.FunctionDescriptor, "_from_python_function",
+            ("func_ir", "typemap", "restype", "calltypes", "native", "mangler", "inline", "noalias", "abi_tags")),
+        lambda: source_has(funcdesc.FunctionDescriptor._from_python_function, "uid=func_ir.func_id.unique_id"),
+        has(library, "finalize", ("self",)),
+        lambda: source_has(library.finalize, "for library in self._linking_libraries:"),
+        lambda: source_has(library.__init__, "self._linking_libraries = "),
+        lambda: source_has(codegen.JITCodeLibrary.get_pointer_to_function, "self._codegen._engine"),
+        has(codegen.JitEngine, "is_symbol_defined", ("self", "name")),
+        has(cache_impl, "reduce", ("self", "cres")),
+        has(cache_impl, "rebuild", ("self", "target_context", "payload")),
+        lambda: source_has(compiler.CompileResult._reduce, "return (libdata, self.fndesc,"),
+        has(caching.Cache, "_load_overload", ("self", "sig", "target_context")))
+
+
+def _apply() -> None:
     """Install the wrappers of numba's linking and caching (:func:`wrap_once`)."""
     from numba.core import caching, codegen, funcdesc
 
@@ -202,3 +230,7 @@ def install() -> None:
     wrap_once(caching.CompileResultCacheImpl, "reduce", _reduce_with_dependencies)
     wrap_once(caching.CompileResultCacheImpl, "rebuild", _rebuild_after_dependencies)
     wrap_once(caching.Cache, "_load_overload", _stale_is_a_miss)
+
+
+#: The standalone kernels as a patch of :mod:`.numba_patches`.
+PATCH = Patch("standalone-linking", _check, _apply)

@@ -38,7 +38,12 @@ its path: ``mass.0.0``, ``stiffness.x.y`` (indices or dof names), ``force.1``,
 ``contact.0.normal.stiffness``, ``slip_band``. An entry written as an expression is set through its
 parameters (a path into it is refused). Errors name the key and the fix in one line.
 
-The file is checked once, when it is read (keys, shapes, names, expressions), into a
+A model of finite-element size keeps its matrices in files, names its dofs by count, writes
+vectors and rows as sparse tables, its damping as Rayleigh's, its many contacts as contact sets,
+and carries its mesh's nodes (:mod:`stickslip.model.model_file_fe`; docs/models.md).
+
+The file is checked once, when it is read (keys, shapes, names, expressions; each entry by
+:class:`~stickslip.model.model_file_parser.Parser`; its matrix files and CSVs read), into a
 :class:`_Template`; each model — the file's, and each ``replace`` of it — is the template's
 entries evaluated at its parameter values, validated once by :class:`FrictionModel`.
 """
@@ -46,18 +51,22 @@ entries evaluated at its parameter values, validated once by :class:`FrictionMod
 from __future__ import annotations
 
 import dataclasses
-import json
 import keyword
-import reprlib
 import sys
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import ExpressionError, FrictionLawError, ModelError, ModelFileError
-from .expressions import RESERVED, Expression, finite_number, grammar, parse_expression
+from ..inputs import read_regular_file
+from .expressions import RESERVED, Expression
 from .friction import FrictionLaw
+from .matrices import is_checked, is_sparse, mark_positive_definite
+from .model_file_fe import ContactSet, FileMatrices, Triplets, dof_names, read_nodes
+from .model_file_parser import (CONTACT_KEYS, FRICTION_KEYS, NORMAL_KEYS, Parser, check_keys, entry_label,
+                                file_number, parse_entry, quote_text, show_value, with_defaults)
 from .system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, NormalLaw, check_name, check_text
 
 if sys.version_info >= (3, 11):
@@ -69,78 +78,22 @@ __all__ = ["load_model_file", "model_from_spec", "resolve_path", "ModelFileError
            "FRICTION_KEYS", "NORMAL_KEYS", "RESERVED_NAMES"]
 
 TOP_KEYS = ("name", "description", "parameters", "dofs", "mass", "damping", "stiffness", "force", "units",
-            "slip_band", "observe", "contact")
-REQUIRED_TOP = ("dofs", "mass", "damping", "stiffness", "contact")
-CONTACT_KEYS = ("name", "tangent", "drive", "normal_force", "normal_gradient", "normal_rate_gradient", "gap",
-                "gap_gradient", "normal", "friction")
-REQUIRED_CONTACT = ("tangent", "friction")
-FRICTION_KEYS = ("law", "mu_k", "delta_mu", "alpha", "mu_v")
-NORMAL_KEYS = ("law", "stiffness", "damping", "restitution")
-#: The keys of a prescribed load and of a unilateral contact (a contact has the one or the other).
-PRESCRIBED_KEYS = ("normal_force", "normal_gradient", "normal_rate_gradient")
-UNILATERAL_KEYS = ("gap", "gap_gradient", "normal")
-
+            "slip_band", "observe", "contact", "contact_set", "nodes")
+REQUIRED_TOP = ("dofs", "mass", "stiffness")
+#: Largest model file read [bytes]: a file of 64 dofs written out in full is about 100 kB, and
+#: larger models keep their matrices in matrix files beside it.
+MAX_MODEL_FILE_BYTES = 64 * 2**20
 #: Names a parameter cannot take: the model file's keys (``--set mass=2`` is the path of a 1×1
 #: mass), the functions and constant of expressions, and the names a sweep's grid gives other
 #: meanings (``model``, ``ic``; ``perturb_<state>`` is refused as a prefix).
 RESERVED_NAMES = frozenset(TOP_KEYS) | RESERVED | {"model", "ic"}
 
-#: Short reprs for messages: a value shown in an error stays on one short line, however deeply
-#: nested or long (levels, list items and characters shown).
-_SHORT = reprlib.Repr()
-_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxstring, _SHORT.maxother = 3, 6, 40, 40
-
-
-def _show(value) -> str:
-    return _SHORT.repr(value)
-
-
-def _quote(text: str) -> str:
-    """An expression as the file writes it, on one line (control characters escaped)."""
-    return json.dumps(text if len(text) <= 60 else text[:57] + "...", ensure_ascii=False)
-
-
-def _label(path: str) -> str:
-    """How errors name an entry: ``mass.0.1`` → ``mass[0][1]``, ``contact.0.drive.0`` → ``contact.0.drive[0]``."""
-    parts = path.split(".")
-    k = len(parts)
-    while k > 1 and parts[k - 1].isdigit():
-        k -= 1
-    return ".".join(parts[:k]) + "".join(f"[{p}]" for p in parts[k:])
-
-
-def _number(value, where: str, hint: str = "") -> float:
-    try:
-        return finite_number(value)
-    except ExpressionError as exc:
-        raise ModelFileError(f"{where} = {_show(value)} {exc}; give a finite number{hint}") from None
-
-
-def _check_keys(table: Mapping, known: tuple, where: str) -> None:
-    unknown = sorted(map(str, set(table) - set(known)))
-    if unknown:
-        raise ModelFileError(f"{where}unknown key(s) {', '.join(unknown)}; valid keys are {', '.join(known)}")
-
-
-def _entry(value, path: str, names) -> float | Expression:
-    """A number of the file: a float, or an expression of the parameters ``names`` (a string)."""
-    label = _label(path)
-    if not isinstance(value, str):
-        return _number(value, label, " or an expression of [parameters] (a string)")
-    try:
-        check_text(value, label)
-    except ModelError as exc:
-        raise ModelFileError(str(exc)) from None
-    try:
-        return parse_expression(value, names)
-    except ExpressionError as exc:
-        raise ModelFileError(f"{label} = {_quote(value)} is not a valid expression: {exc}; {grammar(names)}") from None
-
 
 def _parameters(table) -> dict[str, float]:
     """The ``[parameters]`` table: valid names, finite numbers."""
     if not isinstance(table, Mapping):
-        raise ModelFileError(f"parameters = {_show(table)} must be a table of name = number, e.g. [parameters] V = 0.2")
+        raise ModelFileError(f"parameters = {show_value(table)} must be a table of name = number, e.g. [parameters] "
+                             "V = 0.2")
     out = {}
     for name, value in table.items():
         try:
@@ -151,9 +104,9 @@ def _parameters(table) -> dict[str, float]:
             raise ModelFileError(f"parameters: the name {name!r} is reserved (a key of model files, a function or "
                                  "constant of expressions, or a sweep's model, ic, perturb_*); choose another name")
         if isinstance(value, str):
-            raise ModelFileError(f"parameters.{name} = {_quote(value)} is not a number; give a number (expressions "
+            raise ModelFileError(f"parameters.{name} = {quote_text(value)} is not a number; give a number (expressions "
                                  "go in the model's entries, not in [parameters])")
-        out[name] = _number(value, f"parameters.{name}")
+        out[name] = file_number(value, f"parameters.{name}")
     return out
 
 
@@ -178,6 +131,7 @@ class _Template:
     targets: dict
     named: dict
     slots: dict
+    fe: "_FEParts"
     parameters: dict = dataclasses.field(init=False)
 
     def __post_init__(self) -> None:
@@ -191,7 +145,7 @@ class _Template:
         head, _, rest = path.partition(".")
         if head == "parameters" and rest in self.named:
             return rest
-        return resolve_path(self.spec, path)
+        return resolve_path(self.spec, path, self.dofs)
 
     def with_values(self, values: Mapping[str, Any]) -> FrictionModel:
         """The model at parameter values ``values`` (names and canonical paths, as in :attr:`parameters`).
@@ -216,14 +170,15 @@ class _Template:
             current = self.slots[path]
             if isinstance(current, Expression):
                 uses = ", ".join(sorted(current.names)) or "none"
-                raise ModelFileError(f"--set {path}: {_label(path)} is the expression {_quote(current.text)} of "
+                raise ModelFileError(f"--set {path}: {entry_label(path)} is the expression "
+                                     f"{quote_text(current.text)} of "
                                      f"[parameters]; set the parameters it uses ({uses}) instead, or write a number "
                                      "in the file")
             slots = dict(slots) if slots is self.slots else slots
             if self.targets[path][1] == "law":
                 slots[path] = new
             else:
-                slots[path] = _entry(new, path, self.named)
+                slots[path] = parse_entry(new, path, self.named)
                 new = new if isinstance(new, str) else slots[path]
             edits[path] = new
         if not edits:
@@ -233,8 +188,8 @@ class _Template:
 
 def _parameter_value(value, name: str) -> float:
     if isinstance(value, str):
-        raise ModelFileError(f"parameter {name} = {_quote(value)} is not a number; give a number")
-    return _number(value, f"parameters.{name}")
+        raise ModelFileError(f"parameter {name} = {quote_text(value)} is not a number; give a number")
+    return file_number(value, f"parameters.{name}")
 
 
 def _edited(spec: dict, edits: Mapping[str, Any]) -> dict:
@@ -266,194 +221,103 @@ def _plain_copy(value):
     return value
 
 
-class _Parser:
-    """Checks the entries of a file and collects them as slots of a :class:`_Template`."""
 
-    def __init__(self, n: int, names) -> None:
-        self.n, self.names = n, names
-        self.slots: dict = {}
-        self.targets: dict = {}
-        self.shapes: dict = {"scalars": None}
+@dataclasses.dataclass(frozen=True, eq=False)
+class _FEParts:
+    """What a template holds beside its slots: the matrix files read (key → CSR), the contact sets'
+    structure and the mesh nodes."""
 
-    def number(self, value, path: str, container: str, index) -> None:
-        self.slots[path] = _entry(value, path, self.names)
-        self.targets[path] = (container, index)
-
-    def vector(self, value, n: int, key: str, container: str) -> None:
-        """n entries (a one-entry vector may be written as a number)."""
-        if not isinstance(value, list):
-            if n == 1 and (isinstance(value, (int, float, str)) and not isinstance(value, bool)):
-                self.shapes[container] = (1,)
-                return self.number(value, key, container, 0)
-            raise ModelFileError(f"{key} must be a list of {n} number(s), got {_show(value)}")
-        if len(value) != n:
-            raise ModelFileError(f"{key} must be a list of {n} number(s), got {_show(value)}")
-        self.shapes[container] = (n,)
-        for i, v in enumerate(value):
-            self.number(v, f"{key}.{i}", container, i)
-
-    def matrix(self, value, rows: int | None, key: str, container: str, flat: bool = False) -> int:
-        """A matrix of ``rows`` (None: any number of) rows of n entries; returns the number of rows."""
-        n = self.n
-        if flat:  # a single row written flat
-            value = [value]
-        if not isinstance(value, list) or not value or not all(isinstance(row, list) for row in value):
-            raise ModelFileError(f"{key} must be a list of rows, each a list of {n} numbers, e.g. "
-                                 f"{key.split('.')[-1]} = [[{', '.join(['1.0'] * n)}]]")
-        if rows is not None and len(value) != rows:
-            raise ModelFileError(f"{key} must have {rows} row(s) (one per dof), got {len(value)}")
-        for i, row in enumerate(value):
-            if len(row) != n:
-                raise ModelFileError(f"{key} row {i} must have {n} number(s) (one per dof), got {len(row)}")
-        self.shapes[container] = (len(value), n)
-        for i, row in enumerate(value):
-            for j, v in enumerate(row):
-                self.number(v, f"{key}.{j}" if flat else f"{key}.{i}.{j}", container, (i, j))
-        return len(value)
-
-    def contact(self, c: int, table) -> str:
-        """Contact ``c``'s entries; returns its name."""
-        where = f"contact.{c}"
-        if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([[contact]])")
-        _check_keys(table, CONTACT_KEYS, f"{where}: ")
-        for key in REQUIRED_CONTACT:
-            if key not in table:
-                hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]",
-                        "friction": "add a [contact.friction] table with law, mu_k, delta_mu"}[key]
-                raise ModelFileError(f"{where}.{key} is missing; give {hint}")
-        self.normal_keys(where, table)
-        tangent = table["tangent"]
-        flat = isinstance(tangent, list) and bool(tangent) and not isinstance(tangent[0], list)
-        dim = self.matrix(tangent, None, f"{where}.tangent", f"{c}.tangent", flat=flat)
-        if dim not in (1, 2):
-            raise ModelFileError(f"{where}.tangent must have 1 row (1-D friction) or 2 rows (2-D), got {dim}")
-        self.shapes[f"{c}.drive"] = (dim,)
-        for key, value in table.items():
-            if key in ("drive", "normal_gradient", "normal_rate_gradient"):
-                self.vector(value, dim if key == "drive" else self.n, f"{where}.{key}", f"{c}.{key}")
-            elif key in ("normal_force", "gap"):
-                self.number(value, f"{where}.{key}", "scalars", f"{c}.{key}")
-            elif key == "gap_gradient":
-                self.vector(value, self.n, f"{where}.{key}", f"{c}.{key}")
-            elif key == "friction":
-                self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb or exponential")
-            elif key == "normal":
-                self.law_table(value, f"{where}.normal", NORMAL_KEYS, f"{c}.normal", "compliant")
-        name = table.get("name", f"contact{c}")
-        if not isinstance(name, str):
-            raise ModelFileError(f"{where}.name = {_show(name)} must be a string")
-        check_text(name, f"{where}.name")
-        return name
-
-    @staticmethod
-    def normal_keys(where: str, table) -> None:
-        """A contact has a prescribed load or a gap with a normal law: one of them, whole."""
-        prescribed = [k for k in PRESCRIBED_KEYS if k in table]
-        unilateral = [k for k in UNILATERAL_KEYS if k in table]
-        if prescribed and unilateral:
-            raise ModelFileError(f"{where}: {prescribed[0]} (a prescribed load) and {unilateral[0]} (a unilateral "
-                                 "contact) both given; give normal_force for a contact that is always pressed, or "
-                                 "gap_gradient with a [contact.normal] table for one that opens and closes")
-        if not prescribed and not unilateral:
-            raise ModelFileError(f"{where}.normal_force is missing; give normal_force = N0 > 0 [N] for a contact that "
-                                 "is always pressed, or gap_gradient with a [contact.normal] table for one that opens "
-                                 "and closes")
-        if prescribed and "normal_force" not in table:
-            raise ModelFileError(f"{where}.normal_force is missing; give N0 > 0 [N]")
-        for key in ("gap_gradient", "normal"):
-            if unilateral and key not in table:
-                hint = ("W of g = gap + W·q, one number per dof" if key == "gap_gradient" else
-                        'a [contact.normal] table, e.g. law = "compliant", stiffness = 40.0')
-                raise ModelFileError(f"{where}.{key} is missing for a unilateral contact; give {hint}")
-
-    def law_table(self, table, where: str, keys: tuple, container: str, laws: str) -> None:
-        """A law's table (``[contact.friction]``, ``[contact.normal]``): its law's name and numbers."""
-        if not isinstance(table, Mapping):
-            raise ModelFileError(f"{where} must be a table ([contact.{where.rsplit('.', 1)[1]}])")
-        _check_keys(table, keys, f"{where}: ")
-        self.shapes[container] = None
-        for key, value in table.items():
-            if key != "law":
-                self.number(value, f"{where}.{key}", container, key)
-            elif isinstance(value, str):
-                self.slots[f"{where}.law"] = value
-                self.targets[f"{where}.law"] = (container, "law")
-            else:
-                raise ModelFileError(f"{where}.law = {_show(value)} is not a law name; choose {laws}")
+    matrices: Mapping = dataclasses.field(default_factory=dict)
+    sets: tuple = ()
+    nodes: Any = None
 
 
-def _with_defaults(table):
-    """A unilateral contact's table with its optional numbers written out (gap 0, contact damping 0
-    or a rigid contact's restitution 0),
-    so that ``--set`` reaches them like any entry (a copy; the caller's table is not changed)."""
-    if not (isinstance(table, Mapping) and isinstance(table.get("normal"), Mapping)):
-        return table
-    normal = {**table["normal"]}
-    if normal.get("law") == "rigid":
-        normal.setdefault("restitution", 0.0)
-    else:
-        normal.setdefault("damping", 0.0)
-    return {**table, "gap": table.get("gap", 0.0), "normal": normal}
-
-
-def _template(spec: Mapping[str, Any], source: str, default_name: str) -> _Template:
-    """Check a model file's content (keys, shapes, names, expressions) once."""
-    if not isinstance(spec, Mapping):
-        raise ModelFileError("a model file holds a table of keys (name, dofs, mass, ...)")
-    _check_keys(spec, TOP_KEYS, "")
-    for key in REQUIRED_TOP:
-        if key not in spec:
-            hint = {"contact": "add at least one [[contact]] table", "dofs": 'e.g. dofs = ["x"]'}.get(
-                key, f"give the {key} matrix, one row per dof")
-            raise ModelFileError(f"key {key!r} is missing; {hint}")
-    dofs = spec["dofs"]
-    if not isinstance(dofs, list) or not dofs or not all(isinstance(d, str) and d for d in dofs):
-        raise ModelFileError(f"dofs must be a non-empty list of names, e.g. dofs = [\"x\", \"y\"], got {_show(dofs)}")
-    for i, dof in enumerate(dofs):
-        check_name(dof, f"dofs[{i}]")
+def _header(spec: Mapping[str, Any], dofs: tuple, default_name: str) -> tuple[dict, str, dict, dict]:
+    """The name and description, the observed dof, the units and the named parameters, checked."""
     texts = {key: spec.get(key, default) for key, default in (("name", default_name), ("description", ""))}
     for key, text in texts.items():
         if not isinstance(text, str):
-            raise ModelFileError(f"{key} must be a string, got {_show(text)}")
+            raise ModelFileError(f"{key} must be a string, got {show_value(text)}")
         check_text(text, key)
+    names = set(dofs)
     observe = spec.get("observe", dofs[0])
-    if not isinstance(observe, str) or observe not in dofs:
-        raise ModelFileError(f"observe = {_show(observe)} is not a dof; give one of {', '.join(dofs)}")
+    if not isinstance(observe, str) or observe not in names:
+        shown = ", ".join(dofs[:10]) + (", ..." if len(dofs) > 10 else "")
+        raise ModelFileError(f"observe = {show_value(observe)} is not a dof; give one of {shown}")
     units = spec.get("units", {})
     if not isinstance(units, Mapping) or not all(isinstance(v, str) for v in units.values()):
         raise ModelFileError('units must be a table of dof = "unit", e.g. units = { x = "m" }')
     named = _parameters(spec.get("parameters", {}))
-    unknown = [str(k) for k in units if k not in dofs and k not in named]
+    unknown = [str(k) for k in units if k not in names and k not in named]
     if unknown:
         raise ModelFileError(f"units: {unknown[0]!r} is neither a dof nor a named parameter; units are given for "
-                             f"the dofs ({', '.join(dofs)}) and the [parameters] ({', '.join(named) or 'none'})")
-    tables = spec["contact"]
+                             f"the dofs ({', '.join(dofs[:10])}) and the [parameters] ({', '.join(named) or 'none'})")
+    return texts, observe, dict(units), named
+
+
+def _dofs(spec: Mapping[str, Any], base) -> tuple[tuple, FileMatrices]:
+    """The dof names and the matrix files (read once; the dofs may be named after their labels)."""
+    if not isinstance(spec, Mapping):
+        raise ModelFileError("a model file holds a table of keys (name, dofs, mass, ...)")
+    check_keys(spec, TOP_KEYS, "")
+    for key in REQUIRED_TOP:
+        if key not in spec:
+            hint = {"dofs": 'e.g. dofs = ["x"] or dofs = { count = 100, prefix = "u" }'}.get(
+                key, f"give the {key} matrix, one row per dof, or its file (\"{key[0].upper()}.mtx\")")
+            raise ModelFileError(f"key {key!r} is missing; {hint}")
+    if "contact" not in spec and "contact_set" not in spec:
+        raise ModelFileError("key 'contact' is missing; add at least one [[contact]] table (or a [contact_set.NAME])")
+    files = FileMatrices.read(spec, base)
+    dofs = dof_names(spec["dofs"], files.labels)
+    if isinstance(spec["dofs"], list):
+        for i, dof in enumerate(dofs):
+            check_name(dof, f"dofs[{i}]")
+    files.check_sizes(len(dofs))
+    return dofs, files
+
+
+def _template(spec: Mapping[str, Any], source: str, default_name: str, base=None) -> _Template:
+    """Check a model file's content (keys, shapes, names, expressions) once; read its files."""
+    dofs, files = _dofs(spec, base)
+    texts, observe, units, named = _header(spec, dofs, default_name)
+    tables = spec.get("contact", [])
     if isinstance(tables, Mapping):
         tables = [tables]
-    if not isinstance(tables, list) or not tables:
+    if not isinstance(tables, list) or ("contact" in spec and not tables):
         raise ModelFileError("contact must be one or more [[contact]] tables")
-    tables = [_with_defaults(table) for table in tables]
+    tables = [with_defaults(table) for table in tables]
+    sets = spec.get("contact_set", {})
+    if not isinstance(sets, Mapping) or ("contact_set" in spec and not sets):
+        raise ModelFileError("contact_set must hold one or more [contact_set.NAME] tables")
     n = len(dofs)
-    parser = _Parser(n, tuple(named))
-    contact_names = []
+    parser = Parser(n, tuple(named), dofs)
+    contact_names, plans, set_tables, nodes, frozen = [], [], {}, None, {}
     for key, value in spec.items():  # file order: the order of the parameters
         if key in ("mass", "damping", "stiffness"):
-            parser.matrix(value, n, key, key)
+            parser.square(key, value, files)
         elif key == "force":
             parser.vector(value, n, key, key)
         elif key == "slip_band":
             parser.number(value, key, "scalars", key)
         elif key == "contact":
             contact_names = [parser.contact(c, table) for c, table in enumerate(tables)]
+            frozen["contact"] = tables
+        elif key == "contact_set":
+            for name, table in sets.items():
+                plan, set_tables[name] = parser.contact_set(str(name), table, base)
+                plans.append(plan)
+            frozen["contact_set"] = set_tables
+        elif key == "nodes":
+            nodes, frozen["nodes"] = read_nodes(value, base, parser.index, files.labels)
     parser.shapes.setdefault("force", (n,))
-    frozen = _plain_copy({**spec, "contact": tables})
+    frozen = _plain_copy({**spec, **files.tables, **frozen})  # checked: plain tables, lists and values
     if "slip_band" not in frozen:  # a parameter of every model file
         frozen["slip_band"] = DEFAULT_SLIP_BAND
         parser.number(DEFAULT_SLIP_BAND, "slip_band", "scalars", "slip_band")
-    return _Template(spec=frozen, name=texts["name"], description=texts["description"], dofs=tuple(dofs),
-                     units=dict(units), observe=observe, source=source, contact_names=tuple(contact_names),
-                     shapes=parser.shapes, targets=parser.targets, named=named, slots=parser.slots)
+    return _Template(spec=frozen, name=texts["name"], description=texts["description"], dofs=dofs,
+                     units=units, observe=observe, source=source, contact_names=tuple(contact_names),
+                     shapes=parser.shapes, targets=parser.targets, named=named, slots=parser.slots,
+                     fe=_FEParts(matrices=files.matrices, sets=tuple(plans), nodes=nodes))
 
 
 def _value(raw, path: str, named: Mapping[str, float]):
@@ -464,24 +328,85 @@ def _value(raw, path: str, named: Mapping[str, float]):
         return raw(named)
     except ExpressionError as exc:
         used = ", ".join(f"{k} = {named[k]:g}" for k in sorted(raw.names))
-        raise ModelFileError(f"{_label(path)} = {_quote(raw.text)} cannot be evaluated"
+        raise ModelFileError(f"{entry_label(path)} = {quote_text(raw.text)} cannot be evaluated"
                              f"{' with ' + used if used else ''}: {exc}; fix the expression or give other parameter "
                              "values") from None
 
 
-def _build(t: _Template) -> FrictionModel:
-    """The model of template ``t`` at its parameter values (validated once, by FrictionModel)."""
-    out = {key: {} if shape is None else np.zeros(shape) for key, shape in t.shapes.items()}
+def _containers(t: _Template) -> dict:
+    """Every container of ``t`` filled with its slots' values at ``t``'s parameters: dense arrays,
+    CSR matrices (sparse tables), tables of law values."""
+    out = {}
+    for key, shape in t.shapes.items():
+        out[key] = {} if shape is None else Triplets(*shape[1:]) if shape[0] == "sparse" else np.zeros(shape)
     for path, raw in t.slots.items():
         container, index = t.targets[path]
         out[container][index] = _value(raw, path, t.named)
+    return {key: value.matrix() if isinstance(value, Triplets) else value for key, value in out.items()}
+
+
+def _matrices(t: _Template, out: dict) -> tuple:
+    """M, C, K: written out, or from files (times their ``scale``), C also by Rayleigh or zero."""
+    scalars = out["scalars"]
+    for key, base in t.fe.matrices.items():
+        scale = scalars[f"{key}.scale"]
+        out[key] = base if scale == 1.0 else (base * scale).tocsr()
+        if key == "mass" and out[key] is not base and scale > 0.0 and is_checked(base):
+            mark_positive_definite(out[key])  # a positive multiple of a checked M is as definite
+    M, K = out["mass"], out["stiffness"]
+    if "rayleigh" in out:
+        alpha, beta = out["rayleigh"]
+        if is_sparse(M) or is_sparse(K):
+            M, K = sp.csr_matrix(M), sp.csr_matrix(K)
+            return out["mass"], (alpha * M + beta * K).tocsr(), out["stiffness"]
+        return M, alpha * M + beta * K, K
+    if "damping" not in out:
+        n = len(t.dofs)
+        return M, sp.csr_matrix((n, n)) if is_sparse(M) else np.zeros((n, n)), K
+    return M, out["damping"], K
+
+
+def _law(table, where: str) -> FrictionLaw:
+    try:
+        return FrictionLaw.from_mapping(table, where=where)
+    except FrictionLawError as exc:
+        raise ModelFileError(str(exc)) from None
+
+
+def _set_contacts(cset: ContactSet, out: dict) -> list[Contact]:
+    """The contacts of a contact set: shared laws, per-node or shared numbers."""
+    where = f"contact_set.{cset.name}"
+    law = _law(out[cset.container("friction")], f"{where}.friction")
+    normal = NormalLaw(**out[cset.container("normal")]) if cset.unilateral else None
+    scalars = out["scalars"]
+    drives = out[cset.container("node_drive")]
+    if "drive" not in cset.per_node:
+        drives[:] = out.get(cset.container("drive"), np.zeros(cset.dim))
+    gaps = out[cset.container("node_gap")] if "gap" in cset.per_node else \
+        np.full(len(cset.nodes), scalars.get(cset.container("gap"), 0.0))
+    loads = out[cset.container("node_normal_force")] if "normal_force" in cset.per_node else \
+        np.full(len(cset.nodes), scalars.get(cset.container("normal_force"), 0.0))
+    contacts = []
+    for k, name in enumerate(cset.contact_names):
+        if cset.unilateral:
+            contacts.append(Contact(dim=cset.dim, friction=law, tangent=cset.tangent[k], drive=drives[k], name=name,
+                                    normal=normal, gap=float(gaps[k]), gap_gradient=cset.gap_gradient[k]))
+            continue
+        if not loads[k] > 0.0:
+            raise ModelFileError(f"{where}: normal_force = {loads[k]:g} at node {cset.nodes[k]} must be > 0 (the "
+                                 "contact must be pressed)")
+        contacts.append(Contact(dim=cset.dim, friction=law, normal_force=float(loads[k]), tangent=cset.tangent[k],
+                                drive=drives[k], name=name))
+    return contacts
+
+
+def _build(t: _Template) -> FrictionModel:
+    """The model of template ``t`` at its parameter values (validated once, by FrictionModel)."""
+    out = _containers(t)
     scalars = out["scalars"]
     contacts = []
     for c, name in enumerate(t.contact_names):
-        try:
-            law = FrictionLaw.from_mapping(out[f"{c}.friction"], where=f"contact.{c}.friction")
-        except FrictionLawError as exc:
-            raise ModelFileError(str(exc)) from None
+        law = _law(out[f"{c}.friction"], f"contact.{c}.friction")
         G = out[f"{c}.tangent"]
         if f"{c}.normal" in out:  # unilateral: a gap and its normal law
             normal = NormalLaw(**out[f"{c}.normal"])
@@ -495,38 +420,48 @@ def _build(t: _Template) -> FrictionModel:
         contacts.append(Contact(dim=G.shape[0], friction=law, normal_force=N0, tangent=G, drive=out[f"{c}.drive"],
                                 normal_gradient=out.get(f"{c}.normal_gradient"),
                                 normal_rate_gradient=out.get(f"{c}.normal_rate_gradient"), name=name))
+    for cset in t.fe.sets:
+        contacts += _set_contacts(cset, out)
+    mass, damping, stiffness = _matrices(t, out)
     return FrictionModel(
-        name=t.name, dofs=t.dofs, mass=out["mass"], damping=out["damping"], stiffness=out["stiffness"],
+        name=t.name, dofs=t.dofs, mass=mass, damping=damping, stiffness=stiffness,
         force=out["force"], contacts=tuple(contacts), parameters=t.parameters, builder=t.with_values,
         source=t.source, units=dict(t.units), slip_band=scalars["slip_band"], description=t.description,
-        spec=t.spec, resolver=t.resolve, observed=t.observe,
+        spec=t.spec, resolver=t.resolve, observed=t.observe, nodes=t.fe.nodes,
     )
 
 
-def model_from_spec(spec: Mapping[str, Any], *, source: str = "python", name: str = "model") -> FrictionModel:
+def model_from_spec(spec: Mapping[str, Any], *, source: str = "python", name: str = "model",
+                    base: str | Path | None = None) -> FrictionModel:
     """Build a :class:`FrictionModel` from a model file's content (a parsed TOML mapping).
+
+    ``base`` is the folder that relative paths of matrix files, contact nodes and nodes are
+    relative to (the model file's; default the current folder).
 
     Raises
     ------
     ModelFileError
         Naming the key and the fix, for a missing key, an unknown key, a wrong shape, a
         non-number, a bad expression or parameter, a mass that is not symmetric positive
-        definite, an unknown law or N0 ≤ 0.
+        definite, an unknown law or N0 ≤ 0; a matrix file that is missing, unreadable, of another
+        size or with a non-finite entry.
     """
-    return _build(_template(spec, source, name))
+    return _build(_template(spec, source, name, None if base is None else Path(base)))
 
 
-def resolve_path(spec: Mapping[str, Any], path: str) -> str:
+def resolve_path(spec: Mapping[str, Any], path: str, dofs=None) -> str:
     """The canonical parameter path of ``path``: dof names as indices, and the index of a
-    one-entry vector or 1×1 matrix may be left out (``contact.0.drive`` = ``contact.0.drive.0``)."""
-    dofs = list(spec.get("dofs", []))
+    one-entry vector or 1×1 matrix may be left out (``contact.0.drive`` = ``contact.0.drive.0``).
+    ``dofs``: the dof names (default the spec's ``dofs`` list)."""
+    dofs = spec.get("dofs", []) if dofs is None else dofs
+    index = {dof: i for i, dof in enumerate(dofs)} if isinstance(dofs, (list, tuple)) else {}
     parts = path.split(".")
     node: Any = spec
     canonical: list[str] = []
     for part in parts:
         if isinstance(node, list):
-            if part in dofs:
-                part = str(dofs.index(part))
+            if part in index:
+                part = str(index[part])
             if not part.isdigit() or int(part) >= len(node):
                 raise ModelFileError(f"--set {path}: {'.'.join(canonical) or 'root'} has no entry {part!r}")
             node = node[int(part)]
@@ -556,17 +491,19 @@ def load_model_file(path: str | Path, source: str | None = None) -> FrictionMode
 
     ``source`` labels the model's origin (default ``file:PATH``)."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists() and not path.is_symlink():
         raise ModelFileError(f"model file {path} does not exist; give the path of a .toml model file "
                              "or a library model name (stickslip models)")
+    data = read_regular_file(path, MAX_MODEL_FILE_BYTES, "model file", ModelFileError,
+                             "give the matrices of a large model in matrix files beside it (docs/models.md)")
     try:
-        spec = tomllib.loads(path.read_text())
+        spec = tomllib.loads(data.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ModelFileError(f"{path} is not valid TOML ({exc}); fix the syntax") from None
     except RecursionError:
         raise ModelFileError(f"{path}: a value is nested too deeply to read; a model file holds numbers, lists "
                              "and matrices (lists of lists): fix the brackets") from None
     try:
-        return model_from_spec(spec, source=source or f"file:{path}", name=path.stem)
+        return model_from_spec(spec, source=source or f"file:{path}", name=path.stem, base=path.parent)
     except ModelError as exc:
         raise ModelFileError(f"{path}: {exc}") from None

@@ -27,13 +27,17 @@ from typing import Any, Callable, Mapping, NamedTuple
 import numpy as np
 
 from ..errors import ModelError
+from ..memory import check_memory, largest_dense_dofs, model_data_bytes
 from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
 from .bundle import NORMAL_LAWS
 from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantRigidKinematics, ConstantUnilateralKinematics,
                          allows_rigid, allows_unilateral,
                          computes_gap, kernel_kinematics, registered_kinematics)
+from .matrices import (DENSE_DOFS, MAX_MASS_CONDITION, check_mass, contact_rows, finite, has_nonzero, is_sparse,
+                       square_matrix)
 from .physics import SPEED_FLOOR
+from .sparse_form import NodeMap, SparseForm, sparse_form
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
 
 __all__ = ["FrictionModel", "Contact", "NormalLaw", "NamedState", "ModelError", "DEFAULT_SLIP_BAND", "MAX_MASS_CONDITION",
@@ -47,13 +51,6 @@ __all__ = ["FrictionModel", "Contact", "NormalLaw", "NamedState", "ModelError", 
 #: 1e-5, 1e-4 and 5e-4 give the same errors (≤ 6e-9 in frequency), 1e-3 and above start to show
 #: the band (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
 DEFAULT_SLIP_BAND = 5e-4
-
-#: Largest condition number λmax/λmin of the mass matrix (on the free dofs) accepted. eigvalsh
-#: finds the eigenvalues of M to an absolute error of about n·ε·λmax (ε = 2.2e-16), at most
-#: 64·ε ≈ 1.4e-14·λmax for the kernels' MAX_DOFS = 64; an eigenvalue below 1e-13·λmax is within
-#: ten times that of zero, so M is singular to working precision, and M⁻¹, formed once for the
-#: kernels, would carry relative errors of cond(M)·ε ≈ 2e-3 or more.
-MAX_MASS_CONDITION = 1e13
 
 #: What a dof name may hold: ``--ic x=1,dx=0`` splits at ``,`` and ``=``, ``--set stiffness.x.y``
 #: at ``.``, the shell at whitespace, and a leading digit would read as an index in a path.
@@ -96,6 +93,9 @@ def check_name(name: str, what: str) -> None:
         shown = repr(name) if len(repr(name)) <= 40 else repr(name)[:37] + "..."
         raise ModelError(f"{what} = {shown} is not a valid name; give a name of {NAME_RULE}")
 
+
+#: The dof names last checked by a FrictionModel (the same tuple is not checked again).
+_CHECKED_DOFS: list = [None]
 
 #: Normal laws a unilateral contact may state (:class:`NormalLaw`).
 UNILATERAL_LAWS = ("compliant", "rigid")
@@ -277,6 +277,14 @@ class FrictionModel:
     steady_hint : callable, optional
         ``steady_hint(model, q) -> str``: why steady sliding may not exist near the coordinates
         ``q`` where the search failed, in the model's own terms ("" for no hint).
+    nodes : NodeMap, optional
+        The mesh nodes' coordinates and each dof's node (a finite-element model's; results draw
+        mode shapes with them).
+
+    M, C, K and the contacts' rows may be given dense or as scipy.sparse matrices: a model of at
+    most :data:`~stickslip.model.matrices.DENSE_DOFS` dofs keeps them dense arrays, a larger one
+    CSR matrices (:mod:`stickslip.model.matrices`; :attr:`dense`), and :meth:`sparse_form` gives
+    either as the sparse arrays the sparse numerics take.
     """
 
     name: str
@@ -301,6 +309,7 @@ class FrictionModel:
     label: str = ""
     headline: tuple[str, ...] = ()
     steady_hint: Callable[["FrictionModel", np.ndarray], str] | None = None
+    nodes: NodeMap | None = None
 
     def __post_init__(self) -> None:
         n = len(self.dofs)
@@ -308,25 +317,15 @@ class FrictionModel:
             raise ModelError(f"model {self.name!r} has no degrees of freedom; list them in dofs")
         check_text(self.name, "the model's name")
         check_text(self.description, f"model {self.name!r}: description")
-        for i, dof in enumerate(self.dofs):
-            check_name(dof, f"model {self.name!r}: dof {i}")
-        if len(set(self.dofs)) != n:
-            raise ModelError(f"model {self.name!r}: dof names must be unique, got {list(self.dofs)}")
-        for dof in self.dofs:
-            if "d" + dof in self.dofs:
-                raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
-                                 f"states are the dofs, then d + each dof); give one of them another name")
+        if not (isinstance(self.dofs, tuple) and self.dofs is _CHECKED_DOFS[0]):
+            self._check_dofs()
+        dense = n <= DENSE_DOFS
         for key in ("mass", "damping", "stiffness"):
-            value = np.array(getattr(self, key), dtype=float)
-            if value.shape != (n, n):
-                raise ModelError(f"model {self.name!r}: {key} must be {n}×{n} (one row and column per dof), "
-                                 f"got shape {value.shape}")
-            if not np.isfinite(value).all():
-                raise ModelError(f"model {self.name!r}: {key} has a non-finite entry; give finite numbers")
-            object.__setattr__(self, key, value)
+            object.__setattr__(self, key, square_matrix(getattr(self, key), n, dense, f"model {self.name!r}: {key}"))
         force = np.zeros(n) if self.force is None else np.array(self.force, dtype=float).reshape(-1)
         if force.shape != (n,) or not np.isfinite(force).all():
-            raise ModelError(f"model {self.name!r}: force must be {n} finite numbers, got {force.tolist()}")
+            shown = force.tolist() if force.size <= 8 else f"{force.size} numbers"
+            raise ModelError(f"model {self.name!r}: force must be {n} finite numbers, got {shown}")
         object.__setattr__(self, "force", force)
         free = np.ones(n, dtype=bool) if self.free is None else np.array(self.free, dtype=bool)
         object.__setattr__(self, "free", free)
@@ -343,6 +342,25 @@ class FrictionModel:
             raise ModelError(f"slip_band = {self.slip_band} must be a finite speed > {SPEED_FLOOR} m/s")
         self._check_starts()
 
+    def _check_dofs(self) -> None:
+        """Dof names valid, distinct, and none ``d`` + another (remembered for the tuple last checked:
+        a model file's rebuilds pass the same tuple, of up to 10^6 names)."""
+        n = len(self.dofs)
+        for i, dof in enumerate(self.dofs):
+            check_name(dof, f"model {self.name!r}: dof {i}")
+        names = set(self.dofs)
+        if len(names) != n:
+            seen: set = set()
+            twice = next(d for d in self.dofs if d in seen or seen.add(d))
+            raise ModelError(f"model {self.name!r}: dof names must be unique, {twice!r} is given twice; give each dof "
+                             "its own name")
+        for dof in self.dofs:
+            if "d" + dof in names:
+                raise ModelError(f"model {self.name!r}: dofs {dof} and d{dof} both have the state name d{dof} (the "
+                                 f"states are the dofs, then d + each dof); give one of them another name")
+        if isinstance(self.dofs, tuple):
+            _CHECKED_DOFS[0] = self.dofs
+
     def _check_starts(self) -> None:
         locked = ~np.concatenate([self.free, self.free])
         for name, start in self.starts.items():
@@ -352,19 +370,7 @@ class FrictionModel:
                                  "the locked dofs")
 
     def _check_mass(self) -> None:
-        idx = np.flatnonzero(self.free)
-        M = self.mass[np.ix_(idx, idx)]
-        if not (np.abs(M - M.T) <= 1e-12 * np.abs(M.T)).all():  # M = Mᵀ to 1e-12 relative
-            raise ModelError(f"model {self.name!r}: mass must be symmetric; give M with M[i][j] = M[j][i]")
-        lam = np.linalg.eigvalsh(0.5 * (M + M.T)) if M.size else np.ones(1)
-        low, high = lam.min(), lam.max()
-        if not low > 0.0:
-            raise ModelError(f"model {self.name!r}: mass is not positive definite (smallest eigenvalue "
-                             f"{low:.3g}); masses and inertias must be > 0")
-        if low < np.finfo(float).tiny or not np.isfinite(high) or high > low * MAX_MASS_CONDITION:
-            raise ModelError(f"model {self.name!r}: mass is singular or not positive definite to working precision "
-                             f"(eigenvalues from {low:.3g} to {high:.3g}); masses and inertias must be normal floats "
-                             f"(>= {np.finfo(float).tiny:.3g}) within a factor {MAX_MASS_CONDITION:.0e} of each other")
+        check_mass(self.mass, self.free, f"model {self.name!r}")
 
     def _check_contacts(self) -> None:
         n = self.n
@@ -377,9 +383,6 @@ class FrictionModel:
         if sizes is not None and sizes != (n, len(self.contacts)):
             raise ModelError(f"model {self.name!r}: kinematics {cls.__name__} is for {sizes[0]} dofs and "
                              f"{sizes[1]} contact(s), the model has {n} and {len(self.contacts)}")
-        if sizes is None and (n > MAX_DOFS or len(self.contacts) > MAX_CONTACTS):
-            raise ModelError(f"model {self.name!r}: at most {MAX_DOFS} dofs and {MAX_CONTACTS} contacts are "
-                             f"supported, got {n} and {len(self.contacts)}")
         if not self.contacts:
             raise ModelError(f"model {self.name!r} has no contact; add a [[contact]] table")
         for c, contact in enumerate(self.contacts):
@@ -394,14 +397,11 @@ class FrictionModel:
             for key in ("normal_gradient", "normal_rate_gradient"):
                 value = getattr(contact, key)
                 if value is not None:
-                    value = np.array(value, dtype=float).reshape(-1)
-                    if value.shape != (n,) or not np.isfinite(value).all():
-                        raise ModelError(f"{where}: {key} must be {n} finite numbers")
-                    object.__setattr__(contact, key, value)
+                    object.__setattr__(contact, key, self._vector(value, f"{where}: {key} must be {n} finite numbers"))
             if constant:
                 if contact.tangent is None or contact.drive is None:
                     raise ModelError(f"{where}: give tangent (G) and drive (w) for constant kinematics")
-                G = np.array(contact.tangent, dtype=float)
+                G = contact_rows(contact.tangent, None, n, self.dense)
                 if G.ndim == 1:
                     G = G.reshape(1, -1)
                 w = np.array(contact.drive, dtype=float).reshape(-1)
@@ -409,12 +409,19 @@ class FrictionModel:
                     raise ModelError(f"{where}: tangent must have {contact.dim} row(s) of {n} numbers, got shape {G.shape}")
                 if w.shape != (contact.dim,):
                     raise ModelError(f"{where}: drive must have {contact.dim} number(s), one per tangent row")
-                if not (np.isfinite(G).all() and np.isfinite(w).all()):
+                if not (finite(G) and np.isfinite(w).all()):
                     raise ModelError(f"{where}: tangent and drive must be finite")
-                if not np.any(G[:, self.free]):
+                if not has_nonzero(G, self.free):
                     raise ModelError(f"{where}: tangent is zero on every free dof; the contact cannot slip")
                 object.__setattr__(contact, "tangent", G)
                 object.__setattr__(contact, "drive", w)
+
+    def _vector(self, value, refusal: str):
+        """A contact's gradient (n, n_v or W) as the model keeps it: (n,) dense, (1, n) sparse."""
+        out = contact_rows(value, 1, self.n, self.dense)
+        if out.shape != ((self.n,) if self.dense else (1, self.n)) or not finite(out):
+            raise ModelError(refusal)
+        return out
 
     def _check_gap(self, contact: Contact, where: str) -> None:
         """A unilateral contact: its normal law, a finite gap with a gradient, no prescribed load."""
@@ -439,10 +446,11 @@ class FrictionModel:
                 raise ModelError(f"{where}: kinematics {type(self.kinematics).__name__} computes the gap (its "
                                  "registered gap function); give neither gap nor gap_gradient")
             return
-        W = None if contact.gap_gradient is None else np.array(contact.gap_gradient, dtype=float).reshape(-1)
-        if W is None or W.shape != (self.n,) or not np.isfinite(W).all():
-            raise ModelError(f"{where}: gap_gradient must be {self.n} finite numbers (W of g = g0 + W·q)")
-        if not np.any(W[self.free]):
+        refusal = f"{where}: gap_gradient must be {self.n} finite numbers (W of g = g0 + W·q)"
+        if contact.gap_gradient is None:
+            raise ModelError(refusal)
+        W = self._vector(contact.gap_gradient, refusal)
+        if not has_nonzero(W, self.free):
             raise ModelError(f"{where}: gap_gradient is zero on every free dof; the contact can never open or close")
         object.__setattr__(contact, "gap_gradient", W)
 
@@ -494,12 +502,57 @@ class FrictionModel:
         """Whether G and w are constant (model files)."""
         return type(self.kinematics) in CONSTANT_KINEMATICS
 
+    @property
+    def dense(self) -> bool:
+        """Whether M, C, K and the contact rows are dense arrays (models of at most
+        :data:`~stickslip.model.matrices.DENSE_DOFS` dofs) rather than scipy.sparse CSR matrices."""
+        return not is_sparse(self.mass)
+
     @cached_property
     def data(self) -> ModelData:
-        """The model as the compiled kernels take it (:class:`~stickslip.model.bundle.ModelData`)."""
+        """The model as the compiled kernels take it (:class:`~stickslip.model.bundle.ModelData`).
+
+        Raises
+        ------
+        MemoryLimitError
+            When its dense arrays (:func:`~stickslip.memory.model_data_bytes`) do not fit in memory.
+        ModelError
+            For a model larger than the kernels take (``MAX_DOFS`` dofs, ``MAX_CONTACTS`` contacts,
+            for kinematics that do not fix their sizes); both say to reduce the model.
+        """
+        self._check_compiled_size()
         m = pack(self.mass, self.damping, self.stiffness, self.force, self.free,
                  [contact.spec(self.n) for contact in self.contacts], self.slip_band, self.constant_kinematics)
         return ModelData(m, kernel_kinematics(self.kinematics, *self._contact_kinds()), self.user_law)
+
+    @cached_property
+    def _sparse_form(self) -> SparseForm:
+        return sparse_form(self)
+
+    def sparse_form(self) -> SparseForm:
+        """The model as sparse arrays (:class:`~stickslip.model.sparse_form.SparseForm`), for
+        constant contact frames (model files, dense or sparse).
+
+        Raises
+        ------
+        ModelError
+            For contact frames computed from q (the plates).
+        """
+        return self._sparse_form
+
+    def _check_compiled_size(self) -> None:
+        n, nc = self.n, self.n_contacts
+        if static_sizes(type(self.kinematics)) is not None or (n <= MAX_DOFS and nc <= MAX_CONTACTS):
+            return
+        reduce = ("reduce it to its contact dofs and a few modes with `stickslip reduce` (Craig–Bampton), or "
+                  "analyse the full model with the sparse tools (complex eigenvalues of steady sliding)")
+        check_memory(model_data_bytes(n, nc), f"the compiled form of model {self.name!r} ({n} dofs, {nc} "
+                     "contacts; dense M⁻¹, M, C, K)",
+                     lambda memory: f"at most {largest_dense_dofs(memory, nc)} dofs fit (and the compiled tools "
+                     f"take at most {MAX_DOFS}); {reduce}")
+        raise ModelError(f"model {self.name!r} has {n} dofs and {nc} contacts; the compiled tools (simulate, "
+                         f"stability, orbits, sweeps, basins) take at most {MAX_DOFS} dofs and {MAX_CONTACTS} "
+                         f"contacts: {reduce}")
 
     def _contact_kinds(self) -> tuple[bool, bool]:
         """Whether the model has unilateral contacts, and a rigid one (the kernels compile their code
@@ -547,8 +600,10 @@ class FrictionModel:
             changes = {self.resolver(k): v for k, v in changes.items()}
         unknown = [k for k in changes if k not in self.parameters]
         if unknown:
-            raise ModelError(f"unknown parameter(s) {', '.join(unknown)} of model {self.name!r}; "
-                             f"valid names: {', '.join(self.parameters)}")
+            names = list(self.parameters)
+            shown = ", ".join(names[:24]) + (f", … ({len(names)} in all; 'stickslip models' lists them)"
+                                             if len(names) > 24 else "")
+            raise ModelError(f"unknown parameter(s) {', '.join(unknown)} of model {self.name!r}; valid names: {shown}")
         values = dict(self.parameters)
         values.update(changes)
         return self.builder(values)
@@ -571,6 +626,10 @@ class FrictionModel:
     def natural_frequencies(self) -> np.ndarray:
         """Undamped natural frequencies [Hz] of the free DOFs without friction, ascending
         (eigenvalues of M⁻¹ K; complex pairs of a non-symmetric K give their modulus)."""
+        if not self.dense:
+            raise ModelError(f"model {self.name!r} has {self.n} dofs, too many for all its natural frequencies; "
+                             "take its lowest modes from its sparse form (scipy.sparse.linalg.eigsh(K, M=M, sigma=0) "
+                             "on model.sparse_form()), or reduce it with `stickslip reduce`")
         idx = np.flatnonzero(self.free)
         M = self.mass[np.ix_(idx, idx)]
         K = self.stiffness[np.ix_(idx, idx)]

@@ -206,7 +206,7 @@ def _amplitude(problem: Problem, s: np.ndarray, T: float, lam: float) -> float:
 
 
 def continue_orbit(
-    system=None,
+    model=None,
     param: str = "Omega",
     start=None,
     *,
@@ -218,7 +218,6 @@ def continue_orbit(
     bounds: tuple[float, float] | None = None,
     stop_on: Sequence[str] = (),
     locate: bool = True,
-    model=None,
     section="max",
     rtol: float = 1e-10,
     atol: float | None = None,
@@ -243,7 +242,7 @@ def continue_orbit(
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str, optional
+    model : FrictionModel, Parameters, str, optional
         The model at the start, as :func:`stickslip.simulate` takes it (default: that of ``start``
         if it is a PeriodicOrbit or a run, else the plates with Table 1).
     param : str
@@ -262,10 +261,11 @@ def continue_orbit(
     bounds : (lo, hi), optional
         Interval of λ; the continuation ends on its edge (the last point corrected at λ = edge).
     stop_on : sequence of str
-        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``.
+        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``; ``grazing``
+        (a unilateral contact's flight phase appears or vanishes) only where the model has one.
     locate : bool
         Locate special points (Illinois/bisection); otherwise they are reported at the next point.
-    model, section, rtol, atol, slip_band
+    section, rtol, atol, slip_band
         As :func:`~stickslip.orbits.periodic_orbit` (used when ``start`` is not an orbit).
     tol : float
         Corrector convergence: max |Φ(s0, T) − s0| / σ ≤ tol [-].
@@ -307,9 +307,9 @@ def continue_orbit(
     """
     t_start = time.perf_counter()
     _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
-    if isinstance(start, (PeriodicOrbit, Trajectory)) and system is None and model is None:
-        system = start.system
-    system = resolve(system, model, slip_band)
+    if isinstance(start, (PeriodicOrbit, Trajectory)) and model is None:
+        model = start.system
+    system = resolve(model, slip_band)
     lo, hi = _bounds(bounds, param, numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system,
                                                       param))
     atol, section = 1e-3 * rtol if atol is None else float(atol), resolve_section(section, system)

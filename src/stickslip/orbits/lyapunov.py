@@ -135,7 +135,7 @@ def _check_memory(system, t_transient: float, t_average: float, interval: float,
                                 f"{round_down(largest_count(per, memory) * interval):.3g} s or lengthen {option}")
 
 
-def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average=0.0,
+def _after_transient(model, ic, perturbation, t_transient, rtol, atol, slip_band, t_average=0.0,
                      interval=math.inf, option="chunk"):
     """The common start of the Lyapunov computations: resolve the start, check the memory of the
     transient and of the running estimates (one per ``interval`` of ``t_average``), run the transient.
@@ -146,9 +146,9 @@ def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, s
     transient.
     """
     if isinstance(ic, PeriodicOrbit):
-        system = ic.system if system is None and model is None else system
+        model = ic.system if model is None else model
         ic = ic.state
-    system = resolve(system, model, slip_band)
+    system = resolve(model, slip_band)
     atol = 1e-3 * rtol if atol is None else float(atol)
     if t_transient <= 0.0:
         raise OrbitError("t_transient must be > 0: the transient run sets the scales of the norm")
@@ -170,10 +170,9 @@ def _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, s
 
 
 def lyapunov_exponent(
-    system=None,
+    model=None,
     ic="equilibrium",
     *,
-    model=None,
     t_transient: float = 50.0,
     t_average: float = 200.0,
     chunk: float = 1.0,
@@ -188,12 +187,10 @@ def lyapunov_exponent(
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str, optional
+    model : FrictionModel, Parameters, str, optional
         The model as :func:`stickslip.simulate` takes it (default: the orbit's, else the plates, Table 1).
     ic : "equilibrium", "zero", array-like (2n,), Trajectory or PeriodicOrbit
         Start of the transient run (a PeriodicOrbit: its section state and model).
-    model : str, optional
-        The plates' variant, or a library name / model file as ``system``.
     t_transient : float
         Transient simulated and discarded first [s] (> 0: it also sets the norm's scales).
     t_average : float
@@ -224,8 +221,8 @@ def lyapunov_exponent(
     n_chunks = int(round(t_average / chunk))
     if n_chunks < 1:
         raise OrbitError(f"t_average = {t_average} s is shorter than one chunk ({chunk} s)")
-    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average,
-                                      chunk, "chunk")
+    problem, s_ref = _after_transient(model, ic, perturbation, t_transient, rtol, atol, slip_band, t_average, chunk,
+                                      "chunk")
     free, sigma = problem.free, problem.sigma
 
     def perturbed(direction):
@@ -340,10 +337,9 @@ QR_INTERVAL = 1.0
 
 
 def lyapunov_spectrum(
-    system=None,
+    model=None,
     ic="equilibrium",
     *,
-    model=None,
     t_transient: float = 50.0,
     t_average: float = 200.0,
     record: float = 1.0,
@@ -364,7 +360,7 @@ def lyapunov_spectrum(
 
     Parameters
     ----------
-    system, ic, model, t_transient
+    model, ic, t_transient
         As :func:`lyapunov_exponent`.
     t_average : float
         Averaging time [s].
@@ -400,7 +396,7 @@ def lyapunov_spectrum(
     if t_average <= 0.0:
         raise OrbitError(f"t_average = {t_average} s must be > 0")
     interval, option = (chunk, "chunk") if method == "finite-difference" else (record, "record")
-    problem, s_ref = _after_transient(system, ic, model, perturbation, t_transient, rtol, atol, slip_band, t_average,
+    problem, s_ref = _after_transient(model, ic, perturbation, t_transient, rtol, atol, slip_band, t_average,
                                       interval, option)
     if method == "finite-difference":
         return _fd_spectrum(problem, s_ref, t_transient, t_average, chunk, d0, perturbation, t_start)

@@ -2,7 +2,7 @@
 
 Every orbit tool takes the model as :func:`stickslip.simulate` does — a
 :class:`~stickslip.model.system_model.FrictionModel`, a library name or model file, or the plates'
-:class:`~stickslip.model.parameters.Parameters` with a variant — and works on the
+:class:`~stickslip.model.parameters.Parameters` — and works on the
 :class:`FrictionModel` from then on. A parameter is any name of ``system.parameters``: the plates'
 (``N``, ``Omega``, ...) or a model file's ``--set`` path (``contact.0.drive``).
 """
@@ -13,7 +13,7 @@ import json
 import math
 
 from ..errors import ModelError, OrbitError
-from ..model.library import describe_system, resolve_system
+from ..model.library import describe_system, resolve_model
 from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
@@ -22,8 +22,8 @@ __all__ = ["resolve", "ModelResult", "parameter_value", "with_parameter", "model
            "plates_parameters"]
 
 
-def resolve(system=None, model=None, slip_band: float | None = None) -> FrictionModel:
-    """The FrictionModel of ``system`` / ``model`` (as :func:`stickslip.simulate` takes them).
+def resolve(model=None, slip_band: float | None = None) -> FrictionModel:
+    """The FrictionModel that ``model`` names (as :func:`stickslip.simulate` takes it).
 
     Raises
     ------
@@ -31,7 +31,7 @@ def resolve(system=None, model=None, slip_band: float | None = None) -> Friction
         For a model that cannot be resolved (the message names the fix).
     """
     try:
-        return resolve_system(system, model, slip_band)
+        return resolve_model(model, slip_band)
     except ModelError as exc:
         raise OrbitError(str(exc)) from exc
 

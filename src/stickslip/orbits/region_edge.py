@@ -20,7 +20,10 @@ import numpy as np
 from ..errors import ContinuationError, OrbitError, SimulationError
 from ..files import open_ours
 from ..integrate.driver import simulate
+from ..model.library import two_plates
+from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters
+from ..model.system_model import DEFAULT_SLIP_BAND
 from ..parallel import check_workers, worker_pool
 from . import branch_store as store
 from .branch import Branch, continue_orbit
@@ -138,7 +141,7 @@ EDGE_BISECTIONS, EDGE_PROBE, EDGE_WINDOW = 40, 60.0, 20.0
 EDGE_SEPARATION = 0.05
 
 
-def unstable_cycle(system, orbit_state: np.ndarray, *, model=None, rtol: float = 1e-10,
+def unstable_cycle(model, orbit_state: np.ndarray, *, rtol: float = 1e-10,
                    slip_band: float | None = None, section="max") -> PeriodicOrbit:
     """The saddle cycle on the boundary between the basins of a stable orbit and the equilibrium.
 
@@ -151,11 +154,11 @@ def unstable_cycle(system, orbit_state: np.ndarray, *, model=None, rtol: float =
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str
+    model : FrictionModel, Parameters, str
         The model (as :func:`stickslip.simulate` takes it; e.g. ``Branch.orbit_system(i)``).
     orbit_state : ndarray (2n,)
         A state on the stable stick-slip orbit (e.g. ``Branch.states[i]``).
-    model, rtol, slip_band, section
+    rtol, slip_band, section
         As :func:`~stickslip.orbits.periodic_orbit`.
 
     Returns
@@ -167,7 +170,7 @@ def unstable_cycle(system, orbit_state: np.ndarray, *, model=None, rtol: float =
     ContinuationError
         If the equilibrium end does not go to the equilibrium or the orbit end does not stick.
     """
-    system = resolve(system, model, slip_band)
+    system = resolve(model, slip_band)
     s_eq = equilibrium_state(system)
     s_orb = np.asarray(orbit_state, dtype=float)
     atol = 1e-3 * rtol
@@ -218,7 +221,8 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
     for omega in (omega_start, START_FALLBACK * omega_start):
         p = params.replace(N=float(N), Omega=float(omega))
         try:
-            run = start_run(p, "far", model=model, rtol=rtol, slip_band=band)
+            plates = two_plates(p, model, DEFAULT_SLIP_BAND if band is None else band)
+            run = start_run(plates, "far", rtol=rtol, slip_band=band)
             orbit = start_orbit_from_run(run, rtol=rtol, slip_band=band)
             if orbit.stick_phases == 0:
                 raise ContinuationError(f"the start orbit at Omega = {omega:g} rad/s has no stick phase")
@@ -240,8 +244,20 @@ def _edge_at(N: float, params: Parameters, omega_start: float, omega_max: float,
             time.perf_counter() - t0, branch.stop_reason)
 
 
-def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_start: float = 5.0,
-               omega_max: float = 40.0, model: str = "full", workers: int = 1, step: float = 0.05,
+def _plates_of(model, options: dict) -> tuple[Parameters, str]:
+    """The plates' Parameters and variant that ``model`` names (the fold curve's start runs are
+    the plates' ``far``); a low-speed band of its own joins ``options``."""
+    system = resolve(model)
+    if not is_plates(system):
+        raise ContinuationError(f"the fold curve is the plates' Region II edge; model {system.name!r} is not the two "
+                                "plates: continue its orbits with continue_orbit")
+    if system.slip_band != DEFAULT_SLIP_BAND:
+        options.setdefault("slip_band", system.slip_band)
+    return plates_parameters(system), system.label
+
+
+def fold_curve(N: Sequence[float], model=None, *, omega_start: float = 5.0,
+               omega_max: float = 40.0, workers: int = 1, step: float = 0.05,
                max_step: float = 1.0, max_points: int = 400, rtol: float = FOLD_RTOL, tol: float = FOLD_TOL,
                jacobian_every: int = FOLD_JACOBIAN_EVERY, out=None, resume: bool = True, **options) -> FoldCurve:
     """Ω where the stick-slip orbit ends, for each N: the upper edge of Region II (paper Fig. 8).
@@ -250,15 +266,15 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     ----------
     N : sequence of float
         Normal loads [N].
-    params : Parameters, optional
-        Base parameters (Table 1, μk = 0.2, Δμ = 0.1, α = 5 by default, as in Fig. 8).
+    model : Parameters, FrictionModel or str, optional
+        The two plates, as :func:`stickslip.simulate` takes them: base parameters (Table 1,
+        μk = 0.2, Δμ = 0.1, α = 5 by default, as in Fig. 8), in a variant with
+        ``two_plates(params, "rotation")`` or a variant's name (``full``: Model 1, default).
     omega_start : float
         Ω of the start orbit [rad/s]: it must lie where the ``far`` initial condition reaches a
         period-1 stick-slip orbit (Region I or II of Fig. 8).
     omega_max : float
         Upper bound of the continuation [rad/s].
-    model : str
-        The plates' variant (``full``: Model 1, default; ``x``, ``y``, ``rotation``).
     workers : int
         Processes (one N per task; at most the CPUs this process may run on). They end with this
         process, also when it is killed (:func:`stickslip.parallel.worker_pool`).
@@ -291,7 +307,7 @@ def fold_curve(N: Sequence[float], params: Parameters | None = None, *, omega_st
     """
     t0 = time.perf_counter()
     workers = check_workers(workers)
-    params = Parameters() if params is None else params
+    params, model = _plates_of(model, options)
     Ns = [float(n) for n in N]
     options = dict(options, step=step, max_step=max_step, max_points=max_points, rtol=rtol, tol=tol,
                    jacobian_every=jacobian_every)

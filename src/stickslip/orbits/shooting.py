@@ -31,7 +31,9 @@ from ..errors import OrbitError, SimulationError
 from ..integrate.driver import simulate
 from ..integrate.initial import initial_state, rigid_gaps
 from ..integrate.result import Trajectory
-from ..model.system_model import FrictionModel
+from ..model.library import two_plates
+from ..model.parameters import Parameters
+from ..model.system_model import DEFAULT_SLIP_BAND, FrictionModel
 from .layout import free_states
 from .models import ModelResult, model_attrs, resolve
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
@@ -176,11 +178,21 @@ def _refuse_closed_rigid(system, section, s0) -> None:
                          "('<dof>_max' of the dof that opens the gap)")
 
 
+def _orbit_model(model, guess, slip_band) -> FrictionModel:
+    """The model of :func:`periodic_orbit`: ``model``, by default a Trajectory ``guess``'s; the
+    plates' Parameters with a run of the plates take the run's variant."""
+    if isinstance(guess, Trajectory) and model is None:
+        return guess.system.with_slip_band(guess.system.slip_band if slip_band is None else slip_band)
+    if isinstance(guess, Trajectory) and isinstance(model, Parameters) and "variant" in guess.system.parameters:
+        band = DEFAULT_SLIP_BAND if slip_band is None else slip_band
+        return two_plates(model, guess.system.parameters["variant"], band).with_slip_band(band)
+    return resolve(model, slip_band)
+
+
 def periodic_orbit(
-    system=None,
+    model=None,
     guess=None,
     *,
-    model=None,
     section="max",
     period_multiplicity: int = 1,
     rtol: float = 1e-10,
@@ -197,17 +209,15 @@ def periodic_orbit(
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str, optional
+    model : FrictionModel, Parameters, str, optional
         The model, as :func:`stickslip.simulate` takes it: a FrictionModel, a library name or model
-        file, or the plates' Parameters (with a Trajectory ``guess``: by default its model, and plates'
-        Parameters take its variant; otherwise the plates with Table 1 by default).
+        file, or the plates' Parameters. With a Trajectory ``guess`` the default is the run's model,
+        and the plates' Parameters take the run's variant (new parameters for the run's plates);
+        otherwise the default is the plates with Table 1. Only its free DOFs are unknowns.
     guess : Trajectory, array-like (2n,), mapping, or "equilibrium"/"zero"
         A Trajectory near the orbit (its last ``period_multiplicity + 1`` section crossings give
         the starting state and period), or an initial state (:func:`stickslip.integrate.driver.initial_state`)
         from which a ``search_time`` run is made to find them.
-    model : str, optional
-        The plates' variant (``full`` by default), or a library name / model file as ``system``
-        (ignored when ``guess`` is a Trajectory: its model is used). Only its free DOFs are unknowns.
     section : "max", "<dof>_max", (dof, level) or Section
         Poincaré section: a maximum of the model's observed dof (its velocity through 0 downwards;
         the plates' φ, default), of a named dof, or an up-crossing of a level of a dof. It must be
@@ -249,12 +259,7 @@ def periodic_orbit(
         If no crossings are found, the section is crossed in stick, or Newton does not reach
         ``tol`` within ``max_iter`` iterations (the message gives the residual history).
     """
-    if isinstance(guess, Trajectory) and system is None and model is None:
-        system = guess.system.with_slip_band(guess.system.slip_band if slip_band is None else slip_band)
-    elif isinstance(guess, Trajectory) and model is None and "variant" in guess.system.parameters:
-        system = resolve(system, guess.system.parameters["variant"], slip_band)  # new parameters, the run's variant
-    else:
-        system = resolve(system, model, slip_band)
+    system = _orbit_model(model, guess, slip_band)
     k = int(period_multiplicity)
     if k < 1:
         raise OrbitError(f"period_multiplicity = {period_multiplicity} must be ≥ 1")

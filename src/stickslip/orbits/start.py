@@ -34,19 +34,18 @@ def default_start(system: FrictionModel) -> str:
     return next(iter(system.starts), "zero")
 
 
-def start_run(system, ic=None, *, model=None, t_end: float = START_RUN, rtol: float = 1e-10,
+def start_run(model, ic=None, *, t_end: float = START_RUN, rtol: float = 1e-10,
               slip_band: float | None = None) -> Trajectory:
     """A run from a named initial condition, to hand to ``continue_orbit`` as ``start``.
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str
-        The model (as :func:`stickslip.simulate` takes it; ``model``: the plates' variant).
+    model : FrictionModel, Parameters, str
+        The model (as :func:`stickslip.simulate` takes it).
     ic : str, array-like (2n,) or mapping, optional
         A named start (``zero``, ``equilibrium``, ``near``, the model's own such as the plates'
         ``far``: :func:`stickslip.integrate.initial.start_names`) or a state as ``simulate``
         takes it; default :func:`default_start`.
-    model : str, optional
     t_end : float
         Run length [s]; the orbit guess is taken from its last section crossings.
     rtol : float
@@ -54,7 +53,7 @@ def start_run(system, ic=None, *, model=None, t_end: float = START_RUN, rtol: fl
     slip_band : float, optional
         Low-speed band of the slip direction [m/s] (default: the model's).
     """
-    system = resolve(system, model, slip_band)
+    system = resolve(model, slip_band)
     ic = default_start(system) if ic is None else ic
     if t_end > 0 and t_end < float("inf"):  # its samples: refused by their length, the rate is ours
         check_samples(system, t_end, START_RATE, run="the start run (--search-time)", rate_settable=False)

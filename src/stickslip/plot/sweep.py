@@ -14,16 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.outcome import OUTCOMES, STOPPED, outcome_code
 from ..model.parameters import PARAMETER_UNITS
 from ._common import (MODEL_LABELS, SYMBOLS, agg_figure, cell_edges, grid_axis, is_geometric, param_text, save_figure,
                       symbol, unit_text)
 
-__all__ = ["plot_reduction", "save_sweep_figure", "plot_bifurcation", "save_bifurcation_figure", "KIND_STYLE",
-           "kind_styles", "axis_label"]
+__all__ = ["plot_reduction", "save_sweep_figure", "plot_bifurcation", "save_bifurcation_figure", "CLASS_STYLE",
+           "PERIODIC_SLIP", "point_classes", "axis_label"]
 
-#: Colour and label of each steady-state kind code (:data:`stickslip.analysis.classify.KINDS`,
-#: −1 = the run failed). A sweep file names its codes in the ``flag_values`` / ``flag_meanings``
-#: attributes of ``kind``; :func:`kind_styles` reads them and keeps these colours for known kinds.
+
 def _observed(ds) -> tuple[str, str, str]:
     """(name, symbol, unit) of the coordinate a sweep's peaks follow (the plates' φ [rad])."""
     name = ds.attrs.get("observed", "phi")
@@ -31,19 +30,32 @@ def _observed(ds) -> tuple[str, str, str]:
     return name, symbol(name), unit
 
 
-KIND_STYLE = {
-    -1: ("#d62728", "failed"),
-    0: ("#7f7f7f", "equilibrium"),
-    1: ("#1f77b4", "periodic slip"),
-    2: ("#000000", "periodic stick-slip"),
-    3: ("#ff7f0e", "non-periodic"),
-}
+#: The class of a periodic point without stick; the other classes are the outcome codes
+#: (:data:`~stickslip.analysis.outcome.OUTCOMES`), a periodic one with stick among them.
+PERIODIC_SLIP = len(OUTCOMES)
 
-#: Colours of kinds that :data:`KIND_STYLE` does not know, in order of their codes.
-_EXTRA_COLOURS = ("#9467bd", "#2ca02c", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
+_COLOURS = {"equilibrium": "#7f7f7f", "periodic": "#000000", "quasiperiodic": "#2ca02c", "chaotic": "#ff7f0e",
+            "unsettled": "#bcbd22", "unbounded": "#8c564b", "contact-lost": "#17becf", "failed": "#d62728"}
 
-#: Kinds without an oscillation: their cells carry their own colour in maps of :data:`OSCILLATION_VARS`.
-NOT_OSCILLATING = ("failed", "equilibrium", "unbounded")
+
+
+def _class_style() -> dict[int, tuple[str, str]]:
+    style = {}
+    for name, colour in _COLOURS.items():
+        if name == "periodic":
+            style[outcome_code(name)] = (colour, "periodic stick-slip")
+            style[PERIODIC_SLIP] = ("#1f77b4", "periodic slip")
+        else:
+            style[outcome_code(name)] = (colour, name.replace("-", " "))
+    return style
+
+
+#: Colour and label of each class a sweep's points are drawn in (:func:`point_classes`): the outcome
+#: of the point's run, a periodic one told apart by whether it sticks.
+CLASS_STYLE = _class_style()
+
+#: Classes without an oscillation: their cells carry their own colour in maps of :data:`OSCILLATION_VARS`.
+NOT_OSCILLATING = ("failed", "equilibrium", "unbounded", "contact lost")
 
 #: Reductions that describe an oscillation and mean nothing at rest (at an equilibrium the
 #: sweep stores the decay frequency and the peak-to-peak range of the dying transient).
@@ -98,39 +110,28 @@ def _split_dims(ds, var: str):
     return plotted, panels
 
 
-def _norm_name(name: str) -> str:
-    return name.replace("-", "").replace("_", "").replace(" ", "").lower()
+def point_classes(ds):
+    """The class of each point of a sweep (``xarray.DataArray`` over its grid; NaN where not computed):
+    the outcome code of its ``attractor``, or :data:`PERIODIC_SLIP` for a periodic point whose
+    ``stick_fraction`` is 0."""
+    code = ds["attractor"]
+    if "stick_fraction" not in ds.variables:  # the stick character unknown: periodic stays one class
+        return code
+    slip = (code == outcome_code("periodic")) & ~(ds["stick_fraction"] > 0)
+    return code.where(~slip, PERIODIC_SLIP)
 
 
-def kind_styles(ds) -> dict[int, tuple[str, str]]:
-    """{code: (colour, label)} of the steady-state kinds of a sweep, from the ``flag_values`` and
-    ``flag_meanings`` of its ``kind`` variable (:data:`KIND_STYLE` when it has none); kinds that
-    :data:`KIND_STYLE` does not know get colours of their own."""
-    attrs = ds["kind"].attrs if "kind" in ds.variables else {}
-    values, meanings = attrs.get("flag_values"), attrs.get("flag_meanings")
-    if values is None or meanings is None:
-        return dict(KIND_STYLE)
-    codes = [int(v) for v in (values.split() if isinstance(values, str) else np.atleast_1d(values))]
-    known = {_norm_name(label): (colour, label) for colour, label in KIND_STYLE.values()}
-    extra = iter(_EXTRA_COLOURS)
-    styles = {}
-    for code, name in zip(codes, str(meanings).split()):
-        colour, label = known.get(_norm_name(name), (None, name.replace("-", " ")))
-        styles[code] = (colour if colour is not None else next(extra, "#000080"), label)
-    return styles
-
-
-#: Class of a cell drawn on the colour scale, and of a cell without a value and without a kind
-#: that explains it (:data:`NO_VALUE`); other classes are kind codes.
+#: Class of a cell drawn on the colour scale, and of a cell without a value and without a class
+#: that explains it (:data:`NO_VALUE`); other classes are those of :data:`CLASS_STYLE`.
 _ON_SCALE, _NO_VALUE = -1000, -999
 
 
 def _classes(values, kind, styles, var) -> np.ndarray:
-    """Class of each cell (int array): :data:`_ON_SCALE`, or the kind code where the kind has no
+    """Class of each cell (int array): :data:`_ON_SCALE`, or the point's class where it has no
     oscillation and either ``var`` describes one or the value is missing, or :data:`_NO_VALUE`
-    where the value is missing otherwise. For ``var == "kind"`` the values are the classes."""
+    where the value is missing otherwise. For ``var == "attractor"`` the values are the classes."""
     values = np.asarray(values, dtype=float)
-    if var == "kind":
+    if var == "attractor":
         return np.where(np.isfinite(values), values, _NO_VALUE).astype(int)
     kind = np.full(values.shape, np.nan) if kind is None else np.asarray(kind, dtype=float)
     out = np.full(values.shape, _ON_SCALE, dtype=int)
@@ -142,10 +143,10 @@ def _classes(values, kind, styles, var) -> np.ndarray:
 
 
 def _class_style(key: int, styles, var: str) -> tuple[str, str]:
-    """(colour, legend label) of a cell class; a kind without oscillation says what it lacks."""
+    """(colour, legend label) of a cell class; a class without oscillation says what it lacks."""
     if key == _NO_VALUE:
         return NO_VALUE
-    colour, label = styles.get(int(key), (_EXTRA_COLOURS[-1], f"kind {int(key)}"))
+    colour, label = styles.get(int(key), ("#000080", f"class {int(key)}"))
     if var in OSCILLATION_VARS and label in NOT_OSCILLATING:
         label += f" (no {var})"
     return colour, label
@@ -165,7 +166,7 @@ def _heat_map(ax, da, kind, x, y, var, styles, label, colorbar):
         mesh = ax.pcolormesh(xe, ye, np.ma.masked_where(~on_scale, z), cmap="viridis")
         if colorbar:
             ax.figure.colorbar(mesh, ax=ax, label=label)
-    keys = np.unique(cls[~on_scale])  # sorted: no value first, then the kind codes
+    keys = np.unique(cls[~on_scale])  # sorted: no value first, then the classes
     if keys.size:
         styled = [_class_style(k, styles, var) for k in keys]
         index = np.searchsorted(keys, cls)
@@ -188,7 +189,7 @@ def _line_plot(ax, da, kind, x, categorical, var, styles, label):
     marked = {}
     for cat, line, kline in groups:
         ys = line.transpose(x).values.astype(float)
-        cls = (np.full(ys.shape, _ON_SCALE) if var == "kind" else
+        cls = (np.full(ys.shape, _ON_SCALE) if var == "attractor" else
                _classes(ys, None if kline is None else kline.transpose(x).values, styles, var))
         ax.plot(xs, np.where(cls == _ON_SCALE, ys, np.nan), "o-", ms=3, lw=1.2,
                 label=None if cat is None else f"{categorical} = {cat}")
@@ -198,7 +199,7 @@ def _line_plot(ax, da, kind, x, categorical, var, styles, label):
         colour, text = _class_style(key, styles, var)
         ax.plot(marked[key], np.zeros(len(marked[key])), "|", color=colour, ms=12, mew=2,
                 transform=ax.get_xaxis_transform(), label=text)
-    if var == "kind":
+    if var == "attractor":
         ax.set_yticks(sorted(styles), [styles[c][1] for c in sorted(styles)])
     if categorical or marked:
         ax.legend(fontsize=8)
@@ -216,11 +217,12 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
     * one numeric dimension: a line with markers against it;
     * two numeric dimensions: a heat map whose cells span their true edges (midpoints between
       grid values; geometric grids on a log axis, see :func:`~stickslip.plot._common.cell_edges`),
-      with a colour bar in the variable's units; ``kind`` drawn with one colour per kind;
+      with a colour bar in the variable's units; ``attractor`` drawn with one colour per class
+      (:func:`point_classes`: the outcome, a periodic one split by whether it sticks);
     * one numeric and one categorical (``model``, ``ic``) dimension: one line per category.
 
-    Points whose kind has no oscillation (equilibrium, failed run) are never drawn on the scale
-    of a quantity of an oscillation (:data:`OSCILLATION_VARS`): they get their kind's colour and
+    Points without an oscillation (equilibrium, a run that stopped) are never drawn on the scale
+    of a quantity of an oscillation (:data:`OSCILLATION_VARS`): they get their class's colour and
     a legend entry, as do cells without a value.
 
     Parameters
@@ -228,7 +230,7 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
     result : SweepResult or xarray.Dataset
     var : str
         A variable of the sweep (``frequency`` [Hz], ``amplitude`` [rad], ``stick_fraction`` [-],
-        ``kind``, ``intensity_r_phi`` [m s^-1/2], ...).
+        ``attractor``, ``intensity_r_phi`` [m s^-1/2], ...).
     ax : matplotlib.axes.Axes, optional
     select : dict, optional
         Values of the other dimensions.
@@ -247,8 +249,9 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
-    da = ds[var]
-    kind = ds["kind"] if "kind" in ds.data_vars and var != "kind" else None
+    classes = point_classes(ds) if "attractor" in ds.data_vars else None
+    da = classes if var == "attractor" else ds[var]
+    kind = classes if var != "attractor" else None
     for dim, value in (select or {}).items():
         method = None if not _is_numeric(ds, dim) else "nearest"
         da = da.sel({dim: value}, method=method)
@@ -261,7 +264,7 @@ def plot_reduction(result, var: str = "frequency", ax=None, *, select: dict | No
     for d in numeric:  # a grid given out of order is drawn in order
         da = da.sortby(d)
         kind = None if kind is None else kind.sortby(d)
-    styles = kind_styles(ds)
+    styles = dict(CLASS_STYLE)
     label = axis_label(ds, var)
     if len(dims) > 2 or len(categorical) > 1 or (len(dims) == 2 and not numeric):
         raise ValueError(f"{var} has dimensions {tuple(dims)} after selection; select values of all but two "
@@ -360,9 +363,9 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
     """Bifurcation diagram: the steady-state peak values of φ (events φ̇ = 0) against the control
     parameter, as dots (paper Figs. 12–14).
 
-    Dots are coloured by the steady-state kind of the point (:func:`kind_styles`: periodic
-    stick-slip black, non-periodic orange, periodic slip blue, ...). Equilibria have no peaks and
-    are drawn as grey crosses at the resting φ (the time mean in the window); failed runs as red
+    Dots are coloured by the point's class (:func:`point_classes`, :data:`CLASS_STYLE`: periodic
+    stick-slip black, periodic slip blue, chaotic orange, ...). Equilibria have no peaks and are
+    drawn as grey crosses at the resting φ (the time mean in the window); runs that stopped as
     ticks on the lower edge. A geometric control grid is drawn on a log axis.
 
     Parameters
@@ -395,11 +398,12 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
-    styles = kind_styles(ds)
+    styles = dict(CLASS_STYLE)
     xs = ds[x].values.astype(float)
     peaks = ds["peaks"].transpose(x, "peak").values
-    pending = ~np.isfinite(ds["kind"].values)  # not computed (yet)
-    kind = np.where(pending, -99, ds["kind"].values).astype(int)
+    classes = point_classes(ds).transpose(x).values
+    pending = ~np.isfinite(classes)  # not computed (yet)
+    kind = np.where(pending, -99, classes).astype(int)
     handles = []
     for code, (colour, label) in styles.items():
         rows = kind == code
@@ -411,15 +415,15 @@ def plot_bifurcation(result, ax=None, *, select: dict | None = None, legend: boo
         if np.any(ok):
             ax.scatter(xx[ok], yy[ok], s=marker_size, color=colour, linewidths=0, rasterized=True)
             handles.append(Line2D([], [], ls="", marker="o", ms=5, color=colour, label=label))
-    codes = {label: code for code, (_, label) in styles.items()}
     coordinate, symbol, unit = _observed(ds)
-    eq = kind == codes.get("equilibrium", 0)
+    eq = kind == outcome_code("equilibrium")
     if np.any(eq):
-        colour = styles.get(codes.get("equilibrium", 0), KIND_STYLE[0])[0]
+        colour = styles[outcome_code("equilibrium")][0]
         ax.plot(xs[eq], ds[f"{coordinate}_mean"].values[eq], "x", color=colour, ms=5)
         handles.append(Line2D([], [], ls="", marker="x", ms=5, color=colour, label=f"equilibrium ({symbol} at rest)"))
-    for where, colour, label in ((kind == codes.get("failed", -1), KIND_STYLE[-1][0], "run failed"),
-                                 (pending, "#b0b0b0", "not computed")):
+    stopped = [(kind == outcome_code(name), styles[outcome_code(name)][0], f"run {styles[outcome_code(name)][1]}")
+               for name in STOPPED]
+    for where, colour, label in stopped + [(pending, "#b0b0b0", "not computed")]:
         if np.any(where):  # ticks on the lower edge: these points have no value to show
             ax.plot(xs[where], np.zeros(where.sum()), "|", color=colour, ms=10, transform=ax.get_xaxis_transform())
             handles.append(Line2D([], [], ls="", marker="|", ms=5, mew=1.5, color=colour, label=label))

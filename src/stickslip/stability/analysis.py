@@ -15,8 +15,11 @@ from ..model.derivatives import state_jacobian_from_python
 from ..model.library.two_plates import plates_parameters
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.physics import MODE_SLIP_EXACT
+from ..model.sparse_form import SparseForm
 from ..model.variants import DOF_NAMES
+from .band import BandError, band_stability
 from .equilibrium import model_of, point_text, rigid_constraint, solve_steady
+from .sparse_input import is_sparse_model
 
 __all__ = ["StabilityResult", "stability", "linearization", "model_stability"]
 
@@ -194,26 +197,36 @@ def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return J, -M @ J[k:, :k], -M @ J[k:, k:]
 
 
-def stability(params=None, model="full") -> StabilityResult:
+def stability(model=None, *, max_frequency: float | None = None, method: str | None = None,
+              cutoff: float | None = None, residual: bool = True):
     """Linear stability of steady sliding (paper Sect. 4.1) of any friction model.
 
     Finds the steady-sliding equilibrium (Eq. 14 for the plates), linearises the slip equations
     about it (Eq. 15) with the exact Jacobian of the simulator's right-hand side (complex-step
     differentiation), and takes the eigenvalues.
 
+    A model of sparse matrices (finite elements), or a call with ``max_frequency``, takes the
+    sparse path instead (:func:`~stickslip.stability.band.band_stability`): steady sliding by one
+    sparse solve and every eigenvalue of a band by complex eigenvalue analysis.
+
     Parameters
     ----------
-    params : Parameters, FrictionModel or str, optional
-        The plates' parameters (default Table 1), or any model (a FrictionModel, a library name
-        or a model file path).
-    model : str, iterable of DOF names or Variant
-        The plates' variant: ``full`` (Model 1), ``x`` (2), ``y`` (3), ``rotation`` (4), or the DOFs
-        to free (or a library name / model file, as ``params``). The Jacobian is reduced to the
-        free DOFs.
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it: any model (a FrictionModel, a library
+        name or a model file path) or the plates' parameters (default Table 1; in a variant:
+        ``two_plates(params, "rotation")``, Model 4). The Jacobian is reduced to the free DOFs.
+    max_frequency : float, optional
+        The band's top ω_max [rad/s] of the sparse path (required for a sparse model).
+    method : {"direct", "modal", "dense"}, optional
+        The sparse path's method (default ``direct``).
+    cutoff : float, optional
+        The real modes' cutoff of ``modal`` [rad/s] (default 2 ω_max).
+    residual : bool
+        ``modal``: the residual vectors of the contact rows beside the modes (default).
 
     Returns
     -------
-    StabilityResult
+    StabilityResult, or BandStability on the sparse path
 
     Raises
     ------
@@ -221,8 +234,16 @@ def stability(params=None, model="full") -> StabilityResult:
         No steady sliding (Ω = 0, Newton failure), a sliding speed at equilibrium inside the
         simulator's low-speed band, where its slip direction is not v/|v|, or a Jacobian that
         overflows (values far outside physical size).
+    BandError
+        A sparse model without ``max_frequency``, or a band that holds no eigenvalue.
     """
-    return model_stability(model_of(params, model))
+    system = model if isinstance(model, SparseForm) else model_of(model)
+    if max_frequency is None and method is None and cutoff is None and not is_sparse_model(system):
+        return model_stability(system)
+    if max_frequency is None:
+        raise BandError(f"model {system.name!r} has {system.n} dofs: give max_frequency (--max-frequency), the top "
+                        "of the band whose eigenvalues its sparse analysis computes [rad/s]")
+    return band_stability(system, max_frequency, method=method or "direct", cutoff=cutoff, residual=residual)
 
 
 def model_stability(system) -> StabilityResult:

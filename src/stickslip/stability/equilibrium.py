@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import EquilibriumError, StickSlipError
 from ..model.compile_ahead import compile_apart
 from ..model.bundle import CST
-from ..model.library import resolve_system
+from ..model.library import resolve_model
 from ..model.parameters import Parameters
 from ..model.physics import MODE_SLIP_EXACT, gap, normal_force_of, rhs, rigid_pivot, slip_velocity
 from ..model.system_model import FrictionModel
@@ -255,7 +255,7 @@ def steady_residual(system, q: np.ndarray) -> float:
     return num / scale if scale > 0.0 and np.isfinite(num) else math.inf
 
 
-def equilibrium(system=None, model=None) -> np.ndarray:
+def equilibrium(model=None) -> np.ndarray:
     """Steady-sliding equilibrium q_e (n,) of a model, locked DOFs 0 [units of the dofs].
 
     Solves the force balance at rest (for the plates K x = b(x), paper Eq. 14, b from Appendix
@@ -265,10 +265,9 @@ def equilibrium(system=None, model=None) -> np.ndarray:
 
     Parameters
     ----------
-    system : Parameters, FrictionModel or str, optional
-        The plates' parameters (default Table 1), or any model (as :func:`stickslip.simulate` takes it).
-    model : str, iterable of DOF names or Variant, optional
-        The plates' variant: ``full`` (Model 1), ``x``, ``y``, ``rotation`` (Model 4), or the DOFs to free.
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it (default the plates with Table 1; the
+        plates in a variant: ``two_plates(params, "rotation")``).
 
     Raises
     ------
@@ -279,17 +278,18 @@ def equilibrium(system=None, model=None) -> np.ndarray:
         dragged to the centre of the lower plate and steady sliding ceases to exist), or when the
         sliding speed at equilibrium is inside the simulator's low-speed band.
     """
-    return steady_sliding(model_of(system, model))
+    return steady_sliding(model_of(model))
 
 
-def model_of(params, model) -> FrictionModel:
-    """The model that ``params`` and ``model`` name (as :func:`stickslip.simulate` takes them).
+def model_of(model) -> FrictionModel:
+    """The model that ``model`` names (as :func:`stickslip.simulate` takes it).
 
     Raises
     ------
     TypeError
-        For ``params`` that is not the plates' Parameters, a model, a library name or a model file.
+        For ``model`` that is not a model, the plates' Parameters, a library name or a model file.
     """
-    if params is not None and not isinstance(params, (Parameters, FrictionModel, str, Path)):
-        raise TypeError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
-    return resolve_system(params, model)
+    if model is not None and not isinstance(model, (Parameters, FrictionModel, str, Path)):
+        raise TypeError(f"model must be a FrictionModel, the plates' Parameters or a model's name, got "
+                        f"{type(model).__name__}")
+    return resolve_model(model)

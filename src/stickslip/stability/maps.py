@@ -530,11 +530,10 @@ def _members(system, family) -> tuple[str, list, list]:
 
 
 def stability_map(
-    params=None,
+    model=None,
     N: Sequence[float] = tuple(np.linspace(5.0, 200.0, 40)),
     Omega: Sequence[float] = tuple(np.linspace(0.25, 20.0, 80)),
     *,
-    model="full",
     family: "tuple[str, Sequence] | Mapping[str, Sequence] | str | None" = None,
     boundary: bool = True,
     axes: tuple[str, str] = ("N", "Omega"),
@@ -543,14 +542,13 @@ def stability_map(
 
     Parameters
     ----------
-    params : Parameters, FrictionModel or str, optional
-        The plates' base parameters (default Table 1, μk = 0.2, Δμ = 0.1, α = 5), or any model
-        (a FrictionModel, a library name or a model file path).
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it: the plates' base parameters (default
+        Table 1, μk = 0.2, Δμ = 0.1, α = 5; in a variant: ``two_plates(params, "rotation")``), or
+        any model (a FrictionModel, a library name or a model file path).
     N, Omega : sequence of float
         Values of the first and second parameter (``axes``), strictly increasing; for the plates'
         default axes the normal loads [N] (> 0) and angular velocities [rad/s] (non-zero).
-    model : str or iterable of DOF names
-        The plates' variant, ``full`` (Model 1) … ``rotation`` (Model 4).
     family : (name, values), {name: values}, "name=v1,v2" or None
         A third parameter varied over the map (any parameter of the model other than the axes), or
         for the plates ``"model"`` (e.g. ``("model", ["full", "rotation"])`` for paper Fig. 4).
@@ -571,7 +569,7 @@ def stability_map(
         For an empty or non-increasing grid, N ≤ 0, Ω = 0 (plates), an unknown parameter, or a
         value that makes the model invalid.
     """
-    system = model_of(params, model)
+    system = model_of(model)
     axes = tuple(axes)
     N = _as_float_array(axes[0], N)
     Omega = _as_float_array(axes[1], Omega)

@@ -74,9 +74,10 @@ def _recipe_table2(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 
 # ----------------------------------------------------------------------------- Fig. 7
-def _simulate_named(params, t_end, ic_name, model="full"):
-    ic, pert = initial_condition(ic_name, two_plates(params, model))
-    return simulate(params, t_end, model=model, ic=ic, perturbation=pert, sample_rate=200.0)
+def _simulate_named(params, t_end, ic_name):
+    plates = two_plates(params)
+    ic, pert = initial_condition(ic_name, plates)
+    return simulate(plates, t_end, ic=ic, perturbation=pert, sample_rate=200.0)
 
 
 def _recipe_fig7(out: Path, res: Resolution, cache: dict) -> RecipeResult:
@@ -95,11 +96,11 @@ def _recipe_fig7(out: Path, res: Resolution, cache: dict) -> RecipeResult:
             tr = _simulate_named(p, res.fig7_t_end, ic)
             c = classify(tr, t_from=t_from)
             ss.append(c.is_stick_slip)
-            measured[f"Omega={om:g},{ic}"] = {"kind": c.kind, "stick_fraction": c.stick_fraction}
+            measured[f"Omega={om:g},{ic}"] = {"outcome": c.outcome, "stick_fraction": c.stick_fraction}
             ax = axes[i, j]
             ax.plot(tr.t, tr.states[:, 4], lw=0.6, label="φ")
             ax.plot(tr.t, tr.states[:, 5], lw=0.6, label="ψ")
-            ax.set_title(f"Ω = {om:g} rad/s, IC {ic}: {c.kind}, stick {c.stick_fraction:.2f}", fontsize=9)
+            ax.set_title(f"Ω = {om:g} rad/s, IC {ic}: {c.outcome}, stick {c.stick_fraction:.2f}", fontsize=9)
             ax.set_ylabel("angle [rad]")
             if i == 2:
                 ax.set_xlabel("t [s]")
@@ -109,7 +110,7 @@ def _recipe_fig7(out: Path, res: Resolution, cache: dict) -> RecipeResult:
         pf, pn = paper[om]
         rows.append(Row(f"Fig. 7, Ω = {om:g} rad/s",
                         f"far IC: {word(pf)}, near IC: {word(pn)} (N = 50 N)",
-                        f"far: {measured[f'Omega={om:g},far']['kind']}, near: {measured[f'Omega={om:g},near']['kind']} "
+                        f"far: {measured[f'Omega={om:g},far']['outcome']}, near: {measured[f'Omega={om:g},near']['outcome']} "
                         f"(window {t_from:g}–{res.fig7_t_end:g} s)",
                         _yes(tuple(ss) == (pf, pn)),
                         "stick-slip (stick in the window, not at equilibrium) from each IC as in the paper"))
@@ -124,11 +125,11 @@ PAPER_FIG10 = {30: (1.46, "periodic"), 50: (0.99, "periodic"), 70: (0.78, "perio
 PAPER_FIG11 = {30: (5.0, 15.0), 120: (0.0, 20.0)}
 
 
-def _settled_run(params, res: Resolution, t_min: float, **options):
+def _settled_run(model, res: Resolution, t_min: float):
     """A run extended until it has settled (or reaches ``res.settle_cap``), window ≤ 100 s."""
     window = min(100.0, 0.5 * t_min)
-    return simulate_until_settled(params, cap=res.settle_cap, t_min=t_min, window=window, step=window,
-                                  sample_rate=200.0, **options)
+    return simulate_until_settled(model, cap=res.settle_cap, t_min=t_min, window=window, step=window,
+                                  sample_rate=200.0)
 
 
 def _verdict_text(run) -> str:
@@ -229,13 +230,13 @@ def _recipe_fig11(out: Path, res: Resolution, cache: dict) -> RecipeResult:
 
 # ----------------------------------------------------------------------------- Fig. 15
 def _recipe_fig15(out: Path, res: Resolution, cache: dict) -> RecipeResult:
-    run = _settled_run(Parameters(N=50.0, Omega=0.5), res, res.fig15_t_end, model="rotation")
+    run = _settled_run(two_plates(Parameters(N=50.0, Omega=0.5), "rotation"), res, res.fig15_t_end)
     a = run.attractor
     save_trajectory_figure(run.trajectory, out / "fig15.png")
     rows = [Row("Fig. 15", "Model 4 (rotation only): periodic stick-slip of φ with one period (Sect. 4.2.3, with Fig. 14(e)(f))",
                 f"N = 50 N, Ω = 0.5 rad/s: {_verdict_text(run)}, period {_fmt(a.period_s, 4)} s, stick fraction "
                 f"{_fmt(a.classification.stick_fraction if a.classification else math.nan)}",
-                _yes(a.kind == "periodic-stick-slip" and a.period_count == 1),
+                _yes(a.attractor == "periodic" and a.is_stick_slip and a.period_count == 1),
                 "settled periodic stick-slip with one peak per period (the paper does not print N, Ω of Fig. 15; "
                 "ours are those of Figs. 12(a)/14 at N = 50 N)")]
     return RecipeResult(["fig15.png"], rows, a.to_dict())

@@ -17,8 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.classify import KINDS
-from ..attractors import ATTRACTORS
+from ..analysis.outcome import STOPPED, is_stick_slip, outcome_names
 from ..model.parameters import Parameters
 from ..plot.intensity import save_intensity_figure
 from ..plot.regions import MODEL_LABELS, save_regions_figure
@@ -70,17 +69,9 @@ UNCHANGED_PERIOD_RTOL = 0.05
 DIFFERENT_PERIOD_RTOL = 0.10
 
 
-def _kind_names(ds) -> np.ndarray:
-    """Kind names of a sweep dataset (``failed`` for −1 / missing)."""
-    code = ds["kind"].values
-    names = np.array(KINDS + ("failed",), dtype=object)
-    return names[np.where(np.isfinite(code), code, -1).astype(int)]
-
-
 def _stick_slip(ds) -> np.ndarray:
-    """Boolean: the point is a stick-slip oscillation (not equilibrium, not failed, sticks)."""
-    k = np.where(np.isfinite(ds["kind"].values), ds["kind"].values, -1)
-    return (k > 0) & (np.nan_to_num(ds["stick_fraction"].values) > 0)
+    """Boolean: the point is a stick-slip oscillation (it moves and sticks in its window)."""
+    return is_stick_slip(ds["attractor"].values, ds["stick_fraction"].values)
 
 
 def _spearman(x, y) -> float:
@@ -98,11 +89,9 @@ NON_PERIODIC = ("chaotic", "quasiperiodic")
 
 
 def _attractor_names(ds) -> np.ndarray:
-    """Verdict names of a sweep dataset (:data:`~stickslip.attractors.ATTRACTORS`; ``failed``
-    for −1 / missing)."""
-    code = ds["attractor"].values
-    names = np.array(ATTRACTORS + ("failed",), dtype=object)
-    return names[np.where(np.isfinite(code), code, -1).astype(int)]
+    """Outcome names of a sweep dataset (:data:`~stickslip.analysis.outcome.OUTCOMES`; ``failed``
+    where missing)."""
+    return outcome_names(ds["attractor"].values)
 
 
 def _regimes(values, labels) -> list:
@@ -163,7 +152,7 @@ def _region_maps(out: Path, res: Resolution, models, cache: dict):
     if missing:
         N = np.linspace(*REGIONS_N_RANGE, res.regions_N)
         Om = np.linspace(*REGIONS_OMEGA_RANGE, res.regions_Omega)
-        rm = regions(N, Om, models=missing, out=out / f"regions_{'_'.join(missing)}.nc", t_end=res.regions_t_end,
+        rm = regions(N, Om, variants=missing, out=out / f"regions_{'_'.join(missing)}.nc", t_end=res.regions_t_end,
                      t_from=res.regions_t_from, executor=res.executor, workers=res.workers, overwrite=True)
         for m in missing:
             have[m] = rm.dataset.sel(model=[m])
@@ -216,9 +205,10 @@ def _recipe_fig9(out: Path, res: Resolution, cache: dict) -> RecipeResult:
     region = ds["region"].transpose("model", "N", "Omega").values
     ss = (region == 1) | (region == 2)
     cells = {m: int(ss[i].sum()) for i, m in enumerate(models)}
-    kinds = _kind_names(ds.transpose("model", "N", "Omega", "ic", ...))
-    slip_only = {m: int(np.sum(kinds[i] == "periodic-slip")) for i, m in enumerate(models)}
-    failed = {m: int(np.sum(kinds[i] == "failed")) for i, m in enumerate(models)}
+    cube = ds.transpose("model", "N", "Omega", "ic", ...)
+    names, sticks = _attractor_names(cube), cube["stick_fraction"].values > 0
+    slip_only = {m: int(np.sum((names[i] == "periodic") & ~sticks[i])) for i, m in enumerate(models)}
+    failed = {m: int(np.sum(np.isin(names[i], STOPPED))) for i, m in enumerate(models)}
     smaller = all(cells[m] > 0 and cells["rotation"] <= 0.75 * cells[m] for m in ("full", "x", "y"))
     inside = bool(np.all(ss[0][ss[3]])) and cells["full"] > cells["rotation"]
     measured = "; ".join(f"{MODEL_LABELS[m].split(' (')[0]}: {cells[m]} cells" for m in models)

@@ -9,8 +9,9 @@ not print them; ours are :data:`~stickslip.sweep.spec.NAMED_ICS`):
           stick-slip oscillation that coexists with it (Fig. 7(c)).
 ``near``  the equilibrium of Eq. (14) with φ raised by 1e-3 rad.
 
-Each steady state is classified (:mod:`stickslip.analysis.classify`); a response is
-*stick-slip* when it is not ``equilibrium`` and sticks in the steady window. Then
+Each run's outcome is decided (:func:`stickslip.attractors.attractor`); a response is
+*stick-slip* when it moves to the end of its window and sticks in it
+(:func:`stickslip.analysis.outcome.is_stick_slip`). Then
 
 =========  ====================================================================
 region 1   I: stick-slip from both initial conditions (stick-slip only)
@@ -32,9 +33,11 @@ from typing import Sequence
 
 import numpy as np
 
+from ..analysis.outcome import is_stick_slip, outcome_code
 from ..errors import SweepError
 from ..files import atomic_write, lock
-from ..model.parameters import Parameters
+from ..model.library import resolve_model
+from ..model.library.two_plates import is_plates
 from ..parallel import check_workers
 from ..results import Plottable
 from .engine import SweepResult, sweep
@@ -50,10 +53,11 @@ _RUN_OPTIONS = ("executor", "workers", "address", "batch_size", "progress", "ove
 REGION_NAMES = {0: "other", 1: "I: stick-slip only", 2: "II: coexistence", 3: "III: equilibrium only"}
 
 
-def classify_regions(kind: np.ndarray, stick_fraction: np.ndarray) -> np.ndarray:
-    """Region codes (0–3) from kind codes and stick fractions with the two ICs on the last axis."""
-    stick_slip = (kind != 0) & (kind >= 0) & (stick_fraction > 0)
-    equilibrium = kind == 0
+def classify_regions(outcome: np.ndarray, stick_fraction: np.ndarray) -> np.ndarray:
+    """Region codes (0–3) from outcome codes (:data:`~stickslip.analysis.outcome.OUTCOMES`) and
+    stick fractions, with the two ICs on the last axis."""
+    stick_slip = is_stick_slip(outcome, stick_fraction)
+    equilibrium = outcome == outcome_code("equilibrium")
     a_ss, b_ss = stick_slip[..., 0], stick_slip[..., 1]
     a_eq, b_eq = equilibrium[..., 0], equilibrium[..., 1]
     region = np.zeros(a_ss.shape, dtype=np.int8)
@@ -100,9 +104,9 @@ class RegionMap(Plottable):
 def _with_regions(ds):
     import xarray as xr
 
-    kind = ds["kind"].transpose("model", "N", "Omega", "ic").values
+    outcome = ds["attractor"].transpose("model", "N", "Omega", "ic").values
     sf = ds["stick_fraction"].transpose("model", "N", "Omega", "ic").values
-    region = classify_regions(np.where(np.isfinite(kind), kind, -1), np.nan_to_num(sf))
+    region = classify_regions(outcome, np.nan_to_num(sf))
     omega = ds["Omega"].values
     ss = (region == 1) | (region == 2)
     omax = np.where(ss.any(axis=-1), np.max(np.where(ss, omega, -np.inf), axis=-1), np.nan)
@@ -115,8 +119,8 @@ def _with_regions(ds):
     ) if isinstance(ds, xr.Dataset) else ds
 
 
-def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | None = None, *,
-            models: Sequence[str] = ("full",), out=None, t_end: float = 200.0, t_from: float | None = None,
+def regions(N: Sequence[float], Omega: Sequence[float], model=None, *,
+            variants: Sequence[str] | None = None, out=None, t_end: float = 200.0, t_from: float | None = None,
             **sweep_options) -> RegionMap:
     """Classify (N, Ω) into regions I, II, III (Fig. 8) for each model (Fig. 9 with all four).
 
@@ -124,10 +128,12 @@ def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | Non
     ----------
     N, Omega : sequences
         Grid of normal loads [N] and lower-plate speeds [rad/s] (increasing).
-    params : Parameters, optional
-        Base parameters (μk = 0.2, Δμ = 0.1, α = 5 by default, as in Figs. 8–9).
-    models : sequence of str
-        ``full``, ``x``, ``y``, ``rotation`` (Models 1–4).
+    model : Parameters, FrictionModel or str, optional
+        The two plates, as :func:`stickslip.simulate` takes them: base parameters (μk = 0.2,
+        Δμ = 0.1, α = 5 by default, as in Figs. 8–9), or the plates in a variant.
+    variants : sequence of str, optional
+        The plates' variants mapped: ``full``, ``x``, ``y``, ``rotation`` (Models 1–4); default
+        the variant of ``model`` (``full`` for Parameters).
     out : path, optional
         NetCDF output; resumable like :func:`~stickslip.sweep.sweep`.
     t_end, t_from : float
@@ -142,9 +148,14 @@ def regions(N: Sequence[float], Omega: Sequence[float], params: Parameters | Non
     """
     if "ic" in sweep_options:
         raise SweepError("regions() uses the two initial conditions 'far' and 'near'; do not pass ic")
-    grid = {"model": list(models), "N": list(N), "Omega": list(Omega), "ic": ["far", "near"]}
+    system = resolve_model(model)
+    if not is_plates(system):
+        raise SweepError(f"regions are those of the two plates (Figs. 8, 9); model {system.name!r} is not the plates: "
+                         "sweep its parameters with sweep()")
+    variants = [system.label] if variants is None else list(variants)
+    grid = {"model": variants, "N": list(N), "Omega": list(Omega), "ic": ["far", "near"]}
     run = {k: sweep_options.pop(k) for k in _RUN_OPTIONS if k in sweep_options}
-    spec = SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **sweep_options)  # bad input: before the lock
+    spec = SweepSpec.build(grid, system, t_end=t_end, t_from=t_from, **sweep_options)  # bad input: before the lock
     check_workers(run.get("workers"), address=run.get("address"))
     if out is None:
         res: SweepResult = sweep(spec, **run)

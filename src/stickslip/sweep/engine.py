@@ -11,7 +11,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from ..analysis.classify import KINDS
+from ..analysis.outcome import outcome_names
 from ..errors import SweepError
 from ..integrate.driver import check_samples
 from ..journal import finished_output, output_path
@@ -61,11 +61,10 @@ class SweepResult:
         """The result as an ``xarray.Dataset``."""
         return self.dataset
 
-    def kinds(self) -> np.ndarray:
-        """Steady-state kind names over the grid (``failed`` for −1)."""
-        code = self.dataset["kind"].values
-        names = np.array(KINDS + ("failed",), dtype=object)
-        return names[np.where(np.isfinite(code), code, -1).astype(int)]
+    def outcomes(self) -> np.ndarray:
+        """What each point's run settles to, by name (:data:`~stickslip.analysis.outcome.OUTCOMES`) over
+        the grid; whether it sticks is the ``stick_fraction`` variable beside it."""
+        return outcome_names(self.dataset["attractor"].values)
 
 
 #: Most points per automatic batch: a batch's rows are held in memory until journaled, so this
@@ -131,7 +130,7 @@ def _progress_bar():
                     transient=False)
 
 
-def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
+def sweep(grid: Mapping[str, Sequence] | SweepSpec, model=None, *, out=None,
           executor: str = "processes", workers: int | None = None, address: str | None = None,
           batch_size: int | str = "auto", progress: bool = False, overwrite: bool = False,
           snapshot_interval: float = 60.0, keep_journal: bool = False, t_end: float = 200.0,
@@ -146,9 +145,10 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
         model its parameter paths, e.g. ``contact.0.drive``), ``model`` (the plates' variants),
         ``ic`` (named initial conditions, :data:`~stickslip.sweep.spec.NAMED_ICS`) or
         ``perturb_<state>``.
-    params : Parameters, FrictionModel or str, optional
-        The plates' base parameters (default Table 1 with N = 50 N, Ω = 5 rad/s), or any model
-        stated as a model file (a FrictionModel read from one, a library name or a path).
+    model : FrictionModel, Parameters or str, optional
+        The model, as :func:`stickslip.simulate` takes it: the plates' base parameters (default
+        Table 1 with N = 50 N, Ω = 5 rad/s; in a variant: ``two_plates(params, "rotation")``), or
+        any model stated as a model file (a FrictionModel read from one, a library name or a path).
     out : path, optional
         NetCDF output (``.nc``). Finished points are journaled beside it (``OUT.nc.journal``) as
         they arrive; a sweep killed and restarted with the same arguments recomputes nothing it
@@ -173,7 +173,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     t_end, t_from : float
         Run length and start of the steady window of every point [s] (default t_end/2).
     **options
-        ``model``, ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
+        ``ic``, ``sample_rate`` [Hz] (default 200), ``rtol``, ``atol``, ``max_steps``,
         ``n_peaks``, ``method``, ``settle`` (extend every run until it has settled; then
         ``t_end`` is the first run's length), ``cap`` [s] (longest run when settling),
         ``confirm``: see :class:`~stickslip.sweep.spec.SweepSpec`.
@@ -193,7 +193,7 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
         If the disk is full (the journal keeps every finished point: run again to resume).
     """
     t_start = time.perf_counter()
-    spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, params, t_end=t_end, t_from=t_from, **options)
+    spec = grid if isinstance(grid, SweepSpec) else SweepSpec.build(grid, model, t_end=t_end, t_from=t_from, **options)
     check_executor(executor)
     workers = check_workers(workers, address=address)
     _check_memory(spec, 0 if address else 1 if executor == "serial" else workers)
@@ -206,48 +206,8 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
     journal = Journal(out, spec, overwrite=overwrite)
     info: dict = {"executor": executor, "workers": workers}
     try:
-        todo = np.flatnonzero(~journal.done_mask())
-        info["points_resumed"] = int(spec.size - todo.size)
-        info["points_computed"] = int(todo.size)
-        bar = _progress_bar() if progress else None
-        task = None
-        if bar is not None:
-            bar.start()
-            task = bar.add_task(f"sweep {'×'.join(map(str, spec.shape))}", total=spec.size,
-                                completed=spec.size - todo.size, rate="")
-        compute_start = time.perf_counter()
-        n_done = 0
-        last_snapshot = time.perf_counter()
-
-        def record(idx, rows):
-            nonlocal n_done, last_snapshot
-            journal.append(idx, rows)
-            n_done += len(idx)
-            if bar is not None:
-                rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
-                bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
-            if time.perf_counter() - last_snapshot > snapshot_interval:
-                assemble(journal, out, extra_attrs=_settle_attrs(spec))
-                last_snapshot = time.perf_counter()
-
-        if todo.size:
-            # the first point runs here: it compiles/loads the kernels and times a point
-            t = time.perf_counter()
-            record(*evaluate_batch(spec, todo[:1]))
-            t_point = time.perf_counter() - t
-            rest = todo[1:]
-            size = _auto_batch(t_point, rest.size, workers, executor) if batch_size == "auto" else int(batch_size)
-            if size < 1:
-                raise SweepError(f"batch_size must be >= 1 or 'auto', got {batch_size!r}")
-            batches = [rest[i : i + size] for i in range(0, rest.size, size)]
-            info.update(batch_size=size, batches=len(batches), first_point_s=t_point)
-            if batches:
-                for idx, rows in map_unordered(functools.partial(evaluate_batch, spec), batches, executor=executor,
-                                               workers=workers, address=address, warm=warm_up, info=info):
-                    record(idx, rows)
-        info["compute_s"] = time.perf_counter() - compute_start
-        if bar is not None:
-            bar.stop()
+        _compute(journal, out, info, batch_size=batch_size, address=address, progress=progress,
+                 snapshot_interval=snapshot_interval)
         assemble(journal, out, extra_attrs={"executor": executor, **_settle_attrs(spec)})
         if not keep_journal:
             journal.remove()
@@ -265,3 +225,52 @@ def sweep(grid: Mapping[str, Sequence] | SweepSpec, params=None, *, out=None,
         tmpdir.cleanup()
     return result
 
+
+def _compute(journal: Journal, out: Path, info: dict, *, batch_size, address, progress: bool,
+             snapshot_interval: float) -> None:
+    """Compute the points of ``journal``'s sweep that it does not hold, journaling each batch as it
+    arrives (with ``info``'s executor and workers; its counts and times are added to ``info``) and
+    writing a snapshot of ``out`` every ``snapshot_interval`` seconds."""
+    spec, executor, workers = journal.spec, info["executor"], info["workers"]
+    todo = np.flatnonzero(~journal.done_mask())
+    info["points_resumed"] = int(spec.size - todo.size)
+    info["points_computed"] = int(todo.size)
+    bar = _progress_bar() if progress else None
+    task = None
+    if bar is not None:
+        bar.start()
+        task = bar.add_task(f"sweep {'×'.join(map(str, spec.shape))}", total=spec.size,
+                            completed=spec.size - todo.size, rate="")
+    compute_start = time.perf_counter()
+    n_done = 0
+    last_snapshot = time.perf_counter()
+
+    def record(idx, rows):
+        nonlocal n_done, last_snapshot
+        journal.append(idx, rows)
+        n_done += len(idx)
+        if bar is not None:
+            rate = n_done / max(time.perf_counter() - compute_start, 1e-9)
+            bar.update(task, advance=len(idx), rate=f"{rate:.2f} pts/s")
+        if time.perf_counter() - last_snapshot > snapshot_interval:
+            assemble(journal, out, extra_attrs=_settle_attrs(spec))
+            last_snapshot = time.perf_counter()
+
+    if todo.size:
+        # the first point runs here: it compiles/loads the kernels and times a point
+        t = time.perf_counter()
+        record(*evaluate_batch(spec, todo[:1]))
+        t_point = time.perf_counter() - t
+        rest = todo[1:]
+        size = _auto_batch(t_point, rest.size, workers, executor) if batch_size == "auto" else int(batch_size)
+        if size < 1:
+            raise SweepError(f"batch_size must be >= 1 or 'auto', got {batch_size!r}")
+        batches = [rest[i : i + size] for i in range(0, rest.size, size)]
+        info.update(batch_size=size, batches=len(batches), first_point_s=t_point)
+        if batches:
+            for idx, rows in map_unordered(functools.partial(evaluate_batch, spec), batches, executor=executor,
+                                           workers=workers, address=address, warm=warm_up, info=info):
+                record(idx, rows)
+    info["compute_s"] = time.perf_counter() - compute_start
+    if bar is not None:
+        bar.stop()

@@ -18,15 +18,15 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..analysis.classify import kind_code
 from ..analysis.intensity import angle_range, intensity, trajectory_intensities
+from ..analysis.outcome import outcome_code, outcome_flags
 from ..analysis.signal import OPEN, SLIP, STICK
-from ..attractors import ATTRACTORS, DEFAULT_CAP_S, attractor, simulate_until_settled
+from ..attractors import DEFAULT_CAP_S, attractor, simulate_until_settled
 from ..errors import EquilibriumError, SimulationError, SweepError
 from ..integrate.driver import simulate
 from ..integrate.initial import NAMED_STARTS, NEAR_PERTURBATION, start_names
 from ..integrate.status import Status
-from ..model.library import describe_system, resolve_system, system_from_description, two_plates
+from ..model.library import describe_system, resolve_model, system_from_description, two_plates
 from ..model.library.two_plates import is_plates, plates_parameters
 from ..model.parameters import Parameters
 from ..model.system_model import DEFAULT_SLIP_BAND, FrictionModel
@@ -59,6 +59,12 @@ def initial_condition(name: str, system: FrictionModel) -> tuple[Any, float | No
 
 
 # ----------------------------------------------------------------------------- the row schema
+#: Attributes of a sweep's ``attractor`` variable: the outcome of each point's run.
+ATTRACTOR_ATTRS = {"long_name": "what the run settles to (its outcome)", **outcome_flags(),
+                   "comment": "periodic only when settled (and confirmed by shooting for more than one peak per "
+                              "period); an oscillation with stick_fraction > 0 is stick-slip"}
+
+
 def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str = "rad", unilateral: bool = False):
     """(name, width, attrs) of each reduced quantity, in row order.
 
@@ -70,12 +76,7 @@ def _columns(n_peaks: int, observed: str = "phi", plates: bool = True, unit: str
     ``n_transitions``.
     """
     cols = [
-        ("kind", 1, {"long_name": "steady-state kind", "flag_values": "-1 0 1 2 3",
-                     "flag_meanings": "failed equilibrium periodic-slip periodic-stick-slip non-periodic",
-                     "comment": "periodic only when settled (and confirmed by shooting for more than one "
-                                "peak per period); non-periodic includes unsettled runs"}),
-        ("attractor", 1, {"long_name": "what the run settles to", "flag_values": "-1 0 1 2 3 4 5",
-                          "flag_meanings": "failed " + " ".join(ATTRACTORS)}),
+        ("attractor", 1, ATTRACTOR_ATTRS),
         ("settled", 1, {"long_name": "the window shows the attractor (1) or a transient (0)"}),
         ("period_count", 1, {"long_name": "peaks of phi per period of a settled periodic orbit, 0 otherwise"}),
         ("period", 1, {"units": "s", "long_name": "period of a settled periodic orbit (return map of the peaks of phi)"}),
@@ -216,14 +217,13 @@ class SweepSpec:
     system: dict | None = None
 
     @classmethod
-    def build(cls, grid: Mapping[str, Sequence], params=None, *, t_end: float = 200.0,
+    def build(cls, grid: Mapping[str, Sequence], model=None, *, t_end: float = 200.0,
               t_from: float | None = None, **options) -> "SweepSpec":
         """Validate a grid ``{name: values}`` and options into a spec (see the attributes).
 
-        ``params``: the plates' :class:`Parameters` (default Table 1), or any model (a
-        FrictionModel, library name or model file; also accepted as the ``model`` option).
+        ``model``: as :func:`stickslip.simulate` takes it (default the plates with Table 1).
         """
-        system = _resolve_model(params, options)
+        system = _resolve_model(model)
         fields = {k for k, v in system.parameters.items() if not isinstance(v, (str, bool))}
         states = system.state_names
         if not grid:
@@ -270,7 +270,6 @@ class SweepSpec:
             raise SweepError(f"t_from = {t_from} s must lie in [0, t_end = {t_end} s)")
         ic = str(options.pop("ic", "zero"))
         initial_condition(ic, system)
-        options.pop("model", None)
         spec = cls(dims=tuple(dims), ic=ic, t_end=t_end, t_from=t_from, **_described(system), **options)
         if spec.n_peaks < 1:
             raise SweepError("n_peaks must be >= 1")
@@ -327,20 +326,19 @@ class SweepSpec:
 
 def _described(system: FrictionModel) -> dict:
     """``params``, ``model`` and ``system`` of a spec of ``system``. The plates with their default
-    slip band are described by their Parameters and variant alone (``system`` None), as before
-    models were data: their specs, digests and files stay the same, and journals of earlier
-    sweeps resume."""
+    slip band are described by their Parameters and variant alone (``system`` None): the specs and
+    digests of the plates' sweeps do not depend on how the model is stated in code."""
     if is_plates(system) and system.slip_band == DEFAULT_SLIP_BAND:
         return dict(params=plates_parameters(system).to_dict(), model=system.label, system=None)
     return dict(params=dict(system.parameters), model=system.label or system.name, system=describe_system(system))
 
 
-def _resolve_model(params, options: dict) -> FrictionModel:
-    """The model of a sweep: the plates' Parameters with ``options["model"]`` their variant, or any
-    model (a FrictionModel, a library name or a model file, also as ``options["model"]``)."""
-    if params is not None and not isinstance(params, (Parameters, FrictionModel, str, Path)):
-        raise SweepError(f"params must be a stickslip.Parameters or a model, got {type(params).__name__}")
-    system = resolve_system(params, options.get("model"))
+def _resolve_model(model) -> FrictionModel:
+    """The model of a sweep (as :func:`stickslip.simulate` takes it), one its workers can rebuild."""
+    if model is not None and not isinstance(model, (Parameters, FrictionModel, str, Path)):
+        raise SweepError(f"model must be a FrictionModel, the plates' Parameters or a model's name, got "
+                         f"{type(model).__name__}")
+    system = resolve_model(model)
     if system.builder is None or (system.spec is None and system.source == "python"):
         raise SweepError(f"model {system.name!r} was defined in Python and cannot be rebuilt by the sweep's workers; "
                          "state it as a model file (.toml)")
@@ -412,11 +410,9 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
     if traj is not None:
         out["t_reached"] = float(traj.t[-1])
         out["steps"] = float(traj.stats.steps)
-    if traj is None or traj.status != "success":
-        out["kind"] = -1.0
+    if traj is None or traj.status != "success":  # the run stopped early: unbounded, contact-lost or failed
         verdict = None if traj is None else verdict or attractor(traj, confirm=spec.confirm, lyapunov=spec.confirm)
-        unbounded = verdict is not None and verdict.attractor == "unbounded"
-        out["attractor"] = float(verdict.code) if unbounded else -1.0
+        out["attractor"] = float(outcome_code("failed") if verdict is None else verdict.code)
     else:
         verdict = verdict or attractor(traj, confirm=spec.confirm, lyapunov=spec.confirm)
         c = verdict.classification
@@ -424,9 +420,10 @@ def evaluate(spec: SweepSpec, flat_index: int) -> np.ndarray:
         sel = traj.t >= t_from
         x = traj.states[sel, observed]
         x_min, x_max, x_mean = observed_columns(system.dofs[observed])
-        out.update(kind=float(kind_code(verdict.kind)), attractor=float(verdict.code), settled=float(verdict.settled),
+        out.update(attractor=float(verdict.code), settled=float(verdict.settled),
                    period_count=float(verdict.period_count or 0), period=verdict.period_s,
-                   fundamental_frequency=_nan(verdict.fundamental_frequency_hz), frequency=c.frequency_hz if c.kind.startswith("periodic") else c.peak_rate_hz,
+                   fundamental_frequency=_nan(verdict.fundamental_frequency_hz),
+                   frequency=c.frequency_hz if c.outcome == "periodic" else c.peak_rate_hz,
                    dominant_frequency=_nan(verdict.dominant_frequency_hz),
                    settle_time=_nan(verdict.settle_time_s), stick_fraction=c.stick_fraction, amplitude=c.amplitude,
                    n_peaks=float(len(c.peaks)))

@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from .._version import __version__
+from ..analysis.outcome import outcome_code
 from ..errors import SweepError
 from ..files import format_name, open_ours
 from ..integrate.initial import start_description
@@ -43,11 +44,14 @@ from ..journal import READ_ROWS as JOURNAL_READ_ROWS
 from ..journal import RowJournal, journal_path
 from ..model.library import describe_system
 from ..model.parameters import parameter_attrs
-from .spec import SweepSpec, spec_system
+from .spec import ATTRACTOR_ATTRS, SweepSpec, spec_system
 
 __all__ = ["Journal", "assemble", "load_sweep", "FORMAT", "journal_dir", "flat_hyperslabs", "LOAD_LIMIT_POINTS"]
 
-FORMAT = format_name("sweep", 1)
+FORMAT = format_name("sweep", 2)
+
+#: Sweeps of this format still read (:func:`load_sweep` gives them in the current one's terms).
+EARLIER_FORMAT = format_name("sweep", 1)
 
 #: Journal records read at once (:data:`stickslip.journal.READ_ROWS`, 2.9 MB of ~88 float64 rows;
 #: 16384 measured 20 MB more peak at 10^5 points: two blocks and their sorted copies in flight).
@@ -58,7 +62,7 @@ READ_ROWS = JOURNAL_READ_ROWS
 #: 10^6 points still take only ~250 slabs × 23 variables × ≤ 3 hyperslab writes.
 SLAB_POINTS = 4096
 
-#: Sweeps up to this many points are returned loaded into memory (as before); larger ones are
+#: Sweeps up to this many points are returned loaded into memory; larger ones are
 #: opened lazily (values read from the file on access), so that returning the result does not
 #: hold the whole grid in memory: 65536 points × ~88 float64 = 46 MB at most.
 LOAD_LIMIT_POINTS = 65536
@@ -258,5 +262,29 @@ def load_sweep(path, *, load: bool | str = True):
     """
     if load == "auto":
         load = lambda ds: "done" not in ds or ds["done"].size <= LOAD_LIMIT_POINTS  # noqa: E731
-    return open_ours(path, "sweep", load=load,
-                     what="a .nc file written by `stickslip sweep`, `bifurcation` or `regions`")
+    ds = open_ours(path, "sweep", load=load, versions=(1, 2),
+                   what="a .nc file written by `stickslip sweep`, `bifurcation` or `regions`")
+    return _in_current_terms(ds)
+
+
+#: The outcome of each steady-state kind code of a format-1 sweep without an ``attractor``
+#: variable (equilibrium, periodic slip, periodic stick-slip, non-periodic; −1 failed).
+_KIND_OUTCOMES = {0: "equilibrium", 1: "periodic", 2: "periodic", 3: "unsettled", -1: "failed"}
+
+
+def _in_current_terms(ds):
+    """A format-1 sweep as format 2 has it: the outcome of each point in ``attractor`` (a failed
+    run's −1 as ``failed``; from the steady-state kind where the file has no ``attractor``) and
+    the kind, which the outcome and ``stick_fraction`` say, dropped. The file is not changed."""
+    if ds.attrs.get("format") != EARLIER_FORMAT or "kind" not in ds.variables:
+        return ds
+    failed = outcome_code("failed")
+    if "attractor" in ds.variables:
+        attractor = ds["attractor"].where(ds["attractor"] != -1, failed)
+    else:
+        kind = ds["kind"]
+        attractor = kind.copy(data=np.full(kind.shape, np.nan))
+        for code, name in _KIND_OUTCOMES.items():
+            attractor = attractor.where(kind != code, outcome_code(name))
+    attractor.attrs = dict(ATTRACTOR_ATTRS)
+    return ds.drop_vars("kind").assign(attractor=attractor)

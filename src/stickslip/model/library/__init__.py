@@ -27,7 +27,7 @@ from .two_plates import NAME as TWO_PLATES
 from .two_plates import two_plates
 
 __all__ = ["load_model", "library", "library_names", "two_plates", "TWO_PLATES", "describe_system", "system_from_description",
-           "resolve_system", "plates_variant"]
+           "resolve_model", "plates_variant"]
 
 HERE = Path(__file__).resolve().parent
 
@@ -46,14 +46,17 @@ def library() -> dict[str, str]:
 
 
 def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
-    """A library model by name (``two-plates``, ``belt``, ...) or a model file by path.
+    """A library model by name (``two-plates``, ``belt``, ...), a variant of the plates by name, or
+    a model file by path.
 
     Parameters
     ----------
     name : str, Path or FrictionModel
         A library name (``stickslip models`` lists them: ``two-plates``, ``belt``, ``hoffmann``,
-        ``popp-stelter``, ``slider-belt``, ``sprag-slip``), the path of a model file (``.toml``),
-        or a model, returned as it is. Default: the two plates with Table 1 parameters.
+        ``popp-stelter``, ``slider-belt``, ``sprag-slip``), a variant of the two plates with Table 1
+        parameters (``full``, ``x``, ``y``, ``rotation``, :func:`plates_variant`), the path of a
+        model file (``.toml``), or a model, returned as it is. Default: the two plates with Table 1
+        parameters.
 
     Returns
     -------
@@ -68,50 +71,46 @@ def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
     if isinstance(name, FrictionModel):
         return name
     text = str(name)
-    if text == TWO_PLATES:
-        return two_plates()
+    variant = plates_variant(text) if not isinstance(name, Path) else None
+    if variant is not None:
+        return two_plates(None, variant)
     path = HERE / (text.replace("-", "_") + ".toml")
     if "/" not in text and not text.endswith(".toml") and path.is_file():
         return load_model_file(path, source=f"library:{text}")
-    if text.endswith(".toml") or Path(text).is_file():
-        return load_model_file(text)
+    if text.endswith(".toml") or Path(text).exists() or Path(text).is_symlink():
+        return load_model_file(text)  # refuses what is not a regular file (a folder, a pipe, a device)
     raise ModelError(f"unknown model {text!r}; choose one of {', '.join(library())}, a plates variant "
                      f"({', '.join(MODELS)}) or a model file (.toml)")
 
 
-def resolve_system(system=None, variant=None, slip_band: float | None = None) -> FrictionModel:
-    """The model a simulation or analysis runs on.
+def resolve_model(model=None, slip_band: float | None = None) -> FrictionModel:
+    """The model a simulation or analysis runs on: what every public function's ``model`` names.
 
     Parameters
     ----------
-    system : FrictionModel, Parameters, str or None
-        A model; the plates' :class:`Parameters`; a library name or model file path; None for the
-        plates with Table 1 parameters.
-    variant : str, iterable of DOF names or FrictionModel, optional
-        The plates' variant (``full``, ``x``, ``y``, ``rotation`` or DOFs); also accepted here: a
-        library name, a model file or a FrictionModel (then ``system`` must be None or Parameters
-        of the plates is an error).
+    model : FrictionModel, Parameters, str, Path or None
+        A model (the plates in a variant: ``two_plates(params, "rotation")``); the plates'
+        :class:`Parameters` (all six DOFs free); a library name, a variant of the plates with
+        Table 1 parameters or a model file path (:func:`load_model`, as ``--model`` takes it);
+        None for the plates with Table 1 parameters.
     slip_band : float, optional
         Low-speed band [m/s]; default the model's own.
+
+    Raises
+    ------
+    ModelError
+        For anything else, or an unknown name (naming the choices).
     """
-    if isinstance(variant, FrictionModel) or (isinstance(variant, (str, Path)) and plates_variant(str(variant)) is None):
-        model = load_model(variant)
-        if system is not None and not isinstance(system, FrictionModel):
-            raise ModelError(f"model {variant!s} is not the two plates: give its parameters with --set, "
-                             "not as plate Parameters")
-        model = model if system is None else system
-    elif isinstance(system, FrictionModel):
-        model = system
-    elif isinstance(system, (str, Path)):
-        model = load_model(system)
+    variant = plates_variant(model) if isinstance(model, str) else None
+    if model is None or isinstance(model, Parameters) or variant is not None:  # the band also in the plates' builder
+        params = model if isinstance(model, Parameters) else None
+        system = two_plates(params, variant or "full", DEFAULT_SLIP_BAND if slip_band is None else slip_band)
+    elif isinstance(model, (FrictionModel, str, Path)):
+        system = load_model(model)
     else:
-        if system is not None and not isinstance(system, Parameters):
-            raise ModelError(f"expected a FrictionModel, Parameters or a model name, got {type(system).__name__}")
-        model = two_plates(system, "full" if variant is None else variant,
-                           DEFAULT_SLIP_BAND if slip_band is None else slip_band)
-    if slip_band is not None:
-        model = model.with_slip_band(slip_band)
-    return model
+        raise ModelError(f"expected a model: a FrictionModel, the plates' Parameters, a library name or a model file; "
+                         f"got {type(model).__name__} (the plates in a variant: two_plates(params, 'rotation'))")
+    return system if slip_band is None else system.with_slip_band(slip_band)
 
 
 def plates_variant(text: str) -> str | None:
@@ -144,4 +143,4 @@ def system_from_description(desc: dict) -> FrictionModel:
     if "spec" in desc:
         return model_from_spec(desc["spec"], source=desc.get("source", "python"), name=desc["name"]).with_slip_band(slip_band)
     raise ModelError(f"the file's model {desc.get('name')!r} was defined in Python and cannot be rebuilt from the "
-                     "file; pass it as system= when loading")
+                     "file; pass it as model= when loading")

@@ -28,8 +28,22 @@ _UNITS = {"x1": "m", "y1": "m", "x2": "m", "y2": "m", "phi": "rad", "psi": "rad"
 
 
 def two_plates(params: Parameters | None = None, variant="full", slip_band: float = DEFAULT_SLIP_BAND) -> FrictionModel:
-    """The two-plate model with ``params`` (default Table 1 at N = 50 N, Ω = 5 rad/s) and the
-    free DOFs of ``variant`` (``full``, ``x``, ``y``, ``rotation`` or DOF names)."""
+    """The two plates as a model: what every function's ``model`` takes for the plates in a variant.
+
+    Parameters
+    ----------
+    params : Parameters, optional
+        The plates' parameters (default Table 1 at N = 50 N, Ω = 5 rad/s).
+    variant : str, iterable of DOF names or Variant
+        The free DOFs: ``full`` (Model 1, default), ``x`` (2), ``y`` (3), ``rotation`` (4), or the
+        DOFs to free (``"phi"``: the upper plate's rotation alone, the belt case).
+    slip_band : float
+        Low-speed band of the 2-D slip direction [m/s].
+
+    Returns
+    -------
+    FrictionModel
+    """
     P = Parameters() if params is None else params
     v = resolve_variant(variant)
     mass = np.diag([P.m_p, P.m_p, P.m_d, P.m_d, P.J_p, P.J_d])
