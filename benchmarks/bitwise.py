@@ -49,12 +49,12 @@ def _trajectory(out: dict, key: str, run) -> None:
 
 def simulate_all(out: dict) -> None:
     import stickslip
-    from stickslip.model.library import resolve_system
+    from stickslip.model.library import two_plates
 
     for name in LIBRARY:
         model = stickslip.load_model(name)
         _trajectory(out, f"simulate.{name}", stickslip.simulate(model, 60.0, sample_rate=50.0))
-    rotation = resolve_system(None, "rotation")
+    rotation = two_plates(stickslip.Parameters(), "rotation")
     _trajectory(out, "simulate.plates-rotation", stickslip.simulate(rotation, 60.0, sample_rate=50.0))
     plates = stickslip.load_model("two-plates").replace(N=50.0, Omega=5.0)
     _trajectory(out, "simulate.plates-dense", stickslip.simulate(plates, 20.0, sample_rate=1000.0))
@@ -97,12 +97,12 @@ def _orbit(out: dict, key: str, orbit) -> None:
 
 def orbits(out: dict) -> None:
     import stickslip
+    from stickslip.model.library import two_plates
     from stickslip.model.parameters import Parameters
-    from stickslip.model.library import resolve_system
     from stickslip.orbits import monodromy
     from stickslip.orbits.continuation import continue_orbit
 
-    plates = resolve_system(Parameters(N=50.0, Omega=0.5), "full")
+    plates = two_plates(Parameters(N=50.0, Omega=0.5), "full")
     orbit = stickslip.periodic_orbit(plates, "equilibrium", search_time=30.0)
     _orbit(out, "orbit.plates", orbit)
     fd = monodromy(orbit, "finite-difference")
@@ -115,7 +115,7 @@ def orbits(out: dict) -> None:
     slider = stickslip.load_model(RIGID_SLIDER)
     _orbit(out, "orbit.rigid-slider", stickslip.periodic_orbit(slider, {"x": 1.0, "y": 0.05}, section="y_max",
                                                                search_time=60.0))
-    phi = resolve_system(Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb"), "phi")
+    phi = two_plates(Parameters(c_pphi=0.0, Omega=0.5, friction_law="coulomb"), "phi")
     ic = np.zeros(12)
     ic[10] = 0.5
     start = stickslip.periodic_orbit(phi, ic, search_time=3.0)

@@ -69,7 +69,7 @@ from numba import njit
 from numba.core import sigutils
 from numba.core.registry import CPUDispatcher
 
-from . import kernel_cache, linking, numba_patches
+from . import compile_ahead, compile_speedups, kernel_cache, linking, numba_patches
 from .kernel_cache import compiled_layer_digest, defined_in_package, track_user_code
 from .linking import standalone
 from .numba_patches import Patch, first_problem, has, source_has
@@ -189,7 +189,8 @@ def python_entry_patch() -> Patch:
 #: Whether kernels compile their versions for other kernels without the Python entry (the patch is installed).
 _ENTRY_APART = False
 
-numba_patches.install()
+numba_patches.install([*compile_speedups.PATCHES, python_entry_patch(), linking.PATCH, kernel_cache.PATCH,
+                       compile_ahead.FORK_PATCH])
 
 #: Whether the package's kernels are cached on disk (:func:`.kernel_cache.caching`).
 _CACHE = kernel_cache.caching()

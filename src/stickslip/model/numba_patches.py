@@ -123,20 +123,16 @@ class Patch:
 _STATUS: dict = {}
 
 
-def _patches() -> list[Patch]:
-    from . import compile_ahead, compile_speedups, kernel_cache, linking
-    from .jit import python_entry_patch
-
-    return [*compile_speedups.PATCHES, python_entry_patch(), linking.PATCH, kernel_cache.PATCH,
-            compile_ahead.FORK_PATCH]
-
-
-def install() -> dict:
-    """Apply every patch whose check passes, on a numba of :data:`TESTED` and unless
-    ``STICKSLIP_NUMBA_PATCHES=0``; once per process. Returns :func:`status`."""
+def install(patches=None) -> dict:
+    """Apply every patch of ``patches`` (a sequence of :class:`Patch`) whose check passes, on a
+    numba of :data:`TESTED` and unless ``STICKSLIP_NUMBA_PATCHES=0``; once per process. Returns
+    :func:`status`. :mod:`.jit` installs the package's patches as it is imported, before it
+    declares kernels, and names them (this module imports none of the modules that define them,
+    as each of them imports :class:`Patch` from here); called before that, without ``patches``,
+    it imports :mod:`.jit`."""
     if _STATUS:
         return _STATUS
-    if f"{__package__}.jit" not in sys.modules:  # it installs them as it is imported, before it declares kernels
+    if patches is None:
         importlib.import_module(f"{__package__}.jit")
         return _STATUS
     version = numba.__version__
@@ -149,7 +145,7 @@ def install() -> dict:
                             f"({TESTED[0]}-{TESTED[-1]}); install numba>={TESTED[0]},<{_next_minor(TESTED[-1])}"
     else:
         applied, skipped = [], {}
-        for patch in _patches():
+        for patch in patches:
             try:
                 problem = patch.check()
             except Exception as exc:  # noqa: BLE001 - a check that fails is a patch that does not fit
