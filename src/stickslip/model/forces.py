@@ -12,15 +12,14 @@
 
 :func:`sliding_forces` computes the common case, every contact sliding outside the band, on the
 caller's stack arrays (:func:`sliding_friction` its friction forces alone, for the queries);
-:func:`general_forces_body` any mix of modes, into a :class:`Forces` bundle of those arrays. Both
-fill the generalised force f = f0 − C q̇ − K q + Σ G_cᵀ F_c, from which
-:mod:`stickslip.model.physics` writes the state derivative and answers its per-contact queries.
+:func:`general_forces_body` any mix of modes. Both fill the generalised force
+f = f0 − C q̇ − K q + Σ G_cᵀ F_c, from which :mod:`stickslip.model.physics` writes the state
+derivative and answers its per-contact queries.
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
@@ -28,14 +27,14 @@ from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel, standalone
-from .kinematics import contact_dim, contact_frame, rigid_kernel
+from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
 
-__all__ = ["Forces", "exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
+__all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
            "general_forces", "sliding_friction", "sliding_forces", "rigid_normal_forces", "add_rigid_normal_forces"]
 
@@ -240,50 +239,21 @@ def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
 
 
 # ----------------------------------------------------------------------------- forces of all contacts
-class Forces(NamedTuple):
-    """The frames and forces of all contacts at one state, and the generalised force: the arrays
-    the force kernels fill (on the caller's stack, :mod:`.stack`; numbers of the state's type).
-
-    Attributes
-    ----------
-    G : ndarray (2 nc, n)
-        The contacts' frame rows (contact c's tangent rows at 2c, 2c + 1).
-    w : ndarray (2 nc,)
-        Their drive velocities [m/s].
-    v : ndarray (2 nc,)
-        The slip velocities G q̇ − w [m/s].
-    N : ndarray (nc,)
-        The normal forces [N].
-    h : ndarray (2 nc,)
-        The velocity bias Ġ q̇ − ẇ [m/s²] (filled for the contacts that need it).
-    F : ndarray (2 nc,)
-        The friction forces [N].
-    f : ndarray (n,)
-        The generalised force f0 − C q̇ − K q + Σ G_cᵀ F_c.
-    """
-
-    G: np.ndarray
-    w: np.ndarray
-    v: np.ndarray
-    N: np.ndarray
-    h: np.ndarray
-    F: np.ndarray
-    f: np.ndarray
-
-
 @inlined_kernel
-def general_forces_body(s, cst, md, n, nc, diagonal, forces):
+def general_forces_body(s, cst, md, G, w, v, N, h, F, f):
     """Every contact's friction force at ``s`` in the modes of ``cst`` (any mix of slip, band and
-    stick); fills the :class:`Forces` ``forces``: G, w, v, N, h, F and the total generalised force
-    f = f0 − C q̇ − K q + Σ G_cᵀ F_c.
+    stick); fills the caller's work arrays (numbers of the state's type): the frame rows G (2 nc, n),
+    drive velocities w (2 nc) [m/s], slip velocities v (2 nc) [m/s], normal forces N (nc) [N],
+    velocity biases h (2 nc) [m/s²], friction forces F (2 nc) [N] and the generalised force
+    f = f0 − C q̇ − K q + Σ G_cᵀ F_c (n). The model's sizes are read from ``md``.
 
     Order: slip forces with the exact direction, then those inside the low-speed band (their
     quasi-static direction sees the forces already known), then the stick multipliers of all
     sticking contacts together, then the normal forces of closed rigid contacts. Returns the
     smallest relative pivot of the last (:func:`rigid_normal_forces`; 1.0 without them).
     """
-    G, w, v, N, h, F, f = forces
     m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
     band = m[H_BAND]
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
@@ -309,7 +279,7 @@ def general_forces_body(s, cst, md, n, nc, diagonal, forces):
         else:
             in_band = True
     if in_band:
-        band_forces(s, cst, md, n, nc, diagonal, forces, A)
+        band_forces(s, cst, md, G, w, v, N, h, F, f, A)
     if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
         for c in range(nc):
             if is_stick(cst, c):
@@ -422,13 +392,13 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
 
 @standalone
 @kernel
-def band_forces(s, cst, md, n, nc, diagonal, forces, A):
-    """Slip forces of the contacts inside the low-speed band into the :class:`Forces` ``forces``
-    (after those with the exact direction, whose forces are in ``forces.f`` already): the
+def band_forces(s, cst, md, G, w, v, N, h, F, f, A):
+    """Slip forces of the contacts inside the low-speed band into F and f (after those with the
+    exact direction, whose forces are in ``f`` already): the
     quasi-static direction for a 2-D contact, found with the force that would hold it (the others
     as they are), the stored direction for a 1-D contact. ``A`` (≥ 2 nc square): work."""
-    G, w, v, N, h, F, f = forces
     m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
     band = m[H_BAND]
     for c in range(nc):
         mode = np.int64(cst[CST * c])
@@ -455,10 +425,10 @@ def band_forces(s, cst, md, n, nc, diagonal, forces, A):
 
 @standalone
 @kernel
-def general_forces(s, cst, md, n, nc, diagonal, forces):
+def general_forces(s, cst, md, G, w, v, N, h, F, f):
     """:func:`general_forces_body` as a call (for the queries and the right-hand side's path for
     stick and the band)."""
-    return general_forces_body(s, cst, md, n, nc, diagonal, forces)
+    return general_forces_body(s, cst, md, G, w, v, N, h, F, f)
 
 
 @inlined_kernel

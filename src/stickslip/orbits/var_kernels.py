@@ -89,7 +89,7 @@ def direction_residual(s, cst, c, md, ct, st):
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    P.general_forces(s, cst, md, n, nc, diagonal, P.Forces(G, w, v, N, h, F, f))
+    P.general_forces(s, cst, md, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if P.is_stick(cst, c2) or c2 == c:
             P.add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)
