@@ -16,43 +16,48 @@ import pytest
 import stickslip
 from stickslip.integrate import loop_split
 from stickslip.model import compile_ahead
+from stickslip.model import physics
 from stickslip.model.jit import KernelDispatcher
+from stickslip.orbits import var_kernels
 from stickslip.orbits.linear_flow import VARIATIONAL, flow_jacobian
 
 MODEL_FILE = os.path.join(os.path.dirname(__file__), "..", "orbits", "two_mass_belt.toml")
 
 
-def _available(split, name, md_type) -> bool:
-    """Whether the version of kernel ``name`` that ``split`` compiles is in this process or the cache."""
-    kernel = compile_ahead.kernel_named(name)
-    sig = split.signature(name, md_type)
+def _available(kernel, sig) -> bool:
+    """Whether the version ``sig`` of ``kernel`` is in this process or the cache."""
     if isinstance(kernel, KernelDispatcher):
         return kernel.available(sig)
     return sig in kernel.overloads or kernel._cache.load_overload(sig, kernel.targetctx) is not None
 
 
+def _all_available(split, md) -> None:
+    signatures = split.signatures(md)
+    assert set(signatures) == set(split.helper + split.own)
+    for kernel in split.helper + split.own:
+        assert _available(kernel, signatures[kernel]), kernel
+
+
 @pytest.mark.parametrize("model", ["two-plates", MODEL_FILE])
 def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
-    """Every kernel the two processes compile ahead, with the argument types written in the
-    split, is one the event loop or a run's results call (else the helper would compile in vain):
-    once they are compiled (here or, loaded from the cache, by another process) that version of
-    each is in this process or in the cache. A wrong code is not."""
+    """Every kernel the two processes compile ahead, with the argument types the split derives
+    from the bundles of a run, is one the event loop or a run's results call (else the helper
+    would compile in vain): once they are compiled (here or, loaded from the cache, by another
+    process) that version of each is in this process or in the cache. A wrong type is not."""
     system = stickslip.load_model(model)
     run = stickslip.simulate(system, 0.5)
     assert run.slip_velocity.shape[0] == run.normal_force.shape[0] == run.t.size  # the results' kernels
-    md_type = numba.typeof(system.data)
     split = loop_split.EVENT_LOOP
-    for name in split.helper + split.own:
-        assert _available(split, name, md_type), name
-    rhs = "stickslip.model.physics.rhs"
-    wrong = split.signature(rhs, md_type)[:-1] + (numba.types.float64[:, ::1],)
-    assert not compile_ahead.kernel_named(rhs).available(wrong)
+    _all_available(split, system.data)
+    rhs = physics.rhs
+    wrong = split.signatures(system.data)[rhs][:-1] + (numba.types.float64[:, ::1],)
+    assert not rhs.available(wrong)
 
 
 def test_the_variational_splits_signatures_are_the_ones_the_orbit_tools_compile():
     """As above for the variational equations: after a linearised flow across stick-slip
-    transitions, every kernel of the split is there with the written argument types (the api kernels,
-    which Python calls, with their Python entry)."""
+    transitions, every kernel of the split is there with the derived argument types (the api
+    kernels, which Python calls, with their Python entry)."""
     system = stickslip.load_model(MODEL_FILE)
     run = stickslip.simulate(system, 30.0)
     assert len(run.transitions.time) > 2
@@ -60,25 +65,21 @@ def test_the_variational_splits_signatures_are_the_ones_the_orbit_tools_compile(
     s0 = run.states[np.searchsorted(run.t, t0)]
     fj = flow_jacobian(system, s0, float(run.transitions.time[2]) + 0.1 - t0)
     assert len(fj.events) >= 2
-    md_type = numba.typeof(system.data)
-    for name in VARIATIONAL.helper + VARIATIONAL.own:
-        assert _available(VARIATIONAL, name, md_type), name
-    assert not _available(VARIATIONAL, "stickslip.orbits.var_kernels.contact_gradients",
-                          numba.types.float32)  # any model data type but this one's: not compiled
+    _all_available(VARIATIONAL, system.data)
+    gradients = VARIATIONAL.signatures(system.data)[var_kernels.contact_gradients]
+    assert not _available(var_kernels.contact_gradients, gradients[:3] + (numba.types.float32,) + gradients[4:])
 
 
 def test_the_steady_splits_signatures_are_the_ones_stability_compiles_for_a_model_file():
     """As above for steady sliding's kernels: after a model file's stability, every kernel of the
-    split is there with the written argument types; for the plates, whose sizes are compile-time
+    split is there with the derived argument types; for the plates, whose sizes are compile-time
     constants, the split does not apply."""
     from stickslip.stability.steady import STEADY
 
     system = stickslip.load_model(MODEL_FILE)
     stickslip.stability(system)
-    md_type = numba.typeof(system.data)
     assert STEADY.applies(system.data)
-    for name in STEADY.helper + STEADY.own:
-        assert _available(STEADY, name, md_type), name
+    _all_available(STEADY, system.data)
     assert not STEADY.applies(stickslip.load_model("two-plates").data)
 
 
@@ -197,7 +198,7 @@ def test_a_cold_starts_meanwhile_work_runs_once_before_it_waits_for_the_helper()
         def end(self):
             calls.append("end")
 
-    split = compile_ahead.Split(helper=(), own=(), caller=loop_split.EVENT_LOOP.caller, signatures={})
+    split = compile_ahead.Split(helper=(), own=(), caller=loop_split.EVENT_LOOP.caller, calls=lambda md: {})
     with compile_ahead.meanwhile(lambda: calls.append("work")), compile_ahead.meanwhile(lambda: 1 / 0):
         for _ in range(2):
             with compile_ahead.ColdStart(split, None, Helper()) as cold:

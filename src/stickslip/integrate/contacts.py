@@ -96,6 +96,7 @@ EVENT_CHECKS = 4
 MAX_SETTLE = 64
 
 
+@standalone
 @kernel
 def dense_state(y0, Q, h, theta, out):
     """Evaluate ``out = y0 + h Σ_j Q[:, j] θ^(j+1)`` (Horner)."""
@@ -176,22 +177,27 @@ def illinois_update(a, ga, b, gb, c, gc, before, side):
 
 
 @inlined_kernel
-def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
-    """First θ ∈ (0, 1] where the event function of contact ``c`` turns ≤ 0, located to
-    EVENT_TIME_TOL; −1.0 if no sign change is seen at the EVENT_CHECKS sample points.
+def first_crossing(kind, c, y0, Q, h, e0x, e0y, cst, md, scratch):
+    """First θ ∈ (0, 1] where the event function of contact ``c`` turns ≤ 0 on the dense output
+    (``y0``, ``Q``) of a step of length ``h``, located to EVENT_TIME_TOL; −1.0 if no sign change is
+    seen at the EVENT_CHECKS sample points. ``(e0x, e0y)``: the slip event's direction;
+    ``scratch``: a :class:`~.bundles.Scratch`.
 
     The function is positive at θ = 0 by construction, so its value there is computed only when
     the crossing lies in the first sub-interval (it is the bracket's left end). Refinement:
     Illinois regula falsi.
     """
-    return probed_crossing(-1.0, kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N)
+    return probed_crossing(-1.0, kind, c, y0, Q, h, e0x, e0y, cst, md, scratch)
 
 
 @standalone
 @kernel
-def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, work, F, N):
+def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, scratch):
     """:func:`first_crossing` with one more sample point at θ = ``probe`` ∈ (0, 1) (−1.0: none),
     where a dip of the event function between the regular sample points is expected."""
+    work = scratch.state
+    F = scratch.F
+    N = scratch.N
     a = 0.0
     ga = -1.0  # not yet computed (the function is > 0 at θ = 0)
     b = -1.0

@@ -8,12 +8,16 @@ stage sums are fully unrolled (A_ij: stage i from stage j; B: 5th-order weights;
 weights, 5th minus 4th order; P_jc: dense output, stage j, power θ^(c+1)).
 
 Stage derivatives are the rows ``Kst[0:7]`` of a (7, n) array; stage 7 is f at the 5th-order
-solution (first-same-as-last).
+solution (first-same-as-last). :class:`Step` bundles the arrays of one step.
 """
 
 from __future__ import annotations
 
-from ..model.jit import kernel
+from typing import NamedTuple
+
+import numpy as np
+
+from ..model.jit import kernel, standalone
 
 A21 = 1 / 5
 A31, A32 = 3 / 40, 9 / 40
@@ -31,6 +35,43 @@ P71, P72, P73 = 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423
 
 #: Number of stage derivatives (rows of ``Kst``).
 N_STAGES = 7
+
+SAFETY = 0.9        # standard step-size safety factor
+MIN_FACTOR = 0.2    # largest step reduction after a rejection
+MAX_FACTOR = 5.0    # largest step growth after an acceptance
+
+
+class Step(NamedTuple):
+    """The arrays of one Dormand–Prince step of a state of n entries.
+
+    Attributes
+    ----------
+    y : ndarray (n,)
+        The state at the step's start (advanced in place when a step is accepted).
+    k1 : ndarray (n,)
+        Its derivative f(y).
+    stages : ndarray (7, n)
+        The stage derivatives (:func:`stage_state`); row 6 is f at the step's end.
+    ynew : ndarray (n,)
+        The 5th-order state at the step's end.
+    ytmp : ndarray (n,)
+        The state of the stage being evaluated.
+    dense : ndarray (n, 4)
+        The dense-output coefficients (:func:`dense_coefficients`), formed only when needed.
+    """
+
+    y: np.ndarray
+    k1: np.ndarray
+    stages: np.ndarray
+    ynew: np.ndarray
+    ytmp: np.ndarray
+    dense: np.ndarray
+
+
+def new_step(y: np.ndarray) -> Step:
+    """A :class:`Step` from the state ``y`` (its own array: advanced in place)."""
+    n = y.shape[0]
+    return Step(y, np.empty(n), np.empty((N_STAGES, n)), np.empty(n), np.empty(n), np.empty((n, 4)))
 
 
 @kernel
@@ -67,6 +108,7 @@ def local_error(Kst, h, i):
                 + E7 * Kst[6, i])
 
 
+@standalone
 @kernel
 def dense_coefficients(Kst, Q):
     """Q (n, 4) = Kᵀ P, the interpolant y(θ) = y0 + h Q [θ, θ², θ³, θ⁴]ᵀ (``events.dense_state``)."""

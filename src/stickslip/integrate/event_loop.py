@@ -15,10 +15,28 @@ One compiled loop for any friction-contact model (no Python per step):
 Time inside the loop is *local*: the caller passes ``t_base`` and the loop integrates
 τ = t − t_base from 0, so that step sizes and event tolerances are resolved against τ, not
 against an absolute time whose unit in the last place grows with the run (at t ~ 4e4 s it
-exceeds the event tolerance, and runs used to stop with a step-size underflow). The driver
-calls the loop in chunks (:func:`stickslip.integrate.driver.simulate`), rebasing each; a chunk
-ends at the first accepted step past ``tau_stop`` that is not in the middle of an approach, so
-the steps taken are the same as in one long call.
+exceeds the event tolerance). The runner calls the loop in chunks
+(:class:`stickslip.integrate.runner.EventStepper`), rebasing each; a chunk ends at the first
+accepted step past ``tau_stop`` that is not in the middle of an approach, so the steps taken are
+the same as in one long call.
+
+The loop (:func:`event_loop`) is a sequence of named steps, each inlined into it at its one call
+site, over bundled state: the step's arrays (:class:`~.dormand_prince.Step`), what is kept of
+each slipping contact (:class:`~.slip_watch.SlipWatch`), the samples, the transitions and the
+work arrays (:mod:`.bundles`), the chunk's request (:class:`Controls`) and its progress (a
+:data:`PROGRESS` record on the loop's stack):
+
+* :func:`take_step`: a step of the size proposed, under the error control;
+* :func:`lost_contact`: a prescribed normal force through zero inside it (the run ends there);
+* :func:`.slip_roots`: departures that overshoot the low-speed band, slip → stick roots;
+  :func:`retake`: the step re-taken shorter for either;
+* :func:`.gap_crossing`: a unilateral contact that opens or closes inside the step;
+  :func:`breakaway_root`: the first breakaway inside it; :func:`cut_at_gap`,
+  :func:`cut_at_breakaway`: the step cut at the earlier root, the transition applied there;
+* otherwise :func:`accept_step`: the whole step, its samples, the state advanced;
+  :func:`.arrivals`: the slipping contacts' band departures, homing onto v = 0 and stick entry,
+  and the derivative again where a mode changed;
+* :func:`next_step_size`: the next step's size, and whether the chunk ends.
 
 State layout: the 2n physical states, then the accumulated work of friction and of damping [J],
 integrated with the same steps as quadratures.
@@ -27,40 +45,80 @@ integrated with the same steps as quadratures.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from ..model import physics as P
-from ..model.bundle import CST, H_BAND, offsets
+from ..model.bundle import CST, offsets
 from ..model.jit import inlined_kernel, kernel, standalone
 from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
+from .bundles import on_stack, scratch, store_record
+from .slip_watch import MAX_RETAKES, arrivals, slip_roots, slip_watch
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
-from .transitions import (break_away, crossing_in_step, gap_crossing, jammed_contact, record_transition, settle,
-                          switch_gap)
+from .transitions import break_away, crossing_in_step, gap_crossing, jammed_contact, switch_gap
 
-__all__ = ["integrate_event", "N_EXTRA"]
+__all__ = ["integrate_event", "event_loop", "loop_arrays", "Controls", "controls", "PROGRESS", "N_EXTRA"]
 
 N_EXTRA = 2  # work of friction, work of damping
 
-SAFETY = 0.9        # standard step-size safety factor
-MIN_FACTOR = 0.2    # largest step reduction after a rejection
-MAX_FACTOR = 5.0    # largest step growth after an acceptance
-MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick root
-DEPARTURE_OVERSHOOT = 2.0  # a departure step may end at most this many low-speed bands above v = 0
-#: [s] longest extrapolated step onto v = 0: a small fraction of any mechanical period of interest
-#: (the plates' shortest natural period is 0.36 s).
-MAX_HOMING_STEP = 1e-3
-#: Fraction of the extrapolated time to v = 0 that a homing step of a 1-D contact leaves out. The
-#: extrapolation with the acceleration at the step start is second-order accurate but, with a
-#: falling friction law, |dv/dt| grows towards v = 0 and a full step overshoots; a step past the
-#: zero of a 1-D slip velocity meets the sign change of the friction force and is rejected (seen
-#: as 30 rejections in a row on one approach of the popp-stelter model, ending 7.6e-7 s early).
-HOMING_SHORTFALL = 1e-2
+#: The progress of a chunk of the loop: its outcome (``status``: :mod:`.status`; ``lost``: the
+#: contact lost or inconsistent, −1), the local time reached ``tau`` [s], the step size ``h`` [s]
+#: (to continue with), the next sample ``idx`` and the transitions ``n_tr`` found so far (counted
+#: past the buffers' room), and what the loop carries from step to step: the steps taken, the
+#: re-takes of the current step, the step imposed on the next one (``h_override``, −1: none),
+#: the error controller's step before a homing episode (``h_free``, −1: none), the growth factor
+#: of the step just taken, whether the last step was rejected, whether the slip cache holds the
+#: values at the step's start (``slips_ready``).
+PROGRESS = np.dtype([("status", np.int64), ("lost", np.int64), ("tau", np.float64), ("h", np.float64),
+                     ("idx", np.int64), ("n_tr", np.int64), ("n_steps", np.int64), ("retakes", np.int64),
+                     ("h_override", np.float64), ("h_free", np.float64), ("factor", np.float64),
+                     ("rejected", np.bool_), ("slips_ready", np.bool_)], align=True)
+
+#: What :func:`take_step` found: the step is taken, or rejected (try again with ``progress.h``),
+#: or the run stops (``progress.status``).
+TAKEN, RETRY, STOP = 0, 1, 2
 
 
+class Controls(NamedTuple):
+    """What a chunk of the loop is asked to do.
+
+    Attributes
+    ----------
+    t_base : float
+        Absolute time [s] of the chunk's local time 0 (the samples' and transitions' times are
+        absolute).
+    tau_stop : float
+        Local time [s] after which the chunk ends at the first accepted step outside an approach.
+    tau_end : float
+        Local time [s] of the run's end.
+    rtol, atol : float
+        Local error tolerances.
+    h_max : float
+        Largest step [s].
+    max_steps : int
+        Steps (accepted and rejected) the chunk may take.
+    """
+
+    t_base: float
+    tau_stop: float
+    tau_end: float
+    rtol: float
+    atol: float
+    h_max: float
+    max_steps: int
+
+
+def controls(t_base, tau_stop, tau_end, rtol, atol, h_max, max_steps) -> Controls:
+    """:class:`Controls` of the types the loop is compiled for."""
+    return Controls(float(t_base), float(tau_stop), float(tau_end), float(rtol), float(atol), float(h_max),
+                    int(max_steps))
+
+
+# ----------------------------------------------------------------------------- the step
 @standalone
 @kernel
 def dp_step(y, k1, h, cst, md, Kst, ynew, ytmp):
@@ -97,6 +155,63 @@ def error_norm(y, ynew, Kst, h, md, rtol, atol):
     return math.sqrt(total / count)
 
 
+@inlined_kernel
+def take_step(progress, controls, step, cst, md, stats):
+    """A Dormand–Prince step of the size proposed (``progress.h``, bounded by ``h_max`` and the
+    run's end) and its error control: :data:`TAKEN` (``progress.factor`` the growth it allows;
+    none right after a rejection, Hairer's DOPRI5 rule), :data:`RETRY` (rejected: ``progress.h``
+    shrunk; a rejected re-take keeps homing, the root found before still lies ahead) or
+    :data:`STOP` (the step cap, a step below the round-off of τ, a state that is not finite)."""
+    if progress.n_steps >= controls.max_steps:
+        progress.status = MAX_STEPS
+        return STOP
+    progress.n_steps += 1
+    h = min(progress.h, controls.h_max, controls.tau_end - progress.tau)
+    progress.h = h
+    if h <= 1e-14 * max(1.0, abs(progress.tau)):  # below round-off of τ: no progress possible
+        progress.status = STEP_UNDERFLOW
+        return STOP
+    dp_step(step.y, step.k1, h, cst, md, step.stages, step.ynew, step.ytmp)
+    stats[2] += 6
+    err = error_norm(step.y, step.ynew, step.stages, h, md, controls.rtol, controls.atol)
+    if not math.isfinite(err):
+        if h < 1e-10:
+            progress.status = NOT_FINITE
+            return STOP
+        progress.h = h * DP.MIN_FACTOR
+        stats[1] += 1
+        return RETRY
+    if err > 1.0:
+        progress.h = h * max(DP.MIN_FACTOR, DP.SAFETY * err ** -0.2)
+        stats[1] += 1
+        progress.rejected = True
+        return RETRY
+    factor = DP.MAX_FACTOR if err == 0.0 else min(DP.MAX_FACTOR, DP.SAFETY * err ** -0.2)
+    if progress.rejected:
+        factor = min(factor, 1.0)
+        progress.rejected = False
+    progress.factor = factor
+    return TAKEN
+
+
+@inlined_kernel
+def retake(progress, shrink, theta_slip, stats):
+    """Whether the step is re-taken shorter: by ``shrink`` (a departure that overshoots the
+    low-speed band), or to end at ``theta_slip`` (a slip velocity passes zero inside it; the error
+    controller's step is kept in ``progress.h_free``, to resume from after the event)."""
+    if shrink > 0.0:
+        progress.h *= shrink
+    elif theta_slip > 0.0 and (1.0 - theta_slip) * progress.h > E.EVENT_TIME_TOL and progress.retakes < MAX_RETAKES:
+        if progress.retakes == 0 and progress.h_override < 0.0 and progress.h_free < 0.0:
+            progress.h_free = progress.h
+        progress.h *= theta_slip
+    else:
+        return False
+    progress.retakes += 1
+    stats[3] += 1
+    return True
+
+
 @kernel
 def homing_left(homing):
     """Whether any contact is in the middle of homing in on v = 0 (a loop: ``homing.sum()`` would
@@ -108,91 +223,307 @@ def homing_left(homing):
 
 
 @inlined_kernel
-def store_sample(idx, y, cst, md, F, N, v, out_s, out_mode, out_F):
+def next_step_size(progress, controls, homing):
+    """The next step's size: the one imposed (homing, a bounce's flight), else the error
+    controller's. Returns whether the chunk ends here: past ``tau_stop``, outside an approach."""
+    if progress.h_override > 0.0:
+        progress.h = progress.h_override
+        progress.h_override = -1.0
+        return False
+    progress.h *= progress.factor
+    return (controls.tau_stop <= progress.tau < controls.tau_end and progress.h_free < 0.0
+            and not homing_left(homing))
+
+
+# ----------------------------------------------------------------------------- samples
+@inlined_kernel
+def store_sample(idx, y, cst, md, scratch, samples):
     """Write sample ``idx``: the state, the mode flags (bit c: contact c sticks) and each contact's
     friction force at ``y``."""
     nc = model_sizes(md.kin, md.m)[1]
-    P.contact_forces(y, cst, md, F, N, v)
-    for i in range(out_s.shape[1]):
-        out_s[idx, i] = y[i]
-    out_mode[idx] = E.mode_flags(cst, nc)
+    F = scratch.F
+    P.contact_forces(y, cst, md, F, scratch.N, scratch.v)
+    states = samples.states
+    for i in range(states.shape[1]):
+        states[idx, i] = y[i]
+    samples.modes[idx] = E.mode_flags(cst, nc)
+    forces = samples.forces
     for i in range(2 * nc):
-        out_F[idx, i] = F[i]
+        forces[idx, i] = F[i]
 
 
 @standalone
 @kernel
-def write_samples(idx, tau_to, y0, Q, h, tau_step, t_base, cst, md, sample_times, out_s, out_mode, out_F,
-                  work, F, N, v):
-    """Write the samples from index ``idx`` up to local time ``tau_to``, from the step starting at
-    local time ``tau_step`` (samples are absolute times; ``t_base`` is the local origin)."""
-    n_samples = sample_times.shape[0]
-    while idx < n_samples and sample_times[idx] - t_base <= tau_to:
-        theta = (sample_times[idx] - t_base - tau_step) / h if h > 0.0 else 0.0
-        E.dense_state(y0, Q, h, theta, work)
-        store_sample(idx, work, cst, md, F, N, v, out_s, out_mode, out_F)
+def write_samples(idx, tau_to, tau_step, h, t_base, y0, Q, cst, md, samples, scratch):
+    """Write the samples from index ``idx`` up to local time ``tau_to`` from the dense output
+    (``y0``, ``Q``) of the step of length ``h`` that starts at local time ``tau_step`` (sample
+    times are absolute; ``t_base`` is the local origin). Returns the next index."""
+    times = samples.times
+    n_samples = times.shape[0]
+    while idx < n_samples and times[idx] - t_base <= tau_to:
+        theta = (times[idx] - t_base - tau_step) / h if h > 0.0 else 0.0
+        E.dense_state(y0, Q, h, theta, scratch.state)
+        store_sample(idx, scratch.state, cst, md, scratch, samples)
         idx += 1
     return idx
 
 
+@inlined_kernel
+def first_samples(idx, t_base, y, cst, md, samples, scratch):
+    """Write the samples at or before the chunk's start (local time 0) at ``y``; returns the next index."""
+    times = samples.times
+    while idx < times.shape[0] and times[idx] - t_base <= 0.0:
+        store_sample(idx, y, cst, md, scratch, samples)
+        idx += 1
+    return idx
+
+
+# ----------------------------------------------------------------------------- events inside the step
+@inlined_kernel
+def lost_contact(progress, t_base, step, cst, md, samples, scratch, stats):
+    """A prescribed normal force through zero inside the step: the run ends at the first root
+    (the step cut there, ``progress.status`` CONTACT_LOST). Returns (whether it ends, whether the
+    step's dense-output coefficients are formed)."""
+    n, nc, _ = model_sizes(md.kin, md.m)
+    h = progress.h
+    theta_lost = -1.0
+    lost = np.int64(-1)
+    q_ready = False
+    for c in range(nc):
+        if not is_unilateral(md, n, c) and P.normal_force(step.ynew, c, md) <= 0.0:
+            th = crossing_in_step(E.EVENT_NORMAL, c, step, q_ready, h, cst, md, scratch)
+            q_ready = True
+            if theta_lost < 0.0 or th < theta_lost:
+                theta_lost = th
+                lost = c
+    if theta_lost > 0.0:
+        idx, tau = cut_step(theta_lost, progress.idx, progress.tau, h, t_base, step, cst, md, samples, scratch)
+        progress.idx = idx
+        progress.tau = tau
+        stats[0] += 1
+        progress.status = CONTACT_LOST
+        progress.lost = lost
+        return True, q_ready
+    return False, q_ready
+
+
+@inlined_kernel
+def breakaway_root(any_stick, step, q_ready, h, cst, md, scratch):
+    """(θ, contact, q_ready): the first breakaway of a sticking contact inside the step (θ = −1.0,
+    contact −1: none)."""
+    theta_b = -1.0
+    c_b = np.int64(-1)  # not a literal: numba would type the call of break_away for it first
+    if any_stick:
+        if not q_ready:
+            DP.dense_coefficients(step.stages, step.dense)
+            q_ready = True
+        for c in range(model_sizes(md.kin, md.m)[1]):
+            if np.int64(cst[CST * c]) == P.MODE_STICK:
+                th = E.first_crossing(E.EVENT_STICK, c, step.y, step.dense, h, 0.0, 0.0, cst, md, scratch)
+                if th > 0.0 and (theta_b < 0.0 or th < theta_b):
+                    theta_b = th
+                    c_b = c
+    return theta_b, c_b, q_ready
+
+
+@standalone
 @kernel
-def cut_step(theta, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F, work, F, N, v):
-    """End the step at θ ∈ (0, 1] of its length ``h`` (an event's root): write the samples up to
-    there and move ``y`` (the step's start) onto it. Returns (idx, local time of the cut)."""
+def cut_step(theta, idx, tau, h, t_base, step, cst, md, samples, scratch):
+    """End the step of length ``h`` from local time ``tau`` at θ ∈ (0, 1] (an event's root): write
+    the samples up to there and move ``step.y`` (the step's start) onto it. Returns (idx, local
+    time of the cut)."""
     tau_cut = tau + theta * h
-    idx = write_samples(idx, tau_cut, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F, work, F, N,
-                        v)
-    E.dense_state(y, Q, h, theta, work)
+    idx = write_samples(idx, tau_cut, tau, h, t_base, step.y, step.dense, cst, md, samples, scratch)
+    y = step.y
+    work = scratch.state
+    E.dense_state(y, step.dense, h, theta, work)
     for i in range(y.shape[0]):
         y[i] = work[i]
     return idx, tau_cut
 
 
-def integrate_event(y0, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps,
-                    sample_times, idx0, out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0,
-                    start_modes=False):
-    """Integrate from ``y0`` at local time 0 (absolute ``t_base``) towards ``tau_end``: allocates the
-    work arrays and runs :func:`event_loop` (see there for arguments and results).
-
-    Plain Python: a compiled wrapper would link the whole loop, physics included, into a module of
-    its own and have LLVM optimise and emit all of it a second time on a cold start (2.5 s of a
-    model file's first ``simulate``); a call from Python costs microseconds per chunk.
-    """
-    nc = out_F.shape[1] // 2
-    ns = y0.shape[0]
-    y = y0.copy()
-    work = np.empty((5, ns))
-    Kst = np.empty((7, ns))
-    Q = np.empty((ns, 4))
-    F = np.empty(2 * nc)
-    N = np.empty(nc)
-    vv = np.empty(2 * nc)
-    va = np.empty((2, 4 * nc))
-    homing = np.zeros(nc, dtype=np.int64)
-    stats = np.zeros(6, dtype=np.int64)
-    status, tau, h, idx, n_tr, lost = event_loop(
-        y, cst, float(t_base), float(tau_stop), float(tau_end), md, float(rtol), float(atol), float(h_init),
-        float(h_max), int(max_steps), sample_times, int(idx0), out_s, out_mode, out_F, tr_t, tr_kind, tr_contact,
-        tr_s, int(n_tr0), work, Kst, Q, F, N, vv, va, homing, stats, bool(start_modes))
-    return status, tau, y, h, idx, n_tr, stats, lost
+@inlined_kernel
+def cut_at_gap(progress, theta, c, controls, step, cst, md, samples, scratch, log, stats):
+    """Unilateral contact ``c`` opens or closes at θ inside the step: the step is cut there and
+    the contact switched (:func:`.switch_gap`); a bounce bounds the next step by half its flight.
+    Returns whether the run goes on (False: ``progress.status`` says why)."""
+    idx, tau = cut_step(theta, progress.idx, progress.tau, progress.h, controls.t_base, step, cst, md, samples,
+                        scratch)
+    progress.idx = idx
+    progress.tau = tau
+    n_tr, status, flight = switch_gap(step.y, cst, c, md, controls.rtol, controls.atol, scratch,
+                                      controls.t_base + tau, log, progress.n_tr, stats)
+    progress.n_tr = n_tr
+    if status != SUCCESS:
+        stats[0] += 1
+        progress.status = status
+        progress.lost = c
+        return False
+    if flight < math.inf:  # a bounce: the next step ends inside its flight
+        progress.h_override = 0.5 * flight
+    return True
 
 
+@inlined_kernel
+def cut_at_breakaway(progress, theta, c, controls, step, cst, md, samples, scratch, log, stats):
+    """Sticking contact ``c`` breaks away at θ inside the step: the flow is smooth up to it, so the
+    step is cut there and the breakaway applied (:func:`.break_away`)."""
+    idx, tau = cut_step(theta, progress.idx, progress.tau, progress.h, controls.t_base, step, cst, md, samples,
+                        scratch)
+    progress.idx = idx
+    progress.tau = tau
+    progress.n_tr = break_away(step.y, cst, c, md, scratch, controls.t_base + tau, log, progress.n_tr, stats)
+
+
+@inlined_kernel
+def new_piece(progress, step, cst, md, stats):
+    """After a cut: a new smooth piece starts at the root (its derivative in the new modes)."""
+    stats[0] += 1
+    P.rhs(step.y, cst, md, step.k1)
+    stats[2] += 1
+    progress.slips_ready = False
+    progress.retakes = 0
+
+
+# ----------------------------------------------------------------------------- the whole step
+@inlined_kernel
+def accept_step(progress, t_base, step, slips, cst, md, samples, scratch, q_ready, stats):
+    """Accept the whole step: write its samples, advance the state and its derivative to the
+    step's end, and keep the slip velocities there as those at the next step's start."""
+    h = progress.h
+    tau = progress.tau
+    times = samples.times
+    if progress.idx < times.shape[0] and times[progress.idx] - t_base <= tau + h:
+        if not q_ready:
+            DP.dense_coefficients(step.stages, step.dense)
+        progress.idx = write_samples(progress.idx, tau + h, tau, h, t_base, step.y, step.dense, cst, md, samples,
+                                     scratch)
+    progress.tau = tau + h
+    y = step.y
+    ynew = step.ynew
+    k1 = step.k1
+    stages = step.stages
+    for i in range(y.shape[0]):
+        y[i] = ynew[i]
+        k1[i] = stages[6, i]
+    stats[0] += 1
+    start = slips.start
+    end = slips.end
+    for i in range(start.shape[0]):
+        start[i] = end[i]
+    progress.slips_ready = True
+
+
+# ----------------------------------------------------------------------------- the loop
 @kernel
-def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max, max_steps, sample_times, idx0,
-               out_s, out_mode, out_F, tr_t, tr_kind, tr_contact, tr_s, n_tr0, work5, Kst, Q, F, N, vv, va2, homing,
-               stats, start_modes):
+def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, stats, start_modes):
     """The loop of :func:`integrate_event` (module docstring), free of reference counting.
 
-    ``y`` (2n + 2,) is advanced in place from local time 0 (absolute ``t_base``) towards
-    ``tau_end``; ``cst`` (CST nc,) is the contacts' integration state, updated in place (pass the
-    one returned by the previous chunk). Samples from index ``idx0`` go to ``out_s``, ``out_mode``,
-    ``out_F`` at the absolute ``sample_times``; transitions from number ``n_tr0`` to the ``tr_*``
-    buffers as far as they have room. ``work5`` … ``homing`` are work arrays; ``stats`` (6,)
-    receives accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
-    slip → stick and stick → slip transitions. With ``start_modes``, ``cst`` is first set to the modes
-    that ``y`` starts in (:func:`~stickslip.integrate.contacts.initial_modes`, which may project
-    ``y``): the first call of a run, made with ``tau_end = 0``, does only that (one compiled
-    module instead of two, on a cold start).
+    Parameters
+    ----------
+    controls : Controls
+    md : ModelData
+    cst : ndarray (CST nc,)
+        The contacts' integration state, updated in place (pass the one of the previous chunk).
+    start : ndarray (1,) of :data:`PROGRESS`
+        ``h`` (the first step size), ``idx`` (the first sample) and ``n_tr`` (the transitions
+        before) at the start; the chunk's progress at the end.
+    step : :class:`~.dormand_prince.Step`
+        ``step.y`` (2n + 2,) is advanced in place from local time 0.
+    slips : :class:`~.slip_watch.SlipWatch`
+    scratch : :class:`~.bundles.Scratch`
+    samples : :class:`~.bundles.Samples`
+        Written from ``idx`` at their absolute times.
+    log : :class:`~.bundles.TransitionLog`
+        Transitions from ``n_tr`` on, as far as it has room.
+    stats : ndarray (6,) int64
+        Receives accepted steps, rejected steps, rhs calls, step re-takes at slip → stick roots,
+        slip → stick and stick → slip transitions.
+    start_modes : bool
+        Set ``cst`` first to the modes that ``step.y`` starts in
+        (:func:`~stickslip.integrate.contacts.initial_modes`, which may project it): the first
+        call of a run, made with ``tau_end = 0``, does only that (one compiled module instead of
+        two, on a cold start).
+    """
+    progress = on_stack(start[0])
+    progress.status = SUCCESS
+    progress.lost = -1
+    progress.tau = 0.0
+    if start_modes:
+        E.initial_modes(step.y, cst, md, controls.rtol, controls.atol, scratch.F, scratch.N)
+    P.rhs(step.y, cst, md, step.k1)
+    stats[2] += 1
+    progress.idx = first_samples(progress.idx, controls.t_base, step.y, cst, md, samples, scratch)
+    progress.lost = jammed_contact(step.y, cst, md)
+    if progress.lost >= 0:
+        progress.status = INCONSISTENT
+        store_record(start, progress)
+        return
+    progress.h = min(progress.h, controls.h_max)
+    progress.n_steps = 0
+    progress.retakes = 0
+    progress.h_override = -1.0
+    progress.h_free = -1.0
+    progress.rejected = False
+    progress.slips_ready = False
+    while progress.tau < controls.tau_end:
+        taken = take_step(progress, controls, step, cst, md, stats)
+        if taken == STOP:
+            break
+        if taken == RETRY:
+            continue
+        ended, q_ready = lost_contact(progress, controls.t_base, step, cst, md, samples, scratch, stats)
+        if ended:
+            break
+        shrink, theta_slip, any_stick, q_ready = slip_roots(progress, step, slips, cst, md, scratch, q_ready)
+        if retake(progress, shrink, theta_slip, stats):
+            continue
+        theta_g, c_g, q_ready = gap_crossing(step, q_ready, progress.h, cst, md, scratch)
+        theta_b, c_b, q_ready = breakaway_root(any_stick, step, q_ready, progress.h, cst, md, scratch)
+        cut = theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b)
+        if cut:
+            if not cut_at_gap(progress, theta_g, c_g, controls, step, cst, md, samples, scratch, log, stats):
+                break
+        elif theta_b > 0.0:
+            cut = True
+            cut_at_breakaway(progress, theta_b, c_b, controls, step, cst, md, samples, scratch, log, stats)
+        else:
+            accept_step(progress, controls.t_base, step, slips, cst, md, samples, scratch, q_ready, stats)
+            arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip, any_stick, stats)
+        if cut:
+            new_piece(progress, step, cst, md, stats)
+        if not E.all_finite(step.y):
+            progress.status = NOT_FINITE
+            break
+        progress.lost = jammed_contact(step.y, cst, md)
+        if progress.lost >= 0:
+            progress.status = INCONSISTENT
+            break
+        if next_step_size(progress, controls, slips.homing):
+            progress.status = CHUNK_END
+            break
+    store_record(start, progress)
+
+
+def loop_arrays(y0: np.ndarray, nc: int, h_init: float = 0.0, idx0: int = 0, n_tr0: int = 0):
+    """The arrays :func:`event_loop` works on for a state ``y0`` (copied) and ``nc`` contacts:
+    (start, step, slips, scratch, stats)."""
+    start = np.zeros(1, dtype=PROGRESS)
+    start["h"] = h_init
+    start["idx"] = idx0
+    start["n_tr"] = n_tr0
+    ns = y0.shape[0]
+    return start, DP.new_step(y0.copy()), slip_watch(nc), scratch(ns, nc), np.zeros(6, dtype=np.int64)
+
+
+def integrate_event(md, cst, y0, controls, h_init, samples, idx0, log, n_tr0=0, start_modes=False):
+    """Integrate from ``y0`` at local time 0 (absolute ``controls.t_base``) towards
+    ``controls.tau_end``: allocates the work arrays and runs :func:`event_loop` (see there for the
+    arguments).
+
+    Plain Python: a compiled wrapper would link the whole loop, physics included, into a module of
+    its own and have LLVM optimise and emit all of it a second time on a cold start; a call from
+    Python costs microseconds per chunk.
 
     Returns
     -------
@@ -200,312 +531,23 @@ def event_loop(y, cst, t_base, tau_stop, tau_end, md, rtol, atol, h_init, h_max,
         :mod:`stickslip.integrate.status` code; CHUNK_END when stopped at ``tau_stop``.
     tau : float
         Local time reached [s].
+    y : ndarray (2n + 2,)
+        The state there.
     h : float
         Step size to continue with [s].
     idx : int
         Next sample index.
     n_tr : int
         Transitions found so far (counted past the buffers' room).
+    stats : ndarray (6,) int64
+        As :func:`event_loop`'s.
     lost : int
-        Contact whose normal force reached 0 (status CONTACT_LOST), else −1.
+        Contact whose normal force reached 0 (status CONTACT_LOST) or without a consistent normal
+        force (INCONSISTENT), else −1.
     """
-    m = md.m
-    n, nc, diagonal = model_sizes(md.kin, m)
-    ns = y.shape[0]
-    ynew = work5[0]
-    ytmp = work5[1]
-    work = work5[2]
-    k1 = work5[3]
-    va = va2[0]       # v0x, v0y, a0x, a0y per contact at the step start
-    va1 = va2[1]      # the same at the step end
-    n_tr = n_tr0
-    band = m[H_BAND]
-
-    if start_modes:
-        E.initial_modes(y, cst, md, rtol, atol, F, N)
-    P.rhs(y, cst, md, k1)
-    stats[2] += 1
-    tau = 0.0
-    h = min(h_init, h_max)
-    idx = idx0
-    n_samples = sample_times.shape[0]
-    while idx < n_samples and sample_times[idx] - t_base <= 0.0:
-        store_sample(idx, y, cst, md, F, N, vv, out_s, out_mode, out_F)
-        idx += 1
-
-    status = SUCCESS
-    lost = jammed_contact(y, cst, md)
-    if lost >= 0:
-        return INCONSISTENT, 0.0, h_init, idx, n_tr, lost
-    retakes = 0
-    h_override = -1.0   # step length imposed on the next step (homing), if > 0
-    h_free = -1.0       # step size before a homing episode, if > 0
-    rejected = False
-    va_ready = False    # va holds the values at y (invalidated by projections and mode changes)
-    n_steps = 0
-    while tau < tau_end:
-        if n_steps >= max_steps:
-            status = MAX_STEPS
-            break
-        n_steps += 1
-        h = min(h, h_max, tau_end - tau)
-        if h <= 1e-14 * max(1.0, abs(tau)):  # below round-off of τ: no progress possible
-            status = STEP_UNDERFLOW
-            break
-        dp_step(y, k1, h, cst, md, Kst, ynew, ytmp)
-        stats[2] += 6
-        err = error_norm(y, ynew, Kst, h, md, rtol, atol)
-        if not math.isfinite(err):
-            if h < 1e-10:
-                status = NOT_FINITE
-                break
-            h *= MIN_FACTOR
-            stats[1] += 1
-            continue
-        if err > 1.0:
-            # a rejected re-take keeps homing: the root found before still lies ahead
-            h *= max(MIN_FACTOR, SAFETY * err ** -0.2)
-            stats[1] += 1
-            rejected = True
-            continue
-        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** -0.2)
-        if rejected:
-            factor = min(factor, 1.0)  # no growth right after a rejection (Hairer's DOPRI5 rule)
-            rejected = False
-        q_ready = False  # the dense-output coefficients are formed only when needed
-
-        # ---- a normal force through zero: the model ends there (contact lost)
-        theta_lost = -1.0
-        for c in range(nc):
-            if not is_unilateral(md, n, c) and P.normal_force(ynew, c, md) <= 0.0:
-                th = crossing_in_step(E.EVENT_NORMAL, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
-                q_ready = True
-                if theta_lost < 0.0 or th < theta_lost:
-                    theta_lost = th
-                    lost = c
-        if theta_lost > 0.0:
-            idx, tau = cut_step(theta_lost, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
-                                work, F, N, vv)
-            stats[0] += 1
-            status = CONTACT_LOST
-            break
-
-        # ---- slip contacts: departure overshoot, slip → stick roots inside the step
-        retake = -1.0
-        theta_slip = -1.0
-        any_stick = False
-        for c in range(nc):
-            mode = np.int64(cst[CST * c])
-            if mode == P.MODE_STICK:
-                any_stick = True
-                continue
-            if mode == P.MODE_OPEN:
-                continue
-            v1x, v1y, a1x, a1y = P.slip_velocity_and_rate(ynew, Kst[6], c, md)
-            va1[4 * c] = v1x
-            va1[4 * c + 1] = v1y
-            va1[4 * c + 2] = a1x
-            va1[4 * c + 3] = a1y
-            if mode == P.MODE_SLIP_QUASI_STATIC and retakes < MAX_RETAKES:
-                speed1 = math.sqrt(v1x * v1x + v1y * v1y)
-                if speed1 > DEPARTURE_OVERSHOOT * band:
-                    # the quasi-static direction is an O(|v|) approximation: leave it near the
-                    # band's edge, not far above it; |v| grows like t² after breakaway
-                    f_c = max(MIN_FACTOR, math.sqrt(band / speed1))
-                    retake = f_c if retake < 0.0 else min(retake, f_c)
-            if mode == P.MODE_SLIP_EXACT:  # while departing from v = 0 there is nothing to detect
-                if not va_ready:
-                    for c2 in range(nc):
-                        if np.int64(cst[CST * c2]) != P.MODE_STICK:
-                            vx, vy, ax, ay = P.slip_velocity_and_rate(y, k1, c2, md)
-                            va[4 * c2] = vx
-                            va[4 * c2 + 1] = vy
-                            va[4 * c2 + 2] = ax
-                            va[4 * c2 + 3] = ay
-                    va_ready = True
-                v0x = va[4 * c]
-                v0y = va[4 * c + 1]
-                speed0 = math.sqrt(v0x * v0x + v0y * v0y)
-                e0x = v0x / speed0
-                e0y = v0y / speed0
-                if E.slip_event_possible(speed0, h * (va[4 * c + 2] * e0x + va[4 * c + 3] * e0y),
-                                         v1x * e0x + v1y * e0y, h * (a1x * e0x + a1y * e0y)):
-                    if not q_ready:
-                        DP.dense_coefficients(Kst, Q)
-                        q_ready = True
-                    th = E.first_crossing(E.EVENT_SLIP, c, y, Q, h, e0x, e0y, cst, md, work, F, N)
-                    if th > 0.0 and (theta_slip < 0.0 or th < theta_slip):
-                        theta_slip = th
-        if retake > 0.0:
-            h *= retake
-            retakes += 1
-            stats[3] += 1
-            continue
-        if theta_slip > 0.0 and (1.0 - theta_slip) * h > E.EVENT_TIME_TOL and retakes < MAX_RETAKES:
-            # a slip velocity passes zero inside the step: re-take it to end at the root
-            if retakes == 0 and h_override < 0.0 and h_free < 0.0:
-                h_free = h  # the error controller's step, restored after the event
-            h *= theta_slip
-            retakes += 1
-            stats[3] += 1
-            continue
-
-        # ---- unilateral contacts: opening or closing inside the step cuts it at the root
-        theta_g, c_g, q_ready = gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N)
-
-        # ---- sticking contacts: breakaway inside the step cuts it at the root
-        theta_b = -1.0
-        c_b = np.int64(-1)  # not a literal: numba would type the call below for it first
-        if any_stick:
-            if not q_ready:
-                DP.dense_coefficients(Kst, Q)
-                q_ready = True
-            for c in range(nc):
-                if np.int64(cst[CST * c]) == P.MODE_STICK:
-                    th = E.first_crossing(E.EVENT_STICK, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
-                    if th > 0.0 and (theta_b < 0.0 or th < theta_b):
-                        theta_b = th
-                        c_b = c
-        cut = theta_g > 0.0 and (theta_b < 0.0 or theta_g <= theta_b)
-        if cut:
-            # a unilateral contact opens or closes inside the step: cut the step at the root
-            idx, tau = cut_step(theta_g, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
-                                work, F, N, vv)
-            n_tr, gap_status, flight = switch_gap(y, cst, c_g, md, rtol, atol, F, N, t_base + tau, tr_t, tr_kind,
-                                                  tr_contact, tr_s, n_tr, stats, ytmp)
-            if gap_status != SUCCESS:
-                stats[0] += 1
-                status = gap_status
-                lost = c_g
-                break
-            if flight < math.inf:  # a bounce: the next step ends inside its flight
-                h_override = 0.5 * flight
-        elif theta_b > 0.0:
-            # breakaway inside the step: the flow is smooth up to it, so cut the step at the root
-            cut = True
-            idx, tau = cut_step(theta_b, idx, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode, out_F,
-                                work, F, N, vv)
-            n_tr = break_away(y, cst, c_b, md, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
-        else:
-            # ---- accept the whole step
-            if idx < n_samples and sample_times[idx] - t_base <= tau + h:
-                if not q_ready:
-                    DP.dense_coefficients(Kst, Q)
-                idx = write_samples(idx, tau + h, y, Q, h, tau, t_base, cst, md, sample_times, out_s, out_mode,
-                                    out_F, work, F, N, vv)
-            tau += h
-            for i in range(ns):
-                y[i] = ynew[i]
-                k1[i] = Kst[6, i]
-            stats[0] += 1
-            for i in range(4 * nc):
-                va[i] = va1[i]
-            va_ready = True
-            changed = False
-            if any_stick:
-                P.project_velocities(y, cst, np.int64(-1), md)  # remove constraint drift
-                changed = True
-            v_arrive = E.arrival_speed(y, n, rtol, atol)
-            homing_any = False
-            for c in range(nc):
-                mode = np.int64(cst[CST * c])
-                if mode == P.MODE_STICK or mode == P.MODE_OPEN:
-                    continue
-                v1x = va1[4 * c]
-                v1y = va1[4 * c + 1]
-                a1x = va1[4 * c + 2]
-                a1y = va1[4 * c + 3]
-                speed = math.sqrt(v1x * v1x + v1y * v1y)
-                ex, ey = P.slip_direction(y, cst, c, md, v1x, v1y)
-                cst[CST * c + 1] = ex
-                cst[CST * c + 2] = ey
-                if mode == P.MODE_SLIP_QUASI_STATIC:
-                    if speed > band or v1x * a1x + v1y * a1y < 0.0:
-                        # departed, or |v| falls again inside the band (an approach, which may end
-                        # in stick or a reversal: watched in exact mode): the exact direction from
-                        # the next step on (the force law changes between steps, never inside one)
-                        cst[CST * c] = P.MODE_SLIP_EXACT
-                        changed = True
-                    cst[CST * c + 3] = math.inf
-                    continue
-                # arrived: a located root, homing, or |v| at the error control's resolution and
-                # falling (right after a departure |v| may still be below that resolution, but grows)
-                near = (theta_slip > 0.0 or retakes > 0 or homing[c] > 0
-                        or (speed <= v_arrive and v1x * a1x + v1y * a1y < 0.0))
-                tau_c = E.time_to_zero_of(v1x, v1y, a1x, a1y)
-                tau_start = cst[CST * c + 3]
-                if tau_start < math.inf and tau_c < math.inf:
-                    # approach to stick: the local error of the stiff direction dynamics is a function
-                    # of h/τ (self-similar), so control that ratio, not h: the next step is the same
-                    # fraction of the time left (no accept/reject ping-pong)
-                    factor = min(factor, factor * tau_c / tau_start)
-                cst[CST * c + 3] = tau_c if mode == P.MODE_SLIP_EXACT else math.inf
-                if (theta_slip <= 0.0 and E.ARRIVAL_TIME_TOL < tau_c < MAX_HOMING_STEP and homing[c] < MAX_RETAKES
-                        and (near or tau_c < h * factor)):
-                    # v heads for zero within the next step (or a re-take landed short of it): step
-                    # exactly the extrapolated time instead of letting the stiff direction dynamics
-                    # near v = 0 shrink the steps geometrically
-                    if retakes == 0 and homing[c] == 0 and h_free < 0.0:
-                        h_free = h
-                    if P.contact_dim(md.kin, m, n, c) == 1:
-                        # a 1-D slip velocity changes sign at zero and so does its force: a step past
-                        # the zero is rejected, so aim just short of it (the time left shrinks by
-                        # HOMING_SHORTFALL per homing step)
-                        tau_c *= 1.0 - HOMING_SHORTFALL
-                    h_override = tau_c if h_override < 0.0 else min(h_override, tau_c)
-                    homing[c] += 1
-                    homing_any = True
-                elif near:
-                    homing[c] = 0
-                    stick, nex, ney = E.try_stick(y, cst, c, md, v_arrive, F, N)
-                    if stick:
-                        cst[CST * c] = P.MODE_STICK
-                        cst[CST * c + 3] = math.inf
-                        stats[4] += 1
-                        record_transition(n_tr, t_base + tau, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind,
-                                          tr_contact, tr_s)
-                        n_tr += 1
-                        n_tr = settle(y, cst, md, F, N, t_base + tau, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
-                        changed = True
-                    elif nex != 0.0 or ney != 0.0:
-                        # v reached zero but stick cannot hold: slip departs again (reversal)
-                        cst[CST * c] = P.MODE_SLIP_QUASI_STATIC
-                        cst[CST * c + 1] = nex
-                        cst[CST * c + 2] = ney
-                        cst[CST * c + 3] = math.inf
-                        changed = True
-                    else:
-                        continue
-            if changed:
-                P.rhs(y, cst, md, k1)
-                stats[2] += 1
-                va_ready = False
-            if not homing_any and h_free > 0.0 and h_override < 0.0:
-                # the homing steps were short by construction, not by the error estimate: resume from
-                # the step size before them
-                h_override = max(h * factor, h_free)
-                h_free = -1.0
-            retakes = 0
-        if cut:  # a new smooth piece starts at the root
-            stats[0] += 1
-            P.rhs(y, cst, md, k1)
-            stats[2] += 1
-            va_ready = False
-            retakes = 0
-            homing_any = False
-        if not E.all_finite(y):
-            status = NOT_FINITE
-            break
-        lost = jammed_contact(y, cst, md)
-        if lost >= 0:
-            status = INCONSISTENT
-            break
-        if h_override > 0.0:
-            h = h_override
-            h_override = -1.0
-        else:
-            h *= factor
-            if tau_stop <= tau < tau_end and h_free < 0.0 and not homing_left(homing):
-                status = CHUNK_END
-                break
-    return status, tau, h, idx, n_tr, lost
+    nc = samples.forces.shape[1] // 2
+    start, step, slips, work, stats = loop_arrays(y0, nc, float(h_init), int(idx0), int(n_tr0))
+    event_loop(controls, md, cst, start, step, slips, work, samples, log, stats, bool(start_modes))
+    p = start[0]
+    return (int(p["status"]), float(p["tau"]), step.y, float(p["h"]), int(p["idx"]), int(p["n_tr"]), stats,
+            int(p["lost"]))

@@ -54,16 +54,16 @@ def hermite_coefficients(y0, f0, y1, f1, h, Q):
 
 
 @kernel
-def interpolated_crossing(kind, y0, f0, y1, f1, h, stick, md, Q, work, F, N):
+def interpolated_crossing(kind, y0, f0, y1, f1, h, stick, md, Q, scratch):
     """Root θ ∈ (0, 1] of the event ``kind`` (reference direction none: the stick event) on the
     cubic Hermite interpolant of a step from (y0, f0 = dy/dt) to (y1, f1) of length ``h`` [s]
-    (``contacts.first_crossing``); −1.0 if the interpolant shows none. ``Q`` (n, 3), ``work``
-    (n,), ``F`` (2,), ``N`` (1,) are work arrays.
+    (``contacts.first_crossing``); −1.0 if the interpolant shows none. ``Q`` (n, 3) and
+    ``scratch`` (:class:`~.bundles.Scratch`) are work arrays.
 
     The estimate that bisection on re-stepping starts from (:func:`bisection_point`).
     """
     hermite_coefficients(y0, f0, y1, f1, h, Q)
-    return first_crossing(kind, np.int64(0), y0, Q, h, 0.0, 0.0, stick, md, work, F, N)
+    return first_crossing(kind, np.int64(0), y0, Q, h, 0.0, 0.0, stick, md, scratch)
 
 
 @kernel

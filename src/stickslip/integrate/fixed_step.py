@@ -26,20 +26,22 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import SimulationError
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND, H_N, ModelData, offsets
-from ..model.jit import kernel, loop
+from ..model.jit import inlined_kernel, kernel
 from ..model.system_model import FrictionModel
 from . import events as E
 from . import rk4
+from .bundles import Samples, on_stack, scratch, store_record
 from .event_loop import N_EXTRA
 from .fixed_samples import end_sample_only, write_initial_samples, write_samples
 from .method_aeom import aeom_stick_branch, dependent_states
-from .method_naeom import MAX_NEWTON, VR_TOL, naeom_stick_branch
+from .method_naeom import MAX_NEWTON, VR_TOL, ForceStep, naeom_stick_branch
 from .runner import Chunk, Record, RunOutput, ToTheEnd, run_chunks, stats_dict, transition_room
 from .status import MAX_STEPS as STATUS_MAX_STEPS
 from .status import NOT_FINITE as STATUS_NOT_FINITE
@@ -48,25 +50,11 @@ from .status import STEP_UNDERFLOW as STATUS_STEP_UNDERFLOW
 from .status import SUCCESS as STATUS_OK
 from .status import Status
 from .step_physics import derivative_and_contact, derivative_under_force, stick_force
+from .transitions import record_transition
 
-
-@kernel
-def record_transition(n, t, kind, y, tr_t, tr_kind, tr_s):
-    """Write transition ``n`` (time [s], kind, state) into the buffers if they have room.
-
-    The loop counts on past the capacity and :meth:`FixedStepper.advance` runs again with room for
-    all (:func:`.runner.transition_room`): buffers that grew inside the loop would be loop-carried
-    arrays, which numba reference-counts on every iteration.
-    """
-    if n < tr_t.shape[0]:
-        tr_t[n] = t
-        tr_kind[n] = kind
-        for i in range(tr_s.shape[1]):
-            tr_s[n, i] = y[i]
-
-
-__all__ = ["integrate_fixed_step", "run_fixed_step", "FixedStepper", "check_step", "step_band", "step_data",
-           "STABILITY_LIMIT", "METHOD_AEOM", "METHOD_NAEOM"]
+__all__ = ["integrate_fixed_step", "fixed_loop", "run_fixed_step", "FixedStepper", "FixedStep", "StickArrays",
+           "FixedControls",
+           "FIXED_PROGRESS", "check_step", "step_band", "step_data", "STABILITY_LIMIT", "METHOD_AEOM", "METHOD_NAEOM"]
 
 #: Stick solver codes of :func:`integrate_fixed_step`.
 METHOD_AEOM = 0
@@ -79,6 +67,72 @@ METHOD_CODES = {"aeom": METHOD_AEOM, "naeom": METHOD_NAEOM}
 #: falling friction law and the frictional coupling, and still admits the paper's largest step
 #: Δt = 0.1 s for Table 1 (ω_max = 17.3 rad/s, ω_max Δt = 1.73).
 STABILITY_LIMIT = 2.0
+
+class FixedStep(NamedTuple):
+    """The arrays of one RK4 step of a state of n entries.
+
+    Attributes
+    ----------
+    y : ndarray (n,)
+        The state at the step's start (advanced in place).
+    K : ndarray (4, n)
+        RK4 stages (:mod:`.rk4`); K[0] = f(y), carried from step to step.
+    ynew, fnew : ndarray (n,)
+        The state at the step's end and its derivative.
+    ytmp : ndarray (n,)
+        The state of the stage being evaluated.
+    """
+
+    y: np.ndarray
+    K: np.ndarray
+    ynew: np.ndarray
+    fnew: np.ndarray
+    ytmp: np.ndarray
+
+
+class StickArrays(NamedTuple):
+    """What the stick steps add to a :class:`FixedStep` (n states).
+
+    Attributes
+    ----------
+    dense : ndarray (n, 3)
+        The step's cubic Hermite interpolant (``events.hermite_coefficients``): samples inside the
+        step, the first trials of breakaway's bisection.
+    Kn : ndarray (4, n)
+        Stages of NAEOM's constant-force steps.
+    history : ndarray (7,)
+        NAEOM's force history of the stick phase (:func:`.method_naeom.naeom_stick_branch`).
+    """
+
+    dense: np.ndarray
+    Kn: np.ndarray
+    history: np.ndarray
+
+
+class FixedControls(NamedTuple):
+    """What :func:`fixed_loop` is asked to do: the stick solver ``method`` (:data:`METHOD_AEOM` or
+    :data:`METHOD_NAEOM`), the interval [``t0``, ``t_end``] [s], the step ``dt`` [s] and the cap on
+    the steps ``max_steps``."""
+
+    method: int
+    t0: float
+    t_end: float
+    dt: float
+    max_steps: int
+
+
+#: The progress of :func:`fixed_loop`: its outcome (``status``), the time reached ``t`` [s], the
+#: step just taken ``h`` [s], the next grid point ``k_grid`` (t0 + k Δt), the steps taken, the next
+#: sample ``idx``, the transitions ``n_tr`` found (counted past the buffers' room), the ``mode``
+#: (slip or stick) and the ``transition`` that ends the step just taken (0: none), whether a slip
+#: step ended at a zero of the slip velocity (``crossed``), the reference direction (rx, ry) of
+#: the slip → stick event (:func:`event_direction`), the slip velocity (vx, vy) [m/s] and the
+#: friction force (Fx, Fy) [N] at the step's end.
+FIXED_PROGRESS = np.dtype([("status", np.int64), ("t", np.float64), ("h", np.float64), ("k_grid", np.int64),
+                           ("n_steps", np.int64), ("idx", np.int64), ("n_tr", np.int64), ("mode", np.int64),
+                           ("transition", np.int64), ("crossed", np.bool_), ("rx", np.float64), ("ry", np.float64),
+                           ("vx", np.float64), ("vy", np.float64), ("Fx", np.float64), ("Fy", np.float64)],
+                          align=True)
 
 #: Cap [m/s] of the step-adapted low-speed band (:func:`step_band`). A wider band would put the
 #: quasi-static slip direction in place of v_r/|v_r| over a sizable part of the sliding range
@@ -107,7 +161,7 @@ def rk4_slip_step(y, K, h, cst, md, ynew, ytmp):
 
 
 @kernel
-def slip_step_with_event(y, K, h, rx, ry, cst, md, ynew, fnew, ytmp, F, N, v, stats):
+def slip_step_with_event(step, h, rx, ry, cst, md, F, N, v, stats):
     """A slip step with the slip → stick event located by bisection on re-stepping.
 
     The event function is the projection of v_r on the reference direction (rx, ry)
@@ -118,16 +172,16 @@ def slip_step_with_event(y, K, h, rx, ry, cst, md, ynew, fnew, ytmp, F, N, v, st
     Plain halving from the whole step: unlike breakaway (``events.bisection_point``), the root
     on the step's interpolant is a poor guide here (measured off by 1e-4 to 0.2 of the step at
     Δt = 1e-3 s: near v_r = 0 the slip direction relaxes faster than the step resolves, and the
-    re-taken RK4 steps of different lengths do not follow one smooth path). Starting from it
-    saved 2 % of the re-steps at Δt = 1e-3 s and 26 % at 1e-4 s (0.2 % of that run): not kept.
+    re-taken RK4 steps of different lengths do not follow one smooth path).
 
     ``(rx, ry)``: unit reference direction, (0, 0) for none (right after breakaway, v_r = 0).
     Returns (h_taken, crossed, v1x, v1y, F1x, F1y): the step length actually taken [s], whether
     it ends at a zero of the slip velocity, and v_r [m/s] and the friction force [N] at the step
-    end. ``K`` (4, n) is the stage matrix with K[0] = f(y) (:mod:`.rk4`); ``ynew``, ``fnew`` =
-    f(ynew) hold the step end; ``F``, ``N``, ``v`` are work arrays. ``stats`` is updated (rhs
-    calls at index 2, re-taken steps at 3).
+    end. ``step`` is a :class:`FixedStep` from ``step.y`` with K[0] = f(y); ``step.ynew``,
+    ``step.fnew`` = f(ynew) hold the step end; ``F``, ``N``, ``v`` are work arrays. ``stats`` is
+    updated (rhs calls at index 2, re-taken steps at 3).
     """
+    y, K, ynew, fnew, ytmp = step.y, step.K, step.ynew, step.fnew, step.ytmp
     stats[2] += rk4_slip_step(y, K, h, cst, md, ynew, ytmp)
     F1x, F1y, v1x, v1y, _ = derivative_and_contact(ynew, cst, md, fnew, F, N, v)
     stats[2] += 1
@@ -216,14 +270,202 @@ def next_step(t, t0, dt, k_grid, t_end):
         k_grid += 1
 
 
-@loop
-def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, sample_times, out_s, out_mode, out_F, tr_t,
-                         tr_kind, tr_s):
-    """Integrate the model ``md`` (the plates) from ``y0`` (2n + 2 entries) over [t0, t_end] with
-    the fixed step ``dt`` [s].
+@inlined_kernel
+def grid_step(progress, controls):
+    """The next step's length (:func:`next_step`) into ``progress.h``; False where the run stops
+    (the step cap, a step that is not positive)."""
+    if progress.n_steps >= controls.max_steps:
+        progress.status = STATUS_MAX_STEPS
+        return False
+    progress.n_steps += 1
+    h, k_grid = next_step(progress.t, controls.t0, controls.dt, progress.k_grid, controls.t_end)
+    progress.h = h
+    progress.k_grid = k_grid
+    if h <= 0.0:
+        progress.status = STATUS_STEP_UNDERFLOW
+        return False
+    return True
 
-    ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step). Samples and
-    transitions are written as by the event loop (:mod:`.event_loop`).
+
+@inlined_kernel
+def take_fixed_step(progress, method, step, extra, cst, stick, md, scratch, stats):
+    """One step in the current mode: a slip step with the slip → stick event, or the method's stick
+    step with breakaway (each located by bisection on re-stepping; ``progress.h`` becomes the
+    length taken). False where NAEOM's stick-force solve failed. Each step kernel is given the
+    arrays it uses only: a kernel called at every step takes its arguments word by word."""
+    progress.transition = 0
+    progress.crossed = False
+    if progress.mode == P.MODE_SLIP:
+        rx, ry = event_direction(progress.vx, progress.vy, progress.rx, progress.ry, md.m[H_BAND])
+        progress.rx = rx
+        progress.ry = ry
+        h, crossed, vx, vy, Fx, Fy = slip_step_with_event(step, progress.h, rx, ry, cst, md, scratch.F, scratch.N,
+                                                          scratch.v, stats)
+        progress.crossed = crossed
+        progress.vx = vx
+        progress.vy = vy
+    elif method == METHOD_AEOM:
+        h, transition, Fx, Fy = aeom_stick_branch(step, progress.h, stick, md, extra.dense, scratch, stats)
+        progress.transition = transition
+    else:
+        forced = ForceStep(step.y, step.ynew, step.ytmp, extra.Kn, extra.history)
+        h, transition, Fx, Fy, solved = naeom_stick_branch(forced, progress.t, progress.h, stick, md, extra.dense,
+                                                           scratch, stats)
+        if not solved:
+            progress.status = STATUS_SOLVE_FAILED
+            return False
+        progress.transition = transition
+    progress.h = h
+    progress.Fx = Fx
+    progress.Fy = Fy
+    return True
+
+
+@inlined_kernel
+def step_samples(progress, method, step, dense, cst, md, samples, scratch, stats):
+    """The samples of the step (the friction force at its end (Fx, Fy)), before a transition
+    changes ``cst``: at its end alone where that is all (:func:`.fixed_samples.end_sample_only`),
+    else from its cubic Hermite interpolant (for NAEOM in stick, under its constant force)."""
+    mode = progress.mode
+    Fx = progress.Fx
+    Fy = progress.Fy
+    idx, done = end_sample_only(progress.idx, progress.t, progress.h, step.ynew, mode, Fx, Fy, samples)
+    if not done:
+        fixed_force = np.bool_(False)  # not a literal: one compiled version of write_samples
+        if mode == P.MODE_STICK and method == METHOD_NAEOM:
+            # NAEOM's constant force: derivatives at both step ends under it, for the Hermite samples
+            derivative_under_force(step.y, Fx, Fy, md, step.K[0])
+            derivative_under_force(step.ynew, Fx, Fy, md, step.fnew)
+            stats[2] += 2
+            fixed_force = np.bool_(True)
+        idx = write_samples(idx, progress.t, progress.h, step, dense, (Fx, Fy), mode, fixed_force, cst, md, samples,
+                            scratch)
+    progress.idx = idx
+
+
+@inlined_kernel
+def end_of_step(progress, step, history, cst, stick, md, scratch):
+    """At the step's end: in slip, the slip direction there, and at a located zero of the slip
+    velocity the stick test (:func:`after_slip_root`); after a breakaway, the direction slip
+    departs in."""
+    ynew = step.ynew
+    if progress.mode == P.MODE_SLIP:
+        ex, ey = P.slip_direction(ynew, cst, np.int64(0), md, progress.vx, progress.vy)
+        cst[1] = ex
+        cst[2] = ey
+        if progress.crossed and after_slip_root(ynew, cst, stick, md, scratch.F, scratch.N):
+            progress.transition = E.TRANSITION_TO_STICK
+            history[0] = 0.0
+    elif progress.transition == E.TRANSITION_TO_SLIP:
+        Fx, Fy, _ = stick_force(ynew, stick, md, scratch.F, scratch.N)
+        cst[1], cst[2] = E.breakaway_direction(Fx, Fy, np.int64(2))
+
+
+@inlined_kernel
+def advance(progress, step, stats):
+    """Move to the step's end: the time, the state and its derivative (k1 of the next step; NAEOM in
+    stick does not use it)."""
+    progress.t += progress.h
+    stats[0] += 1
+    y = step.y
+    ynew = step.ynew
+    k1 = step.K[0]
+    fnew = step.fnew
+    for i in range(y.shape[0]):
+        y[i] = ynew[i]
+        k1[i] = fnew[i]
+
+
+@inlined_kernel
+def switch_mode(progress, step, cst, md, scratch, log, stats):
+    """The step ended in a transition: the new mode, its record, the derivative in it."""
+    transition = progress.transition
+    mode = P.MODE_STICK if transition == E.TRANSITION_TO_STICK else P.MODE_SLIP
+    progress.mode = mode
+    cst[0] = mode
+    stats[4 if transition == E.TRANSITION_TO_STICK else 5] += 1
+    record_transition(log, progress.n_tr, progress.t, transition, np.int64(0), step.y)
+    progress.n_tr += 1
+    _, _, vx, vy, _ = derivative_and_contact(step.y, cst, md, step.K[0], scratch.F, scratch.N, scratch.v)  # projected
+    progress.vx = vx
+    progress.vy = vy
+    stats[2] += 1
+
+
+@inlined_kernel
+def begin(progress, controls, step, cst, stick, md, samples, scratch, stats):
+    """The mode the state starts in (AEOM in stick: x2, y2 from the trapezoidal rule), its
+    derivative and slip velocity, the samples at or before the start."""
+    y = step.y
+    mode = E.initial_mode(y, cst, stick, md, scratch.F, scratch.N)
+    if controls.method == METHOD_AEOM and mode == P.MODE_STICK:
+        dependent_states(y, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, md)
+    _, _, vx, vy, _ = derivative_and_contact(y, cst, md, step.K[0], scratch.F, scratch.N, scratch.v)
+    stats[2] += 1
+    progress.idx = write_initial_samples(y, controls.t0, mode, cst, md, samples, scratch)
+    progress.mode = mode
+    progress.vx = vx
+    progress.vy = vy
+    progress.rx = 0.0  # no reference direction of the slip → stick event yet (event_direction)
+    progress.ry = 0.0
+    progress.t = controls.t0
+    progress.k_grid = 1
+    progress.status = STATUS_OK
+    progress.n_steps = 0
+    progress.n_tr = 0
+
+
+@kernel
+def fixed_loop(controls, md, start, step, extra, cst, stick, scratch, samples, log, stats):
+    """The loop of :func:`integrate_fixed_step`: the model ``md`` (the plates) from ``step.y``
+    (2n + 2 entries, advanced in place) over [t0, t_end] with the fixed step ``dt``.
+
+    Parameters
+    ----------
+    controls : FixedControls
+    md : ModelData
+    start : ndarray (1,) of :data:`FIXED_PROGRESS`
+        The loop's progress at its end.
+    step : FixedStep
+    extra : StickArrays
+    cst, stick : ndarray (CST,)
+        The contact's state in its current mode (mode, slip direction ex, ey, τ), and the same in
+        stick (the stick multiplier, the projection, breakaway).
+    scratch : :class:`~.bundles.Scratch`
+    samples : :class:`~.bundles.Samples`
+        Written as by the event loop (:mod:`.event_loop`).
+    log : :class:`~.bundles.TransitionLog`
+        The transitions, as far as it has room.
+    stats : ndarray (8,) int64
+        steps, 0 (no rejections), rhs calls (each RK4 stage counts one), re-taken (bisection)
+        steps, slip → stick, stick → slip, NAEOM's total Newton iterations and most iterations
+        of one solve.
+    """
+    progress = on_stack(start[0])
+    begin(progress, controls, step, cst, stick, md, samples, scratch, stats)
+    while progress.t < controls.t_end:
+        if not grid_step(progress, controls):
+            break
+        if not take_fixed_step(progress, controls.method, step, extra, cst, stick, md, scratch, stats):
+            break
+        step_samples(progress, controls.method, step, extra.dense, cst, md, samples, scratch, stats)
+        end_of_step(progress, step, extra.history, cst, stick, md, scratch)
+        advance(progress, step, stats)
+        if progress.transition != 0:
+            switch_mode(progress, step, cst, md, scratch, log, stats)
+        if not E.all_finite(step.y):
+            progress.status = STATUS_NOT_FINITE
+            break
+    store_record(start, progress)
+
+
+def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, samples, log):
+    """Integrate the model ``md`` (the plates) from ``y0`` (2n + 2 entries) over [t0, t_end] with
+    the fixed step ``dt`` [s]: allocates the work arrays and runs :func:`fixed_loop`.
+
+    ``method`` is :data:`METHOD_AEOM` or :data:`METHOD_NAEOM` (the stick step). Samples go to the
+    :class:`~.bundles.Samples` ``samples`` and transitions to the
+    :class:`~.bundles.TransitionLog` ``log`` (contact 0), as by the event loop.
 
     Returns
     -------
@@ -236,112 +478,19 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, sample_times,
     n_transitions : int
         Transitions found (in the buffers up to their room).
     stats : ndarray (8,) int64
-        steps, 0 (no rejections), rhs calls (each RK4 stage counts one), re-taken (bisection)
-        steps, slip → stick, stick → slip, NAEOM's total Newton iterations and most iterations
-        of one solve.
+        As :func:`fixed_loop`'s.
     """
     n = y0.shape[0]
-    y = y0.copy()
-    ynew = np.empty(n)
-    ytmp = np.empty(n)
-    work = np.empty(n)
-    K = np.empty((4, n))  # RK4 stages (rk4.py); K[0] = k1 = f(y), carried from step to step
-    k1 = K[0]
-    fnew = np.empty(n)
-    Kn = np.empty((4, n))  # NAEOM's constant-force steps in stick
-    Q = np.empty((n, 3))
-    hist = np.zeros(7)  # NAEOM: force history of the stick phase (method_naeom.naeom_stick_branch)
-    cst = np.empty(CST)  # the contact's state (mode, slip direction ex, ey, τ) in its current mode
-    stick = np.empty(CST)  # the same in stick: the stick multiplier, the projection, breakaway
-    stick[0] = P.MODE_STICK
-    stick[1] = 0.0
-    stick[2] = 0.0
-    stick[3] = math.inf
-    F = np.empty(2)
-    N = np.empty(1)
-    v = np.empty(2)
-    n_tr = np.int64(0)  # not a literal: one compiled version of the callees
+    step = FixedStep(y0.copy(), np.empty((4, n)), np.empty(n), np.empty(n), np.empty(n))
+    extra = StickArrays(np.empty((n, 3)), np.empty((4, n)), np.zeros(7))
+    cst = np.empty(CST)
+    stick = np.array([P.MODE_STICK, 0.0, 0.0, math.inf])
     stats = np.zeros(8, dtype=np.int64)
-    force_given = np.bool_(True)  # write_samples' fixed_force; not literals: one compiled version
-    force_from_state = np.bool_(False)
-    band = md.m[H_BAND]
-
-    mode = E.initial_mode(y, cst, stick, md, F, N)
-    if method == METHOD_AEOM and mode == P.MODE_STICK:
-        dependent_states(y, 0.0, y[2] - y[0], y[3] - y[1], 0.0, 0.0, md)
-    _, _, vx, vy, _ = derivative_and_contact(y, cst, md, k1, F, N, v)
-    stats[2] += 1
-    idx = write_initial_samples(y, t0, mode, cst, md, sample_times, out_s, out_mode, out_F, F, N, v)
-    rx = 0.0  # reference direction of the slip → stick event (event_direction)
-    ry = 0.0
-    t = t0
-    k_grid = np.int64(1)  # not a literal: one compiled version of next_step
-    status = STATUS_OK
-    n_steps = 0
-    while t < t_end:
-        if n_steps >= max_steps:
-            status = STATUS_MAX_STEPS
-            break
-        n_steps += 1
-        h, k_grid = next_step(t, t0, dt, k_grid, t_end)
-        if h <= 0.0:
-            status = STATUS_STEP_UNDERFLOW
-            break
-        transition = 0
-        crossed = False
-        if mode == P.MODE_SLIP:
-            rx, ry = event_direction(vx, vy, rx, ry, band)
-            h, crossed, vx, vy, Fx, Fy = slip_step_with_event(y, K, h, rx, ry, cst, md, ynew, fnew, ytmp, F, N,
-                                                              v, stats)
-        elif method == METHOD_AEOM:
-            h, transition, Fx, Fy = aeom_stick_branch(y, K, h, stick, md, ynew, fnew, ytmp, Q, work, F, N, v,
-                                                      stats)
-        else:
-            h, transition, Fx, Fy, solved = naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, Kn, Q, F, N,
-                                                               stats)
-            if not solved:
-                status = STATUS_SOLVE_FAILED
-                break
-        # samples of the step (Fx, Fy: the friction force at its end), before a transition changes cst
-        idx, done = end_sample_only(idx, t, h, sample_times, ynew, mode, Fx, Fy, out_s, out_mode, out_F)
-        if not done:
-            fixed_force = force_from_state
-            if mode == P.MODE_STICK and method == METHOD_NAEOM:
-                # NAEOM's constant force: derivatives at both step ends under it, for the Hermite samples
-                derivative_under_force(y, Fx, Fy, md, k1)
-                derivative_under_force(ynew, Fx, Fy, md, fnew)
-                stats[2] += 2
-                fixed_force = force_given
-            idx = write_samples(idx, t, h, y, k1, ynew, fnew, Fx, Fy, mode, fixed_force, cst, md, sample_times,
-                                out_s, out_mode, out_F, Q, work, F, N, v)
-        if mode == P.MODE_SLIP:
-            ex, ey = P.slip_direction(ynew, cst, np.int64(0), md, vx, vy)
-            cst[1] = ex
-            cst[2] = ey
-            if crossed and after_slip_root(ynew, cst, stick, md, F, N):
-                transition = E.TRANSITION_TO_STICK
-                hist[0] = 0.0
-        elif transition == E.TRANSITION_TO_SLIP:
-            Fx, Fy, _ = stick_force(ynew, stick, md, F, N)
-            cst[1], cst[2] = E.breakaway_direction(Fx, Fy, np.int64(2))
-        t += h
-        stats[0] += 1
-        for i in range(n):
-            y[i] = ynew[i]
-            k1[i] = fnew[i]  # (NAEOM in stick does not use k1)
-        if transition != 0:
-            mode = P.MODE_STICK if transition == E.TRANSITION_TO_STICK else P.MODE_SLIP
-            cst[0] = mode
-            stats[4 if transition == E.TRANSITION_TO_STICK else 5] += 1
-            record_transition(n_tr, t, transition, y, tr_t, tr_kind, tr_s)
-            n_tr += 1
-            _, _, vx, vy, _ = derivative_and_contact(y, cst, md, k1, F, N, v)  # projected / new mode
-            stats[2] += 1
-        if not E.all_finite(y):
-            status = STATUS_NOT_FINITE
-        if status != STATUS_OK:
-            break
-    return status, t, y, n_tr, stats
+    start = np.zeros(1, dtype=FIXED_PROGRESS)
+    fixed_loop(FixedControls(int(method), float(t0), float(t_end), float(dt), int(max_steps)), md, start, step, extra,
+               cst, stick, scratch(n, 1), samples, log, stats)
+    p = start[0]
+    return int(p["status"]), float(p["t"]), step.y, int(p["n_tr"]), stats
 
 
 # --------------------------------------------------------------------------- Python runners
@@ -409,13 +558,11 @@ def step_data(model: FrictionModel, dt: float) -> ModelData:
 def warm_up(md: ModelData, ns: int, t0, dt, method) -> float:
     """Compile (or load from cache) :func:`integrate_fixed_step` on a one-step run of a state of
     ``ns`` entries; seconds spent, 0 if compiled already."""
-    if integrate_fixed_step.signatures:
+    if fixed_loop.signatures:
         return 0.0
     start = time.perf_counter()
-    y = np.zeros(ns)
-    integrate_fixed_step(method, y, t0, t0 + dt, dt, md, 10, np.array([t0]), np.zeros((1, ns)),
-                         np.zeros(1, dtype=np.int8), np.zeros((1, 2)), np.empty(1), np.empty(1, dtype=np.int8),
-                         np.empty((1, ns)))
+    samples = Samples(np.array([t0]), np.zeros((1, ns)), np.zeros(1, dtype=np.int8), np.zeros((1, 2)))
+    integrate_fixed_step(method, np.zeros(ns), t0, t0 + dt, dt, md, 10, samples, transition_room(0.0, ns, 1))
     return time.perf_counter() - start
 
 
@@ -448,11 +595,10 @@ class FixedStepper:
         capacity = None
         while True:
             tr = transition_room(self.t_end - self.t, self.ns, capacity)
-            times, row, out_s, out_mode, out_F = record.loop_arrays()
-            status, t_reached, _, n_tr, st = integrate_fixed_step(
-                self.code, self.y, self.t, self.t_end, self.dt, self.md, self.max_steps, times, out_s, out_mode,
-                out_F, tr[0], tr[1], tr[3])
-            if n_tr <= tr[0].size:
+            samples, _ = record.loop_arrays()
+            status, t_reached, _, n_tr, st = integrate_fixed_step(self.code, self.y, self.t, self.t_end, self.dt,
+                                                                  self.md, self.max_steps, samples, tr)
+            if n_tr <= tr.times.size:
                 break
             capacity = n_tr  # again with room for every transition (same result)
         if status == STATUS_SOLVE_FAILED:
@@ -460,7 +606,6 @@ class FixedStepper:
                 f"naeom: the stick-force solve did not reach |v_r| ≤ {VR_TOL:g} m/s in {MAX_NEWTON} Newton "
                 f"iterations at t = {t_reached:.6g} s (dt = {self.dt:g} s); give a smaller dt"
             )
-        tr[2][:n_tr] = 0  # the plates' one contact
         tau = t_reached - self.t
         self.t = t_reached
         self.stats += st[:6]

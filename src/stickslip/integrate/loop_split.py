@@ -3,62 +3,80 @@
 :data:`EVENT_LOOP`: the stick solve's subtree (:func:`~stickslip.integrate.contacts.try_stick`,
 the release of an overloaded stick, the contact forces, the low-speed band's direction and the
 starting modes) in the helper, the step's (the right-hand side, the Dormand–Prince step, the
-crossings' probe, the samples) here. On two cores, from an empty cache: the plates' ``simulate``
-−17 %, a model file's −18 %. The two subtrees share ``general_forces``, which both compile: the
-split is as even as the loop's call tree allows, and the loop's own body compiles after both.
-The helper also compiles the kernels that a run's results call after the loop (each contact's
-slip velocity and normal force at the samples), the release of overloaded sticks after a
-transition, a breakaway, the error norm and the slip velocity's rate; this process the cut of a
+crossings' probe, the samples) here. The two subtrees share ``general_forces``, which both
+compile: the split is as even as the loop's call tree allows, and the loop's own body compiles
+after both. The helper also compiles the kernels that a run's results call after the loop (each
+contact's slip velocity and normal force at the samples), the release of overloaded sticks after
+a transition, a breakaway, the error norm and the slip velocity's rate; this process the cut of a
 step at an event and the step's small helpers (the dense-output coefficients, the slip-event
-test): what neither side compiles, the loop compiles alone, after both. The run starts the helper
-(:func:`start_callees`) before it checks that no contact is open at the start (a refused run ends
-it); this process, done with its side, does the command's
-:func:`~stickslip.model.compile_ahead.meanwhile` work while the helper finishes.
+test): what neither side compiles, the loop compiles alone, after both. The kernels are named by
+reference and their argument types derived from the bundles a run builds
+(:func:`_loop_calls`). The run starts the helper (:func:`start_callees`) before it checks that no
+contact is open at the start (a refused run ends it); this process, done with its side, does the
+command's :func:`~stickslip.model.compile_ahead.meanwhile` work while the helper finishes.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
+from ..model import physics as P
+from ..model.bundle import H_N, H_NC, H_UNILATERAL, contact_state
 from ..model.compile_ahead import ColdStart, Split, start_apart
+from . import contacts as E
+from . import dormand_prince as DP
+from . import event_loop as L
+from . import result as R
+from . import transitions as T
+from .bundles import Samples, transition_log
 
 __all__ = ["EVENT_LOOP", "start_callees"]
 
+
+def _loop_calls(md) -> dict:
+    """The arguments with which the event loop (and a run's results after it) call the kernels of
+    :data:`EVENT_LOOP`, for the model data ``md``: the bundles :func:`.event_loop.integrate_event`
+    and :class:`.runner.Record` build."""
+    n, nc = int(md.m[H_N]), int(md.m[H_NC])
+    ns = 2 * n + L.N_EXTRA
+    cst = contact_state(md.m)
+    start, step, slips, scratch, stats = L.loop_arrays(np.zeros(ns), nc)
+    y, F, N = step.y, scratch.F, scratch.N
+    modes = np.zeros(1, dtype=R.mode_dtype(nc, bool(md.m[H_UNILATERAL])))
+    samples = Samples(np.zeros(1), np.zeros((1, ns)), modes, np.zeros((1, 2 * nc)))
+    log = transition_log(1, ns)
+    i, f = np.int64(0), 0.0
+    return {E.try_stick: (y, cst, i, md, f, F, N),
+            E.release_most_overloaded: (y, cst, md, F, N),
+            P.contact_forces: (y, cst, md, F, N, scratch.v),
+            P.band_direction: (y, cst, i, md, f),
+            E.initial_modes: (y, cst, md, f, f, F, N),
+            R._slip_velocities: (samples.states, md, i),
+            R._normal_forces: (samples.states, samples.modes, md, i),
+            T.settle: (y, cst, md, scratch, f, log, i, stats),
+            T.break_away: (y, cst, i, md, scratch, f, log, i, stats),
+            P.slip_velocity_and_rate: (y, y, i, md),
+            L.error_norm: (y, y, step.stages, f, md, f, f),
+            P.rhs: (y, cst, md, y),
+            L.dp_step: (y, y, f, cst, md, step.stages, y, y),
+            E.probed_crossing: (f, i, i, y, step.dense, f, f, f, cst, md, scratch),
+            L.write_samples: (i, f, f, f, f, y, step.dense, cst, md, samples, scratch),
+            L.cut_step: (f, i, f, f, f, step, cst, md, samples, scratch),
+            DP.dense_coefficients: (step.stages, step.dense),
+            E.slip_event_possible: (f, f, f, f),
+            E.time_to_zero_of: (f, f, f, f),
+            E.all_finite: (y,),
+            L.homing_left: (slips.homing,)}
+
+
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.
 EVENT_LOOP = Split(
-    helper=("stickslip.integrate.contacts.try_stick", "stickslip.integrate.contacts.release_most_overloaded",
-            "stickslip.model.physics.contact_forces", "stickslip.model.physics.band_direction",
-            "stickslip.integrate.contacts.initial_modes", "stickslip.integrate.result._slip_velocities",
-            "stickslip.integrate.result._normal_forces", "stickslip.integrate.transitions.settle",
-            "stickslip.integrate.transitions.break_away", "stickslip.model.physics.slip_velocity_and_rate",
-            "stickslip.integrate.event_loop.error_norm"),
-    own=("stickslip.model.physics.rhs", "stickslip.integrate.event_loop.dp_step",
-         "stickslip.integrate.contacts.probed_crossing", "stickslip.integrate.event_loop.write_samples",
-         "stickslip.integrate.event_loop.cut_step", "stickslip.integrate.dormand_prince.dense_coefficients",
-         "stickslip.integrate.contacts.slip_event_possible", "stickslip.integrate.contacts.time_to_zero_of",
-         "stickslip.integrate.contacts.all_finite", "stickslip.integrate.event_loop.homing_left"),
-    caller="stickslip.integrate.event_loop.event_loop",
-    signatures={
-        "stickslip.integrate.contacts.try_stick": "v v i M f v v",
-        "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
-        "stickslip.model.physics.contact_forces": "v v M v v v",
-        "stickslip.model.physics.band_direction": "v v i M f",
-        "stickslip.model.physics.rhs": "v v M v",
-        "stickslip.integrate.event_loop.dp_step": "v v f v M m v v",
-        "stickslip.integrate.contacts.probed_crossing": "f i i v m f f f v M v v v",
-        "stickslip.integrate.contacts.release_most_overloaded": "v v M v v",
-        "stickslip.integrate.event_loop.write_samples": "i f v m f f f v M v m b m v v v v",
-        "stickslip.integrate.result._slip_velocities": "m M i",
-        "stickslip.integrate.result._normal_forces": "m b M i",
-        "stickslip.integrate.transitions.settle": "v v M v v f v b b m i I",
-        "stickslip.integrate.transitions.break_away": "v v i M v v f v b b m i I",
-        "stickslip.integrate.event_loop.error_norm": "v v m f M f f",
-        "stickslip.model.physics.slip_velocity_and_rate": "v v i M",
-        "stickslip.integrate.dormand_prince.dense_coefficients": "m m",
-        "stickslip.integrate.contacts.slip_event_possible": "f f f f",
-        "stickslip.integrate.contacts.time_to_zero_of": "f f f f",
-        "stickslip.integrate.contacts.all_finite": "v",
-        "stickslip.integrate.event_loop.homing_left": "I",
-        "stickslip.integrate.event_loop.cut_step": "f i v m f f f v M v m b m v v v v",
-    })
+    helper=(E.try_stick, E.release_most_overloaded, P.contact_forces, P.band_direction, E.initial_modes,
+            R._slip_velocities, R._normal_forces, T.settle, T.break_away, P.slip_velocity_and_rate, L.error_norm),
+    own=(P.rhs, L.dp_step, E.probed_crossing, L.write_samples, L.cut_step, DP.dense_coefficients,
+         E.slip_event_possible, E.time_to_zero_of, E.all_finite, L.homing_left),
+    caller=L.event_loop,
+    calls=_loop_calls)
 
 
 def start_callees(md) -> ColdStart | None:

@@ -136,8 +136,8 @@ def aeom_stick_step(y, K, h, stick, md, ynew, ytmp):
 
     The stages call ``physics.general_rhs``, the right-hand side's path for stick, which
     ``physics.rhs_body`` calls after its fast path (every contact sliding) declines: inlining
-    ``rhs_body`` here, as the slip step does, would add its cold compile (3.8 s measured) for
-    nothing, and calling ``physics.rhs`` would add a call per stage (+5 % per run measured).
+    ``rhs_body`` here, as the slip step does, would add its cold compile for nothing, and calling
+    ``physics.rhs`` would add a call per stage.
     """
     u0, w0, a0, b0 = _trapezoid_base(y, md)
     for stage in range(3):
@@ -153,26 +153,28 @@ def aeom_stick_step(y, K, h, stick, md, ynew, ytmp):
 
 
 @kernel
-def aeom_stick_branch(y, K, h, stick, md, ynew, fnew, ytmp, Q, work, F, N, v, stats):
+def aeom_stick_branch(step, h, stick, md, dense, scratch, stats):
     """An AEOM stick step of length ``h`` [s] with breakaway located by bisection on re-stepping.
 
     If the stick force at the step end violates Eq. (10), θ ∈ (0, 1] is bisected, each trial
-    re-taking the stick step with θ h from ``y``, until the bracket is shorter than
+    re-taking the stick step with θ h from ``step.y``, until the bracket is shorter than
     ``events.EVENT_TIME_TOL``; the step then ends on the slip side of the root.
 
-    ``K`` (4, n): the RK4 stages with K[0] = f(y) in stick. Returns (h_taken, transition, Fx, Fy):
-    the step length taken [s], 0 or
-    ``events.TRANSITION_TO_SLIP`` and the stick force at the step end [N]. ``ynew`` and
-    ``fnew`` = f(ynew) (stick) hold the step end; ``stats`` counts rhs calls (index 2) and
-    re-taken steps (index 3). ``Q``, ``work``, ``F``, ``N``, ``v`` are work arrays.
+    ``step``: a :class:`~.fixed_step.FixedStep` whose stages K have K[0] = f(y) in stick. Returns
+    (h_taken, transition, Fx, Fy): the step length taken [s], 0 or ``events.TRANSITION_TO_SLIP``
+    and the stick force at the step end [N]. ``step.ynew`` and ``step.fnew`` = f(ynew) (stick)
+    hold the step end; ``stats`` counts rhs calls (index 2) and re-taken steps (index 3);
+    ``dense`` (n, 3) and ``scratch`` (:class:`~.bundles.Scratch`) are work arrays.
     """
+    y, K, ynew, fnew, ytmp = step.y, step.K, step.ynew, step.fnew, step.ytmp
+    F, N, v = scratch.F, scratch.N, scratch.v
     calls = aeom_stick_step(y, K, h, stick, md, ynew, ytmp)
     Fx, Fy, _, _, normal = derivative_and_contact(ynew, stick, md, fnew, F, N, v)
     stats[2] += calls + 1
     limit = P.static_limit(md.m, model_sizes(md.kin, md.m)[0], np.int64(0), normal)
     if limit - math.sqrt(Fx * Fx + Fy * Fy) > 0.0:  # Eq. (10) holds: still stuck
         return h, 0, Fx, Fy
-    estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, fnew, h, stick, md, Q, work, F, N)
+    estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, fnew, h, stick, md, dense, scratch)
     a, b, at, c = E.first_trial(estimate, h)
     while c >= 0.0:
         stats[2] += aeom_stick_step(y, K, c * h, stick, md, ynew, ytmp)

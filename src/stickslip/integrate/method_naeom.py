@@ -29,6 +29,7 @@ are shared with ``aeom`` (:mod:`~stickslip.integrate.fixed_step`). What is speci
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,7 +40,7 @@ from . import rk4
 from .status import SOLVE_FAILED as STATUS_SOLVE_FAILED
 from .step_physics import constraint_metric, contact_limit, derivative_under_force, stick_force
 
-__all__ = ["naeom_stick_branch", "solve_stick_step", "rk4_force_step", "VR_TOL", "MAX_NEWTON", "STATUS_SOLVE_FAILED"]
+__all__ = ["ForceStep", "naeom_stick_branch", "solve_stick_step", "rk4_force_step", "VR_TOL", "MAX_NEWTON", "STATUS_SOLVE_FAILED"]
 
 #: Tolerance [m/s] of the stick-force solve on |v_r(t_n)|. v_r is a difference of terms of
 #: order Ω R ≈ 1 m/s (paper's cases), so its round-off is ~1e-16 m/s; 1e-12 m/s is 10⁴ times
@@ -149,21 +150,48 @@ def solve_stick_step(y, h, Fx, Fy, md, ynew, ytmp, K, stats):
     return Fx, Fy, -1
 
 
-@kernel
-def naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, K, Q, F, N, stats):
-    """A NAEOM stick step from ``y`` at time ``t`` [s] of length ``h`` [s], breakaway bisected.
+class ForceStep(NamedTuple):
+    """The arrays of NAEOM's constant-force steps in stick (n states).
 
-    ``hist`` (7,) is the force history of the current stick phase, updated here: the number of
-    steps so far, then (mid-step time, Fx, Fy) of the last two steps. The start value of the
-    force solve is its linear extrapolation (O(Δt²)), or the exact stick multiplier at the first
-    step of a stick phase (``stick``: the contact state in stick).
+    Attributes
+    ----------
+    y : ndarray (n,)
+        The state at the step's start.
+    ynew : ndarray (n,)
+        The state at its end.
+    ytmp : ndarray (n,)
+        The state of the stage being evaluated.
+    K : ndarray (4, n)
+        RK4 stages (:func:`rk4_force_step`).
+    history : ndarray (7,)
+        The force history of the stick phase (:func:`naeom_stick_branch`).
+    """
+
+    y: np.ndarray
+    ynew: np.ndarray
+    ytmp: np.ndarray
+    K: np.ndarray
+    history: np.ndarray
+
+
+@kernel
+def naeom_stick_branch(step, t, h, stick, md, dense, scratch, stats):
+    """A NAEOM stick step from ``step.y`` at time ``t`` [s] of length ``h`` [s], breakaway bisected.
+
+    ``step.history`` (7,) is the force history of the current stick phase, updated here: the
+    number of steps so far, then (mid-step time, Fx, Fy) of the last two steps. The start value of
+    the force solve is its linear extrapolation (O(Δt²)), or the exact stick multiplier at the
+    first step of a stick phase (``stick``: the contact state in stick).
 
     Returns (h_taken, transition, Fx, Fy, solved): the step length taken [s], 0 or
     ``events.TRANSITION_TO_SLIP``, the solved force [N], and False if a solve failed
-    (:data:`MAX_NEWTON`). ``ynew`` holds the step end. Breakaway is bisected on re-solved steps,
-    the first trials around the root on the step's interpolant (``events.bisection_point``);
-    ``K`` (4, n), ``Q`` (n, 3), ``F`` (2,), ``N`` (1,) are work arrays.
+    (:data:`MAX_NEWTON`). ``step.ynew`` holds the step end. Breakaway is bisected on re-solved
+    steps, the first trials around the root on the step's interpolant (``events.bisection_point``);
+    ``step.K`` (4, n), ``dense`` (n, 3) and ``scratch`` (:class:`~.bundles.Scratch`) are work
+    arrays.
     """
+    y, hist, ynew, ytmp, K = step.y, step.history, step.ynew, step.ytmp, step.K
+    F, N = scratch.F, scratch.N
     n_hist = hist[0]
     tm = t + 0.5 * h
     if n_hist >= 2:
@@ -182,7 +210,7 @@ def naeom_stick_branch(y, t, h, hist, stick, md, ynew, ytmp, K, Q, F, N, stats):
         # the step's Hermite interpolant under the solved force gives the first trials
         derivative_under_force(y, Fx, Fy, md, K[0])
         derivative_under_force(ynew, Fx, Fy, md, K[1])
-        estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, K[1], h, stick, md, Q, ytmp, F, N)
+        estimate = E.interpolated_crossing(E.EVENT_STICK, y, K[0], ynew, K[1], h, stick, md, dense, scratch)
         a, b, at, c = E.first_trial(estimate, h)
         while c >= 0.0:
             Fx, Fy, it = solve_stick_step(y, c * h, Fx, Fy, md, ynew, ytmp, K, stats)

@@ -34,7 +34,8 @@ from ..errors import SimulationError
 from ..model.bundle import contact_state
 from ..model.system_model import FrictionModel
 from . import contacts as E
-from .event_loop import N_EXTRA, integrate_event
+from .bundles import Samples, TransitionLog, transition_log
+from .event_loop import N_EXTRA, controls, integrate_event
 from .interrupt import interruptible
 from .loop_split import start_callees
 from .result import Transitions, mode_dtype
@@ -77,11 +78,11 @@ NO_STEP_CAP = 2**62
 COMPILE_REPORT_S = 0.05
 
 
-def transition_room(duration: float, ns: int, capacity: int | None = None):
+def transition_room(duration: float, ns: int, capacity: int | None = None) -> TransitionLog:
     """Transition buffers (times, kinds, contacts, states (·, ns)) for a chunk of ``duration`` [s]:
     ``capacity`` entries, default :data:`MIN_TRANSITION_ROOM` + :data:`TRANSITIONS_PER_SECOND` per second."""
     cap = capacity or MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * max(duration, 0.0))
-    return np.empty(cap), np.empty(cap, dtype=np.int8), np.empty(cap, dtype=np.int8), np.empty((cap, ns))
+    return transition_log(cap, ns)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -158,11 +159,11 @@ class Record:
         self.transition_count = 0
 
     # ------------------------------------------------------------------ samples
-    def loop_arrays(self):
-        """(sample times, next row, states, mode, friction) for a compiled loop that writes the next
-        samples in place: rows of the held arrays, times from :attr:`base` on."""
+    def loop_arrays(self) -> tuple[Samples, int]:
+        """(samples, next row) for a compiled loop that writes the next samples in place: the held
+        arrays, their times from :attr:`base` on."""
         times = self.sample_times[self.base:self.base + self.capacity]
-        return times, self.n - self.base, self._states, self._mode, self._friction
+        return Samples(times, self._states, self._mode, self._friction), self.n - self.base
 
     @property
     def room(self) -> int:
@@ -277,11 +278,11 @@ class EventStepper:
     def _warm_up(self, system: FrictionModel) -> None:
         """Compile (or load from cache) the event loop for this kinematics class and set the modes
         the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇)."""
-        tr = transition_room(0.0, self.ns, 1)
-        y = integrate_event(self.y, self.cst, 0.0, 0.0, 0.0, self.md, self.rtol, self.atol, 1e-7, 1e-6, 10,
-                            np.empty(0), 0, np.empty((1, self.ns)), np.empty(1, dtype=np.int8),
-                            np.empty((1, 2 * system.n_contacts)), tr[0], tr[1], tr[2], tr[3], 0, start_modes=True)[2]
-        self.y = y
+        nc = system.n_contacts
+        samples = Samples(np.empty(0), np.empty((1, self.ns)), np.empty(1, dtype=mode_dtype(nc, system.unilateral)),
+                          np.empty((1, 2 * nc)))
+        self.y = integrate_event(self.md, self.cst, self.y, controls(0.0, 0.0, 0.0, self.rtol, self.atol, 1e-6, 10),
+                                 1e-7, samples, 0, transition_room(0.0, self.ns, 1), start_modes=True)[2]
 
     def advance(self, tau_stop: float, record: Record) -> Chunk:
         """Integrate about ``tau_stop`` seconds more (to the first accepted step past it outside an
@@ -291,11 +292,11 @@ class EventStepper:
         capacity = None
         while True:
             tr = transition_room(tau_stop, self.ns, capacity)
-            times, row, out_s, out_mode, out_F = record.loop_arrays()
-            status, tau, y, h, idx, n_tr, st, lost = integrate_event(
-                self.y, self.cst, self.t, tau_stop, tau_end, self.md, self.rtol, self.atol, self.h, self.h_max,
-                self.steps_left, times, row, out_s, out_mode, out_F, tr[0], tr[1], tr[2], tr[3], 0)
-            if n_tr <= tr[0].size:
+            samples, row = record.loop_arrays()
+            chunk = controls(self.t, tau_stop, tau_end, self.rtol, self.atol, self.h_max, self.steps_left)
+            status, tau, y, h, idx, n_tr, st, lost = integrate_event(self.md, self.cst, self.y, chunk, self.h,
+                                                                     samples, row, tr)
+            if n_tr <= tr.times.size:
                 break
             capacity = n_tr  # again from the chunk's start with room for all its transitions
             self.y, self.cst, self.h = start[0].copy(), start[1].copy(), start[2]

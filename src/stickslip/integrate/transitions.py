@@ -13,7 +13,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import CST
-from ..model.jit import inlined_kernel, kernel
+from ..model.jit import inlined_kernel, kernel, standalone
 from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from ..model.normal import is_unilateral
 from . import contacts as E
@@ -25,45 +25,52 @@ __all__ = ["crossing_in_step", "record_transition", "settle", "break_away", "swi
 
 
 @inlined_kernel
-def crossing_in_step(kind, c, y, Kst, Q, q_ready, h, cst, md, work, F, N):
-    """θ ∈ (0, 1] of the first crossing of event ``kind`` of contact ``c`` inside a step whose end
-    is past it (1.0 where the sample points see no sign change: the root is at the end); forms the
-    step's dense-output coefficients ``Q`` from ``Kst`` first unless ``q_ready``."""
+def crossing_in_step(kind, c, step, q_ready, h, cst, md, scratch):
+    """θ ∈ (0, 1] of the first crossing of event ``kind`` of contact ``c`` inside the step ``step``
+    (a :class:`~.dormand_prince.Step` of length ``h``) whose end is past it (1.0 where the sample
+    points see no sign change: the root is at the end); forms the step's dense-output
+    coefficients first unless ``q_ready``."""
     if not q_ready:
-        DP.dense_coefficients(Kst, Q)
-    th = E.first_crossing(kind, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+        DP.dense_coefficients(step.stages, step.dense)
+    th = E.first_crossing(kind, c, step.y, step.dense, h, 0.0, 0.0, cst, md, scratch)
     return 1.0 if th <= 0.0 else th
 
 
+@standalone
 @kernel
-def record_transition(n_tr, t, kind, contact, y, tr_t, tr_kind, tr_contact, tr_s):
-    """Write transition ``n_tr`` (time [s], kind, contact, state) into the buffers if they have
-    room; the caller counts on and runs again with room for all (buffers that grew inside the
-    loop would be loop-carried arrays, which numba reference-counts on every iteration)."""
-    if n_tr < tr_t.shape[0]:
-        tr_t[n_tr] = t
-        tr_kind[n_tr] = kind
-        tr_contact[n_tr] = contact
-        for i in range(tr_s.shape[1]):
-            tr_s[n_tr, i] = y[i]
+def record_transition(log, n_tr, t, kind, contact, y):
+    """Write transition ``n_tr`` (time [s], kind, contact, state) into the :class:`~.bundles.TransitionLog`
+    ``log`` if it has room; the caller counts on and runs again with room for all (buffers that
+    grew inside the loop would be loop-carried arrays, which numba reference-counts on every
+    iteration)."""
+    if n_tr < log.times.shape[0]:
+        log.times[n_tr] = t
+        log.kinds[n_tr] = kind
+        log.contacts[n_tr] = contact
+        states = log.states
+        for i in range(states.shape[1]):
+            states[n_tr, i] = y[i]
 
 
+@standalone
 @kernel
-def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+def settle(y, cst, md, scratch, t, log, n_tr, stats):
     """Release sticking contacts whose joint stick force exceeds the static limit (the most
-    overloaded first) and record their breakaways at time ``t``; returns the transition count."""
+    overloaded first) and record their breakaways at time ``t`` in ``log``; returns the
+    transition count."""
     for _ in range(E.MAX_SETTLE):
-        c = E.release_most_overloaded(y, cst, md, F, N)
+        c = E.release_most_overloaded(y, cst, md, scratch.F, scratch.N)
         if c < 0:
             break
-        record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        record_transition(log, n_tr, t, E.TRANSITION_TO_SLIP, c, y)
         n_tr += 1
         stats[5] += 1
     return n_tr
 
 
+@standalone
 @kernel
-def break_away(y, cst, c, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
+def break_away(y, cst, c, md, scratch, t, log, n_tr, stats):
     """Sticking contact ``c`` breaks away at ``y`` (time ``t``, the root of its stick margin): the
     velocities are projected onto the stick constraints, ``c`` slips quasi-statically along its
     stick force's direction, and the breakaway and any release it causes (:func:`settle`) are
@@ -71,26 +78,26 @@ def break_away(y, cst, c, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, st
     that a cold start compiles it beside the loop instead of inside it."""
     m = md.m
     n = model_sizes(md.kin, m)[0]
+    F = scratch.F
     P.project_velocities(y, cst, np.int64(-1), md)
-    P.stick_forces(y, cst, np.int64(-1), md, F, N)
+    P.stick_forces(y, cst, np.int64(-1), md, F, scratch.N)
     ex, ey = E.breakaway_direction(F[2 * c], F[2 * c + 1], P.contact_dim(md.kin, m, n, c))
     cst[CST * c] = P.MODE_SLIP_QUASI_STATIC
     cst[CST * c + 1] = ex
     cst[CST * c + 2] = ey
     cst[CST * c + 3] = math.inf
     stats[5] += 1
-    record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
-    return settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr + 1, stats)
+    record_transition(log, n_tr, t, E.TRANSITION_TO_SLIP, c, y)
+    return settle(y, cst, md, scratch, t, log, n_tr + 1, stats)
 
 
-@unilateral_kernel(lambda y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work:
-                   (n_tr, SUCCESS, math.inf))
-def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats, work):  # pragma: no cover
+@unilateral_kernel(lambda y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats: (n_tr, SUCCESS, math.inf))
+def switch_gap(y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats):  # pragma: no cover
     """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
-    change its mode, record the transitions (a sticking contact that opens first leaves stick; a
-    contact that closes with v_c = 0 and an admissible stick force sticks; a rigid one closes with
-    an impact, recorded with the state before it, then ``open`` where it bounces off or ``close``
-    where it stays, with the state after it), re-check the sticking set.
+    change its mode, record the transitions in ``log`` (a sticking contact that opens first leaves
+    stick; a contact that closes with v_c = 0 and an admissible stick force sticks; a rigid one
+    closes with an impact, recorded with the state before it, then ``open`` where it bounces off
+    or ``close`` where it stays, with the state after it), re-check the sticking set.
 
     Returns (transition count, status, flight): status SUCCESS, or INCONSISTENT where a rigid
     contact's impact has no consistent impulse; flight the predicted time [s] to a bounced
@@ -98,36 +105,37 @@ def switch_gap(y, cst, c, md, rtol, atol, F, N, t, tr_t, tr_kind, tr_contact, tr
     kinematics)."""
     flight = math.inf
     if P.is_open(cst, c) and P.rigid(c, md):
-        record_transition(n_tr, t, E.TRANSITION_IMPACT, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        record_transition(log, n_tr, t, E.TRANSITION_IMPACT, c, y)
         n_tr += 1
-        phase, sticks, impulse, before, after, flight = E.land(y, cst, c, md, rtol, atol, F, N, work)
+        phase, sticks, impulse, before, after, flight = E.land(y, cst, c, md, rtol, atol, scratch.F, scratch.N,
+                                                               scratch.state)
         if phase == E.LAND_INCONSISTENT:
             return n_tr, INCONSISTENT, flight
         kind = E.TRANSITION_OPEN if phase == E.LAND_OPEN else E.TRANSITION_CLOSE
-        record_transition(n_tr, t, kind, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        record_transition(log, n_tr, t, kind, c, y)
         n_tr += 1
         if sticks:
             stats[4] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            record_transition(log, n_tr, t, E.TRANSITION_TO_STICK, c, y)
             n_tr += 1
     elif P.is_open(cst, c):
-        record_transition(n_tr, t, E.TRANSITION_CLOSE, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        record_transition(log, n_tr, t, E.TRANSITION_CLOSE, c, y)
         n_tr += 1
-        if E.close_contact(y, cst, c, md, rtol, atol, F, N):
+        if E.close_contact(y, cst, c, md, rtol, atol, scratch.F, scratch.N):
             stats[4] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_STICK, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            record_transition(log, n_tr, t, E.TRANSITION_TO_STICK, c, y)
             n_tr += 1
     else:
         if np.int64(cst[CST * c]) == P.MODE_STICK:
             stats[5] += 1
-            record_transition(n_tr, t, E.TRANSITION_TO_SLIP, c, y, tr_t, tr_kind, tr_contact, tr_s)
+            record_transition(log, n_tr, t, E.TRANSITION_TO_SLIP, c, y)
             n_tr += 1
         cst[CST * c] = P.MODE_OPEN
         cst[CST * c + 3] = math.inf
-        record_transition(n_tr, t, E.TRANSITION_OPEN, c, y, tr_t, tr_kind, tr_contact, tr_s)
+        record_transition(log, n_tr, t, E.TRANSITION_OPEN, c, y)
         n_tr += 1
     P.project_velocities(y, cst, np.int64(-1), md)  # the sticking set's constraints, after the change
-    n_tr = settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats)
+    n_tr = settle(y, cst, md, scratch, t, log, n_tr, stats)
     return n_tr, SUCCESS, flight
 
 
@@ -145,11 +153,10 @@ def jammed_contact(y, cst, md):  # pragma: no cover - compiled only
     return np.int64(-1)
 
 
-@unilateral_kernel(lambda y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N: (-1.0, np.int64(-1), q_ready),
-                   inline="always")
-def gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):  # pragma: no cover
+@unilateral_kernel(lambda step, q_ready, h, cst, md, scratch: (-1.0, np.int64(-1), q_ready), inline="always")
+def gap_crossing(step, q_ready, h, cst, md, scratch):  # pragma: no cover
     """(θ, contact, q_ready) of the first opening or closing of a unilateral contact inside the step
-    from ``y`` (derivative ``k1``) to ``ynew`` (stages ``Kst``), θ = −1.0 and contact −1 for none.
+    ``step`` (a :class:`~.dormand_prince.Step` of length ``h``), θ = −1.0 and contact −1 for none.
     Besides a contact whose indicator has turned at the step's end, a flight (or a touch) that
     begins and ends inside the step is found where the step's Hermite interpolant of the gap dips
     and the dense output there confirms it. Nothing for pressed-only kinematics, whose kernels then
@@ -162,15 +169,15 @@ def gap_crossing(y, k1, ynew, Kst, Q, q_ready, h, cst, md, work, F, N):  # pragm
     for c in range(nc):
         if not is_unilateral(md, n, c):
             continue
-        if P.indicator(ynew, cst, c, md) <= 0.0:
-            th = crossing_in_step(E.EVENT_GAP, c, y, Kst, Q, q_ready, h, cst, md, work, F, N)
+        if P.indicator(step.ynew, cst, c, md) <= 0.0:
+            th = crossing_in_step(E.EVENT_GAP, c, step, q_ready, h, cst, md, scratch)
         else:
-            probe = E.gap_dip(y, k1, ynew, Kst[6], h, cst, c, md)
+            probe = E.gap_dip(step.y, step.k1, step.ynew, step.stages[6], h, cst, c, md)
             if probe < 0.0:
                 continue
             if not q_ready:
-                DP.dense_coefficients(Kst, Q)
-            th = E.probed_crossing(probe, E.EVENT_GAP, c, y, Q, h, 0.0, 0.0, cst, md, work, F, N)
+                DP.dense_coefficients(step.stages, step.dense)
+            th = E.probed_crossing(probe, E.EVENT_GAP, c, step.y, step.dense, h, 0.0, 0.0, cst, md, scratch)
         q_ready = True
         if th > 0.0 and (theta_g < 0.0 or th < theta_g):
             theta_g = th

@@ -18,14 +18,16 @@ event loop), the variational equations of the orbit tools
 turns to its own side (:func:`start_apart`, :class:`ColdStart`), and a command may hand the split
 work it does later anyway (:func:`meanwhile`: the CLI imports what writes its outputs).
 
-The callees' argument types are written as short codes (:data:`CODES`: the callers' own call
-sites; the tests check that they are the signatures the callers compile). Where the helper cannot
-run (one core, a model class its process cannot import, a failure, kernels not cached on disk:
-:func:`.kernel_cache.caching`) this process compiles everything itself: the helper only ever adds
-kernels to the cache. ``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test suite does, its
-workers already fill the cores; so do the workers of sweeps and basins). The helper is a fork
-where numba's compiler lock and compile listeners are as the patch ``fork-helper`` of
-:mod:`.numba_patches` expects (:data:`FORK_PATCH`), else a new interpreter.
+A split names its kernels by reference and derives their argument types: ``calls(md)`` gives
+each kernel's arguments as its caller passes them, from the bundles a run builds for the model
+data ``md``, and their numba types are the signature (the tests check that they are the
+signatures the callers compile). Where the helper cannot run (one core, a model class its process
+cannot import, a failure, kernels not cached on disk: :func:`.kernel_cache.caching`) this process
+compiles everything itself: the helper only ever adds kernels to the cache.
+``STICKSLIP_COMPILE_PROCESSES=1`` turns it off (the test suite does, its workers already fill the
+cores; so do the workers of sweeps and basins). The helper is a fork where numba's compiler lock
+and compile listeners are as the patch ``fork-helper`` of :mod:`.numba_patches` expects
+(:data:`FORK_PATCH`), else a new interpreter.
 """
 
 from __future__ import annotations
@@ -40,23 +42,17 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numba
-from numba import types
 from numba.core import event
 
 from .kernel_cache import caching
 from .numba_patches import Patch, active, first_problem, has
 
-__all__ = ["Split", "CODES", "ColdStart", "start_apart", "compile_apart", "meanwhile", "enabled", "kernel_named"]
-
-#: Argument codes: v float64[::1], m float64[:, ::1], z complex128[::1], Z complex128[:, ::1],
-#: b int8[::1], I int64[::1], i int64, f float64, c complex128, B bool, M the model data.
-CODES = {"v": types.float64[::1], "m": types.float64[:, ::1], "z": types.complex128[::1],
-         "Z": types.complex128[:, ::1], "b": types.int8[::1], "I": types.int64[::1], "i": types.int64,
-         "f": types.float64, "c": types.complex128, "B": types.boolean}
+__all__ = ["Split", "ColdStart", "start_apart", "compile_apart", "meanwhile", "enabled"]
 
 #: Seconds to wait for the helper before going on without it.
 HELPER_TIMEOUT_S = 600.0
@@ -68,13 +64,15 @@ class Split:
 
     Attributes
     ----------
-    helper, own : tuple of str
-        Kernels (``"stickslip.<module>.<name>"``) the helper process compiles, and this process
-        meanwhile; the helper's first one tells whether the split is a cold start.
-    caller : str
+    helper, own : tuple of kernels
+        Kernels (numba dispatchers) the helper process compiles, and this process meanwhile; the
+        helper's first one tells whether the split is a cold start.
+    caller : kernel
         The kernel that calls them, compiled after both (its compile event spans the pair).
-    signatures : mapping of str to str
-        Each kernel's argument codes (:data:`CODES`), separated by spaces.
+    calls : callable
+        ``calls(md)``: each kernel of ``helper`` and ``own`` mapped to its arguments as its caller
+        passes them for the model data ``md`` (arrays, bundles and numbers of the types and layouts
+        a run builds); their numba types are the signature compiled (:meth:`signatures`).
     applies : callable, optional
         ``applies(md)``: whether the split's signatures are those the caller compiles for the
         model data ``md`` (default: always).
@@ -82,13 +80,14 @@ class Split:
 
     helper: tuple
     own: tuple
-    caller: str
-    signatures: Mapping
+    caller: Any
+    calls: Callable
     applies: Callable | None = None
 
-    def signature(self, name: str, md_type) -> tuple:
-        """The argument types of kernel ``name`` for model data of numba type ``md_type``."""
-        return tuple(md_type if code == "M" else CODES[code] for code in self.signatures[name].split())
+    def signatures(self, md) -> dict:
+        """Each kernel's argument types for the model data ``md``: the numba types of its
+        arguments in :attr:`calls`."""
+        return {kernel: tuple(numba.typeof(a) for a in args) for kernel, args in self.calls(md).items()}
 
 
 _started: set = set()
@@ -104,17 +103,10 @@ def enabled() -> bool:
     return compile_processes() >= 2 and (os.cpu_count() or 1) >= 2 and caching()
 
 
-def kernel_named(name: str):
-    """The kernel (a numba dispatcher) ``"stickslip.<module>.<name>"``."""
-    module, attr = name.rsplit(".", 1)
-    return getattr(importlib.import_module(module), attr)
-
-
-def _compile(split: Split, names, md_type) -> None:
-    for name in names:
-        kernel = kernel_named(name)
+def _compile(kernels, signatures) -> None:
+    for kernel in kernels:
         with contextlib.suppress(numba.core.errors.NumbaError):
-            kernel.compile(split.signature(name, md_type))
+            kernel.compile(signatures[kernel])
 
 
 class ColdStart:
@@ -122,16 +114,16 @@ class ColdStart:
     and waits for the helper; :meth:`end` stops a helper that is still running (use as a context
     manager, so that an error or Ctrl-C on this side ends it)."""
 
-    def __init__(self, split: Split, md_type, helper):
-        self.split, self.md_type, self.helper = split, md_type, helper
+    def __init__(self, split: Split, signatures, helper):
+        self.split, self.signatures, self.helper = split, signatures, helper
 
     def finish(self) -> None:
         """Compile this process's kernels, run the :func:`meanwhile` work, then wait for the helper."""
         # outermost compile events around this process's side and the wait for the helper, so that
         # the time waited counts as compiling and the meanwhile work does not
-        compiling = {"dispatcher": kernel_named(self.split.caller), "args": (), "return_type": None}
+        compiling = {"dispatcher": self.split.caller, "args": (), "return_type": None}
         with event.trigger_event("numba:compile", data=compiling):
-            _compile(self.split, self.split.own, self.md_type)
+            _compile(self.split.own, self.signatures)
         while _meanwhile:
             with contextlib.suppress(Exception):  # preparation only: the same work fails again where it is due
                 _meanwhile.pop(0)()
@@ -159,11 +151,12 @@ def start_apart(md, split: Split, split_name: str) -> ColdStart | None:
     if (split_name, md_type) in _started or not enabled() or (split.applies is not None and not split.applies(md)):
         return None
     _started.add((split_name, md_type))
+    signatures = split.signatures(md)
     probe = split.helper[0]
-    if kernel_named(probe).available(split.signature(probe, md_type)):
+    if probe.available(signatures[probe]):
         return None
-    helper = _forked_helper(split, md_type) if _FORK and active("fork-helper") else _spawned_helper(md, split_name)
-    return None if helper is None else ColdStart(split, md_type, helper)
+    helper = _forked_helper(split, signatures) if _FORK and active("fork-helper") else _spawned_helper(md, split_name)
+    return None if helper is None else ColdStart(split, signatures, helper)
 
 
 def compile_apart(md, split: Split, split_name: str) -> bool:
@@ -224,7 +217,7 @@ class _ForkedHelper:
             self.running = False
 
 
-def _forked_helper(split: Split, md_type) -> _ForkedHelper | None:
+def _forked_helper(split: Split, signatures) -> _ForkedHelper | None:
     """Fork the helper: the child compiles the helper's kernels of ``split`` into the cache and
     exits, without running anything else of this process (no exit handlers, no buffered output)."""
     from numba.core.compiler_lock import global_compiler_lock
@@ -243,7 +236,7 @@ def _forked_helper(split: Split, md_type) -> _ForkedHelper | None:
     try:
         event._registered.clear()  # this process's compile listeners (a command's notice) stay silent
         watch_parent(parent)
-        _compile(split, split.helper, md_type)
+        _compile(split.helper, signatures)
         status = 0
     finally:
         os._exit(status)
@@ -316,5 +309,5 @@ def helper_main(path: str, parent: str, split_name: str) -> int:
     split = getattr(importlib.import_module(module), attr)
     with open(path, "rb") as handle:
         md = pickle.load(handle)  # noqa: S301 - written by the parent process a moment ago
-    _compile(split, split.helper, numba.typeof(md))
+    _compile(split.helper, split.signatures(md))
     return 0

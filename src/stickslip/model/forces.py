@@ -11,8 +11,9 @@
   and so is the friction of one that slides, −μ λ e.
 
 :func:`sliding_forces` computes the common case, every contact sliding outside the band, on the
-caller's stack arrays (:func:`sliding_friction` its friction forces alone, for the queries); :func:`general_forces_body` any mix of modes. Both fill the generalised
-force f = f0 − C q̇ − K q + Σ G_cᵀ F_c, from which :mod:`stickslip.model.physics` writes the state
+caller's stack arrays (:func:`sliding_friction` its friction forces alone, for the queries);
+:func:`general_forces_body` any mix of modes. Both fill the generalised force
+f = f0 − C q̇ − K q + Σ G_cᵀ F_c, from which :mod:`stickslip.model.physics` writes the state
 derivative and answers its per-contact queries.
 """
 
@@ -26,7 +27,7 @@ from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel, standalone
-from .kinematics import contact_dim, contact_frame, rigid_kernel
+from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
                          is_stick, kinetic_coefficient)
@@ -239,9 +240,12 @@ def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
 
 # ----------------------------------------------------------------------------- forces of all contacts
 @inlined_kernel
-def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
+def general_forces_body(s, cst, md, G, w, v, N, h, F, f):
     """Every contact's friction force at ``s`` in the modes of ``cst`` (any mix of slip, band and
-    stick); fills G, w, v, N, h, F and the total generalised force f = f0 − C q̇ − K q + Σ G_cᵀ F_c.
+    stick); fills the caller's work arrays (numbers of the state's type): the frame rows G (2 nc, n),
+    drive velocities w (2 nc) [m/s], slip velocities v (2 nc) [m/s], normal forces N (nc) [N],
+    velocity biases h (2 nc) [m/s²], friction forces F (2 nc) [N] and the generalised force
+    f = f0 − C q̇ − K q + Σ G_cᵀ F_c (n). The model's sizes are read from ``md``.
 
     Order: slip forces with the exact direction, then those inside the low-speed band (their
     quasi-static direction sees the forces already known), then the stick multipliers of all
@@ -249,6 +253,7 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
     smallest relative pivot of the last (:func:`rigid_normal_forces`; 1.0 without them).
     """
     m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
     band = m[H_BAND]
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
@@ -274,7 +279,7 @@ def general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
         else:
             in_band = True
     if in_band:
-        band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A)
+        band_forces(s, cst, md, G, w, v, N, h, F, f, A)
     if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
         for c in range(nc):
             if is_stick(cst, c):
@@ -387,11 +392,13 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
 
 @standalone
 @kernel
-def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
-    """Slip forces of the contacts inside the low-speed band (after those with the exact direction,
-    whose forces are in ``f`` already): the quasi-static direction for a 2-D contact, found with the
-    force that would hold it (the others as they are), the stored direction for a 1-D contact."""
+def band_forces(s, cst, md, G, w, v, N, h, F, f, A):
+    """Slip forces of the contacts inside the low-speed band into F and f (after those with the
+    exact direction, whose forces are in ``f`` already): the
+    quasi-static direction for a 2-D contact, found with the force that would hold it (the others
+    as they are), the stored direction for a 1-D contact. ``A`` (≥ 2 nc square): work."""
     m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
     band = m[H_BAND]
     for c in range(nc):
         mode = np.int64(cst[CST * c])
@@ -418,10 +425,10 @@ def band_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f, A):
 
 @standalone
 @kernel
-def general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f):
-    """:func:`general_forces_body` as a call (for the queries; :func:`~stickslip.model.physics.general_rhs`
-    inlines it)."""
-    return general_forces_body(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+def general_forces(s, cst, md, G, w, v, N, h, F, f):
+    """:func:`general_forces_body` as a call (for the queries and the right-hand side's path for
+    stick and the band)."""
+    return general_forces_body(s, cst, md, G, w, v, N, h, F, f)
 
 
 @inlined_kernel

@@ -3,9 +3,11 @@
 ``kernel``: numba ``njit`` with an on-disk cache and *without* the numba runtime (NRT). Kernels
 only read and write the arrays they are given and never allocate, so they need no reference
 counting; compiled without NRT their calls carry no atomic incref/decref per array argument.
-Functions that allocate (the integrator loops) use ``loop`` (plain cached ``njit``); they
-allocate only on entry and never reassign an array variable inside their main loop, since numba
-reference-counts loop-carried arrays on every iteration (``fixed_step.record_transition``).
+Functions that allocate (the orbit tools' segment integrator, steady sliding) use ``loop`` (plain
+cached ``njit``); they allocate only on entry and never reassign an array variable inside their
+main loop, since numba reference-counts loop-carried arrays on every iteration
+(``transitions.record_transition``). The simulators' loops are kernels whose arrays their Python
+callers allocate (``integrate/bundles.py``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
 kernels on the innermost path (``forces.slip_force``, ``forces.add_contact_force``,
@@ -187,15 +189,8 @@ def python_entry_patch() -> Patch:
 #: Whether kernels compile their versions for other kernels without the Python entry (the patch is installed).
 _ENTRY_APART = False
 
-
-
-def _patches() -> list[Patch]:
-    """Every change stickslip makes to numba, in the order they are installed."""
-    return [*compile_speedups.PATCHES, python_entry_patch(), linking.PATCH, kernel_cache.PATCH,
-            compile_ahead.FORK_PATCH]
-
-
-numba_patches.install(_patches)
+numba_patches.install([*compile_speedups.PATCHES, python_entry_patch(), linking.PATCH, kernel_cache.PATCH,
+                       compile_ahead.FORK_PATCH])
 
 #: Whether the package's kernels are cached on disk (:func:`.kernel_cache.caching`).
 _CACHE = kernel_cache.caching()

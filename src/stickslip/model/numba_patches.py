@@ -123,14 +123,13 @@ class Patch:
 _STATUS: dict = {}
 
 
-def install(patches: Callable[[], list[Patch]] | None = None) -> dict:
-    """Apply every patch whose check passes, on a numba of :data:`TESTED` and unless
-    ``STICKSLIP_NUMBA_PATCHES=0``; once per process. Returns :func:`status`.
-
-    ``patches`` lists them: :mod:`.jit` gives it as it is imported, before it declares kernels (the
-    modules that define patches import this one, so it does not import them); without it, this
-    imports :mod:`.jit`, which installs them.
-    """
+def install(patches=None) -> dict:
+    """Apply every patch of ``patches`` (a sequence of :class:`Patch`) whose check passes, on a
+    numba of :data:`TESTED` and unless ``STICKSLIP_NUMBA_PATCHES=0``; once per process. Returns
+    :func:`status`. :mod:`.jit` installs the package's patches as it is imported, before it
+    declares kernels, and names them (this module imports none of the modules that define them,
+    as each of them imports :class:`Patch` from here); called before that, without ``patches``,
+    it imports :mod:`.jit`."""
     if _STATUS:
         return _STATUS
     if patches is None:
@@ -146,7 +145,7 @@ def install(patches: Callable[[], list[Patch]] | None = None) -> dict:
                             f"({TESTED[0]}-{TESTED[-1]}); install numba>={TESTED[0]},<{_next_minor(TESTED[-1])}"
     else:
         applied, skipped = [], {}
-        for patch in patches():
+        for patch in patches:
             try:
                 problem = patch.check()
             except Exception as exc:  # noqa: BLE001 - a check that fails is a patch that does not fit

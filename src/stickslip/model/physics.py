@@ -105,7 +105,7 @@ def general_rhs(s, cst, md, ds):
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    general_forces(s, cst, md, G, w, v, N, h, F, f)
     write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
 
 
@@ -157,7 +157,7 @@ def contact_forces(s, cst, md, F_out, N_out, v_out):
     G = work_matrix(md.kin, ROWS, DOFS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     if not sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
-        general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+        general_forces(s, cst, md, G, w, v, N, h, F, f)
     export_contacts(nc, N, F, v, N_out, F_out, v_out)
 
 
@@ -170,7 +170,7 @@ def rhs_and_forces(s, cst, md, ds, F_out, N_out, v_out):
     G = work_matrix(md.kin, ROWS, DOFS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     if not sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
-        general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+        general_forces(s, cst, md, G, w, v, N, h, F, f)
     write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds)
     export_contacts(nc, N, F, v, N_out, F_out, v_out)
 
@@ -185,7 +185,7 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    general_forces(s, cst, md, G, w, v, N, h, F, f)
     if extra >= 0 and not is_stick(cst, extra):
         # solve again with the extra contact held: remove the forces of the contacts to be solved
         for c in range(nc):
@@ -211,7 +211,7 @@ def stick_margin(s, cst, c, md):
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)  # a call: events only, not the rhs
+    general_forces(s, cst, md, G, w, v, N, h, F, f)  # a call: events only, not the rhs
     return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
 
 
@@ -234,7 +234,7 @@ def contact_event(s, cst, c, md):  # pragma: no cover - compiled only
     if is_rigid(md, n, c) and not is_open(cst, c):
         G = work_matrix(md.kin, ROWS, DOFS, s)
         w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-        general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+        general_forces(s, cst, md, G, w, v, N, h, F, f)
         return N[c]
     return contact_indicator(s, cst, md, n, c)
 
@@ -258,7 +258,7 @@ def rigid_pivot(s, cst, md):
         return 1.0
     G = work_matrix(md.kin, ROWS, DOFS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    return general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    return general_forces(s, cst, md, G, w, v, N, h, F, f)
 
 
 @kernel
@@ -300,6 +300,7 @@ def normal_force(s, c, md):
     return contact_frame(md.kin, s, c, md.m, G2, w2)
 
 
+@standalone
 @kernel
 def slip_velocity_and_rate(s, ds, c, md):
     """(v0, v1, a0, a1): slip velocity of contact ``c`` [m/s] and its rate dv/dt = G q̈ + h [m/s²]
@@ -335,7 +336,7 @@ def band_direction(s, cst, c, md, speed):
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    general_forces(s, cst, md, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if is_stick(cst, c2) or c2 == c:
             add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)

@@ -237,8 +237,8 @@ def continue_orbit(
 
     Unknowns: the free states on the Poincaré section (except the section coordinate), the period T
     and the parameter λ; equations: the shooting equations Φ(s0, T; λ) − s0 = 0 on the free states
-    (Φ the exact stick-slip flow of paper Eqs. 1–13, integrated by the ``event`` method) and the
-    arclength condition τᵀ (v − v_k) = h in scaled unknowns v = (s0/σ, T/T_0, λ/λ_s).
+    (Φ the ``event`` method's flow) and the arclength condition τᵀ (v − v_k) = h in scaled
+    unknowns v = (s0/σ, T/T_0, λ/λ_s). docs/continuation.md has the method, the stops and resuming.
 
     Parameters
     ----------
@@ -246,27 +246,23 @@ def continue_orbit(
         The model at the start, as :func:`stickslip.simulate` takes it (default: that of ``start``
         if it is a PeriodicOrbit or a run, else the plates with Table 1).
     param : str
-        The parameter to vary: any numeric parameter of the model — the plates' fields (``N`` [N],
-        ``Omega`` [rad/s], ``delta_mu``, ``alpha`` [s/m], ``k_px`` [N/m], ...) or a model file's
-        ``--set`` path (``contact.0.drive``, ``stiffness.x.x``, ...).
+        The parameter to vary: any numeric parameter of the model (the plates' ``N`` [N],
+        ``Omega`` [rad/s], ...; a model file's ``--set`` path, ``contact.0.drive``, ...).
     start : PeriodicOrbit, Trajectory, array-like (2n,), mapping or "equilibrium"
-        The first orbit; or a run that settled on it (shot by
-        :func:`~stickslip.orbits.start.start_orbit_from_run`, one
-        stick onset per period); or a state handed to :func:`~stickslip.orbits.periodic_orbit`.
+        The first orbit; or a run that settled on it (:func:`~stickslip.orbits.start.start_orbit_from_run`);
+        or a state handed to :func:`~stickslip.orbits.periodic_orbit`.
     direction : {+1, −1}
         Start towards increasing (+1) or decreasing (−1) λ.
     step, min_step, max_step : float
-        Initial, smallest and largest step in scaled arclength (≈ relative change of λ where the
-        branch is steep in λ) [-]. The step grows by 1.5 after a corrector converges in ≤ 3
-        iterations and halves after a failure; below ``min_step`` the continuation stops.
+        Initial, smallest and largest step in scaled arclength [-]: ×1.5 after an easy corrector,
+        ×0.5 after a failure; the continuation stops below ``min_step``.
     max_points : int
         Branch points to compute (the start included).
     bounds : (lo, hi), optional
-        Interval of λ; the continuation ends on its edge (the last point is corrected at λ = edge).
+        Interval of λ; the continuation ends on its edge (the last point corrected at λ = edge).
     stop_on : sequence of str
-        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``;
-        ``grazing`` (a flight phase of a unilateral contact appears or vanishes) is tested only
-        where the model has a unilateral contact.
+        Special-point kinds (:data:`SPECIAL_KINDS`) after which to stop, e.g. ``("fold",)``; ``grazing``
+        (a unilateral contact's flight phase appears or vanishes) only where the model has one.
     locate : bool
         Locate special points (Illinois/bisection); otherwise they are reported at the next point.
     section, rtol, atol, slip_band
@@ -278,32 +274,22 @@ def continue_orbit(
     param_scale : float, optional
         λ_s, the unit of λ in the arclength (default |λ0|, or 1 if λ0 = 0).
     amplitude : bool
-        Measure the peak-to-peak φ of every orbit (one extra run per point).
+        Measure the peak-to-peak range of the observed dof of every orbit (one extra run per point).
     min_stick_fraction : float
-        Stop when the stick time per period of a stick-slip orbit falls below this fraction of
-        the period (the stick phase vanishes; a ``stick-vanishing`` point is reported) [-].
+        Stop where the stick time per period falls below this fraction of the period [-].
     jacobian_every : int
-        Recompute the finite-difference Jacobian (2 (2 n_free + 1) simulations) at every
-        ``jacobian_every``-th point only; in between, the corrector's Broyden-updated Jacobian gives
-        the tangent, and the points have no multipliers (NaN; ``n_unstable`` −1). Period doubling
-        and Neimark–Sacker are then detected between points with multipliers. 1 (default): every
-        point has multipliers.
+        Recompute the finite-difference Jacobian at every ``jacobian_every``-th point only (in
+        between the corrector's Broyden update gives the tangent; those points have NaN
+        multipliers and ``n_unstable`` −1).
     callback : callable, optional
-        ``callback(i, value, period, stable)`` after each accepted point (progress), once the
-        point is journaled when writing to ``out``.
+        ``callback(i, value, period, stable)`` after each accepted point (once journaled).
     out : path, optional
-        NetCDF output (``.nc``) written as the branch is computed: the start orbit and every
-        accepted point (with its special points and the step after it) are appended to the journal
-        ``OUT.nc.journal`` as they are found (:mod:`.branch_store`); at the end the branch is
-        written to ``out`` (:meth:`Branch.to_netcdf`) and the journal removed.
+        NetCDF output (``.nc``), journaled point by point (``OUT.nc.journal``) as it is computed.
     resume : bool
-        With ``out``: continue an interrupted run from its journal (the last journaled point, its
-        Jacobian, tangent and step: the resumed branch is the uninterrupted one), or return the
-        branch of a finished ``out``, when they were written with the same start and settings
-        (the same digest). False: delete ``out`` and its journal and start over.
+        With ``out``: continue an interrupted run, or return the finished branch, written with the
+        same start and settings; False: delete ``out`` and its journal and start over.
     on_resume : callable, optional
-        ``on_resume(k)`` once, before any computation, when ``k`` points are read from ``out`` or
-        its journal.
+        ``on_resume(k)`` once, before any computation, when ``k`` points are read from ``out``.
 
     Returns
     -------
@@ -314,141 +300,216 @@ def continue_orbit(
     ContinuationError
         If ``param`` is not numeric, the start orbit cannot be found, or the first Jacobian fails.
     SteadySlidingError
-        If the start orbit is steady sliding, not a cycle (a ContinuationError; nothing is left
-        at ``out``).
+        If the start orbit is steady sliding, not a cycle (a ContinuationError).
     stickslip.orbits.branch_store.JournalMismatch
-        If ``out`` or its journal was written with another start or other settings (an
-        :class:`~stickslip.orbits.OrbitError`, like ContinuationError), or, for a model with
-        unilateral contacts, by an earlier version that did not count their open phases.
+        If ``out`` or its journal was written with another start or other settings, or, for a
+        model with unilateral contacts, by a version that did not count their open phases.
     """
     t_start = time.perf_counter()
     _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
-    jacobian_every = int(jacobian_every)
     if isinstance(start, (PeriodicOrbit, Trajectory)) and model is None:
         model = start.system
     system = resolve(model, slip_band)
-    lam_start = numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system, param)
-    lo = hi = None
-    if bounds is not None:
-        lo, hi = float(bounds[0]), float(bounds[1])
-        if not (lo < hi) or not (lo <= lam_start <= hi):
-            raise ContinuationError(f"bounds ({lo:g}, {hi:g}) must satisfy lo < hi and contain the start "
-                                    f"{param} = {lam_start:g}")
-    atol = 1e-3 * rtol if atol is None else float(atol)
-    section = resolve_section(section, system)
+    lo, hi = _bounds(bounds, param, numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system,
+                                                      param))
+    atol, section = 1e-3 * rtol if atol is None else float(atol), resolve_section(section, system)
     numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
                     bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
                     tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
-                    min_stick_fraction=min_stick_fraction, jacobian_every=jacobian_every)
+                    min_stick_fraction=min_stick_fraction, jacobian_every=int(jacobian_every))
     settings = store.branch_settings(system, param, start, section, rtol, atol, numerics)
     digest = store.digest_of(settings)
-    journal = None
-    if out is not None:
-        journal, finished = store.open_output(out, "branch", digest, settings, resume, _read_branch)
-        if system.unilateral:
-            _refuse_without_open_phases(out, journal, finished)
-        if finished is not None:  # nothing left to compute
+    journal, finished = _open_output(out, system, digest, settings, resume, on_resume)
+    if finished is not None:  # nothing left to compute
+        return finished
+    run = _Continuation.begin(system, param, start, section, rtol, atol, numerics, journal, callback, on_resume, t_start)
+    run.go_on()
+    return run.finish(rtol, atol, digest, out)
+
+
+def _bounds(bounds, param: str, lam_start: float) -> tuple:
+    """(lo, hi) of ``bounds`` (None, None without), refused unless lo < hi contains the start."""
+    if bounds is None:
+        return None, None
+    lo, hi = float(bounds[0]), float(bounds[1])
+    if not (lo < hi) or not (lo <= lam_start <= hi):
+        raise ContinuationError(f"bounds ({lo:g}, {hi:g}) must satisfy lo < hi and contain the start "
+                                f"{param} = {lam_start:g}")
+    return lo, hi
+
+
+def _open_output(out, system: FrictionModel, digest: str, settings: dict, resume: bool, on_resume) -> tuple:
+    """(journal, finished): the journal of ``out`` (None without ``out``), and the branch already
+    finished there (None if there is work left; with its resumed count)."""
+    if out is None:
+        return None, None
+    journal, finished = store.open_output(out, "branch", digest, settings, resume, _read_branch)
+    if system.unilateral:
+        _refuse_without_open_phases(out, journal, finished)
+    if finished is None:
+        return journal, None
+    if on_resume is not None:
+        on_resume(len(finished))
+    return journal, dataclasses.replace(finished, timings={**finished.timings, "points_resumed": len(finished)})
+
+
+#: What :meth:`_Continuation.advance` catches as a failed step (shrunk and tried again).
+_STEP_FAILURES = (OrbitError, SimulationError, ParameterError, ModelError, np.linalg.LinAlgError)
+
+
+@dataclasses.dataclass(eq=False)
+class _Continuation:
+    """A continuation under way (internal): the problem, the walk so far and the numerical options
+    (:func:`continue_orbit`'s ``numerics``), with one method per part of a step."""
+
+    problem: Problem
+    begin_orbit: Start
+    walk: "_Walk"
+    numerics: dict
+    journal: object
+    callback: object
+    measure: object
+    size0: float | None
+    resumed: int
+    t_start: float
+
+    @classmethod
+    def begin(cls, system, param, start, section, rtol, atol, numerics, journal, callback, on_resume, t_start):
+        """The start orbit (found, or read from the journal) and the walk at its first point, or
+        at the last journaled one."""
+        records = [] if journal is None else journal.records
+        start_rec = next((r["start"] for r in records if "start" in r), None)
+        if start_rec is None:
+            begin = Start.of(start_orbit(system, param, start, section, rtol, atol))
+            if journal is not None:
+                journal.append({"start": store.start_record(begin)})
+        else:
+            begin = Start(**store.start_fields(start_rec))
+        problem = problem_of(begin, param, numerics["fd_step"], numerics["param_scale"])
+        lam0 = numeric_parameter(begin.system, param)
+        if not is_orbit(problem, begin.state, lam0, begin.stick_phases):
+            if journal is not None:
+                journal.remove()  # it holds no work: nothing to resume
+            raise SteadySlidingError(param, lam0)
+        measure = (lambda p: _amplitude(problem, *problem.unpack(p.v))) if numerics["amplitude"] \
+            else (lambda p: float("nan"))
+        walk = _walk_from_records(records)
+        resumed = 0 if walk is None else len(walk.points)
+        if walk is None:
+            walk = _first_walk(problem, begin, numerics["direction"], numerics["step"], measure)
+            _journal_point(journal, walk, problem, [], 0.0, t_start)
+        else:
+            problem.counter["simulations"] = walk.simulations
             if on_resume is not None:
-                on_resume(len(finished))
-            return dataclasses.replace(finished, timings={**finished.timings, "points_resumed": len(finished)})
-    records = [] if journal is None else journal.records
-    start_rec = next((r["start"] for r in records if "start" in r), None)
-    if start_rec is None:
-        begin = Start.of(start_orbit(system, param, start, section, rtol, atol))
-        if journal is not None:
-            journal.append({"start": store.start_record(begin)})
-    else:
-        begin = Start(**store.start_fields(start_rec))
-    problem = problem_of(begin, param, fd_step, param_scale)
-    lam0 = numeric_parameter(begin.system, param)
-    if not is_orbit(problem, begin.state, lam0, begin.stick_phases):
-        if journal is not None:
-            journal.remove()  # it holds no work: nothing to resume
-        raise SteadySlidingError(param, lam0)
-    measure = (lambda p: _amplitude(problem, *problem.unpack(p.v))) if amplitude else (lambda p: float("nan"))
-    walk = _walk_from_records(records)
-    resumed = 0 if walk is None else len(walk.points)
-    if walk is None:
-        walk = _first_walk(problem, begin, direction, step, measure)
-        _journal_point(journal, walk, problem, [], 0.0, t_start)
-    else:
-        problem.counter["simulations"] = walk.simulations
-        if on_resume is not None:
-            on_resume(len(walk.points))
-    size0 = distance_from_equilibrium(problem, begin.state, problem.unpack(walk.points[0].v)[2]) \
-        if begin.stick_phases == 0 else None
-    while walk.stop is None and len(walk.points) < max_points:
+                on_resume(len(walk.points))
+        size0 = distance_from_equilibrium(problem, begin.state, problem.unpack(walk.points[0].v)[2]) \
+            if begin.stick_phases == 0 else None
+        return cls(problem, begin, walk, numerics, journal, callback, measure, size0, resumed, t_start)
+
+    def go_on(self) -> None:
+        """Take steps until the walk stops or has ``max_points`` points."""
+        walk = self.walk
+        while walk.stop is None and len(walk.points) < self.numerics["max_points"]:
+            self.advance()
+
+    def advance(self) -> None:
+        """One step along the branch from its last point: predictor and corrector (:func:`.arclength.step_from`,
+        with a fresh finite-difference Jacobian every ``jacobian_every`` points), the edge of the
+        bounds, then :meth:`accept`; a failed step :meth:`recovers <recover>`."""
+        walk, numerics = self.walk, self.numerics
         last = walk.points[-1]
-        fresh = (len(walk.points) - walk.fresh_index) >= jacobian_every
+        fresh = (len(walk.points) - walk.fresh_index) >= numerics["jacobian_every"]
         try:
-            new = step_from(problem, last, walk.h, tol, with_jacobian=fresh)
+            new = step_from(self.problem, last, walk.h, numerics["tol"], with_jacobian=fresh)
             if float(new.tangent @ last.tangent) < MIN_TANGENT_COS:
                 raise OrbitError("tangent turned too far")
-        except (OrbitError, SimulationError, ParameterError, ModelError, np.linalg.LinAlgError):
-            # step changes are not journaled: a resumed run repeats these deterministic retries
-            if not last.fresh:  # first renew the Broyden-updated Jacobian, then shrink
-                try:
-                    walk.points[-1] = point_at(problem, last.v, last.iterations, last.tangent)
-                    found, walk.stop = detect_after_renewal(problem, walk, tol, locate, size0, stop_on)
-                    walk.fresh_index = len(walk.points) - 1
-                    walk.special.extend(found)
-                    _journal_point(journal, walk, problem, found, walk.elapsed, t_start)  # replaces the record
-                    continue
-                except (OrbitError, SimulationError):
-                    pass
-            walk.h *= SHRINK
-            if walk.h < min_step:
-                walk.stop = "min_step"
-            continue
+        except _STEP_FAILURES:
+            self.recover(last)
+            return
         stop = None
-        lam_new = problem.unpack(new.v)[2]
-        if bounds is not None and not (lo <= lam_new <= hi):
+        bounds = numerics["bounds"]
+        lam_new = self.problem.unpack(new.v)[2]
+        if bounds is not None and not (bounds[0] <= lam_new <= bounds[1]):
             try:
-                new = correct_onto_bound(problem, last, new, hi if lam_new > hi else lo, tol)
-            except (OrbitError, SimulationError, ParameterError, ModelError, np.linalg.LinAlgError):
+                new = correct_onto_bound(self.problem, last, new, bounds[1] if lam_new > bounds[1] else bounds[0],
+                                         numerics["tol"])
+            except _STEP_FAILURES:
                 walk.stop = "bounds (last point before the edge)"
-                break
+                return
             stop = "bounds"
+        self.accept(last, new, stop)
+
+    def recover(self, last: Point) -> None:
+        """After a failed step: first renew the Broyden-updated Jacobian of the last point (and look
+        for special points again with it), then shrink the step; below ``min_step`` the walk stops.
+        Step changes are not journaled: a resumed run repeats these deterministic retries."""
+        walk, numerics = self.walk, self.numerics
+        if not last.fresh:
+            try:
+                walk.points[-1] = point_at(self.problem, last.v, last.iterations, last.tangent)
+                found, walk.stop = detect_after_renewal(self.problem, walk, numerics["tol"], numerics["locate"],
+                                                        self.size0, numerics["stop_on"])
+                walk.fresh_index = len(walk.points) - 1
+                walk.special.extend(found)
+                _journal_point(self.journal, walk, self.problem, found, walk.elapsed, self.t_start)  # replaces it
+                return
+            except (OrbitError, SimulationError):
+                pass
+        walk.h *= SHRINK
+        if walk.h < numerics["min_step"]:
+            walk.stop = "min_step"
+
+    def accept(self, last: Point, new: Point, stop: str | None) -> None:
+        """Add the point ``new``: the special points between ``last`` and it (a point that is steady
+        sliding is dropped and ends the branch), its arclength and amplitude, the next step's size
+        from the corrector's effort, the journal and the callback."""
+        walk, numerics, problem = self.walk, self.numerics, self.problem
         walk.points.append(new)
-        found, stop, quiet, drop = detect_after_point(problem, walk, last, new, stop, tol, locate, min_stick_fraction,
-                                                      size0, stop_on)
+        found, stop, quiet, drop = detect_after_point(problem, walk, last, new, stop, numerics["tol"],
+                                                      numerics["locate"], numerics["min_stick_fraction"], self.size0,
+                                                      numerics["stop_on"])
         if drop:  # steady sliding, not an orbit: the branch ends at the point before
             walk.points.pop()
         else:
             new = walk.points[-1]  # its Jacobian may have been renewed to classify a turn
             walk.arclength.append(walk.arclength[-1] + float(np.linalg.norm(new.v - last.v)))
-            walk.amplitudes.append(measure(new))
+            walk.amplitudes.append(self.measure(new))
         walk.special.extend(found)
         walk.stop = stop
         if stop is None:
             if new.iterations <= EASY_ITERATIONS:
-                walk.h = min(walk.h * GROW, max_step)
+                walk.h = min(walk.h * GROW, numerics["max_step"])
             elif new.iterations >= HARD_ITERATIONS:
-                walk.h = max(walk.h * SHRINK, min_step)
-        _journal_point(journal, walk, problem, found, walk.elapsed, t_start)
-        if callback is not None and not quiet:
+                walk.h = max(walk.h * SHRINK, numerics["min_step"])
+        _journal_point(self.journal, walk, problem, found, walk.elapsed, self.t_start)
+        if self.callback is not None and not quiet:
             _s, T_new, lam_cb = problem.unpack(new.v)
-            callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
-    if walk.stop == "min_step" and problem.shooting.system.rigid:
-        grazing = flight_vanishing(problem, walk.points)
-        if grazing is not None:
-            walk.special.append(grazing)
-            walk.stop = FLIGHT_VANISHING_STOP
-    stop_reason = walk.stop or "max_points"
-    if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
-        journal.append({"end": stop_reason})
-    branch = _assemble_branch(problem, begin, walk, stop_reason,
-                              dict(rtol=rtol, atol=atol, tol=tol, fd_step=fd_step, step=step, min_step=min_step,
-                                   max_step=max_step, max_points=max_points, slip_band=problem.shooting.system.slip_band,
-                                   param_scale=problem.p_scale, period_scale=problem.T_scale,
-                                   bounds=None if bounds is None else [lo, hi], direction=direction,
-                                   jacobian_every=jacobian_every),
-                              walk.elapsed + time.perf_counter() - t_start, resumed if out is not None else None,
-                              digest)
-    if journal is not None:
-        store.write_dataset(branch.to_xarray(), out)
-        journal.remove()
-    return branch
+            self.callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
+
+    def finish(self, rtol: float, atol: float, digest: str, out) -> Branch:
+        """The :class:`Branch` of the finished walk (a grazing point where a rigid contact's flight
+        vanished), written to ``out`` (the journal removed)."""
+        walk, journal, numerics, problem = self.walk, self.journal, self.numerics, self.problem
+        options = dict(rtol=rtol, atol=atol, **{key: numerics[key] for key in ("tol", "fd_step", "step", "min_step",
+                                                                                "max_step", "max_points")},
+                       slip_band=problem.shooting.system.slip_band, param_scale=problem.p_scale,
+                       period_scale=problem.T_scale, bounds=numerics["bounds"], direction=numerics["direction"],
+                       jacobian_every=numerics["jacobian_every"])
+        if walk.stop == "min_step" and self.problem.shooting.system.rigid:
+            grazing = flight_vanishing(self.problem, walk.points)
+            if grazing is not None:
+                walk.special.append(grazing)
+                walk.stop = FLIGHT_VANISHING_STOP
+        stop_reason = walk.stop or "max_points"
+        if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
+            journal.append({"end": stop_reason})
+        branch = _assemble_branch(self.problem, self.begin_orbit, walk, stop_reason, options,
+                                  walk.elapsed + time.perf_counter() - self.t_start,
+                                  self.resumed if out is not None else None, digest)
+        if journal is not None:
+            store.write_dataset(branch.to_xarray(), out)
+            journal.remove()
+        return branch
 
 
 def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on) -> None:

@@ -27,7 +27,7 @@ from ..errors import OrbitError
 from ..integrate import contacts as E
 from ..model.compile_ahead import Split, compile_apart
 from ..model import physics as P
-from ..model.bundle import CST, contact_state
+from ..model.bundle import CST, H_N, H_NC, contact_state
 from . import saltation as S
 from . import var_kernels as V
 from .layout import free_states
@@ -56,28 +56,40 @@ MATCH_TIME_TOL = 1e-6
 #: Step cap of one segment.
 MAX_SEGMENT_STEPS = 1_000_000
 
+
+def _variational_calls(md) -> dict:
+    """The arguments with which the segment integrator and the saltation matrices call the kernels
+    of :data:`VARIATIONAL`, for the model data ``md``."""
+    n, nc = int(md.m[H_N]), int(md.m[H_NC])
+    n2 = 2 * n
+    y = np.zeros(n2 + n2 * n2)
+    s = np.zeros(n2)
+    z = np.zeros(n2, dtype=complex)
+    cst = contact_state(md.m)
+    F, N = np.zeros(2 * nc), np.zeros(nc)
+    kind, level = np.zeros(nc, dtype=np.int64), np.zeros(nc)
+    return {V.event_value: (V.EV_NONE, 0, s, 0.0, 0.0, cst, md),
+            V.variational_rhs: (y, cst, md, n2, False, y, s, z, z, s),
+            V.direction_residual: (z, cst, 0, md, 0.0, 0.0),
+            V._first_event: (V.SegmentEvents(kind, level, level), y, y, np.zeros((y.size, 4)), 0.0, cst, md, n2, level,
+                             y, s),
+            V.contact_gradients: (s, cst, 0, md, n2, np.zeros((2, n2)), np.zeros((2, n2)), s, z,
+                                  np.zeros(2 * nc, dtype=complex), np.zeros(nc, dtype=complex),
+                                  np.zeros(2 * nc, dtype=complex)),
+            E.initial_modes: (s, cst, md, 0.0, 0.0, F, N)}
+
+
 #: A cold start's variational kernels in two processes (:mod:`stickslip.model.compile_ahead`):
 #: the event functions, then the variational right-hand side (with the complex-step physics under
 #: it) in the helper; the complex-step version of the band direction's residual, the first event's
-#: search, the contact gradients of the saltation matrices and the starting modes here; the
-#: segment integrator then loads both. A model file's ``orbit`` after its ``stability``, from an
-#: empty cache otherwise: the variational kernels in 14 s instead of 21 s; with the residual here
-#: (the helper, the longer side before, then mostly finds it in the cache) the two sides 3.9–4.0 s
-#: instead of 4.6 s; with the event functions in the helper (which the first event's search here
-#: then loads) 2.9–3.0 s against 3.1–3.2 s.
+#: search (which loads the helper's event functions), the contact gradients of the saltation
+#: matrices and the starting modes here; the segment integrator then loads both.
 VARIATIONAL = Split(
-    helper=("stickslip.orbits.var_kernels.event_value", "stickslip.orbits.var_kernels.variational_rhs"),
-    own=("stickslip.orbits.var_kernels.direction_residual", "stickslip.orbits.var_kernels._first_event",
-         "stickslip.orbits.var_kernels.contact_gradients", "stickslip.integrate.contacts.initial_modes"),
-    caller="stickslip.orbits.var_kernels.integrate_segment",
-    signatures={
-        "stickslip.orbits.var_kernels.variational_rhs": "v v M i B v v z z v",
-        "stickslip.orbits.var_kernels.direction_residual": "z v i M f f",
-        "stickslip.orbits.var_kernels.event_value": "i i v f f v M",
-        "stickslip.orbits.var_kernels._first_event": "I v v v v m f v M i v v v",
-        "stickslip.orbits.var_kernels.contact_gradients": "v v i M i m m v z z z z",
-        "stickslip.integrate.contacts.initial_modes": "v v M f f v v",
-    })
+    helper=(V.event_value, V.variational_rhs),
+    own=(V.direction_residual, V._first_event, V.contact_gradients, E.initial_modes),
+    caller=V.integrate_segment,
+    calls=_variational_calls)
+
 
 #: Kind of the recorded transition each event kind ends in (+1 slip → stick, −1 stick → slip).
 _RECORDED_KIND = {V.EV_MARGIN: E.TRANSITION_TO_SLIP, V.EV_ZERO: E.TRANSITION_TO_STICK,
@@ -242,7 +254,7 @@ def _segment(system, y, Phi, t0, t1, cst, rtol):
     atol = np.full(y0.size, VAR_ATOL_PHI)
     atol[:n2] = VAR_ATOL_STATE
     status, t, y_end, c = V.integrate_segment(y0, float(t0), float(t1), cst, system.data, n2, band,
-                                              float(rtol), atol, kind, level, e, MAX_SEGMENT_STEPS)
+                                              float(rtol), atol, V.SegmentEvents(kind, level, e), MAX_SEGMENT_STEPS)
     if status > 1:
         raise OrbitError(f"variational integration failed at t = {t} s "
                          f"({'step underflow' if status == 2 else 'too many steps'})")
@@ -283,154 +295,216 @@ def propagate(system, s0, T: float, tr, end, Phi: np.ndarray, *, scale=None, aft
     mismatch : float
     """
     n2 = 2 * system.n
-    free = free_states(system)
-    free_q = free[: free.size // 2]
-    sigma = _sigma(system, scale)
     atol = 1e-3 * rtol if atol is None else atol
-    events = []
-    mismatch = 0.0
     k_cols = Phi.shape[1]
-
-    def check(s_var, s_ref, which=free):
-        nonlocal mismatch
-        d = float(np.max(np.abs(s_var[which] - s_ref[which]) / sigma[which]))
-        mismatch = max(mismatch, d)
-        if d > MATCH_TOL:
-            raise OrbitError(
-                f"the variational re-integration left the event integrator's trajectory (scaled "
-                f"difference {d:.1e} > {MATCH_TOL:.0e}): the event sequence differs (grazing, or a "
-                "return to v ≈ 0 inside the low-speed band?)")
-
     compile_apart(system.data, VARIATIONAL, f"{__name__}:VARIATIONAL")
     y, cst = initial_contacts(system, np.asarray(s0, dtype=float), rtol, atol)
     user_after = (lambda t, Q: Q) if after is None else after
 
-    def after(t, Q):  # the caller sees its k columns; the integration carries 2n
+    def carried(t, Q):  # the caller sees its k columns; the integration carries 2n
         out = np.zeros((n2, n2))
         out[:, :k_cols] = user_after(t, Q[:, :k_cols])
         return out
 
     full = np.zeros((n2, n2))
     full[:, :k_cols] = Phi
-    Phi = full
     if S.sticking(cst):
-        Phi = S.stick_projection(system, y, cst) @ Phi
-    t = 0.0
-    k = 0
-    n_tr = len(tr)
-    while t < T:
-        t_next = float(tr.time[k]) if k < n_tr else T
-        t1 = min(t + max_interval, t_next + 1.0 if k < n_tr else T)
-        seg = _segment(system, y, Phi, t, t1, cst, rtol)
-        if not seg.event and k < n_tr and seg.t >= t_next + MATCH_TIME_TOL and \
-                int(tr.kind[k]) in (E.TRANSITION_OPEN, E.TRANSITION_CLOSE):
-            # a flight (or touch) shorter than the re-integration's steps, which see the contact
-            # alike at both ends of one: the run found it inside its step (on the gap's Hermite
-            # dip), so carry the variations to its recorded instant and take its jump there
-            seg = _segment(system, y, Phi, t, t_next, cst, rtol)
-            if not seg.event:
-                seg.event, seg.contact, seg.kind = True, system.n_contacts + int(tr.contact[k]), V.EV_GAP
+        full = S.stick_projection(system, y, cst) @ full
+    carry = _Carry(system, tr, _sigma(system, scale), carried, y, cst, full)
+    while carry.t < T:
+        t_next = float(tr.time[carry.k]) if carry.k < len(tr) else T
+        seg = carry.segment(T, t_next, max_interval, rtol)
         if not seg.event:
-            if k < n_tr and seg.t >= t_next + MATCH_TIME_TOL:
-                raise OrbitError(f"the re-integration did not meet the integrator's transition at {t_next:.9f} s")
-            y, t, Phi = seg.s, seg.t, after(seg.t, seg.Phi)
-            continue
-        c, kind = seg.contact, seg.kind
-        if kind == V.EV_GAP and system.contacts[c - system.n_contacts].unilateral \
-                and system.contacts[c - system.n_contacts].normal.law == "rigid" \
-                and int(cst[CST * (c - system.n_contacts)]) == P.MODE_OPEN:
-            c -= system.n_contacts
-            at = [j for j in range(k, n_tr) if abs(float(tr.time[j]) - seg.t) <= MATCH_TIME_TOL
-                  and int(tr.contact[j]) == c]
-            kinds = [int(tr.kind[j]) for j in at]
-            if E.TRANSITION_IMPACT not in kinds or kinds[-1] not in (E.TRANSITION_OPEN, E.TRANSITION_CLOSE):
-                raise OrbitError(f"contact {c} lands in the re-integration at {seg.t:.9f} s, the integrator's next "
-                                 f"transition is at {t_next:.9f} s" + (" (it sticks there: no saltation matrix "
-                                                                      "for stick at an impact; use the "
-                                                                      "finite-difference monodromy)"
-                                                                      if E.TRANSITION_TO_STICK in kinds else ""))
-            i_impact = at[kinds.index(E.TRANSITION_IMPACT)]
-            bounced = kinds[-1] == E.TRANSITION_OPEN
-            if not bounced and system.contacts[c].normal.restitution > 0.0:
-                raise OrbitError(f"contact {c}'s bounces accumulate at {seg.t:.9f} s (a Zeno sequence): no saltation "
-                                 "matrix; use the finite-difference monodromy")
-            s_i = tr.state[i_impact][:n2]
-            check(seg.s, s_i)
-            jump, cst = S.impact_jump(system, s_i, cst, c, bounced)
-            Phi = after(float(tr.time[i_impact]), jump @ seg.Phi)
-            events.append((float(tr.time[i_impact]), "impact", c))
-            y, t, k = tr.state[at[-1]][:n2].copy(), float(tr.time[at[-1]]), at[-1] + 1
-            continue
-        if kind == V.EV_GAP:
-            c -= system.n_contacts
-            recorded = E.TRANSITION_CLOSE if int(cst[CST * c]) == P.MODE_OPEN else E.TRANSITION_OPEN
-            # an opening from stick is recorded as stick → slip, then open, at one instant
-            at = [j for j in range(k, n_tr) if abs(float(tr.time[j]) - seg.t) <= MATCH_TIME_TOL
-                  and int(tr.contact[j]) == c]
-            if not any(int(tr.kind[j]) == recorded for j in at):
-                raise OrbitError(f"contact {c} {'closes' if recorded == E.TRANSITION_CLOSE else 'opens'} in the "
-                                 f"re-integration at {seg.t:.9f} s, the integrator's next transition is at "
-                                 f"{t_next:.9f} s")
-            s_g = tr.state[at[-1]][:n2]
-            check(seg.s, s_g)
-            jump, cst = S.gap_jump(system, s_g, cst, c)
-            Phi = after(float(tr.time[at[-1]]), jump @ seg.Phi)
-            events.append((float(tr.time[at[-1]]), E.TRANSITION_KINDS[recorded], c))
-            y, t, k = s_g.copy(), float(tr.time[at[-1]]), at[-1] + 1
-            if int(tr.kind[at[-1]]) == E.TRANSITION_TO_STICK:
-                raise OrbitError(f"contact {c} closes and sticks at {t:.9f} s: stick at closing has no saltation "
-                                 "matrix here; use the finite-difference monodromy")
-            continue
-        if kind == V.EV_BAND:
-            jump, cst = S.band_exit_jump(system, seg.s, cst, c)
-            y, t, Phi = seg.s, seg.t, after(seg.t, jump @ seg.Phi)
-            events.append((t, "band", c))
-            continue
-        matched = (k < n_tr and abs(seg.t - t_next) <= MATCH_TIME_TOL and int(tr.contact[k]) == c
-                   and int(tr.kind[k]) == _RECORDED_KIND[kind])
-        if kind == V.EV_MARGIN:
-            if not matched:
-                raise OrbitError(f"breakaway of contact {c} in the re-integration at {seg.t:.9f} s, "
-                                 f"the integrator's next transition is at {t_next:.9f} s")
-            s_b = tr.state[k][:n2]
-            check(seg.s, s_b)
-            jump, cst = S.breakaway_jump(system, s_b, cst, c)
-            Phi = after(t_next, jump @ seg.Phi)
-            events.append((t_next, "breakaway", c))
-            y, t, k = s_b.copy(), t_next, k + 1
-            continue
-        if matched:
-            s_s = tr.state[k][:n2]
-            # positions only, extrapolated over the rest of a 2-D approach to the integrator's
-            # instant: the velocities differ by that O(τ) rest and the integrator's projection
-            s_x = seg.s + (t_next - seg.t) * S.field(system, seg.s, cst)
-            check(s_x, s_s, free_q)
-            jump, cst = S.arrival_jump(system, seg.s, cst, c, s_s)
-            Phi = after(t_next, jump @ seg.Phi)
-            events.append((t_next, "stick", c))
-            y, t, k = s_s.copy(), t_next, k + 1
-            continue
-        if k < n_tr and seg.t > t_next + MATCH_TIME_TOL:
-            raise OrbitError(f"arrival at stick of contact {c} in the re-integration at {seg.t:.9f} s, "
-                             f"the integrator's transition at {t_next:.9f} s")
-        # v_c reaches 0 before the integrator's next transition: stick must be inadmissible there
-        # (a velocity reversal, which the integrator does not record)
+            carry.smooth(seg, t_next)
+        elif seg.kind == V.EV_GAP and carry.lands(seg.contact - system.n_contacts):
+            carry.impact(seg, t_next)
+        elif seg.kind == V.EV_GAP:
+            carry.gap(seg, t_next)
+        elif seg.kind == V.EV_BAND:
+            carry.band(seg)
+        elif seg.kind == V.EV_MARGIN:
+            carry.breakaway(seg, t_next)
+        else:
+            carry.arrival(seg, t_next)
+    carry.check(carry.y, np.asarray(end)[:n2])
+    return carry.Phi[:, :k_cols], carry.events, carry.mismatch
+
+
+@dataclasses.dataclass(eq=False)
+class _Carry:
+    """The variations :func:`propagate` carries along the event integrator's run (internal): the
+    re-integration's state ``y``, time ``t`` [s], contact states ``cst`` and variations ``Phi``
+    (2n × 2n), the next recorded transition ``k``, the jumps applied and the largest mismatch."""
+
+    system: object
+    tr: object
+    sigma: np.ndarray
+    after: object
+    y: np.ndarray
+    cst: np.ndarray
+    Phi: np.ndarray
+    t: float = 0.0
+    k: int = 0
+    events: list = dataclasses.field(default_factory=list)
+    mismatch: float = 0.0
+
+    def check(self, s_var, s_ref, which=None) -> None:
+        """Refuse a re-integrated state ``s_var`` that left the run's ``s_ref`` (scaled difference on
+        the free states, or on ``which``, beyond :data:`MATCH_TOL`)."""
+        which = free_states(self.system) if which is None else which
+        d = float(np.max(np.abs(s_var[which] - s_ref[which]) / self.sigma[which]))
+        self.mismatch = max(self.mismatch, d)
+        if d > MATCH_TOL:
+            raise OrbitError(
+                f"the variational re-integration left the event integrator's trajectory (scaled "
+                f"difference {d:.1e} > {MATCH_TOL:.0e}): the event sequence differs (grazing, or a "
+                "return to v ≈ 0 inside the low-speed band?)")
+
+    def pending(self, kinds=None) -> bool:
+        """Whether a recorded transition is ahead (of one of ``kinds``, if given)."""
+        return self.k < len(self.tr) and (kinds is None or int(self.tr.kind[self.k]) in kinds)
+
+    def segment(self, T: float, t_next: float, max_interval: float, rtol: float):
+        """The next smooth piece (:func:`_segment`), up to its first event, at most ``max_interval``
+        and a second past the next recorded transition (at ``t_next``). A flight (or touch) shorter
+        than the re-integration's steps, which see the contact alike at both ends of one, was found
+        by the run inside its step (on the gap's Hermite dip): the piece then ends at the recorded
+        instant, with that transition's gap event."""
+        t1 = min(self.t + max_interval, t_next + 1.0 if self.pending() else T)
+        seg = _segment(self.system, self.y, self.Phi, self.t, t1, self.cst, rtol)
+        if not seg.event and self.pending((E.TRANSITION_OPEN, E.TRANSITION_CLOSE)) \
+                and seg.t >= t_next + MATCH_TIME_TOL:
+            seg = _segment(self.system, self.y, self.Phi, self.t, t_next, self.cst, rtol)
+            if not seg.event:
+                seg.event, seg.contact, seg.kind = True, self.system.n_contacts + int(self.tr.contact[self.k]), V.EV_GAP
+        return seg
+
+    def smooth(self, seg, t_next: float) -> None:
+        """A piece without an event, which must not pass the next recorded transition."""
+        if self.pending() and seg.t >= t_next + MATCH_TIME_TOL:
+            raise OrbitError(f"the re-integration did not meet the integrator's transition at {t_next:.9f} s")
+        self.y, self.t, self.Phi = seg.s, seg.t, self.after(seg.t, seg.Phi)
+
+    def lands(self, c: int) -> bool:
+        """Whether a gap event of contact ``c`` is a rigid contact's landing (an impact)."""
+        contact = self.system.contacts[c]
+        return contact.unilateral and contact.normal.law == "rigid" and int(self.cst[CST * c]) == P.MODE_OPEN
+
+    def recorded_at(self, seg, c: int) -> list:
+        """The recorded transitions of contact ``c`` at the piece's event instant, from ``k`` on."""
+        tr = self.tr
+        return [j for j in range(self.k, len(tr)) if abs(float(tr.time[j]) - seg.t) <= MATCH_TIME_TOL
+                and int(tr.contact[j]) == c]
+
+    def jump(self, matrix, seg_Phi, t: float, kind: str, c: int) -> None:
+        """Apply the jump ``matrix`` at ``t`` to the piece's variations, and list it."""
+        self.Phi = self.after(t, matrix @ seg_Phi)
+        self.events.append((t, kind, c))
+
+    def impact(self, seg, t_next: float) -> None:
+        """A rigid contact lands: the impact's saltation matrix, at the recorded impact; the
+        re-integration goes on from the recorded state after it (bounced off or closed)."""
+        system, tr = self.system, self.tr
+        c = seg.contact - system.n_contacts
+        at = self.recorded_at(seg, c)
+        kinds = [int(tr.kind[j]) for j in at]
+        if E.TRANSITION_IMPACT not in kinds or kinds[-1] not in (E.TRANSITION_OPEN, E.TRANSITION_CLOSE):
+            raise OrbitError(f"contact {c} lands in the re-integration at {seg.t:.9f} s, the integrator's next "
+                             f"transition is at {t_next:.9f} s" + (" (it sticks there: no saltation matrix "
+                                                                  "for stick at an impact; use the "
+                                                                  "finite-difference monodromy)"
+                                                                  if E.TRANSITION_TO_STICK in kinds else ""))
+        i_impact = at[kinds.index(E.TRANSITION_IMPACT)]
+        bounced = kinds[-1] == E.TRANSITION_OPEN
+        if not bounced and system.contacts[c].normal.restitution > 0.0:
+            raise OrbitError(f"contact {c}'s bounces accumulate at {seg.t:.9f} s (a Zeno sequence): no saltation "
+                             "matrix; use the finite-difference monodromy")
+        s_i = tr.state[i_impact][:2 * system.n]
+        self.check(seg.s, s_i)
+        jump, self.cst = S.impact_jump(system, s_i, self.cst, c, bounced)
+        self.jump(jump, seg.Phi, float(tr.time[i_impact]), "impact", c)
+        self.y, self.t, self.k = tr.state[at[-1]][:2 * system.n].copy(), float(tr.time[at[-1]]), at[-1] + 1
+
+    def gap(self, seg, t_next: float) -> None:
+        """A unilateral contact opens or closes (an opening from stick is recorded as stick → slip,
+        then open, at one instant): the gap's saltation matrix at the recorded transition."""
+        system, tr = self.system, self.tr
+        c = seg.contact - system.n_contacts
+        recorded = E.TRANSITION_CLOSE if int(self.cst[CST * c]) == P.MODE_OPEN else E.TRANSITION_OPEN
+        at = self.recorded_at(seg, c)
+        if not any(int(tr.kind[j]) == recorded for j in at):
+            raise OrbitError(f"contact {c} {'closes' if recorded == E.TRANSITION_CLOSE else 'opens'} in the "
+                             f"re-integration at {seg.t:.9f} s, the integrator's next transition is at "
+                             f"{t_next:.9f} s")
+        s_g = tr.state[at[-1]][:2 * system.n]
+        self.check(seg.s, s_g)
+        jump, self.cst = S.gap_jump(system, s_g, self.cst, c)
+        self.jump(jump, seg.Phi, float(tr.time[at[-1]]), E.TRANSITION_KINDS[recorded], c)
+        self.y, self.t, self.k = s_g.copy(), float(tr.time[at[-1]]), at[-1] + 1
+        if int(tr.kind[at[-1]]) == E.TRANSITION_TO_STICK:
+            raise OrbitError(f"contact {c} closes and sticks at {self.t:.9f} s: stick at closing has no saltation "
+                             "matrix here; use the finite-difference monodromy")
+
+    def band(self, seg) -> None:
+        """A 2-D contact leaves the low-speed band (the run records nothing there)."""
+        jump, self.cst = S.band_exit_jump(self.system, seg.s, self.cst, seg.contact)
+        self.y, self.t = seg.s, seg.t
+        self.jump(jump, seg.Phi, seg.t, "band", seg.contact)
+
+    def matched(self, seg, t_next: float) -> bool:
+        """Whether the event is the next recorded transition (same contact and kind, same instant)."""
+        return (self.pending() and abs(seg.t - t_next) <= MATCH_TIME_TOL and int(self.tr.contact[self.k]) == seg.contact
+                and int(self.tr.kind[self.k]) == _RECORDED_KIND[seg.kind])
+
+    def breakaway(self, seg, t_next: float) -> None:
+        """A sticking contact breaks away: the breakaway's saltation matrix at the recorded one."""
+        c = seg.contact
+        if not self.matched(seg, t_next):
+            raise OrbitError(f"breakaway of contact {c} in the re-integration at {seg.t:.9f} s, "
+                             f"the integrator's next transition is at {t_next:.9f} s")
+        s_b = self.tr.state[self.k][:2 * self.system.n]
+        self.check(seg.s, s_b)
+        jump, self.cst = S.breakaway_jump(self.system, s_b, self.cst, c)
+        self.jump(jump, seg.Phi, t_next, "breakaway", c)
+        self.y, self.t, self.k = s_b.copy(), t_next, self.k + 1
+
+    def arrival(self, seg, t_next: float) -> None:
+        """A slipping contact reaches v = 0: stick at the recorded arrival (positions only,
+        extrapolated over the rest of a 2-D approach to the integrator's instant: the velocities
+        differ by that O(τ) rest and the integrator's projection), or, before the next recorded
+        transition, a reversal."""
+        c = seg.contact
+        if not self.matched(seg, t_next):
+            if self.pending() and seg.t > t_next + MATCH_TIME_TOL:
+                raise OrbitError(f"arrival at stick of contact {c} in the re-integration at {seg.t:.9f} s, "
+                                 f"the integrator's transition at {t_next:.9f} s")
+            self.reversal(seg, t_next)
+            return
+        system = self.system
+        s_s = self.tr.state[self.k][:2 * system.n]
+        s_x = seg.s + (t_next - seg.t) * S.field(system, seg.s, self.cst)
+        free = free_states(system)
+        self.check(s_x, s_s, free[: free.size // 2])
+        jump, self.cst = S.arrival_jump(system, seg.s, self.cst, c, s_s)
+        self.jump(jump, seg.Phi, t_next, "stick", c)
+        self.y, self.t, self.k = s_s.copy(), t_next, self.k + 1
+
+    def reversal(self, seg, t_next: float) -> None:
+        """v_c reaches 0 before the integrator's next transition: stick must be inadmissible there
+        (a velocity reversal, which the integrator does not record); slip departs along the
+        breakaway direction of the stick force."""
+        system, c = self.system, seg.contact
         s_r = seg.s.copy()
-        P.project_velocities(s_r, cst, np.int64(c), system.data)
+        P.project_velocities(s_r, self.cst, np.int64(c), system.data)
         F = np.empty(2 * system.n_contacts)
         N = np.empty(system.n_contacts)
-        P.stick_forces(s_r, cst, np.int64(c), system.data, F, N)
-        dim = system.contacts[c].dim
+        P.stick_forces(s_r, self.cst, np.int64(c), system.data, F, N)
         limit = S.static_coefficient(system.contacts[c].friction.row()) * N[c]
         if np.hypot(F[2 * c], F[2 * c + 1]) <= limit:
             raise OrbitError(f"the re-integration reaches an admissible stick of contact {c} at {seg.t:.9f} s, "
                              f"the event integrator does not (next transition {t_next:.9f} s): the event "
                              "sequences differ (e.g. a return to v ≈ 0 inside the low-speed band)")
-        e_b = E.breakaway_direction(F[2 * c], F[2 * c + 1], dim)
-        jump, cst = S.arrival_jump(system, seg.s, cst, c, s_r, departure=e_b)
-        Phi = after(seg.t, jump @ seg.Phi)
-        events.append((seg.t, "reversal", c))
-        y, t = s_r, seg.t
-    check(y, np.asarray(end)[:n2])
-    return Phi[:, :k_cols], events, mismatch
-
+        e_b = E.breakaway_direction(F[2 * c], F[2 * c + 1], system.contacts[c].dim)
+        jump, self.cst = S.arrival_jump(system, seg.s, self.cst, c, s_r, departure=e_b)
+        self.jump(jump, seg.Phi, seg.t, "reversal", c)
+        self.y, self.t = s_r, seg.t

@@ -20,6 +20,7 @@ gradients ∂v_c/∂s, ∂F_c/∂s, ∂N_c/∂s of one contact, from which the s
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -32,7 +33,7 @@ from ..model.jit import api_kernel, inlined_kernel, kernel, loop, standalone
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, work_matrix, work_vectors
 
-__all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "EV_GAP", "integrate_segment",
+__all__ = ["EV_NONE", "EV_MARGIN", "EV_ZERO", "EV_ARRIVE", "EV_BAND", "EV_GAP", "SegmentEvents", "integrate_segment",
            "variational_rhs", "contact_gradients", "indicator_gradient", "event_value"]
 
 #: Per-contact event kinds of a segment. Each event function starts positive; the event is its
@@ -88,7 +89,7 @@ def direction_residual(s, cst, c, md, ct, st):
     G = work_matrix(md.kin, ROWS, DOFS, s)
     A = work_matrix(md.kin, ROWS, ROWS, s)
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
-    P.general_forces(s, cst, md, n, nc, diagonal, G, w, v, N, h, F, f)
+    P.general_forces(s, cst, md, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if P.is_stick(cst, c2) or c2 == c:
             P.add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)
@@ -180,13 +181,34 @@ def variational_rhs(y, cst, md, n2, band, dy, s, z, dz, gq):
         band_correction(s, cst, md, n2, Phi, out, z, gq)
 
 
+class SegmentEvents(NamedTuple):
+    """The events a segment watches (:func:`integrate_segment`).
+
+    Attributes
+    ----------
+    kind : ndarray (nc,) or (2 nc,) int64
+        Event kind of each contact (``EV_*``; ``EV_NONE``: not watched), then with unilateral
+        contacts the ``EV_GAP`` of each.
+    level : ndarray, as ``kind``
+        Speed level of ``EV_ARRIVE`` / ``EV_BAND`` [m/s].
+    e : ndarray, as ``kind``
+        Stored slip direction (±1) of ``EV_ZERO``.
+    """
+
+    kind: np.ndarray
+    level: np.ndarray
+    e: np.ndarray
+
+
 @standalone
 @kernel
-def _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, s):
-    """(θ, contact) of the earliest event in the accepted step from ``y`` (θ ∈ (0, 1]), or (−1, −1).
+def _first_event(events, y, ynew, Q, h, cst, md, n2, g0, work, s):
+    """(θ, contact) of the earliest of the :class:`SegmentEvents` ``events`` in the accepted step
+    from ``y`` (θ ∈ (0, 1]), or (−1, −1).
 
     ``g0`` (nc,): the event values at the step start (updated to the step end when none fires).
     """
+    ev_kind, ev_level, ev_e = events
     nc = ev_kind.shape[0]
     best = -1.0
     best_c = -1
@@ -234,19 +256,14 @@ def _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, 
 
 
 @loop
-def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_level, ev_e, max_steps):
+def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, events, max_steps):
     """Dormand–Prince 5(4) on y = [s, Φ] (2n + 4n²,) from ``t0`` towards ``t1`` in the modes of
     ``cst``, stopping at the first event of any contact.
 
     Parameters
     ----------
-    ev_kind : ndarray (nc,) or (2 nc,) int64
-        Event kind of each contact (``EV_*``; ``EV_NONE``: not watched), then with unilateral
-        contacts the ``EV_GAP`` of each.
-    ev_level : ndarray, as ``ev_kind``
-        Speed level of ``EV_ARRIVE`` / ``EV_BAND`` [m/s].
-    ev_e : ndarray, as ``ev_kind``
-        Stored slip direction (±1) of ``EV_ZERO``.
+    events : SegmentEvents
+        The events watched.
     atol : ndarray (2n + 4n²,)
         Absolute tolerances; error control is the RMS of the local error over ``atol + rtol |y|``.
 
@@ -259,8 +276,9 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
     y : ndarray
         State and variations there.
     contact : int
-        Index of the event in ``ev_kind`` (−1 without).
+        Index of the event in ``events.kind`` (−1 without).
     """
+    ev_kind, ev_level, ev_e = events
     n = y0.shape[0]
     nc = ev_kind.shape[0]
     y = y0.copy()
@@ -303,7 +321,7 @@ def integrate_segment(y0, t0, t1, cst, md, n2, band, rtol, atol, ev_kind, ev_lev
             h *= 0.2 if not math.isfinite(err_norm) else max(0.2, 0.9 * err_norm ** -0.2)
             continue
         DP.dense_coefficients(Kst, Q)
-        theta, c_ev = _first_event(ev_kind, ev_level, ev_e, y, ynew, Q, h, cst, md, n2, g0, work, s)
+        theta, c_ev = _first_event(events, y, ynew, Q, h, cst, md, n2, g0, work, s)
         if c_ev >= 0:
             E.dense_state(y, Q, h, theta, work)
             return 1, t + theta * h, work.copy(), c_ev

@@ -232,9 +232,9 @@ class MapGrid:
         ra = self.rows_a
         if not self.separable:
             ra, ia = ra[ia * self.b.size + ib], np.arange(ia.size, dtype=np.int64)
-        steady.jacobian_points(ra[:, :L], rb[:, :L], self.mask_b[:L], ra[:, L:], rb[:, L:], self.mask_b[L:],
-                               ia.astype(np.int64), ib.astype(np.int64), system.data.kin, system.data.law, free,
-                               MAX_ITER, RESIDUAL_TOL, out)
+        tables = steady.AxisTables(ra[:, :L], rb[:, :L], self.mask_b[:L], ra[:, L:], rb[:, L:], self.mask_b[L:],
+                                   ia.astype(np.int64), ib.astype(np.int64))
+        steady.jacobian_points(tables, system.data.kin, system.data.law, free, MAX_ITER, RESIDUAL_TOL, out)
         return out
 
     def max_real_part(self) -> np.ndarray:

@@ -18,20 +18,25 @@ map.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba.extending import overload
 
+from ..model.bundle import C_DIM, C_N0, CST, H_BAND, H_DIAGONAL, H_N, H_NC, ModelData, contact_offsets, offsets
 from ..model.compile_ahead import Split
-from ..model.bundle import C_DIM, C_N0, CST, H_BAND, ModelData, contact_offsets, offsets
 from ..model.derivatives import acceleration_jacobian, state_jacobian
-from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
+from ..model.forces import solve_stick_rows
 from ..model.frame_pointers import is_pointer_class
+from ..model.frames import _frame_bias_central
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
 from ..model.kinematics import model_sizes, sizes_at_run_time
+from ..model.model_data import kinetic_coefficient
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
 __all__ = ["NEWTON_OK", "NEWTON_MAX_ITER", "NEWTON_SINGULAR", "NEWTON_NOT_FINITE", "NEWTON_NO_DESCENT",
            "NEWTON_NOT_SLIDING", "NEWTON_TARGET", "CONTINUATION_ACCEPT", "steady_sliding_point",
-           "steady_jacobian", "jacobian_points", "kinematics_from", "kinematics_values"]
+           "steady_jacobian", "AxisTables", "jacobian_points", "kinematics_from", "kinematics_values"]
 
 NEWTON_OK = 0
 NEWTON_MAX_ITER = 1
@@ -230,25 +235,6 @@ def _newton_from(q, cst, md, free, max_iter):
     return NEWTON_MAX_ITER, rel, max_iter
 
 
-#: A cold start's steady-sliding kernels in two processes (:mod:`stickslip.model.compile_ahead`),
-#: for kinematics whose sizes are run-time data (model files; fixed sizes are compile-time constants
-#: in these signatures): the complex-step stick solve (the deepest level of the chain under the
-#: Newton) in the helper; the friction coefficient, the frame's central-difference bias (complex)
-#: and the Newton's linear solve here; :func:`steady_sliding_point` then loads both.
-STEADY = Split(
-    helper=("stickslip.model.forces.solve_stick_rows",),
-    own=("stickslip.model.model_data.kinetic_coefficient", "stickslip.model.frames._frame_bias_central",
-         "stickslip.stability.steady._solve_inplace"),
-    caller="stickslip.stability.steady.steady_sliding_point",
-    signatures={
-        "stickslip.model.forces.solve_stick_rows": "z M i i B v i Z z z z Z",
-        "stickslip.model.model_data.kinetic_coefficient": "M i i c",
-        "stickslip.model.frames._frame_bias_central": "z i M Z z z",
-        "stickslip.stability.steady._solve_inplace": "m v",
-    },
-    applies=lambda md: sizes_at_run_time(md.kin))
-
-
 @loop
 def steady_sliding_point(md, free, max_iter):
     """Steady sliding of the model ``md``: Newton from q = 0, load continuation as a fallback.
@@ -339,6 +325,31 @@ def _steady_sliding(md, free, max_iter):
     return q, status, rel, iterations
 
 
+def _steady_calls(md) -> dict:
+    """The arguments with which steady sliding's Newton calls the kernels of :data:`STEADY`, for
+    the model data ``md`` (complex-step physics: complex states and work arrays)."""
+    m = md.m
+    n, nc, diagonal = int(m[H_N]), int(m[H_NC]), bool(m[H_DIAGONAL] != 0.0)
+    s = np.zeros(2 * n, dtype=complex)
+    cst = np.zeros(CST * nc)
+    G = np.zeros((2 * nc, n), dtype=complex)
+    rows = np.zeros(2 * nc, dtype=complex)
+    return {solve_stick_rows: (s, md, n, nc, diagonal, cst, -1, G, rows, np.zeros(n, dtype=complex), rows,
+                               np.zeros((2 * nc, 2 * nc), dtype=complex)),
+            kinetic_coefficient: (md, n, 0, 0j),
+            _frame_bias_central: (s, 0, md, G[0:2], rows[0:2], rows[0:2]),
+            _solve_inplace: (np.zeros((n, n)), np.zeros(n))}
+
+
+#: A cold start's steady-sliding kernels in two processes (:mod:`stickslip.model.compile_ahead`),
+#: for kinematics whose sizes are run-time data (model files; fixed sizes are compile-time constants
+#: in these signatures): the complex-step stick solve (the deepest level of the chain under the
+#: Newton) in the helper; the friction coefficient, the frame's central-difference bias (complex)
+#: and the Newton's linear solve here; :func:`steady_sliding_point` then loads both.
+STEADY = Split(helper=(solve_stick_rows,), own=(kinetic_coefficient, _frame_bias_central, _solve_inplace),
+               caller=steady_sliding_point, calls=_steady_calls, applies=lambda md: sizes_at_run_time(md.kin))
+
+
 @loop
 def steady_jacobian(md, free, max_iter, tol, J):
     """Steady sliding, then the Jacobian of the slip equations there, reduced to the free DOFs.
@@ -370,16 +381,45 @@ def steady_jacobian(md, free, max_iter, tol, J):
     return True
 
 
-@loop
-def jacobian_points(m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib, kin0, law, free, max_iter, tol, out):
-    """:func:`steady_jacobian` at points assembled from two axis tables, into ``out`` (P, 2k, 2k).
+class AxisTables(NamedTuple):
+    """The points of a grid over two parameters, as two tables of model numbers (:func:`jacobian_points`).
 
     Point p has the data array ``m_a[ia[p]]`` with the entries flagged in ``mask_b`` taken from
-    ``m_b[ib[p]]``, and kinematics ``kinematics_from(kin0, kv)`` with kv = ``kv_a[ia[p]]`` and the
-    fields flagged in ``kmask_b`` from ``kv_b[ib[p]]``, and the user friction law ``law`` of the
-    model (:class:`~stickslip.model.friction.NoUserLaw` if none). A map whose two parameters touch disjoint
-    entries is thus nA + nB tables instead of nA × nB models. NaN where no steady sliding exists.
+    ``m_b[ib[p]]``, and the kinematics fields ``kv_a[ia[p]]`` with those flagged in ``kmask_b``
+    from ``kv_b[ib[p]]``. A map whose two parameters touch disjoint entries is thus nA + nB rows
+    instead of nA × nB models.
+
+    Attributes
+    ----------
+    m_a, m_b : ndarray (nA, L), (nB, L)
+        Data arrays along each axis.
+    mask_b : ndarray (L,) bool
+        Entries of ``m`` taken from ``m_b``.
+    kv_a, kv_b : ndarray (nA, nf), (nB, nf)
+        Kinematics fields along each axis (:func:`kinematics_values`).
+    kmask_b : ndarray (nf,) bool
+        Fields taken from ``kv_b``.
+    ia, ib : ndarray (P,) int64
+        Each point's rows.
     """
+
+    m_a: np.ndarray
+    m_b: np.ndarray
+    mask_b: np.ndarray
+    kv_a: np.ndarray
+    kv_b: np.ndarray
+    kmask_b: np.ndarray
+    ia: np.ndarray
+    ib: np.ndarray
+
+
+@loop
+def jacobian_points(tables, kin0, law, free, max_iter, tol, out):
+    """:func:`steady_jacobian` at the points of the :class:`AxisTables` ``tables``, into ``out``
+    (P, 2k, 2k); the kinematics of a point are ``kinematics_from(kin0, kv)``, its user friction law
+    ``law`` (:class:`~stickslip.model.friction.NoUserLaw` if none). NaN where no steady sliding
+    exists."""
+    m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib = tables
     mw = np.empty(m_a.shape[1])
     kv = np.empty(kv_a.shape[1])
     for p in range(ia.shape[0]):
