@@ -150,6 +150,7 @@ def orbit_command(
 @app.command("lyapunov")
 @grouped
 def lyapunov_command(
+    *,
     point: OperatingPoint = OperatingPoint(),
     model: Model = "full",
     ic: StartIc = None,

@@ -189,6 +189,21 @@ def _orbit_model(model, guess, slip_band) -> FrictionModel:
     return resolve(model, slip_band)
 
 
+def _orbit_monodromy(problem, orbit, method: str) -> tuple[np.ndarray, str]:
+    """(M, method used): the converged orbit's monodromy matrix, by saltation matrices (finite
+    differences, with a warning, where that integration fails) or by finite differences."""
+    if method == "saltation":
+        try:
+            M, _ = problem.monodromy(orbit.state, orbit.period, method)
+            return M, method
+        except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            warnings.warn(f"saltation monodromy failed ({exc}); using finite differences", RuntimeWarning,
+                          stacklevel=3)
+            method = "finite-difference"
+    M, _ = problem.monodromy(orbit.state, orbit.period, method)
+    return M, method
+
+
 def periodic_orbit(
     model=None,
     guess=None,
@@ -295,16 +310,7 @@ def periodic_orbit(
         raise SteadySlidingOrbitError(
             f"shooting converged onto steady sliding (no stick phase, {orbit.period:.6g} s being any period of the "
             "equilibrium), not a cycle: start from a state on the cycle or from a run that has reached it")
-    method = monodromy
-    if method == "saltation":
-        try:
-            M, _ = problem.monodromy(orbit.state, orbit.period, method)
-        except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError) as exc:
-            warnings.warn(f"saltation monodromy failed ({exc}); using finite differences", RuntimeWarning,
-                          stacklevel=2)
-            method = "finite-difference"
-    if method == "finite-difference":
-        M, _ = problem.monodromy(orbit.state, orbit.period, method)
+    M, method = _orbit_monodromy(problem, orbit, monodromy)
     return PeriodicOrbit(
         state=orbit.state, period=orbit.period, multiplicity=k, stick_phases=stick_phases,
         residual=orbit.history[-1], iterations=orbit.iterations, residual_history=np.array(orbit.history),
