@@ -1,10 +1,10 @@
 """Results of the library models as exact numbers, for comparing numba runs with and without
 stickslip's changes to numba (tests/reliability/test_numba_patches.py runs this as a script).
 
-    python numba_results.py MODEL[,MODEL...] [--stability MODEL] [--orbit MODEL]
+    python numba_results.py MODEL[,MODEL...] [--stability MODEL] [--orbit MODEL:SECTION]
 
 prints one JSON object: per model its final state and the sums of its sampled states and times, a
-stability eigenvalue set, and an orbit's period and multipliers, every float as ``float.hex``
+stability eigenvalue set, and the period and multipliers of a stick-slip orbit found from rest, every float as ``float.hex``
 (bit for bit).
 """
 
@@ -45,7 +45,8 @@ def main() -> None:
     if args.stability:
         out["stability"] = exact(np.sort_complex(stickslip.stability(args.stability).eigenvalues))
     if args.orbit:
-        orbit = stickslip.periodic_orbit(args.orbit, {"x": 1.0, "dx": 1.0}, search_time=60.0)
+        name, section = args.orbit.split(":")
+        orbit = stickslip.periodic_orbit(name, "zero", section=section, search_time=60.0)
         out["orbit"] = {"period": exact([orbit.period]), "multipliers": exact(np.sort_complex(orbit.multipliers))}
     print(json.dumps(out, sort_keys=True))
 
