@@ -72,8 +72,8 @@ pad = SparseForm(
     slip_band=5e-4)
 
 # %%
-# The mode-coupling diagram: every eigenvalue with :math:`|\operatorname{Im}\,\lambda|` ≤ 1.6e5 rad/s (25 kHz) for μ from 0 to
-# 0.5, each a CEA of the full model; the onsets (Re λ through 0) are located by root finding
+# The mode-coupling diagram: every eigenvalue with :math:`|\operatorname{Im}\,\lambda|` ≤ 1.6e5 rad/s
+# (25 kHz) for μ from 0 to 0.5, each a CEA of the full model; the onsets (Re λ through 0) are located by root finding
 # (to 1e-3 here; the default is 1e-10).
 # (Past μ ≈ 0.55 the friction moment lifts the trailing edge of the face off the belt, and steady
 # sliding with every contact closed no longer exists: the CEA refuses it, naming the contact.)
