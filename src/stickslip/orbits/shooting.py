@@ -264,6 +264,10 @@ def periodic_orbit(
         Jacobian ∂Φ/∂s0 of the Newton iteration: one variational integration (default; an
         iteration where it fails, e.g. because the iterate's event sequence differs from the
         integrator's, uses finite differences) or 2 (2 n_free − 1) flow maps.
+    steady_sliding : {"refuse", "keep"}
+        What to do where Newton converged onto steady sliding (no stick phase, within the orbit
+        size of the equilibrium: a fixed point that any period fits, not a cycle): raise
+        :class:`SteadySlidingOrbitError` (default), or return it as found.
 
     Returns
     -------
