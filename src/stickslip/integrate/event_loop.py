@@ -115,7 +115,7 @@ def store_sample(idx, y, cst, md, F, N, v, out_s, out_mode, out_F):
     P.contact_forces(y, cst, md, F, N, v)
     for i in range(out_s.shape[1]):
         out_s[idx, i] = y[i]
-    out_mode[idx] = E.mode_flags(cst, nc)
+    E.store_mode(out_mode, idx, cst, nc)
     for i in range(2 * nc):
         out_F[idx, i] = F[i]
 

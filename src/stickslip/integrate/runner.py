@@ -37,7 +37,8 @@ from . import contacts as E
 from .event_loop import N_EXTRA, integrate_event
 from .interrupt import interruptible
 from .loop_split import start_callees
-from .result import Transitions, mode_dtype
+from ..analysis.modes import contact_index_dtype, mode_words
+from .result import Transitions, mode_array
 from .status import CHUNK_END, Status
 
 __all__ = ["EventStepper", "Record", "Chunk", "RunOutput", "StopCondition", "ToTheEnd", "run_chunks",
@@ -77,11 +78,13 @@ NO_STEP_CAP = 2**62
 COMPILE_REPORT_S = 0.05
 
 
-def transition_room(duration: float, ns: int, capacity: int | None = None):
+def transition_room(duration: float, ns: int, capacity: int | None = None, n_contacts: int = 1):
     """Transition buffers (times, kinds, contacts, states (·, ns)) for a chunk of ``duration`` [s]:
-    ``capacity`` entries, default :data:`MIN_TRANSITION_ROOM` + :data:`TRANSITIONS_PER_SECOND` per second."""
+    ``capacity`` entries, default :data:`MIN_TRANSITION_ROOM` + :data:`TRANSITIONS_PER_SECOND` per second;
+    the contacts' indices int8, wider for a model of more than 127 contacts."""
     cap = capacity or MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * max(duration, 0.0))
-    return np.empty(cap), np.empty(cap, dtype=np.int8), np.empty(cap, dtype=np.int8), np.empty((cap, ns))
+    return (np.empty(cap), np.empty(cap, dtype=np.int8), np.empty(cap, dtype=contact_index_dtype(n_contacts)),
+            np.empty((cap, ns)))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -147,7 +150,7 @@ class Record:
         self.ns = 2 * system.n + N_EXTRA
         self.capacity = k
         self._states = np.empty((k, self.ns))
-        self._mode = np.empty(k, dtype=mode_dtype(system.n_contacts, system.unilateral))
+        self._mode = mode_array(k, system.n_contacts, system.unilateral)
         self._friction = np.empty((k, 2 * system.n_contacts))
         self.base = 0
         self.n = 0
@@ -263,6 +266,7 @@ class EventStepper:
         self.h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
         self.steps_left = int(max_steps)
         self.stats = np.zeros(6, dtype=np.int64)
+        self.n_contacts = system.n_contacts
         # on a cold start the loop's callees compile in two processes (:mod:`.loop_split`): the
         # helper starts before the check of the contacts' loads, which compiles meanwhile
         with start_callees(md) or contextlib.nullcontext() as cold:
@@ -277,11 +281,19 @@ class EventStepper:
     def _warm_up(self, system: FrictionModel) -> None:
         """Compile (or load from cache) the event loop for this kinematics class and set the modes
         the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇)."""
-        tr = transition_room(0.0, self.ns, 1)
+        tr = transition_room(0.0, self.ns, 1, system.n_contacts)
         y = integrate_event(self.y, self.cst, 0.0, 0.0, 0.0, self.md, self.rtol, self.atol, 1e-7, 1e-6, 10,
-                            np.empty(0), 0, np.empty((1, self.ns)), np.empty(1, dtype=np.int8),
+                            np.empty(0), 0, np.empty((1, self.ns)), self._start_mode_array(system),
                             np.empty((1, 2 * system.n_contacts)), tr[0], tr[1], tr[2], tr[3], 0, start_modes=True)[2]
         self.y = y
+
+    @staticmethod
+    def _start_mode_array(system: FrictionModel) -> np.ndarray:
+        """The mode array of the start-modes call: one int8 sample, or one of words for a model of
+        more than 32 flags (the run's own type, so the loop compiles once)."""
+        if mode_words(system.n_contacts, system.unilateral) == 0:
+            return np.empty(1, dtype=np.int8)
+        return mode_array(1, system.n_contacts, system.unilateral)
 
     def advance(self, tau_stop: float, record: Record) -> Chunk:
         """Integrate about ``tau_stop`` seconds more (to the first accepted step past it outside an
@@ -290,7 +302,7 @@ class EventStepper:
         tau_end = self.t_end - self.t
         capacity = None
         while True:
-            tr = transition_room(tau_stop, self.ns, capacity)
+            tr = transition_room(tau_stop, self.ns, capacity, self.n_contacts)
             times, row, out_s, out_mode, out_F = record.loop_arrays()
             status, tau, y, h, idx, n_tr, st, lost = integrate_event(
                 self.y, self.cst, self.t, tau_stop, tau_end, self.md, self.rtol, self.atol, self.h, self.h_max,

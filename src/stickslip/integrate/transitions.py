@@ -52,7 +52,7 @@ def record_transition(n_tr, t, kind, contact, y, tr_t, tr_kind, tr_contact, tr_s
 def settle(y, cst, md, F, N, t, tr_t, tr_kind, tr_contact, tr_s, n_tr, stats):
     """Release sticking contacts whose joint stick force exceeds the static limit (the most
     overloaded first) and record their breakaways at time ``t``; returns the transition count."""
-    for _ in range(E.MAX_SETTLE):
+    for _ in range(max(E.MAX_SETTLE, cst.shape[0] // CST)):
         c = E.release_most_overloaded(y, cst, md, F, N)
         if c < 0:
             break
