@@ -19,6 +19,7 @@ from ..model import physics
 from ..model.bundle import CST
 from ..model.library import describe_system, system_from_description, two_plates
 from ..model.library.two_plates import is_plates, plates_parameters
+from ..model.matrices import dense_array
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
 from ..results import Plottable
@@ -204,15 +205,15 @@ def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
     n = system.n
     kinds = transitions.kind
     rows = [i for i in np.flatnonzero(kinds == TRANSITION_IMPACT) if i + 1 < kinds.size]
-    directions = [np.asarray(c.gap_gradient, float) for c in system.contacts if c.gap_gradient is not None]
-    directions += [row for c in system.contacts if c.tangent is not None for row in np.atleast_2d(c.tangent)]
+    directions = [dense_array(c.gap_gradient).reshape(-1) for c in system.contacts if c.gap_gradient is not None]
+    directions += [row for c in system.contacts if c.tangent is not None for row in np.atleast_2d(dense_array(c.tangent))]
     out = {key: np.empty(len(rows)) for key in ("time", "before", "after", "impulse")}
     contact = np.empty(len(rows), dtype=int)
     for j, i in enumerate(rows):
         c = int(transitions.contact[i])
-        W = np.asarray(system.contacts[c].gap_gradient, float)
+        W = dense_array(system.contacts[c].gap_gradient).reshape(-1)
         before, after = transitions.state[i], transitions.state[i + 1]
-        change = system.mass @ (after[n:2 * n] - before[n:2 * n])
+        change = dense_array(system.mass) @ (after[n:2 * n] - before[n:2 * n])
         basis = np.array([W] + [d for d in directions if d is not W and not np.array_equal(d, W)]).T
         coef = np.linalg.lstsq(basis, change, rcond=None)[0]
         out["time"][j] = transitions.time[i]
@@ -380,8 +381,9 @@ class Trajectory(Plottable):
         """½ q̇ᵀ M q̇ + ½ qᵀ K_s q (k,) [J], K_s the symmetric part of K (locked DOFs never move)."""
         n = self.system.n
         q, dq = self.states[:, :n], self.states[:, n:2 * n]
-        Ks = 0.5 * (self.system.stiffness + self.system.stiffness.T)
-        return 0.5 * np.einsum("ki,ij,kj->k", dq, self.system.mass, dq) + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q)
+        K = dense_array(self.system.stiffness)
+        Ks = 0.5 * (K + K.T)
+        return 0.5 * np.einsum("ki,ij,kj->k", dq, dense_array(self.system.mass), dq) + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q)
 
     @property
     def final_state(self) -> np.ndarray:

@@ -637,14 +637,19 @@ class FrictionModel:
 
     def natural_frequencies(self) -> np.ndarray:
         """Undamped natural frequencies [Hz] of the free DOFs without friction, ascending
-        (eigenvalues of M⁻¹ K; complex pairs of a non-symmetric K give their modulus)."""
-        if not self.dense:
-            raise ModelError(f"model {self.name!r} has {self.n} dofs, too many for all its natural frequencies; "
-                             "take its lowest modes from its sparse form (scipy.sparse.linalg.eigsh(K, M=M, sigma=0) "
-                             "on model.sparse_form()), or reduce it with `stickslip reduce`")
+        (eigenvalues of M⁻¹ K; complex pairs of a non-symmetric K give their modulus).
+
+        Raises
+        ------
+        MemoryLimitError, ModelError
+            For a sparse model too large for the compiled tools (:attr:`data`): its lowest modes come
+            from its sparse form (``scipy.sparse.linalg.eigsh(K, M=M, sigma=0)``).
+        """
+        if not self.dense:  # as dense as the compiled tools take it, where that fits in memory
+            self._check_compiled_size()
         idx = np.flatnonzero(self.free)
-        M = self.mass[np.ix_(idx, idx)]
-        K = self.stiffness[np.ix_(idx, idx)]
+        M = dense_array(self.mass)[np.ix_(idx, idx)]
+        K = dense_array(self.stiffness)[np.ix_(idx, idx)]
         lam = np.linalg.eigvals(np.linalg.solve(M, K))
         return np.sort(np.sqrt(np.abs(lam)) / (2.0 * np.pi))
 
