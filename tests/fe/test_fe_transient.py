@@ -122,3 +122,18 @@ def test_reduced_transient_equals_the_full_one(pad, tmp_path):
         x, y = a.states[:, full_part], b.states[:, red_part]
         assert np.abs(x - y).max() <= 1e-6 * np.abs(x).max()
     np.testing.assert_allclose(a.normal_force, b.normal_force, rtol=0, atol=1e-6 * np.abs(a.normal_force).max())
+
+
+def test_a_model_whose_compiled_form_does_not_fit_is_refused_in_one_line(pad, monkeypatch, tmp_path):
+    from typer.testing import CliRunner
+
+    import stickslip.memory as memory
+    from stickslip.cli import app
+
+    fe, _ = pad
+    path = fe.write(tmp_path / "pad")
+    monkeypatch.setattr(memory, "available_memory", lambda: 2e5)
+    result = CliRunner().invoke(app, ["simulate", "--model", str(path), "--t-end", "0.001", "--no-plot"])
+    lines = result.output.strip().splitlines()
+    assert result.exit_code == 2 and len(lines) == 1, result.output
+    assert "72 dofs, 9 contacts" in lines[0] and "dofs fit" in lines[0] and "stickslip reduce" in lines[0]
