@@ -133,7 +133,8 @@ def test_a_model_whose_compiled_form_does_not_fit_is_refused_in_one_line(pad, mo
     fe, _ = pad
     path = fe.write(tmp_path / "pad")
     monkeypatch.setattr(memory, "available_memory", lambda: 2e5)
-    result = CliRunner().invoke(app, ["simulate", "--model", str(path), "--t-end", "0.001", "--no-plot"])
+    result = CliRunner().invoke(app, ["simulate", "--model", str(path), "--t-end", "0.01", "--sample-rate", "1e5",
+                                      "--no-plot"])
     lines = result.output.strip().splitlines()
     assert result.exit_code == 2 and len(lines) == 1, result.output
     assert "72 dofs, 9 contacts" in lines[0] and "dofs fit" in lines[0] and "stickslip reduce" in lines[0]
