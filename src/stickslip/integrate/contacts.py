@@ -139,7 +139,7 @@ def mode_flags(cst, nc):
 def store_mode(out_mode, idx, cst, nc):  # pragma: no cover - resolved by numba (overload below)
     """Write sample ``idx``'s mode flags (:func:`mode_flags`) into ``out_mode``: one integer per
     sample (k,), or for a model of more flags words of MODE_WORD_BITS (k, words)
-    (:func:`stickslip.model.model_data.mode_shape`)."""
+    (:func:`stickslip.analysis.modes.mode_shape`)."""
     raise NotImplementedError("store_mode is called from compiled code only")
 
 

@@ -92,7 +92,7 @@ class Transitions:
 def mode_dtype(n_contacts: int, unilateral: bool = False):
     """Integer type of the sampled mode (bit c set: contact c sticks; with unilateral contacts bit
     nc + c set: contact c is open): the narrowest of int8, int16, int32 with a bit for each flag,
-    or int64 words for more flags (:func:`stickslip.model.model_data.mode_shape`)."""
+    or int64 words for more flags (:func:`stickslip.analysis.modes.mode_shape`)."""
     return mode_shape(0, n_contacts, unilateral)[1]
 
 
