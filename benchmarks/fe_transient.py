@@ -129,7 +129,8 @@ def target(folder: Path, periods: float = 20.0) -> dict:
            "wall_per_period_s": wall / periods, "goal_s_for_20_periods": 60.0, "status": run.status,
            "t_reached_periods": float(run.t[-1] * f1), "steps": run.stats.accepted_steps,
            "rejected": run.stats.rejected_steps, "rhs_calls": run.stats.rhs_calls,
-           "contacts_that_stuck": int(run.stick.any(axis=0).sum()), "contacts_that_opened": int(run.open.any(axis=0).sum())}
+           "contacts_that_stuck": int(run.stick.any(axis=0).sum()),
+           "contacts_that_opened": int(run.open.any(axis=0).sum())}
     print(json.dumps(row), flush=True)
     return row
 

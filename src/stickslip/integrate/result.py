@@ -26,7 +26,8 @@ from ..results import Plottable
 from .contacts import TRANSITION_IMPACT
 from .status import Status
 
-__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "mode_array", "Impacts", "find_impacts"]
+__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "mode_array",
+           "Impacts", "find_impacts"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -206,7 +207,8 @@ def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
     kinds = transitions.kind
     rows = [i for i in np.flatnonzero(kinds == TRANSITION_IMPACT) if i + 1 < kinds.size]
     directions = [dense_array(c.gap_gradient).reshape(-1) for c in system.contacts if c.gap_gradient is not None]
-    directions += [row for c in system.contacts if c.tangent is not None for row in np.atleast_2d(dense_array(c.tangent))]
+    directions += [row for c in system.contacts if c.tangent is not None
+                   for row in np.atleast_2d(dense_array(c.tangent))]
     out = {key: np.empty(len(rows)) for key in ("time", "before", "after", "impulse")}
     contact = np.empty(len(rows), dtype=int)
     for j, i in enumerate(rows):
@@ -383,7 +385,8 @@ class Trajectory(Plottable):
         q, dq = self.states[:, :n], self.states[:, n:2 * n]
         K = dense_array(self.system.stiffness)
         Ks = 0.5 * (K + K.T)
-        return 0.5 * np.einsum("ki,ij,kj->k", dq, dense_array(self.system.mass), dq) + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q)
+        return (0.5 * np.einsum("ki,ij,kj->k", dq, dense_array(self.system.mass), dq)
+                + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q))
 
     @property
     def final_state(self) -> np.ndarray:

@@ -38,7 +38,8 @@ from numba.core import cgutils, types
 from numba.extending import intrinsic
 from numba.np.arrayobj import populate_array
 
-__all__ = ["work_matrix", "work_vectors", "static_sizes", "register_heap", "on_heap", "MAX_DOFS", "MAX_CONTACTS", "DOFS", "STATES", "CONTACTS", "ROWS",
+__all__ = ["work_matrix", "work_vectors", "static_sizes", "register_heap", "on_heap", "MAX_DOFS", "MAX_CONTACTS",
+           "DOFS", "STATES", "CONTACTS", "ROWS",
            "ONE", "TWO", "IMPULSE_ROWS"]
 
 #: Largest model (DOFs, contacts) whose kinematics class does not fix its size; a larger one is
