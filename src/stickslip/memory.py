@@ -31,7 +31,7 @@ from .errors import MemoryLimitError
 
 __all__ = ["available_memory", "check_memory", "largest_count", "sample_bytes", "state_bytes", "param_bytes",
            "grid_point_bytes", "map_point_bytes", "average_bytes", "format_bytes", "model_data_bytes",
-           "largest_dense_dofs", "matrix_file_bytes"]
+           "largest_dense_dofs", "matrix_file_bytes", "compiled_model_bytes", "work_array_bytes"]
 
 #: Control-group memory limits (v2, then v1) that cap what the kernel gives this process.
 _CGROUP_LIMITS = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
@@ -213,11 +213,33 @@ def model_data_bytes(n_dofs: int, n_contacts: int) -> float:
     return 8.0 * (_DENSE_COPIES * n * n + nc * (5 * n + 16) + 2 * n + 8)
 
 
+#: Call sites of work arrays in the compiled kernels (``model/stack.py``), each compiled for
+#: float and complex numbers: a model above the stack maxima holds one heap buffer per site
+#: reached (the source has about 60 sites; the float and the complex-step kernels reach each at
+#: most once, and an inlined kernel's sites once per caller: 120 bounds what a process compiles
+#: for one kinematics class, counted generously).
+_WORK_SITES = 120
+
+
+def work_array_bytes(n_dofs: int, n_contacts: int) -> float:
+    """Bytes of the kernels' heap work arrays of a model above the stack maxima: per site the
+    largest a site takes, complex (16 B): an impact's 3 nc × n rows and 3 nc × 3 nc system, and
+    seven vectors of max(n, 2 nc)."""
+    n, nc = int(n_dofs), int(n_contacts)
+    return 16.0 * _WORK_SITES * (3 * nc * n + 9 * nc * nc + 7 * max(n, 2 * nc))
+
+
+def compiled_model_bytes(n_dofs: int, n_contacts: int) -> float:
+    """Peak bytes of a model in the compiled kernels: its packed data (:func:`model_data_bytes`)
+    and, above the stack maxima, the kernels' work arrays (:func:`work_array_bytes`)."""
+    return model_data_bytes(n_dofs, n_contacts) + work_array_bytes(n_dofs, n_contacts)
+
+
 def largest_dense_dofs(memory: float, n_contacts: int = 0) -> int:
-    """The most coordinates whose packed model (:func:`model_data_bytes`) fits in ``memory`` bytes."""
+    """The most coordinates whose compiled model (:func:`compiled_model_bytes`) fits in ``memory`` bytes."""
     n = int(math.isqrt(max(int(memory // (8 * _DENSE_COPIES)), 0)))
-    while n > 0 and model_data_bytes(n, n_contacts) > memory:
-        n -= 1
+    while n > 0 and compiled_model_bytes(n, n_contacts) > memory:
+        n = min(n - 1, int(n * 0.99))
     return n
 
 

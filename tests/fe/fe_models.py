@@ -13,6 +13,14 @@ node coordinates) that :meth:`FEModel.write` saves as matrix files and a model f
     u[2 k + 1], k = j (nx + 1) + i; node ids k + 1. n = 2 (nx + 1) ny: 10×4 elements 88 dofs,
     250×100 50 200 dofs, 500×100 100 200 dofs.
 
+``belt_with_modes(modes, ...)``
+    The library's mass on a belt (bSTAB's friction case: unit mass, damping 0.1, stiffness 1, a
+    pressed contact of N = 1 with exponential friction, belt speed 1.5) as dof ``u0``, beside
+    ``modes`` modal coordinates that nothing forces or couples (unit masses, frequencies ω_r spread
+    over [2, 9] rad/s, damping ratio ``zeta``): a model of 1 + modes dofs whose motions are the
+    belt's with the modes at rest, and whose Floquet multipliers add to the belt's the
+    closed-form exp(λ_r T), λ_r = −ζ ω_r ± i ω_r √(1 − ζ²), of each mode.
+
 ``bar_chain(n, ...)``
     n equal masses m in a chain of equal springs k, the first tied to the wall, one 1-D pressed
     contact on the last mass. Its undamped natural frequencies are in closed form
@@ -39,7 +47,7 @@ import scipy.io
 import scipy.sparse as sp
 import tomli_w
 
-__all__ = ["FEModel", "pad_on_belt", "bar_chain", "q4_element"]
+__all__ = ["FEModel", "pad_on_belt", "bar_chain", "q4_element", "belt_with_modes", "one_contact"]
 
 
 @dataclasses.dataclass
@@ -325,3 +333,25 @@ def bar_chain(n: int = 8, *, mass: float = 1.0, stiffness: float = 100.0, dampin
                    coordinates=np.stack([np.arange(1, n + 1, dtype=float), np.zeros(n), np.zeros(n)], axis=1),
                    ids=np.arange(1, n + 1), dof_node=np.arange(n), dof_component=np.zeros(n, dtype=int),
                    chain=(n, mass, stiffness))
+
+
+def belt_with_modes(modes: int = 69, *, zeta: float = 0.05, name: str = "belt-with-modes") -> FEModel:
+    """The belt with ``modes`` unforced, uncoupled modal coordinates (module docstring)."""
+    n = 1 + modes
+    omega = np.linspace(2.0, 9.0, modes)
+    M = sp.identity(n, format="csr")
+    K = sp.diags(np.concatenate([[1.0], omega**2]), format="csr")
+    C = sp.diags(np.concatenate([[0.1], 2.0 * zeta * omega]), format="csr")
+    return FEModel(name=name, mass=M, stiffness=K, rayleigh=None, damping=C, tangent_dof=np.array([0]),
+                   normal_dof=np.array([0]), gap=np.zeros(1), drive=1.5, node_ids=np.array([1]),
+                   contact={"normal_force": 1.0}, friction={"law": "exponential", "mu_k": 0.5, "delta_mu": 0.5,
+                                                            "alpha": 2.0},
+                   coordinates=np.zeros((n, 3)), ids=np.arange(1, n + 1), dof_node=np.arange(n),
+                   dof_component=np.zeros(n, dtype=int))
+
+
+def one_contact(model: FEModel, index: int) -> FEModel:
+    """``model`` with only its contact ``index`` (the others removed)."""
+    keep = np.array([index])
+    return dataclasses.replace(model, tangent_dof=model.tangent_dof[keep], normal_dof=model.normal_dof[keep],
+                               gap=model.gap[keep], node_ids=model.node_ids[keep])

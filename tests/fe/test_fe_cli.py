@@ -83,6 +83,9 @@ def test_a_model_file_or_config_past_its_size_limit_is_refused(folder):
     refused(run("--config", "huge.toml"), "--config", "larger than")
 
 
-def test_a_model_too_large_for_the_compiled_tools_is_refused_by_simulate(folder):
+def test_a_model_too_large_for_memory_is_refused_by_simulate(folder, monkeypatch):
+    import stickslip.memory as memory
+
     pad_on_belt(10, 4).write(folder / "big", matrix_format="npz")
-    refused(run("--model", str(folder / "big" / "model.toml")), "88 dofs", "stickslip reduce")
+    monkeypatch.setattr(memory, "available_memory", lambda: 2e5)
+    refused(run("--model", str(folder / "big" / "model.toml")), "88 dofs", "dofs fit", "stickslip reduce")

@@ -39,6 +39,7 @@ import math
 
 import numpy as np
 
+from .modes import sample_flags
 from .outcome import is_stick_slip, outcome_code
 from .peaks import Peaks
 from .period import DECAY_FACTOR, MAX_MULTIPLICITY, MIN_PERIODS, SETTLE_RTOL, decay_ratio, detect_period
@@ -261,7 +262,7 @@ def classify(traj, t_from: float | None = None, dof: str | None = None) -> Class
     if ts.size < 8:
         raise ValueError(f"t_from = {t_from} s leaves fewer than 8 samples; choose an earlier time")
     tr = traj.transitions
-    stick, _ = stick_time(float(ts[0]), float(ts[-1]), int(traj.mode[sel][0]), tr.time, tr.kind, tr.contact,
+    stick, _ = stick_time(float(ts[0]), float(ts[-1]), sample_flags(traj.mode[sel][0]), tr.time, tr.kind, tr.contact,
                           system.n_contacts)
     frac = stick / float(ts[-1] - ts[0])
     free = [int(i) for i in np.flatnonzero(system.free) if i != j]

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from .modes import sample_flags
 from .period import detect_period
 from .signal import REST_AMPLITUDE, SLIP, STICK, open_time, spectral_peak, stick_time
 
@@ -145,7 +146,7 @@ def summarize(t, states, mode, transitions, t_from, *, n_contacts: int, coordina
     dphi = states[sel, rate]
     t0, t1 = float(ts[0]), float(ts[-1])
     # mode just after t0: the sample's mode unless a transition sits exactly on t0
-    mode0 = int(mode[sel][0])
+    mode0 = sample_flags(mode[sel][0])
     tt = np.asarray(transitions.time)
     kinds = np.asarray(transitions.kind)
     window = (tt > t0) & (tt <= t1) & ((kinds == STICK) | (kinds == SLIP))

@@ -9,7 +9,7 @@ runs, :func:`model_of`):
   :data:`SAMPLES_PER_PERIOD` times, integrated in chunks of :data:`CHUNK_PERIODS` T_c, with a
   window of the last :data:`WINDOW_PERIODS` T_c kept for the section crossings and the verdict;
 * **steady sliding** s_e = (q_e, 0) and whether it is linearly stable
-  (:func:`stickslip.stability.analysis.stability`);
+  (:func:`stickslip.stability.analysis.model_stability`: the dense path, for models above 64 dofs too);
 * for a stable one, the linear flow over one chunk, Φ = exp(A Δ), and a quadratic Lyapunov
   function V(δ) = δᵀ P δ of the linearisation A (Aᵀ P + P A = −Q, Q the diagonal of the
   stiffness and mass, an energy weighting), in which the linear flow contracts monotonically.
@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import StickSlipError
 from ..model.library import describe_system, system_from_description
-from ..stability.analysis import stability
+from ..stability.analysis import model_stability
 from ..stability.equilibrium import rigid_constraint
 
 __all__ = ["Context", "make_context", "model_of", "model_key", "SAMPLES_PER_PERIOD", "CHUNK_PERIODS",
@@ -145,8 +145,8 @@ def _period(model, eigenvalues) -> float:
 def _energy_weights(model, free_dofs) -> np.ndarray:
     """Diagonal weights (2k,) of the Lyapunov equation: |K_ii| for positions (M_ii ω² where K_ii
     is 0), M_ii for rates."""
-    K = np.abs(np.diag(model.stiffness))[free_dofs]
-    M = np.diag(model.mass)[free_dofs]
+    K = np.abs(model.stiffness.diagonal())[free_dofs]  # a dense array or a sparse matrix
+    M = model.mass.diagonal()[free_dofs]
     wq = np.where(K > 0.0, K, M * (2.0 * math.pi / _period(model, None)) ** 2)
     return np.concatenate([wq, M])
 
@@ -161,7 +161,7 @@ def make_context(model, *, key: str | None = None) -> Context:
     free = np.concatenate([free_dofs, n + free_dofs]).astype(np.int64)
     k2 = free.size
     try:
-        stab = stability(model)
+        stab = model_stability(model)
     except (StickSlipError, ArithmeticError, np.linalg.LinAlgError):
         stab = None
     period = _period(model, None if stab is None else stab.eigenvalues)

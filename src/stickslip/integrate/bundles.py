@@ -102,9 +102,10 @@ def scratch(ns: int, nc: int) -> Scratch:
     return Scratch(np.empty(ns), np.empty(2 * nc), np.empty(nc), np.empty(2 * nc))
 
 
-def transition_log(capacity: int, ns: int) -> TransitionLog:
-    """An empty :class:`TransitionLog` with room for ``capacity`` transitions of ``ns`` states."""
-    return TransitionLog(np.empty(capacity), np.empty(capacity, dtype=np.int8), np.empty(capacity, dtype=np.int8),
+def transition_log(capacity: int, ns: int, contact_dtype=np.int8) -> TransitionLog:
+    """An empty :class:`TransitionLog` with room for ``capacity`` transitions of ``ns`` states;
+    the contacts' indices of ``contact_dtype`` (int8, wider for a model of more than 127 contacts)."""
+    return TransitionLog(np.empty(capacity), np.empty(capacity, dtype=np.int8), np.empty(capacity, dtype=contact_dtype),
                          np.empty((capacity, ns)))
 
 

@@ -28,10 +28,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba.extending import overload
 
+from ..analysis.modes import MODE_WORD_BITS
 from ..model import physics as P
 from ..model.bundle import C_NORMAL_C, C_NORMAL_K, CST, contact_offsets
-from ..model.jit import api_kernel, inlined_kernel, kernel, standalone
+from ..model.jit import KERNEL_OPTIONS, api_kernel, inlined_kernel, kernel, standalone
 from ..model.kinematics import model_sizes, rigid_kernel
 from ..model.impact import IMPACT_INCONSISTENT, impact, remove_gap_rate, restitution_of
 from ..model.normal import gap_and_rate, gap_with_rate, is_open, is_rigid, starts_open
@@ -42,7 +44,7 @@ __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "hermite_dip", "gap_dip", "probed_crossing", "contact_lost",
-           "mode_flags"]
+           "mode_flags", "store_mode"]
 
 EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
 EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
@@ -91,8 +93,8 @@ MAX_REFINEMENTS = 200
 #: Sub-intervals of a step on which the event function is sampled for a sign change.
 EVENT_CHECKS = 4
 
-#: Largest number of contacts released in one settling of the sticking set (each pass releases
-#: one contact, so nc passes always suffice).
+#: Passes of one settling of the sticking set, at least (each pass releases one contact, so nc
+#: passes always suffice: a model of more contacts takes nc).
 MAX_SETTLE = 64
 
 
@@ -133,6 +135,31 @@ def mode_flags(cst, nc):
         elif mode == P.MODE_OPEN:
             flags |= 1 << (nc + c)
     return flags
+
+
+def store_mode(out_mode, idx, cst, nc):  # pragma: no cover - resolved by numba (overload below)
+    """Write sample ``idx``'s mode flags (:func:`mode_flags`) into ``out_mode``: one integer per
+    sample (k,), or for a model of more flags words of MODE_WORD_BITS (k, words)
+    (:func:`stickslip.analysis.modes.mode_shape`)."""
+    raise NotImplementedError("store_mode is called from compiled code only")
+
+
+@overload(store_mode, jit_options=KERNEL_OPTIONS, inline="always")
+def _store_mode(out_mode, idx, cst, nc):
+    if out_mode.ndim == 1:
+        def one(out_mode, idx, cst, nc):
+            out_mode[idx] = mode_flags(cst, nc)
+        return one
+
+    def words(out_mode, idx, cst, nc):
+        for w in range(out_mode.shape[1]):
+            out_mode[idx, w] = 0
+        for c in range(nc):
+            mode = np.int64(cst[CST * c])
+            bit = c if mode == P.MODE_STICK else nc + c if mode == P.MODE_OPEN else -1
+            if bit >= 0:
+                out_mode[idx, bit // MODE_WORD_BITS] |= np.int64(1) << np.int64(bit % MODE_WORD_BITS)
+    return words
 
 
 @inlined_kernel
@@ -478,7 +505,7 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
         elif ex != 0.0 or ey != 0.0:
             cst[CST * c + 1] = ex
             cst[CST * c + 2] = ey
-    for _ in range(MAX_SETTLE):
+    for _ in range(max(MAX_SETTLE, nc)):
         if release_most_overloaded(y, cst, md, F, N) < 0:
             break
     for c in range(nc):  # a closed rigid contact that nothing presses is open (where its normal force is

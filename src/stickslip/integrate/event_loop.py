@@ -246,7 +246,7 @@ def store_sample(idx, y, cst, md, scratch, samples):
     states = samples.states
     for i in range(states.shape[1]):
         states[idx, i] = y[i]
-    samples.modes[idx] = E.mode_flags(cst, nc)
+    E.store_mode(samples.modes, idx, cst, nc)
     forces = samples.forces
     for i in range(2 * nc):
         forces[idx, i] = F[i]

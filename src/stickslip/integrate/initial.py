@@ -12,6 +12,7 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import EquilibriumError, SimulationError
+from ..model.matrices import dense_array
 from ..model.system_model import FrictionModel
 from ..stability.equilibrium import steady_sliding
 from .result import Trajectory, load_trajectory
@@ -151,7 +152,7 @@ def rigid_gaps(system: FrictionModel, states: np.ndarray):
     for c, contact in enumerate(system.contacts):
         if not (contact.unilateral and contact.normal.law == "rigid"):
             continue
-        W = np.asarray(contact.gap_gradient, dtype=float)
+        W = dense_array(contact.gap_gradient).reshape(-1)
         g = contact.gap + S[:, :n] @ W
         tol = 1e-12 * (1.0 + abs(contact.gap) + np.abs(S[:, :n] * W).sum(axis=1))
         yield c, g, S[:, n:2 * n] @ W, tol

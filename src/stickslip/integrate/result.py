@@ -11,6 +11,7 @@ import numpy as np
 from numba import njit
 
 from .._version import __version__
+from ..analysis.modes import MODE_WORD_BITS, contact_index_dtype, flag_bits, mode_shape
 from ..analysis.steady import SteadyState, summarize
 from ..errors import FileFormatError
 from ..files import format_name, open_ours, save_netcdf
@@ -18,13 +19,15 @@ from ..model import physics
 from ..model.bundle import CST
 from ..model.library import describe_system, system_from_description, two_plates
 from ..model.library.two_plates import is_plates, plates_parameters
+from ..model.matrices import dense_array
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.system_model import FrictionModel
 from ..results import Plottable
 from .contacts import TRANSITION_IMPACT
 from .status import Status
 
-__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "Impacts", "find_impacts"]
+__all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "mode_array",
+           "Impacts", "find_impacts"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -89,9 +92,15 @@ class Transitions:
 
 def mode_dtype(n_contacts: int, unilateral: bool = False):
     """Integer type of the sampled mode (bit c set: contact c sticks; with unilateral contacts bit
-    nc + c set: contact c is open): the narrowest of int8, int16, int32 with a bit for each flag."""
-    bits = 2 * n_contacts if unilateral else n_contacts
-    return np.int8 if bits <= 8 else np.int16 if bits <= 16 else np.int32
+    nc + c set: contact c is open): the narrowest of int8, int16, int32 with a bit for each flag,
+    or int64 words for more flags (:func:`stickslip.analysis.modes.mode_shape`)."""
+    return mode_shape(0, n_contacts, unilateral)[1]
+
+
+def mode_array(k: int, n_contacts: int, unilateral: bool = False) -> np.ndarray:
+    """An uninitialised mode array of k samples: (k,), or (k, words) for a model of more than 32 flags."""
+    shape, dtype = mode_shape(k, n_contacts, unilateral)
+    return np.empty(shape, dtype=dtype)
 
 
 @njit(cache=True)
@@ -107,11 +116,35 @@ def _slip_velocities(states, md, nc):
     return out
 
 
-@njit(cache=True)
-def _normal_forces(states, mode, md, nc):
+def _sample_normal_forces(states, mode, md, nc):
     """Normal force of every contact (k, nc) at each sample [N], a unilateral contact's in its
     sampled state (0 while open: bit nc + c of ``mode``; a closed rigid contact's multiplier with
     the sampled stick set, bit c)."""
+    if mode.ndim == 1:
+        return _normal_forces(states, mode, md, nc)
+    codes = np.where(flag_bits(mode, nc, nc), physics.MODE_OPEN,
+                     np.where(flag_bits(mode, 0, nc), physics.MODE_STICK, physics.MODE_SLIP))
+    return _normal_forces_of_codes(states, codes.astype(np.int8), md, nc)
+
+
+@njit(cache=True)
+def _normal_forces_of_codes(states, codes, md, nc):
+    """:func:`_sample_normal_forces` from each contact's mode code (k, nc) (a model of many flags)."""
+    k = states.shape[0]
+    out = np.empty((k, nc))
+    cst = np.zeros(CST * nc)
+    for i in range(k):
+        for c in range(nc):
+            cst[CST * c] = codes[i, c]
+            cst[CST * c + 1] = 1.0
+        for c in range(nc):
+            out[i, c] = physics.normal_force_of(states[i], cst, c, md)
+    return out
+
+
+@njit(cache=True)
+def _normal_forces(states, mode, md, nc):
+    """:func:`_sample_normal_forces` from the flags of one integer per sample."""
     k = states.shape[0]
     out = np.empty((k, nc))
     cst = np.zeros(CST * nc)
@@ -173,15 +206,16 @@ def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
     n = system.n
     kinds = transitions.kind
     rows = [i for i in np.flatnonzero(kinds == TRANSITION_IMPACT) if i + 1 < kinds.size]
-    directions = [np.asarray(c.gap_gradient, float) for c in system.contacts if c.gap_gradient is not None]
-    directions += [row for c in system.contacts if c.tangent is not None for row in np.atleast_2d(c.tangent)]
+    directions = [dense_array(c.gap_gradient).reshape(-1) for c in system.contacts if c.gap_gradient is not None]
+    directions += [row for c in system.contacts if c.tangent is not None
+                   for row in np.atleast_2d(dense_array(c.tangent))]
     out = {key: np.empty(len(rows)) for key in ("time", "before", "after", "impulse")}
     contact = np.empty(len(rows), dtype=int)
     for j, i in enumerate(rows):
         c = int(transitions.contact[i])
-        W = np.asarray(system.contacts[c].gap_gradient, float)
+        W = dense_array(system.contacts[c].gap_gradient).reshape(-1)
         before, after = transitions.state[i], transitions.state[i + 1]
-        change = system.mass @ (after[n:2 * n] - before[n:2 * n])
+        change = dense_array(system.mass) @ (after[n:2 * n] - before[n:2 * n])
         basis = np.array([W] + [d for d in directions if d is not W and not np.array_equal(d, W)]).T
         coef = np.linalg.lstsq(basis, change, rcond=None)[0]
         out["time"][j] = transitions.time[i]
@@ -312,12 +346,13 @@ class Trajectory(Plottable):
     @cached_property
     def normal_force(self) -> np.ndarray:
         """Normal force of each contact (k, nc) [N]: a prescribed N, or a unilateral contact's λ (0 open)."""
-        return _normal_forces(np.ascontiguousarray(self.states), self.mode, self.system.data, self.system.n_contacts)
+        return _sample_normal_forces(np.ascontiguousarray(self.states), self.mode, self.system.data,
+                                     self.system.n_contacts)
 
     @property
     def stick(self) -> np.ndarray:
         """Whether each contact sticks at each sample (k, nc) bool."""
-        return ((self.mode[:, None].astype(np.int64) >> np.arange(self.system.n_contacts)) & 1).astype(bool)
+        return flag_bits(self.mode, 0, self.system.n_contacts)
 
     @property
     def open(self) -> np.ndarray:
@@ -325,7 +360,7 @@ class Trajectory(Plottable):
         nc = self.system.n_contacts
         if not self.system.unilateral:
             return np.zeros((self.t.size, nc), dtype=bool)
-        return ((self.mode[:, None].astype(np.int64) >> (nc + np.arange(nc))) & 1).astype(bool)
+        return flag_bits(self.mode, nc, nc)
 
     @cached_property
     def gap(self) -> np.ndarray:
@@ -348,8 +383,10 @@ class Trajectory(Plottable):
         """½ q̇ᵀ M q̇ + ½ qᵀ K_s q (k,) [J], K_s the symmetric part of K (locked DOFs never move)."""
         n = self.system.n
         q, dq = self.states[:, :n], self.states[:, n:2 * n]
-        Ks = 0.5 * (self.system.stiffness + self.system.stiffness.T)
-        return 0.5 * np.einsum("ki,ij,kj->k", dq, self.system.mass, dq) + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q)
+        K = dense_array(self.system.stiffness)
+        Ks = 0.5 * (K + K.T)
+        return (0.5 * np.einsum("ki,ij,kj->k", dq, dense_array(self.system.mass), dq)
+                + 0.5 * np.einsum("ki,ij,kj->k", q, Ks, q))
 
     @property
     def final_state(self) -> np.ndarray:
@@ -421,7 +458,12 @@ class Trajectory(Plottable):
         else:
             mode_attrs = {"long_name": "sticking contacts (bit c set: contact c sticks)",
                           "flag_masks": " ".join(str(1 << c) for c in range(nc))}
-        data["mode"] = ("time", self.mode, mode_attrs)
+        if self.mode.ndim == 2:  # words of flags (a large model): flag b is bit b % 63 of word b // 63
+            mode_attrs = {"long_name": mode_attrs["long_name"] + f"; flag b is bit b % {MODE_WORD_BITS} of word "
+                                                                 f"b // {MODE_WORD_BITS}"}
+            data["mode"] = (("time", "mode_word"), self.mode, mode_attrs)
+        else:
+            data["mode"] = ("time", self.mode, mode_attrs)
         data["stick"] = (("time", "contact"), self.stick.astype(np.int8),
                          {"long_name": "each contact sticks (1) or slips (0)", "flag_values": "0 1",
                           "flag_meanings": "slip stick"})
@@ -448,7 +490,7 @@ class Trajectory(Plottable):
                                     (" 4" if system.rigid else ""),
                                     "flag_meanings": "stick_to_slip slip_to_stick" +
                                     (" open close" if system.unilateral else "") + (" impact" if system.rigid else "")})
-        data["transition_contact"] = ("transition", self.transitions.contact.astype(np.int8))
+        data["transition_contact"] = ("transition", self.transitions.contact.astype(contact_index_dtype(nc)))
         data["transition_state"] = (("transition", "state"), self.transitions.state)
         attrs = {
             "format": FORMAT,
@@ -504,7 +546,7 @@ class Trajectory(Plottable):
             work=np.stack([ds["work_friction"].values, ds["work_damping"].values], axis=1),
             transitions=Transitions(ds["transition_time"].values, ds["transition_kind"].values.astype(np.int8),
                                     ds["transition_state"].values.reshape(-1, 2 * system.n),
-                                    ds["transition_contact"].values.astype(np.int8),
+                                    ds["transition_contact"].values.astype(contact_index_dtype(nc)),
                                     int(ds.attrs.get("transitions_dropped", 0))),
             stats=Stats(**json.loads(ds.attrs["stats"])), status=ds.attrs["status"], system=system,
             method=ds.attrs["method"], options=json.loads(ds.attrs["options"]),

@@ -38,7 +38,8 @@ from .bundles import Samples, TransitionLog, transition_log
 from .event_loop import N_EXTRA, controls, integrate_event
 from .interrupt import interruptible
 from .loop_split import start_callees
-from .result import Transitions, mode_dtype
+from ..analysis.modes import contact_index_dtype, mode_words
+from .result import Transitions, mode_array
 from .status import CHUNK_END, Status
 
 __all__ = ["EventStepper", "Record", "Chunk", "RunOutput", "StopCondition", "ToTheEnd", "run_chunks",
@@ -78,11 +79,12 @@ NO_STEP_CAP = 2**62
 COMPILE_REPORT_S = 0.05
 
 
-def transition_room(duration: float, ns: int, capacity: int | None = None) -> TransitionLog:
+def transition_room(duration: float, ns: int, capacity: int | None = None, n_contacts: int = 1) -> TransitionLog:
     """Transition buffers (times, kinds, contacts, states (·, ns)) for a chunk of ``duration`` [s]:
-    ``capacity`` entries, default :data:`MIN_TRANSITION_ROOM` + :data:`TRANSITIONS_PER_SECOND` per second."""
+    ``capacity`` entries, default :data:`MIN_TRANSITION_ROOM` + :data:`TRANSITIONS_PER_SECOND` per second;
+    the contacts' indices int8, wider for a model of more than 127 contacts."""
     cap = capacity or MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * max(duration, 0.0))
-    return transition_log(cap, ns)
+    return transition_log(cap, ns, contact_index_dtype(n_contacts))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -148,7 +150,7 @@ class Record:
         self.ns = 2 * system.n + N_EXTRA
         self.capacity = k
         self._states = np.empty((k, self.ns))
-        self._mode = np.empty(k, dtype=mode_dtype(system.n_contacts, system.unilateral))
+        self._mode = mode_array(k, system.n_contacts, system.unilateral)
         self._friction = np.empty((k, 2 * system.n_contacts))
         self.base = 0
         self.n = 0
@@ -264,6 +266,7 @@ class EventStepper:
         self.h = min(1e-3, h_max)  # a fraction of the mechanical periods of interest; the controller adapts it
         self.steps_left = int(max_steps)
         self.stats = np.zeros(6, dtype=np.int64)
+        self.n_contacts = system.n_contacts
         # on a cold start the loop's callees compile in two processes (:mod:`.loop_split`): the
         # helper starts before the check of the contacts' loads, which compiles meanwhile
         with start_callees(md) or contextlib.nullcontext() as cold:
@@ -279,10 +282,10 @@ class EventStepper:
         """Compile (or load from cache) the event loop for this kinematics class and set the modes
         the state starts in (the loop's ``start_modes`` call: no time passes, it may project q̇)."""
         nc = system.n_contacts
-        samples = Samples(np.empty(0), np.empty((1, self.ns)), np.empty(1, dtype=mode_dtype(nc, system.unilateral)),
+        samples = Samples(np.empty(0), np.empty((1, self.ns)), mode_array(1, nc, system.unilateral),
                           np.empty((1, 2 * nc)))
         self.y = integrate_event(self.md, self.cst, self.y, controls(0.0, 0.0, 0.0, self.rtol, self.atol, 1e-6, 10),
-                                 1e-7, samples, 0, transition_room(0.0, self.ns, 1), start_modes=True)[2]
+                                 1e-7, samples, 0, transition_room(0.0, self.ns, 1, nc), start_modes=True)[2]
 
     def advance(self, tau_stop: float, record: Record) -> Chunk:
         """Integrate about ``tau_stop`` seconds more (to the first accepted step past it outside an
@@ -291,7 +294,7 @@ class EventStepper:
         tau_end = self.t_end - self.t
         capacity = None
         while True:
-            tr = transition_room(tau_stop, self.ns, capacity)
+            tr = transition_room(tau_stop, self.ns, capacity, self.n_contacts)
             samples, row = record.loop_arrays()
             chunk = controls(self.t, tau_stop, tau_end, self.rtol, self.atol, self.h_max, self.steps_left)
             status, tau, y, h, idx, n_tr, st, lost = integrate_event(self.md, self.cst, self.y, chunk, self.h,

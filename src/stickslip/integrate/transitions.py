@@ -58,7 +58,7 @@ def settle(y, cst, md, scratch, t, log, n_tr, stats):
     """Release sticking contacts whose joint stick force exceeds the static limit (the most
     overloaded first) and record their breakaways at time ``t`` in ``log``; returns the
     transition count."""
-    for _ in range(E.MAX_SETTLE):
+    for _ in range(max(E.MAX_SETTLE, cst.shape[0] // CST)):
         c = E.release_most_overloaded(y, cst, md, scratch.F, scratch.N)
         if c < 0:
             break

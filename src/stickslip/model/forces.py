@@ -30,7 +30,7 @@ from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
-                         is_stick, kinetic_coefficient)
+                         gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
 
@@ -136,7 +136,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
             for i in range(contact_dim(md.kin, m, n, c)):
-                apply_inverse_mass(m, n, diagonal, G[2 * c + i], MG[k])
+                inverse_mass_of_row(md.kin, m, n, diagonal, G[2 * c + i], MG[k])
                 acc = h[2 * c + i]
                 for j in range(n):
                     acc += G[2 * c + i, j] * a[j]
@@ -148,11 +148,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
             for i in range(contact_dim(md.kin, m, n, c)):
-                for r2 in range(k):
-                    acc = csm.zero(s[0])
-                    for j in range(n):
-                        acc += G[2 * c + i, j] * MG[r2, j]
-                    A[r, r2] = acc
+                gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, csm.zero(s[0]))
                 r += 1
     solve_psd(A, b, x, V, k)
     r = 0

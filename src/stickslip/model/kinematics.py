@@ -54,7 +54,9 @@ __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEM
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
            "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel",
            "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid",
-           "kernel_kinematics", "bias_at_run_time", "pointer_class"]
+           "kernel_kinematics", "bias_at_run_time", "pointer_class", "LargeConstantKinematics",
+           "LargeConstantUnilateralKinematics", "LargeConstantRigidKinematics", "LARGE_KINEMATICS", "fits_stack",
+           "large_kinematics"]
 
 
 #: Registered frame functions by kinematics class.
@@ -437,6 +439,53 @@ class ConstantRigidKinematics(NamedTuple):
 CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics, ConstantRigidKinematics)
 
 
+class LargeConstantKinematics(NamedTuple):
+    """The kernels' :class:`ConstantKinematics` of a model larger than the stack arrays hold
+    (:data:`~stickslip.model.stack.MAX_DOFS`, :data:`~stickslip.model.stack.MAX_CONTACTS`): its
+    work arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register_heap`),
+    so it has no fixed maximum. ``FrictionModel.data`` chooses it; the model keeps its own class."""
+
+    ndof: int = 0
+    ncontacts: int = 0
+
+
+class LargeConstantUnilateralKinematics(NamedTuple):
+    """:class:`LargeConstantKinematics` for :class:`ConstantUnilateralKinematics` (compliant contacts)."""
+
+    ndof: int = 0
+    ncontacts: int = 0
+
+
+class LargeConstantRigidKinematics(NamedTuple):
+    """:class:`LargeConstantKinematics` for :class:`ConstantRigidKinematics` (a rigid contact)."""
+
+    ndof: int = 0
+    ncontacts: int = 0
+
+
+#: The heap class the kernels of a large model of each constant-kinematics class take.
+LARGE_KINEMATICS = {ConstantKinematics: LargeConstantKinematics,
+                    ConstantUnilateralKinematics: LargeConstantUnilateralKinematics,
+                    ConstantRigidKinematics: LargeConstantRigidKinematics}
+
+
+def fits_stack(cls: type, n: int, nc: int) -> bool:
+    """Whether a model of n dofs and nc contacts of kinematics class ``cls`` has kernels with stack
+    work arrays (its class fixes its sizes, or they are within the maxima)."""
+    return stack.static_sizes(cls) is not None or (n <= stack.MAX_DOFS and nc <= stack.MAX_CONTACTS)
+
+
+def large_kinematics(kin, n: int, nc: int):
+    """The kinematics data the kernels take for a model of n dofs and nc contacts: ``kin`` where
+    it fits the stack arrays (:func:`fits_stack`), else its heap class (None where it has none: a
+    frame computed from q, which the stack maxima bound)."""
+    cls = type(kin)
+    if fits_stack(cls, n, nc):
+        return kin
+    large = LARGE_KINEMATICS.get(cls)
+    return None if large is None else large(int(n), int(nc))
+
+
 @kernel
 def constant_frame(kin, s, c, m, G, w):
     """Frame of :class:`ConstantKinematics`: G and w copied from the data array, N affine in s."""
@@ -455,3 +504,8 @@ def constant_frame(kin, s, c, m, G, w):
 register_kinematics(ConstantKinematics, constant_frame, unilateral=False)
 register_kinematics(ConstantUnilateralKinematics, constant_frame, rigid=False)
 register_kinematics(ConstantRigidKinematics, constant_frame)
+register_kinematics(LargeConstantKinematics, constant_frame, unilateral=False)
+register_kinematics(LargeConstantUnilateralKinematics, constant_frame, rigid=False)
+register_kinematics(LargeConstantRigidKinematics, constant_frame)
+for _large in LARGE_KINEMATICS.values():
+    stack.register_heap(_large)

@@ -39,7 +39,7 @@ import scipy.sparse as sp
 from ..errors import ModelError
 from .stack import MAX_DOFS
 
-__all__ = ["DENSE_DOFS", "is_sparse", "square_matrix", "contact_rows", "has_nonzero",
+__all__ = ["DENSE_DOFS", "is_sparse", "dense_array", "dense_spec", "square_matrix", "contact_rows", "has_nonzero",
            "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite", "is_checked"]
 
 #: Largest model kept dense: the compiled kernels' limit. Larger models keep their matrices sparse.
@@ -63,6 +63,23 @@ _CHECKED: dict[int, weakref.ref] = {}
 def is_sparse(value) -> bool:
     """Whether ``value`` is a scipy.sparse matrix or array."""
     return sp.issparse(value)
+
+
+def dense_array(value) -> np.ndarray:
+    """``value`` as a dense float array (a sparse matrix's ``toarray()``): for the compiled kernels'
+    packed data of a large model, whose size the memory estimate checked first."""
+    return value.toarray() if is_sparse(value) else np.asarray(value, dtype=float)
+
+
+def dense_spec(spec: dict) -> dict:
+    """A contact's spec (``Contact.spec``) with its rows dense (tangent rows G (dim, n), gradients
+    n, n_v, W (n,)), as :func:`stickslip.model.bundle.pack` takes it."""
+    out = dict(spec)
+    for key in ("G", "n_q", "n_v", "W"):
+        if key in out and is_sparse(out[key]):
+            value = out[key].toarray()
+            out[key] = value if key == "G" else value.reshape(-1)
+    return out
 
 
 def _csr(value) -> sp.csr_matrix:

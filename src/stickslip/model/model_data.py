@@ -20,11 +20,15 @@ import numpy as np
 from . import csmath as csm
 from .bundle import CST, C_LAW, contact_offsets, offsets
 from .friction import LAW_WIDTH, friction_coefficient, static_coefficient
-from .jit import inlined_kernel, kernel
+from numba.extending import overload
+
+from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
 from .kinematics import model_sizes
+from .stack import on_heap
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
-           "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy"]
+           "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy",
+           "inverse_mass_of_row", "gram_row"]
 
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
@@ -73,6 +77,64 @@ def apply_inverse_mass(m, n, diagonal, f, a):
             for j in range(n):
                 acc += m[o + i * n + j] * f[j]
             a[i] = acc
+
+
+def inverse_mass_of_row(kin, m, n, diagonal, g, out):  # pragma: no cover - resolved by numba (overload below)
+    """out = M⁻¹ g for a contact row g (n,): :func:`apply_inverse_mass`; for a model of a heap
+    kinematics class (hundreds of DOFs, :mod:`stickslip.model.stack`) the same sums over the
+    nonzero entries of g only (a contact row touches a few DOFs: n·nnz instead of n² operations,
+    the same numbers, each sum taken in the same order less its exact zeros)."""
+    raise NotImplementedError
+
+
+@overload(inverse_mass_of_row, jit_options=KERNEL_OPTIONS, inline="always")
+def _inverse_mass_of_row(kin, m, n, diagonal, g, out):
+    if not on_heap(getattr(kin, "instance_class", None)):
+        def dense(kin, m, n, diagonal, g, out):
+            apply_inverse_mass(m, n, diagonal, g, out)
+        return dense
+
+    def by_columns(kin, m, n, diagonal, g, out):
+        if diagonal:
+            apply_inverse_mass(m, n, diagonal, g, out)
+            return
+        o = offsets(n)[0]
+        for i in range(n):
+            out[i] = csm.zero(g[0])
+        for j in range(n):
+            gj = g[j]
+            if gj != 0.0:
+                for i in range(n):
+                    out[i] += m[o + i * n + j] * gj
+    return by_columns
+
+
+def gram_row(kin, g, MG, k, n, A, r, zero):  # pragma: no cover - resolved by numba (overload below)
+    """A[r, r2] = g · MG[r2] for r2 < k (a row of G_S M⁻¹ G_Sᵀ), each sum from ``zero`` in the order
+    of j; for a heap kinematics class over the nonzero entries of g only (as :func:`inverse_mass_of_row`)."""
+    raise NotImplementedError
+
+
+@overload(gram_row, jit_options=KERNEL_OPTIONS, inline="always")
+def _gram_row(kin, g, MG, k, n, A, r, zero):
+    if not on_heap(getattr(kin, "instance_class", None)):
+        def dense(kin, g, MG, k, n, A, r, zero):
+            for r2 in range(k):
+                acc = zero
+                for j in range(n):
+                    acc += g[j] * MG[r2, j]
+                A[r, r2] = acc
+        return dense
+
+    def by_columns(kin, g, MG, k, n, A, r, zero):
+        for r2 in range(k):
+            A[r, r2] = zero
+        for j in range(n):
+            gj = g[j]
+            if gj != 0.0:
+                for r2 in range(k):
+                    A[r, r2] += gj * MG[r2, j]
+    return by_columns
 
 
 @inlined_kernel

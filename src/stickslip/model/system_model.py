@@ -27,15 +27,16 @@ from typing import Any, Callable, Mapping, NamedTuple
 import numpy as np
 
 from ..errors import ModelError
-from ..memory import check_memory, largest_dense_dofs, model_data_bytes
+from ..memory import check_memory, compiled_model_bytes, largest_dense_dofs
 from .bundle import ModelData, pack
 from .friction import FrictionLaw, NoUserLaw
 from .bundle import NORMAL_LAWS
 from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantRigidKinematics, ConstantUnilateralKinematics,
                          allows_rigid, allows_unilateral,
-                         computes_gap, kernel_kinematics, registered_kinematics)
-from .matrices import (DENSE_DOFS, MAX_MASS_CONDITION, check_mass, contact_rows, finite, has_nonzero, is_sparse,
-                       square_matrix)
+                         LARGE_KINEMATICS, computes_gap, fits_stack, kernel_kinematics, large_kinematics,
+                         registered_kinematics)
+from .matrices import (DENSE_DOFS, MAX_MASS_CONDITION, check_mass, contact_rows, dense_array, dense_spec, finite,
+                       has_nonzero, is_sparse, square_matrix)
 from .physics import SPEED_FLOOR
 from .sparse_form import NodeMap, SparseForm, sparse_form
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
@@ -206,7 +207,7 @@ class Contact:
             out["w"] = self.drive
         if self.normal is not None:
             k, c = self.normal.stiffness, self.normal.damping
-            W = np.zeros(n) if self.gap_gradient is None else np.asarray(self.gap_gradient, dtype=float)
+            W = np.zeros(n) if self.gap_gradient is None else dense_array(self.gap_gradient).reshape(-1)
             # closed, the compliant force −k (g0 + W·q) − c W·q̇ is the affine N0 + n·q + n_v·q̇ of the
             # constant kinematics' frame
             # (a rigid contact has k = c = 0: its normal force is a multiplier, not part of the frame)
@@ -515,15 +516,24 @@ class FrictionModel:
         Raises
         ------
         MemoryLimitError
-            When its dense arrays (:func:`~stickslip.memory.model_data_bytes`) do not fit in memory.
+            When its dense arrays and the kernels' work arrays of a model above the stack maxima
+            (:func:`~stickslip.memory.compiled_model_bytes`) do not fit in memory.
         ModelError
-            For a model larger than the kernels take (``MAX_DOFS`` dofs, ``MAX_CONTACTS`` contacts,
-            for kinematics that do not fix their sizes); both say to reduce the model.
+            For a model above ``MAX_DOFS`` dofs or ``MAX_CONTACTS`` contacts whose contact frame is
+            computed from q (only constant frames have a heap flavour,
+            :func:`~stickslip.model.kinematics.large_kinematics`); both say to reduce the model.
+
+        A model of at most ``MAX_DOFS`` dofs and ``MAX_CONTACTS`` contacts (or of a kinematics
+        class that fixes its sizes) gets kernels with stack work arrays; a larger one of constant
+        frames the heap flavour (:mod:`stickslip.model.stack`), its matrices packed dense
+        (n² numbers each, for hundreds to a few thousand dofs).
         """
         self._check_compiled_size()
-        m = pack(self.mass, self.damping, self.stiffness, self.force, self.free,
-                 [contact.spec(self.n) for contact in self.contacts], self.slip_band, self.constant_kinematics)
-        return ModelData(m, kernel_kinematics(self.kinematics, *self._contact_kinds()), self.user_law)
+        m = pack(dense_array(self.mass), dense_array(self.damping), dense_array(self.stiffness), self.force, self.free,
+                 [dense_spec(contact.spec(self.n)) for contact in self.contacts], self.slip_band,
+                 self.constant_kinematics)
+        kin = large_kinematics(kernel_kinematics(self.kinematics, *self._contact_kinds()), self.n, self.n_contacts)
+        return ModelData(m, kin, self.user_law)
 
     @cached_property
     def _sparse_form(self) -> SparseForm:
@@ -542,17 +552,19 @@ class FrictionModel:
 
     def _check_compiled_size(self) -> None:
         n, nc = self.n, self.n_contacts
-        if static_sizes(type(self.kinematics)) is not None or (n <= MAX_DOFS and nc <= MAX_CONTACTS):
+        cls = type(self.kinematics)
+        if fits_stack(cls, n, nc):
             return
         reduce = ("reduce it to its contact dofs and a few modes with `stickslip reduce` (Craig–Bampton), or "
                   "analyse the full model with the sparse tools (complex eigenvalues of steady sliding)")
-        check_memory(model_data_bytes(n, nc), f"the compiled form of model {self.name!r} ({n} dofs, {nc} "
-                     "contacts; dense M⁻¹, M, C, K)",
-                     lambda memory: f"at most {largest_dense_dofs(memory, nc)} dofs fit (and the compiled tools "
-                     f"take at most {MAX_DOFS}); {reduce}")
-        raise ModelError(f"model {self.name!r} has {n} dofs and {nc} contacts; the compiled tools (simulate, "
-                         f"stability, orbits, sweeps, basins) take at most {MAX_DOFS} dofs and {MAX_CONTACTS} "
-                         f"contacts: {reduce}")
+        if cls not in LARGE_KINEMATICS:
+            raise ModelError(f"model {self.name!r} has {n} dofs and {nc} contacts; the compiled tools take at most "
+                             f"{MAX_DOFS} dofs and {MAX_CONTACTS} contacts for a contact frame computed from q "
+                             f"(kinematics {cls.__name__}): state its contacts with constant rows (a model file), "
+                             "or reduce the model")
+        check_memory(compiled_model_bytes(n, nc), f"the compiled form of model {self.name!r} ({n} dofs, {nc} "
+                     "contacts; dense M⁻¹, M, C, K and the kernels' work arrays)",
+                     lambda memory: f"at most {largest_dense_dofs(memory, nc)} dofs fit; {reduce}")
 
     def _contact_kinds(self) -> tuple[bool, bool]:
         """Whether the model has unilateral contacts, and a rigid one (the kernels compile their code
@@ -625,14 +637,19 @@ class FrictionModel:
 
     def natural_frequencies(self) -> np.ndarray:
         """Undamped natural frequencies [Hz] of the free DOFs without friction, ascending
-        (eigenvalues of M⁻¹ K; complex pairs of a non-symmetric K give their modulus)."""
-        if not self.dense:
-            raise ModelError(f"model {self.name!r} has {self.n} dofs, too many for all its natural frequencies; "
-                             "take its lowest modes from its sparse form (scipy.sparse.linalg.eigsh(K, M=M, sigma=0) "
-                             "on model.sparse_form()), or reduce it with `stickslip reduce`")
+        (eigenvalues of M⁻¹ K; complex pairs of a non-symmetric K give their modulus).
+
+        Raises
+        ------
+        MemoryLimitError, ModelError
+            For a sparse model too large for the compiled tools (:attr:`data`): its lowest modes come
+            from its sparse form (``scipy.sparse.linalg.eigsh(K, M=M, sigma=0)``).
+        """
+        if not self.dense:  # as dense as the compiled tools take it, where that fits in memory
+            self._check_compiled_size()
         idx = np.flatnonzero(self.free)
-        M = self.mass[np.ix_(idx, idx)]
-        K = self.stiffness[np.ix_(idx, idx)]
+        M = dense_array(self.mass)[np.ix_(idx, idx)]
+        K = dense_array(self.stiffness)[np.ix_(idx, idx)]
         lam = np.linalg.eigvals(np.linalg.solve(M, K))
         return np.sort(np.sqrt(np.abs(lam)) / (2.0 * np.pi))
 

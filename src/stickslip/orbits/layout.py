@@ -16,6 +16,7 @@ from ..integrate.contacts import STICK_SPEED_TOL
 from ..integrate.initial import refused_rigid_starts, rigid_gaps
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
+from ..model.matrices import dense_array
 from ..stability.equilibrium import steady_sliding
 
 __all__ = ["free_states", "equilibrium_state", "ORBIT_MIN_SIZE", "distance_from_steady_sliding", "is_steady_sliding",
@@ -98,7 +99,7 @@ def rigid_admissible(system, s: np.ndarray, sp: np.ndarray) -> np.ndarray:
     """
     n = system.n
     out = np.array(sp, dtype=float)
-    closed = [np.asarray(system.contacts[c].gap_gradient, dtype=float)
+    closed = [dense_array(system.contacts[c].gap_gradient).reshape(-1)
               for c, g, _, tol in rigid_gaps(system, s) if g[0] <= tol[0]]
     if closed:
         W = np.array(closed)

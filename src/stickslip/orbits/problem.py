@@ -30,6 +30,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._version import __version__
+from ..analysis.modes import sample_flags
 from ..analysis.signal import CLOSE, OPEN
 from ..analysis.signal import open_time as signal_open_time
 from ..analysis.signal import stick_time as signal_stick_time
@@ -163,7 +164,7 @@ def stick_summary(traj, period: float) -> dict:
     tr = traj.transitions
     system = traj.system
     nc = system.n_contacts
-    mode0 = int(traj.mode[0])
+    mode0 = sample_flags(traj.mode[0])
     total, each = signal_stick_time(0.0, period, mode0, tr.time, tr.kind, tr.contact, nc)
     contacts = {name: {"stick_phases": int(np.sum((tr.kind == 1) & (tr.contact == c))),
                        "stick_fraction": float(each[c] / period)}

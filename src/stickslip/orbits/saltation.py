@@ -48,6 +48,7 @@ from ..model.bundle import CST
 from ..model.derivatives import state_jacobian_from_python
 from ..model.friction import static_coefficient
 from ..model.impact import IMPACT_INCONSISTENT, impact, restitution_of
+from ..model.matrices import dense_array
 from .var_kernels import contact_gradients, indicator_gradient
 
 __all__ = ["saltation_matrix", "field", "ContactState", "contact_at", "stick_projection", "breakaway_jump",
@@ -141,7 +142,7 @@ def inverse_mass(system) -> np.ndarray:
     """M⁻¹ (n × n) on the free DOFs, zero rows and columns for the locked ones."""
     free = np.flatnonzero(system.free)
     Minv = np.zeros((system.n, system.n))
-    Minv[np.ix_(free, free)] = np.linalg.inv(system.mass[np.ix_(free, free)])
+    Minv[np.ix_(free, free)] = np.linalg.inv(dense_array(system.mass)[np.ix_(free, free)])
     return Minv
 
 

@@ -23,6 +23,7 @@ from ..errors import OrbitError
 from ..integrate.driver import simulate
 from ..model import physics as P
 from ..model.bundle import CST, contact_state
+from ..analysis.modes import sample_flags
 
 __all__ = ["Section", "resolve_section", "OrbitError", "flow", "vector_field", "section_crossings"]
 
@@ -144,7 +145,7 @@ def _state_rates(system, states: np.ndarray, mode: np.ndarray, index: int, where
         return states[:, index + system.n].copy()
     out = np.full(states.shape[0], np.nan)
     for i in where:
-        out[i] = vector_field(system, states[i], int(mode[i]))[index]
+        out[i] = vector_field(system, states[i], sample_flags(mode[i]))[index]
     return out
 
 

@@ -13,6 +13,7 @@ from ..errors import EquilibriumError
 from ..model.bundle import CST, contact_state
 from ..model.derivatives import state_jacobian_from_python
 from ..model.library.two_plates import plates_parameters
+from ..model.matrices import dense_array
 from ..model.parameters import Parameters, parameter_attrs
 from ..model.physics import MODE_SLIP_EXACT
 from ..model.sparse_form import SparseForm
@@ -210,7 +211,7 @@ def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     k = free.size
     idx = np.concatenate([free, n + free])
     J = J_full[np.ix_(idx, idx)]
-    M = system.mass[np.ix_(free, free)]
+    M = dense_array(system.mass)[np.ix_(free, free)]
     return J, -M @ J[k:, :k], -M @ J[k:, k:]
 
 
@@ -287,7 +288,7 @@ def model_stability(system) -> StabilityResult:
         m = int(np.argmax(np.abs(shapes[j])))
         if shapes[j, m] != 0:
             shapes[j] /= shapes[j, m]
-    M = system.mass[np.ix_(free, free)]
+    M = dense_array(system.mass)[np.ix_(free, free)]
     diagonal = np.count_nonzero(M - np.diag(np.diag(M))) == 0
     return StabilityResult(
         params=plates_parameters(system), model=system.label or system.name,
