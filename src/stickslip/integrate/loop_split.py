@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analysis.modes import contact_index_dtype
 from ..model import physics as P
 from ..model.bundle import H_N, H_NC, H_UNILATERAL, contact_state
 from ..model.compile_ahead import ColdStart, Split, start_apart
@@ -42,9 +43,9 @@ def _loop_calls(md) -> dict:
     cst = contact_state(md.m)
     start, step, slips, scratch, stats = L.loop_arrays(np.zeros(ns), nc)
     y, F, N = step.y, scratch.F, scratch.N
-    modes = np.zeros(1, dtype=R.mode_dtype(nc, bool(md.m[H_UNILATERAL])))
+    modes = R.mode_array(1, nc, bool(md.m[H_UNILATERAL]))
     samples = Samples(np.zeros(1), np.zeros((1, ns)), modes, np.zeros((1, 2 * nc)))
-    log = transition_log(1, ns)
+    log = transition_log(1, ns, contact_index_dtype(nc))
     i, f = np.int64(0), 0.0
     return {E.try_stick: (y, cst, i, md, f, F, N),
             E.release_most_overloaded: (y, cst, md, F, N),
@@ -52,7 +53,7 @@ def _loop_calls(md) -> dict:
             P.band_direction: (y, cst, i, md, f),
             E.initial_modes: (y, cst, md, f, f, F, N),
             R._slip_velocities: (samples.states, md, i),
-            R._normal_forces: (samples.states, samples.modes, md, i),
+            R._normal_forces: (samples.states, np.zeros((1, nc), np.int8), md, i),
             T.settle: (y, cst, md, scratch, f, log, i, stats),
             T.break_away: (y, cst, i, md, scratch, f, log, i, stats),
             P.slip_velocity_and_rate: (y, y, i, md),

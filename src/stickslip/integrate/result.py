@@ -120,39 +120,20 @@ def _sample_normal_forces(states, mode, md, nc):
     """Normal force of every contact (k, nc) at each sample [N], a unilateral contact's in its
     sampled state (0 while open: bit nc + c of ``mode``; a closed rigid contact's multiplier with
     the sampled stick set, bit c)."""
-    if mode.ndim == 1:
-        return _normal_forces(states, mode, md, nc)
     codes = np.where(flag_bits(mode, nc, nc), physics.MODE_OPEN,
                      np.where(flag_bits(mode, 0, nc), physics.MODE_STICK, physics.MODE_SLIP))
-    return _normal_forces_of_codes(states, codes.astype(np.int8), md, nc)
+    return _normal_forces(states, codes.astype(np.int8), md, nc)
 
 
 @njit(cache=True)
-def _normal_forces_of_codes(states, codes, md, nc):
-    """:func:`_sample_normal_forces` from each contact's mode code (k, nc) (a model of many flags)."""
+def _normal_forces(states, codes, md, nc):
+    """:func:`_sample_normal_forces` from each contact's mode code (k, nc) int8 (``physics.MODE_*``)."""
     k = states.shape[0]
     out = np.empty((k, nc))
     cst = np.zeros(CST * nc)
     for i in range(k):
         for c in range(nc):
             cst[CST * c] = codes[i, c]
-            cst[CST * c + 1] = 1.0
-        for c in range(nc):
-            out[i, c] = physics.normal_force_of(states[i], cst, c, md)
-    return out
-
-
-@njit(cache=True)
-def _normal_forces(states, mode, md, nc):
-    """:func:`_sample_normal_forces` from the flags of one integer per sample."""
-    k = states.shape[0]
-    out = np.empty((k, nc))
-    cst = np.zeros(CST * nc)
-    for i in range(k):
-        for c in range(nc):
-            flags = np.int64(mode[i])
-            cst[CST * c] = physics.MODE_OPEN if (flags >> (nc + c)) & 1 else \
-                physics.MODE_STICK if (flags >> c) & 1 else physics.MODE_SLIP
             cst[CST * c + 1] = 1.0
         for c in range(nc):
             out[i, c] = physics.normal_force_of(states[i], cst, c, md)
