@@ -34,8 +34,8 @@ Every function that runs a model takes it as one argument, ``model``: a ``Fricti
 library name or model file path, or the plates' ``Parameters`` (the plates in a variant:
 ``two_plates(params, "rotation")``).
 
-The simulation core is imported at once; stability, sweeps and orbit tools are imported on
-first use (PEP 562), so ``import stickslip`` stays fast.
+Every public name is imported on first use (PEP 562): ``import stickslip`` loads neither numpy
+nor numba, so that the command line's ``--version`` and ``--help`` answer at once.
 """
 
 import importlib
@@ -48,6 +48,11 @@ _startup.hold()
 
 #: Public names imported on first access, by the module that defines them.
 _LAZY = {
+    **dict.fromkeys(["OUTCOMES", "Classification", "classify", "find_peaks", "intensity"], ".analysis"),
+    **dict.fromkeys(["simulate"], ".integrate.driver"),
+    **dict.fromkeys(["Trajectory", "load_trajectory"], ".integrate.result"),
+    **dict.fromkeys(["Parameters"], ".model.parameters"),
+    **dict.fromkeys(["DOF_NAMES", "MODELS", "STATE_NAMES"], ".model.variants"),
     **dict.fromkeys(["FrictionModel", "Contact", "FrictionLaw", "ModelError", "load_model", "two_plates"], ".model"),
     **dict.fromkeys(["basin_stability", "BasinResult"], ".basins"),
     **dict.fromkeys(["attractor", "simulate_until_settled", "Attractor", "SettledRun", "run_summary"], ".attractors"),
@@ -80,12 +85,7 @@ class _Package(types.ModuleType):
 sys.modules[__name__].__class__ = _Package  # before the imports below, which import stickslip.stability
 
 from ._version import __version__  # noqa: E402
-from .analysis import OUTCOMES, Classification, classify, find_peaks, intensity  # noqa: E402
 from .errors import FileFormatError, ParameterError, SimulationError, StickSlipError, VariantError  # noqa: E402
-from .integrate.driver import simulate  # noqa: E402
-from .integrate.result import Trajectory, load_trajectory  # noqa: E402
-from .model.parameters import Parameters  # noqa: E402
-from .model.variants import DOF_NAMES, MODELS, STATE_NAMES  # noqa: E402
 from .results import Plottable  # noqa: E402
 
 

@@ -19,6 +19,7 @@ import typer
 from typer.testing import CliRunner
 
 from stickslip.cli import app
+from stickslip.cli._lazy import import_all
 
 runner = CliRunner()
 
@@ -37,7 +38,8 @@ def one_error_line(res, code=2, prefix="error:") -> str:
 
 
 def commands(typer_app=app, path=()):
-    """(command path, callback) of every command."""
+    """(command path, callback) of every command (each command's module imported: they register when asked for)."""
+    import_all()
     for info in typer_app.registered_commands:
         yield [*path, info.name or info.callback.__name__.replace("_", "-")], info.callback
     for group in typer_app.registered_groups:

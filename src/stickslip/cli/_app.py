@@ -25,7 +25,6 @@ import warnings
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
 import rich
 import typer
 from rich.console import Console
@@ -38,14 +37,8 @@ from .._version import __version__
 from ..errors import StickSlipError
 from ..files import lock, refuse_output
 from ..inputs import read_regular_file
-from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
-from ..model.library import load_model, plates_variant, two_plates
-from ..model.library.two_plates import is_plates
-from ..model.numba_patches import end_run
-from ..model.parameters import Parameters
-from ..parallel import compile_processes
-from ._compiling import compile_notice
 from ._kept import forget_outputs, on_disk, on_interrupt
+from ._lazy import LazyCommands
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -101,6 +94,7 @@ def resumable_holds(what: str) -> Callable[[Path], str]:
     written: the finished ``what``, or part of it with the journal that keeps the rest."""
     def holds(path: Path) -> str:
         import h5py  # the attributes alone, without opening the dataset (h5py is already loaded by then)
+        import numpy as np
 
         with h5py.File(path, "r") as fh:
             complete = int(np.ravel(fh.attrs.get("complete", 1))[0])  # netCDF attributes are arrays
@@ -129,7 +123,9 @@ def _end_interrupted() -> None:
     process could crash at exit) and could deliver a Ctrl-C that a finaliser had swallowed
     (:mod:`stickslip._startup` delivers it again a moment later) a second time, ending the process
     by the signal after its one line."""
-    end_run()
+    patches = sys.modules.get("stickslip.model.numba_patches")  # loaded with numba, if the command got that far
+    if patches is not None:
+        patches.end_run()
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
@@ -171,8 +167,9 @@ def _escape_help(command) -> None:
         _escape_help(sub)
 
 
-class _Application(TyperGroup):
-    """The ``stickslip`` group: the one place where errors become a line and an exit code."""
+class _Application(LazyCommands, TyperGroup):
+    """The ``stickslip`` group: the one place where errors become a line and an exit code. Its
+    commands are imported when asked for (:class:`._lazy.LazyCommands`)."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -205,6 +202,8 @@ class _Application(TyperGroup):
         sys.exit(code)
 
     def invoke(self, ctx):
+        from ..integrate.interrupt import forget_ctrl_c, on_ctrl_c
+
         forget_ctrl_c()
         try:
             _check_environment()
@@ -268,12 +267,16 @@ def _compile_notice():
     rich's global console, the console of the studies' progress bars, so that rich shows both
     together instead of letting them overwrite each other; it is transient and leaves nothing in
     the output."""
+    from ._compiling import compile_notice
+
     terminal = getattr(sys.stderr, "isatty", lambda: False)()
     return compile_notice(note_line if terminal else None, rich.get_console() if terminal else None)
 
 
 def _check_environment() -> None:
     """Refuse an environment the kernels cannot run in; say what :mod:`stickslip._startup` changed."""
+    from ..parallel import compile_processes
+
     if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
         raise CLIError(f"NUMBA_DISABLE_JIT={os.environ['NUMBA_DISABLE_JIT']}: stickslip's kernels must be compiled "
                        "(interpreted, a run would take hours and some kernels cannot run at all); unset "
@@ -291,6 +294,7 @@ app = _Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+_Application.build = staticmethod(lambda: typer.main.get_command(app))
 
 
 # ----------------------------------------------------------------------------- option parsing
@@ -348,6 +352,8 @@ def _config_table(config) -> dict:
 def config_values(config) -> dict:
     """``{name: value}`` of the parameters a --config TOML file sets (validated; names it does
     not set are left out)."""
+    from ..model.parameters import Parameters
+
     data = _config_table(config)
     table = data.get("parameters", data)
     if not isinstance(table, dict):
@@ -387,6 +393,10 @@ def build_system(model: str, config, assignments, *, base=None, swept: dict | No
         For an unknown model or parameter, a plates option given for another model, or two
         options that set the same parameter.
     """
+    from ..model.library import load_model, plates_variant, two_plates
+    from ..model.library.two_plates import is_plates
+    from ..model.parameters import Parameters
+
     variant = plates_variant(model)
     if base is not None:  # a continued run: its own model (the caller checked that ``model`` names it)
         system = base
