@@ -26,13 +26,14 @@ from ..model.parameters import Parameters
 from ..model.system_model import FrictionModel
 from . import branch_store as store
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, Point, Problem, correct_onto_bound,
-                        numeric_parameter, point_at, problem_of, step_from)
+                        monodromy_method, numeric_parameter, point_at, problem_of, step_from)
 from .models import ModelResult, plates_parameters, resolve, with_parameter
 from .problem import unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
-from .special_points import (FLIGHT_VANISHING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
-                             detect_after_renewal, distance_from_equilibrium, flight_vanishing, is_orbit)
+from .special_points import (FLIGHT_VANISHING_STOP, IMPACT_GRAZING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint,
+                             detect_after_point, detect_after_renewal, distance_from_equilibrium, flight_vanishing,
+                             impact_grazing, is_orbit)
 from .start import Start, start_orbit
 
 __all__ = ["Branch", "continue_orbit", "load_branch"]
@@ -63,8 +64,8 @@ class Branch(ModelResult, store.NetCDFResult):
     states : ndarray (n, 2n)
         States on the Poincaré section (the model's ``state_names``).
     multipliers : ndarray (n, 2 n_free) complex
-        Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus
-        (NaN at points without a finite-difference Jacobian, see ``jacobian_every``).
+        Floquet multipliers (eigenvalues of the monodromy, ``options["monodromy"]``), by decreasing
+        modulus (NaN at points without a Jacobian of their own, see ``jacobian_every``).
     stable : ndarray (n,) bool
         Every non-trivial multiplier inside the unit circle.
     n_unstable : ndarray (n,) int
@@ -87,8 +88,8 @@ class Branch(ModelResult, store.NetCDFResult):
     stop_reason : str
         Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``,
         ``steady sliding at <param> = <value>`` where the corrector converged onto the equilibrium
-        (that point is not in the branch), ``flight vanishing (grazing of a rigid contact)``
-        with a ``grazing`` point after the last, ...).
+        (that point is not in the branch), ``flight vanishing (grazing of a rigid contact)`` or
+        ``impact grazing (...)`` with a ``grazing`` point after the last, ...).
     system : FrictionModel
         The model at the start (the continuation parameter at its start value); ``params`` and
         ``model``: the plates' Parameters and variant, or None and the model's name.
@@ -228,6 +229,7 @@ def continue_orbit(
     amplitude: bool = True,
     min_stick_fraction: float = MIN_STICK_FRACTION,
     jacobian_every: int = 1,
+    monodromy: str = "auto",
     callback=None,
     out=None,
     resume: bool = True,
@@ -278,9 +280,15 @@ def continue_orbit(
     min_stick_fraction : float
         Stop where the stick time per period falls below this fraction of the period [-].
     jacobian_every : int
-        Recompute the finite-difference Jacobian at every ``jacobian_every``-th point only (in
-        between the corrector's Broyden update gives the tangent; those points have NaN
-        multipliers and ``n_unstable`` −1).
+        Recompute the Jacobian at every ``jacobian_every``-th point only (in between the
+        corrector's Broyden update gives the tangent; those points have NaN multipliers and
+        ``n_unstable`` −1).
+    monodromy : {"auto", "saltation", "finite-difference"}
+        How each point's monodromy (the multipliers, and the state columns of the Jacobian) is
+        computed: the variational equations with saltation matrices (central differences at a
+        point where they cannot follow the run's events), or central differences of the flow map.
+        ``auto``: saltation where the model has a rigid contact (an impact that grazes makes the
+        differences meaningless, :func:`.arclength.monodromy_method`), else differences.
     callback : callable, optional
         ``callback(i, value, period, stable)`` after each accepted point (once journaled).
     out : path, optional
@@ -316,8 +324,11 @@ def continue_orbit(
     numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
                     bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
                     tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
-                    min_stick_fraction=min_stick_fraction, jacobian_every=int(jacobian_every))
-    settings = store.branch_settings(system, param, start, section, rtol, atol, numerics)
+                    min_stick_fraction=min_stick_fraction, jacobian_every=int(jacobian_every),
+                    monodromy=monodromy_method(system, monodromy))
+    # branches by differences keep the digest they had before the choice existed (their journals resume)
+    recorded = {k: v for k, v in numerics.items() if k != "monodromy" or v != "finite-difference"}
+    settings = store.branch_settings(system, param, start, section, rtol, atol, recorded)
     digest = store.digest_of(settings)
     journal, finished = _open_output(out, system, digest, settings, resume, on_resume)
     if finished is not None:  # nothing left to compute
@@ -385,7 +396,7 @@ class _Continuation:
                 journal.append({"start": store.start_record(begin)})
         else:
             begin = Start(**store.start_fields(start_rec))
-        problem = problem_of(begin, param, numerics["fd_step"], numerics["param_scale"])
+        problem = problem_of(begin, param, numerics["fd_step"], numerics["param_scale"], numerics["monodromy"])
         lam0 = numeric_parameter(begin.system, param)
         if not is_orbit(problem, begin.state, lam0, begin.stick_phases):
             if journal is not None:
@@ -494,12 +505,14 @@ class _Continuation:
                                                                                 "max_step", "max_points")},
                        slip_band=problem.shooting.system.slip_band, param_scale=problem.p_scale,
                        period_scale=problem.T_scale, bounds=numerics["bounds"], direction=numerics["direction"],
-                       jacobian_every=numerics["jacobian_every"])
+                       jacobian_every=numerics["jacobian_every"], monodromy=numerics["monodromy"])
         if walk.stop == "min_step" and self.problem.shooting.system.rigid:
-            grazing = flight_vanishing(self.problem, walk.points)
-            if grazing is not None:
-                walk.special.append(grazing)
-                walk.stop = FLIGHT_VANISHING_STOP
+            for ends, reason in ((flight_vanishing, FLIGHT_VANISHING_STOP), (impact_grazing, IMPACT_GRAZING_STOP)):
+                grazing = ends(self.problem, walk.points)
+                if grazing is not None:
+                    walk.special.append(grazing)
+                    walk.stop = reason
+                    break
         stop_reason = walk.stop or "max_points"
         if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
             journal.append({"end": stop_reason})

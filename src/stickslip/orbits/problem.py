@@ -317,25 +317,36 @@ class ShootingProblem:
         return central_differences(lambda s: self.flow(s, T, system)[0], s0, self.free, self.fd_step * self.sigma,
                                    cols)
 
-    def monodromy(self, s0: np.ndarray, T: float, method: str = "saltation"):
-        """∂Φ(s0, T)/∂s0 on the free states (2 n_free × 2 n_free) and the jumps applied
-        (``saltation``: :func:`.linear_flow.flow_jacobian`, which raises where it cannot follow the
-        event sequence; ``finite-difference``: :meth:`fd_monodromy`, no jumps)."""
+    def monodromy(self, s0: np.ndarray, T: float, method: str = "saltation", system: FrictionModel | None = None):
+        """∂Φ(s0, T)/∂s0 on the free states (2 n_free × 2 n_free) of ``system`` (default: the
+        problem's) and the jumps applied (``saltation``: :func:`.linear_flow.flow_jacobian`, which
+        raises where it cannot follow the event sequence; ``finite-difference``: :meth:`fd_monodromy`,
+        no jumps)."""
         if method == "saltation":
-            fj = _lin.flow_jacobian(self.system, s0, T, scale=self.sigma, rtol=self.rtol, atol=self.atol)
+            self.counter["simulations"] += 1
+            fj = _lin.flow_jacobian(self.system if system is None else system, s0, T, scale=self.sigma,
+                                    rtol=self.rtol, atol=self.atol)
             return fj.matrix[np.ix_(self.free, self.free)], fj.events
-        return self.fd_monodromy(s0, T), ()
+        return self.fd_monodromy(s0, T, system=system), ()
 
-    def newton_columns(self, s0: np.ndarray, T: float, method: str) -> np.ndarray:
-        """∂Φ(s0, T)/∂s0 on the free rows and the unknown columns by ``method``; ``saltation``
-        falls back to differences where the variational re-integration fails (e.g. an iterate
-        whose event sequence differs from the integrator's)."""
+    def monodromy_columns(self, s0: np.ndarray, T: float, method: str, cols=None,
+                          system: FrictionModel | None = None) -> np.ndarray:
+        """∂Φ(s0, T)/∂s0 on the free rows and the columns ``cols`` (positions in :attr:`free`;
+        default all) by ``method``; ``saltation`` falls back to differences where the variational
+        re-integration fails (e.g. an iterate whose event sequence differs from the integrator's,
+        an impact that ends in stick)."""
         if method == "saltation":
             try:
-                return self.monodromy(s0, T, method)[0][:, self.unknown]
+                M = self.monodromy(s0, T, method, system)[0]
+                return M if cols is None else M[:, cols]
             except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError):
                 pass
-        return self.fd_monodromy(s0, T, self.unknown)
+        return self.fd_monodromy(s0, T, cols, system)
+
+    def newton_columns(self, s0: np.ndarray, T: float, method: str) -> np.ndarray:
+        """∂Φ(s0, T)/∂s0 on the free rows and the unknown columns by ``method``
+        (:meth:`monodromy_columns`)."""
+        return self.monodromy_columns(s0, T, method, self.unknown)
 
     def jacobian(self, columns: np.ndarray, end: np.ndarray, system: FrictionModel | None = None,
                  T_scale: float = 1.0) -> np.ndarray:
