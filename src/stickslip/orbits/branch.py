@@ -28,7 +28,7 @@ from . import branch_store as store
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, Point, Problem, correct_onto_bound,
                         monodromy_method, numeric_parameter, point_at, problem_of, step_from)
 from .models import ModelResult, plates_parameters, resolve, with_parameter
-from .problem import unstable_count
+from .problem import floquet_verdict, unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
 from .special_points import (FLIGHT_VANISHING_STOP, IMPACT_GRAZING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint,
@@ -67,7 +67,9 @@ class Branch(ModelResult, store.NetCDFResult):
         Floquet multipliers (eigenvalues of the monodromy, ``options["monodromy"]``), by decreasing
         modulus (NaN at points without a Jacobian of their own, see ``jacobian_every``).
     stable : ndarray (n,) bool
-        Every non-trivial multiplier inside the unit circle.
+        Every non-trivial multiplier inside the unit circle (by more than the multipliers' own
+        error, :func:`~stickslip.orbits.problem.floquet_verdict`: :attr:`verdicts` tells a
+        marginal orbit, on the circle within it, from an unstable one).
     n_unstable : ndarray (n,) int
         Non-trivial multipliers outside the unit circle (−1 where not computed, ``jacobian_every``).
     stick_phases : ndarray (n,) int
@@ -134,6 +136,12 @@ class Branch(ModelResult, store.NetCDFResult):
 
     def __len__(self) -> int:
         return int(self.values.size)
+
+    @property
+    def verdicts(self) -> list:
+        """Floquet verdict of each orbit: ``stable``, ``marginal``, ``unstable`` or ``unknown``
+        (no multipliers, ``jacobian_every``) (:func:`~stickslip.orbits.problem.floquet_verdict`)."""
+        return [floquet_verdict(m) for m in self.multipliers]
 
     def folds(self) -> list:
         """The special points of kind ``fold``."""
@@ -495,7 +503,7 @@ class _Continuation:
         _journal_point(self.journal, walk, problem, found, walk.elapsed, self.t_start)
         if self.callback is not None and not quiet:
             _s, T_new, lam_cb = problem.unpack(new.v)
-            self.callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
+            self.callback(len(walk.points) - 1, lam_cb, T_new, floquet_verdict(new.multipliers) == "stable")
 
     def finish(self, rtol: float, atol: float, digest: str, out) -> Branch:
         """The :class:`Branch` of the finished walk (a grazing point where a rigid contact's flight
@@ -625,7 +633,8 @@ def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: s
     if resumed is not None:
         timings["points_resumed"] = resumed
     return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
-                  stable=n_unst == 0, n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
+                  stable=np.array([floquet_verdict(p.multipliers) == "stable" for p in points], dtype=bool),
+                  n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
                   stick_time=np.array([p.stick_time for p in points]),
                   amplitude=np.array(walk.amplitudes, dtype=float), arclength=np.array(walk.arclength),
                   residuals=np.array([p.residual for p in points]),

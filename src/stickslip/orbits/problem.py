@@ -38,13 +38,14 @@ from ..errors import OrbitError, SimulationError
 from ..model.bundle import CST
 from ..model.physics import MODE_STICK, gap
 from ..model.system_model import FrictionModel
+from ..stability.verdict import MARGINAL_RTOL
 from . import linear_flow as _lin
 from .layout import free_states, resting_contacts, rigid_admissible, stick_projected
 from .models import ModelResult, model_attrs
 from .section import Section, flow, vector_field
 
 __all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
-           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time", "stick_summary",
+           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "floquet_verdict", "multiplier_tolerance", "stick_count", "stick_time", "stick_summary",
            "open_count", "open_time",
            "check_method", "check_section", "METHODS", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
 
@@ -139,9 +140,39 @@ def nontrivial(multipliers: np.ndarray) -> np.ndarray:
     return np.delete(np.asarray(multipliers), k)
 
 
+def multiplier_tolerance(multipliers: np.ndarray) -> float:
+    """Distance from the unit circle within which a multiplier counts as on it [-].
+
+    The trivial multiplier is exactly 1 for the exact monodromy, so its distance from 1 measures
+    the error of the computed one (≈ 1e-8 for saltation, 1e-5 for differences, docs/orbits.md); a
+    round-off floor :data:`~stickslip.stability.verdict.MARGINAL_RTOL` × max(1, max |μ|) is kept
+    below it, as for the eigenvalues of steady sliding.
+    """
+    mu = np.asarray(multipliers)
+    trivial = float(np.min(np.abs(mu - 1.0)))
+    return max(trivial, MARGINAL_RTOL * max(1.0, float(np.max(np.abs(mu)))))
+
+
+def floquet_verdict(multipliers: np.ndarray) -> str:
+    """``stable`` (every non-trivial |μ| < 1 − tolerance), ``unstable`` (some > 1 + tolerance) or
+    ``marginal`` (the largest on the unit circle within :func:`multiplier_tolerance`: a neutral
+    cycle, e.g. of a conservative motion, which the linearisation leaves undecided); ``unknown``
+    where the multipliers are not computed (NaN)."""
+    mu = np.asarray(multipliers)
+    if mu.size == 0 or not np.all(np.isfinite(mu)):
+        return "unknown"
+    others = np.abs(nontrivial(mu))
+    if others.size == 0:
+        return "stable"
+    tol = multiplier_tolerance(mu)
+    if others.max() > 1.0 + tol:
+        return "unstable"
+    return "stable" if others.max() < 1.0 - tol else "marginal"
+
+
 def unstable_count(multipliers: np.ndarray) -> int:
-    """Number of non-trivial multipliers outside the unit circle."""
-    return int(np.sum(np.abs(nontrivial(multipliers)) > 1.0))
+    """Number of non-trivial multipliers outside the unit circle (by more than :func:`multiplier_tolerance`)."""
+    return int(np.sum(np.abs(nontrivial(multipliers)) > 1.0 + multiplier_tolerance(multipliers)))
 
 
 def stick_count(transitions) -> int:
@@ -440,9 +471,15 @@ class Multipliers:
         return nontrivial(self.multipliers)
 
     @property
+    def verdict(self) -> str:
+        """``stable``, ``marginal`` or ``unstable`` (:func:`floquet_verdict`)."""
+        return floquet_verdict(self.multipliers)
+
+    @property
     def stable(self) -> bool:
-        """True if every non-trivial multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.nontrivial_multipliers) < 1.0))
+        """True if every non-trivial multiplier lies inside the unit circle (by more than
+        :func:`multiplier_tolerance`: a neutral cycle is marginal, not stable)."""
+        return self.verdict == "stable"
 
 
 def multiplier_variables(multipliers: np.ndarray, dims) -> dict:
