@@ -22,6 +22,8 @@ from scipy.integrate import solve_ivp
 import stickslip
 from stickslip.orbits.continuation import continue_orbit, start_run
 
+from .flow_differences import flow_map_differences
+
 BELT_STOP = Path(__file__).with_name("belt_stop.toml")
 
 
@@ -41,19 +43,6 @@ def free_cycle_maximum() -> float:
     turning.terminal, turning.direction = True, -1
     sol = solve_ivp(rhs, (0.0, 10.0), [0.85, 1.5], method="DOP853", rtol=1e-13, atol=1e-14, events=turning)
     return float(sol.y_events[0][0][0])
-
-
-def flow_map_differences(model, s0, T, h=1e-5):
-    """∂Φ(s0, T)/∂s0 by central differences of plain simulations (rtol 1e-12)."""
-    n2 = s0.size
-    D = np.empty((n2, n2))
-    for j in range(n2):
-        step = np.zeros(n2)
-        step[j] = h
-        ends = [stickslip.simulate(model, T, ic=s0 + sign * step, rtol=1e-12, atol=1e-14, sample_rate=1.0 / T)
-                .final_state for sign in (1.0, -1.0)]
-        D[:, j] = (ends[0] - ends[1]) / (2.0 * h)
-    return D
 
 
 @pytest.fixture(scope="module")
@@ -87,6 +76,6 @@ def test_the_grazing_is_located_where_the_free_cycle_touches_the_stop(branch):
 @pytest.mark.parametrize("i", [0, 2, 4])
 def test_multipliers_equal_differences_of_the_flow_map(model, branch, i):
     system = model.replace(clearance=float(branch.values[i]))
-    D = flow_map_differences(system, branch.states[i], float(branch.periods[i]))
+    D = flow_map_differences(system, branch.states[i], float(branch.periods[i]), [0, 1], h=1e-5)
     fd = np.sort_complex(np.linalg.eigvals(D))
     np.testing.assert_allclose(np.sort_complex(branch.multipliers[i]), fd, rtol=0, atol=1e-6)

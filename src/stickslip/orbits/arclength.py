@@ -29,12 +29,13 @@ import numpy as np
 from ..errors import ContinuationError, OrbitError, SteadySlidingError
 from ..integrate.result import find_impacts
 from ..model.system_model import FrictionModel
+from .layout import independent_states
 from .models import parameter_value, with_parameter
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, check_method, open_count, open_time,
                       sorted_eigenvalues, stick_count, stick_time)
 
 __all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR",
-           "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND"]
+           "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND", "GRAZING_LANDING_RTOL", "monodromy_method"]
 
 #: Corrector iterations before a step counts as failed (then halved). Broyden from the previous
 #: point's Jacobian reduces the residual ~5× per iteration (measured on Model 1, N = 50 N: the
@@ -45,6 +46,15 @@ MAX_CORRECTOR = 8
 #: Smallest cosine between consecutive tangents accepted: a larger turn means the step jumped
 #: over a sharp feature (or onto another branch); the step is halved instead.
 MIN_TANGENT_COS = 0.9
+
+#: An impact landing slower than this fraction of the largest velocity scale σ grazes: the
+#: saltation matrix divides the variations' crossing by the landing speed, so the 1e-10 accuracy of
+#: the variational integration and the 1e-6 match of its events are amplified by σ / v_i, and the
+#: multipliers of such a point are left unknown (NaN: no special point is classified on them, and
+#: no stability is claimed). Measured on the rigid slider towards its grazing: the exact monodromy
+#: has rank 1 (multipliers {1, 0, 0, 0}); saltation gives that to 1e-6 down to v_i = 1.2e-6 σ and a
+#: multiplier 57 at 6e-7 σ; central differences straddle the grazing well before.
+GRAZING_LANDING_RTOL = 1e-5
 
 #: Steps of a flow map allowed per simulated second: a period of Model 1 takes ~1e3 steps at
 #: rtol 1e-10; a stalled integration (approach to stick, docs/orbits.md) fails fast instead of
@@ -115,6 +125,7 @@ def problem_of(start, param: str, fd_step: float, param_scale: float | None,
         scale = 1.0  # λ0 = 0: work in the parameter's own unit
     o = start.options
     shooting = ShootingProblem.build(start.system, sigma=start.scale, section=start.section, rtol=o["rtol"],
+                                     constraint=independent_states(start.system, start.state)[1],
                                      atol=o["atol"], fd_step=fd_step, max_steps_per_second=MAX_STEPS_PER_SECOND)
     return Problem(shooting=shooting, param=param, T_scale=float(start.period), p_scale=scale, monodromy=monodromy)
 
@@ -223,7 +234,13 @@ class Point:
 
     @property
     def fresh(self) -> bool:
-        """True if J is a finite-difference Jacobian at this point (multipliers known)."""
+        """True if J is a Jacobian of this point's own (its monodromy M computed), not Broyden's update."""
+        return bool(np.all(np.isfinite(self.M)))
+
+    @property
+    def has_multipliers(self) -> bool:
+        """True if the point's multipliers are known: a fresh point whose impacts do not graze
+        (:data:`GRAZING_LANDING_RTOL`)."""
         return bool(np.all(np.isfinite(self.multipliers)))
 
 
@@ -243,11 +260,25 @@ def phases(problem: Problem, v: np.ndarray, tr) -> dict:
 
 
 def _make_point(problem: Problem, v, R, end, tr, iterations, previous_tangent, direction) -> Point:
-    """The point at ``v`` with its finite-difference Jacobian, tangent and multipliers."""
+    """The point at ``v`` with its Jacobian, tangent and multipliers (NaN where an impact grazes,
+    :func:`grazes`)."""
     J, M = _jacobian(problem, v, end)
-    return Point(v=v, J=J, M=M, tangent=_tangent(J, previous_tangent, direction),
-                  multipliers=sorted_eigenvalues(M), residual=float(np.max(np.abs(R))), iterations=iterations,
-                  **phases(problem, v, tr))
+    found = phases(problem, v, tr)
+    multipliers = np.full(M.shape[0], np.nan + 0j) if grazes(problem, found.get("impact_speed")) \
+        else sorted_eigenvalues(M)
+    return Point(v=v, J=J, M=M, tangent=_tangent(J, previous_tangent, direction), multipliers=multipliers,
+                 residual=float(np.max(np.abs(R))), iterations=iterations, **found)
+
+
+def grazes(problem: Problem, impact_speed: float | None) -> bool:
+    """Whether an orbit's slowest impact lands so slowly (``impact_speed`` [m/s], None: no impact)
+    that its monodromy does not resolve the multipliers (:data:`GRAZING_LANDING_RTOL` of the
+    largest velocity scale σ)."""
+    if impact_speed is None:
+        return False
+    sp = problem.shooting
+    velocities = sp.sigma[sp.free >= sp.system.n]
+    return impact_speed < GRAZING_LANDING_RTOL * float(np.max(velocities))
 
 
 def point_at(problem: Problem, v: np.ndarray, iterations: int, previous_tangent=None, direction: float = 1.0) -> Point:

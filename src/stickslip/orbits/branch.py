@@ -31,7 +31,8 @@ from .models import ModelResult, plates_parameters, resolve, with_parameter
 from .problem import floquet_verdict, unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
-from .special_points import (FLIGHT_VANISHING_STOP, IMPACT_GRAZING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint,
+from .special_points import (FLIGHT_VANISHING_STOP, IMPACT_GRAZING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS,
+                             VANISH_FIT_POINTS, SpecialPoint,
                              detect_after_point, detect_after_renewal, distance_from_equilibrium, flight_vanishing,
                              impact_grazing, is_orbit)
 from .start import Start, start_orbit
@@ -65,13 +66,14 @@ class Branch(ModelResult, store.NetCDFResult):
         States on the Poincaré section (the model's ``state_names``).
     multipliers : ndarray (n, 2 n_free) complex
         Floquet multipliers (eigenvalues of the monodromy, ``options["monodromy"]``), by decreasing
-        modulus (NaN at points without a Jacobian of their own, see ``jacobian_every``).
+        modulus (NaN at points without a Jacobian of their own, see ``jacobian_every``, and where an
+        impact lands too slowly for them to be resolved, :data:`.arclength.GRAZING_LANDING_RTOL`).
     stable : ndarray (n,) bool
         Every non-trivial multiplier inside the unit circle (by more than the multipliers' own
         error, :func:`~stickslip.orbits.problem.floquet_verdict`: :attr:`verdicts` tells a
         marginal orbit, on the circle within it, from an unstable one).
     n_unstable : ndarray (n,) int
-        Non-trivial multipliers outside the unit circle (−1 where not computed, ``jacobian_every``).
+        Non-trivial multipliers outside the unit circle (−1 where they are not known).
     stick_phases : ndarray (n,) int
         Slip → stick transitions per period (0: pure slip).
     stick_time : ndarray (n,)
@@ -514,7 +516,9 @@ class _Continuation:
                        slip_band=problem.shooting.system.slip_band, param_scale=problem.p_scale,
                        period_scale=problem.T_scale, bounds=numerics["bounds"], direction=numerics["direction"],
                        jacobian_every=numerics["jacobian_every"], monodromy=numerics["monodromy"])
-        if walk.stop == "min_step" and self.problem.shooting.system.rigid:
+        if walk.stop == "min_step" and self.problem.shooting.system.rigid and _flight_vanished(walk):
+            walk.stop = FLIGHT_VANISHING_STOP
+        elif walk.stop == "min_step" and self.problem.shooting.system.rigid:
             for ends, reason in ((flight_vanishing, FLIGHT_VANISHING_STOP), (impact_grazing, IMPACT_GRAZING_STOP)):
                 grazing = ends(self.problem, walk.points)
                 if grazing is not None:
@@ -531,6 +535,17 @@ class _Continuation:
             store.write_dataset(branch.to_xarray(), out)
             journal.remove()
         return branch
+
+
+def _flight_vanished(walk: "_Walk") -> bool:
+    """Whether the walk ends just past a located grazing where the flight phases ended (→ 0; within
+    its last :data:`.special_points.VANISH_FIT_POINTS` points, none of which flies): a rigid
+    contact's flight vanished there, and with it a section that lies in the flight."""
+    last = walk.special[-1] if walk.special else None
+    if last is None or last.kind != "grazing" or last.after != 0 or not last.located:
+        return False
+    after = walk.points[last.index + 1:]
+    return len(after) <= VANISH_FIT_POINTS and all(p.open_phases == 0 for p in after)
 
 
 def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on) -> None:
@@ -626,7 +641,7 @@ def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: s
     periods = np.array([u[1] for u in unpacked])
     values = np.array([u[2] for u in unpacked])
     mult = np.array([p.multipliers for p in points])
-    n_unst = np.array([unstable_count(p.multipliers) if p.fresh else -1 for p in points])
+    n_unst = np.array([unstable_count(p.multipliers) if p.has_multipliers else -1 for p in points])
     timings = {"total_s": total_s, "points": len(points), "simulations": problem.counter["simulations"]}
     opened = {} if points[0].open_phases is None else {
         "open_phases": np.array([p.open_phases for p in points]), "open_time": np.array([p.open_time for p in points])}

@@ -298,6 +298,8 @@ def _locate(problem: Problem, left: Point, right: Point, kind: str, h: float, to
             break
         evaluations += 1
         fs = _test_values(p)[kind]
+        if fs is None:  # no multipliers there (an impact grazes): not located further
+            break
         best = p
         same_as_left = (np.sign(fs) == np.sign(fa)) if continuous else (fs == f_left)
         if same_as_left:
