@@ -4,7 +4,8 @@ The belt (1 DOF, exponential friction) settles on a stick-slip cycle whose large
 is x* ≈ 2.2065; a stop at x = clearance below x* is hit once a period (restitution 0.5), and the
 landing speed falls to 0 as the clearance rises to x*. Continued in the clearance, the branch
 must call every orbit stable (each period holds a stick phase, which collapses every direction
-but the flow's: the multipliers are {1, 0}) and end at a located grazing point at x*.
+but the flow's: the multipliers are {1, 0}) and end at a located grazing point at x*; continued
+down from above x*, the free orbits' branch must end there too.
 
 Independent references: x* from the free cycle (slip from the breakaway state (0.85, 1.5) to its
 turning point) integrated in the test with scipy's ``solve_ivp``; the multipliers from central
@@ -71,6 +72,21 @@ def test_the_grazing_is_located_where_the_free_cycle_touches_the_stop(branch):
     (grazing,) = branch.special
     assert grazing.located and grazing.value == pytest.approx(x_star, abs=1e-4)
     assert branch.values[-1] < x_star and grazing.index == len(branch) - 1
+
+
+def test_the_grazing_is_located_from_the_free_side_too(model):
+    """From a clearance above x* the orbits do not touch the stop (the free cycle, the same for every
+    clearance); continued down, the branch ends where their smallest gap to the stop vanishes."""
+    system = model.replace(clearance=2.3)
+    run = start_run(system, {"x": 0.0, "dx": 1.5}, t_end=60.0)
+    free = continue_orbit(system, "clearance", start=run, section=("x", 1.0), direction=-1, bounds=(2.1, 2.3),
+                          amplitude=False)
+    assert free.stop_reason == "impact grazing (the free orbit touches a rigid stop)"
+    assert (free.open_phases == 0).all() and free.stable.all()
+    (grazing,) = free.special
+    assert grazing.kind == "grazing" and grazing.located
+    assert grazing.value == pytest.approx(free_cycle_maximum(), abs=1e-4)
+    np.testing.assert_allclose(free.periods, free.periods[0], rtol=1e-9)  # the free cycle throughout
 
 
 @pytest.mark.parametrize("i", [0, 2, 4])
