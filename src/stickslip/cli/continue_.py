@@ -103,8 +103,9 @@ def continue_command(
     overwrite: Restart = False,
     no_plot: NoPlot = False,
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
-    monodromy: str = typer.Option("auto", "--monodromy", help="Monodromy of each orbit: auto (saltation where the "
-                                  "model has a rigid contact, else finite-difference) | saltation | finite-difference."),
+    monodromy: str = typer.Option("auto", "--monodromy", help="Monodromy of each orbit: auto (saltation where "
+                                  "the model has a rigid contact, else finite-difference) | saltation | "
+                                  "finite-difference."),
     as_json: JsonSummary = False,
 ) -> None:
     """Continue a periodic orbit in one parameter, with stability, folds, stick-phase changes and grazing.

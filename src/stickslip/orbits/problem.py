@@ -45,8 +45,8 @@ from .models import ModelResult, model_attrs
 from .section import Section, flow, vector_field
 
 __all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
-           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "floquet_verdict", "multiplier_tolerance", "stick_count", "stick_time", "stick_summary",
-           "open_count", "open_time",
+           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "floquet_verdict", "multiplier_tolerance",
+           "stick_count", "stick_time", "stick_summary", "open_count", "open_time",
            "check_method", "check_section", "METHODS", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
 
 #: Ways of computing ∂Φ/∂s0: variational equations with saltation matrices, or central differences.
