@@ -29,7 +29,7 @@ from . import branch_store as store
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, Point, Problem, correct_onto_bound,
                         monodromy_method, numeric_parameter, point_at, problem_of, step_from)
 from .models import ModelResult, plates_parameters, resolve, with_parameter
-from .problem import floquet_verdict, unstable_count
+from .problem import METHODS, floquet_verdict, unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
 from .special_points import (APPROACH_GRAZING_STOP, FLIGHT_VANISHING_STOP, IMPACT_GRAZING_STOP, MIN_STICK_FRACTION,
@@ -323,11 +323,7 @@ def continue_orbit(
         corrector's Broyden update gives the tangent; those points have NaN multipliers and
         ``n_unstable`` −1).
     monodromy : {"auto", "saltation", "finite-difference"}
-        How each point's monodromy (the multipliers, and the state columns of the Jacobian) is
-        computed: the variational equations with saltation matrices (central differences at a
-        point where they cannot follow the run's events), or central differences of the flow map.
-        ``auto``: saltation where the model has a rigid contact (an impact that grazes makes the
-        differences meaningless, :func:`.arclength.monodromy_method`), else differences.
+        Each point's monodromy; ``auto``: saltation with a rigid contact (:func:`.arclength.monodromy_method`).
     callback : callable, optional
         ``callback(i, value, period, stable)`` after each accepted point (once journaled).
     out : path, optional
@@ -353,28 +349,30 @@ def continue_orbit(
         model with unilateral contacts, by a version that did not count their open phases.
     """
     t_start = time.perf_counter()
-    _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
-    if isinstance(start, (PeriodicOrbit, Trajectory)) and model is None:
-        model = start.system
-    system = resolve(model, slip_band)
-    lo, hi = _bounds(bounds, param, numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system,
-                                                      param))
+    _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on, monodromy)
+    system, (lo, hi) = _resolved(model, start, param, slip_band, bounds)
     atol, section = 1e-3 * rtol if atol is None else float(atol), resolve_section(section, system)
     numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
                     bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
                     tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
-                    min_stick_fraction=min_stick_fraction, jacobian_every=int(jacobian_every),
+                    jacobian_every=int(jacobian_every), min_stick_fraction=min_stick_fraction,
                     monodromy=monodromy_method(system, monodromy))
-    # branches by differences keep the digest they had before the choice existed (their journals resume)
-    recorded = {k: v for k, v in numerics.items() if k != "monodromy" or v != "finite-difference"}
-    settings = store.branch_settings(system, param, start, section, rtol, atol, recorded)
-    digest = store.digest_of(settings)
+    settings, digest = _settings(system, param, start, section, rtol, atol, numerics)
     journal, finished = _open_output(out, system, digest, settings, resume, on_resume)
     if finished is not None:  # nothing left to compute
         return finished
     run = _Continuation.begin(system, param, start, section, rtol, atol, numerics, journal, callback, on_resume, t_start)
     run.go_on()
     return run.finish(rtol, atol, digest, out)
+
+
+def _resolved(model, start, param: str, slip_band, bounds) -> tuple:
+    """The model of :func:`continue_orbit` (by default that of a ``start`` orbit or run) and (lo, hi)
+    of its ``bounds`` (:func:`_bounds`)."""
+    system = resolve(start.system if model is None and isinstance(start, (PeriodicOrbit, Trajectory)) else model,
+                     slip_band)
+    lam_start = numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system, param)
+    return system, _bounds(bounds, param, lam_start)
 
 
 def _bounds(bounds, param: str, lam_start: float) -> tuple:
@@ -579,8 +577,18 @@ def _flight_vanished(walk: "_Walk") -> bool:
     return len(after) <= VANISH_FIT_POINTS and all(p.open_phases == 0 for p in after)
 
 
-def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on) -> None:
+def _settings(system, param, start, section, rtol, atol, numerics: dict) -> tuple[dict, str]:
+    """(settings, digest) of a branch (:func:`.branch_store.branch_settings`); a branch by
+    differences keeps the digest it had before the choice of monodromy existed (its journal resumes)."""
+    recorded = {k: v for k, v in numerics.items() if k != "monodromy" or v != "finite-difference"}
+    settings = store.branch_settings(system, param, start, section, rtol, atol, recorded)
+    return settings, store.digest_of(settings)
+
+
+def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on, monodromy) -> None:
     """Refuse bad numerical options of :func:`continue_orbit` before computing (ContinuationError)."""
+    if monodromy not in ("auto",) + METHODS:
+        raise ContinuationError(f"unknown monodromy {monodromy!r}; choose auto, {', '.join(METHODS)}")
     if direction not in (1, -1):
         raise ContinuationError(f"direction must be +1 or -1, got {direction}")
     if not (0.0 < min_step <= step <= max_step):
