@@ -77,6 +77,34 @@ def test_classify_constructed_signals():
     assert classify_response(t, np.full_like(t, 0.02), np.zeros_like(t)).outcome == "equilibrium"
 
 
+@pytest.mark.parametrize("phase", np.linspace(0.0, 2.0 * np.pi, 7))
+def test_a_conservative_oscillation_is_not_a_decay(phase):
+    """An undamped slip-only motion neither grows nor decays: two modes beating (quasi-periodic,
+    so no period is found) and one mode whose period is 0.7 of the window (too few peaks for a
+    period) are ``unsettled`` at every phase, never an ``equilibrium`` that ``decays``. The quarter
+    comparison alone called 3 of the 7 beats and 2 of the 7 short windows decaying."""
+    t = np.linspace(0.0, 100.0, 20001)
+    x = np.cos(t + phase) + 0.5 * np.cos(math.sqrt(2.0) * t)
+    dx = -np.sin(t + phase) - 0.5 * math.sqrt(2.0) * np.sin(math.sqrt(2.0) * t)
+    c = classify_response(t, x, dx)
+    assert c.outcome == "unsettled" and c.signal != "decaying"
+    t = np.linspace(0.0, 10.0, 4001)
+    w = 2.0 * np.pi / 7.0
+    c = classify_response(t, np.cos(w * t + phase), -w * np.sin(w * t + phase))
+    assert c.outcome == "unsettled" and c.signal != "decaying"
+
+
+def test_a_slow_decay_is_still_a_decay():
+    """The slowest free decay the threshold is set for (time constant 200 s) over a 100 s window of
+    a slip-only oscillation: every quarter holds peaks and each is smaller than the one before."""
+    t = np.linspace(0.0, 100.0, 20001)
+    w = 2.0 * np.pi / 0.4
+    x = np.exp(-t / 200.0) * np.sin(w * t)
+    dx = np.exp(-t / 200.0) * (w * np.cos(w * t) - np.sin(w * t) / 200.0)
+    c = classify_response(t, x, dx)
+    assert (c.outcome, c.signal) == ("equilibrium", "decaying")
+
+
 def test_intensity_of_an_analytic_signal():
     # X − X_e = A sin(ω t) over n whole periods: ∫ = A² T / 2, so I = A / √(2 T) (Eq. 16)
     A, f, xe = 0.3, 2.0, 0.05

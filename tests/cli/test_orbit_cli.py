@@ -22,7 +22,7 @@ runner = CliRunner()
 SEARCH = 10.0
 
 ORBIT_KEYS = {"out", "figure", "model", "period_s", "frequency_hz", "stick_phases", "stick_fraction", "contacts",
-              "max_nontrivial_multiplier_abs", "trivial_multiplier_error", "stable", "monodromy", "iterations",
+              "max_nontrivial_multiplier_abs", "trivial_multiplier_error", "stable", "verdict", "monodromy", "iterations",
               "residual", "wall_time_s", "compile_time_s"}
 LYAPUNOV_KEYS = {"out", "figure", "model", "method", "t_transient_s", "t_average_s", "exponents", "largest",
                  "stick_phases", "wall_time_s", "compile_time_s", "seed", "t_frame_s"}

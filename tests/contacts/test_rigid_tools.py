@@ -21,6 +21,8 @@ from stickslip.integrate.contacts import TRANSITION_OPEN
 from stickslip.orbits.continuation import continue_orbit
 from stickslip.orbits.problem import stick_summary
 
+from orbits.flow_differences import flow_map_differences  # tests/orbits: plain simulations of the flow map
+
 RIGID_SLIDER = Path(__file__).with_name("rigid_slider.toml")
 
 
@@ -99,14 +101,20 @@ def test_basins_refuse_states_inside_the_stop(model, tmp_path):
         stickslip.basin_stability(model, states, t_end=100.0, workers=1, out=tmp_path / "b.nc")
 
 
-def test_a_section_crossed_with_the_rigid_contact_closed_is_refused(model, orbit):
-    """An up-crossing of x in a slip phase of the closed contact:
-    Newton's unknowns would leave the stop's surface."""
+def test_a_section_crossed_with_the_rigid_contact_closed_eliminates_its_normal_coordinate(model, orbit):
+    """An up-crossing of x in a slip phase of the closed contact: shooting keeps y = 0, y' = 0 (the
+    contact's normal coordinate is eliminated, its unknowns are x and x') and finds the cycle shot
+    from the flight (period to 1e-10 relative); its monodromy on x, x' equals central differences of
+    the flow map along the belt's surface (1e-6), multipliers {1, 0}: stick collapses the rest."""
     run = orbit.trajectory(3.0, sample_rate=1000.0)
     rising = ~run.open[:, 0] & ~run.stick[:, 0] & (run.states[:, 2] > 0.0)
     level = float(np.median(run.states[rising, 0]))
-    with pytest.raises(stickslip.errors.OrbitError, match="crossed with rigid contact belt closed"):
-        stickslip.periodic_orbit(model, run, section=("x", level))
+    closed = stickslip.periodic_orbit(model, run, section=("x", level))
+    assert closed.free_states == ("x", "dx") and closed.state[1] == 0.0 and closed.state[3] == 0.0
+    assert closed.period == pytest.approx(orbit.period, rel=1e-10)
+    D = flow_map_differences(model, closed.state, closed.period, [0, 2], h=1e-6)
+    np.testing.assert_allclose(closed.monodromy, D, rtol=0, atol=1e-6 * np.abs(D).max())
+    np.testing.assert_allclose(np.sort(np.abs(closed.multipliers)), [0.0, 1.0], atol=1e-6)
 
 
 def test_continuation_ends_at_the_grazing_of_the_rigid_contact(model, orbit):

@@ -98,3 +98,29 @@ def test_a_run_at_rest_on_a_centre_is_called_marginal_not_unstable(ic):
     reason = verdict.evidence["reason"]
     assert reason.startswith("at rest, but steady sliding is marginal") and "unstable" not in reason
     assert verdict.evidence["stability"]["verdict"] == "marginal"
+
+
+def test_a_map_of_centres_is_marginal_everywhere(tmp_path):
+    """Over the belt speed and the load the undamped oscillator stays a centre (Re λ = 0): every
+    point of its map is marginal, none stable or unstable, also read back from its file; with a
+    damper every point is stable (Re λ = −c/2)."""
+    axes = ("contact.0.drive", "contact.0.normal_force")
+    smap = stickslip.stability_map(oscillator(), [0.5, 1.0, 2.0], [0.5, 1.0], axes=axes, boundary=False)
+    np.testing.assert_allclose(smap.tolerance, MARGINAL_RTOL * K, rtol=1e-12)
+    assert smap.marginal.all() and not smap.stable.any() and (smap.verdicts == "marginal").all()
+    back = stickslip.load_stability_map(smap.to_netcdf(tmp_path / "map.nc"))
+    assert (back.verdicts == "marginal").all()
+    damped = stickslip.stability_map(oscillator(1e-3), [0.5, 1.0, 2.0], [0.5, 1.0], axes=axes, boundary=False)
+    np.testing.assert_allclose(damped.max_real_part, -0.5e-3, rtol=1e-9)
+    assert damped.stable.all() and not damped.marginal.any()
+
+
+def test_a_neutral_cycle_is_marginal_not_stable():
+    """The undamped oscillator slipping about x_e without reaching the belt speed is a linear
+    motion: its monodromy over a period 2π/ω is the identity, both multipliers 1 (closed form):
+    the cycle is marginal, neither stable nor unstable. With a damper there is no cycle to shoot."""
+    omega = math.sqrt(K)
+    orbit = stickslip.periodic_orbit(oscillator(), {"x": MU * N / K + 0.05}, search_time=10.0)
+    assert orbit.stick_phases == 0 and orbit.period == pytest.approx(2 * math.pi / omega, rel=1e-9)
+    np.testing.assert_allclose(orbit.monodromy, np.eye(2), atol=1e-7)
+    assert orbit.verdict == "marginal" and not orbit.stable

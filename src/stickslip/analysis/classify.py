@@ -11,9 +11,13 @@ named in the one vocabulary of :mod:`.outcome`, the signal's own finding in ``si
    the window shows no drift and no decaying return differences: ``periodic``, settled; a
    stick-slip orbit when any stick occurs in the window (``stick_fraction`` > 0), else a
    pure-slip orbit.
-3. **Decay** (``decaying``) – no settled period, no stick, and the peak-to-peak amplitude in the
-   last quarter of the window below :data:`DECAY_RATIO` times that of the first quarter, in x
-   and in every other given response: ``equilibrium`` (converging to steady sliding). The signal
+3. **Decay** (``decaying``) – no settled period, no stick, each quarter of the window holding
+   at least :data:`DECAY_MIN_PEAKS` maxima of x (so that a quarter's peak-to-peak is an
+   amplitude, not a part of one oscillation), the peak-to-peak amplitude falling from each
+   quarter to the next and in the last quarter below :data:`DECAY_RATIO` times that of the first,
+   in x and in every other given response: ``equilibrium`` (converging to steady sliding). A
+   conservative oscillation (undamped, slip only) does not decay: its quarters' amplitudes stay
+   or go up and down (a beat between modes), or its quarters are shorter than its period. The signal
    cannot tell a decay onto the equilibrium from one onto a small slip limit cycle or a mode
    growing unseen below it, so this is not settled here: :mod:`stickslip.attractors` confirms
    it with the linear stability of the equilibrium. A slip-only response that grows in any
@@ -56,6 +60,11 @@ SIGNALS = ("at-rest", "periodic", "decaying", "stationary", "drifting")
 #: periodic before this test). The slowest free decay of Table 1 (time constant 2 m_d / c_dx =
 #: 200 s) gives e^(−0.75 W / 200) < 0.99 for any window W > 2.7 s.
 DECAY_RATIO = 0.99
+
+#: Maxima of x each quarter of the window must hold before the quarters' amplitudes are compared
+#: (with fewer, a quarter's peak-to-peak depends on where the oscillation's phase cuts it: an
+#: undamped cosine whose period is 0.7 of the window has quarter amplitudes 0.57 of each other).
+DECAY_MIN_PEAKS = 2
 
 #: Smallest return spread (relative to A) of a stationary non-periodic window: a window that
 #: nearly repeats (spread 1e-5 … 1e-3) is a slow approach to a periodic orbit until shown
@@ -159,8 +168,15 @@ def _quarters(t, x, t0, t1):
 
 
 def _decaying(q):
-    """Whether the last quarter's amplitude is below DECAY_RATIO × the first's (or at rest)."""
-    return q[-1] < REST_AMPLITUDE or q[-1] < DECAY_RATIO * q[0]
+    """Whether the quarters' amplitudes fall from each quarter to the next, the last below
+    DECAY_RATIO × the first's (or whether the last is at rest)."""
+    return q[-1] < REST_AMPLITUDE or (bool(np.all(np.diff(q) < 0.0)) and q[-1] < DECAY_RATIO * q[0])
+
+
+def _peaks_per_quarter(times, t0, t1) -> int:
+    """The fewest maxima (at ``times``) in a quarter of [t0, t1]."""
+    counts = np.histogram(times, bins=np.linspace(t0, t1, 5))[0]
+    return int(counts.min())
 
 
 def range_change(a: np.ndarray, b: np.ndarray, amplitude: float) -> float:
@@ -215,7 +231,8 @@ def classify_response(t, x, dx, *, stick_fraction: float = 0.0, t_from: float | 
                               signal="periodic", evidence=evidence, **base)
     quarters = [_quarters(t, x, t0, t1)] + ([] if others is None else [_quarters(t, y, t0, t1) for y in others.T])
     evidence["amplitude_ratio"] = float(quarters[0][-1] / quarters[0][0]) if quarters[0][0] > 0 else math.nan
-    if stick_fraction == 0.0 and all(_decaying(q) for q in quarters):
+    if stick_fraction == 0.0 and _peaks_per_quarter(pk.time, t0, t1) >= DECAY_MIN_PEAKS \
+            and all(_decaying(q) for q in quarters):
         return Classification("equilibrium", 0, math.nan, math.nan, fft_f, settled=False, signal="decaying",
                               evidence=evidence, **base)
     mid = 0.5 * (t0 + t1)

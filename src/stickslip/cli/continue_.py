@@ -17,9 +17,10 @@ from ..errors import SteadySlidingError, StickSlipError
 from ..orbits import resolve_section
 from ..orbits.continuation import SPECIAL_KINDS, continue_orbit, start_run
 from ..orbits.models import parameter_value, with_parameter
+from ..orbits.problem import METHODS as MONODROMY_METHODS
 from ..plot.continuation import save_branch_figure
-from ._app import (CLIError, app, check_below_one, check_finite, check_positive, check_resumable_output, console,
-                   error_line, exact, note_line, resumable_holds)
+from ._app import (CLIError, app, check_below_one, check_choice, check_finite, check_positive, check_resumable_output,
+                   console, error_line, exact, note_line, resumable_holds)
 from ._compiling import time_text, timed
 from ._groups import grouped
 from ._json import print_json
@@ -102,6 +103,9 @@ def continue_command(
     overwrite: Restart = False,
     no_plot: NoPlot = False,
     no_progress: bool = typer.Option(False, "--no-progress", help="Do not print a line per orbit."),
+    monodromy: str = typer.Option("auto", "--monodromy", help="Monodromy of each orbit: auto (saltation where "
+                                  "the model has a rigid contact, else finite-difference) | saltation | "
+                                  "finite-difference."),
     as_json: JsonSummary = False,
 ) -> None:
     """Continue a periodic orbit in one parameter, with stability, folds, stick-phase changes and grazing.
@@ -110,6 +114,7 @@ def continue_command(
     """
     stop_on = list(stop_on or [])
     _check(start, stop, max_points, step, max_step, search.search_time, tol, stop_on)
+    check_choice("--monodromy", monodromy, ("auto",) + MONODROMY_METHODS)
     ic_start = parse_start(search.ic)
     system = model_system(model, changes, slip_band, swept={param: f"--param {param}"}, **point.named())
     try:
@@ -131,7 +136,7 @@ def continue_command(
                                     max_step=max_step, max_points=max_points,
                                     bounds=(min(start, stop), max(start, stop)), stop_on=tuple(stop_on), section=sec,
                                     rtol=rtol, tol=tol, callback=progress, out=out, on_resume=_note_resume,
-                                    resume=not overwrite)
+                                    resume=not overwrite, monodromy=monodromy)
         except SteadySlidingError as exc:
             raise _steady_start(exc, system) from None
     figure = None
@@ -142,6 +147,7 @@ def continue_command(
         "out": str(out), "figure": None if figure is None else str(figure), "param": param,
         "points": len(branch), "from": float(branch.values[0]), "to": float(branch.values[-1]),
         "stable_points": int(branch.stable.sum()), "stop_reason": branch.stop_reason,
+        "monodromy": branch.options.get("monodromy", "finite-difference"),
         "special": [{"kind": p.kind, "value": p.value, "located": p.located, "multipliers": _pairs(p.multipliers),
                      "multipliers_before": _pairs(p.multipliers_before),
                      "multipliers_after": _pairs(p.multipliers_after)} for p in branch.special],

@@ -125,7 +125,7 @@ def orbit_command(
         "stick_phases": int(orbit.stick_phases), **stick,
         "max_nontrivial_multiplier_abs": float(others.max()) if others.size else None,
         "trivial_multiplier_error": float(abs(orbit.trivial_multiplier - 1.0)),
-        "stable": bool(orbit.stable), "monodromy": orbit.options.get("monodromy", monodromy),
+        "stable": bool(orbit.stable), "verdict": orbit.verdict, "monodromy": orbit.options.get("monodromy", monodromy),
         "iterations": int(orbit.iterations), "residual": float(orbit.residual),
         "wall_time_s": timing.wall_s, "compile_time_s": timing.compile_s,
     }
@@ -140,7 +140,8 @@ def orbit_command(
     if summary["max_nontrivial_multiplier_abs"] is not None:
         table.add_row("largest |μ| (non-trivial)", f"{summary['max_nontrivial_multiplier_abs']:.8g}")
     table.add_row("|μ_trivial − 1|", f"{summary['trivial_multiplier_error']:.2e} ({summary['monodromy']})")
-    table.add_row("stability", Text("stable", style="green") if orbit.stable else Text("unstable", style="bold red"))
+    table.add_row("stability", Text(orbit.verdict, style={"stable": "green", "marginal": "yellow"}.get(orbit.verdict,
+                                                                                                       "bold red")))
     table.add_row("Newton", f"{summary['iterations']} iterations, residual {summary['residual']:.2e}")
     table.add_row("wall time", time_text(timing.wall_s, timing.compile_s, "start run + shooting + multipliers"))
     table.add_row("wrote", str(out) + ("" if figure is None else f", {figure}"))

@@ -157,11 +157,12 @@ def stability_map(
                           inputs=inputs, draw=lambda tmp: save_stability_map_figure(smap, tmp))
     rows = []
     for f, label in enumerate(smap.family_labels):
-        mrp = smap.max_real_part[f]
+        mrp, verdicts = smap.max_real_part[f], smap.verdicts[f]
         found = np.isfinite(mrp)
         rows.append({
             "member": label,
-            "unstable_fraction": float(np.mean(mrp[found] > 0)) if np.any(found) else None,
+            "unstable_fraction": float(np.mean(verdicts[found] == "unstable")) if np.any(found) else None,
+            "marginal_fraction": float(np.mean(verdicts[found] == "marginal")) if np.any(found) else None,
             "no_equilibrium_fraction": float(np.mean(~found)),
             "boundary_points": int(np.sum(np.isfinite(smap.boundary[f]))),
         })
@@ -172,11 +173,11 @@ def stability_map(
         return
     table = Table(title=f"stability map {values[0].size} × {values[1].size} ({names[0]} × {names[1]}), "
                         f"model {smap.model}")
-    for head in ("member", "unstable fraction", "no equilibrium", "boundary points"):
+    for head in ("member", "unstable fraction", "marginal", "no equilibrium", "boundary points"):
         table.add_column(head)
     for r in rows:
-        uf = "–" if r["unstable_fraction"] is None else f"{r['unstable_fraction']:.3f}"
-        table.add_row(r["member"], uf, f"{r['no_equilibrium_fraction']:.3f}", str(r["boundary_points"]))
+        uf, mf = ("–" if r[key] is None else f"{r[key]:.3f}" for key in ("unstable_fraction", "marginal_fraction"))
+        table.add_row(r["member"], uf, mf, f"{r['no_equilibrium_fraction']:.3f}", str(r["boundary_points"]))
     console.print(table)
     t = smap.timings
     detail = f"grid {t['grid_s']:.2f} s, boundary {t['boundary_s']:.2f} s"

@@ -27,13 +27,15 @@ import dataclasses
 import numpy as np
 
 from ..errors import ContinuationError, OrbitError, SteadySlidingError
+from ..integrate.result import find_impacts
 from ..model.system_model import FrictionModel
+from .layout import independent_states
 from .models import parameter_value, with_parameter
-from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, open_count, open_time, sorted_eigenvalues,
-                      stick_count, stick_time)
+from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, ShootingProblem, check_method, open_count, open_time,
+                      sorted_eigenvalues, stick_count, stick_time)
 
 __all__ = ["ContinuationError", "SteadySlidingError", "DEFAULT_TOL", "DEFAULT_FD_STEP", "MAX_CORRECTOR",
-           "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND"]
+           "MIN_TANGENT_COS", "MAX_STEPS_PER_SECOND", "GRAZING_LANDING_RTOL", "monodromy_method"]
 
 #: Corrector iterations before a step counts as failed (then halved). Broyden from the previous
 #: point's Jacobian reduces the residual ~5× per iteration (measured on Model 1, N = 50 N: the
@@ -44,6 +46,15 @@ MAX_CORRECTOR = 8
 #: Smallest cosine between consecutive tangents accepted: a larger turn means the step jumped
 #: over a sharp feature (or onto another branch); the step is halved instead.
 MIN_TANGENT_COS = 0.9
+
+#: An impact landing slower than this fraction of the largest velocity scale σ grazes: the
+#: saltation matrix divides the variations' crossing by the landing speed, so the 1e-10 accuracy of
+#: the variational integration and the 1e-6 match of its events are amplified by σ / v_i, and the
+#: multipliers of such a point are left unknown (NaN: no special point is classified on them, and
+#: no stability is claimed). Measured on the rigid slider towards its grazing: the exact monodromy
+#: has rank 1 (multipliers {1, 0, 0, 0}); saltation gives that to 1e-6 down to v_i = 1.2e-6 σ and a
+#: multiplier 57 at 6e-7 σ; central differences straddle the grazing well before.
+GRAZING_LANDING_RTOL = 1e-5
 
 #: Steps of a flow map allowed per simulated second: a period of Model 1 takes ~1e3 steps at
 #: rtol 1e-10; a stalled integration (approach to stick, docs/orbits.md) fails fast instead of
@@ -59,6 +70,7 @@ class Problem:
     param: str
     T_scale: float  # [s]
     p_scale: float  # [unit of the parameter]
+    monodromy: str = "finite-difference"  # how each point's ∂Φ/∂s0 is computed (:func:`monodromy_method`)
 
     @property
     def counter(self) -> dict:
@@ -87,16 +99,35 @@ def numeric_parameter(system: FrictionModel, param: str) -> float:
         raise ContinuationError(f"cannot continue in {param!r}: {exc}") from None
 
 
-def problem_of(start, param: str, fd_step: float, param_scale: float | None) -> Problem:
-    """The continuation problem of a start orbit (state, period, scale, system, section, options)."""
+def monodromy_method(system: FrictionModel, method: str = "auto") -> str:
+    """How the points of a branch of ``system`` get ∂Φ/∂s0: ``saltation`` or ``finite-difference``;
+    ``auto`` is ``saltation`` where the model has a rigid contact, else ``finite-difference``.
+
+    Central differences of the flow map straddle every event whose instant moves with the
+    perturbation, and near an impact that grazes (landing speed → 0) the flow map has a
+    square-root singularity: differences of steps ``fd_step`` σ across it give multipliers of any
+    size (|μ| up to 12 measured on the belt with a stop, where the cycle is stable with {1, 0}).
+    The saltation matrices are exact there, as long as the impact lands at all.
+    """
+    if method == "auto":
+        return "saltation" if system.rigid else "finite-difference"
+    check_method(method, "monodromy method")
+    return method
+
+
+def problem_of(start, param: str, fd_step: float, param_scale: float | None,
+               monodromy: str = "finite-difference") -> Problem:
+    """The continuation problem of a start orbit (state, period, scale, system, section, options);
+    ``monodromy``: ``saltation`` or ``finite-difference`` (:func:`monodromy_method`)."""
     lam0 = numeric_parameter(start.system, param)
     scale = abs(lam0) if param_scale is None else float(param_scale)
     if not (np.isfinite(scale) and scale > 0.0):
         scale = 1.0  # λ0 = 0: work in the parameter's own unit
     o = start.options
     shooting = ShootingProblem.build(start.system, sigma=start.scale, section=start.section, rtol=o["rtol"],
+                                     constraint=independent_states(start.system, start.state)[1],
                                      atol=o["atol"], fd_step=fd_step, max_steps_per_second=MAX_STEPS_PER_SECOND)
-    return Problem(shooting=shooting, param=param, T_scale=float(start.period), p_scale=scale)
+    return Problem(shooting=shooting, param=param, T_scale=float(start.period), p_scale=scale, monodromy=monodromy)
 
 
 def _residual(problem: Problem, v: np.ndarray):
@@ -106,10 +137,12 @@ def _residual(problem: Problem, v: np.ndarray):
 
 
 def _jacobian(problem: Problem, v: np.ndarray, end: np.ndarray):
-    """Finite-difference Jacobian ∂F/∂v (2 n_free × 2 n_free + 1) and the monodromy matrix.
+    """Jacobian ∂F/∂v (2 n_free × 2 n_free + 1) and the monodromy matrix.
 
-    Central differences in every free state and in λ; the T column is exact, f(Φ) from the vector
-    field. 2 (2 n_free + 1) simulations.
+    The monodromy by ``problem.monodromy``: the variational equations with saltation matrices (one
+    re-integration; central differences where it cannot follow the run's events) or central
+    differences in every free state (2 (2 n_free) simulations); the T column is exact, f(Φ) from
+    the vector field; the λ column a central difference (two simulations).
 
     Returns
     -------
@@ -121,7 +154,7 @@ def _jacobian(problem: Problem, v: np.ndarray, end: np.ndarray):
     s, T, lam = problem.unpack(v)
     system = problem.system_at(lam)
     sp = problem.shooting
-    M = sp.fd_monodromy(s, T, system=system)
+    M = sp.monodromy_columns(s, T, problem.monodromy, system=system)
     J = np.empty((sp.free.size, sp.free.size + 1))
     J[:, :-1] = sp.jacobian(M[:, sp.unknown], end, system, problem.T_scale)
     dl = sp.fd_step * problem.p_scale
@@ -182,7 +215,8 @@ class Point:
     ``stick_phases`` and ``stick_time`` [s] count the slip → stick transitions of its period and
     the time in stick; ``open_phases`` and ``open_time`` [s] the openings of unilateral contacts
     (flight phases) and the time with some contact open, None for a model without unilateral
-    contacts.
+    contacts; ``impact_speed`` the smallest landing speed −ġ⁻ of the rigid contacts' impacts
+    over the period [m/s], None where it has none.
     """
 
     v: np.ndarray
@@ -196,30 +230,55 @@ class Point:
     iterations: int
     open_phases: int | None = None
     open_time: float | None = None
+    impact_speed: float | None = None
 
     @property
     def fresh(self) -> bool:
-        """True if J is a finite-difference Jacobian at this point (multipliers known)."""
+        """True if J is a Jacobian of this point's own (its monodromy M computed), not Broyden's update."""
+        return bool(np.all(np.isfinite(self.M)))
+
+    @property
+    def has_multipliers(self) -> bool:
+        """True if the point's multipliers are known: a fresh point whose impacts do not graze
+        (:data:`GRAZING_LANDING_RTOL`)."""
         return bool(np.all(np.isfinite(self.multipliers)))
 
 
 def phases(problem: Problem, v: np.ndarray, tr) -> dict:
     """The stick and flight phases of the period at ``v`` from its run's transitions ``tr``: the
     :class:`Point` fields ``stick_phases``, ``stick_time`` and, where the model has unilateral
-    contacts, ``open_phases`` and ``open_time``."""
+    contacts, ``open_phases`` and ``open_time``, and where its period has impacts ``impact_speed``."""
     out = {"stick_phases": stick_count(tr), "stick_time": stick_time(tr)}
     if problem.shooting.system.unilateral:
         s, T, lam = problem.unpack(v)
-        out.update(open_phases=open_count(tr), open_time=open_time(tr, T, problem.system_at(lam), s))
+        system = problem.system_at(lam)
+        out.update(open_phases=open_count(tr), open_time=open_time(tr, T, system, s))
+        landing = -find_impacts(system, tr).speed_before
+        if landing.size:
+            out["impact_speed"] = float(landing.min())
     return out
 
 
 def _make_point(problem: Problem, v, R, end, tr, iterations, previous_tangent, direction) -> Point:
-    """The point at ``v`` with its finite-difference Jacobian, tangent and multipliers."""
+    """The point at ``v`` with its Jacobian, tangent and multipliers (NaN where an impact grazes,
+    :func:`grazes`)."""
     J, M = _jacobian(problem, v, end)
-    return Point(v=v, J=J, M=M, tangent=_tangent(J, previous_tangent, direction),
-                  multipliers=sorted_eigenvalues(M), residual=float(np.max(np.abs(R))), iterations=iterations,
-                  **phases(problem, v, tr))
+    found = phases(problem, v, tr)
+    multipliers = np.full(M.shape[0], np.nan + 0j) if grazes(problem, found.get("impact_speed")) \
+        else sorted_eigenvalues(M)
+    return Point(v=v, J=J, M=M, tangent=_tangent(J, previous_tangent, direction), multipliers=multipliers,
+                 residual=float(np.max(np.abs(R))), iterations=iterations, **found)
+
+
+def grazes(problem: Problem, impact_speed: float | None) -> bool:
+    """Whether an orbit's slowest impact lands so slowly (``impact_speed`` [m/s], None: no impact)
+    that its monodromy does not resolve the multipliers (:data:`GRAZING_LANDING_RTOL` of the
+    largest velocity scale σ)."""
+    if impact_speed is None:
+        return False
+    sp = problem.shooting
+    velocities = sp.sigma[sp.free >= sp.system.n]
+    return impact_speed < GRAZING_LANDING_RTOL * float(np.max(velocities))
 
 
 def point_at(problem: Problem, v: np.ndarray, iterations: int, previous_tangent=None, direction: float = 1.0) -> Point:

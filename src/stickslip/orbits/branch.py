@@ -12,6 +12,7 @@ point is journaled (:mod:`.branch_store`) and the same call again resumes from t
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from typing import Sequence
 
@@ -26,13 +27,15 @@ from ..model.parameters import Parameters
 from ..model.system_model import FrictionModel
 from . import branch_store as store
 from .arclength import (DEFAULT_FD_STEP, DEFAULT_TOL, MIN_TANGENT_COS, Point, Problem, correct_onto_bound,
-                        numeric_parameter, point_at, problem_of, step_from)
+                        monodromy_method, numeric_parameter, point_at, problem_of, step_from)
 from .models import ModelResult, plates_parameters, resolve, with_parameter
-from .problem import unstable_count
+from .problem import METHODS, floquet_verdict, unstable_count
 from .section import Section, resolve_section
 from .shooting import PeriodicOrbit
-from .special_points import (FLIGHT_VANISHING_STOP, MIN_STICK_FRACTION, SPECIAL_KINDS, SpecialPoint, detect_after_point,
-                             detect_after_renewal, distance_from_equilibrium, flight_vanishing, is_orbit)
+from .special_points import (APPROACH_GRAZING_STOP, FLIGHT_VANISHING_STOP, IMPACT_GRAZING_STOP, MIN_STICK_FRACTION,
+                             SPECIAL_KINDS, VANISH_FIT_POINTS, SpecialPoint, approach_grazing, detect_after_point,
+                             detect_after_renewal, distance_from_equilibrium, flight_vanishing, impact_grazing,
+                             is_orbit)
 from .start import Start, start_orbit
 
 __all__ = ["Branch", "continue_orbit", "load_branch"]
@@ -45,6 +48,12 @@ HARD_ITERATIONS = 6
 
 #: Samples per period of the run that measures the amplitude of φ of each point.
 AMPLITUDE_SAMPLES = 400
+
+#: Samples per period of the run that finds a free orbit's smallest gap to a rigid stop (refined by
+#: a parabola through the smallest and its neighbours: exact for a quadratic minimum, off by
+#: ~h³ |g⃛| for a sample spacing h: ~3e-8 estimated for the belt with a stop, whose grazing it
+#: locates to 2e-10 of the closed reference).
+GAP_SAMPLES = 2000
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -63,12 +72,15 @@ class Branch(ModelResult, store.NetCDFResult):
     states : ndarray (n, 2n)
         States on the Poincaré section (the model's ``state_names``).
     multipliers : ndarray (n, 2 n_free) complex
-        Floquet multipliers (eigenvalues of the finite-difference monodromy), by decreasing modulus
-        (NaN at points without a finite-difference Jacobian, see ``jacobian_every``).
+        Floquet multipliers (eigenvalues of the monodromy, ``options["monodromy"]``), by decreasing
+        modulus (NaN at points without a Jacobian of their own, see ``jacobian_every``, and where an
+        impact lands too slowly for them to be resolved, :data:`.arclength.GRAZING_LANDING_RTOL`).
     stable : ndarray (n,) bool
-        Every non-trivial multiplier inside the unit circle.
+        Every non-trivial multiplier inside the unit circle (by more than the multipliers' own
+        error, :func:`~stickslip.orbits.problem.floquet_verdict`: :attr:`verdicts` tells a
+        marginal orbit, on the circle within it, from an unstable one).
     n_unstable : ndarray (n,) int
-        Non-trivial multipliers outside the unit circle (−1 where not computed, ``jacobian_every``).
+        Non-trivial multipliers outside the unit circle (−1 where they are not known).
     stick_phases : ndarray (n,) int
         Slip → stick transitions per period (0: pure slip).
     stick_time : ndarray (n,)
@@ -87,8 +99,9 @@ class Branch(ModelResult, store.NetCDFResult):
     stop_reason : str
         Why the continuation ended (``bounds``, ``max_points``, ``min_step``, ``stop_on fold``,
         ``steady sliding at <param> = <value>`` where the corrector converged onto the equilibrium
-        (that point is not in the branch), ``flight vanishing (grazing of a rigid contact)``
-        with a ``grazing`` point after the last, ...).
+        (that point is not in the branch), ``flight vanishing (grazing of a rigid contact)`` or
+        ``impact grazing (...)`` (an impact's landing speed vanishes, or the free orbits touch a
+        rigid stop) with a ``grazing`` point after the last, ...).
     system : FrictionModel
         The model at the start (the continuation parameter at its start value); ``params`` and
         ``model``: the plates' Parameters and variant, or None and the model's name.
@@ -133,6 +146,12 @@ class Branch(ModelResult, store.NetCDFResult):
 
     def __len__(self) -> int:
         return int(self.values.size)
+
+    @property
+    def verdicts(self) -> list:
+        """Floquet verdict of each orbit: ``stable``, ``marginal``, ``unstable`` or ``unknown``
+        (no multipliers, ``jacobian_every``) (:func:`~stickslip.orbits.problem.floquet_verdict`)."""
+        return [floquet_verdict(m) for m in self.multipliers]
 
     def folds(self) -> list:
         """The special points of kind ``fold``."""
@@ -192,6 +211,27 @@ def _read_branch(path) -> tuple:
     return ds.attrs, (Branch.from_xarray(ds) if ds.attrs.get("digest") else None)
 
 
+def _smallest_rigid_gap(problem: Problem, point) -> float:
+    """The smallest gap of the rigid contacts over one period of ``point``'s orbit [m] (NaN if the run
+    fails): the smallest sample of :data:`GAP_SAMPLES` per period, refined by the parabola through it
+    and its neighbours."""
+    s, T, lam = problem.unpack(point.v)
+    system = problem.system_at(lam)
+    sp = problem.shooting
+    try:
+        traj = simulate(system, T, ic=s, sample_rate=GAP_SAMPLES / T,
+                        max_steps=int(sp.max_steps_per_second * max(T, 1.0)), rtol=sp.rtol, atol=sp.atol)
+    except SimulationError:
+        return float("nan")
+    rigid = [c for c, contact in enumerate(system.contacts) if contact.unilateral and contact.normal.law == "rigid"]
+    if traj.status != "success" or not rigid:
+        return float("nan")
+    g = np.min(traj.gap[:, rigid], axis=1)
+    i = int(np.clip(np.argmin(g), 1, g.size - 2))
+    curvature = g[i - 1] - 2.0 * g[i] + g[i + 1]
+    return float(g[i] - (g[i + 1] - g[i - 1]) ** 2 / (8.0 * curvature) if curvature > 0.0 else g[i])
+
+
 def _amplitude(problem: Problem, s: np.ndarray, T: float, lam: float) -> float:
     """Peak-to-peak range of the observed dof (the plates' φ [rad]) over one period from a sampled
     run (NaN if it fails)."""
@@ -228,6 +268,7 @@ def continue_orbit(
     amplitude: bool = True,
     min_stick_fraction: float = MIN_STICK_FRACTION,
     jacobian_every: int = 1,
+    monodromy: str = "auto",
     callback=None,
     out=None,
     resume: bool = True,
@@ -278,9 +319,11 @@ def continue_orbit(
     min_stick_fraction : float
         Stop where the stick time per period falls below this fraction of the period [-].
     jacobian_every : int
-        Recompute the finite-difference Jacobian at every ``jacobian_every``-th point only (in
-        between the corrector's Broyden update gives the tangent; those points have NaN
-        multipliers and ``n_unstable`` −1).
+        Recompute the Jacobian at every ``jacobian_every``-th point only (in between the
+        corrector's Broyden update gives the tangent; those points have NaN multipliers and
+        ``n_unstable`` −1).
+    monodromy : {"auto", "saltation", "finite-difference"}
+        Each point's monodromy; ``auto``: saltation with a rigid contact (:func:`.arclength.monodromy_method`).
     callback : callable, optional
         ``callback(i, value, period, stable)`` after each accepted point (once journaled).
     out : path, optional
@@ -306,25 +349,30 @@ def continue_orbit(
         model with unilateral contacts, by a version that did not count their open phases.
     """
     t_start = time.perf_counter()
-    _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on)
-    if isinstance(start, (PeriodicOrbit, Trajectory)) and model is None:
-        model = start.system
-    system = resolve(model, slip_band)
-    lo, hi = _bounds(bounds, param, numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system,
-                                                      param))
+    _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on, monodromy)
+    system, (lo, hi) = _resolved(model, start, param, slip_band, bounds)
     atol, section = 1e-3 * rtol if atol is None else float(atol), resolve_section(section, system)
     numerics = dict(direction=direction, step=step, min_step=min_step, max_step=max_step, max_points=max_points,
                     bounds=None if bounds is None else [lo, hi], stop_on=list(stop_on), locate=bool(locate),
                     tol=tol, fd_step=fd_step, param_scale=param_scale, amplitude=bool(amplitude),
-                    min_stick_fraction=min_stick_fraction, jacobian_every=int(jacobian_every))
-    settings = store.branch_settings(system, param, start, section, rtol, atol, numerics)
-    digest = store.digest_of(settings)
+                    jacobian_every=int(jacobian_every), min_stick_fraction=min_stick_fraction,
+                    monodromy=monodromy_method(system, monodromy))
+    settings, digest = _settings(system, param, start, section, rtol, atol, numerics)
     journal, finished = _open_output(out, system, digest, settings, resume, on_resume)
     if finished is not None:  # nothing left to compute
         return finished
     run = _Continuation.begin(system, param, start, section, rtol, atol, numerics, journal, callback, on_resume, t_start)
     run.go_on()
     return run.finish(rtol, atol, digest, out)
+
+
+def _resolved(model, start, param: str, slip_band, bounds) -> tuple:
+    """The model of :func:`continue_orbit` (by default that of a ``start`` orbit or run) and (lo, hi)
+    of its ``bounds`` (:func:`_bounds`)."""
+    system = resolve(start.system if model is None and isinstance(start, (PeriodicOrbit, Trajectory)) else model,
+                     slip_band)
+    lam_start = numeric_parameter(start.system if isinstance(start, PeriodicOrbit) else system, param)
+    return system, _bounds(bounds, param, lam_start)
 
 
 def _bounds(bounds, param: str, lam_start: float) -> tuple:
@@ -385,7 +433,7 @@ class _Continuation:
                 journal.append({"start": store.start_record(begin)})
         else:
             begin = Start(**store.start_fields(start_rec))
-        problem = problem_of(begin, param, numerics["fd_step"], numerics["param_scale"])
+        problem = problem_of(begin, param, numerics["fd_step"], numerics["param_scale"], numerics["monodromy"])
         lam0 = numeric_parameter(begin.system, param)
         if not is_orbit(problem, begin.state, lam0, begin.stick_phases):
             if journal is not None:
@@ -484,7 +532,7 @@ class _Continuation:
         _journal_point(self.journal, walk, problem, found, walk.elapsed, self.t_start)
         if self.callback is not None and not quiet:
             _s, T_new, lam_cb = problem.unpack(new.v)
-            self.callback(len(walk.points) - 1, lam_cb, T_new, new.fresh and unstable_count(new.multipliers) == 0)
+            self.callback(len(walk.points) - 1, lam_cb, T_new, floquet_verdict(new.multipliers) == "stable")
 
     def finish(self, rtol: float, atol: float, digest: str, out) -> Branch:
         """The :class:`Branch` of the finished walk (a grazing point where a rigid contact's flight
@@ -494,12 +542,18 @@ class _Continuation:
                                                                                 "max_step", "max_points")},
                        slip_band=problem.shooting.system.slip_band, param_scale=problem.p_scale,
                        period_scale=problem.T_scale, bounds=numerics["bounds"], direction=numerics["direction"],
-                       jacobian_every=numerics["jacobian_every"])
-        if walk.stop == "min_step" and self.problem.shooting.system.rigid:
-            grazing = flight_vanishing(self.problem, walk.points)
-            if grazing is not None:
-                walk.special.append(grazing)
-                walk.stop = FLIGHT_VANISHING_STOP
+                       jacobian_every=numerics["jacobian_every"], monodromy=numerics["monodromy"])
+        if walk.stop == "min_step" and self.problem.shooting.system.rigid and _flight_vanished(walk):
+            walk.stop = FLIGHT_VANISHING_STOP
+        elif walk.stop == "min_step" and self.problem.shooting.system.rigid:
+            approach = functools.partial(approach_grazing, smallest_gap=lambda p: _smallest_rigid_gap(self.problem, p))
+            for ends, reason in ((flight_vanishing, FLIGHT_VANISHING_STOP), (impact_grazing, IMPACT_GRAZING_STOP),
+                                 (approach, APPROACH_GRAZING_STOP)):
+                grazing = ends(self.problem, walk.points)
+                if grazing is not None:
+                    walk.special.append(grazing)
+                    walk.stop = reason
+                    break
         stop_reason = walk.stop or "max_points"
         if journal is not None and "stop" not in (journal.records[-1] if journal.records else {}):
             journal.append({"end": stop_reason})
@@ -512,8 +566,29 @@ class _Continuation:
         return branch
 
 
-def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on) -> None:
+def _flight_vanished(walk: "_Walk") -> bool:
+    """Whether the walk ends just past a located grazing where the flight phases ended (→ 0; within
+    its last :data:`.special_points.VANISH_FIT_POINTS` points, none of which flies): a rigid
+    contact's flight vanished there, and with it a section that lies in the flight."""
+    last = walk.special[-1] if walk.special else None
+    if last is None or last.kind != "grazing" or last.after != 0 or not last.located:
+        return False
+    after = walk.points[last.index + 1:]
+    return len(after) <= VANISH_FIT_POINTS and all(p.open_phases == 0 for p in after)
+
+
+def _settings(system, param, start, section, rtol, atol, numerics: dict) -> tuple[dict, str]:
+    """(settings, digest) of a branch (:func:`.branch_store.branch_settings`); a branch by
+    differences keeps the digest it had before the choice of monodromy existed (its journal resumes)."""
+    recorded = {k: v for k, v in numerics.items() if k != "monodromy" or v != "finite-difference"}
+    settings = store.branch_settings(system, param, start, section, rtol, atol, recorded)
+    return settings, store.digest_of(settings)
+
+
+def _check_request(direction, step, min_step, max_step, max_points, jacobian_every, stop_on, monodromy) -> None:
     """Refuse bad numerical options of :func:`continue_orbit` before computing (ContinuationError)."""
+    if monodromy not in ("auto",) + METHODS:
+        raise ContinuationError(f"unknown monodromy {monodromy!r}; choose auto, {', '.join(METHODS)}")
     if direction not in (1, -1):
         raise ContinuationError(f"direction must be +1 or -1, got {direction}")
     if not (0.0 < min_step <= step <= max_step):
@@ -605,14 +680,15 @@ def _assemble_branch(problem: Problem, begin: Start, walk: _Walk, stop_reason: s
     periods = np.array([u[1] for u in unpacked])
     values = np.array([u[2] for u in unpacked])
     mult = np.array([p.multipliers for p in points])
-    n_unst = np.array([unstable_count(p.multipliers) if p.fresh else -1 for p in points])
+    n_unst = np.array([unstable_count(p.multipliers) if p.has_multipliers else -1 for p in points])
     timings = {"total_s": total_s, "points": len(points), "simulations": problem.counter["simulations"]}
     opened = {} if points[0].open_phases is None else {
         "open_phases": np.array([p.open_phases for p in points]), "open_time": np.array([p.open_time for p in points])}
     if resumed is not None:
         timings["points_resumed"] = resumed
     return Branch(param=problem.param, values=values, periods=periods, states=states, multipliers=mult,
-                  stable=n_unst == 0, n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
+                  stable=np.array([floquet_verdict(p.multipliers) == "stable" for p in points], dtype=bool),
+                  n_unstable=n_unst, stick_phases=np.array([p.stick_phases for p in points]),
                   stick_time=np.array([p.stick_time for p in points]),
                   amplitude=np.array(walk.amplitudes, dtype=float), arclength=np.array(walk.arclength),
                   residuals=np.array([p.residual for p in points]),

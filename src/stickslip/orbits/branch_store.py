@@ -209,7 +209,8 @@ def section_of(spec) -> Section:
 
 def point_record(point) -> dict:
     """A branch point as a JSON-ready dict (exact floats: a resumed run restarts bit for bit);
-    ``open_phases`` and ``open_time`` only where the model has unilateral contacts."""
+    ``open_phases`` and ``open_time`` only where the model has unilateral contacts,
+    ``impact_speed`` only where the point's period has impacts."""
     enc = encode_array
     rec = {"v": enc(point.v), "J": enc(point.J), "M": enc(point.M), "tangent": enc(point.tangent),
            "multipliers": enc(point.multipliers), "stick_phases": int(point.stick_phases),
@@ -217,6 +218,8 @@ def point_record(point) -> dict:
            "iterations": int(point.iterations)}
     if point.open_phases is not None:
         rec.update(open_phases=int(point.open_phases), open_time=float(point.open_time))
+    if point.impact_speed is not None:
+        rec["impact_speed"] = float(point.impact_speed)
     return rec
 
 
@@ -225,6 +228,8 @@ def point_fields(rec: dict) -> dict:
     dec = decode_array
     opened = {} if "open_phases" not in rec else dict(open_phases=int(rec["open_phases"]),
                                                       open_time=float(rec["open_time"]))
+    if "impact_speed" in rec:
+        opened["impact_speed"] = float(rec["impact_speed"])
     return dict(v=dec(rec["v"]), J=dec(rec["J"]), M=dec(rec["M"]), tangent=dec(rec["tangent"]),
                 multipliers=dec(rec["multipliers"]).astype(complex), stick_phases=int(rec["stick_phases"]),
                 stick_time=float(rec["stick_time"]), residual=float(rec["residual"]), iterations=int(rec["iterations"]),

@@ -9,7 +9,10 @@ motion start from — is here.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
+import scipy.linalg
 
 from ..errors import EquilibriumError
 from ..integrate.contacts import STICK_SPEED_TOL
@@ -20,7 +23,7 @@ from ..model.matrices import dense_array
 from ..stability.equilibrium import steady_sliding
 
 __all__ = ["free_states", "equilibrium_state", "ORBIT_MIN_SIZE", "distance_from_steady_sliding", "is_steady_sliding",
-           "stick_projected", "resting_contacts", "rigid_admissible"]
+           "stick_projected", "resting_contacts", "rigid_admissible", "Constraint", "independent_states"]
 
 #: A solution of the shooting equations without stick phases whose state on the section lies closer
 #: than this to the steady-sliding state (‖(s − s_eq)/σ‖ over the free states, σ the orbit's scales)
@@ -109,3 +112,76 @@ def rigid_admissible(system, s: np.ndarray, sp: np.ndarray) -> np.ndarray:
     if refused_rigid_starts(system, out)[0]:
         out = 2.0 * np.asarray(s, dtype=float) - out
     return out
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Constraint:
+    """The rigid contacts closed at a state, whose normal coordinates the orbit tools eliminate.
+
+    A closed rigid contact holds g = g0 + W·q = 0 and ġ = W·q̇ = 0 (its gap is affine in q), so a
+    state on the constraint is fixed by the other free states: for each closed contact one free
+    dof (a pivot of a column-pivoted QR of W on the free dofs: the largest independent entries) is
+    *dependent*, its position and velocity solved from the others. Shooting takes the other free
+    states as its unknowns (``free``), so every iterate lies on the constraint, and its monodromy
+    is the flow's linearisation restricted to the constraint's tangent space, 2(k − m) square for k
+    free dofs and m closed contacts.
+
+    Attributes
+    ----------
+    contacts : tuple of int
+        The closed rigid contacts.
+    free : ndarray (2 (k − m),)
+        State indices of the independent free states: positions, then velocities.
+    dependent : ndarray (m,)
+        The dependent dofs (their positions; their velocities are at n + dependent).
+    W : ndarray (m, n)
+        The contacts' gap gradients.
+    g0 : ndarray (m,)
+        Their gaps at q = 0 [m].
+    """
+
+    contacts: tuple
+    free: np.ndarray
+    dependent: np.ndarray
+    W: np.ndarray
+    g0: np.ndarray
+
+    def complete(self, s: np.ndarray) -> np.ndarray:
+        """``s`` (2n,) with the dependent positions and velocities solved from the others (a copy)."""
+        n = self.W.shape[1]
+        out = np.array(s, dtype=float)
+        J = self.dependent
+        others = np.setdiff1d(np.arange(n), J)
+        WJ, Wo = self.W[:, J], self.W[:, others]
+        out[J] = np.linalg.solve(WJ, -self.g0 - Wo @ out[others])
+        out[n + J] = np.linalg.solve(WJ, -Wo @ out[n + others])
+        return out
+
+    def embedding(self) -> np.ndarray:
+        """∂s/∂s_free (2n × free.size): how a variation of the independent states moves every state."""
+        n = self.W.shape[1]
+        E = np.zeros((2 * n, self.free.size))
+        E[self.free, np.arange(self.free.size)] = 1.0
+        solve = np.linalg.solve(self.W[:, self.dependent], self.W)  # (m, n): rows of W_J⁻¹ W
+        for k, j in enumerate(self.free):
+            part = 0 if j < n else n
+            E[part + self.dependent, k] = -solve[:, j - part]
+        return E
+
+
+def independent_states(system, s: np.ndarray) -> tuple[np.ndarray, Constraint | None]:
+    """The free states that shooting from ``s`` takes as unknowns (with the section's), and the
+    :class:`Constraint` of the rigid contacts closed at ``s`` (None where none is: then every free
+    state, :func:`free_states`)."""
+    closed = [c for c, g, _, tol in rigid_gaps(system, s) if g[0] <= tol[0]] if system.rigid else []
+    if not closed:
+        return free_states(system), None
+    n = system.n
+    W = np.array([dense_array(system.contacts[c].gap_gradient).reshape(-1) for c in closed])
+    g0 = np.array([float(system.contacts[c].gap) for c in closed])
+    dofs = np.flatnonzero(system.free)
+    pivots = scipy.linalg.qr(W[:, dofs], pivoting=True)[2][:len(closed)]
+    dependent = np.sort(dofs[pivots])
+    kept = np.setdiff1d(dofs, dependent)
+    free = np.concatenate([kept, kept + n])
+    return free, Constraint(tuple(closed), free, dependent, W, g0)

@@ -38,14 +38,15 @@ from ..errors import OrbitError, SimulationError
 from ..model.bundle import CST
 from ..model.physics import MODE_STICK, gap
 from ..model.system_model import FrictionModel
+from ..stability.verdict import MARGINAL_RTOL
 from . import linear_flow as _lin
-from .layout import free_states, resting_contacts, rigid_admissible, stick_projected
+from .layout import Constraint, free_states, independent_states, resting_contacts, rigid_admissible, stick_projected
 from .models import ModelResult, model_attrs
 from .section import Section, flow, vector_field
 
 __all__ = ["ShootingProblem", "NewtonResult", "Monodromy", "monodromy", "central_differences",
-           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "stick_count", "stick_time", "stick_summary",
-           "open_count", "open_time",
+           "scales", "sorted_eigenvalues", "nontrivial", "unstable_count", "floquet_verdict", "multiplier_tolerance",
+           "stick_count", "stick_time", "stick_summary", "open_count", "open_time",
            "check_method", "check_section", "METHODS", "DEFAULT_TOL", "DEFAULT_FD_STEP"]
 
 #: Ways of computing ∂Φ/∂s0: variational equations with saltation matrices, or central differences.
@@ -139,9 +140,39 @@ def nontrivial(multipliers: np.ndarray) -> np.ndarray:
     return np.delete(np.asarray(multipliers), k)
 
 
+def multiplier_tolerance(multipliers: np.ndarray) -> float:
+    """Distance from the unit circle within which a multiplier counts as on it [-].
+
+    The trivial multiplier is exactly 1 for the exact monodromy, so its distance from 1 measures
+    the error of the computed one (≈ 1e-8 for saltation, 1e-5 for differences, docs/orbits.md); a
+    round-off floor :data:`~stickslip.stability.verdict.MARGINAL_RTOL` × max(1, max |μ|) is kept
+    below it, as for the eigenvalues of steady sliding.
+    """
+    mu = np.asarray(multipliers)
+    trivial = float(np.min(np.abs(mu - 1.0)))
+    return max(trivial, MARGINAL_RTOL * max(1.0, float(np.max(np.abs(mu)))))
+
+
+def floquet_verdict(multipliers: np.ndarray) -> str:
+    """``stable`` (every non-trivial |μ| < 1 − tolerance), ``unstable`` (some > 1 + tolerance) or
+    ``marginal`` (the largest on the unit circle within :func:`multiplier_tolerance`: a neutral
+    cycle, e.g. of a conservative motion, which the linearisation leaves undecided); ``unknown``
+    where the multipliers are not computed (NaN)."""
+    mu = np.asarray(multipliers)
+    if mu.size == 0 or not np.all(np.isfinite(mu)):
+        return "unknown"
+    others = np.abs(nontrivial(mu))
+    if others.size == 0:
+        return "stable"
+    tol = multiplier_tolerance(mu)
+    if others.max() > 1.0 + tol:
+        return "unstable"
+    return "stable" if others.max() < 1.0 - tol else "marginal"
+
+
 def unstable_count(multipliers: np.ndarray) -> int:
-    """Number of non-trivial multipliers outside the unit circle."""
-    return int(np.sum(np.abs(nontrivial(multipliers)) > 1.0))
+    """Number of non-trivial multipliers outside the unit circle (by more than :func:`multiplier_tolerance`)."""
+    return int(np.sum(np.abs(nontrivial(multipliers)) > 1.0 + multiplier_tolerance(multipliers)))
 
 
 def stick_count(transitions) -> int:
@@ -246,6 +277,10 @@ class ShootingProblem:
         The Poincaré section (None: a flow map without a section, as for Lyapunov exponents).
     max_steps_per_second : float, optional
         Cap on the integrator steps per simulated second of a flow map (None: the driver's cap).
+    constraint : Constraint, optional
+        The rigid contacts closed on the section (:func:`.layout.independent_states`): ``free`` are
+        then the independent free states, every state the problem makes is completed onto the
+        constraint, and ∂Φ/∂s0 is restricted to it.
     counter : dict
         ``{"simulations": flow maps run}``.
     """
@@ -258,22 +293,47 @@ class ShootingProblem:
     fd_step: float = DEFAULT_FD_STEP
     section: Section | None = None
     max_steps_per_second: float | None = None
+    constraint: Constraint | None = None
     counter: dict = dataclasses.field(default_factory=lambda: {"simulations": 0})
 
     @classmethod
     def build(cls, system: FrictionModel, *, sigma, rtol: float, atol: float, section: Section | None = None,
-              **options) -> "ShootingProblem":
-        """The problem of ``system`` (``options``: fd_step, max_steps_per_second).
+              constraint: Constraint | None = None, **options) -> "ShootingProblem":
+        """The problem of ``system`` (``options``: fd_step, max_steps_per_second); ``sigma`` the scales
+        of its free states, the independent ones of ``constraint`` where given.
 
         Raises
         ------
         OrbitError
-            If ``section`` fixes a state the model locks.
+            If ``section`` fixes a state the model locks, or one the constraint makes dependent.
         """
+        free = free_states(system) if constraint is None else constraint.free
         if section is not None:
             check_section(section, system)
-        return cls(system=system, free=free_states(system), sigma=np.asarray(sigma, dtype=float), rtol=rtol,
-                   atol=atol, section=section, **options)
+            if section.index not in free:
+                raise OrbitError(f"section {section.name} fixes {system.state_names[section.index]}, which rigid "
+                                 f"contact {system.contact_names[constraint.contacts[0]]} holds closed on the "
+                                 "section: choose a section of another coordinate")
+        return cls(system=system, free=free, sigma=np.asarray(sigma, dtype=float), rtol=rtol, atol=atol,
+                   section=section, constraint=constraint, **options)
+
+    def complete(self, s: np.ndarray) -> np.ndarray:
+        """``s`` on the constraint (its dependent states solved from the others), or ``s`` itself."""
+        return s if self.constraint is None else self.constraint.complete(s)
+
+    @functools.cached_property
+    def embedding(self) -> np.ndarray:
+        """∂s/∂s_free (2n × 2 n_free) on the constraint: a unit variation of each free state, completed."""
+        return self.constraint.embedding()
+
+    def _check_scale(self) -> np.ndarray:
+        """σ of every free state of the model (1 on the dependent ones): the scales of the
+        variational re-integration's consistency checks."""
+        if self.constraint is None:
+            return self.sigma
+        full = np.ones(2 * self.system.n)
+        full[self.free] = self.sigma
+        return full[free_states(self.system)]
 
     @property
     def options(self) -> dict:
@@ -303,7 +363,7 @@ class ShootingProblem:
         k = self.unknown
         s[self.free[k]] = z * self.sigma[k]
         s[self.section.index] = self.section.value
-        return s
+        return self.complete(s)
 
     def unknowns(self, s: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`state`: the unknown states of ``s`` in units of σ."""
@@ -314,28 +374,41 @@ class ShootingProblem:
     def fd_monodromy(self, s0: np.ndarray, T: float, cols=None, system: FrictionModel | None = None) -> np.ndarray:
         """∂Φ(s0, T)/∂s0 by central differences (steps ``fd_step`` σ), free rows × ``cols``
         (positions in :attr:`free`; default all): two flow maps a column."""
-        return central_differences(lambda s: self.flow(s, T, system)[0], s0, self.free, self.fd_step * self.sigma,
-                                   cols)
+        return central_differences(lambda s: self.flow(self.complete(s), T, system)[0], s0, self.free,
+                                   self.fd_step * self.sigma, cols)
 
-    def monodromy(self, s0: np.ndarray, T: float, method: str = "saltation"):
-        """∂Φ(s0, T)/∂s0 on the free states (2 n_free × 2 n_free) and the jumps applied
-        (``saltation``: :func:`.linear_flow.flow_jacobian`, which raises where it cannot follow the
-        event sequence; ``finite-difference``: :meth:`fd_monodromy`, no jumps)."""
+    def monodromy(self, s0: np.ndarray, T: float, method: str = "saltation", system: FrictionModel | None = None):
+        """∂Φ(s0, T)/∂s0 on the free states (2 n_free × 2 n_free) of ``system`` (default: the
+        problem's) and the jumps applied (``saltation``: :func:`.linear_flow.flow_jacobian`, which
+        raises where it cannot follow the event sequence; ``finite-difference``: :meth:`fd_monodromy`,
+        no jumps)."""
         if method == "saltation":
-            fj = _lin.flow_jacobian(self.system, s0, T, scale=self.sigma, rtol=self.rtol, atol=self.atol)
-            return fj.matrix[np.ix_(self.free, self.free)], fj.events
-        return self.fd_monodromy(s0, T), ()
+            self.counter["simulations"] += 1
+            fj = _lin.flow_jacobian(self.system if system is None else system, s0, T, scale=self._check_scale(),
+                                    rtol=self.rtol, atol=self.atol)
+            if self.constraint is None:
+                return fj.matrix[np.ix_(self.free, self.free)], fj.events
+            return fj.matrix[self.free] @ self.embedding, fj.events
+        return self.fd_monodromy(s0, T, system=system), ()
 
-    def newton_columns(self, s0: np.ndarray, T: float, method: str) -> np.ndarray:
-        """∂Φ(s0, T)/∂s0 on the free rows and the unknown columns by ``method``; ``saltation``
-        falls back to differences where the variational re-integration fails (e.g. an iterate
-        whose event sequence differs from the integrator's)."""
+    def monodromy_columns(self, s0: np.ndarray, T: float, method: str, cols=None,
+                          system: FrictionModel | None = None) -> np.ndarray:
+        """∂Φ(s0, T)/∂s0 on the free rows and the columns ``cols`` (positions in :attr:`free`;
+        default all) by ``method``; ``saltation`` falls back to differences where the variational
+        re-integration fails (e.g. an iterate whose event sequence differs from the integrator's,
+        an impact that ends in stick)."""
         if method == "saltation":
             try:
-                return self.monodromy(s0, T, method)[0][:, self.unknown]
+                M = self.monodromy(s0, T, method, system)[0]
+                return M if cols is None else M[:, cols]
             except (OrbitError, SimulationError, ArithmeticError, np.linalg.LinAlgError):
                 pass
-        return self.fd_monodromy(s0, T, self.unknown)
+        return self.fd_monodromy(s0, T, cols, system)
+
+    def newton_columns(self, s0: np.ndarray, T: float, method: str) -> np.ndarray:
+        """∂Φ(s0, T)/∂s0 on the free rows and the unknown columns by ``method``
+        (:meth:`monodromy_columns`)."""
+        return self.monodromy_columns(s0, T, method, self.unknown)
 
     def jacobian(self, columns: np.ndarray, end: np.ndarray, system: FrictionModel | None = None,
                  T_scale: float = 1.0) -> np.ndarray:
@@ -377,6 +450,7 @@ class ShootingProblem:
             for _ in range(MAX_HALVINGS + 1):
                 s_new = s0.copy()
                 s_new[moved] += lam * step[:-1] * sigma[self.unknown]
+                s_new = self.complete(s_new)
                 T_new = T + lam * step[-1]
                 try:
                     R_new, end_new, tr_new = self.residual(s_new, T_new)
@@ -429,9 +503,15 @@ class Multipliers:
         return nontrivial(self.multipliers)
 
     @property
+    def verdict(self) -> str:
+        """``stable``, ``marginal`` or ``unstable`` (:func:`floquet_verdict`)."""
+        return floquet_verdict(self.multipliers)
+
+    @property
     def stable(self) -> bool:
-        """True if every non-trivial multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.nontrivial_multipliers) < 1.0))
+        """True if every non-trivial multiplier lies inside the unit circle (by more than
+        :func:`multiplier_tolerance`: a neutral cycle is marginal, not stable)."""
+        return self.verdict == "stable"
 
 
 def multiplier_variables(multipliers: np.ndarray, dims) -> dict:
@@ -518,6 +598,7 @@ def monodromy(orbit, method: str = "saltation", *, fd_step: float | None = None)
     t0 = _time.perf_counter()
     opt = orbit.options
     problem = ShootingProblem.build(orbit.system, sigma=orbit.scale, rtol=opt["rtol"], atol=opt["atol"],
+                                    constraint=independent_states(orbit.system, orbit.state)[1],
                                     fd_step=opt.get("fd_step", DEFAULT_FD_STEP) if fd_step is None else fd_step)
     M, events = problem.monodromy(orbit.state, orbit.period, method)
     return Monodromy(matrix=M, multipliers=sorted_eigenvalues(M), method=method, period=float(orbit.period),

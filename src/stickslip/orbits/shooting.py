@@ -34,7 +34,7 @@ from ..integrate.result import Trajectory
 from ..model.library import two_plates
 from ..model.parameters import Parameters
 from ..model.system_model import DEFAULT_SLIP_BAND, FrictionModel
-from .layout import free_states, is_steady_sliding
+from .layout import independent_states, is_steady_sliding
 from .models import ModelResult, model_attrs, resolve
 from .problem import (DEFAULT_FD_STEP, DEFAULT_TOL, MAX_HALVINGS, SCALE_FLOOR, Multipliers, ShootingProblem,
                       check_method, check_section, multiplier_variables, scales, sorted_eigenvalues, stick_count)
@@ -168,13 +168,16 @@ def _guess_from_samples(system, section, t, states, mode, multiplicity, *, rtol,
     return s0, T0, ptp, miss
 
 
-def _refuse_closed_rigid(system, section, s0) -> None:
-    """Refuse a section crossed with a rigid contact closed: the unknowns would leave g = 0 (into
-    the stop, or off it without an opening), so such an orbit is shot from a flight."""
-    closed = [system.contact_names[c] for c, g, _, tol in rigid_gaps(system, s0) if g[0] <= tol[0]]
-    if closed:
-        raise OrbitError(f"section {section.name} is crossed with rigid contact {', '.join(closed)} closed; choose a "
-                         "section crossed while the rigid contacts are open, e.g. the highest point of a flight "
+def _check_on_constraint(system, constraint, end) -> None:
+    """Refuse an orbit whose run leaves the rigid contacts that are closed on its section open at
+    its end (the eliminated states then do not return: not a periodic orbit)."""
+    if constraint is None:
+        return
+    opened = [system.contact_names[c] for c, g, _, tol in rigid_gaps(system, end) if c in constraint.contacts
+              and g[0] > tol[0]]
+    if opened:
+        raise OrbitError(f"shooting converged onto a state whose run ends with rigid contact {', '.join(opened)} "
+                         "open, closed on the section: not a periodic orbit; choose a section crossed in a flight "
                          "('<dof>_max' of the dof that opens the gap)")
 
 
@@ -305,10 +308,11 @@ def periodic_orbit(
         if guess.status != "success":
             raise OrbitError(f"the search run failed: {guess.status}")
     s0, T, ptp, _ = _guess_from_samples(system, sec, guess.t, guess.states, guess.mode, k, **opts)
-    _refuse_closed_rigid(system, sec, s0)
-    problem = ShootingProblem.build(system, sigma=scales(ptp, free_states(system)), section=sec, fd_step=fd_step,
-                                    **opts)
-    orbit = problem.newton(s0, T, tol=tol, max_iter=max_iter, method=newton_jacobian)
+    free, constraint = independent_states(system, s0)
+    problem = ShootingProblem.build(system, sigma=scales(ptp, free), section=sec, fd_step=fd_step,
+                                    constraint=constraint, **opts)
+    orbit = problem.newton(problem.complete(s0), T, tol=tol, max_iter=max_iter, method=newton_jacobian)
+    _check_on_constraint(system, constraint, orbit.end)
     stick_phases = stick_count(orbit.transitions)
     if steady_sliding == "refuse" and is_steady_sliding(system, orbit.state, problem.free, problem.sigma, stick_phases):
         raise SteadySlidingOrbitError(

@@ -32,6 +32,13 @@ consecutive points that have multipliers, and classify a change by what crossed 
                       singular there): where the steps shrink below ``min_step`` and the flight
                       time τ_open of the last points extrapolates to zero (τ_open² linear in λ,
                       as for ``stick-vanishing``), the grazing is reported after the last point.
+                      So does an impact that grazes (its landing speed v_i → 0 where the
+                      free motion's extreme touches the stop): the return map has a square-root
+                      singularity there (v_i ∝ √(λ* − λ), the period turns with the same root),
+                      the steps shrink below ``min_step`` and the grazing is where v_i² of the
+                      last points extrapolates linearly to zero (:func:`impact_grazing`); from
+                      the side of the free orbits, where their smallest gap to the stop does
+                      (:func:`approach_grazing`).
 ``hopf``              the branch turns where a pure-slip cycle has shrunk onto the equilibrium
                       (distance from it < :data:`HOPF_RATIO` of the start's): the Hopf point of
                       the linearisation (paper Eq. 15, Appendix); the branch ends.
@@ -95,6 +102,10 @@ LOCATE_RTOL, MAX_LOCATE = 1e-3, 12
 HOPF_STOP = "hopf (the cycle shrinks onto the equilibrium)"
 #: Stop reason of a branch that ends at a rigid contact's grazing (:func:`flight_vanishing`).
 FLIGHT_VANISHING_STOP = "flight vanishing (grazing of a rigid contact)"
+#: Stop reason of a branch that ends where an impact grazes (:func:`impact_grazing`).
+IMPACT_GRAZING_STOP = "impact grazing (the landing speed of a rigid contact vanishes)"
+#: Stop reason of a branch of free orbits that ends where they touch a rigid stop (:func:`approach_grazing`).
+APPROACH_GRAZING_STOP = "impact grazing (the free orbit touches a rigid stop)"
 
 #: Tests located by the Illinois method (sign changes of a continuous function).
 _CONTINUOUS = ("fold", "period-doubling")
@@ -291,6 +302,8 @@ def _locate(problem: Problem, left: Point, right: Point, kind: str, h: float, to
             break
         evaluations += 1
         fs = _test_values(p)[kind]
+        if fs is None:  # no multipliers there (an impact grazes): not located further
+            break
         best = p
         same_as_left = (np.sign(fs) == np.sign(fa)) if continuous else (fs == f_left)
         if same_as_left:
@@ -474,6 +487,58 @@ def _stick_vanishing(problem: Problem, points: list, index: int) -> SpecialPoint
                         multipliers_before=points[-2].multipliers, multipliers_after=last.multipliers)
 
 
+def _grazing_after(problem: Problem, points: list, duration, before: float, after: float = 0.0) -> SpecialPoint | None:
+    """A ``grazing`` point after the last of ``points`` where ``duration`` (a positive size of the
+    last points that vanishes as √(λ* − λ)) extrapolates to zero, or None where it is not located."""
+    last = points[-1]
+    value, located = _extrapolated_zero(problem, points, duration)
+    if not located:
+        return None
+    s, T, lam_last = problem.unpack(last.v)
+    return SpecialPoint(kind="grazing", index=len(points) - 1, value=value, period=T, state=s,
+                        multipliers=last.multipliers, before=before, after=after,
+                        bracket=float(abs(value - lam_last)), located=True, multipliers_before=last.multipliers,
+                        multipliers_after=_nan_like(last))
+
+
+def impact_grazing(problem: Problem, points: list) -> SpecialPoint | None:
+    """The grazing of an impact where a branch ends, or None.
+
+    Towards the parameter λ* where the free motion's extreme just touches a rigid stop, the
+    smallest landing speed of the orbit's impacts vanishes as v_i ∝ √(λ* − λ) (the penetration the
+    free motion would make, v_i²/(2 |g̈|), is linear in λ); the return map has a square-root
+    singularity there and the corrector's steps shrink to ``min_step`` before it. When the branch
+    ends so, the grazing is where v_i² of the last points extrapolates linearly to zero
+    (:func:`_extrapolated_zero`): a ``grazing`` point after the last (``before`` its flight phases
+    per period, ``after`` 0), reported only where the extrapolation locates it.
+    """
+    last = points[-1]
+    if last.impact_speed is None:
+        return None
+    return _grazing_after(problem, points, lambda p: p.impact_speed or 0.0, float(last.open_phases or 0))
+
+
+def approach_grazing(problem: Problem, points: list, smallest_gap) -> SpecialPoint | None:
+    """The grazing of a rigid stop that a branch of free orbits ends at, or None.
+
+    Towards it the smallest gap g_min of the free motion to a rigid contact (``smallest_gap(point)``,
+    ≥ 0 [m]) falls linearly in λ to 0; past it the orbit lands on the stop, whose return map has a
+    square-root singularity there, so the corrector's steps shrink to ``min_step`` before it. The
+    grazing is where g_min of the last points extrapolates linearly to zero
+    (:func:`_extrapolated_zero` of √g_min): a ``grazing`` point after the last (``before`` its
+    flight phases per period, ``after`` one more: an impact appears), reported only where the
+    extrapolation locates it.
+    """
+    last = points[-1]
+    if last.impact_speed is not None:
+        return None
+    gaps = {id(p): smallest_gap(p) for p in points[-VANISH_FIT_POINTS:]}
+    if not all(np.isfinite(g) and g >= 0.0 for g in gaps.values()):
+        return None
+    before = float(last.open_phases or 0)
+    return _grazing_after(problem, points, lambda p: np.sqrt(gaps.get(id(p), 0.0)), before, before + 1.0)
+
+
 def flight_vanishing(problem: Problem, points: list) -> SpecialPoint | None:
     """The grazing of a rigid contact where a branch ends, or None.
 
@@ -488,11 +553,4 @@ def flight_vanishing(problem: Problem, points: list) -> SpecialPoint | None:
     last = points[-1]
     if not last.open_phases:
         return None
-    value, located = _extrapolated_zero(problem, points, lambda p: p.open_time or 0.0)
-    if not located:
-        return None
-    s, T, lam_last = problem.unpack(last.v)
-    return SpecialPoint(kind="grazing", index=len(points) - 1, value=value, period=T, state=s,
-                        multipliers=last.multipliers, before=float(last.open_phases), after=0.0,
-                        bracket=float(abs(value - lam_last)), located=True, multipliers_before=last.multipliers,
-                        multipliers_after=_nan_like(last))
+    return _grazing_after(problem, points, lambda p: p.open_time or 0.0, float(last.open_phases))

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.modes import flag_bits
 from ._common import agg_figure, save_figure
 from .trajectory import stick_intervals
 
@@ -100,7 +101,7 @@ def plot_belt(attractors, window=40.0, fig=None):
     ax_p.grid(alpha=0.3)
     run = attractors.runs["LC"]
     shown = run.t >= run.t[-1] - window
-    for a, b in stick_intervals(run.t[shown], run.mode[shown]):
+    for a, b in stick_intervals(run.t[shown], flag_bits(run.mode[shown], 0, run.system.n_contacts).any(axis=1)):
         ax_t.axvspan(a, b, color="tab:orange", alpha=0.25, lw=0)
     ax_t.plot(run.t[shown], run.states[shown, 0], color="tab:red", lw=1.2, label="x (LC)")
     ax_t.axhline(attractors.breakaway, color="tab:orange", lw=0.8, ls="--")
@@ -136,12 +137,13 @@ def plot_popp_stelter(traj, periods_shown=3.0, period=None, fig=None):
     shown = traj.t >= traj.t[-1] - periods_shown * period
     t = traj.t[shown]
     n = traj.system.n
+    sticks = flag_bits(traj.mode[shown], 0, traj.system.n_contacts)  # (k, nc): any width of mode word
     for c, colour in enumerate(CONTACT_COLOURS[:traj.system.n_contacts]):
-        stuck = ((traj.mode[shown] >> c) & 1).astype(np.int8)
+        stuck = sticks[:, c]
         V = traj.system.contacts[c].drive[0]
         ax_t, ax_p = axes[c]
         for other, other_colour in enumerate(CONTACT_COLOURS[:traj.system.n_contacts]):
-            for a, b in stick_intervals(t, (traj.mode[shown] >> other) & 1):
+            for a, b in stick_intervals(t, sticks[:, other]):
                 ax_t.axvspan(a, b, color=other_colour, alpha=0.25 if other == c else 0.08, lw=0)
         x, v = traj.states[shown, c], traj.states[shown, n + c]
         ax_t.plot(t, x, color="k", lw=1.0)
@@ -156,7 +158,7 @@ def plot_popp_stelter(traj, periods_shown=3.0, period=None, fig=None):
         ax_p.grid(alpha=0.3)
     axes[1][0].set_xlabel("time [-]")
     axes[0][0].set_title("shaded: stick of contact 0 (orange) and contact 1 (purple)", fontsize=8)
-    stuck_both = np.count_nonzero(traj.mode[shown] == 3)
+    stuck_both = np.count_nonzero(sticks[:, :2].all(axis=1))
     fig.suptitle(f"popp-stelter: stick-slip orbit, period {period:.4f}; the contacts stick in turn"
                  + ("" if stuck_both == 0 else " and together"), fontsize=10)
     return fig

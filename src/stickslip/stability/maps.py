@@ -33,6 +33,7 @@ from ..results import Plottable
 from . import steady
 from .analysis import model_stability
 from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds
+from .verdict import MARGINAL_RTOL
 
 __all__ = ["StabilityMap", "stability_map", "max_real_part", "boundary_omegas", "load_stability_map",
            "parse_family", "MapGrid"]
@@ -237,27 +238,36 @@ class MapGrid:
         steady.jacobian_points(tables, system.data.kin, system.data.law, free, MAX_ITER, RESIDUAL_TOL, out)
         return out
 
-    def max_real_part(self) -> np.ndarray:
-        """max Re λ over the grid (nA, nB) [1/s], NaN where no steady sliding exists."""
+    def max_real_part(self) -> tuple[np.ndarray, np.ndarray]:
+        """max Re λ over the grid (nA, nB) [1/s], NaN where no steady sliding exists, and the
+        tolerance within which it counts as 0 (:data:`.verdict.MARGINAL_RTOL` × ‖J‖₂) [1/s]."""
         nA, nB = self.a.size, self.b.size
         if self.system.rigid:
-            return np.array([[self.value_at(i, y) for y in self.b] for i in range(nA)]).reshape(nA, nB)
+            rows = [[self.constrained_point(i, y) for y in self.b] for i in range(nA)]
+            return tuple(np.array([[p[k] for p in row] for row in rows]).reshape(nA, nB) for k in (0, 1))
         ia_all = np.repeat(np.arange(nA, dtype=np.int64), nB)
         ib_all = np.tile(np.arange(nB, dtype=np.int64), nA)
         out = np.full(nA * nB, np.nan)
+        tol = np.full(nA * nB, np.nan)
         for p0 in range(0, nA * nB, CHUNK_POINTS):
             sl = slice(p0, p0 + CHUNK_POINTS)
             J = self.jacobians(ia_all[sl], ib_all[sl])
             ok = np.isfinite(J[:, 0, 0])
             if np.any(ok):
                 out[sl][ok] = np.linalg.eigvals(J[ok]).real.max(axis=-1)
-        return out.reshape(nA, nB)
+                tol[sl][ok] = MARGINAL_RTOL * np.linalg.norm(J[ok], 2, axis=(1, 2))
+        return out.reshape(nA, nB), tol.reshape(nA, nB)
+
+    def constrained_point(self, i: int, y: float) -> tuple[float, float]:
+        """(max Re λ, its tolerance) [1/s] of a model with rigid contacts at ``a[i]`` and the second
+        parameter = ``y`` (:func:`_constrained_max_real_part`)."""
+        return _constrained_max_real_part(self.system.replace(**{self.names[0]: float(self.a[i]),
+                                                                 self.names[1]: float(y)}))
 
     def value_at(self, i: int, y: float) -> float:
         """max Re λ at the first axis' value ``a[i]`` and the second parameter = ``y`` [1/s]."""
         if self.system.rigid:
-            return _constrained_max_real_part(self.system.replace(**{self.names[0]: float(self.a[i]),
-                                                                     self.names[1]: float(y)}))
+            return self.constrained_point(i, y)[0]
         if self.separable:
             J = self.jacobians(np.array([i]), np.array([0]), self.axis_b.rows([y]))
         else:
@@ -265,17 +275,19 @@ class MapGrid:
         return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
 
 
-def _constrained_max_real_part(system) -> float:
-    """max Re λ at steady sliding of a model with rigid contacts [1/s], NaN without steady sliding.
+def _constrained_max_real_part(system) -> tuple[float, float]:
+    """max Re λ at steady sliding of a model with rigid contacts and its tolerance [1/s], NaN without
+    steady sliding.
 
     Its closed rigid contacts make the eigenproblem a constrained one (the motion that keeps them
     closed, :func:`~stickslip.stability.analysis.model_stability`), which the compiled grid kernel
     does not solve: each point is one Newton solve and one eigenproblem in Python (milliseconds).
     """
     try:
-        return float(np.max(model_stability(system).eigenvalues.real))
+        result = model_stability(system)
     except EquilibriumError:
-        return math.nan
+        return math.nan, math.nan
+    return float(np.max(result.eigenvalues.real)), float(result.tolerance)
 
 
 def _jacobian_of(system) -> np.ndarray:
@@ -362,6 +374,10 @@ class StabilityMap(Plottable):
         ``contact.0.friction.mu_k``).
     system : FrictionModel or None
         The base model.
+    marginal_tolerance : ndarray (nF, nA, nB), optional
+        Tolerance within which max Re λ counts as 0 at each point, :data:`.verdict.MARGINAL_RTOL`
+        × ‖J‖₂ [1/s]: a point within it is ``marginal`` (a centre or a zero eigenvalue), neither
+        stable nor unstable (:attr:`verdicts`).
     """
 
     FIGURE = "stability_map"
@@ -379,12 +395,37 @@ class StabilityMap(Plottable):
     timings: dict
     axes: tuple = ("N", "Omega")
     system: object = None
+    marginal_tolerance: np.ndarray | None = None
+
+    @property
+    def tolerance(self) -> np.ndarray:
+        """(nF, nA, nB): the tolerance within which max Re λ counts as 0 (:data:`.verdict.MARGINAL_RTOL`
+        × ‖J‖₂ of each point; 0 for a map read from a file written without it) [1/s]."""
+        if self.marginal_tolerance is None:
+            return np.zeros_like(self.max_real_part)
+        return self.marginal_tolerance
 
     @property
     def stable(self) -> np.ndarray:
-        """Boolean (nF, nA, nB): max Re λ < 0 (False where no equilibrium exists)."""
+        """Boolean (nF, nA, nB): max Re λ < −tolerance (False where no equilibrium exists)."""
         with np.errstate(invalid="ignore"):
-            return self.max_real_part < 0.0
+            return self.max_real_part < -self.tolerance
+
+    @property
+    def marginal(self) -> np.ndarray:
+        """Boolean (nF, nA, nB): |max Re λ| ≤ tolerance, a centre or a zero eigenvalue that the
+        linearisation leaves undecided (:func:`.verdict.stability_verdict`)."""
+        with np.errstate(invalid="ignore"):
+            return np.abs(self.max_real_part) <= self.tolerance
+
+    @property
+    def verdicts(self) -> np.ndarray:
+        """(nF, nA, nB) of str: ``stable``, ``marginal``, ``unstable`` or ``none`` (no equilibrium)."""
+        out = np.full(self.max_real_part.shape, "unstable", dtype=object)
+        out[self.stable] = "stable"
+        out[self.marginal] = "marginal"
+        out[~np.isfinite(self.max_real_part)] = "none"
+        return out
 
     @property
     def family_labels(self) -> list[str]:
@@ -420,7 +461,12 @@ class StabilityMap(Plottable):
                               {"units": "1/s", "long_name": "largest real part of the eigenvalues at steady sliding"}),
             "stable": (grid, self.stable.astype(np.int8),
                        {"long_name": "steady sliding asymptotically stable", "flag_values": "0 1",
-                        "flag_meanings": "unstable_or_no_equilibrium stable"}),
+                        "flag_meanings": "unstable_marginal_or_no_equilibrium stable"}),
+            "marginal": (grid, self.marginal.astype(np.int8),
+                         {"long_name": "max Re(lambda) = 0 within the eigenvalue solver's accuracy",
+                          "flag_values": "0 1", "flag_meanings": "decided marginal"}),
+            "marginal_tolerance": (grid, self.tolerance,
+                                   {"units": "1/s", "long_name": "tolerance within which max Re(lambda) counts as 0"}),
             "equilibrium_found": (grid, np.isfinite(self.max_real_part).astype(np.int8),
                                   {"long_name": "steady-sliding equilibrium found"}),
             bname: (("family", a, "crossing"), self.boundary, battrs),
@@ -494,6 +540,7 @@ def load_stability_map(path: str | Path) -> StabilityMap:
         boundary=ds["boundary_omega" if "boundary_omega" in ds else "boundary"].values,
         boundary_direction=ds["boundary_direction"].values, boundary_jump=ds["boundary_jump"].values.astype(bool),
         timings=json.loads(ds.attrs["timings"]), axes=(a, b), system=system,
+        marginal_tolerance=ds["marginal_tolerance"].values if "marginal_tolerance" in ds else None,
     )
 
 
@@ -583,7 +630,7 @@ def stability_map(
     _check_memory(system, N.size, Omega.size, len(systems))
     t0 = time.perf_counter()
     grids = [MapGrid.build(sy, axes, N, Omega) for sy in systems]
-    mrp = np.stack([g.max_real_part() for g in grids])
+    mrp, tol = (np.stack(part) for part in zip(*(g.max_real_part() for g in grids)))
     t1 = time.perf_counter()
     per = [[([], [], []) for _ in N] for _ in systems]
     if boundary:
@@ -606,4 +653,5 @@ def stability_map(
         family_name=name, family_values=values if name else [],
         max_real_part=mrp, boundary=bnd, boundary_direction=bdir, boundary_jump=bjump,
         timings={"grid_s": t1 - t0, "boundary_s": t2 - t1, "points": int(mrp.size)}, axes=axes, system=system,
+        marginal_tolerance=tol,
     )
