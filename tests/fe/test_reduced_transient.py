@@ -78,6 +78,33 @@ def test_every_contact_node_sticks_slips_and_lifts_off(pad):
     assert np.all(run.stick.any(axis=0)) and np.all(run.open.any(axis=0)) and np.all(slipping.any(axis=0))
 
 
+def test_the_full_run_before_its_first_transition_against_scipy(pad):
+    """Until the first transition every contact is closed and slips against the belt: a linear ODE
+    that scipy's DOP853 integrates from the matrices alone (normal force k (preload − u_y), friction
+    μk N along +x, the belt's direction)."""
+    from scipy.integrate import solve_ivp
+
+    _, full, _, run = pad
+    fe = lined_pad(**LINED)
+    M, C, K = fe.mass.toarray(), fe.damping_matrix.toarray(), fe.stiffness.toarray()
+    Minv, n, kc = np.linalg.inv(M), fe.n, fe.contact["stiffness"]
+
+    def rhs(t, s):
+        f = -C @ s[n:] - K @ s[:n]
+        normal = -kc * (fe.gap + s[fe.normal_dof])
+        f[fe.normal_dof] += normal
+        f[fe.tangent_dof] += fe.friction["mu_k"] * normal
+        return np.concatenate([s[n:], Minv @ f])
+
+    first = float(run.transitions.time[0])
+    short = simulate(full, 0.99 * first, sample_rate=50 / first, **TOL)  # 50 samples before it
+    assert short.transitions.time.size == 0 and np.all(~short.stick & ~short.open)
+    ref = solve_ivp(rhs, (0.0, short.t[-1]), np.zeros(2 * n), method="DOP853", t_eval=short.t, rtol=1e-12, atol=1e-16)
+    for part in (slice(0, n), slice(n, 2 * n)):  # displacements, velocities: each to 1e-8 of its range
+        expected = ref.y.T[:, part]
+        np.testing.assert_allclose(short.states[:, part], expected, rtol=0, atol=1e-8 * np.abs(expected).max())
+
+
 def test_truncated_craig_bampton_runs_the_full_transient_to_1e_6(pad):
     _, full, _, run = pad
     measured = {}
