@@ -118,14 +118,15 @@ def _residual_vectors(Mii, solve, load, Phi, blocks: int) -> np.ndarray:
     for _ in range(blocks):
         X = solve(X)
         scale = np.max(np.einsum("ij,ij->j", X, Mii @ X), initial=0.0)  # the largest M-norm² before projection
-        for _ in range(2):  # Gram–Schmidt twice: the blocks are nearly parallel to the modes kept
-            X = X - basis @ (basis.T @ (Mii @ X))
-        G = X.T @ (Mii @ X)
-        w, U = np.linalg.eigh(0.5 * (G + G.T))
-        keep = w > 1e-10 * scale  # directions the basis holds already (to round-off) are dropped
-        if not keep.any():
+        for _ in range(2):  # twice: the blocks are nearly parallel to the modes kept, and to round-off
+            X = X - basis @ (basis.T @ (Mii @ X))  # M-orthogonal to the basis
+            G = X.T @ (Mii @ X)
+            w, U = np.linalg.eigh(0.5 * (G + G.T))
+            keep = w > 1e-10 * scale  # directions the basis holds already (to round-off) are dropped
+            X = X @ (U[:, keep] / np.sqrt(w[keep]))  # M-orthonormal within the block
+            scale = 1.0
+        if not X.shape[1]:
             break
-        X = X @ (U[:, keep] / np.sqrt(w[keep]))
         basis = np.hstack([basis, X])
         X = Mii @ X
     return basis[:, Phi.shape[1]:]
