@@ -79,8 +79,8 @@ def reduce(
         print_json(summary)
         return
     console.print(f"{method}: {system.n} dofs → {reduced.form.n} ({reduced.boundary.size} contact and loaded dofs "
-                  f"kept, {reduced.frequencies.size} modes up to {reduced.frequencies[-1]:.6g} rad/s, {reduced.residual} residual "
-                  f"vectors); wrote {out}")
+                  f"kept, {reduced.frequencies.size} modes up to {reduced.frequencies[-1]:.6g} rad/s, "
+                  f"{reduced.residual} residual vectors); wrote {out}")
     if report is not None:
         table = Table(title=f"steady-sliding eigenvalues with |Im λ| ≤ {band:.6g} rad/s: full model and reduced")
         for head in ("full: growth rate [1/s]", "angular frequency [rad/s]", "reduced: growth rate",

@@ -17,9 +17,9 @@ response to the inertia load of a unit boundary acceleration, X₁ = K_ii⁻¹ (
 X_{k+1} = K_ii⁻¹ M_ii X_k (a Krylov sequence of the boundary's inertia load), each block
 M_ii-orthogonalised against Φ and the blocks before it. The truncated modes' part of the interior
 motion driven by the boundary is, to leading order in (ω/ω_c)², the static response the first block
-holds; each further block carries the next order (the second-order Craig–Bampton bases and the
-Krylov-augmented ones of the literature; Nastran's ``RESVEC`` of the interior's inertia). They
-cost one pair of triangular solves of K_ii per block and boundary DOF.
+holds; each further block carries the next order (the second-order and Krylov-augmented
+Craig–Bampton bases of the literature). They cost one pair of triangular solves of K_ii per block
+and boundary DOF.
 
 The contacts touch only boundary DOFs and the η columns of T vanish there, so every contact row
 re-expressed on the reduced coordinates (G T, W T, n T) is the same row on the same named DOFs:
