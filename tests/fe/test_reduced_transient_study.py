@@ -77,3 +77,12 @@ def test_without_separation_a_truncated_basis_stays_far_off(tmp_path):
     fe = dataclasses.replace(fe, mass=sp.diags(np.asarray(fe.mass.sum(axis=1)).ravel(), format="csr"))
     _, _, out = study(fe, tmp_path, [(50, 0), (40, 0)])  # of its 54 interior modes
     assert all(max(row[1]) > 1e-1 for row in out.values()), out
+
+
+def test_a_finer_plate_keeps_the_reduced_size_and_error(tmp_path):
+    """The plate meshed in 11 rows instead of 7 (216 dofs): the reduced models keep their sizes (set by
+    the contact dofs) and their errors."""
+    fe = lined_pad(**{**LINED, "ny": 12})
+    full, _, out = study(fe, tmp_path, [(2, 0), (2, 1), (16, 0)])
+    assert full.n == 216 and out[2, 1][0] == 38
+    assert max(out[2, 1][1]) <= 1e-6 and max(out[16, 0][1]) <= 1e-6 and out[2, 1][2], out
