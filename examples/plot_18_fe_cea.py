@@ -129,15 +129,20 @@ run = simulate(model, 0.01, ic="equilibrium", perturbation=1e-9, sample_rate=1e5
 print(f"{model.n} dofs, {model.n_contacts} contacts: {run.status}, {run.stats.accepted_steps} steps, "
       f"{len(run.transitions.time)} transitions")
 state = np.where(run.open, 2, np.where(run.stick, 1, 0))  # slip 0, stick 1, open 2
-fig, (ax_u, ax_s) = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
+# the colour bar in a column of its own, so that both time axes keep the same extent
+fig, ((ax_u, blank), (ax_s, ax_bar)) = plt.subplots(2, 2, figsize=(8, 6), width_ratios=(1.0, 0.03),
+                                                    layout="constrained")
+blank.set_axis_off()
+ax_s.sharex(ax_u)
 for c in (0, 10, 20):  # the face's ends and middle: each node's displacement along the belt
     j = int(np.flatnonzero(model.contacts[c].tangent[0])[0])
     ax_u.plot(1e3 * run.t, 1e6 * run.states[:, j], label=model.contact_names[c])
 ax_u.set_ylabel("displacement [µm]")
 ax_u.legend(loc="upper left")
+ax_u.tick_params(labelbottom=False)
 image = ax_s.imshow(state.T, aspect="auto", interpolation="nearest", origin="lower", cmap="viridis", vmin=0, vmax=2,
                     extent=(1e3 * run.t[0], 1e3 * run.t[-1], -0.5, model.n_contacts - 0.5))
 ax_s.set_xlabel("time [ms]")
 ax_s.set_ylabel("contact node")
-fig.colorbar(image, ax=ax_s, ticks=[0, 1, 2]).ax.set_yticklabels(["slip", "stick", "open"])
+fig.colorbar(image, cax=ax_bar, ticks=[0, 1, 2]).ax.set_yticklabels(["slip", "stick", "open"])
 plt.show()

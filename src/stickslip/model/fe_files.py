@@ -116,8 +116,9 @@ def read_matrix(path: Path, where: str, name: str | None = None, fmt: str | None
     what = f"{where}: matrix file"
     size = regular_file_size(path, what, ModelFileError)
     unpacked = _npz_unpacked(path, size) if kind == "npz" else None
-    check_memory(matrix_file_bytes(size, unpacked), f"reading {where} from {path.name} ({format_bytes(size)})",
-                 "free memory, or give the matrix in a compact binary format (.npz)")
+    advice = ("free memory (its arrays are read whole, unpacked)" if kind == "npz" else
+              "free memory, or give the matrix in a compact binary format (.npz)")
+    check_memory(matrix_file_bytes(size, unpacked), f"reading {where} from {path.name} ({format_bytes(size)})", advice)
     data = read_regular_file(path, MAX_MATRIX_FILE_BYTES, what, ModelFileError)
     where = f"{where}: {path.name}"
     try:
