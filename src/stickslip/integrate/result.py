@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import operator
+from collections.abc import Sequence
 from functools import cached_property
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -27,7 +30,7 @@ from .contacts import TRANSITION_IMPACT
 from .status import Status
 
 __all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "mode_array",
-           "Impacts", "find_impacts"]
+           "Impact", "Impacts", "find_impacts"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -152,9 +155,32 @@ def _gaps(states, md, nc):
     return out
 
 
+class Impact(NamedTuple):
+    """One impact of a rigid contact (an item of :class:`Impacts`).
+
+    Attributes
+    ----------
+    time : float
+        Instant [s].
+    contact : int
+        The contact that closed.
+    speed_before, speed_after : float
+        Its normal speed ġ = W·q̇ just before and after [m/s].
+    impulse : float
+        The normal impulse P_N [N s].
+    """
+
+    time: float
+    contact: int
+    speed_before: float
+    speed_after: float
+    impulse: float
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
-class Impacts:
-    """Impacts of the rigid contacts in a run, in order.
+class Impacts(Sequence):
+    """Impacts of the rigid contacts in a run, in order: a sequence of :class:`Impact` records
+    (``impacts[0]``, ``impacts[-3:]``, ``for impact in impacts``) with the columns as arrays.
 
     Attributes
     ----------
@@ -178,6 +204,20 @@ class Impacts:
 
     def __len__(self) -> int:
         return int(self.time.size)
+
+    def __getitem__(self, index):
+        """Impact ``index`` as an :class:`Impact`; a slice as :class:`Impacts`."""
+        if isinstance(index, slice):
+            return Impacts(self.time[index], self.contact[index], self.speed_before[index],
+                           self.speed_after[index], self.impulse[index])
+        i = operator.index(index)
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"impact {i} of a run with {len(self)} impacts")
+        return Impact(float(self.time[i]), int(self.contact[i]), float(self.speed_before[i]),
+                      float(self.speed_after[i]), float(self.impulse[i]))
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self)))
 
 
 def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
