@@ -29,6 +29,7 @@ import stickslip
 from stickslip.cli import app
 from stickslip.errors import ModelError, SimulationError
 from stickslip.integrate.contacts import TRANSITION_CLOSE, TRANSITION_IMPACT, TRANSITION_OPEN, TRANSITION_TO_STICK
+from stickslip.integrate.result import Impact, Impacts
 from stickslip.integrate.status import Status
 from stickslip.model import model_from_spec
 from stickslip.model.system_model import NormalLaw
@@ -117,6 +118,23 @@ def test_landing_speeds_impulses_and_rebounds(run):
     np.testing.assert_allclose(imp.impulse[:-1], (1.0 + E) * speeds[:k - 1], rtol=1e-8, atol=1e-10)
     assert imp.speed_after[-1] == 0.0  # the accumulation point: at rest on the stop
     assert (run.transitions.kind == TRANSITION_OPEN).sum() == k - 1
+
+
+def test_impacts_are_a_sequence_of_typed_records(run):
+    """``run.impacts[i]`` is impact i of the closed form: its instant, contact, speeds and impulse."""
+    times, speeds, _, _, _ = closed_form()
+    imp = run.impacts
+    first = imp[0]
+    assert isinstance(first, Impact) and first.contact == 0
+    assert abs(first.time - times[0]) < 1e-8
+    assert abs(first.speed_before + speeds[0]) < 1e-8 * speeds[0]
+    assert abs(first.speed_after - E * speeds[0]) < 1e-8 * speeds[0]
+    assert abs(first.impulse - (1.0 + E) * speeds[0]) < 1e-8 * speeds[0]
+    assert imp[-1].time == imp.time[-1] and imp[-1].speed_after == 0.0
+    assert [i.time for i in imp] == list(imp.time) and len(list(imp)) == len(imp)
+    assert isinstance(imp[1:3], Impacts) and len(imp[1:3]) == 2 and imp[1:3][0] == imp[1]
+    with pytest.raises(IndexError):
+        imp[len(imp)]
 
 
 @pytest.mark.parametrize("mu", [MU, 0.02])
@@ -210,3 +228,26 @@ def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_statu
     tr = stickslip.simulate(model, 1.0, sample_rate=100.0)
     assert tr.status_code is Status.INCONSISTENT
     assert "Painlevé" in tr.status and "\n" not in tr.status
+
+
+def _refuse_constant(name):
+    raise ValueError(f"{name} is not strict JSON")
+
+
+def test_max_impact_speed_is_exact_beyond_the_kept_transition_states(tmp_path):
+    """With e = 1 from rest at y0 every landing has the speed u = ω √((y0 + d)² − d²) (energy is
+    conserved in flight and at the impacts); from y0 = 1e-8 the flights last ~0.14 ms, so 30 s
+    hold some 2·10⁵ impacts, more transitions in the steady window than the run keeps states of.
+    The window's largest landing speed is still u, and every --json value strict JSON."""
+    y0 = 1e-8
+    u = OMEGA * math.sqrt((y0 + D) ** 2 - D ** 2)
+    result = CliRunner().invoke(app, ["simulate", "--model", "impact-oscillator", "--set",
+                                      "contact.0.normal.restitution=1", "--ic", f"y={y0}", "--t-end", "30",
+                                      "--sample-rate", "10", "--json", "--out", str(tmp_path / "r.nc")])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout, parse_constant=_refuse_constant)
+    assert out["impacts"] > 100_000 and "max_impact_speed_reason" not in out
+    assert abs(out["max_impact_speed"] - u) < 1e-6 * u
+    tr = stickslip.load_trajectory(tmp_path / "r.nc")
+    assert np.isnan(tr.transitions.state[0]).all()  # states dropped: the speed comes from the tally
+    assert tr.steady.impacts == out["impacts"] and tr.steady.max_impact_speed == out["max_impact_speed"]

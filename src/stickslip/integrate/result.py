@@ -30,7 +30,8 @@ from .contacts import TRANSITION_IMPACT
 from .status import Status
 
 __all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "mode_array",
-           "Impact", "Impacts", "find_impacts"]
+           "Impact", "Impacts", "find_impacts",
+           "ImpactTally", "impact_speeds"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -177,6 +178,59 @@ class Impact(NamedTuple):
     impulse: float
 
 
+@njit(cache=True)
+def _impact_speeds(states, contacts, md):
+    """Normal speed ġ⁻ = W·q̇ of contact ``contacts[i]`` at each state (k, ≥ 2n) before an impact [m/s]."""
+    out = np.empty(states.shape[0])
+    for i in range(states.shape[0]):
+        out[i] = physics.gap(states[i], np.int64(contacts[i]), md)[1]
+    return out
+
+
+def impact_speeds(system: FrictionModel, kinds: np.ndarray, contacts: np.ndarray, states: np.ndarray):
+    """(instants' indices, |ġ⁻| [m/s]) of the impacts among transitions of ``kinds`` (k,) with the
+    ``contacts`` (k,) and ``states`` (k, ≥ 2n) there (the state before each impact)."""
+    rows = np.flatnonzero(kinds == TRANSITION_IMPACT)
+    if rows.size == 0:
+        return rows, np.empty(0)
+    speeds = _impact_speeds(np.ascontiguousarray(states[rows]), contacts[rows].astype(np.int64), system.data)
+    return rows, np.abs(speeds)
+
+
+@dataclasses.dataclass(frozen=True)
+class ImpactTally:
+    """The impacts of a run's steady window counted as the run went, from every impact's state
+    (those of the transition log beyond its kept states included), so that their number and
+    largest speed are exact however many impacts the run had.
+
+    Attributes
+    ----------
+    t_from, t_to : float
+        The window (t_from, t_to] [s]: the steady window the run was started with and its last sample.
+    count : int
+        Impacts in the window.
+    max_speed : float
+        Largest normal speed |ġ⁻| among them [m/s] (0 without impacts).
+    """
+
+    t_from: float
+    t_to: float
+    count: int = 0
+    max_speed: float = 0.0
+
+    def add(self, times: np.ndarray, speeds: np.ndarray) -> "ImpactTally":
+        """This tally with the impacts at ``times`` [s] of normal speeds |ġ⁻| ``speeds`` [m/s] added."""
+        inside = (times > self.t_from) & (times <= self.t_to)
+        if not inside.any():
+            return self
+        return dataclasses.replace(self, count=self.count + int(inside.sum()),
+                                   max_speed=max(self.max_speed, float(speeds[inside].max())))
+
+    def covers(self, t_from: float, t_to: float) -> bool:
+        """Whether this tally is of the window (t_from, t_to]."""
+        return self.t_from == t_from and self.t_to == t_to
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class Impacts(Sequence):
     """Impacts of the rigid contacts in a run, in order: a sequence of :class:`Impact` records
@@ -285,6 +339,10 @@ class Trajectory(Plottable):
     status_code : Status
         How the run ended, as an enum (``Status.SUCCESS``, ``Status.INCONSISTENT``, ...);
         :attr:`status` is its message.
+    impact_tally : ImpactTally, optional
+        The impacts of the steady window counted during the run (models with rigid contacts):
+        :attr:`steady` takes their number and largest speed from it, exact however many
+        transitions the run dropped.
     """
 
     FIGURE = "trajectory"
@@ -302,6 +360,7 @@ class Trajectory(Plottable):
     options: dict
     steady_from: float
     status_code: Status = Status.SUCCESS
+    impact_tally: ImpactTally | None = None
 
     # ------------------------------------------------------------- the model
     @property
@@ -423,6 +482,9 @@ class Trajectory(Plottable):
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
         impacts = (self.impacts.time, self.impacts.speed_before) if self.system.rigid else None
+        tally = self.impact_tally
+        if impacts is not None and tally is not None and tally.covers(float(t_from), float(self.t[-1])):
+            impacts = tally
         return summarize(self.t, self.states, self.mode, self.transitions, t_from, n_contacts=self.system.n_contacts,
                          coordinate=i, rate=i + self.system.n, name=self.system.dofs[i],
                          unilateral=self.system.unilateral, impacts=impacts)
@@ -443,7 +505,7 @@ class Trajectory(Plottable):
             b, t=np.concatenate([a.t, b.t[1:]]), states=np.concatenate([a.states, b.states[1:]]),
             mode=np.concatenate([a.mode, b.mode[1:]]), friction=np.concatenate([a.friction, b.friction[1:]]),
             work=np.concatenate([a.work, b.work[1:] + a.work[-1]]), transitions=tr, stats=stats,
-            options=dict(a.options, t_end=b.options["t_end"]))
+            options=dict(a.options, t_end=b.options["t_end"]), impact_tally=None)
 
     def tail(self, t_from: float) -> "Trajectory":
         """The part of this run from ``t_from`` [s] on (transitions before it counted as dropped)."""
@@ -530,6 +592,8 @@ class Trajectory(Plottable):
             "parameters": json.dumps(dict(system.parameters)),
             "transitions_dropped": int(self.transitions.dropped),
         }
+        if self.impact_tally is not None:
+            attrs["impact_tally"] = json.dumps(dataclasses.asdict(self.impact_tally))
         if self.is_plates:
             attrs.update(parameter_attrs(self.params.to_dict()))
         for key, value in self.steady.to_dict().items():
@@ -572,6 +636,7 @@ class Trajectory(Plottable):
             stats=Stats(**json.loads(ds.attrs["stats"])), status=ds.attrs["status"], system=system,
             method=ds.attrs["method"], options=json.loads(ds.attrs["options"]),
             steady_from=float(ds.attrs["steady_from"]), status_code=code,
+            impact_tally=ImpactTally(**json.loads(ds.attrs["impact_tally"])) if "impact_tally" in ds.attrs else None,
         )
 
     @classmethod
