@@ -228,6 +228,22 @@ def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_statu
     tr = stickslip.simulate(model, 1.0, sample_rate=100.0)
     assert tr.status_code is Status.INCONSISTENT
     assert "Painlevé" in tr.status and "\n" not in tr.status
+    # the one sample, at the start, has no normal force: undefined, not the multiplier solved there
+    assert tr.t.size == 1 and np.isnan(tr.normal_force[0, 0])
+
+
+def test_a_consistent_rigid_normal_force_is_sampled_as_it_is():
+    """The model above with μ = 0.5 (D = 1 − μ > 0): closed and sliding forward, y'' = −y − 1 +
+    (1 − μ) λ = 0 at y = 0, so λ = 1 / (1 − μ) = 2 N from the first sample on."""
+    model = model_from_spec({
+        "name": "painleve", "dofs": ["x", "y"], "mass": [[1.0, 0.0], [0.0, 1.0]],
+        "damping": [[0.0, 0.0], [0.0, 0.0]], "stiffness": [[0.0, 0.0], [0.0, 1.0]], "force": [0.0, -1.0],
+        "contact": [{"tangent": [[1.0, 1.0]], "drive": [-1.0], "gap": 0.0, "gap_gradient": [0.0, 1.0],
+                     "normal": {"law": "rigid", "restitution": 0.0},
+                     "friction": {"law": "coulomb", "mu_k": 0.5, "delta_mu": 0.0}}]})
+    tr = stickslip.simulate(model, 0.2, sample_rate=100.0)
+    assert tr.status_code is Status.SUCCESS
+    np.testing.assert_allclose(tr.normal_force[:, 0], 2.0, rtol=1e-12)
 
 
 def _refuse_constant(name):

@@ -120,13 +120,34 @@ def _slip_velocities(states, md, nc):
     return out
 
 
-def _sample_normal_forces(states, mode, md, nc):
+def _sample_normal_forces(states, mode, md, nc, rigid=None):
     """Normal force of every contact (k, nc) at each sample [N], a unilateral contact's in its
     sampled state (0 while open: bit nc + c of ``mode``; a closed rigid contact's multiplier with
-    the sampled stick set, bit c)."""
+    the sampled stick set, bit c). With ``rigid``, the (nc,) bool mask of a model's rigid contacts, NaN for the closed
+    rigid contacts at a sample where their normal forces have no consistent value (Painlevé: the
+    multiplier solved there is no force of the motion)."""
     codes = np.where(flag_bits(mode, nc, nc), physics.MODE_OPEN,
-                     np.where(flag_bits(mode, 0, nc), physics.MODE_STICK, physics.MODE_SLIP))
-    return _normal_forces(states, codes.astype(np.int8), md, nc)
+                     np.where(flag_bits(mode, 0, nc), physics.MODE_STICK, physics.MODE_SLIP)).astype(np.int8)
+    out = _normal_forces(states, codes, md, nc)
+    if rigid is not None and rigid.any():
+        undefined = ~_consistent_normal_forces(states, codes, md, nc)
+        out[undefined[:, None] & rigid[None, :] & (codes != physics.MODE_OPEN)] = np.nan
+    return out
+
+
+@njit(cache=True)
+def _consistent_normal_forces(states, codes, md, nc):
+    """Whether the closed rigid contacts' normal forces have a consistent value at each sample
+    (k,) bool: the relative pivot of their normal-force system is positive (true where none is closed)."""
+    k = states.shape[0]
+    out = np.ones(k, dtype=np.bool_)
+    cst = np.zeros(CST * nc)
+    for i in range(k):
+        for c in range(nc):
+            cst[CST * c] = codes[i, c]
+            cst[CST * c + 1] = 1.0
+        out[i] = physics.rigid_pivot(states[i], cst, md) > 0.0
+    return out
 
 
 @njit(cache=True)
@@ -425,9 +446,11 @@ class Trajectory(Plottable):
 
     @cached_property
     def normal_force(self) -> np.ndarray:
-        """Normal force of each contact (k, nc) [N]: a prescribed N, or a unilateral contact's λ (0 open)."""
+        """Normal force of each contact (k, nc) [N]: a prescribed N, or a unilateral contact's λ (0 open;
+        NaN for a closed rigid contact at a sample where it has no consistent normal force, Painlevé)."""
         return _sample_normal_forces(np.ascontiguousarray(self.states), self.mode, self.system.data,
-                                     self.system.n_contacts)
+                                     self.system.n_contacts,
+                                     np.array([c.unilateral and c.normal.law == "rigid" for c in self.system.contacts]))
 
     @property
     def stick(self) -> np.ndarray:
