@@ -411,8 +411,17 @@ class Trajectory(Plottable):
     # ------------------------------------------------------------- derived series
     @cached_property
     def slip_velocity(self) -> np.ndarray:
-        """Slip velocity of each contact (k, 2 nc) [m/s]; for the plates v_r of Eq. (9)."""
-        return _slip_velocities(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
+        """Slip velocity of each contact (k, 2 nc) [m/s]; for the plates v_r of Eq. (9); NaN for a
+        contact without friction."""
+        return self._without_friction(_slip_velocities(np.ascontiguousarray(self.states), self.system.data,
+                                                       self.system.n_contacts))
+
+    def _without_friction(self, v: np.ndarray) -> np.ndarray:
+        """Slip velocities ``v`` (k, 2 nc) with NaN for contacts without friction, which have none."""
+        for c, contact in enumerate(self.system.contacts):
+            if contact.frictionless:
+                v[:, 2 * c:2 * c + 2] = np.nan
+        return v
 
     @property
     def relative_velocity(self) -> np.ndarray:
@@ -432,7 +441,7 @@ class Trajectory(Plottable):
         n, nc = self.system.n, self.system.n_contacts
         at_rest = np.ascontiguousarray(self.states).copy()
         at_rest[:, n:] = 0.0
-        v0 = _slip_velocities(at_rest, self.system.data, nc).reshape(-1, nc, 2)
+        v0 = self._without_friction(_slip_velocities(at_rest, self.system.data, nc)).reshape(-1, nc, 2)
         v = self.slip_velocity.reshape(-1, nc, 2)
         cross = v0[..., 0] * v[..., 1] - v0[..., 1] * v[..., 0]
         dot = v0[..., 0] * v[..., 0] + v0[..., 1] * v[..., 1]
