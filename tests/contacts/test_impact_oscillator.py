@@ -216,15 +216,20 @@ def test_starts_a_rigid_contact_cannot_take_are_refused(state, words):
         stickslip.simulate(model, 1.0, ic=np.array(state))
 
 
-def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_status():
-    """W = [0, 1] and G = [1, 1] with M = I: sliding forward (e = +1), D = W·(W − μ G e) = 1 − μ,
-    negative for μ = 1.5: no normal force keeps the contact closed consistently (Painlevé)."""
-    model = model_from_spec({
+def painleve_slider(mu: float):
+    """A rigid contact with W = [0, 1], G = [1, 1], M = I, sliding forward, friction coefficient ``mu``."""
+    return model_from_spec({
         "name": "painleve", "dofs": ["x", "y"], "mass": [[1.0, 0.0], [0.0, 1.0]],
         "damping": [[0.0, 0.0], [0.0, 0.0]], "stiffness": [[0.0, 0.0], [0.0, 1.0]], "force": [0.0, -1.0],
         "contact": [{"tangent": [[1.0, 1.0]], "drive": [-1.0], "gap": 0.0, "gap_gradient": [0.0, 1.0],
                      "normal": {"law": "rigid", "restitution": 0.0},
-                     "friction": {"law": "coulomb", "mu_k": 1.5, "delta_mu": 0.0}}]})
+                     "friction": {"law": "coulomb", "mu_k": mu, "delta_mu": 0.0}}]})
+
+
+def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_status():
+    """W = [0, 1] and G = [1, 1] with M = I: sliding forward (e = +1), D = W·(W − μ G e) = 1 − μ,
+    negative for μ = 1.5: no normal force keeps the contact closed consistently (Painlevé)."""
+    model = painleve_slider(1.5)
     tr = stickslip.simulate(model, 1.0, sample_rate=100.0)
     assert tr.status_code is Status.INCONSISTENT
     assert "Painlevé" in tr.status and "\n" not in tr.status
@@ -235,12 +240,7 @@ def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_statu
 def test_a_consistent_rigid_normal_force_is_sampled_as_it_is():
     """The model above with μ = 0.5 (D = 1 − μ > 0): closed and sliding forward, y'' = −y − 1 +
     (1 − μ) λ = 0 at y = 0, so λ = 1 / (1 − μ) = 2 N from the first sample on."""
-    model = model_from_spec({
-        "name": "painleve", "dofs": ["x", "y"], "mass": [[1.0, 0.0], [0.0, 1.0]],
-        "damping": [[0.0, 0.0], [0.0, 0.0]], "stiffness": [[0.0, 0.0], [0.0, 1.0]], "force": [0.0, -1.0],
-        "contact": [{"tangent": [[1.0, 1.0]], "drive": [-1.0], "gap": 0.0, "gap_gradient": [0.0, 1.0],
-                     "normal": {"law": "rigid", "restitution": 0.0},
-                     "friction": {"law": "coulomb", "mu_k": 0.5, "delta_mu": 0.0}}]})
+    model = painleve_slider(0.5)
     tr = stickslip.simulate(model, 0.2, sample_rate=100.0)
     assert tr.status_code is Status.SUCCESS
     np.testing.assert_allclose(tr.normal_force[:, 0], 2.0, rtol=1e-12)

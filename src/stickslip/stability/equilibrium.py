@@ -178,26 +178,12 @@ def _solve_with_open(system, opened: tuple[int, ...]) -> tuple[np.ndarray, float
     """Steady sliding with the contacts ``opened`` open (no force) and the others closed: scipy's
     hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0, (q_p, Z) the closed rigid contacts' constraint
     (:func:`rigid_constraint`; q_p = 0 and Z the free DOFs where none is closed)."""
-    from scipy.optimize import root  # imported on use, as in rigid_constraint
-
     n = system.n
     cst = _sliding_modes(system, opened)
     speeds = sliding_speeds(system, np.zeros(n))
     if any(speeds[c] == 0.0 for c in range(system.n_contacts) if c not in opened):
         raise EquilibriumError(_not_sliding_message(system, np.zeros(n)))
-    q_p, Z = rigid_constraint(system, exclude=opened)
-
-    def acceleration(r):
-        s = np.zeros(2 * n)
-        s[:n] = q_p + Z @ r
-        ds = np.zeros(2 * n)
-        rhs(s, cst, system.data, ds)
-        return Z.T @ ds[n:]
-    if Z.shape[1]:
-        sol = root(acceleration, np.zeros(Z.shape[1]), method="hybr", options={"xtol": 1e-14})
-        q, nfev = q_p + Z @ sol.x, int(sol.nfev)
-    else:  # the closed contacts fix every free dof
-        q, nfev = q_p, 0
+    q, nfev, _ = _root_on_constraint(system, cst, *rigid_constraint(system, exclude=opened))
     rel = steady_residual(system, q, cst)
     if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
         raise EquilibriumError(f"no steady sliding with contacts {list(opened)} open (relative residual {rel:.2e})")
@@ -225,17 +211,15 @@ def rigid_constraint(system, exclude=()) -> tuple[np.ndarray, np.ndarray]:
     return q_p, Z
 
 
-def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
-    """:func:`solve_steady` with every contact sliding and the rigid ones closed (module docstring):
-    scipy's hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0, the rigid normal forces
-    the right-hand side's multipliers."""
+def _root_on_constraint(system, cst: np.ndarray, q_p: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, int, str]:
+    """(q, evaluations, the root finder's message): scipy's hybrid Powell method on
+    Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0 in the contact modes ``cst`` (q_p where Z has no column:
+    the closed contacts fix every free dof)."""
     from scipy.optimize import root  # imported on use, as in rigid_constraint
 
-    if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:
-        raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
-    q_p, Z = rigid_constraint(system)
     n = system.n
-    cst = _sliding_modes(system)
+    if not Z.shape[1]:
+        return q_p, 0, "the constraint fixes every free dof"
 
     def acceleration(r):
         s = np.zeros(2 * n)
@@ -244,7 +228,19 @@ def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
         rhs(s, cst, system.data, ds)
         return Z.T @ ds[n:]
     sol = root(acceleration, np.zeros(Z.shape[1]), method="hybr", options={"xtol": 1e-14})
-    q = q_p + Z @ sol.x
+    return q_p + Z @ sol.x, int(sol.nfev), sol.message
+
+
+def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
+    """:func:`solve_steady` with every contact sliding and the rigid ones closed (module docstring):
+    scipy's hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0, the rigid normal forces
+    the right-hand side's multipliers."""
+    if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:
+        raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
+    q_p, Z = rigid_constraint(system)
+    n = system.n
+    cst = _sliding_modes(system)
+    q, nfev, message = _root_on_constraint(system, cst, q_p, Z)
     for at in (q, q_p):  # where the solve ended, else (a state not finite) on the constraint at r = 0
         s = np.zeros(2 * n)
         s[:n] = at
@@ -260,10 +256,10 @@ def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
     if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
         raise EquilibriumError(f"no steady-sliding equilibrium found for {point_text(system)}: no position with the "
                                f"rigid contacts closed balances the forces (relative residual {rel:.2e} > "
-                               f"{RESIDUAL_TOL:g} where the root finder stopped: {sol.message.rstrip('.')}); steady "
+                               f"{RESIDUAL_TOL:g} where the root finder stopped: {message.rstrip('.')}); steady "
                                "sliding may not exist at these parameters (is there a free direction along the contact "
                                "without stiffness against the friction?)")
-    return q, float(rel), int(sol.nfev)
+    return q, float(rel), nfev
 
 
 def _solve_closed(system) -> tuple[np.ndarray, float, int]:
