@@ -109,8 +109,9 @@ def solve_steady_modes(system) -> tuple[np.ndarray, float, int, tuple[int, ...]]
     (λ ≤ 0; a rigid one at rest at λ = 0 counts as closed), they are opened and the equilibrium
     solved again with them carrying no force, until the set is consistent: each open contact's gap
     is positive at the equilibrium (it contributes nothing there, nor to the linearisation) and
-    each closed one is pressed. The refusal where no such set exists is that of the closed solve
-    (the contact is not pressed at all, or the friction jams it).
+    each closed one is pressed, and some contact with friction stays closed (slides: with all of them
+    open there is no sliding). The refusal where no such set exists is that of the closed solve (the
+    contact is not pressed at all, or the friction jams it).
 
     Returns
     -------
@@ -148,6 +149,8 @@ def _solve_open(system, q_closed, failure) -> tuple[np.ndarray, float, int, tupl
         closing = {c for c in opened if not gap(s, c, system.data)[0] > 0.0}
         opening = set(_unpressed(system, q, opened))
         if not closing and not opening and rigid_pivot(s, _sliding_modes(system, opened), system.data) > 0.0:
+            if not any(c not in opened and not contact.frictionless for c, contact in enumerate(system.contacts)):
+                break  # every contact with friction open: a free equilibrium, no sliding
             return q, rel, iterations, tuple(sorted(opened))
         if opened == (opened - closing) | opening:
             break
