@@ -551,8 +551,8 @@ def land(y, cst, c, md, rtol, atol, F, N, work):  # pragma: no cover - compiled 
     whether it closed sticking; the normal impulse [N s]; ġ⁻ and ġ⁺ [m/s]; for ``LAND_OPEN`` the
     flight time [s] that the normal acceleration at the take-off predicts (∞ if it does not pull
     the contact back). ``y`` and ``cst`` are updated. A contact that stays closed but whose
-    normal force comes out < 0 (the motion leaves it with ġ = 0) is left open; at λ = 0 it rests on it. (Compiled only for
-    kinematics that may have rigid contacts.)
+    normal force comes out < 0 (the motion leaves it with ġ = 0) is left open; at λ = 0 it rests on
+    it. (Compiled only for kinematics that may have rigid contacts.)
     """
     n = model_sizes(md.kin, md.m)[0]
     e = restitution_of(c, md)

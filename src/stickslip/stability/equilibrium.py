@@ -28,7 +28,8 @@ from ..model.system_model import FrictionModel
 from . import steady
 
 __all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "RESIDUAL_TOL", "steady_sliding",
-           "steady_residual", "solve_steady", "solve_steady_modes", "point_text", "sliding_speeds", "model_of", "rigid_constraint"]
+           "steady_residual", "solve_steady", "solve_steady_modes",
+           "point_text", "sliding_speeds", "model_of", "rigid_constraint"]
 
 #: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved. Newton reaches ~1e-16
 #: (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while still

@@ -53,8 +53,9 @@ def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
     Parameters
     ----------
     name : str, Path or FrictionModel
-        A library name (``stickslip models`` lists them: ``two-plates``, ``belt``, ``clearance-oscillator``, ``hoffmann``,
-        ``impact-oscillator``, ``popp-stelter``, ``slider-belt``, ``sprag-slip``), a variant of the two plates with Table 1
+        A library name (``stickslip models`` lists them: ``two-plates``, ``belt``, ``clearance-oscillator``,
+        ``hoffmann``, ``impact-oscillator``, ``popp-stelter``, ``slider-belt``, ``sprag-slip``), a variant of
+        the two plates with Table 1
         parameters (``full``, ``x``, ``y``, ``rotation``, :func:`plates_variant`), the path of a
         model file (``.toml``), or a model, returned as it is. Default: the two plates with Table 1
         parameters.
