@@ -122,8 +122,8 @@ def test_bad_model_file_is_one_line_naming_the_key(edit, words, tmp_path):
 def test_models_lists_the_library_and_shows_a_model():
     res = invoke("models", "--json")
     assert res.exit_code == 0, res.output
-    assert list(json.loads(res.stdout)) == ["two-plates", "belt", "hoffmann", "impact-oscillator", "popp-stelter",
-                                                "slider-belt", "sprag-slip"]
+    assert list(json.loads(res.stdout)) == ["two-plates", "belt", "clearance-oscillator", "hoffmann",
+                                                "impact-oscillator", "popp-stelter", "slider-belt", "sprag-slip"]
     res = invoke("models", "belt", "--json")
     assert res.exit_code == 0, res.output
     d = json.loads(res.stdout)

@@ -29,6 +29,7 @@ import stickslip
 from stickslip.cli import app
 from stickslip.errors import ModelError, SimulationError
 from stickslip.integrate.contacts import TRANSITION_CLOSE, TRANSITION_IMPACT, TRANSITION_OPEN, TRANSITION_TO_STICK
+from stickslip.integrate.result import Impact, Impacts
 from stickslip.integrate.status import Status
 from stickslip.model import model_from_spec
 from stickslip.model.system_model import NormalLaw
@@ -119,6 +120,23 @@ def test_landing_speeds_impulses_and_rebounds(run):
     assert (run.transitions.kind == TRANSITION_OPEN).sum() == k - 1
 
 
+def test_impacts_are_a_sequence_of_typed_records(run):
+    """``run.impacts[i]`` is impact i of the closed form: its instant, contact, speeds and impulse."""
+    times, speeds, _, _, _ = closed_form()
+    imp = run.impacts
+    first = imp[0]
+    assert isinstance(first, Impact) and first.contact == 0
+    assert abs(first.time - times[0]) < 1e-8
+    assert abs(first.speed_before + speeds[0]) < 1e-8 * speeds[0]
+    assert abs(first.speed_after - E * speeds[0]) < 1e-8 * speeds[0]
+    assert abs(first.impulse - (1.0 + E) * speeds[0]) < 1e-8 * speeds[0]
+    assert imp[-1].time == imp.time[-1] and imp[-1].speed_after == 0.0
+    assert [i.time for i in imp] == list(imp.time) and len(list(imp)) == len(imp)
+    assert isinstance(imp[1:3], Impacts) and len(imp[1:3]) == 2 and imp[1:3][0] == imp[1]
+    with pytest.raises(IndexError):
+        imp[len(imp)]
+
+
 @pytest.mark.parametrize("mu", [MU, 0.02])
 def test_coulomb_impulses_stick_or_slide_as_the_closed_form(run, mu):
     """μ = 0.3 (the file's): every landing's tangential impulse is admissible, x'⁺ = V; μ = 0.02:
@@ -198,15 +216,54 @@ def test_starts_a_rigid_contact_cannot_take_are_refused(state, words):
         stickslip.simulate(model, 1.0, ic=np.array(state))
 
 
-def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_status():
-    """W = [0, 1] and G = [1, 1] with M = I: sliding forward (e = +1), D = W·(W − μ G e) = 1 − μ,
-    negative for μ = 1.5: no normal force keeps the contact closed consistently (Painlevé)."""
-    model = model_from_spec({
+def painleve_slider(mu: float):
+    """A rigid contact with W = [0, 1], G = [1, 1], M = I, sliding forward, friction coefficient ``mu``."""
+    return model_from_spec({
         "name": "painleve", "dofs": ["x", "y"], "mass": [[1.0, 0.0], [0.0, 1.0]],
         "damping": [[0.0, 0.0], [0.0, 0.0]], "stiffness": [[0.0, 0.0], [0.0, 1.0]], "force": [0.0, -1.0],
         "contact": [{"tangent": [[1.0, 1.0]], "drive": [-1.0], "gap": 0.0, "gap_gradient": [0.0, 1.0],
                      "normal": {"law": "rigid", "restitution": 0.0},
-                     "friction": {"law": "coulomb", "mu_k": 1.5, "delta_mu": 0.0}}]})
+                     "friction": {"law": "coulomb", "mu_k": mu, "delta_mu": 0.0}}]})
+
+
+def test_painleve_sliding_without_a_consistent_normal_force_stops_with_its_status():
+    """W = [0, 1] and G = [1, 1] with M = I: sliding forward (e = +1), D = W·(W − μ G e) = 1 − μ,
+    negative for μ = 1.5: no normal force keeps the contact closed consistently (Painlevé)."""
+    model = painleve_slider(1.5)
     tr = stickslip.simulate(model, 1.0, sample_rate=100.0)
     assert tr.status_code is Status.INCONSISTENT
     assert "Painlevé" in tr.status and "\n" not in tr.status
+    # the one sample, at the start, has no normal force: undefined, not the multiplier solved there
+    assert tr.t.size == 1 and np.isnan(tr.normal_force[0, 0])
+
+
+def test_a_consistent_rigid_normal_force_is_sampled_as_it_is():
+    """The model above with μ = 0.5 (D = 1 − μ > 0): closed and sliding forward, y'' = −y − 1 +
+    (1 − μ) λ = 0 at y = 0, so λ = 1 / (1 − μ) = 2 N from the first sample on."""
+    model = painleve_slider(0.5)
+    tr = stickslip.simulate(model, 0.2, sample_rate=100.0)
+    assert tr.status_code is Status.SUCCESS
+    np.testing.assert_allclose(tr.normal_force[:, 0], 2.0, rtol=1e-12)
+
+
+def _refuse_constant(name):
+    raise ValueError(f"{name} is not strict JSON")
+
+
+def test_max_impact_speed_is_exact_beyond_the_kept_transition_states(tmp_path):
+    """With e = 1 from rest at y0 every landing has the speed u = ω √((y0 + d)² − d²) (energy is
+    conserved in flight and at the impacts); from y0 = 1e-8 the flights last ~0.14 ms, so 30 s
+    hold some 2·10⁵ impacts, more transitions in the steady window than the run keeps states of.
+    The window's largest landing speed is still u, and every --json value strict JSON."""
+    y0 = 1e-8
+    u = OMEGA * math.sqrt((y0 + D) ** 2 - D ** 2)
+    result = CliRunner().invoke(app, ["simulate", "--model", "impact-oscillator", "--set",
+                                      "contact.0.normal.restitution=1", "--ic", f"y={y0}", "--t-end", "30",
+                                      "--sample-rate", "10", "--json", "--out", str(tmp_path / "r.nc")])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout, parse_constant=_refuse_constant)
+    assert out["impacts"] > 100_000 and "max_impact_speed_reason" not in out
+    assert abs(out["max_impact_speed"] - u) < 1e-6 * u
+    tr = stickslip.load_trajectory(tmp_path / "r.nc")
+    assert np.isnan(tr.transitions.state[0]).all()  # states dropped: the speed comes from the tally
+    assert tr.steady.impacts == out["impacts"] and tr.steady.max_impact_speed == out["max_impact_speed"]

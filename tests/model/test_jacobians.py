@@ -83,8 +83,9 @@ def test_slip_jacobian_equals_central_differences(name):
 @pytest.mark.parametrize("name", list(MODELS))
 def test_stick_jacobian_equals_central_differences(name):
     model = MODELS[name]()
-    for c in range(model.n_contacts):
+    can_stick = [not contact.frictionless for contact in model.contacts]  # a contact without friction never sticks
+    for c in np.flatnonzero(can_stick):
         modes = [MODE_SLIP_EXACT] * model.n_contacts
         modes[c] = MODE_STICK
-        assert_jacobians_agree(model, modes, seed=c)
-    assert_jacobians_agree(model, [MODE_STICK] * model.n_contacts, seed=7)
+        assert_jacobians_agree(model, modes, seed=int(c))
+    assert_jacobians_agree(model, [MODE_STICK if stick else MODE_SLIP_EXACT for stick in can_stick], seed=7)

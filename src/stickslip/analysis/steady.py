@@ -134,7 +134,8 @@ def summarize(t, states, mode, transitions, t_from, *, n_contacts: int, coordina
     """Steady-state summary of samples with t ≥ ``t_from`` (see :class:`SteadyState`), following the
     state column ``coordinate`` (its rate in column ``rate``), the dof called ``name``, of a model
     with ``n_contacts`` contacts (``unilateral``: some of them open and close; ``impacts``: the
-    instants [s] and normal speeds ġ⁻ [m/s] of its rigid contacts' impacts, None without them).
+    instants [s] and normal speeds ġ⁻ [m/s] of its rigid contacts' impacts, or their tally of the
+    window counted during the run (an object with ``count`` and ``max_speed``), None without them).
     ``transitions`` has the run's transitions as arrays ``time``, ``kind`` and ``contact`` (a
     :class:`stickslip.integrate.result.Transitions`)."""
     t = np.asarray(t)
@@ -194,6 +195,8 @@ def _impacts_in(impacts, t0: float, t1: float) -> dict:
     unknown (NaN, with the reason), not the maximum of the others."""
     if impacts is None:
         return {}
+    if hasattr(impacts, "max_speed"):  # counted during the run (an integrate.result.ImpactTally): exact
+        return {"impacts": int(impacts.count), "max_impact_speed": float(impacts.max_speed)}
     times, speeds = (np.asarray(a, dtype=float) for a in impacts)
     inside = (times > t0) & (times <= t1)
     unknown = int(np.isnan(speeds[inside]).sum())

@@ -41,7 +41,8 @@ def contact_lines(system) -> list[str]:
     """One line per run of consecutive contacts with the same slip dimension and friction law."""
     lines, start = [], 0
     contacts, names = system.contacts, system.contact_names
-    described = [(c.dim, ", ".join(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}"
+    described = [(0, "") if c.frictionless else
+                 (c.dim, ", ".join(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}"
                                    for k, v in c.friction.to_dict().items())) for c in contacts]
     for end in range(1, len(contacts) + 1):
         if end < len(contacts) and described[end] == described[start]:
@@ -51,7 +52,7 @@ def contact_lines(system) -> list[str]:
             label = f"contact {start}" + (f" ({names[start]})" if names[start] else "")
         else:
             label = f"contacts {start}–{end - 1}" + (f" ({names[start]} … {names[end - 1]})" if names[start] else "")
-        lines.append(f"{label}: {dim}-D slip, {law}")
+        lines.append(f"{label}: {f'{dim}-D slip, {law}' if dim else 'no friction (normal only)'}")
         start = end
     return lines
 

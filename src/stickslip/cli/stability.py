@@ -72,6 +72,9 @@ def stability(
         eq.add_column(name, justify="right")
     eq.add_row(*[f"{result.equilibrium_dict[d]:.6g}" for d in result.dofs])
     console.print(eq)
+    if result.open_contacts:
+        console.print(f"open at steady sliding (no force, nothing in the linearisation): "
+                      f"{', '.join(result.open_contacts)}")
     modes = Table(title="modes (one per conjugate pair), sorted by growth rate")
     for head in ("#", "growth rate [1/s]", "frequency [Hz]", "dominant DOF", "shape |.| (" + ", ".join(result.dofs) + ")"):
         modes.add_column(head, justify="right" if head != "dominant DOF" else "left")

@@ -44,7 +44,7 @@ __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "hermite_dip", "gap_dip", "probed_crossing", "contact_lost",
-           "mode_flags", "store_mode"]
+           "mode_flags", "store_mode", "leaves_state"]
 
 EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
 EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
@@ -444,6 +444,19 @@ def release_most_overloaded(y, cst, md, F, N):
 
 
 @kernel
+def leaves_state(y, cst, c, md):
+    """Whether unilateral contact ``c`` leaves its state of ``cst`` at ``y``: its indicator is ≤ 0
+    (:func:`stickslip.model.physics.indicator`), except that a closed rigid contact leaves only
+    where its normal force turns negative, λ < 0 (the free motion would lift it: its gap
+    acceleration turns positive). A rigid contact at rest at zero force, λ = 0, stays closed: a
+    state, not an opening followed by a landing at zero speed, again and again."""
+    phi = P.indicator(y, cst, c, md)
+    if phi < 0.0:
+        return True
+    return phi == 0.0 and (is_open(cst, c) or not P.rigid(c, md))
+
+
+@kernel
 def contact_lost(y, md):
     """Index of the first contact with a prescribed load whose normal force is ≤ 0 at ``y``, or −1."""
     nc = model_sizes(md.kin, md.m)[1]
@@ -508,9 +521,9 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
     for _ in range(max(MAX_SETTLE, nc)):
         if release_most_overloaded(y, cst, md, F, N) < 0:
             break
-    for c in range(nc):  # a closed rigid contact that nothing presses is open (where its normal force is
-        # consistent at all: else it stays closed and the run reports that, Painlevé)
-        if is_rigid(md, n, c) and not is_open(cst, c) and P.indicator(y, cst, c, md) <= 0.0 \
+    for c in range(nc):  # a closed rigid contact pulled off (λ < 0) is open (where its normal force is
+        # consistent at all: else it stays closed and the run reports that, Painlevé); at λ = 0 it rests on it
+        if is_rigid(md, n, c) and not is_open(cst, c) and leaves_state(y, cst, c, md) \
                 and P.rigid_pivot(y, cst, md) > 0.0:
             cst[CST * c] = P.MODE_OPEN
     for c in range(nc):
@@ -538,8 +551,8 @@ def land(y, cst, c, md, rtol, atol, F, N, work):  # pragma: no cover - compiled 
     whether it closed sticking; the normal impulse [N s]; ġ⁻ and ġ⁺ [m/s]; for ``LAND_OPEN`` the
     flight time [s] that the normal acceleration at the take-off predicts (∞ if it does not pull
     the contact back). ``y`` and ``cst`` are updated. A contact that stays closed but whose
-    normal force comes out ≤ 0 (the motion leaves it with ġ = 0) is left open. (Compiled only for
-    kinematics that may have rigid contacts.)
+    normal force comes out < 0 (the motion leaves it with ġ = 0) is left open; at λ = 0 it rests on
+    it. (Compiled only for kinematics that may have rigid contacts.)
     """
     n = model_sizes(md.kin, md.m)[0]
     e = restitution_of(c, md)
@@ -558,7 +571,7 @@ def land(y, cst, c, md, rtol, atol, F, N, work):  # pragma: no cover - compiled 
         phase = LAND_ZENO
     cst[CST * c] = P.MODE_SLIP
     sticks = close_contact(y, cst, c, md, rtol, atol, F, N)
-    if P.indicator(y, cst, c, md) <= 0.0:
+    if leaves_state(y, cst, c, md):
         cst[CST * c] = P.MODE_OPEN
         cst[CST * c + 3] = math.inf
         return LAND_OPEN, False, impulse, before, after, math.inf

@@ -184,8 +184,10 @@ def simulate(
                               f"model {system.name!r} runs with method='event' (CLI: --method event)")
 
     start = time.perf_counter()
+    # a model with impacts tallies those of the steady window as it runs (exact beyond the kept states)
+    window = {"impact_window": _steady_start(t0, sample_times, steady_from)} if system.rigid else {}
     out = RUNNERS[method](system, y0, t0, t_end, sample_times, rtol=rtol, atol=atol, dt=dt,
-                          max_steps=NO_STEP_CAP if max_steps is None else int(max_steps))
+                          max_steps=NO_STEP_CAP if max_steps is None else int(max_steps), **window)
     wall = time.perf_counter() - start - out.stats["compile_time_s"]  # integration only
     if out.interrupted and not partial_on_ctrl_c():  # also when the run had just finished: the caller stops
         forget_ctrl_c()  # acted on here
@@ -213,8 +215,7 @@ def _trajectory(out, system, method: str, sample_times: np.ndarray, options: dic
     code, record, n_kept = out.status, out.record, out.record.n
     t0 = options["t0"]
     t_samples = sample_times[:n_kept]  # the samples up to the time reached: a prefix, so views
-    if steady_from is None:
-        steady_from = t0 + 0.5 * (t_samples[-1] - t0)
+    steady_from = _steady_start(t0, t_samples, steady_from)
     n2 = 2 * system.n
     transitions = record.transitions()
     _, states, mode, friction = record.samples()
@@ -233,4 +234,10 @@ def _trajectory(out, system, method: str, sample_times: np.ndarray, options: dic
         options=options,
         steady_from=float(steady_from),
         status_code=code,
+        impact_tally=record.tally,
     )
+
+
+def _steady_start(t0: float, sample_times: np.ndarray, steady_from: float | None) -> float:
+    """The start of the steady window [s]: ``steady_from``, by default the last half of the samples."""
+    return float(t0 + 0.5 * (sample_times[-1] - t0) if steady_from is None else steady_from)

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import operator
+from collections.abc import Sequence
 from functools import cached_property
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -27,7 +30,8 @@ from .contacts import TRANSITION_IMPACT
 from .status import Status
 
 __all__ = ["Stats", "Transitions", "Trajectory", "load_trajectory", "FileFormatError", "mode_dtype", "mode_array",
-           "Impacts", "find_impacts"]
+           "Impact", "Impacts", "find_impacts",
+           "ImpactTally", "impact_speeds"]
 
 FORMAT = format_name("trajectory", 2)
 #: Format versions :func:`load_trajectory` reads (1: the two plates only, before models as data).
@@ -116,13 +120,34 @@ def _slip_velocities(states, md, nc):
     return out
 
 
-def _sample_normal_forces(states, mode, md, nc):
+def _sample_normal_forces(states, mode, md, nc, rigid=None):
     """Normal force of every contact (k, nc) at each sample [N], a unilateral contact's in its
     sampled state (0 while open: bit nc + c of ``mode``; a closed rigid contact's multiplier with
-    the sampled stick set, bit c)."""
+    the sampled stick set, bit c). With ``rigid``, the (nc,) bool mask of a model's rigid contacts, NaN for the closed
+    rigid contacts at a sample where their normal forces have no consistent value (Painlevé: the
+    multiplier solved there is no force of the motion)."""
     codes = np.where(flag_bits(mode, nc, nc), physics.MODE_OPEN,
-                     np.where(flag_bits(mode, 0, nc), physics.MODE_STICK, physics.MODE_SLIP))
-    return _normal_forces(states, codes.astype(np.int8), md, nc)
+                     np.where(flag_bits(mode, 0, nc), physics.MODE_STICK, physics.MODE_SLIP)).astype(np.int8)
+    out = _normal_forces(states, codes, md, nc)
+    if rigid is not None and rigid.any():
+        undefined = ~_consistent_normal_forces(states, codes, md, nc)
+        out[undefined[:, None] & rigid[None, :] & (codes != physics.MODE_OPEN)] = np.nan
+    return out
+
+
+@njit(cache=True)
+def _consistent_normal_forces(states, codes, md, nc):
+    """Whether the closed rigid contacts' normal forces have a consistent value at each sample
+    (k,) bool: the relative pivot of their normal-force system is positive (true where none is closed)."""
+    k = states.shape[0]
+    out = np.ones(k, dtype=np.bool_)
+    cst = np.zeros(CST * nc)
+    for i in range(k):
+        for c in range(nc):
+            cst[CST * c] = codes[i, c]
+            cst[CST * c + 1] = 1.0
+        out[i] = physics.rigid_pivot(states[i], cst, md) > 0.0
+    return out
 
 
 @njit(cache=True)
@@ -152,9 +177,85 @@ def _gaps(states, md, nc):
     return out
 
 
+class Impact(NamedTuple):
+    """One impact of a rigid contact (an item of :class:`Impacts`).
+
+    Attributes
+    ----------
+    time : float
+        Instant [s].
+    contact : int
+        The contact that closed.
+    speed_before, speed_after : float
+        Its normal speed ġ = W·q̇ just before and after [m/s].
+    impulse : float
+        The normal impulse P_N [N s].
+    """
+
+    time: float
+    contact: int
+    speed_before: float
+    speed_after: float
+    impulse: float
+
+
+@njit(cache=True)
+def _impact_speeds(states, contacts, md):
+    """Normal speed ġ⁻ = W·q̇ of contact ``contacts[i]`` at each state (k, ≥ 2n) before an impact [m/s]."""
+    out = np.empty(states.shape[0])
+    for i in range(states.shape[0]):
+        out[i] = physics.gap(states[i], np.int64(contacts[i]), md)[1]
+    return out
+
+
+def impact_speeds(system: FrictionModel, kinds: np.ndarray, contacts: np.ndarray, states: np.ndarray):
+    """(instants' indices, |ġ⁻| [m/s]) of the impacts among transitions of ``kinds`` (k,) with the
+    ``contacts`` (k,) and ``states`` (k, ≥ 2n) there (the state before each impact)."""
+    rows = np.flatnonzero(kinds == TRANSITION_IMPACT)
+    if rows.size == 0:
+        return rows, np.empty(0)
+    speeds = _impact_speeds(np.ascontiguousarray(states[rows]), contacts[rows].astype(np.int64), system.data)
+    return rows, np.abs(speeds)
+
+
+@dataclasses.dataclass(frozen=True)
+class ImpactTally:
+    """The impacts of a run's steady window counted as the run went, from every impact's state
+    (those of the transition log beyond its kept states included), so that their number and
+    largest speed are exact however many impacts the run had.
+
+    Attributes
+    ----------
+    t_from, t_to : float
+        The window (t_from, t_to] [s]: the steady window the run was started with and its last sample.
+    count : int
+        Impacts in the window.
+    max_speed : float
+        Largest normal speed |ġ⁻| among them [m/s] (0 without impacts).
+    """
+
+    t_from: float
+    t_to: float
+    count: int = 0
+    max_speed: float = 0.0
+
+    def add(self, times: np.ndarray, speeds: np.ndarray) -> "ImpactTally":
+        """This tally with the impacts at ``times`` [s] of normal speeds |ġ⁻| ``speeds`` [m/s] added."""
+        inside = (times > self.t_from) & (times <= self.t_to)
+        if not inside.any():
+            return self
+        return dataclasses.replace(self, count=self.count + int(inside.sum()),
+                                   max_speed=max(self.max_speed, float(speeds[inside].max())))
+
+    def covers(self, t_from: float, t_to: float) -> bool:
+        """Whether this tally is of the window (t_from, t_to]."""
+        return self.t_from == t_from and self.t_to == t_to
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
-class Impacts:
-    """Impacts of the rigid contacts in a run, in order.
+class Impacts(Sequence):
+    """Impacts of the rigid contacts in a run, in order: a sequence of :class:`Impact` records
+    (``impacts[0]``, ``impacts[-3:]``, ``for impact in impacts``) with the columns as arrays.
 
     Attributes
     ----------
@@ -178,6 +279,20 @@ class Impacts:
 
     def __len__(self) -> int:
         return int(self.time.size)
+
+    def __getitem__(self, index):
+        """Impact ``index`` as an :class:`Impact`; a slice as :class:`Impacts`."""
+        if isinstance(index, slice):
+            return Impacts(self.time[index], self.contact[index], self.speed_before[index],
+                           self.speed_after[index], self.impulse[index])
+        i = operator.index(index)
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"impact {i} of a run with {len(self)} impacts")
+        return Impact(float(self.time[i]), int(self.contact[i]), float(self.speed_before[i]),
+                      float(self.speed_after[i]), float(self.impulse[i]))
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self)))
 
 
 def find_impacts(system: FrictionModel, transitions: Transitions) -> Impacts:
@@ -245,6 +360,10 @@ class Trajectory(Plottable):
     status_code : Status
         How the run ended, as an enum (``Status.SUCCESS``, ``Status.INCONSISTENT``, ...);
         :attr:`status` is its message.
+    impact_tally : ImpactTally, optional
+        The impacts of the steady window counted during the run (models with rigid contacts):
+        :attr:`steady` takes their number and largest speed from it, exact however many
+        transitions the run dropped.
     """
 
     FIGURE = "trajectory"
@@ -262,6 +381,7 @@ class Trajectory(Plottable):
     options: dict
     steady_from: float
     status_code: Status = Status.SUCCESS
+    impact_tally: ImpactTally | None = None
 
     # ------------------------------------------------------------- the model
     @property
@@ -291,8 +411,17 @@ class Trajectory(Plottable):
     # ------------------------------------------------------------- derived series
     @cached_property
     def slip_velocity(self) -> np.ndarray:
-        """Slip velocity of each contact (k, 2 nc) [m/s]; for the plates v_r of Eq. (9)."""
-        return _slip_velocities(np.ascontiguousarray(self.states), self.system.data, self.system.n_contacts)
+        """Slip velocity of each contact (k, 2 nc) [m/s]; for the plates v_r of Eq. (9); NaN for a
+        contact without friction."""
+        return self._without_friction(_slip_velocities(np.ascontiguousarray(self.states), self.system.data,
+                                                       self.system.n_contacts))
+
+    def _without_friction(self, v: np.ndarray) -> np.ndarray:
+        """Slip velocities ``v`` (k, 2 nc) with NaN for contacts without friction, which have none."""
+        for c, contact in enumerate(self.system.contacts):
+            if contact.frictionless:
+                v[:, 2 * c:2 * c + 2] = np.nan
+        return v
 
     @property
     def relative_velocity(self) -> np.ndarray:
@@ -312,7 +441,7 @@ class Trajectory(Plottable):
         n, nc = self.system.n, self.system.n_contacts
         at_rest = np.ascontiguousarray(self.states).copy()
         at_rest[:, n:] = 0.0
-        v0 = _slip_velocities(at_rest, self.system.data, nc).reshape(-1, nc, 2)
+        v0 = self._without_friction(_slip_velocities(at_rest, self.system.data, nc)).reshape(-1, nc, 2)
         v = self.slip_velocity.reshape(-1, nc, 2)
         cross = v0[..., 0] * v[..., 1] - v0[..., 1] * v[..., 0]
         dot = v0[..., 0] * v[..., 0] + v0[..., 1] * v[..., 1]
@@ -326,9 +455,11 @@ class Trajectory(Plottable):
 
     @cached_property
     def normal_force(self) -> np.ndarray:
-        """Normal force of each contact (k, nc) [N]: a prescribed N, or a unilateral contact's λ (0 open)."""
+        """Normal force of each contact (k, nc) [N]: a prescribed N, or a unilateral contact's λ (0 open;
+        NaN for a closed rigid contact at a sample where it has no consistent normal force, Painlevé)."""
         return _sample_normal_forces(np.ascontiguousarray(self.states), self.mode, self.system.data,
-                                     self.system.n_contacts)
+                                     self.system.n_contacts,
+                                     np.array([c.unilateral and c.normal.law == "rigid" for c in self.system.contacts]))
 
     @property
     def stick(self) -> np.ndarray:
@@ -383,6 +514,9 @@ class Trajectory(Plottable):
         """Steady-state summary over t ≥ ``t_from`` [s]."""
         i = self.observed
         impacts = (self.impacts.time, self.impacts.speed_before) if self.system.rigid else None
+        tally = self.impact_tally
+        if impacts is not None and tally is not None and tally.covers(float(t_from), float(self.t[-1])):
+            impacts = tally
         return summarize(self.t, self.states, self.mode, self.transitions, t_from, n_contacts=self.system.n_contacts,
                          coordinate=i, rate=i + self.system.n, name=self.system.dofs[i],
                          unilateral=self.system.unilateral, impacts=impacts)
@@ -403,7 +537,7 @@ class Trajectory(Plottable):
             b, t=np.concatenate([a.t, b.t[1:]]), states=np.concatenate([a.states, b.states[1:]]),
             mode=np.concatenate([a.mode, b.mode[1:]]), friction=np.concatenate([a.friction, b.friction[1:]]),
             work=np.concatenate([a.work, b.work[1:] + a.work[-1]]), transitions=tr, stats=stats,
-            options=dict(a.options, t_end=b.options["t_end"]))
+            options=dict(a.options, t_end=b.options["t_end"]), impact_tally=None)
 
     def tail(self, t_from: float) -> "Trajectory":
         """The part of this run from ``t_from`` [s] on (transitions before it counted as dropped)."""
@@ -490,6 +624,8 @@ class Trajectory(Plottable):
             "parameters": json.dumps(dict(system.parameters)),
             "transitions_dropped": int(self.transitions.dropped),
         }
+        if self.impact_tally is not None:
+            attrs["impact_tally"] = json.dumps(dataclasses.asdict(self.impact_tally))
         if self.is_plates:
             attrs.update(parameter_attrs(self.params.to_dict()))
         for key, value in self.steady.to_dict().items():
@@ -532,6 +668,7 @@ class Trajectory(Plottable):
             stats=Stats(**json.loads(ds.attrs["stats"])), status=ds.attrs["status"], system=system,
             method=ds.attrs["method"], options=json.loads(ds.attrs["options"]),
             steady_from=float(ds.attrs["steady_from"]), status_code=code,
+            impact_tally=ImpactTally(**json.loads(ds.attrs["impact_tally"])) if "impact_tally" in ds.attrs else None,
         )
 
     @classmethod

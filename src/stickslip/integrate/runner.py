@@ -39,7 +39,7 @@ from .event_loop import N_EXTRA, controls, integrate_event
 from .interrupt import interruptible
 from .loop_split import start_callees
 from ..analysis.modes import contact_index_dtype, mode_words
-from .result import Transitions, mode_array
+from .result import ImpactTally, Transitions, impact_speeds, mode_array
 from .status import CHUNK_END, Status
 
 __all__ = ["EventStepper", "Record", "Chunk", "RunOutput", "StopCondition", "ToTheEnd", "run_chunks",
@@ -142,11 +142,20 @@ class Record:
     chunks : list of (int, int, int)
         For each chunk: its first sample, its first transition (as counted by
         :attr:`transition_count`) and its number of samples.
+    tally : ImpactTally or None
+        With ``impact_window`` (a model with rigid contacts): the number and largest speed of the
+        impacts in (impact_window, last sample time], exact however many transitions are dropped.
     """
 
-    def __init__(self, system: FrictionModel, sample_times: np.ndarray, capacity: int | None = None):
+    def __init__(self, system: FrictionModel, sample_times: np.ndarray, capacity: int | None = None,
+                 impact_window: float | None = None):
         k = sample_times.size if capacity is None else min(int(capacity), sample_times.size)
+        self.system = system
         self.sample_times = sample_times
+        #: The impacts after ``impact_window`` [s] up to the last sample time, counted chunk by
+        #: chunk from the states the chunk logged (before older states are dropped): None unless asked
+        self.tally = None if impact_window is None or not system.rigid or sample_times.size == 0 else \
+            ImpactTally(float(impact_window), float(sample_times[-1]))
         self.ns = 2 * system.n + N_EXTRA
         self.capacity = k
         self._states = np.empty((k, self.ns))
@@ -198,6 +207,10 @@ class Record:
         self.chunks.append((self.n, self.transition_count, chunk.idx - self.n))
         self.n = chunk.idx
         n_tr = chunk.transitions[0].size
+        if self.tally is not None and n_tr:
+            times, kinds, contacts, states = chunk.transitions
+            rows, speeds = impact_speeds(self.system, kinds, contacts, states)
+            self.tally = self.tally.add(times[rows], speeds)
         self.transition_count += n_tr
         self._tr.append(tuple(a.copy() for a in chunk.transitions))
         self.kept += n_tr
@@ -405,8 +418,10 @@ def stats_dict(st, prepare_s: float) -> dict:
 
 
 def run_event(system: FrictionModel, s0: np.ndarray, t0: float, t_end: float, sample_times: np.ndarray, *,
-              rtol: float, atol: float, dt: float | None, max_steps: int) -> RunOutput:
-    """The ``event`` method from ``s0`` at ``t0`` to ``t_end``, to the end or Ctrl-C (:func:`run_chunks`).
+              rtol: float, atol: float, dt: float | None, max_steps: int, impact_window: float | None = None
+              ) -> RunOutput:
+    """The ``event`` method from ``s0`` at ``t0`` to ``t_end``, to the end or Ctrl-C (:func:`run_chunks`);
+    ``impact_window``: the start of the steady window whose impacts the record tallies (:class:`Record`).
 
     Raises
     ------
@@ -418,7 +433,7 @@ def run_event(system: FrictionModel, s0: np.ndarray, t0: float, t_end: float, sa
     if stepper.open_contact >= 0:
         raise SimulationError(f"the normal force of contact {stepper.open_contact} is ≤ 0 at the initial state: the "
                               "contact is open; start from a state where every contact is pressed")
-    record = Record(system, sample_times)
+    record = Record(system, sample_times, impact_window=impact_window)
     rate = (sample_times.size - 1) / (sample_times[-1] - sample_times[0]) if sample_times.size > 1 else 0.0
     numbers = record.ns + 1 + 2 * system.n_contacts  # per sample: states, mode, friction
     stop = ToTheEnd(CHUNK_SAMPLE_NUMBERS / (numbers * rate) if rate > 0 else float("inf"))

@@ -169,7 +169,7 @@ def gap_crossing(step, q_ready, h, cst, md, scratch):  # pragma: no cover
     for c in range(nc):
         if not is_unilateral(md, n, c):
             continue
-        if P.indicator(step.ynew, cst, c, md) <= 0.0:
+        if E.leaves_state(step.ynew, cst, c, md):
             th = crossing_in_step(E.EVENT_GAP, c, step, q_ready, h, cst, md, scratch)
         else:
             probe = E.gap_dip(step.y, step.k1, step.ynew, step.stages[6], h, cst, c, md)

@@ -406,6 +406,10 @@ def _build(t: _Template) -> FrictionModel:
     scalars = out["scalars"]
     contacts = []
     for c, name in enumerate(t.contact_names):
+        if f"{c}.tangent" not in out:  # no tangent and no friction: a frictionless unilateral contact
+            contacts.append(Contact(name=name, normal=NormalLaw(**out[f"{c}.normal"]),
+                                    gap=scalars.get(f"{c}.gap", 0.0), gap_gradient=out[f"{c}.gap_gradient"]))
+            continue
         law = _law(out[f"{c}.friction"], f"contact.{c}.friction")
         G = out[f"{c}.tangent"]
         if f"{c}.normal" in out:  # unilateral: a gap and its normal law

@@ -171,12 +171,19 @@ class Parser:
         if not isinstance(table, Mapping):
             raise ModelFileError(f"{where} must be a table ([[contact]])")
         check_keys(table, CONTACT_KEYS, f"{where}: ")
+        self.normal_keys(where, table)
+        if not any(key in table for key in (*REQUIRED_CONTACT, "drive")):
+            if "normal" not in table:  # a frictionless contact acts through its gap only
+                raise ModelFileError(f"{where}: a contact without tangent and friction acts along its normal only; "
+                                     "give it gap_gradient with a [contact.normal] table, or a tangent with a "
+                                     "[contact.friction] table")
+            return self.contact_name(where, table, c)
         for key in REQUIRED_CONTACT:
             if key not in table:
                 hint = {"tangent": "the rows of G, e.g. tangent = [[1.0]]",
                         "friction": "add a [contact.friction] table with law, mu_k, delta_mu"}[key]
-                raise ModelFileError(f"{where}.{key} is missing; give {hint}")
-        self.normal_keys(where, table)
+                raise ModelFileError(f"{where}.{key} is missing; give {hint} (or leave out tangent, drive and "
+                                     "friction for a contact without friction)")
         tangent = table["tangent"]
         flat = isinstance(tangent, Mapping) or (isinstance(tangent, list) and bool(tangent)
                                                 and not isinstance(tangent[0], (list, Mapping)))
@@ -195,6 +202,18 @@ class Parser:
                 self.law_table(value, f"{where}.friction", FRICTION_KEYS, f"{c}.friction", "coulomb, exponential or stribeck")
             elif key == "normal":
                 self.normal_table(value, f"{where}.normal", f"{c}.normal")
+        return self.contact_name(where, table, c)
+
+    def contact_name(self, where: str, table, c: int) -> str:
+        """Contact ``c``'s name, checked; a frictionless one's gap and normal law collected first."""
+        if "tangent" not in table:
+            for key, value in table.items():
+                if key == "gap":
+                    self.number(value, f"{where}.{key}", "scalars", f"{c}.{key}")
+                elif key == "gap_gradient":
+                    self.vector(value, self.n, f"{where}.{key}", f"{c}.{key}", sparse=True)
+                elif key == "normal":
+                    self.normal_table(value, f"{where}.normal", f"{c}.normal")
         name = table.get("name", f"contact{c}")
         if not isinstance(name, str):
             raise ModelFileError(f"{where}.name = {show_value(name)} must be a string")

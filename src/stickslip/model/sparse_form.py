@@ -263,6 +263,11 @@ def sparse_form(model) -> SparseForm:
                          f"{type(model.kinematics).__name__}); the sparse form needs constant tangent rows and drives "
                          "(a model file, or a FrictionModel with tangent= and drive= on each contact)")
     n, contacts = model.n, model.contacts
+    frictionless = [name for c, name in zip(contacts, model.contact_names) if c.frictionless]
+    if frictionless:
+        raise ModelError(f"model {model.name!r}: contact {frictionless[0]} has no friction, which the sparse form "
+                         "(finite-element numerics) does not take yet; use the dense tools (stickslip stability "
+                         "without --max-frequency), or give the contact a tangent and a friction law")
     dims = [c.dim for c in contacts]
     laws = [c.normal.law if c.unilateral else "" for c in contacts]
     normal = [c.normal for c in contacts]

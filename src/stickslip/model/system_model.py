@@ -53,6 +53,13 @@ __all__ = ["FrictionModel", "Contact", "NormalLaw", "NamedState", "ModelError", 
 #: the band (docs/numerics.md); 5e-4 takes 15–65 % fewer steps than 1e-4 and 1e-5.
 DEFAULT_SLIP_BAND = 5e-4
 
+#: The friction law the kernels take for a frictionless contact (:class:`Contact`): zero coefficients.
+FRICTIONLESS = FrictionLaw("coulomb", mu_k=0.0, delta_mu=0.0)
+
+#: [m/s] The constant speed at which a frictionless contact's zero tangent row "slides" in the
+#: kernels (v = −w): never 0, so it never sticks nor raises a slip event.
+FRICTIONLESS_DRIVE = 1.0
+
 #: What a dof name may hold: ``--ic x=1,dx=0`` splits at ``,`` and ``=``, ``--set stiffness.x.y``
 #: at ``.``, the shell at whitespace, and a leading digit would read as an index in a path.
 NAME_RULE = "ASCII letters, digits and _, not starting with a digit"
@@ -159,8 +166,9 @@ class Contact:
     ----------
     dim : {1, 2}
         Dimension of the tangential slip velocity (1: along a line; 2: in the contact plane).
-    friction : FrictionLaw
-        The contact's friction law.
+    friction : FrictionLaw, optional
+        The contact's friction law; None (with no ``tangent`` and ``drive``) for a *frictionless*
+        unilateral contact, one that acts along its normal only (:attr:`frictionless`).
     normal_force : float
         N0 [N], the constant part of a prescribed normal force (> 0; 0 for a unilateral contact).
     tangent : ndarray (dim, n) or None
@@ -178,10 +186,19 @@ class Contact:
         kinematics computes the gap (``register_kinematics(..., gap=...)``).
     gap_gradient : ndarray (n,), optional
         W [m per unit of each dof] of a unilateral contact; None when the kinematics computes the gap.
+
+    Notes
+    -----
+    A frictionless contact has no tangential part: it opens, closes and takes impacts, never
+    sticks or slips. The compiled kernels take it as a 1-D contact whose tangent row is zero, whose
+    drive is 1 m/s and whose friction coefficients are 0 (:data:`FRICTIONLESS_DRIVE`): its slip
+    velocity is the constant −1 m/s, so it never reaches v = 0 (no stick, no slip event) and its
+    friction force and impulse are 0; no coordinate is added. Results report its slip velocity
+    as NaN and its friction as 0.
     """
 
-    dim: int
-    friction: FrictionLaw
+    dim: int = 1
+    friction: FrictionLaw | None = None
     normal_force: float = 0.0
     tangent: np.ndarray | None = None
     drive: np.ndarray | None = None
@@ -191,6 +208,16 @@ class Contact:
     normal: NormalLaw | None = None
     gap: float = 0.0
     gap_gradient: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.friction is None:  # frictionless: the kernels' zero friction law (class Notes)
+            object.__setattr__(self, "friction", FRICTIONLESS)
+            object.__setattr__(self, "frictionless_contact", True)
+
+    @property
+    def frictionless(self) -> bool:
+        """Whether the contact acts along its normal only: no friction, no tangent (class Notes)."""
+        return getattr(self, "frictionless_contact", False)
 
     @property
     def unilateral(self) -> bool:
@@ -202,7 +229,10 @@ class Contact:
         out = {"dim": self.dim, "N0": self.normal_force, "law_row": self.friction.row(),
                "n_q": np.zeros(n) if self.normal_gradient is None else self.normal_gradient,
                "n_v": np.zeros(n) if self.normal_rate_gradient is None else self.normal_rate_gradient}
-        if self.tangent is not None:
+        if self.frictionless:  # a zero tangent row sliding at a constant speed (class Notes)
+            out["G"] = np.zeros((1, n))
+            out["w"] = np.array([FRICTIONLESS_DRIVE])
+        elif self.tangent is not None:
             out["G"] = self.tangent
             out["w"] = self.drive
         if self.normal is not None:
@@ -399,7 +429,9 @@ class FrictionModel:
                 value = getattr(contact, key)
                 if value is not None:
                     object.__setattr__(contact, key, self._vector(value, f"{where}: {key} must be {n} finite numbers"))
-            if constant:
+            if contact.frictionless:
+                self._check_frictionless(contact, where, constant)
+            elif constant:
                 if contact.tangent is None or contact.drive is None:
                     raise ModelError(f"{where}: give tangent (G) and drive (w) for constant kinematics")
                 G = contact_rows(contact.tangent, None, n, self.dense)
@@ -416,6 +448,19 @@ class FrictionModel:
                     raise ModelError(f"{where}: tangent is zero on every free dof; the contact cannot slip")
                 object.__setattr__(contact, "tangent", G)
                 object.__setattr__(contact, "drive", w)
+
+    @staticmethod
+    def _check_frictionless(contact: Contact, where: str, constant: bool) -> None:
+        """A frictionless contact: unilateral, 1-D, with neither tangent nor drive, constant kinematics."""
+        if not contact.unilateral:
+            raise ModelError(f"{where}: a contact without friction acts through its gap only; give it a gap with a "
+                             "normal law (gap_gradient and [contact.normal]) or a friction law")
+        if contact.dim != 1 or contact.tangent is not None or contact.drive is not None:
+            raise ModelError(f"{where}: a contact without friction has no tangent or drive; give a friction law "
+                             "with them, or leave all three out")
+        if not constant:
+            raise ModelError(f"{where}: contacts without friction are for models of constant frames (model files); "
+                             "give this contact a friction law with zero coefficients")
 
     def _vector(self, value, refusal: str):
         """A contact's gradient (n, n_v or W) as the model keeps it: (n,) dense, (1, n) sparse."""
@@ -656,5 +701,6 @@ class FrictionModel:
     def describe(self) -> dict:
         """JSON-ready description: name, source, dofs, contacts, parameters (written into results)."""
         return {"name": self.name, "source": self.source, "dofs": list(self.dofs),
-                "contacts": [{"dim": c.dim, **c.friction.to_dict()} for c in self.contacts],
+                "contacts": [{"dim": 0, "law": "none"} if c.frictionless else {"dim": c.dim, **c.friction.to_dict()}
+                             for c in self.contacts],
                 "parameters": {k: v for k, v in self.parameters.items()}}

@@ -15,11 +15,11 @@ from ..model.derivatives import state_jacobian_from_python
 from ..model.library.two_plates import plates_parameters
 from ..model.matrices import dense_array
 from ..model.parameters import Parameters, parameter_attrs
-from ..model.physics import MODE_SLIP_EXACT
+from ..model.physics import MODE_OPEN, MODE_SLIP_EXACT
 from ..model.sparse_form import SparseForm
 from ..model.variants import DOF_NAMES
 from .band import BandError, band_stability
-from .equilibrium import model_of, point_text, rigid_constraint, solve_steady
+from .equilibrium import model_of, point_text, rigid_constraint, solve_steady_modes
 from .sparse_input import is_sparse_model
 from .verdict import MARGINAL_RTOL, stability_verdict
 
@@ -58,6 +58,9 @@ class StabilityResult:
         The model linearised.
     all_dofs : tuple of str
         Every dof of the model, free or locked, in q order (the order of ``equilibrium``).
+    open_contacts : tuple of str
+        The unilateral contacts that steady sliding leaves open (gap > 0 at ``equilibrium``): they
+        carry no force there and contribute nothing to ``jacobian``.
     """
 
     params: Parameters
@@ -73,6 +76,7 @@ class StabilityResult:
     mode_shapes: np.ndarray
     system: object = None
     all_dofs: tuple[str, ...] = DOF_NAMES
+    open_contacts: tuple[str, ...] = ()
 
     # ------------------------------------------------------------------ derived
     @property
@@ -132,12 +136,13 @@ class StabilityResult:
         return rows
 
     def summary(self) -> dict:
-        """JSON-ready summary: equilibrium (names → values), eigenvalues [[re, im], ...],
-        max_real_part, stable, verdict (stable | marginal | unstable) and the tolerance within
-        which a real part counts as 0 (``marginal_tolerance`` [1/s])."""
+        """JSON-ready summary: equilibrium (names → values), the contacts open there, eigenvalues
+        [[re, im], ...], max_real_part, stable, verdict (stable | marginal | unstable) and the
+        tolerance within which a real part counts as 0 (``marginal_tolerance`` [1/s])."""
         return {
             "model": self.model,
             "equilibrium": self.equilibrium_dict,
+            "open_contacts": list(self.open_contacts),
             "eigenvalues": [[float(v.real), float(v.imag)] for v in self.eigenvalues],
             "max_real_part": self.max_real_part,
             "stable": bool(self.stable),
@@ -188,9 +193,9 @@ class StabilityResult:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def linearization(system, q: np.ndarray, open_contacts=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Jacobian of the slip equations of any model at (q, q̇ = 0), reduced to the free DOFs (for
-    the plates: Eq. 15 with K_L and C_L of the Appendix).
+    the plates: Eq. 15 with K_L and C_L of the Appendix), with the contacts ``open_contacts`` open.
 
     The complex-step Jacobian of the simulator's own right-hand side.
 
@@ -206,6 +211,8 @@ def linearization(system, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     s[:n] = q
     cst = contact_state(system.data.m)
     cst[0::CST] = MODE_SLIP_EXACT
+    for c in open_contacts:
+        cst[CST * c] = MODE_OPEN
     J_full = state_jacobian_from_python(s, cst, system.data)
     free = np.flatnonzero(system.free)
     k = free.size
@@ -266,8 +273,8 @@ def stability(model=None, *, max_frequency: float | None = None, method: str | N
 
 def model_stability(system) -> StabilityResult:
     """:func:`stability` of a :class:`~stickslip.model.FrictionModel`."""
-    q, residual, _ = solve_steady(system)
-    J, K_L, C_L = linearization(system, q)
+    q, residual, _, opened = solve_steady_modes(system)
+    J, K_L, C_L = linearization(system, q, opened)
     if not np.all(np.isfinite(J)):
         raise EquilibriumError(f"the linearisation at steady sliding is not finite ({point_text(system)}: overflow); "
                                "give values of physical size")
@@ -277,7 +284,7 @@ def model_stability(system) -> StabilityResult:
     if system.rigid:
         # the closed rigid contacts hold W q = −g0 and W q̇ = 0, an invariant subspace of the
         # linearised flow (J T = T Tᵀ J T): its eigenvalues are those of Tᵀ J T, T = diag(Z, Z)
-        basis = rigid_constraint(system)[1][free]
+        basis = rigid_constraint(system, exclude=opened)[1][free]
     T = np.kron(np.eye(2), basis)
     lam, vec = np.linalg.eig(T.T @ J @ T)
     order = np.lexsort((-lam.imag, -lam.real))  # real part descending, then Im descending
@@ -295,4 +302,5 @@ def model_stability(system) -> StabilityResult:
         dofs=tuple(system.dofs[i] for i in free), equilibrium=q, residual=residual, jacobian=J,
         stiffness=K_L, damping=C_L, mass=np.diag(M).copy() if diagonal else M, eigenvalues=lam,
         mode_shapes=shapes, system=system, all_dofs=tuple(system.dofs),
+        open_contacts=tuple(system.contact_names[c] for c in opened),
     )

@@ -23,12 +23,13 @@ from ..model.compile_ahead import compile_apart
 from ..model.bundle import CST
 from ..model.library import resolve_model
 from ..model.parameters import Parameters
-from ..model.physics import MODE_SLIP_EXACT, gap, normal_force_of, rhs, rigid_pivot, slip_velocity
+from ..model.physics import MODE_OPEN, MODE_SLIP_EXACT, gap, normal_force_of, rhs, rigid_pivot, slip_velocity
 from ..model.system_model import FrictionModel
 from . import steady
 
 __all__ = ["EquilibriumError", "equilibrium", "equilibrium_residual", "RESIDUAL_TOL", "steady_sliding",
-           "steady_residual", "solve_steady", "point_text", "sliding_speeds", "model_of", "rigid_constraint"]
+           "steady_residual", "solve_steady", "solve_steady_modes",
+           "point_text", "sliding_speeds", "model_of", "rigid_constraint"]
 
 #: Relative residual |K x − b| / max(|K x|, |b|) accepted as solved. Newton reaches ~1e-16
 #: (round-off of the force balance); 1e-10 leaves room for ill-conditioned cases while still
@@ -99,22 +100,114 @@ def solve_steady(system) -> tuple[np.ndarray, float, int]:
         0) or, for a 2-D contact, slides inside the low-speed band (the simulator's slip direction
         there is not v/|v|, so steady sliding is not an equilibrium of the simulated equations).
     """
-    q, rel, iterations = _solve_rigid(system) if system.rigid else _solve_closed(system)
-    _check_closed(system, q)
-    return q, rel, iterations
+    return solve_steady_modes(system)[:3]
 
 
-def rigid_constraint(system) -> tuple[np.ndarray, np.ndarray]:
+def solve_steady_modes(system) -> tuple[np.ndarray, float, int, tuple[int, ...]]:
+    """:func:`solve_steady`, with the unilateral contacts that steady sliding leaves open.
+
+    Every unilateral contact is first held closed. Where that leaves some of them not pressed
+    (λ ≤ 0; a rigid one at rest at λ = 0 counts as closed), they are opened and the equilibrium
+    solved again with them carrying no force, until the set is consistent: each open contact's gap
+    is positive at the equilibrium (it contributes nothing there, nor to the linearisation) and
+    each closed one is pressed, and some contact with friction stays closed (slides: with all of them
+    open there is no sliding). The refusal where no such set exists is that of the closed solve (the
+    contact is not pressed at all, or the friction jams it).
+
+    Returns
+    -------
+    q, relative_residual, iterations
+        As :func:`solve_steady`.
+    open_contacts : tuple of int
+        The contacts open at the equilibrium, ascending (empty where all are closed).
+    """
+    try:
+        q, rel, iterations = _solve_rigid(system) if system.rigid else _solve_closed(system)
+    except EquilibriumError as exc:
+        if not system.unilateral:
+            raise
+        return _solve_open(system, None, exc)
+    if _open_contact(system, q) is None:
+        return q, rel, iterations, ()
+    return _solve_open(system, q, None)
+
+
+def _solve_open(system, q_closed, failure) -> tuple[np.ndarray, float, int, tuple[int, ...]]:
+    """The active set of :func:`solve_steady_modes` from the closed solve's ``q_closed`` (None where
+    it failed, with ``failure``): open the contacts it leaves unpressed, solve, and move contacts
+    between the sets until each open one has a positive gap and each closed one is pressed."""
+    unilateral = {c for c, contact in enumerate(system.contacts) if contact.unilateral}
+    opened = set(unilateral) if q_closed is None else set(_unpressed(system, q_closed, ()))
+    iterations = 0
+    for _ in range(len(unilateral) + 1):
+        try:
+            q, rel, it = _solve_with_open(system, tuple(sorted(opened)))
+        except EquilibriumError:
+            break
+        iterations += it
+        s = np.zeros(2 * system.n)
+        s[:system.n] = q
+        closing = {c for c in opened if not gap(s, c, system.data)[0] > 0.0}
+        opening = set(_unpressed(system, q, opened))
+        if not closing and not opening and rigid_pivot(s, _sliding_modes(system, opened), system.data) > 0.0:
+            if not any(c not in opened and not contact.frictionless for c, contact in enumerate(system.contacts)):
+                break  # every contact with friction open: a free equilibrium, no sliding
+            return q, rel, iterations, tuple(sorted(opened))
+        if opened == (opened - closing) | opening:
+            break
+        opened = (opened - closing) | opening
+    if failure is not None:
+        raise failure
+    _check_closed(system, q_closed)
+    raise EquilibriumError(f"no steady sliding at {system.point_text()}: no set of open contacts is consistent")
+
+
+def _unpressed(system, q: np.ndarray, opened) -> list[int]:
+    """The unilateral contacts closed in the steady state ``q`` (those not in ``opened``) that
+    nothing presses: a compliant one with g ≥ 0 or λ ≤ 0, a rigid one with λ < 0."""
+    s = np.zeros(2 * system.n)
+    s[:system.n] = q
+    cst = _sliding_modes(system, opened)
+    out = []
+    for c, contact in enumerate(system.contacts):
+        if contact.unilateral and c not in opened:
+            g = gap(s, c, system.data)[0]
+            lam = normal_force_of(s, cst, c, system.data)
+            if not (lam >= 0.0 if contact.normal.law == "rigid" else (g < 0.0 and lam > 0.0)):
+                out.append(c)
+    return out
+
+
+def _solve_with_open(system, opened: tuple[int, ...]) -> tuple[np.ndarray, float, int]:
+    """Steady sliding with the contacts ``opened`` open (no force) and the others closed: scipy's
+    hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0, (q_p, Z) the closed rigid contacts' constraint
+    (:func:`rigid_constraint`; q_p = 0 and Z the free DOFs where none is closed)."""
+    n = system.n
+    cst = _sliding_modes(system, opened)
+    speeds = sliding_speeds(system, np.zeros(n))
+    if any(speeds[c] == 0.0 for c in range(system.n_contacts) if c not in opened):
+        raise EquilibriumError(_not_sliding_message(system, np.zeros(n)))
+    q, nfev, _ = _root_on_constraint(system, cst, *rigid_constraint(system, exclude=opened))
+    rel = steady_residual(system, q, cst)
+    if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
+        raise EquilibriumError(f"no steady sliding with contacts {list(opened)} open (relative residual {rel:.2e})")
+    return q, float(rel), nfev
+
+
+def rigid_constraint(system, exclude=()) -> tuple[np.ndarray, np.ndarray]:
     """(q_p, Z): the least-norm point q_p (n,) of W_R q = −g0 and an orthonormal basis Z (n, k − m)
     of null(W_R) on the free DOFs (zero rows on locked ones), W_R (m, n) the rigid contacts' gap
-    gradients, g0 their gaps."""
+    gradients, g0 their gaps; the contacts in ``exclude`` (open ones) left out (q_p = 0 and Z the
+    free DOFs' columns of the identity where no rigid contact is left)."""
     from scipy.linalg import null_space  # imported on use: scipy takes ~0.3 s of every command's start
 
-    rows = [(np.asarray(c.gap_gradient, float), c.gap) for c in system.contacts
-            if c.unilateral and c.normal.law == "rigid"]
+    rows = [(np.asarray(c.gap_gradient, float).reshape(-1), c.gap) for i, c in enumerate(system.contacts)
+            if c.unilateral and c.normal.law == "rigid" and i not in exclude]
+    free = np.flatnonzero(system.free)
+    if not rows:
+        return np.zeros(system.n), np.eye(system.n)[:, free]
     W = np.array([w for w, _ in rows])
     g0 = np.array([g for _, g in rows])
-    free = np.flatnonzero(system.free)
     q_p = np.zeros(system.n)
     q_p[free] = -np.linalg.pinv(W[:, free]) @ g0
     Z = np.zeros((system.n, free.size - np.linalg.matrix_rank(W[:, free])))
@@ -122,17 +215,15 @@ def rigid_constraint(system) -> tuple[np.ndarray, np.ndarray]:
     return q_p, Z
 
 
-def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
-    """:func:`solve_steady` with every contact sliding and the rigid ones closed (module docstring):
-    scipy's hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0, the rigid normal forces
-    the right-hand side's multipliers."""
+def _root_on_constraint(system, cst: np.ndarray, q_p: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, int, str]:
+    """(q, evaluations, the root finder's message): scipy's hybrid Powell method on
+    Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0 in the contact modes ``cst`` (q_p where Z has no column:
+    the closed contacts fix every free dof)."""
     from scipy.optimize import root  # imported on use, as in rigid_constraint
 
-    if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:
-        raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
-    q_p, Z = rigid_constraint(system)
     n = system.n
-    cst = _sliding_modes(system)
+    if not Z.shape[1]:
+        return q_p, 0, "the constraint fixes every free dof"
 
     def acceleration(r):
         s = np.zeros(2 * n)
@@ -141,7 +232,19 @@ def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
         rhs(s, cst, system.data, ds)
         return Z.T @ ds[n:]
     sol = root(acceleration, np.zeros(Z.shape[1]), method="hybr", options={"xtol": 1e-14})
-    q = q_p + Z @ sol.x
+    return q_p + Z @ sol.x, int(sol.nfev), sol.message
+
+
+def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
+    """:func:`solve_steady` with every contact sliding and the rigid ones closed (module docstring):
+    scipy's hybrid Powell method on Zᵀ q̈(q_p + Z r, 0) = 0 from r = 0, the rigid normal forces
+    the right-hand side's multipliers."""
+    if min(sliding_speeds(system, np.zeros(system.n))) == 0.0:
+        raise EquilibriumError(_not_sliding_message(system, np.zeros(system.n)))
+    q_p, Z = rigid_constraint(system)
+    n = system.n
+    cst = _sliding_modes(system)
+    q, nfev, message = _root_on_constraint(system, cst, q_p, Z)
     for at in (q, q_p):  # where the solve ended, else (a state not finite) on the constraint at r = 0
         s = np.zeros(2 * n)
         s[:n] = at
@@ -157,10 +260,10 @@ def _solve_rigid(system) -> tuple[np.ndarray, float, int]:
     if not (np.all(np.isfinite(q)) and rel <= RESIDUAL_TOL):
         raise EquilibriumError(f"no steady-sliding equilibrium found for {point_text(system)}: no position with the "
                                f"rigid contacts closed balances the forces (relative residual {rel:.2e} > "
-                               f"{RESIDUAL_TOL:g} where the root finder stopped: {sol.message.rstrip('.')}); steady "
+                               f"{RESIDUAL_TOL:g} where the root finder stopped: {message.rstrip('.')}); steady "
                                "sliding may not exist at these parameters (is there a free direction along the contact "
                                "without stiffness against the friction?)")
-    return q, float(rel), int(sol.nfev)
+    return q, float(rel), nfev
 
 
 def _solve_closed(system) -> tuple[np.ndarray, float, int]:
@@ -224,11 +327,14 @@ def _check_closed(system, q: np.ndarray) -> None:
                            "negative gap) or simulate the free motion")
 
 
-def _sliding_modes(system) -> np.ndarray:
-    """Contact states with every contact slipping (exact direction), as steady sliding has them."""
+def _sliding_modes(system, opened=()) -> np.ndarray:
+    """Contact states with every contact slipping (exact direction), as steady sliding has them,
+    but those in ``opened``, open."""
     cst = np.zeros(CST * system.n_contacts)
     cst[0::CST] = MODE_SLIP_EXACT
     cst[3::CST] = np.inf
+    for c in opened:
+        cst[CST * c] = MODE_OPEN
     return cst
 
 
@@ -237,24 +343,26 @@ def steady_sliding(system) -> np.ndarray:
     return solve_steady(system)[0]
 
 
-def equilibrium_residual(system, q: np.ndarray) -> np.ndarray:
+def equilibrium_residual(system, q: np.ndarray, cst: np.ndarray | None = None) -> np.ndarray:
     """Force residual −M q̈ of the slip equations at (q, q̇ = 0), shape (n,) [N or N m per dof].
 
     Evaluated by the simulator's right-hand side, so its zero is exactly the steady sliding state
     the simulator sees (for the plates: K q − Gᵀ F(v_r = Ω(Y, −X)), paper Eq. 14). Locked DOFs give 0.
+    ``cst``: the contacts' modes (default every contact sliding).
     """
     n = system.n
     s = np.zeros(2 * n)
     s[:n] = q
     ds = np.zeros(2 * n)
-    rhs(s, _sliding_modes(system), system.data, ds)
+    rhs(s, _sliding_modes(system) if cst is None else cst, system.data, ds)
     return np.where(system.free, -(system.mass @ ds[n:]), 0.0)
 
 
-def steady_residual(system, q: np.ndarray) -> float:
-    """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)."""
+def steady_residual(system, q: np.ndarray, cst: np.ndarray | None = None) -> float:
+    """Relative force residual |M q̈| / max(|K q|, |f0|, |Σ Gᵀ F|) of steady sliding at q (q̇ = 0)
+    (``cst``: the contacts' modes, default every contact sliding)."""
     free = np.flatnonzero(system.free)
-    Q = -equilibrium_residual(system, q)[free]
+    Q = -equilibrium_residual(system, q, cst)[free]
     Kq = (system.stiffness @ np.asarray(q, float))[free]
     f0 = system.force[free]
     num = float(np.max(np.abs(Q), initial=0.0))

@@ -1,14 +1,15 @@
 """The model library: friction-contact models by name, and model files by path.
 
-=======================  ==========================================================================
-``two-plates``           the paper's two rigid plates (default; :mod:`.two_plates`)
-``belt``                 1-DOF mass on a moving belt, the bSTAB friction case (``belt.toml``)
-``hoffmann``             2-DOF mode-coupling (flutter) model (``hoffmann.toml``)
-``impact-oscillator``    mass bouncing on a rigid moving stop (``impact_oscillator.toml``)
-``popp-stelter``         two masses on one belt, two contacts (``popp_stelter.toml``)
-``slider-belt``          2-DOF slider on a belt, contact opens and closes (``slider_belt.toml``)
-``sprag-slip``           tilted beam on a belt: no steady sliding above μ* (``sprag_slip.toml``)
-=======================  ==========================================================================
+========================  ==========================================================================
+``two-plates``            the paper's two rigid plates (default; :mod:`.two_plates`)
+``belt``                  1-DOF mass on a moving belt, the bSTAB friction case (``belt.toml``)
+``clearance-oscillator``  the belt with a frictionless stop at a clearance (``clearance_oscillator.toml``)
+``hoffmann``              2-DOF mode-coupling (flutter) model (``hoffmann.toml``)
+``impact-oscillator``     mass bouncing on a rigid moving stop (``impact_oscillator.toml``)
+``popp-stelter``          two masses on one belt, two contacts (``popp_stelter.toml``)
+``slider-belt``           2-DOF slider on a belt, contact opens and closes (``slider_belt.toml``)
+``sprag-slip``            tilted beam on a belt: no steady sliding above μ* (``sprag_slip.toml``)
+========================  ==========================================================================
 
 Library models stated as model files live beside this module as TOML; ``stickslip models``
 lists them. :func:`load_model` accepts a library name or the path of a model file.
@@ -52,8 +53,9 @@ def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
     Parameters
     ----------
     name : str, Path or FrictionModel
-        A library name (``stickslip models`` lists them: ``two-plates``, ``belt``, ``hoffmann``,
-        ``impact-oscillator``, ``popp-stelter``, ``slider-belt``, ``sprag-slip``), a variant of the two plates with Table 1
+        A library name (``stickslip models`` lists them: ``two-plates``, ``belt``, ``clearance-oscillator``,
+        ``hoffmann``, ``impact-oscillator``, ``popp-stelter``, ``slider-belt``, ``sprag-slip``), a variant of
+        the two plates with Table 1
         parameters (``full``, ``x``, ``y``, ``rotation``, :func:`plates_variant`), the path of a
         model file (``.toml``), or a model, returned as it is. Default: the two plates with Table 1
         parameters.
