@@ -39,8 +39,8 @@ import stickslip  # noqa: E402
 from stickslip import Parameters  # noqa: E402
 from stickslip.model import physics  # noqa: E402
 from stickslip.model.bundle import contact_state  # noqa: E402
-from stickslip.stability import stability_map  # noqa: E402
 from stickslip.model.library import two_plates  # noqa: E402
+from stickslip.stability import stability_map  # noqa: E402
 from stickslip.stability.equilibrium import equilibrium_residual  # noqa: E402
 
 GOAL_MAP_S = 10.0
