@@ -33,8 +33,11 @@ complex steps of the contact's slip velocity, friction and normal force
       S = R + (f⁺ − R f⁻) ∇gᵀ / (∇g · f⁻),    R = ∂Π/∂s
 
   (Leine & Nijmeijer 2004, ch. 3), with h = g the gap, R by central differences of the compiled
-  impact map (linear in the velocities for constant G and W, so exact to round-off there), f⁺ at
-  s⁺ in the modes after (bounced off: open; stayed: sliding).
+  impact map (linear in the velocities for constant G and W, so exact to round-off there; the
+  velocity steps stay under half the one that reverses ġ⁻, where the map has a kink), f⁺ at
+  s⁺ in the modes after (bounced off: open; stayed: sliding). The variations enter it at the
+  run's recorded impact instant (:mod:`.linear_flow`): S divides by ġ⁻, so the variations and
+  the state it is built at must be taken at one instant.
 """
 
 from __future__ import annotations
@@ -246,7 +249,7 @@ def _impact_step(value: float, normal_rate: float, landing: float) -> float:
     landing speed ``landing`` = |ġ⁻| by ``normal_rate`` per unit: 1e-7 max(1, |value|), at most half
     the step that reverses ġ⁻. Π has a kink at ġ⁻ = 0 (a contact that does not approach gets no
     impulse), and a difference straddling it mixes the two branches: on the rigid slider near its
-    flight's vanishing (ġ⁻ = −8.7e-8) a velocity step of 1e-7 gave ∂ẏ⁺/∂ẏ⁻ = 0.07 instead of 0
+    flight's vanishing (ġ⁻ = −8.7e-8) a velocity step of 1e-7 gives ∂ẏ⁺/∂ẏ⁻ = 0.07 instead of 0
     (plastic) and a multiplier −98."""
     h = 1e-7 * max(1.0, abs(value))
     return min(h, 0.5 * landing / abs(normal_rate)) if normal_rate != 0.0 else h
