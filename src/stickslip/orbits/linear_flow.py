@@ -393,8 +393,8 @@ class _Carry:
         the gap by the landing speed ġ⁻; its error from evaluating the jump at the recorded state and
         the variations at another instant δt is ~ g̈ δt / ġ⁻ times the jump's large column. The
         re-integration's own landing lies up to :data:`MATCH_TIME_TOL` from the record, and near a
-        grazing (a dip of the gap shorter than its steps, ~ ġ⁻/g̈) it can miss the landing at
-        all: the variations are therefore carried to the recorded instant itself."""
+        grazing (a dip of the gap shorter than its steps, ~ ġ⁻/g̈) it can miss the landing
+        altogether: the variations are therefore carried to the recorded instant itself."""
         c = int(self.tr.contact[self.k])
         seg = _segment(self.system, self.y, self.Phi, self.t, t_next, self.cst, rtol, unwatched=c)
         if not seg.event:
