@@ -18,10 +18,12 @@ import stickslip
 from stickslip.basins.states import box
 from stickslip.errors import BasinError
 from stickslip.integrate.contacts import TRANSITION_OPEN
+from stickslip.integrate.result import find_impacts
 from stickslip.orbits.continuation import continue_orbit
+from stickslip.orbits.linear_flow import flow_jacobian
 from stickslip.orbits.problem import stick_summary
 
-from orbits.flow_differences import flow_map_differences  # tests/orbits: plain simulations of the flow map
+from orbits.flow_differences import flow_map_differences, plain_flow  # tests/orbits: plain runs of the flow map
 
 RIGID_SLIDER = Path(__file__).with_name("rigid_slider.toml")
 
@@ -136,6 +138,30 @@ def test_continuation_ends_at_the_grazing_of_the_rigid_contact(model, orbit):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if flies(mid) else (mid, hi)
     assert grazing.value == pytest.approx(0.5 * (lo + hi), abs=1e-5)
+
+
+@pytest.mark.parametrize(("speed", "landing"), [(0.37054988, 1.1e-3), (0.36615648, 1.2e-5), (0.36594959, 8.7e-8)])
+def test_saltation_monodromy_towards_the_flight_vanishing_equals_one_sided_differences(model, speed, landing):
+    """Belt speeds where the cycle's flight is short and its plastic impact lands at about ``landing``
+    (relative to the velocity scale ≈ 1), down to 8.7e-8, where the impact map's central differences
+    of step 1e-7 straddled the reversal of the landing speed (a multiplier −98 before).
+
+    Reference: forward differences of plain runs of step 1e-10 (the flight at the section is 1.2e-10
+    high at the slowest landing: the y column there converges like the square-root singularity,
+    8e-2, 1.6e-2, 9e-4 at steps 1e-6, 1e-8, 1e-10); multipliers {1, 0, 0, 0}."""
+    system = model.replace(V=speed)
+    orbit = stickslip.periodic_orbit(system, {"x": 1.0, "y": 0.05}, section="y_max", search_time=60.0,
+                                     monodromy="saltation")
+    slowest = float(np.min(-find_impacts(system, orbit.trajectory(1.0, sample_rate=10.0).transitions).speed_before))
+    assert 0.5 * landing < slowest < 1.5 * landing
+    np.testing.assert_allclose(np.sort(np.abs(orbit.multipliers)), [0.0, 0.0, 0.0, 1.0], atol=1e-6)
+    M = flow_jacobian(system, orbit.state, orbit.period, rtol=1e-10).matrix
+    h = 1e-10
+    end = plain_flow(system, orbit.state, orbit.period)
+    D = np.column_stack([(plain_flow(system, orbit.state + h * np.eye(4)[j], orbit.period) - end) / h
+                         for j in range(4)])
+    column_tol = np.array([1e-4, 2e-3 if landing < 1e-6 else 1e-4, 1e-4, 1e-4])
+    assert (np.abs(M - D).max(axis=0) < column_tol).all(), np.abs(M - D).max(axis=0)
 
 
 def test_lyapunov_exponents_from_perturbed_trajectories_across_impacts(model, orbit):

@@ -14,6 +14,7 @@ differences of the flow map, each run a plain simulation from a perturbed state.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,9 @@ from scipy.integrate import solve_ivp
 import stickslip
 from stickslip.orbits.continuation import continue_orbit, start_run
 
-from .flow_differences import flow_map_differences
+from stickslip.integrate.result import find_impacts
+
+from .flow_differences import flow_map_differences, plain_flow
 
 BELT_STOP = Path(__file__).with_name("belt_stop.toml")
 
@@ -95,3 +98,33 @@ def test_multipliers_equal_differences_of_the_flow_map(model, branch, i):
     D = flow_map_differences(system, branch.states[i], float(branch.periods[i]), [0, 1], h=1e-5)
     fd = np.sort_complex(np.linalg.eigvals(D))
     np.testing.assert_allclose(np.sort_complex(branch.multipliers[i]), fd, rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("landing", [1e-3, 1e-4, 1e-5])
+def test_saltation_monodromy_at_slow_impacts_equals_one_sided_differences(model, landing):
+    """Clearances just below x*, where the cycle lands at about ``landing`` (v_i² ≈ 2 |x''(x*)| (x* − clearance),
+    x''(x*) = −x* + μ(1.5) ≈ −1.68). The monodromy grows like 1/v_i (the flow map's square-root singularity
+    at the grazing), and must be the saltation one (no fallback to differences, which straddle the grazing).
+
+    Reference: forward differences of plain runs with steps h = 1e-3 v_i², well inside the impacting side
+    (the perturbed orbits reach the stop up to ~0.3 v_i² further). Their truncation error is ~ h/v_i² of the
+    entries (1.2e-3 and 3.3e-3 measured at 1e-3 and 1e-4); at 1e-5 the steps (1e-13) are below the plain runs'
+    noise, and only the multipliers are compared: {1, 0}, the stick phase collapsing all but the flow."""
+    x_star = free_cycle_maximum()
+    system = model.replace(clearance=x_star - landing ** 2 / (2.0 * 1.6816))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a fallback to differences warns
+        orbit = stickslip.periodic_orbit(system, {"x": 0.0, "dx": 1.5}, section=("x", 1.0), search_time=60.0,
+                                         monodromy="saltation")
+    speed = -find_impacts(system, orbit.trajectory(1.0, sample_rate=10.0).transitions).speed_before
+    assert speed.size == 1 and 0.5 * landing < speed[0] < 1.5 * landing
+    M = orbit.monodromy
+    assert np.abs(M).max() > 0.5 / landing  # the singular growth is resolved, not damped
+    np.testing.assert_allclose(np.sort(np.abs(orbit.multipliers)), [0.0, 1.0], atol=1e-3)
+    if landing < 1e-4:
+        return
+    h = 1e-3 * landing ** 2
+    end = plain_flow(system, orbit.state, orbit.period)
+    D = np.column_stack([(plain_flow(system, orbit.state + h * np.eye(2)[j], orbit.period) - end) / h
+                         for j in range(2)])
+    np.testing.assert_allclose(M, D, rtol=0, atol=1e-2 * np.abs(D).max())

@@ -246,10 +246,13 @@ def _events_of(system, cst):
     return kind, level, e, band
 
 
-def _segment(system, y, Phi, t0, t1, cst, rtol):
-    """Integrate [s, Φ] from t0 towards t1 in the modes of ``cst`` until the first event."""
+def _segment(system, y, Phi, t0, t1, cst, rtol, unwatched: int = -1):
+    """Integrate [s, Φ] from t0 towards t1 in the modes of ``cst`` until the first event (the gap
+    event of contact ``unwatched``, if one is given, not watched)."""
     n2 = 2 * system.n
     kind, level, e, band = _events_of(system, cst)
+    if unwatched >= 0:
+        kind[system.n_contacts + unwatched] = V.EV_NONE
     y0 = np.concatenate([y[:n2], Phi.ravel()])
     atol = np.full(y0.size, VAR_ATOL_PHI)
     atol[:n2] = VAR_ATOL_STATE
@@ -369,7 +372,10 @@ class _Carry:
         and a second past the next recorded transition (at ``t_next``). A flight (or touch) shorter
         than the re-integration's steps, which see the contact alike at both ends of one, was found
         by the run inside its step (on the gap's Hermite dip): the piece then ends at the recorded
-        instant, with that transition's gap event."""
+        instant, with that transition's gap event. A piece towards a recorded impact ends at its
+        instant (:meth:`towards_impact`)."""
+        if self.pending((E.TRANSITION_IMPACT,)) and self.t + max_interval >= t_next:
+            return self.towards_impact(t_next, rtol)
         t1 = min(self.t + max_interval, t_next + 1.0 if self.pending() else T)
         seg = _segment(self.system, self.y, self.Phi, self.t, t1, self.cst, rtol)
         if not seg.event and self.pending((E.TRANSITION_OPEN, E.TRANSITION_CLOSE)) \
@@ -377,6 +383,22 @@ class _Carry:
             seg = _segment(self.system, self.y, self.Phi, self.t, t_next, self.cst, rtol)
             if not seg.event:
                 seg.event, seg.contact, seg.kind = True, self.system.n_contacts + int(self.tr.contact[self.k]), V.EV_GAP
+        return seg
+
+    def towards_impact(self, t_next: float, rtol: float):
+        """The piece up to the recorded impact of contact c at ``t_next``, its gap event unwatched, so
+        that it ends there with c's gap event (unless another event comes first).
+
+        The impact's jump (:func:`.saltation.impact_jump`) divides the variations' component across
+        the gap by the landing speed ġ⁻; its error from evaluating the jump at the recorded state and
+        the variations at another instant δt is ~ g̈ δt / ġ⁻ times the jump's large column. The
+        re-integration's own landing lies up to :data:`MATCH_TIME_TOL` from the record, and near a
+        grazing (a dip of the gap shorter than its steps, ~ ġ⁻/g̈) it can miss the landing
+        altogether: the variations are therefore carried to the recorded instant itself."""
+        c = int(self.tr.contact[self.k])
+        seg = _segment(self.system, self.y, self.Phi, self.t, t_next, self.cst, rtol, unwatched=c)
+        if not seg.event:
+            seg.event, seg.contact, seg.kind = True, self.system.n_contacts + c, V.EV_GAP
         return seg
 
     def smooth(self, seg, t_next: float) -> None:

@@ -33,8 +33,11 @@ complex steps of the contact's slip velocity, friction and normal force
       S = R + (f⁺ − R f⁻) ∇gᵀ / (∇g · f⁻),    R = ∂Π/∂s
 
   (Leine & Nijmeijer 2004, ch. 3), with h = g the gap, R by central differences of the compiled
-  impact map (linear in the velocities for constant G and W, so exact to round-off there), f⁺ at
-  s⁺ in the modes after (bounced off: open; stayed: sliding).
+  impact map (linear in the velocities for constant G and W, so exact to round-off there; the
+  velocity steps stay under half the one that reverses ġ⁻, where the map has a kink), f⁺ at
+  s⁺ in the modes after (bounced off: open; stayed: sliding). The variations enter it at the
+  run's recorded impact instant (:mod:`.linear_flow`): S divides by ġ⁻, so the variations and
+  the state it is built at must be taken at one instant.
 """
 
 from __future__ import annotations
@@ -47,7 +50,7 @@ from ..model import physics as P
 from ..model.bundle import CST
 from ..model.derivatives import state_jacobian_from_python
 from ..model.friction import static_coefficient
-from ..model.impact import IMPACT_INCONSISTENT, impact, restitution_of
+from ..model.impact import IMPACT_INCONSISTENT, gap_rate, impact, restitution_of
 from ..model.matrices import dense_array
 from .var_kernels import contact_gradients, indicator_gradient
 
@@ -241,6 +244,17 @@ def impact_map(system, s: np.ndarray, cst: np.ndarray, c: int) -> np.ndarray:
     return out
 
 
+def _impact_step(value: float, normal_rate: float, landing: float) -> float:
+    """Step of the central difference of the impact map in a state of ``value`` that changes the
+    landing speed ``landing`` = |ġ⁻| by ``normal_rate`` per unit: 1e-7 max(1, |value|), at most half
+    the step that reverses ġ⁻. Π has a kink at ġ⁻ = 0 (a contact that does not approach gets no
+    impulse), and a difference straddling it mixes the two branches: on the rigid slider near its
+    flight's vanishing (ġ⁻ = −8.7e-8) a velocity step of 1e-7 gives ∂ẏ⁺/∂ẏ⁻ = 0.07 instead of 0
+    (plastic) and a multiplier −98."""
+    h = 1e-7 * max(1.0, abs(value))
+    return min(h, 0.5 * landing / abs(normal_rate)) if normal_rate != 0.0 else h
+
+
 def impact_jump(system, s: np.ndarray, cst: np.ndarray, c: int, bounced: bool):
     """Saltation matrix (2n × 2n) of the impact of rigid contact ``c`` (open in ``cst``) at ``s``
     (module docstring); ``bounced``: whether it leaves the stop again (open after), else it stays
@@ -254,9 +268,17 @@ def impact_jump(system, s: np.ndarray, cst: np.ndarray, c: int, bounced: bool):
     n2 = 2 * system.n
     s = np.ascontiguousarray(s[:n2], dtype=float)
     after_state = impact_map(system, s, cst, c)
+    landing = abs(gap_rate(s, c, system.data))
+    if landing == 0.0:
+        raise OrbitError(f"contact {c} touches its stop with ġ = 0 (grazing): no saltation matrix")
+    normal = np.zeros(n2)  # ∂ġ/∂s: the gap's gradient W_c on the velocities (the gap is affine in q)
+    for j in range(system.n, n2):
+        unit = np.zeros(n2)
+        unit[j] = 1.0
+        normal[j] = gap_rate(unit, c, system.data)
     R = np.empty((n2, n2))
     for j in range(n2):
-        h = 1e-7 * max(1.0, abs(s[j]))
+        h = _impact_step(s[j], normal[j], landing)
         up, down = s.copy(), s.copy()
         up[j] += h
         down[j] -= h
