@@ -136,9 +136,9 @@ def model_of(key: str):
 def _period(model, eigenvalues) -> float:
     """T_c: 2π over the smallest non-zero |Im λ| of steady sliding, else 1 / the smallest
     non-zero undamped natural frequency, else 1."""
-    if eigenvalues is not None:
+    if eigenvalues is not None:  # none at all where closed rigid contacts fix every free dof
         im = np.abs(np.imag(eigenvalues))
-        im = im[im > 1e-9 * max(1.0, float(np.max(np.abs(eigenvalues))))]
+        im = im[im > 1e-9 * max(1.0, float(np.max(np.abs(eigenvalues), initial=0.0)))]
         if im.size:
             return 2.0 * math.pi / float(im.min())
     f = model.natural_frequencies()

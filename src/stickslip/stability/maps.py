@@ -31,8 +31,8 @@ from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
 from ..model.variants import resolve_variant
 from ..results import Plottable
 from . import steady
-from .analysis import model_stability
-from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds
+from .analysis import linearization, model_stability
+from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds, solve_steady_modes
 from .verdict import MARGINAL_RTOL
 
 __all__ = ["StabilityMap", "stability_map", "max_real_part", "boundary_omegas", "load_stability_map",
@@ -277,20 +277,28 @@ class MapGrid:
 
 def _unilateral_max_real_part(system) -> tuple[float, float]:
     """max Re λ at steady sliding of a model with unilateral contacts and its tolerance [1/s], NaN
-    without steady sliding (−inf where the closed contacts fix every free dof: no motion is left).
+    without steady sliding (−inf where closed rigid contacts fix every free dof: no motion is left).
 
-    Steady sliding may leave such contacts open, and which ones depends on the point
-    (:func:`~stickslip.stability.equilibrium.solve_steady_modes`), while the compiled grid kernel
-    holds every contact closed; closed rigid contacts also make the eigenproblem a constrained one
-    (the motion that keeps them closed), which that kernel does not solve. So each point is
-    :func:`~stickslip.stability.analysis.model_stability`, what ``stickslip stability`` computes:
-    one steady-sliding solve and one eigenproblem in Python (milliseconds).
+    Steady sliding may leave such contacts open, and which ones depends on the point, while the
+    compiled grid kernel holds every contact closed. So each point takes the open set that
+    ``stickslip stability`` takes (:func:`~stickslip.stability.equilibrium.solve_steady_modes`):
+    one steady-sliding solve in Python (milliseconds). Closed rigid contacts make the eigenproblem
+    a constrained one (the motion that keeps them closed), solved as
+    :func:`~stickslip.stability.analysis.model_stability` solves it; without them the eigenvalues
+    are those of the Jacobian, as the compiled grid takes them (the same numbers bit for bit where
+    every contact is closed).
     """
     try:
-        result = model_stability(system)
+        if system.rigid:
+            result = model_stability(system)
+            return result.max_real_part, float(result.tolerance)
+        q, _, _, opened = solve_steady_modes(system)
     except EquilibriumError:
         return math.nan, math.nan
-    return result.max_real_part, float(result.tolerance)
+    J = linearization(system, q, opened)[0]
+    if not np.all(np.isfinite(J)):
+        return math.nan, math.nan
+    return float(np.max(np.linalg.eigvals(J).real)), float(MARGINAL_RTOL * np.linalg.norm(J, 2))
 
 
 def _jacobian_of(system) -> np.ndarray:
