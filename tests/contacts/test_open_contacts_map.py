@@ -6,6 +6,8 @@
   else x_e = (μ(v_d) + KS xs) / (1 + KS) with it pressed. Linearised by hand (μ'(|v|) = −exp(−2|v|),
   d|v|/dẋ = −1): J = [[0, 1], [−D, T]], T = −0.1 + exp(−2 v_d), D = 1 open or 1 + KS closed, so
   max Re λ = T / 2 where T² < 4 D. A map over xs and v_d crosses from the stop pressed to open.
+* ``slider-belt`` with a negative preload: its one contact, the one with friction, is open at the
+  equilibrium: no steady sliding (NaN in the map).
 * ``clearance-oscillator`` itself (the stop rigid): pressed, the stop fixes the one dof and no
   motion is left (max Re λ −inf); open, the free oscillator's T / 2.
 """
@@ -18,6 +20,7 @@ import numpy as np
 import pytest
 
 import stickslip
+from stickslip.errors import EquilibriumError
 from stickslip.model import model_from_spec
 from stickslip.stability import stability
 from stickslip.stability.maps import stability_map
@@ -48,23 +51,30 @@ def by_hand(xs: float, drive: float) -> float:
     return trace / 2.0
 
 
-def check_map_against_stability(model, expected) -> set:
-    """Every point of the map over (xs, v_d) equals ``stability()`` there (1e-9 relative) and
-    ``expected(xs, v_d)``; returns the open sets met."""
-    smap = stability_map(model, XS, DRIVES, axes=("xs", "contact.0.drive.0"), boundary=False)
+def check_map_against_stability(model, axes=("xs", "contact.0.drive.0"), a=XS, b=DRIVES, expected=None) -> set:
+    """Every point of the map over ``axes`` equals ``stability()`` there (1e-9 relative; NaN where
+    it finds no steady sliding) and ``expected(a, b)`` where given; returns the open sets met
+    (None for a point without steady sliding)."""
+    smap = stability_map(model, a, b, axes=axes, boundary=False)
     seen = set()
-    for i, xs in enumerate(XS):
-        for j, drive in enumerate(DRIVES):
-            res = stability(model.replace(xs=float(xs), **{"contact.0.drive.0": float(drive)}))
-            seen.add(res.open_contacts)
+    for i, x in enumerate(a):
+        for j, y in enumerate(b):
             got = smap.max_real_part[0, i, j]
-            assert got == pytest.approx(res.max_real_part, rel=1e-9, abs=0.0), (xs, drive)
-            assert got == pytest.approx(expected(xs, drive), rel=1e-9, abs=0.0), (xs, drive)
+            try:
+                res = stability(model.replace(**{axes[0]: float(x), axes[1]: float(y)}))
+            except EquilibriumError:
+                assert np.isnan(got), (x, y)
+                seen.add(None)
+                continue
+            seen.add(res.open_contacts)
+            assert got == pytest.approx(res.max_real_part, rel=1e-9, abs=0.0), (x, y)
+            if expected is not None:
+                assert got == pytest.approx(expected(x, y), rel=1e-9, abs=0.0), (x, y)
     return seen
 
 
 def test_a_map_over_a_compliant_stop_opens_it_where_stability_does():
-    seen = check_map_against_stability(compliant_stop_model(), by_hand)
+    seen = check_map_against_stability(compliant_stop_model(), expected=by_hand)
     assert seen == {(), ("stop",)}  # the map crosses from the stop pressed to open
 
 
@@ -72,11 +82,19 @@ def test_a_map_over_a_rigid_stop_leaves_no_motion_where_it_is_pressed():
     def expected(xs, drive):
         return by_hand(xs, drive) if xs > 0.5 + 0.5 * math.exp(-2.0 * drive) else -math.inf
 
-    seen = check_map_against_stability(stickslip.load_model("clearance-oscillator"), expected)
+    seen = check_map_against_stability(stickslip.load_model("clearance-oscillator"), expected=expected)
     assert seen == {(), ("stop",)}
     pressed = stability(stickslip.load_model("clearance-oscillator").replace(xs=0.3))
     assert pressed.verdict == "stable"
     assert pressed.summary()["max_real_part_reason"].startswith("no eigenvalues")
+
+
+def test_a_map_has_no_steady_sliding_where_the_only_contact_with_friction_opens():
+    """``slider-belt`` lifted off its belt (preload P < 0): its one contact is open at the
+    equilibrium, so nothing slides there (``stability`` refuses), and the map has no value."""
+    seen = check_map_against_stability(stickslip.load_model("slider-belt"), ("P", "V"), [-0.3, -0.1, 0.3, 0.6],
+                                       [0.3, 0.5])
+    assert seen == {None, ()}
 
 
 @pytest.mark.parametrize("xs, open_fraction", [(1.2, 1.0), (0.3, 0.0)])
