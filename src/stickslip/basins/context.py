@@ -82,6 +82,9 @@ class Context:
         Φ = exp(A · chunk · dt) (zeros when not stable).
     rest : float
         √V below which a deviation from s_e counts as at rest (1e-6 of √V(s_e)).
+    open_contacts : tuple of int
+        The unilateral contacts that steady sliding leaves open (ascending; empty where all are
+        closed or there is no steady sliding).
     """
 
     key: str
@@ -96,6 +99,7 @@ class Context:
     lyapunov: np.ndarray
     flow: np.ndarray
     rest: float
+    open_contacts: tuple = ()
 
 
 def model_key(model) -> str:
@@ -132,9 +136,9 @@ def model_of(key: str):
 def _period(model, eigenvalues) -> float:
     """T_c: 2π over the smallest non-zero |Im λ| of steady sliding, else 1 / the smallest
     non-zero undamped natural frequency, else 1."""
-    if eigenvalues is not None:
+    if eigenvalues is not None:  # none at all where closed rigid contacts fix every free dof
         im = np.abs(np.imag(eigenvalues))
-        im = im[im > 1e-9 * max(1.0, float(np.max(np.abs(eigenvalues))))]
+        im = im[im > 1e-9 * max(1.0, float(np.max(np.abs(eigenvalues), initial=0.0)))]
         if im.size:
             return 2.0 * math.pi / float(im.min())
     f = model.natural_frequencies()
@@ -173,7 +177,9 @@ def make_context(model, *, key: str | None = None) -> Context:
     stable = False
     max_re = math.nan
     rest = 0.0
+    opened = ()
     if stab is not None:
+        opened = tuple(model.contact_names.index(name) for name in stab.open_contacts)
         equilibrium = np.concatenate([stab.equilibrium, np.zeros(n)])
         max_re = float(stab.max_real_part)
         # a marginal centre (Re λ = 0 within the solver's accuracy: stickslip.stability.verdict) is
@@ -186,7 +192,7 @@ def make_context(model, *, key: str | None = None) -> Context:
             # closed rigid contacts: the linear flow lives on W q = −g0, W q̇ = 0 (orthonormal
             # basis T); off it (a flight) the deviation counts with the weights Q and is not
             # linear motion (the flow's prediction drops it)
-            T = np.kron(np.eye(2), rigid_constraint(model)[1][free_dofs]) if model.rigid else np.eye(k2)
+            T = np.kron(np.eye(2), rigid_constraint(model, exclude=opened)[1][free_dofs]) if model.rigid else np.eye(k2)
             A_c = T.T @ A @ T
             P = T @ solve_continuous_lyapunov(A_c.T, -(T.T @ Q @ T)) @ T.T
             off = np.eye(k2) - T @ T.T
@@ -198,4 +204,4 @@ def make_context(model, *, key: str | None = None) -> Context:
             else:  # the Lyapunov solve failed (ill-conditioned): no linear test
                 stable, P, flow = False, np.zeros((k2, k2)), np.zeros((k2, k2))
     return Context(key or model_key(model), period, dt, chunk, WINDOW_PERIODS * SAMPLES_PER_PERIOD, equilibrium,
-                   stable, max_re, free, P, flow, rest)
+                   stable, max_re, free, P, flow, rest, opened)

@@ -135,7 +135,8 @@ def _check_memory(model, spec: BasinSpec) -> None:
 def _contexts(models, keys):
     ctxs = [make_context(m, key=k) for m, k in zip(models, keys)]
     info = [{"equilibrium": c.equilibrium, "stable": c.stable, "max_real_part": c.max_real_part, "period": c.period,
-             "unilateral": bool(m.unilateral)} for c, m in zip(ctxs, models)]
+             "unilateral": bool(m.unilateral), "open_at_equilibrium": bool(c.open_contacts)}
+            for c, m in zip(ctxs, models)]
     return ctxs, info
 
 

@@ -79,7 +79,8 @@ def assemble(spec: BasinSpec, models: list[dict], initial: np.ndarray, indices: 
     models : list of dict
         Per parameter value: ``equilibrium`` ((2n,) or None), ``stable`` (bool), ``max_real_part``
         [1/s], ``period`` (T_c [s]), ``unilateral`` (bool: the model has contacts that open; its
-        attractors then get an ``open_fraction``).
+        attractors then get an ``open_fraction``), ``open_at_equilibrium`` (bool: steady sliding
+        leaves some contact open; the equilibrium's ``open_fraction`` is then 1).
     initial : ndarray (n_params, n_states, 2n)
         The initial states.
     indices, rows : ndarray
@@ -144,7 +145,9 @@ def _tables(spec: BasinSpec, models: list[dict], per_param: list, labelled: list
         eq = models[p]["equilibrium"]
         if "equilibrium" in code and eq is not None:
             a = code["equilibrium"]
-            out["amplitude"][p, a], out["stick_fraction"][p, a], out["open_fraction"][p, a] = 0.0, 0.0, 0.0
+            # at rest in steady sliding: a contact open there stays open the whole window
+            out["amplitude"][p, a], out["stick_fraction"][p, a] = 0.0, 0.0
+            out["open_fraction"][p, a] = 1.0 if models[p].get("open_at_equilibrium") else 0.0
             rep[p, a] = eq
     return out
 

@@ -91,8 +91,9 @@ class StabilityResult:
 
     @property
     def max_real_part(self) -> float:
-        """Largest real part of the eigenvalues [1/s]."""
-        return float(self.eigenvalues.real[0])
+        """Largest real part of the eigenvalues [1/s]; −inf where there are none (closed rigid
+        contacts fix every free dof: no motion is left to grow)."""
+        return float(self.eigenvalues.real[0]) if self.eigenvalues.size else -math.inf
 
     @property
     def tolerance(self) -> float:
@@ -148,6 +149,8 @@ class StabilityResult:
             "stable": bool(self.stable),
             "verdict": self.verdict,
             "marginal_tolerance": self.tolerance,
+            **({} if self.eigenvalues.size else
+               {"max_real_part_reason": "no eigenvalues: the closed contacts fix every free dof"}),
         }
 
     def to_xarray(self):

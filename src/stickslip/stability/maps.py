@@ -31,8 +31,8 @@ from ..model.parameters import PARAMETER_UNITS, Parameters, parameter_attrs
 from ..model.variants import resolve_variant
 from ..results import Plottable
 from . import steady
-from .analysis import model_stability
-from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds
+from .analysis import linearization, model_stability
+from .equilibrium import MAX_ITER, RESIDUAL_TOL, model_of, sliding_speeds, solve_steady_modes
 from .verdict import MARGINAL_RTOL
 
 __all__ = ["StabilityMap", "stability_map", "max_real_part", "boundary_omegas", "load_stability_map",
@@ -242,8 +242,8 @@ class MapGrid:
         """max Re λ over the grid (nA, nB) [1/s], NaN where no steady sliding exists, and the
         tolerance within which it counts as 0 (:data:`.verdict.MARGINAL_RTOL` × ‖J‖₂) [1/s]."""
         nA, nB = self.a.size, self.b.size
-        if self.system.rigid:
-            rows = [[self.constrained_point(i, y) for y in self.b] for i in range(nA)]
+        if self.system.unilateral:
+            rows = [[self.point_stability(i, y) for y in self.b] for i in range(nA)]
             return tuple(np.array([[p[k] for p in row] for row in rows]).reshape(nA, nB) for k in (0, 1))
         ia_all = np.repeat(np.arange(nA, dtype=np.int64), nB)
         ib_all = np.tile(np.arange(nB, dtype=np.int64), nA)
@@ -258,16 +258,16 @@ class MapGrid:
                 tol[sl][ok] = MARGINAL_RTOL * np.linalg.norm(J[ok], 2, axis=(1, 2))
         return out.reshape(nA, nB), tol.reshape(nA, nB)
 
-    def constrained_point(self, i: int, y: float) -> tuple[float, float]:
-        """(max Re λ, its tolerance) [1/s] of a model with rigid contacts at ``a[i]`` and the second
-        parameter = ``y`` (:func:`_constrained_max_real_part`)."""
-        return _constrained_max_real_part(self.system.replace(**{self.names[0]: float(self.a[i]),
-                                                                 self.names[1]: float(y)}))
+    def point_stability(self, i: int, y: float) -> tuple[float, float]:
+        """(max Re λ, its tolerance) [1/s] of a model with unilateral contacts at ``a[i]`` and the
+        second parameter = ``y`` (:func:`_unilateral_max_real_part`)."""
+        return _unilateral_max_real_part(self.system.replace(**{self.names[0]: float(self.a[i]),
+                                                                self.names[1]: float(y)}))
 
     def value_at(self, i: int, y: float) -> float:
         """max Re λ at the first axis' value ``a[i]`` and the second parameter = ``y`` [1/s]."""
-        if self.system.rigid:
-            return self.constrained_point(i, y)[0]
+        if self.system.unilateral:
+            return self.point_stability(i, y)[0]
         if self.separable:
             J = self.jacobians(np.array([i]), np.array([0]), self.axis_b.rows([y]))
         else:
@@ -275,19 +275,30 @@ class MapGrid:
         return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
 
 
-def _constrained_max_real_part(system) -> tuple[float, float]:
-    """max Re λ at steady sliding of a model with rigid contacts and its tolerance [1/s], NaN without
-    steady sliding.
+def _unilateral_max_real_part(system) -> tuple[float, float]:
+    """max Re λ at steady sliding of a model with unilateral contacts and its tolerance [1/s], NaN
+    without steady sliding (−inf where closed rigid contacts fix every free dof: no motion is left).
 
-    Its closed rigid contacts make the eigenproblem a constrained one (the motion that keeps them
-    closed, :func:`~stickslip.stability.analysis.model_stability`), which the compiled grid kernel
-    does not solve: each point is one Newton solve and one eigenproblem in Python (milliseconds).
+    Steady sliding may leave such contacts open, and which ones depends on the point, while the
+    compiled grid kernel holds every contact closed. So each point takes the open set that
+    ``stickslip stability`` takes (:func:`~stickslip.stability.equilibrium.solve_steady_modes`):
+    one steady-sliding solve in Python (milliseconds). Closed rigid contacts make the eigenproblem
+    a constrained one (the motion that keeps them closed), solved as
+    :func:`~stickslip.stability.analysis.model_stability` solves it; without them the eigenvalues
+    are those of the Jacobian, as the compiled grid takes them (the same numbers bit for bit where
+    every contact is closed).
     """
     try:
-        result = model_stability(system)
+        if system.rigid:
+            result = model_stability(system)
+            return result.max_real_part, float(result.tolerance)
+        q, _, _, opened = solve_steady_modes(system)
     except EquilibriumError:
         return math.nan, math.nan
-    return float(np.max(result.eigenvalues.real)), float(result.tolerance)
+    J = linearization(system, q, opened)[0]
+    if not np.all(np.isfinite(J)):
+        return math.nan, math.nan
+    return float(np.max(np.linalg.eigvals(J).real)), float(MARGINAL_RTOL * np.linalg.norm(J, 2))
 
 
 def _jacobian_of(system) -> np.ndarray:
@@ -301,7 +312,10 @@ def _jacobian_of(system) -> np.ndarray:
 def max_real_part(system, N: float, Omega: float, names: tuple[str, str] = ("N", "Omega")) -> float:
     """Largest real part of the eigenvalues at steady sliding with the parameters ``names`` set to
     (N, Ω) [1/s]; NaN without steady sliding."""
-    J = _jacobian_of(system.replace(**{names[0]: float(N), names[1]: float(Omega)}))
+    point = system.replace(**{names[0]: float(N), names[1]: float(Omega)})
+    if point.unilateral:
+        return _unilateral_max_real_part(point)[0]
+    J = _jacobian_of(point)
     return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
 
 
