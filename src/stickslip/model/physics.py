@@ -46,7 +46,7 @@ import math
 import numpy as np
 
 from . import csmath as csm
-from .bundle import CST, H_BAND, offsets
+from .bundle import CST, H_BAND
 from .forces import (add_contact_force, general_forces, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
@@ -54,7 +54,7 @@ from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
-                         apply_inverse_mass, gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient,
+                         apply_inverse_mass, damping_power, gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient,
                          kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
 from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
@@ -87,16 +87,7 @@ def write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds):
         for i in range(2 * nc):
             power += F[i] * (v[i] + w[i])
         ds[2 * n] = power
-        oc = offsets(n)[2]
-        damping = csm.zero(s[0])
-        if diagonal:
-            for i in range(n):
-                damping -= m[oc + i * (n + 1)] * s[n + i] * s[n + i]
-        else:
-            for i in range(n):
-                for j in range(n):
-                    damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
-        ds[2 * n + 1] = damping
+        ds[2 * n + 1] = damping_power(md.kin, s, m, n, diagonal)
 
 
 @standalone
