@@ -168,7 +168,7 @@ def first_breakaway(step, h, cst, md, scratch):
     root among them is the first of all, and each root is the one ``first_crossing`` finds: the
     same values, without one solve of every contact's forces per contact and point.
     """
-    nc = model_sizes(md.kin, md.m)[1]
+    nc = np.int64(model_sizes(md.kin, md.m)[1])  # not a literal: one compiled version of stick_margins
     g = scratch.g  # g[c]: the margins at the point sampled last, g[nc + c]: at the one before
     a = 0.0
     b = -1.0
