@@ -170,11 +170,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", default="dofs,contacts,target,cold")
     ap.add_argument("--periods", type=float, default=20.0, help="periods of the target run (the goal: 20)")
+    ap.add_argument("--folder", default=None, help="keep the reduced models here (reused by a later run)")
     args = ap.parse_args()
     only = set(args.only.split(","))
     out: dict = {"machine": "shared 2-core machine, other work running"}
     with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
+        folder = Path(args.folder or tmp)
+        folder.mkdir(parents=True, exist_ok=True)
         if "dofs" in only:
             out["dofs"] = with_slopes(sweep([(10, n) for n in (100, 200, 400, 800)], folder), "dofs")
         if "contacts" in only:

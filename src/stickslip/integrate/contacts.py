@@ -248,14 +248,16 @@ def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, scratch):
         return -1.0
     if ga < 0.0:
         ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
-    return refined_crossing(kind, c, y0, Q, h, a, ga, b, gb, e0x, e0y, cst, md, scratch)
+    return refined_crossing(kind, c, y0, Q, h, (a, ga, b, gb), e0x, e0y, cst, md, scratch)
 
 
 @kernel
-def refined_crossing(kind, c, y0, Q, h, a, ga, b, gb, e0x, e0y, cst, md, scratch):
-    """The root of the event function of ``kind`` for contact ``c`` in the bracket θ ∈ (a, b] of
-    the dense output (``y0``, ``Q``) of a step of length ``h``, with values ``ga`` > 0 and ``gb`` ≤ 0
-    at its ends, located to EVENT_TIME_TOL by Illinois regula falsi: the end b of the last bracket."""
+def refined_crossing(kind, c, y0, Q, h, bracket, e0x, e0y, cst, md, scratch):
+    """The root of the event function of ``kind`` for contact ``c`` in the ``bracket`` (a, ga, b, gb):
+    θ ∈ (a, b] of the dense output (``y0``, ``Q``) of a step of length ``h``, with values ga > 0 and
+    gb ≤ 0 at its ends, located to EVENT_TIME_TOL by Illinois regula falsi: the end b of the last
+    bracket."""
+    a, ga, b, gb = bracket
     work = scratch.state
     F = scratch.F
     N = scratch.N

@@ -190,8 +190,9 @@ def first_breakaway(step, h, cst, md, scratch):
     c_b = np.int64(-1)
     for c in range(nc):
         if np.int64(cst[CST * c]) == P.MODE_STICK and g[c] <= 0.0:
-            th = E.refined_crossing(E.EVENT_STICK, c, step.y, step.dense, h, a, g[nc + c], b, g[c], 0.0, 0.0, cst,
-                                    md, scratch)
+            bracket = (a, g[nc + c], b, g[c])
+            th = E.refined_crossing(np.int64(E.EVENT_STICK), c, step.y, step.dense, h, bracket, 0.0, 0.0, cst, md,
+                                    scratch)
             if th > 0.0 and (theta_b < 0.0 or th < theta_b):
                 theta_b = th
                 c_b = c

@@ -159,24 +159,31 @@ def base_force_of(kin, s, m, n, diagonal, f):  # pragma: no cover - resolved by 
     raise NotImplementedError
 
 
+def _for_kinematics(kin, dense, heap):
+    """The implementation of an overload below for the kinematics type ``kin``: ``heap`` for a heap
+    kinematics class (:mod:`stickslip.model.stack`), ``dense`` for the others."""
+    return heap if on_heap(getattr(kin, "instance_class", None)) else dense
+
+
+def _base_force_dense(kin, s, m, n, diagonal, f):
+    base_force(s, m, n, diagonal, f)
+
+
+def _base_force_by_pattern(kin, s, m, n, diagonal, f):
+    _, _, oc, ok, of, _, _ = offsets(n)
+    rows = kin.force_rows
+    columns = kin.force_columns
+    for i in range(n):
+        acc = m[of + i] + csm.zero(s[0])
+        for p in range(rows[i], rows[i + 1]):
+            j = columns[p]
+            acc -= m[oc + i * n + j] * s[n + j] + m[ok + i * n + j] * s[j]
+        f[i] = acc
+
+
 @overload(base_force_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _base_force_of(kin, s, m, n, diagonal, f):
-    if not on_heap(getattr(kin, "instance_class", None)):
-        def dense(kin, s, m, n, diagonal, f):
-            base_force(s, m, n, diagonal, f)
-        return dense
-
-    def by_pattern(kin, s, m, n, diagonal, f):
-        _, _, oc, ok, of, _, _ = offsets(n)
-        rows = kin.force_rows
-        columns = kin.force_columns
-        for i in range(n):
-            acc = m[of + i] + csm.zero(s[0])
-            for p in range(rows[i], rows[i + 1]):
-                j = columns[p]
-                acc -= m[oc + i * n + j] * s[n + j] + m[ok + i * n + j] * s[j]
-            f[i] = acc
-    return by_pattern
+    return _for_kinematics(kin, _base_force_dense, _base_force_by_pattern)
 
 
 def damping_power(kin, s, m, n, diagonal):  # pragma: no cover - resolved by numba (overload below)
@@ -185,33 +192,34 @@ def damping_power(kin, s, m, n, diagonal):  # pragma: no cover - resolved by num
     raise NotImplementedError
 
 
+def _damping_power_dense(kin, s, m, n, diagonal):
+    oc = offsets(n)[2]
+    damping = csm.zero(s[0])
+    if diagonal:
+        for i in range(n):
+            damping -= m[oc + i * (n + 1)] * s[n + i] * s[n + i]
+    else:
+        for i in range(n):
+            for j in range(n):
+                damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
+    return damping
+
+
+def _damping_power_by_pattern(kin, s, m, n, diagonal):
+    oc = offsets(n)[2]
+    rows = kin.force_rows
+    columns = kin.force_columns
+    damping = csm.zero(s[0])
+    for i in range(n):
+        for p in range(rows[i], rows[i + 1]):
+            j = columns[p]
+            damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
+    return damping
+
+
 @overload(damping_power, jit_options=KERNEL_OPTIONS, inline="always")
 def _damping_power(kin, s, m, n, diagonal):
-    if not on_heap(getattr(kin, "instance_class", None)):
-        def dense(kin, s, m, n, diagonal):
-            oc = offsets(n)[2]
-            damping = csm.zero(s[0])
-            if diagonal:
-                for i in range(n):
-                    damping -= m[oc + i * (n + 1)] * s[n + i] * s[n + i]
-            else:
-                for i in range(n):
-                    for j in range(n):
-                        damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
-            return damping
-        return dense
-
-    def by_pattern(kin, s, m, n, diagonal):
-        oc = offsets(n)[2]
-        rows = kin.force_rows
-        columns = kin.force_columns
-        damping = csm.zero(s[0])
-        for i in range(n):
-            for p in range(rows[i], rows[i + 1]):
-                j = columns[p]
-                damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
-        return damping
-    return by_pattern
+    return _for_kinematics(kin, _damping_power_dense, _damping_power_by_pattern)
 
 
 @kernel
