@@ -12,8 +12,10 @@ Rows:
 
 * ``dofs``: 10 contact nodes, n = 100 … 800 DOFs: the seconds of one right-hand side with every
   contact sliding, of one with every contact sticking (the stick system of all contacts solved),
-  and of a step of a short run (wall time / accepted steps); the log-log slope of each against n;
-* ``contacts``: n = 400 DOFs, 10 … 80 contact nodes: the same against the contacts;
+  and of a step of a short run (wall time / accepted steps; its accepted and rejected steps and
+  right-hand sides counted); the log-log slope of each against n;
+* ``contacts``: n = 400 DOFs, 10 … 80 contact nodes: the same against the contacts (the log-log
+  slope of each against nc);
 * ``target``: 900 DOFs with 40 compliant contact nodes, 20 periods (``--periods``) of its first
   mode (``natural_frequencies()[0]``) from rest at rtol 1e-8: wall time, steps and how many contacts
   stuck and opened;
@@ -91,7 +93,8 @@ def step_seconds(model, periods: float = 1.0) -> dict:
     f1 = float(model.natural_frequencies()[0])
     run = simulate(model, periods / f1, sample_rate=50 * f1, rtol=1e-8, atol=1e-12)
     steps = run.stats.accepted_steps
-    return {"run_s": run.stats.wall_time_s, "steps": int(steps), "step_s": run.stats.wall_time_s / max(steps, 1)}
+    return {"run_s": run.stats.wall_time_s, "steps": int(steps), "rejected": int(run.stats.rejected_steps),
+            "rhs_calls": int(run.stats.rhs_calls), "step_s": run.stats.wall_time_s / max(steps, 1)}
 
 
 def slope(x, y) -> float:
@@ -167,11 +170,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", default="dofs,contacts,target,cold")
     ap.add_argument("--periods", type=float, default=20.0, help="periods of the target run (the goal: 20)")
+    ap.add_argument("--folder", default=None, help="keep the reduced models here (reused by a later run)")
     args = ap.parse_args()
     only = set(args.only.split(","))
     out: dict = {"machine": "shared 2-core machine, other work running"}
     with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
+        folder = Path(args.folder or tmp)
+        folder.mkdir(parents=True, exist_ok=True)
         if "dofs" in only:
             out["dofs"] = with_slopes(sweep([(10, n) for n in (100, 200, 400, 800)], folder), "dofs")
         if "contacts" in only:

@@ -89,17 +89,22 @@ class Scratch(NamedTuple):
         Normal forces [N].
     v : ndarray (2 nc,)
         Slip velocities [m/s].
+    g : ndarray (2 nc,)
+        An event function of every contact at two points of a step: entries c at the point
+        sampled last, nc + c at the one before (the breakaway search,
+        :func:`~.transitions.first_breakaway`).
     """
 
     state: np.ndarray
     F: np.ndarray
     N: np.ndarray
     v: np.ndarray
+    g: np.ndarray
 
 
 def scratch(ns: int, nc: int) -> Scratch:
     """:class:`Scratch` for ``ns`` states and ``nc`` contacts."""
-    return Scratch(np.empty(ns), np.empty(2 * nc), np.empty(nc), np.empty(2 * nc))
+    return Scratch(np.empty(ns), np.empty(2 * nc), np.empty(nc), np.empty(2 * nc), np.empty(2 * nc))
 
 
 def transition_log(capacity: int, ns: int, contact_dtype=np.int8) -> TransitionLog:

@@ -41,7 +41,7 @@ from ..model.normal import gap_and_rate, gap_with_rate, is_open, is_rigid, start
 __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION_TO_STICK", "TRANSITION_TO_SLIP",
            "TRANSITION_OPEN", "TRANSITION_CLOSE", "TRANSITION_IMPACT", "TRANSITION_KINDS",
            "LAND_OPEN", "LAND_CLOSED", "LAND_ZENO", "LAND_INCONSISTENT", "ZENO_TIME", "land", "EVENT_TIME_TOL", "close_contact",
-           "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "dense_state",
+           "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "refined_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "hermite_dip", "gap_dip", "probed_crossing", "contact_lost",
            "mode_flags", "store_mode", "leaves_state"]
@@ -248,6 +248,19 @@ def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, scratch):
         return -1.0
     if ga < 0.0:
         ga = event_value(kind, c, y0, e0x, e0y, cst, md, F, N)
+    return refined_crossing(kind, c, y0, Q, h, (a, ga, b, gb), e0x, e0y, cst, md, scratch)
+
+
+@kernel
+def refined_crossing(kind, c, y0, Q, h, bracket, e0x, e0y, cst, md, scratch):
+    """The root of the event function of ``kind`` for contact ``c`` in the ``bracket`` (a, ga, b, gb):
+    θ ∈ (a, b] of the dense output (``y0``, ``Q``) of a step of length ``h``, with values ga > 0 and
+    gb ≤ 0 at its ends, located to EVENT_TIME_TOL by Illinois regula falsi: the end b of the last
+    bracket."""
+    a, ga, b, gb = bracket
+    work = scratch.state
+    F = scratch.F
+    N = scratch.N
     tol = EVENT_TIME_TOL / h if h > 0.0 else 0.0
     side = np.int64(0)  # not a literal: one compiled version of illinois_update
     for _ in range(MAX_REFINEMENTS):

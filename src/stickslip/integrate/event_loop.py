@@ -50,7 +50,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..model import physics as P
-from ..model.bundle import CST, offsets
+from ..model.bundle import offsets
 from ..model.jit import inlined_kernel, kernel, standalone
 from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
@@ -59,7 +59,7 @@ from . import dormand_prince as DP
 from .bundles import on_stack, scratch, store_record
 from .slip_watch import MAX_RETAKES, arrivals, slip_roots, slip_watch
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
-from .transitions import break_away, crossing_in_step, gap_crossing, jammed_contact, switch_gap
+from .transitions import break_away, crossing_in_step, first_breakaway, gap_crossing, jammed_contact, switch_gap
 
 __all__ = ["integrate_event", "event_loop", "loop_arrays", "Controls", "controls", "PROGRESS", "N_EXTRA"]
 
@@ -310,20 +310,13 @@ def lost_contact(progress, t_base, step, cst, md, samples, scratch, stats):
 @inlined_kernel
 def breakaway_root(any_stick, step, q_ready, h, cst, md, scratch):
     """(θ, contact, q_ready): the first breakaway of a sticking contact inside the step (θ = −1.0,
-    contact −1: none)."""
-    theta_b = -1.0
-    c_b = np.int64(-1)  # not a literal: numba would type the call of break_away for it first
-    if any_stick:
-        if not q_ready:
-            DP.dense_coefficients(step.stages, step.dense)
-            q_ready = True
-        for c in range(model_sizes(md.kin, md.m)[1]):
-            if np.int64(cst[CST * c]) == P.MODE_STICK:
-                th = E.first_crossing(E.EVENT_STICK, c, step.y, step.dense, h, 0.0, 0.0, cst, md, scratch)
-                if th > 0.0 and (theta_b < 0.0 or th < theta_b):
-                    theta_b = th
-                    c_b = c
-    return theta_b, c_b, q_ready
+    contact −1: none; :func:`.first_breakaway`)."""
+    if not any_stick:
+        return -1.0, np.int64(-1), q_ready
+    if not q_ready:
+        DP.dense_coefficients(step.stages, step.dense)
+    theta_b, c_b = first_breakaway(step, h, cst, md, scratch)
+    return theta_b, c_b, True
 
 
 @standalone

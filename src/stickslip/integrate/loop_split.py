@@ -56,6 +56,7 @@ def _loop_calls(md) -> dict:
             R._normal_forces: (samples.states, np.zeros((1, nc), np.int8), md, i),
             T.settle: (y, cst, md, scratch, f, log, i, stats),
             T.break_away: (y, cst, i, md, scratch, f, log, i, stats),
+            T.first_breakaway: (step, f, cst, md, scratch),
             P.slip_velocity_and_rate: (y, y, i, md),
             L.error_norm: (y, y, step.stages, f, md, f, f),
             P.rhs: (y, cst, md, y),
@@ -73,7 +74,8 @@ def _loop_calls(md) -> dict:
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.
 EVENT_LOOP = Split(
     helper=(E.try_stick, E.release_most_overloaded, P.contact_forces, P.band_direction, E.initial_modes,
-            R._slip_velocities, R._normal_forces, T.settle, T.break_away, P.slip_velocity_and_rate, L.error_norm),
+            R._slip_velocities, R._normal_forces, T.settle, T.break_away, T.first_breakaway, P.slip_velocity_and_rate,
+            L.error_norm),
     own=(P.rhs, L.dp_step, E.probed_crossing, L.write_samples, L.cut_step, DP.dense_coefficients,
          E.slip_event_possible, E.time_to_zero_of, E.all_finite, L.homing_left),
     caller=L.event_loop,

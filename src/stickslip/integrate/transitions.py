@@ -21,7 +21,7 @@ from . import dormand_prince as DP
 from .status import INCONSISTENT, SUCCESS
 
 __all__ = ["crossing_in_step", "record_transition", "settle", "break_away", "switch_gap", "jammed_contact",
-           "gap_crossing"]
+           "gap_crossing", "first_breakaway"]
 
 
 @inlined_kernel
@@ -151,6 +151,61 @@ def jammed_contact(y, cst, md):  # pragma: no cover - compiled only
         if P.rigid(c, md) and not P.is_open(cst, c):
             return np.int64(c)
     return np.int64(-1)
+
+
+@standalone
+@kernel
+def first_breakaway(step, h, cst, md, scratch):
+    """(θ, contact) of the first breakaway of a sticking contact inside the step ``step`` (a
+    :class:`~.dormand_prince.Step` of length ``h`` with its dense-output coefficients formed);
+    θ = −1.0 and contact −1 for none.
+
+    The stick margins of all sticking contacts are sampled together at the EVENT_CHECKS points of
+    :func:`~.contacts.first_crossing`, one solve of the forces per point
+    (:func:`~stickslip.model.physics.stick_margins`), up to the first point where one is ≤ 0;
+    only the contacts whose margin turned there are refined, each as ``first_crossing`` refines
+    it. A contact whose margin turns at a later point has its root past that point, so the first
+    root among them is the first of all, and each root is the one ``first_crossing`` finds: the
+    same values, without one solve of every contact's forces per contact and point.
+    """
+    nc = np.int64(model_sizes(md.kin, md.m)[1])  # not a literal: one compiled version of stick_margins
+    g = scratch.g  # g[c]: the margins at the point sampled last, g[nc + c]: at the one before
+    a = 0.0
+    b = -1.0
+    for j in range(1, E.EVENT_CHECKS + 1):
+        theta = j / E.EVENT_CHECKS
+        E.dense_state(step.y, step.dense, h, theta, scratch.state)
+        P.stick_margins(scratch.state, cst, md, g, np.int64(0))
+        if _any_margin_spent(cst, g, nc):
+            b = theta
+            break
+        a = theta
+        for c in range(nc):
+            g[nc + c] = g[c]
+    if b < 0.0:
+        return -1.0, np.int64(-1)
+    if a == 0.0:
+        P.stick_margins(step.y, cst, md, g, nc)
+    theta_b = -1.0
+    c_b = np.int64(-1)
+    for c in range(nc):
+        if np.int64(cst[CST * c]) == P.MODE_STICK and g[c] <= 0.0:
+            bracket = (a, g[nc + c], b, g[c])
+            th = E.refined_crossing(np.int64(E.EVENT_STICK), c, step.y, step.dense, h, bracket, 0.0, 0.0, cst, md,
+                                    scratch)
+            if th > 0.0 and (theta_b < 0.0 or th < theta_b):
+                theta_b = th
+                c_b = c
+    return theta_b, c_b
+
+
+@kernel
+def _any_margin_spent(cst, g, nc):
+    """Whether some sticking contact's stick margin g[c] is ≤ 0."""
+    for c in range(nc):
+        if np.int64(cst[CST * c]) == P.MODE_STICK and g[c] <= 0.0:
+            return True
+    return False
 
 
 @unilateral_kernel(lambda step, q_ready, h, cst, md, scratch: (-1.0, np.int64(-1), q_ready), inline="always")

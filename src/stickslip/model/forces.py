@@ -29,7 +29,7 @@ from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd, solve_psd_2x2
-from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force,
+from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force_of,
                          gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
@@ -253,7 +253,7 @@ def general_forces_body(s, cst, md, G, w, v, N, h, F, f):
     band = m[H_BAND]
     A = work_matrix(md.kin, ROWS, ROWS, s)
     all_frames(s, cst, md, n, nc, G, w, v, N, h, np.int64(1))
-    base_force(s, m, n, diagonal, f)
+    base_force_of(md.kin, s, m, n, diagonal, f)
     add_normal_forces(s, cst, md, n, nc, N, f)
     in_band = False
     for c in range(nc):
@@ -470,7 +470,7 @@ def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
     if not sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
         return False
     m = md.m
-    base_force(s, m, n, diagonal, f)
+    base_force_of(md.kin, s, m, n, diagonal, f)
     for c in range(nc):
         add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
     add_normal_forces(s, cst, md, n, nc, N, f)

@@ -56,6 +56,7 @@ __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEM
            "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid",
            "kernel_kinematics", "bias_at_run_time", "pointer_class", "LargeConstantKinematics",
            "LargeConstantUnilateralKinematics", "LargeConstantRigidKinematics", "LARGE_KINEMATICS", "fits_stack",
+           "force_pattern",
            "large_kinematics"]
 
 
@@ -443,24 +444,35 @@ class LargeConstantKinematics(NamedTuple):
     """The kernels' :class:`ConstantKinematics` of a model larger than the stack arrays hold
     (:data:`~stickslip.model.stack.MAX_DOFS`, :data:`~stickslip.model.stack.MAX_CONTACTS`): its
     work arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register_heap`),
-    so it has no fixed maximum. ``FrictionModel.data`` chooses it; the model keeps its own class."""
+    so it has no fixed maximum. ``FrictionModel.data`` chooses it; the model keeps its own class.
 
-    ndof: int = 0
-    ncontacts: int = 0
+    ``force_rows`` (n + 1,) and ``force_columns`` (int64) hold the row-compressed pattern of the
+    entries of C and K that are not both zero (:func:`force_pattern`): the base force
+    f0 − C q̇ − K q sums over those only (:func:`~stickslip.model.model_data.base_force_of`), as a
+    reduced or finite-element model's C and K are mostly zero."""
+
+    ndof: int
+    ncontacts: int
+    force_rows: np.ndarray
+    force_columns: np.ndarray
 
 
 class LargeConstantUnilateralKinematics(NamedTuple):
     """:class:`LargeConstantKinematics` for :class:`ConstantUnilateralKinematics` (compliant contacts)."""
 
-    ndof: int = 0
-    ncontacts: int = 0
+    ndof: int
+    ncontacts: int
+    force_rows: np.ndarray
+    force_columns: np.ndarray
 
 
 class LargeConstantRigidKinematics(NamedTuple):
     """:class:`LargeConstantKinematics` for :class:`ConstantRigidKinematics` (a rigid contact)."""
 
-    ndof: int = 0
-    ncontacts: int = 0
+    ndof: int
+    ncontacts: int
+    force_rows: np.ndarray
+    force_columns: np.ndarray
 
 
 #: The heap class the kernels of a large model of each constant-kinematics class take.
@@ -475,15 +487,25 @@ def fits_stack(cls: type, n: int, nc: int) -> bool:
     return stack.static_sizes(cls) is not None or (n <= stack.MAX_DOFS and nc <= stack.MAX_CONTACTS)
 
 
-def large_kinematics(kin, n: int, nc: int):
+def force_pattern(damping: np.ndarray, stiffness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(rows (n + 1,), columns) int64: the row-compressed pattern of the entries (i, j) where the
+    dense (n, n) ``damping`` or ``stiffness`` is not zero, columns ascending in each row."""
+    nonzero = (np.asarray(damping) != 0.0) | (np.asarray(stiffness) != 0.0)
+    rows = np.zeros(nonzero.shape[0] + 1, dtype=np.int64)
+    np.cumsum(nonzero.sum(axis=1), out=rows[1:])
+    return rows, np.nonzero(nonzero)[1].astype(np.int64)
+
+
+def large_kinematics(kin, n: int, nc: int, damping: np.ndarray | None = None, stiffness: np.ndarray | None = None):
     """The kinematics data the kernels take for a model of n dofs and nc contacts: ``kin`` where
-    it fits the stack arrays (:func:`fits_stack`), else its heap class (None where it has none: a
-    frame computed from q, which the stack maxima bound)."""
+    it fits the stack arrays (:func:`fits_stack`), else its heap class with the pattern of the
+    dense (n, n) ``damping`` and ``stiffness`` (:func:`force_pattern`; None where it has no heap
+    class: a frame computed from q, which the stack maxima bound)."""
     cls = type(kin)
     if fits_stack(cls, n, nc):
         return kin
     large = LARGE_KINEMATICS.get(cls)
-    return None if large is None else large(int(n), int(nc))
+    return None if large is None else large(int(n), int(nc), *force_pattern(damping, stiffness))
 
 
 @kernel

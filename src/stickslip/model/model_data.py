@@ -28,7 +28,7 @@ from .stack import on_heap
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
            "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy",
-           "inverse_mass_of_row", "gram_row"]
+           "inverse_mass_of_row", "gram_row", "base_force_of", "damping_power"]
 
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
@@ -150,6 +150,76 @@ def base_force(s, m, n, diagonal, f):
             for j in range(n):
                 acc -= m[oc + i * n + j] * s[n + j] + m[ok + i * n + j] * s[j]
             f[i] = acc
+
+
+def base_force_of(kin, s, m, n, diagonal, f):  # pragma: no cover - resolved by numba (overload below)
+    """:func:`base_force`; for a model of a heap kinematics class (:mod:`stickslip.model.stack`)
+    the same sums over the entries of C and K in its pattern only (``kin.force_rows``,
+    ``kin.force_columns``: the others are zero in both), each in the same order less its exact zeros."""
+    raise NotImplementedError
+
+
+def _for_kinematics(kin, dense, heap):
+    """The implementation of an overload below for the kinematics type ``kin``: ``heap`` for a heap
+    kinematics class (:mod:`stickslip.model.stack`), ``dense`` for the others."""
+    return heap if on_heap(getattr(kin, "instance_class", None)) else dense
+
+
+def _base_force_dense(kin, s, m, n, diagonal, f):
+    base_force(s, m, n, diagonal, f)
+
+
+def _base_force_by_pattern(kin, s, m, n, diagonal, f):
+    _, _, oc, ok, of, _, _ = offsets(n)
+    rows = kin.force_rows
+    columns = kin.force_columns
+    for i in range(n):
+        acc = m[of + i] + csm.zero(s[0])
+        for p in range(rows[i], rows[i + 1]):
+            j = columns[p]
+            acc -= m[oc + i * n + j] * s[n + j] + m[ok + i * n + j] * s[j]
+        f[i] = acc
+
+
+@overload(base_force_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _base_force_of(kin, s, m, n, diagonal, f):
+    return _for_kinematics(kin, _base_force_dense, _base_force_by_pattern)
+
+
+def damping_power(kin, s, m, n, diagonal):  # pragma: no cover - resolved by numba (overload below)
+    """−q̇ᵀ C q̇ [W]; for a model of a heap kinematics class over the entries of its pattern only
+    (:func:`base_force_of`), each sum in the same order less its exact zeros."""
+    raise NotImplementedError
+
+
+def _damping_power_dense(kin, s, m, n, diagonal):
+    oc = offsets(n)[2]
+    damping = csm.zero(s[0])
+    if diagonal:
+        for i in range(n):
+            damping -= m[oc + i * (n + 1)] * s[n + i] * s[n + i]
+    else:
+        for i in range(n):
+            for j in range(n):
+                damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
+    return damping
+
+
+def _damping_power_by_pattern(kin, s, m, n, diagonal):
+    oc = offsets(n)[2]
+    rows = kin.force_rows
+    columns = kin.force_columns
+    damping = csm.zero(s[0])
+    for i in range(n):
+        for p in range(rows[i], rows[i + 1]):
+            j = columns[p]
+            damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
+    return damping
+
+
+@overload(damping_power, jit_options=KERNEL_OPTIONS, inline="always")
+def _damping_power(kin, s, m, n, diagonal):
+    return _for_kinematics(kin, _damping_power_dense, _damping_power_by_pattern)
 
 
 @kernel

@@ -46,7 +46,7 @@ import math
 import numpy as np
 
 from . import csmath as csm
-from .bundle import CST, H_BAND, offsets
+from .bundle import CST, H_BAND
 from .forces import (add_contact_force, general_forces, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
@@ -54,13 +54,15 @@ from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
-                         apply_inverse_mass, is_stick, kinetic_coefficient, kinetic_energy, law_row, static_limit)
+                         apply_inverse_mass, damping_power, gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient,
+                         kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
 from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
            "indicator", "gap", "unilateral", "rigid", "rigid_pivot", "is_open", "normal_force_of",
-           "rhs", "rhs_body", "general_rhs", "rhs_and_forces", "contact_forces", "normal_force", "stick_margin", "stick_forces", "project_velocities", "slip_velocity",
+           "rhs", "rhs_body", "general_rhs", "rhs_and_forces", "contact_forces", "normal_force", "stick_margin",
+           "stick_margins", "stick_forces", "project_velocities", "slip_velocity",
            "slip_velocity_and_rate", "slip_direction", "band_direction", "static_limit", "kinetic_energy", "solve_psd",
            "solve_psd_2x2", "contact_dim", "frame_with_bias", "COMPLEX_STEP",
            # used by the orbits' variational kernels (orbits/var_kernels.py)
@@ -85,16 +87,7 @@ def write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds):
         for i in range(2 * nc):
             power += F[i] * (v[i] + w[i])
         ds[2 * n] = power
-        oc = offsets(n)[2]
-        damping = csm.zero(s[0])
-        if diagonal:
-            for i in range(n):
-                damping -= m[oc + i * (n + 1)] * s[n + i] * s[n + i]
-        else:
-            for i in range(n):
-                for j in range(n):
-                    damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
-        ds[2 * n + 1] = damping
+        ds[2 * n + 1] = damping_power(md.kin, s, m, n, diagonal)
 
 
 @standalone
@@ -213,6 +206,21 @@ def stick_margin(s, cst, c, md):
     w, v, N, h, F, f = work_vectors(md.kin, 6, s)
     general_forces(s, cst, md, G, w, v, N, h, F, f)  # a call: events only, not the rhs
     return static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
+
+
+@kernel
+def stick_margins(s, cst, md, out, at):
+    """:func:`stick_margin` of every sticking contact c at ``s`` into ``out[at + c]`` (the others'
+    entries untouched): the forces of all contacts solved once, where the margin of each contact
+    alone solves them once per contact."""
+    m = md.m
+    n, nc, _ = model_sizes(md.kin, m)
+    G = work_matrix(md.kin, ROWS, DOFS, s)
+    w, v, N, h, F, f = work_vectors(md.kin, 6, s)
+    general_forces(s, cst, md, G, w, v, N, h, F, f)
+    for c in range(nc):
+        if is_stick(cst, c):
+            out[at + c] = static_limit(m, n, c, N[c]) - math.sqrt(F[2 * c] * F[2 * c] + F[2 * c + 1] * F[2 * c + 1])
 
 
 @api_kernel
@@ -384,7 +392,7 @@ def project_velocities(s, cst, extra, md):
             dim = contact_dim(md.kin, m, n, c)
             v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
             for i in range(dim):
-                apply_inverse_mass(m, n, diagonal, G[2 * c + i], MG[k])
+                inverse_mass_of_row(md.kin, m, n, diagonal, G[2 * c + i], MG[k])
                 b[k] = v0 if i == 0 else v1
                 k += 1
     if k == 0:
@@ -394,11 +402,7 @@ def project_velocities(s, cst, extra, md):
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
             for i in range(contact_dim(md.kin, m, n, c)):
-                for r2 in range(k):
-                    acc = 0.0
-                    for j in range(n):
-                        acc += G[2 * c + i, j] * MG[r2, j]
-                    A[r, r2] = acc
+                gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, 0.0)
                 r += 1
     solve_psd(A, b, x, V, k)
     for r in range(k):

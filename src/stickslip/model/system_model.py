@@ -574,10 +574,12 @@ class FrictionModel:
         (n² numbers each, for hundreds to a few thousand dofs).
         """
         self._check_compiled_size()
-        m = pack(dense_array(self.mass), dense_array(self.damping), dense_array(self.stiffness), self.force, self.free,
+        damping, stiffness = dense_array(self.damping), dense_array(self.stiffness)
+        m = pack(dense_array(self.mass), damping, stiffness, self.force, self.free,
                  [dense_spec(contact.spec(self.n)) for contact in self.contacts], self.slip_band,
                  self.constant_kinematics)
-        kin = large_kinematics(kernel_kinematics(self.kinematics, *self._contact_kinds()), self.n, self.n_contacts)
+        kin = large_kinematics(kernel_kinematics(self.kinematics, *self._contact_kinds()), self.n, self.n_contacts,
+                               damping, stiffness)
         return ModelData(m, kin, self.user_law)
 
     @cached_property
