@@ -89,11 +89,14 @@ def work_matrix(typingctx, kin, rows, cols, like):
     """
     dtype = _number_type(like)
     arrty = types.Array(dtype, 2, "C")
+    # Read while typing, so that typing with the sizes as plain integers fails and numba types the
+    # call with their literals: numba 0.57's intrinsic ignores prefer_literal and tries plain first
+    row_code, col_code = rows.literal_value, cols.literal_value
     if _heap(kin):
         def heap_codegen(context, builder, signature, args):
             n, nc = _run_time_sizes(kin, builder, args[0])
-            r = _extent_value(builder, rows.literal_value, n, nc)
-            c = _extent_value(builder, cols.literal_value, n, nc)
+            r = _extent_value(builder, row_code, n, nc)
+            c = _extent_value(builder, col_code, n, nc)
             ptr, itemsize, intp = _site_buffer(context, builder, dtype, builder.mul(r, c))
             ary = context.make_array(arrty)(context, builder)
             populate_array(ary, data=ptr, shape=[r, c], strides=[builder.mul(c, intp(itemsize)), intp(itemsize)],
@@ -102,8 +105,8 @@ def work_matrix(typingctx, kin, rows, cols, like):
 
         return arrty(kin, rows, cols, like), heap_codegen
     n, nc = _sizes(kin)
-    r = _extent(rows.literal_value, n, nc)
-    c = _extent(cols.literal_value, n, nc)
+    r = _extent(row_code, n, nc)
+    c = _extent(col_code, n, nc)
 
     def codegen(context, builder, signature, args):
         ptr, itemsize, intp = _stack_block(context, builder, dtype, r * c)

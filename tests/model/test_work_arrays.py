@@ -1,0 +1,22 @@
+"""The work arrays' size codes are literals when a kernel is typed, on every numba the project allows."""
+
+import numba
+import pytest
+from numba.core import types
+
+from stickslip.model import stack
+from stickslip.model.kinematics import ConstantKinematics, LargeConstantKinematics
+
+
+@pytest.mark.parametrize("kin", [ConstantKinematics(), LargeConstantKinematics(70, 20)], ids=["stack", "heap"])
+def test_work_matrix_is_typed_only_with_literal_size_codes(kin):
+    """numba 0.57 types an intrinsic with plain integers first and keeps the first typing that
+    succeeds (its ``intrinsic`` ignores ``prefer_literal``): the typing must refuse plain integers,
+    for the stack and the heap flavour alike (the heap flavour's lowering failed on 0.57, every
+    large model's run with it)."""
+    kin_type, like = numba.typeof(kin), types.float64[:]
+    with pytest.raises(AttributeError, match="literal_value"):
+        stack.work_matrix._defn(None, kin_type, types.intp, types.intp, like)
+    signature, _ = stack.work_matrix._defn(None, kin_type, types.IntegerLiteral(stack.TWO),
+                                           types.IntegerLiteral(stack.DOFS), like)
+    assert signature.return_type == types.Array(types.float64, 2, "C")
