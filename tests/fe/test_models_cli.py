@@ -52,7 +52,7 @@ def test_json_stays_complete(tmp_path):
 
 def test_runs_of_contacts_and_groups_of_parameters():
     coulomb, other = FrictionLaw("coulomb", mu_k=0.3, delta_mu=0.0), FrictionLaw("coulomb", mu_k=0.5, delta_mu=0.0)
-    contacts = [types.SimpleNamespace(dim=1, friction=law) for law in [coulomb] * 3 + [other] + [coulomb] * 2]
+    contacts = [types.SimpleNamespace(dim=1, friction=law, frictionless=False) for law in [coulomb] * 3 + [other] + [coulomb] * 2]
     system = types.SimpleNamespace(contacts=contacts, contact_names=tuple(f"c{k}" for k in range(6)))
     assert contact_lines(system) == ["contacts 0–2 (c0 … c2): 1-D slip, law coulomb, mu_k 0.3, delta_mu 0",
                                      "contact 3 (c3): 1-D slip, law coulomb, mu_k 0.5, delta_mu 0",

@@ -256,7 +256,7 @@ def _stickslip_after(module: str, *args) -> list:
     return [sys.executable, "-c", code, *args]
 
 
-@pytest.mark.parametrize("module", ["stickslip.analysis", "stickslip.cli.basins"])
+@pytest.mark.parametrize("module", ["stickslip.analysis", "stickslip.cli.simulate"])
 def test_ctrl_c_while_importing_is_one_line(module, tmp_path):
     """(It was a KeyboardInterrupt traceback from whatever module was being imported.)"""
     res = subprocess.run(_stickslip_after(module, *SIMULATE, "--out", str(tmp_path / "x.nc")), capture_output=True,

@@ -62,9 +62,12 @@ SIGNALS = ("at-rest", "periodic", "decaying", "stationary", "drifting")
 DECAY_RATIO = 0.99
 
 #: Maxima of x each quarter of the window must hold before the quarters' amplitudes are compared
-#: (with fewer, a quarter's peak-to-peak depends on where the oscillation's phase cuts it: an
+#: (in a quarter without one, the peak-to-peak depends on where the oscillation's phase cuts it: an
 #: undamped cosine whose period is 0.7 of the window has quarter amplitudes 0.57 of each other).
-DECAY_MIN_PEAKS = 2
+#: One is enough with the amplitudes falling quarter by quarter (a beat goes up and down); two
+#: would refuse a decay whose window holds fewer than eight periods (the belt's 30 s window at
+#: period 2π holds 4.8, and steady sliding was then called unsettled).
+DECAY_MIN_PEAKS = 1
 
 #: Smallest return spread (relative to A) of a stationary non-periodic window: a window that
 #: nearly repeats (spread 1e-5 … 1e-3) is a slow approach to a periodic orbit until shown
