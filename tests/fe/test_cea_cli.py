@@ -12,18 +12,11 @@ from stickslip.model.library import load_model
 from stickslip.stability.band import band_stability
 
 from .fe_models import pad_on_belt
+from .refusals import refused
 
 
 def run(*args):
     return CliRunner().invoke(app, ["stability", *args])
-
-
-def refused(result, *words):
-    assert result.exit_code == 2, result.output
-    lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in result.output, result.output
-    for word in words:
-        assert word in lines[0], (word, lines[0])
 
 
 @pytest.fixture(scope="module")

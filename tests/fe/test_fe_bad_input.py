@@ -10,14 +10,7 @@ from stickslip.cli import app
 from stickslip.model.model_file import load_model_file
 
 from .fe_models import pad_on_belt
-
-
-def refused(result, *words):
-    assert result.exit_code == 2, result.output
-    lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in result.output, result.output
-    for word in words:
-        assert word in lines[0], (word, lines[0])
+from .refusals import refused
 
 
 @pytest.fixture

@@ -13,18 +13,11 @@ from typer.testing import CliRunner
 from stickslip.cli import app
 
 from .fe_models import pad_on_belt
+from .refusals import refused
 
 
 def run(*args):
     return CliRunner().invoke(app, ["simulate", "--t-end", "1", "--no-plot", *args])
-
-
-def refused(result, *words):
-    assert result.exit_code == 2, result.output
-    lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in result.output, result.output
-    for word in words:
-        assert word in lines[0], (word, lines[0])
 
 
 @pytest.fixture
