@@ -39,8 +39,8 @@ import scipy.sparse as sp
 from ..errors import ModelError
 from .stack import MAX_DOFS
 
-__all__ = ["DENSE_DOFS", "is_sparse", "dense_array", "dense_spec", "square_matrix", "contact_rows", "has_nonzero",
-           "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite", "is_checked"]
+__all__ = ["DENSE_DOFS", "arpack_start", "is_sparse", "dense_array", "dense_spec", "square_matrix", "contact_rows",
+           "has_nonzero", "mark_positive_definite", "check_mass", "MAX_MASS_CONDITION", "finite", "is_checked"]
 
 #: Largest model kept dense: the compiled kernels' limit. Larger models keep their matrices sparse.
 DENSE_DOFS = MAX_DOFS
@@ -58,6 +58,12 @@ _SYMMETRY = 1e-12
 
 #: Sparse mass matrices that passed :func:`check_mass`: id → weak reference.
 _CHECKED: dict[int, weakref.ref] = {}
+
+
+def arpack_start(n: int) -> np.ndarray:
+    """ARPACK's start vector (n,): fixed, so that an eigen-solve gives the same result every run
+    (ARPACK's own start is random, and a reduction's basis would differ in its last digits)."""
+    return np.random.default_rng(0).standard_normal(n)
 
 
 def is_sparse(value) -> bool:
@@ -232,7 +238,7 @@ def _factored_range(M: sp.csr_matrix, where: str) -> tuple[float, float]:
     try:
         inverse = LinearOperator((n, n), matvec=lu.solve, dtype=float)
         low = float(eigsh(A, k=1, sigma=0.0, which="LM", OPinv=inverse, return_eigenvectors=False, tol=1e-6,
-                        v0=np.random.default_rng(0).standard_normal(A.shape[0]))[0])  # fixed start: same every run
+                        v0=arpack_start(n))[0])
     except ArpackNoConvergence:  # the pivots lie in [λmin, λmax]: the smallest is what can be said
         low = float(pivots.min())
     return low, high

@@ -38,6 +38,7 @@ import scipy.sparse as sp
 
 from ..errors import StickSlipError
 from ..memory import check_memory, format_bytes
+from ..model.matrices import arpack_start
 from ..model.sparse_form import NodeMap, SparseForm
 from ..stability.modal_cea import lowest_modes
 from ..stability.sparse_input import sparse_form
@@ -142,7 +143,7 @@ def _frequency_of_mode(K, M, modes: int) -> float:
     lu = factorize(K, pivot=0.0)
     op = LinearOperator((n, n), matvec=lambda x: lu.solve(np.asarray(x).reshape(-1)), dtype=float)
     w2 = np.sort(eigsh(sp.csr_matrix(K), k=modes + 1, M=sp.csr_matrix(M), sigma=0.0, OPinv=op, which="LM",
-                       v0=np.random.default_rng(0).standard_normal(n), return_eigenvectors=False))  # fixed start
+                       v0=arpack_start(n), return_eigenvectors=False))
     return float(np.sqrt(0.5 * (w2[modes - 1] + w2[modes])))
 
 

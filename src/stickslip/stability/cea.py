@@ -38,6 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import EquilibriumError
+from ..model.matrices import arpack_start
 from .sparse_sliding import SlidingState, factorize
 
 __all__ = ["BandEigen", "band_eigen", "dense_eigen", "backward_errors", "frictionless_count", "modes_below", "REAL_MARGIN",
@@ -150,7 +151,7 @@ def _arnoldi(state: SlidingState, radius: float, k: int, v0) -> tuple[np.ndarray
     T = _operator(state)
     n2 = 2 * state.n
     if v0 is None:  # a fixed start: the same run every time (ARPACK's own start is random)
-        v0 = np.random.default_rng(0).standard_normal(n2)
+        v0 = arpack_start(n2)
     runs, previous = [], None
     while True:
         k = int(min(k, n2 - 2))

@@ -39,6 +39,7 @@ import scipy.sparse as sp
 
 from ..errors import EquilibriumError
 from ..memory import check_memory, format_bytes
+from ..model.matrices import arpack_start
 from .cea import BandEigen, _frictionless_stiffness, band_eigen, modes_below
 from .sparse_sliding import SlidingState, factorize
 
@@ -145,9 +146,7 @@ def lowest_modes(K, M, cutoff: float) -> tuple[np.ndarray, np.ndarray, int | Non
 
             w2, V = eigh(K.toarray(), M.toarray())
         else:
-            # a fixed start: the same modes every run (ARPACK's own start is random, and the basis
-            # of a reduction built on these modes would differ from run to run in its last digits)
-            w2, V = eigsh(K, k=k, M=M, sigma=0.0, OPinv=op, which="LM", v0=np.random.default_rng(0).standard_normal(n))
+            w2, V = eigsh(K, k=k, M=M, sigma=0.0, OPinv=op, which="LM", v0=arpack_start(n))
         order = np.argsort(w2)
         w2, V = w2[order], V[:, order]
         below = w2 < cutoff**2
