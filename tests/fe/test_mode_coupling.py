@@ -38,3 +38,22 @@ def test_command(tmp_path):
     bad = CliRunner().invoke(app, ["mode-coupling", "--model", "hoffmann", "--mu", "1,0.5", "--max-frequency", "3",
                                    "--out", str(tmp_path / "b.nc")])
     assert bad.exit_code == 2 and "increasing" in bad.output
+
+
+def test_onset_labels_one_per_mu_and_apart():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from stickslip.plot.fe import plot_mode_coupling
+    from stickslip.stability.mode_coupling import ModeCoupling
+
+    mu = np.linspace(0.0, 1.0, 5)
+    lam = np.tile(np.array([-0.1 + 1j, -0.1 + 2j, -0.1 + 3j]), (5, 1))
+    onsets = [{"mu": 0.5, "angular_frequency": 1.0, "branch": 0, "partner": 1},
+              {"mu": 0.5, "angular_frequency": 2.0, "branch": 1, "partner": 0},
+              {"mu": 0.52, "angular_frequency": 3.0, "branch": 2, "partner": None}]
+    fig = plot_mode_coupling(ModeCoupling("m", mu, lam, 4.0, onsets))
+    texts = [(t.get_text(), t.xyann) for t in fig.axes[1].texts]
+    # the first two onsets print as one μ: one label; the third a label of its own, raised above it
+    assert [t for t, _ in texts] == ["μ = 0.5", "μ = 0.52"]
+    assert texts[0][1][1] < texts[1][1][1]

@@ -30,6 +30,16 @@ def cell_edges(cells) -> np.ndarray:
     return np.unique(np.sort(np.vstack(pairs), axis=1), axis=0)
 
 
+def _onset_labels(onsets) -> list[tuple[float, str]]:
+    """One label per distinct onset μ (as printed, 4 digits), in increasing μ: onsets of several
+    branch pairs at one μ share a label, and the caller staggers neighbours' heights so that close
+    labels do not overlap."""
+    labels: dict[str, float] = {}
+    for onset in sorted(onsets, key=lambda o: o["mu"]):
+        labels.setdefault(f"μ = {onset['mu']:.4g}", float(onset["mu"]))
+    return [(mu, text) for text, mu in labels.items()]
+
+
 def plot_mode_coupling(result, *, hz: bool = False, ax=None):
     """Frequencies (top) and real parts (bottom) of the band's eigenvalues against μ, each branch a
     line, the instabilities' onsets (coalescences) marked.
@@ -58,7 +68,8 @@ def plot_mode_coupling(result, *, hz: bool = False, ax=None):
     for onset in result.onsets:
         ax[0].plot(onset["mu"], onset["angular_frequency"] * scale, "o", mfc="none", mec="tab:red", ms=9)
         ax[1].plot(onset["mu"], 0.0, "o", mfc="none", mec="tab:red", ms=9)
-        ax[1].annotate(f"μ = {onset['mu']:.4g}", (onset["mu"], 0.0), textcoords="offset points", xytext=(4, 6),
+    for row, label in enumerate(_onset_labels(result.onsets)):
+        ax[1].annotate(label[1], (label[0], 0.0), textcoords="offset points", xytext=(4, 6 + 11 * (row % 3)),
                        fontsize=8, color="tab:red")
     ax[1].axhline(0.0, color="k", lw=0.6)
     ax[0].set_ylabel("frequency [Hz]" if hz else "Im λ [rad/s]")
