@@ -68,38 +68,6 @@ def test_hoffmann_map_is_the_analytic_spectrum_and_onset():
         assert roots[0] == pytest.approx(hoffmann_onset(c, 0.1), abs=1e-9)
 
 
-def test_hoffmann_map_is_stability_at_each_point_pressed_or_lifted_off():
-    """Across N0 = 0 the contact spring lifts off (N0 ≤ 0: nothing presses it, and with the one
-    contact with friction open nothing slides): there the compiled grid leaves the point to the
-    open-set solve in Python, which finds no steady sliding. Every point equals ``stability()``
-    there (NaN where it refuses) and, pressed, the closed form (the preload does not enter K(μ))."""
-    from stickslip.errors import EquilibriumError
-
-    base = load_model("hoffmann").replace(**{"damping.x.x": 0.1, "damping.y.y": 0.1})
-    axes = ("N0", "contact.0.friction.mu_k")
-    n0 = np.array([-0.4, 0.0, 0.5, 1.5])
-    mu = np.linspace(0.3, 2.5, 12)
-    m = stability_map(base, n0, mu, axes=axes)
-    outcomes = set()
-    for i, x in enumerate(n0):
-        for j, u in enumerate(mu):
-            got = m.max_real_part[0, i, j]
-            try:
-                res = stability(base.replace(**{axes[0]: float(x), axes[1]: float(u)}))
-            except EquilibriumError:
-                assert np.isnan(got), (x, u)
-                outcomes.add("none")
-                continue
-            outcomes.add("unstable" if res.max_real_part > 0 else "stable")
-            assert got == pytest.approx(res.max_real_part, rel=1e-9, abs=0.0), (x, u)
-            assert m.tolerance[0, i, j] == pytest.approx(res.tolerance, rel=1e-9), (x, u)
-            assert got == pytest.approx(hoffmann_max_real_part(u, 0.1, 0.1), rel=1e-9, abs=1e-15), (x, u)
-    assert outcomes == {"none", "stable", "unstable"}
-    assert np.all(np.isnan(m.max_real_part[0, :2])) and np.all(np.isfinite(m.max_real_part[0, 2:]))
-    for i in (2, 3):  # the flutter onset, where the preload presses the contact
-        assert m.boundary[0, i, 0] == pytest.approx(hoffmann_onset(0.1, 0.1), abs=1e-9)
-
-
 def test_belt_map_boundary_is_the_closed_form():
     N = np.linspace(0.5, 2.0, 7)
     V = np.linspace(0.2, 3.0, 15)
