@@ -10,6 +10,10 @@
   equilibrium: no steady sliding (NaN in the map).
 * ``clearance-oscillator`` itself (the stop rigid): pressed, the stop fixes the one dof and no
   motion is left (max Re λ −inf); open, the free oscillator's T / 2.
+* ``hoffmann`` (K(μ) = [[2, 1 − μ], [1, 2]], damping c on both dofs) across N0 = 0, where its
+  contact spring lifts off (its one contact with friction open: no steady sliding), and across its
+  flutter onset: pressed, max Re λ is the largest real root of the characteristic polynomial
+  λ⁴ + 2c λ³ + (4 + c²) λ² + 4c λ + 3 + μ, which the preload does not enter.
 """
 
 from __future__ import annotations
@@ -95,6 +99,21 @@ def test_a_map_has_no_steady_sliding_where_the_only_contact_with_friction_opens(
     seen = check_map_against_stability(stickslip.load_model("slider-belt"), ("P", "V"), [-0.3, -0.1, 0.3, 0.6],
                                        [0.3, 0.5])
     assert seen == {None, ()}
+
+
+def test_a_hoffmann_map_across_lift_off_and_flutter_is_stability_at_each_point():
+    """The compiled grid holds the contact closed; where that leaves it unpressed (N0 ≤ 0) the map
+    takes the point's open set as ``stability`` does (no steady sliding: NaN)."""
+    c = 0.1
+    model = stickslip.load_model("hoffmann").replace(**{"damping.x.x": c, "damping.y.y": c})
+
+    def by_hand(n0, mu):
+        return float(np.max(np.roots([1.0, 2.0 * c, 4.0 + c * c, 4.0 * c, 3.0 + mu]).real))
+
+    seen = check_map_against_stability(model, ("N0", "contact.0.friction.mu_k"), np.array([-0.4, 0.0, 0.5, 1.5]),
+                                       np.linspace(0.3, 2.5, 12), expected=by_hand)
+    assert seen == {None, ()}  # lifted off and pressed; the grid crosses the flutter onset μ = 1 + 2c²:
+    assert by_hand(1.0, 0.9) < 0.0 < by_hand(1.0, 1.1)
 
 
 @pytest.mark.parametrize("xs, open_fraction", [(1.2, 1.0), (0.3, 0.0)])

@@ -22,6 +22,7 @@ from scipy.optimize import brentq
 
 from stickslip.model.library import load_model
 from stickslip.stability import stability, stability_map
+from stickslip.stability import steady
 from stickslip.stability.maps import MapGrid
 
 K11, K12, K21, K22, K3, N0 = 2.0, 1.0, 1.0, 2.0, 1.0, 1.0
@@ -108,7 +109,8 @@ def test_plates_axes_are_separable_and_exact():
 
     grid = MapGrid.build(two_plates(), ("N", "Omega"), np.array([10.0, 50.0, 90.0]), np.array([0.5, 5.0]))
     assert grid.separable and grid.axis_a.fast and grid.axis_b.fast
-    J = grid.jacobians(np.array([1]), np.array([1]))
+    J, found = grid.jacobians(np.array([1]), np.array([1]))
+    assert found[0] == steady.STEADY_PRESSED
     ref = stability(two_plates().replace(N=50.0, Omega=5.0)).jacobian
     np.testing.assert_array_equal(J[0], ref)
 

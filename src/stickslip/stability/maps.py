@@ -2,7 +2,10 @@
 
 For each grid point the equilibrium and the Jacobian are computed in one compiled call over the
 whole grid (:func:`stickslip.stability.steady.jacobian_points`), the eigenvalues by NumPy's batched
-LAPACK, and the boundary where max Re λ crosses 0 along the second axis by brentq.
+LAPACK, and the boundary where max Re λ crosses 0 along the second axis by brentq. The grid holds
+every contact closed; where that leaves a unilateral contact unpressed, or finds no steady sliding
+of a model with unilateral contacts, the point is solved in Python with the open set that
+``stickslip stability`` takes (as is every point of a model with rigid contacts).
 
 A point's model is not rebuilt in Python: each axis is a table of data arrays (one row per value,
 :class:`_Axis`), and a point takes the first axis' row with the second axis' entries put in. This is
@@ -223,26 +226,36 @@ class MapGrid:
             mask_b = np.zeros_like(mask_b)
         return cls(system, tuple(names), a, b, axis_a, axis_b, rows_a, rows_b, mask_b, bool(separable))
 
-    def jacobians(self, ia: np.ndarray, ib: np.ndarray, rows_b: np.ndarray | None = None) -> np.ndarray:
-        """Jacobians (P, 2k, 2k) at the points (ia[p], ib[p]); NaN where no steady sliding exists."""
+    def jacobians(self, ia: np.ndarray, ib: np.ndarray, rows_b: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """Jacobians (P, 2k, 2k) at the points (ia[p], ib[p]) with every contact closed (NaN where
+        no such steady sliding exists), and each point's outcome (P,) int8: ``steady.STEADY_*``
+        (whether every unilateral contact is pressed there)."""
         system = self.system
         L = system.data.m.size
         rb = self.rows_b if rows_b is None else rows_b
         free = np.flatnonzero(system.free).astype(np.int64)
         out = np.empty((ia.size, 2 * free.size, 2 * free.size))
+        found = np.empty(ia.size, dtype=np.int8)
         ra = self.rows_a
         if not self.separable:
             ra, ia = ra[ia * self.b.size + ib], np.arange(ia.size, dtype=np.int64)
         tables = steady.AxisTables(ra[:, :L], rb[:, :L], self.mask_b[:L], ra[:, L:], rb[:, L:], self.mask_b[L:],
                                    ia.astype(np.int64), ib.astype(np.int64))
-        steady.jacobian_points(tables, system.data.kin, system.data.law, free, MAX_ITER, RESIDUAL_TOL, out)
-        return out
+        steady.jacobian_points(tables, system.data.kin, system.data.law, free, MAX_ITER, RESIDUAL_TOL, out, found)
+        return out, found
 
     def max_real_part(self) -> tuple[np.ndarray, np.ndarray]:
         """max Re λ over the grid (nA, nB) [1/s], NaN where no steady sliding exists, and the
-        tolerance within which it counts as 0 (:data:`.verdict.MARGINAL_RTOL` × ‖J‖₂) [1/s]."""
+        tolerance within which it counts as 0 (:data:`.verdict.MARGINAL_RTOL` × ‖J‖₂) [1/s].
+
+        Every point is solved by the compiled grid with every contact closed. A model with
+        unilateral contacts takes, at the points where that leaves one unpressed or finds no steady
+        sliding, the open set that ``stickslip stability`` takes (:meth:`point_stability`, one solve
+        in Python each); a model with rigid contacts takes it at every point (the constrained
+        eigenproblem)."""
         nA, nB = self.a.size, self.b.size
-        if self.system.unilateral:
+        if self.system.rigid:
             rows = [[self.point_stability(i, y) for y in self.b] for i in range(nA)]
             return tuple(np.array([[p[k] for p in row] for row in rows]).reshape(nA, nB) for k in (0, 1))
         ia_all = np.repeat(np.arange(nA, dtype=np.int64), nB)
@@ -251,11 +264,14 @@ class MapGrid:
         tol = np.full(nA * nB, np.nan)
         for p0 in range(0, nA * nB, CHUNK_POINTS):
             sl = slice(p0, p0 + CHUNK_POINTS)
-            J = self.jacobians(ia_all[sl], ib_all[sl])
-            ok = np.isfinite(J[:, 0, 0])
+            J, found = self.jacobians(ia_all[sl], ib_all[sl])
+            ok = np.isfinite(J[:, 0, 0]) & (found != steady.STEADY_UNPRESSED)
             if np.any(ok):
                 out[sl][ok] = np.linalg.eigvals(J[ok]).real.max(axis=-1)
                 tol[sl][ok] = MARGINAL_RTOL * np.linalg.norm(J[ok], 2, axis=(1, 2))
+            if self.system.unilateral:
+                for p in p0 + np.flatnonzero(~ok):
+                    out[p], tol[p] = self.point_stability(ia_all[p], self.b[ib_all[p]])
         return out.reshape(nA, nB), tol.reshape(nA, nB)
 
     def point_stability(self, i: int, y: float) -> tuple[float, float]:
@@ -269,7 +285,7 @@ class MapGrid:
         if self.system.unilateral:
             return self.point_stability(i, y)[0]
         if self.separable:
-            J = self.jacobians(np.array([i]), np.array([0]), self.axis_b.rows([y]))
+            J = self.jacobians(np.array([i]), np.array([0]), self.axis_b.rows([y]))[0]
         else:
             J = _jacobian_of(self.system.replace(**{self.names[0]: float(self.a[i]), self.names[1]: float(y)}))
         return float(np.max(np.linalg.eigvals(J[0]).real)) if np.isfinite(J[0, 0, 0]) else math.nan
@@ -280,7 +296,7 @@ def _unilateral_max_real_part(system) -> tuple[float, float]:
     without steady sliding (−inf where closed rigid contacts fix every free dof: no motion is left).
 
     Steady sliding may leave such contacts open, and which ones depends on the point, while the
-    compiled grid kernel holds every contact closed. So each point takes the open set that
+    compiled grid kernel holds every contact closed. So such a point takes the open set that
     ``stickslip stability`` takes (:func:`~stickslip.stability.equilibrium.solve_steady_modes`):
     one steady-sliding solve in Python (milliseconds). Closed rigid contacts make the eigenproblem
     a constrained one (the motion that keeps them closed), solved as

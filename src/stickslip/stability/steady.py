@@ -32,10 +32,12 @@ from ..model.frames import _frame_bias_central
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
 from ..model.kinematics import model_sizes, sizes_at_run_time
 from ..model.model_data import kinetic_coefficient
+from ..model.normal import contact_indicator, is_rigid, is_unilateral
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
 
 __all__ = ["NEWTON_OK", "NEWTON_MAX_ITER", "NEWTON_SINGULAR", "NEWTON_NOT_FINITE", "NEWTON_NO_DESCENT",
-           "NEWTON_NOT_SLIDING", "NEWTON_TARGET", "CONTINUATION_ACCEPT", "steady_sliding_point",
+           "NEWTON_NOT_SLIDING", "NEWTON_TARGET", "CONTINUATION_ACCEPT", "STEADY_NONE", "STEADY_PRESSED",
+           "STEADY_UNPRESSED", "steady_sliding_point",
            "steady_jacobian", "AxisTables", "jacobian_points", "kinematics_from", "kinematics_values"]
 
 NEWTON_OK = 0
@@ -52,6 +54,15 @@ NEWTON_TARGET = 1e-14
 
 #: Relative residual below which a solve counts as converged for the load continuation.
 CONTINUATION_ACCEPT = 1e-10
+
+#: :func:`steady_jacobian`'s outcomes: no steady sliding with every contact closed (J NaN); steady
+#: sliding with every unilateral contact pressed (g < 0, λ > 0), J its linearisation; steady
+#: sliding held closed that leaves some unilateral contact unpressed (or holds a rigid one closed,
+#: whose normal force is a multiplier: not decided here), J that of the closed contacts, which is
+#: not the model's where that contact opens.
+STEADY_NONE = 0
+STEADY_PRESSED = 1
+STEADY_UNPRESSED = 2
 
 
 def kinematics_values(kin) -> np.ndarray:
@@ -352,10 +363,13 @@ STEADY = Split(helper=(solve_stick_rows,), own=(kinetic_coefficient, _frame_bias
 
 @loop
 def steady_jacobian(md, free, max_iter, tol, J):
-    """Steady sliding, then the Jacobian of the slip equations there, reduced to the free DOFs.
+    """Steady sliding with every contact closed, then the Jacobian of the slip equations there,
+    reduced to the free DOFs.
 
-    Writes J (2k × 2k) = ∂(ds/dt)/∂s on [q_free, q̇_free] and returns True when Newton reached the
-    relative residual ``tol`` with every contact sliding; otherwise ``J`` is NaN.
+    Writes J (2k × 2k) = ∂(ds/dt)/∂s on [q_free, q̇_free] and returns :data:`STEADY_PRESSED` or
+    :data:`STEADY_UNPRESSED` when Newton reached the relative residual ``tol`` with every contact
+    sliding (whether each unilateral contact is pressed there: :func:`_pressed`); otherwise
+    :data:`STEADY_NONE` and ``J`` NaN.
     """
     n, nc, diagonal = model_sizes(md.kin, md.m)
     k = free.shape[0]
@@ -364,7 +378,7 @@ def steady_jacobian(md, free, max_iter, tol, J):
         for i in range(2 * k):
             for j in range(2 * k):
                 J[i, j] = np.nan
-        return False
+        return STEADY_NONE
     s = np.zeros(2 * n)
     for i in range(n):
         s[i] = q[i]
@@ -378,6 +392,18 @@ def steady_jacobian(md, free, max_iter, tol, J):
             J[a, k + b] = full[free[a], n + free[b]]
             J[k + a, b] = full[n + free[a], free[b]]
             J[k + a, k + b] = full[n + free[a], n + free[b]]
+    return STEADY_PRESSED if _pressed(s, cst, md, n, nc) else STEADY_UNPRESSED
+
+
+@inlined_kernel
+def _pressed(s, cst, md, n, nc):
+    """Whether every unilateral contact is pressed at ``s`` in the modes ``cst`` (all closed): a
+    compliant one with g < 0 and λ̃ = −k g − c ġ > 0 (its indicator min(−g, λ̃/k) > 0), as
+    :func:`stickslip.stability.equilibrium.solve_steady_modes` asks; False where a rigid one is
+    closed (its normal force, a multiplier, is not computed here)."""
+    for c in range(nc):
+        if is_unilateral(md, n, c) and (is_rigid(md, n, c) or not contact_indicator(s, cst, md, n, c) > 0.0):
+            return False
     return True
 
 
@@ -414,11 +440,11 @@ class AxisTables(NamedTuple):
 
 
 @loop
-def jacobian_points(tables, kin0, law, free, max_iter, tol, out):
+def jacobian_points(tables, kin0, law, free, max_iter, tol, out, found):
     """:func:`steady_jacobian` at the points of the :class:`AxisTables` ``tables``, into ``out``
-    (P, 2k, 2k); the kinematics of a point are ``kinematics_from(kin0, kv)``, its user friction law
-    ``law`` (:class:`~stickslip.model.friction.NoUserLaw` if none). NaN where no steady sliding
-    exists."""
+    (P, 2k, 2k) and its outcome into ``found`` (P,) int8 (``STEADY_*``); the kinematics of a point
+    are ``kinematics_from(kin0, kv)``, its user friction law ``law``
+    (:class:`~stickslip.model.friction.NoUserLaw` if none). NaN where no steady sliding exists."""
     m_a, m_b, mask_b, kv_a, kv_b, kmask_b, ia, ib = tables
     mw = np.empty(m_a.shape[1])
     kv = np.empty(kv_a.shape[1])
@@ -429,4 +455,4 @@ def jacobian_points(tables, kin0, law, free, max_iter, tol, out):
             mw[i] = m_b[b, i] if mask_b[i] else m_a[a, i]
         for i in range(kv.shape[0]):
             kv[i] = kv_b[b, i] if kmask_b[i] else kv_a[a, i]
-        steady_jacobian(ModelData(mw, kinematics_from(kin0, kv), law), free, max_iter, tol, out[p])
+        found[p] = steady_jacobian(ModelData(mw, kinematics_from(kin0, kv), law), free, max_iter, tol, out[p])
