@@ -10,8 +10,13 @@ itself and its waited-for children: the pool's workers, the forked writer) per s
 ms·core, and the wall time; the machine's load average before and after each. The labels are
 compared state by state, and the fractions and their standard errors.
 
+With ``--breakdown N`` it measures instead, in this process and serially on N states, where
+the Python classifier's time per state goes (building a run, the calls of the compiled loop,
+the tests after each chunk, the outcome rows) against the compiled batch on the same states.
+
     python benchmarks/ensembles.py [--rev main] [--states 20000] [--workers 2] [--pairs 1]
-Writes benchmarks/results/ensembles.json.
+    python benchmarks/ensembles.py --breakdown 2000
+Writes benchmarks/results/ensembles.json (ensembles_breakdown.json).
 """
 
 from __future__ import annotations
@@ -76,6 +81,72 @@ def run(package: str, path: Path, cache: Path, args, labels: Path) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def breakdown(n: int) -> dict:
+    """Where a state's CPU time goes in the Python classifier, against the compiled batch (module docstring)."""
+    import time
+
+    from stickslip.basins import batch, box, early
+    from stickslip.basins.context import make_context
+    from stickslip.basins.cycles import find_cycle
+    from stickslip.integrate import runner
+    from stickslip.model.library import load_model
+
+    belt = load_model("belt")
+    ctx = make_context(belt)
+    states = box(belt, {"x": (-2.0, 2.0), "dx": (0.0, 2.0)}, n=n, seed=0).states(belt, ctx.equilibrium[:1])
+    opts = early.Options()
+    spent = {"run_setup": 0.0, "loop_calls": 0.0, "tests_after_chunks": 0.0, "outcome_rows": 0.0}
+    calls = {"loop_calls": 0, "tests_after_chunks": 0}
+
+    def timed(owner, name, key):
+        original = getattr(owner, name)
+
+        def wrapper(*a, **k):
+            c = time.process_time()
+            try:
+                return original(*a, **k)
+            finally:
+                spent[key] += time.process_time() - c
+                calls[key] = calls.get(key, 0) + 1
+        setattr(owner, name, wrapper)
+        return original
+
+    early.classify_state(ctx, belt, states[0], [], opts)
+    batch.classify_batch(ctx, belt, states[:1], [], opts)
+    originals = [(runner.EventStepper, "__init__", timed(runner.EventStepper, "__init__", "run_setup")),
+                 (runner, "integrate_event", timed(runner, "integrate_event", "loop_calls")),
+                 (early.EarlyStop, "_decide", timed(early.EarlyStop, "_decide", "tests_after_chunks")),
+                 (early.Outcome, "to_row", timed(early.Outcome, "to_row", "outcome_rows"))]
+    cycles, steps = [], 0
+    c0 = time.process_time()
+    for s0 in states:
+        o = early.classify_state(ctx, belt, s0, cycles, opts)
+        if o.verdict == "periodic" and find_cycle(cycles, o.cycle, opts.match_rtol) < 0:
+            cycles.append(o.cycle)
+        o.to_row()
+        steps += o.steps
+    python_s = time.process_time() - c0
+    for owner, name, original in originals:
+        setattr(owner, name, original)
+    c0 = time.process_time()
+    rows, _ = batch.classify_batch(ctx, belt, states, [], opts)
+    batch_s = time.process_time() - c0
+    # the compiled loop alone: one chunk over 50 time units, no tests (steps cost, its call negligible)
+    stepper = runner.EventStepper(belt, states[1], 0.0, 500.0, rtol=opts.rtol, atol=opts.atol, h_max=ctx.chunk * ctx.dt,
+                                  max_steps=10**9)
+    record = runner.Record(belt, np.arange(int(500.0 / ctx.dt) + 2) * ctx.dt)
+    c0 = time.process_time()
+    chunk = stepper.advance(50.0, record)
+    step_us = 1e6 * (time.process_time() - c0) / chunk.steps
+    per = {k: 1e3 * v / n for k, v in spent.items()}
+    per["of_which_compiled_steps"] = 1e-3 * step_us * steps / n
+    out = {"states": n, "python_ms_core_per_state": 1e3 * python_s / n, "batch_ms_core_per_state": 1e3 * batch_s / n,
+           "ms_per_state": per, "calls_per_state": {k: v / n for k, v in calls.items()}, "steps_per_state": steps / n,
+           "us_per_step_in_a_long_chunk": step_us, "load": [round(x, 2) for x in os.getloadavg()]}
+    print(json.dumps(out, indent=1))
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rev", default="main")
@@ -83,7 +154,14 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--executor", default="processes", choices=["serial", "processes"])
     ap.add_argument("--pairs", type=int, default=1)
+    ap.add_argument("--breakdown", type=int, default=0, help="states of the breakdown (module docstring)")
     args = ap.parse_args()
+    if args.breakdown:
+        result = breakdown(args.breakdown)
+        path = ROOT / "benchmarks" / "results" / "ensembles_breakdown.json"
+        path.parent.mkdir(exist_ok=True)
+        path.write_text(json.dumps(result, indent=1) + "\n")
+        return
     rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", args.rev], check=True, capture_output=True,
                          text=True).stdout.strip()
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], check=True, capture_output=True,
@@ -121,6 +199,7 @@ def main() -> None:
           f"{t['fractions']} +- {t['standard_errors']} (equal: {result['fractions_equal']}, "
           f"{result['standard_errors_equal']})")
     path = ROOT / "benchmarks" / "results" / "ensembles.json"
+    path.parent.mkdir(exist_ok=True)
     path.write_text(json.dumps(result, indent=1) + "\n")
     print(f"wrote {path}")
 

@@ -29,7 +29,7 @@ from ..model.bundle import contact_state
 from .batch_kernels import AT_REST, MATCHED, Plan, Work, classify_states
 from .context import Context
 from .cycles import KMAX, find_cycle
-from .early import LINEAR_CHUNKS, RULE_PERIODS, Options, Outcome, classify_state, row_width
+from .early import LINEAR_CHUNKS, RULE_PERIODS, Options, Outcome, classify_state, row_column, row_width
 
 __all__ = ["classify_batch", "compiled_batch_applies"]
 
@@ -101,17 +101,21 @@ def _prepare(model, s0: np.ndarray, opts: Options) -> None:
 
 
 def _rows(result, lo: int, hi: int, cycles, n2: int, wall: float) -> np.ndarray:
-    """The outcome rows (:meth:`.early.Outcome.to_row`) of the states lo ≤ i < hi decided in the compiled call."""
-    codes, matched, t_decided, steps, final = result
-    rows = np.empty((hi - lo, row_width(n2 // 2)))
-    for i in range(lo, hi):
-        if codes[i] == MATCHED:
-            c = cycles[int(matched[i])]
-            o = Outcome("periodic", "matched", float(t_decided[i]), c, c.state, None, int(steps[i]), wall)
-        else:
-            o = Outcome("equilibrium", "at-rest" if codes[i] == AT_REST else "linear", float(t_decided[i]), None,
-                        final[i].copy(), None, int(steps[i]), wall)
-        rows[i - lo] = o.to_row()
+    """The outcome rows (:meth:`.early.Outcome.to_row`) of the states lo ≤ i < hi decided in the
+    compiled call: each one's kind of row (the cycle's for a match) with its time decided, steps,
+    wall time and, for an equilibrium, the state it ended in."""
+    codes, matched, t_decided, steps, final = (a[lo:hi] for a in result)
+    zero = np.zeros(n2)
+    kinds = [Outcome("equilibrium", "at-rest", 0.0, None, zero).to_row(),
+             Outcome("equilibrium", "linear", 0.0, None, zero).to_row()]
+    kinds += [Outcome("periodic", "matched", 0.0, c, c.state).to_row() for c in cycles]
+    kind = np.where(codes == MATCHED, 2 + matched, np.where(codes == AT_REST, 0, 1))
+    rows = np.array(kinds)[kind]
+    rows[:, row_column("t_decided")] = t_decided
+    rows[:, row_column("steps")] = steps
+    rows[:, row_column("wall_time")] = wall
+    state = row_column("state")
+    rows[codes != MATCHED, state:state + n2] = final[codes != MATCHED]
     return rows
 
 
