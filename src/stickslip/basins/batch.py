@@ -60,7 +60,7 @@ def _work(model, plan: Plan, times: np.ndarray) -> Work:
     n, nc = model.n, model.n_contacts
     ns = 2 * n + N_EXTRA
     cst = contact_state(model.data.m)
-    room = MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * 4.0 * plan.h_max) + 1
+    room = MIN_TRANSITION_ROOM + int(TRANSITIONS_PER_SECOND * 2.0 * plan.h_max)  # a chunk asks for at most h_max
     crossings = plan.capacity // 2 + 2
     return Work(np.zeros(1, dtype=PROGRESS), np.zeros(ns), cst.copy(), np.zeros(ns), cst.copy(),
                 new_step(np.zeros(ns)), slip_watch(nc), scratch(ns, nc), np.zeros(6, dtype=np.int64),
