@@ -131,18 +131,24 @@ def breakdown(n: int) -> dict:
     c0 = time.process_time()
     rows, _ = batch.classify_batch(ctx, belt, states, [], opts)
     batch_s = time.process_time() - c0
-    # the compiled loop alone: one chunk over 50 time units, no tests (steps cost, its call negligible)
-    stepper = runner.EventStepper(belt, states[1], 0.0, 500.0, rtol=opts.rtol, atol=opts.atol, h_max=ctx.chunk * ctx.dt,
-                                  max_steps=10**9)
+    # the compiled loop alone: 400 time units in one chunk on the cycle, less the cost of a call
+    # (calls that take no step), per step
+    stepper = runner.EventStepper(belt, np.array([-1.0, 1.5]), 0.0, 500.0, rtol=opts.rtol, atol=opts.atol,
+                                  h_max=ctx.chunk * ctx.dt, max_steps=10**9)
     record = runner.Record(belt, np.arange(int(500.0 / ctx.dt) + 2) * ctx.dt)
     c0 = time.process_time()
-    chunk = stepper.advance(50.0, record)
-    step_us = 1e6 * (time.process_time() - c0) / chunk.steps
+    for _ in range(200):
+        stepper.advance(0.0, record)
+    call_s = (time.process_time() - c0) / 200
+    c0 = time.process_time()
+    chunk = stepper.advance(400.0, record)
+    step_us = 1e6 * (time.process_time() - c0 - call_s) / chunk.steps
     per = {k: 1e3 * v / n for k, v in spent.items()}
-    per["of_which_compiled_steps"] = 1e-3 * step_us * steps / n
+    per["loop_calls_of_which_compiled_steps"] = 1e-3 * step_us * steps / n
+    per["loop_calls_of_which_calling"] = 1e3 * call_s * calls["loop_calls"] / n
     out = {"states": n, "python_ms_core_per_state": 1e3 * python_s / n, "batch_ms_core_per_state": 1e3 * batch_s / n,
            "ms_per_state": per, "calls_per_state": {k: v / n for k, v in calls.items()}, "steps_per_state": steps / n,
-           "us_per_step_in_a_long_chunk": step_us, "load": [round(x, 2) for x in os.getloadavg()]}
+           "us_per_step_in_a_long_chunk": step_us, "ms_per_loop_call": 1e3 * call_s, "load": [round(x, 2) for x in os.getloadavg()]}
     print(json.dumps(out, indent=1))
     return out
 
