@@ -34,12 +34,13 @@ __all__ = ["Plan", "Work", "classify_states", "UNDECIDED", "AT_REST", "LINEAR", 
 #: What a state came to (:func:`classify_states`' codes).
 UNDECIDED, AT_REST, LINEAR, MATCHED, PYTHON = 0, 1, 2, 3, -1
 
-#: Consecutive linear chunks that decide the equilibrium, and the span of the period rule in
-#: T_c (:data:`.early.LINEAR_CHUNKS`, :data:`.early.RULE_PERIODS`; passed in :class:`Plan`).
-
 
 class Plan(NamedTuple):
-    """The numbers of a study that every state's run shares (from its context and options)."""
+    """The numbers of a study that every state's run shares (from its context and options,
+    :func:`.batch.classify_batch`): t_end, the sample interval dt [s], the samples of a chunk and
+    of the window, the rows of the record, the tolerances, the largest step (one chunk) [s], the
+    step cap, T_c [s], the match tolerance, whether steady sliding is stable, the observed
+    coordinate, n, and :data:`.early.LINEAR_CHUNKS` and :data:`.early.RULE_PERIODS`."""
 
     t_end: float
     dt: float
