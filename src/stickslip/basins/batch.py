@@ -11,7 +11,6 @@ call shared equally among the states of the call.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import time
 
@@ -20,7 +19,6 @@ import numpy as np
 from ..integrate.bundles import Samples, scratch, transition_log
 from ..integrate.event_loop import N_EXTRA, PROGRESS
 from ..integrate.dormand_prince import new_step
-from ..integrate.loop_split import start_callees
 from ..integrate.result import mode_array
 from ..integrate.runner import MIN_TRANSITION_ROOM, TRANSITIONS_PER_SECOND, EventStepper
 from ..integrate.slip_watch import slip_watch
@@ -89,13 +87,12 @@ def _cycle_arrays(cycles) -> tuple:
 
 def _prepare(model, s0: np.ndarray, opts: Options) -> None:
     """On a model class's first batch in this process: a run's start, which on a cold start
-    compiles the event loop's callees in two processes (:mod:`stickslip.integrate.loop_split`)."""
+    compiles the event loop's callees in two processes (:mod:`stickslip.integrate.loop_split`) and
+    the loop with its Python entry, the version the batch kernel then links and the Python
+    classifier calls."""
     kind = type(model.data.kin)
     if kind in _PREPARED:
         return
-    with start_callees(model.data) or contextlib.nullcontext() as cold:
-        if cold is not None:
-            cold.finish()
     EventStepper(model, s0, 0.0, float(opts.t_end), rtol=opts.rtol, atol=opts.atol, h_max=1.0, max_steps=10)
     _PREPARED.add(kind)
 
