@@ -160,6 +160,8 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--executor", default="processes", choices=["serial", "processes"])
     ap.add_argument("--pairs", type=int, default=1)
+    ap.add_argument("--cache", default=str(Path(tempfile.gettempdir()) / "stickslip-ensembles-cache"),
+                    help="numba caches of the two packages, kept between runs")
     ap.add_argument("--breakdown", type=int, default=0, help="states of the breakdown (module docstring)")
     args = ap.parse_args()
     if args.breakdown:
@@ -176,8 +178,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         baseline_package(rev, tmp)
-        sides = {"baseline": ("stickslip_baseline", tmp, tmp / "cache-baseline"),
-                 "tree": ("stickslip", ROOT / "src", tmp / "cache-tree")}
+        caches = Path(args.cache)  # kept between runs: a cold compile of each package only once
+        sides = {"baseline": ("stickslip_baseline", tmp, caches / f"baseline-{rev[:12]}"),
+                 "tree": ("stickslip", ROOT / "src", caches / "tree")}
         for _ in range(args.pairs):
             for side, (package, path, cache) in sides.items():
                 runs[side].append(run(package, path, cache, args, tmp / f"{side}.npy"))
