@@ -46,7 +46,7 @@ from .context import Context
 from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
 
 __all__ = ["Options", "Outcome", "classify_state", "EarlyStop", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
-           "RULE_PERIODS", "row_width", "DEFAULT_MAX_STEPS"]
+           "RULE_PERIODS", "row_width", "row_column", "DEFAULT_MAX_STEPS"]
 
 #: How the verdict was reached (``matched-at-end``: set when the study is assembled, for a run
 #: unsettled at t_end whose last crossings recur on a cycle found from another state).
@@ -76,6 +76,12 @@ _HEAD = ("verdict", "decided_by", "t_decided", "period", "multiplicity", "amplit
 def row_width(n: int) -> int:
     """Numbers per outcome row of a model with n coordinates."""
     return len(_HEAD) + KMAX + 2 * n + 3 * N_CROSSINGS
+
+
+def row_column(name: str) -> int:
+    """The column of an outcome row that holds ``name`` (``verdict``, ``decided_by``, ``t_decided``,
+    ``steps``, ``wall_time``, …; ``state``: the first of the state's 2n)."""
+    return len(_HEAD) + KMAX if name == "state" else _HEAD.index(name)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.outcome import outcome_code
 from ..errors import BasinError, StickSlipError
 from ..integrate.initial import refused_rigid_starts, rigid_gaps
 from ..integrate.interrupt import interruptible
@@ -31,9 +32,10 @@ from ..journal import finished_output, output_path
 from ..memory import check_memory, format_bytes, largest_count, param_bytes, state_bytes
 from ..model.library import load_model
 from ..parallel import EXECUTORS, check_executor, check_workers, map_unordered
+from .batch import classify_batch, compiled_batch_applies
 from .context import Context, make_context, model_of, register_model
 from .cycles import find_cycle
-from .early import Options, Outcome, classify_state
+from .early import DECIDED, Options, Outcome, classify_state, row_column
 from .result import BasinResult, assemble
 from .spec import BasinSpec, build_spec
 from .states import StateSpec
@@ -60,6 +62,8 @@ def evaluate_batch(task):
     """
     ctx, indices, states, cycles, opts = task
     model = model_of(ctx.key)
+    if compiled_batch_applies(model):  # one compiled call for the states its tests decide
+        return indices, classify_batch(ctx, model, states, cycles, opts)[0]
     cycles = list(cycles)
     rows = []
     for s0 in states:
@@ -271,7 +275,11 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
     registry: list[list] = [[] for _ in range(spec.n_params)]
 
     def learn(idx, rws):
-        for flat, row in zip(idx, rws):
+        # a matched outcome's cycle is one the registry holds: only the others can be new
+        rws = np.asarray(rws).reshape(-1, spec.row_width)
+        new = (rws[:, row_column("verdict")] == outcome_code("periodic")) & \
+            (rws[:, row_column("decided_by")] != DECIDED.index("matched"))
+        for flat, row in zip(np.asarray(idx)[new], rws[new]):
             o = Outcome.from_row(row, n)
             reg = registry[int(flat) // N]
             if o.verdict == "periodic" and find_cycle(reg, o.cycle, spec.options.match_rtol) < 0:
