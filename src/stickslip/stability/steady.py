@@ -30,7 +30,7 @@ from ..model.forces import solve_stick_rows
 from ..model.frame_pointers import is_pointer_class
 from ..model.frames import _frame_bias_central
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
-from ..model.kinematics import model_sizes, sizes_at_run_time
+from ..model.kinematics import model_sizes, sizes_at_run_time, unilateral_kernel
 from ..model.model_data import kinetic_coefficient
 from ..model.normal import contact_indicator, is_rigid, is_unilateral
 from ..model.physics import MODE_SLIP_EXACT, rhs, slip_velocity
@@ -395,12 +395,13 @@ def steady_jacobian(md, free, max_iter, tol, J):
     return STEADY_PRESSED if _pressed(s, cst, md, n, nc) else STEADY_UNPRESSED
 
 
-@inlined_kernel
-def _pressed(s, cst, md, n, nc):
+@unilateral_kernel(lambda s, cst, md, n, nc: True, inline="always")
+def _pressed(s, cst, md, n, nc):  # pragma: no cover - compiled only
     """Whether every unilateral contact is pressed at ``s`` in the modes ``cst`` (all closed): a
     compliant one with g < 0 and λ̃ = −k g − c ġ > 0 (its indicator min(−g, λ̃/k) > 0), as
     :func:`stickslip.stability.equilibrium.solve_steady_modes` asks; False where a rigid one is
-    closed (its normal force, a multiplier, is not computed here)."""
+    closed (its normal force, a multiplier, is not computed here). Kinematics without unilateral
+    contacts compile the constant True instead."""
     for c in range(nc):
         if is_unilateral(md, n, c) and (is_rigid(md, n, c) or not contact_indicator(s, cst, md, n, c) > 0.0):
             return False
