@@ -17,6 +17,7 @@ and reported the same way.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import math
 import os
@@ -38,7 +39,7 @@ from ..errors import StickSlipError
 from ..files import lock, refuse_output
 from ..inputs import read_regular_file
 from ._kept import forget_outputs, on_disk, on_interrupt
-from ._lazy import LazyCommands
+from ._lazy import LazyCommands, runs_kernels
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -171,6 +172,10 @@ class _Application(LazyCommands, TyperGroup):
     """The ``stickslip`` group: the one place where errors become a line and an exit code. Its
     commands are imported when asked for (:class:`._lazy.LazyCommands`)."""
 
+    #: What the running command is inside of (:meth:`invoke`): the compile notice joins it once the
+    #: command is known to run kernels (:meth:`resolve_command`).
+    _scope = None
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         _escape_help(self)
@@ -209,7 +214,7 @@ class _Application(LazyCommands, TyperGroup):
             _check_environment()
             # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
             # `simulate` keeps its one interrupted run instead
-            with warnings.catch_warnings(), on_ctrl_c(partial=False), _compile_notice():
+            with warnings.catch_warnings(), on_ctrl_c(partial=False), contextlib.ExitStack() as self._scope:
                 warnings.showwarning = _show_warning
                 return super().invoke(ctx)
         except StickSlipError as exc:
@@ -228,7 +233,14 @@ class _Application(LazyCommands, TyperGroup):
             raise typer.Exit(130) from None
         finally:
             release_outputs()
+            self._scope = None
         raise typer.Exit(2)
+
+    def resolve_command(self, ctx, args):
+        if args and self._scope is not None and runs_kernels(args[0]):
+            # before the command's module is imported: a kernel compiled from then on is counted
+            self._scope.enter_context(_compile_notice())
+        return super().resolve_command(ctx, args)
 
 
 class _Typer(typer.Typer):
