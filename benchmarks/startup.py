@@ -21,17 +21,18 @@ benchmarks/results/startup.json.
 from __future__ import annotations
 
 import argparse
-import io
 import json
 import os
 import resource
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from first_call import baseline_tree  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -42,20 +43,14 @@ COMMANDS = {"version": ["--version"], "help": ["--help"], "models": ["models"], 
 TIMING_FIELDS = ("wall_time_s", "compile_time_s")
 
 
-def baseline_tree(rev: str) -> tuple[str, Path]:
+def baseline(rev: str) -> tuple[str, Path]:
     """``src/stickslip`` at ``rev`` extracted once per commit under the temporary folder; returns
     the commit and the folder to put on PYTHONPATH."""
     commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", rev], check=True, capture_output=True,
                             text=True).stdout.strip()
     into = Path(tempfile.gettempdir()) / f"stickslip-startup-{commit[:12]}"
     if not (into / "src" / "stickslip" / "__init__.py").is_file():
-        data = subprocess.run(["git", "-C", str(ROOT), "archive", commit, "src/stickslip"], check=True,
-                              capture_output=True).stdout
-        with tarfile.open(fileobj=io.BytesIO(data)) as tar:
-            try:
-                tar.extractall(into, filter="data")
-            except TypeError:  # Python < 3.11.4 has no extraction filters (our own repository's archive)
-                tar.extractall(into)
+        baseline_tree(commit, into)
     return commit, into / "src"
 
 
@@ -87,7 +82,7 @@ def main() -> None:
     ap.add_argument("--only", default=",".join(COMMANDS), help=f"commands to time, of {', '.join(COMMANDS)}")
     args = ap.parse_args()
     names = [n.strip() for n in args.only.split(",") if n.strip()]
-    commit, base = baseline_tree(args.rev)
+    commit, base = baseline(args.rev)
     trees = {"baseline": base, "new": ROOT / "src"}
     for tree in trees.values():
         subprocess.run([sys.executable, "-m", "compileall", "-q", str(tree / "stickslip")], check=True)
