@@ -36,15 +36,8 @@ from typer.core import TyperGroup
 from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
-from ..files import lock, refuse_output
-from ..inputs import read_regular_file
 from ._kept import forget_outputs, on_disk, on_interrupt
 from ._lazy import LazyCommands, runs_kernels
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised only on Python 3.10
-    import tomli as tomllib
 
 console = Console(markup=False, emoji=False, highlight=False)
 err_console = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
@@ -350,6 +343,14 @@ MAX_CONFIG_BYTES = 2**20
 def _config_table(config) -> dict:
     """The TOML of a ``--config`` file, read bounded (a regular file of at most
     :data:`MAX_CONFIG_BYTES`: a folder, a pipe or a device is refused before it is read)."""
+    # here, not at start-up: `--version`, `--help` and `models` need no files read or written
+    from ..inputs import read_regular_file  # noqa: PLC0415
+
+    if sys.version_info >= (3, 11):
+        import tomllib  # noqa: PLC0415
+    else:  # pragma: no cover - exercised only on Python 3.10
+        import tomli as tomllib  # noqa: PLC0415
+
     data = read_regular_file(config, MAX_CONFIG_BYTES, "--config", CLIError,
                              "give a TOML file with a [parameters] table")
     try:
@@ -499,6 +500,8 @@ _held_outputs: list = []
 def hold_output(out: Path) -> None:
     """Take the lock of output ``out`` for the rest of the command: a second writer of it is
     refused now, before anything is computed, not after (:class:`stickslip.files.OutputLock`)."""
+    from ..files import lock  # noqa: PLC0415 - see _config_table
+
     _held_outputs.append(lock(out))
 
 
@@ -537,6 +540,8 @@ def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: di
     what : str, optional
         How the messages name the file (default ``"{flag} {path}"``).
     """
+    from ..files import refuse_output  # noqa: PLC0415 - see _config_table
+
     refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag, what=what)
     _check_folder(path, flag)
 
@@ -574,6 +579,8 @@ def check_resumable_output(out: Path, figure: bool, overwrite: bool, inputs: dic
         Whether the figure may replace an existing file: with ``overwrite``, or when the run
         resumes (its figure is the command's own).
     """
+    from ..files import refuse_output  # noqa: PLC0415 - see _config_table
+
     check_nc_path(out)
     refuse_output(out, overwrite=True, inputs=inputs)
     _check_folder(out, "--out")
