@@ -33,7 +33,7 @@ warning line).
 **Public names on first use.** A package's ``__init__`` that imported every module it re-exports
 would make the import of any one of its modules import them all (Python runs a package's
 ``__init__`` before any module in it): the command line's ``models`` would load numba, and
-``simulate`` the layers of orbits and stability constants it never uses. :func:`export_on_first_use`
+every command every module of each layer it touches. :func:`export_on_first_use`
 makes a package's public names (PEP 562) imported from the module that defines them when first
 asked for, as ``from stickslip.integrate import simulate`` or ``stickslip.integrate.simulate``
 asks, and keeps a public function named like a module of its package (``stickslip.analysis.classify``)
