@@ -38,10 +38,6 @@ Every public name is imported on first use (PEP 562): ``import stickslip`` loads
 nor numba, so that the command line's ``--version`` and ``--help`` answer at once.
 """
 
-import importlib
-import sys
-import types
-
 from . import _startup  # first: Ctrl-C held during the import; NUMBA_NUM_THREADS made valid before numba loads
 
 _startup.hold()
@@ -69,20 +65,9 @@ _LAZY = {
 }
 
 
-#: Public functions named like the subpackage that defines them (``stickslip.stability``,
-#: ``stickslip.sweep``): the package attribute stays the function even after the subpackage is
-#: imported (the import system would otherwise bind the subpackage over it).
-_FUNCTIONS_OVER_PACKAGES = frozenset({"stability", "sweep"})
-
-
-class _Package(types.ModuleType):
-    def __setattr__(self, name, value):
-        if name in _FUNCTIONS_OVER_PACKAGES and isinstance(value, types.ModuleType):
-            return  # a subpackage being bound: its function is found by __getattr__ instead
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package  # before the imports below, which import stickslip.stability
+# public functions named like a subpackage (``stickslip.stability``, ``stickslip.sweep``) stay the
+# functions when the subpackage is imported; before the imports below
+_startup.export_on_first_use(__name__, _LAZY)
 
 from ._version import __version__  # noqa: E402
 from .errors import FileFormatError, ParameterError, SimulationError, StickSlipError, VariantError  # noqa: E402
@@ -100,18 +85,6 @@ def _draw(result, **kwargs):
 Plottable.draw = staticmethod(_draw)
 
 _startup.release()  # a Ctrl-C held during the import is raised here
-
-
-def __getattr__(name):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(__all__)
 
 
 __all__ = [

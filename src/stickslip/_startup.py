@@ -29,18 +29,29 @@ where it acts as the Ctrl-C the user pressed; other unraisable exceptions go to 
 setting has no effect on it: a value that is not a number ≥ 1 is removed from this process's
 environment before numba is imported, and :data:`notes` says so (the command line prints it as a
 warning line).
+
+**Public names on first use.** A package's ``__init__`` that imported every module it re-exports
+would make the import of any one of its modules import them all (Python runs a package's
+``__init__`` before any module in it): the command line's ``models`` would load numba, and
+every command every module of each layer it touches. :func:`export_on_first_use`
+makes a package's public names (PEP 562) imported from the module that defines them when first
+asked for, as ``from stickslip.integrate import simulate`` or ``stickslip.integrate.simulate``
+asks, and keeps a public function named like a module of its package (``stickslip.analysis.classify``)
+the function, as the eager import did.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import signal
 import sys
 import threading
 import time
+import types
 import _thread
 
-__all__ = ["hold", "release", "notes", "INTERRUPTED_LINE"]
+__all__ = ["hold", "release", "notes", "INTERRUPTED_LINE", "export_on_first_use"]
 
 #: What a Ctrl-C during the import leaves: nothing was computed or written yet.
 INTERRUPTED_LINE = "interrupted: nothing was written"
@@ -133,6 +144,45 @@ def _redeliver_interrupts() -> None:
     if getattr(previous, "__name__", "") != "redeliver_interrupts":
         hook.__name__ = "redeliver_interrupts"
         sys.unraisablehook = hook
+
+
+class _Package(types.ModuleType):
+    """A package whose public names are imported on first use (:func:`export_on_first_use`)."""
+
+    def __setattr__(self, name, value):
+        if isinstance(value, types.ModuleType) and name in self.__dict__.get("_EXPORTS", ()):
+            return  # a module being bound over the public name it defines: the name is found by __getattr__
+        super().__setattr__(name, value)
+
+
+def export_on_first_use(package: str, exports: dict[str, str]) -> None:
+    """Make the public names of ``package`` imported when first asked for (PEP 562).
+
+    Parameters
+    ----------
+    package : str
+        The package's ``__name__`` (its ``__init__`` calls this).
+    exports : dict
+        Public name → the module that defines it, relative to the package (``".driver"``). Every
+        name is a function, class or constant, never a module: a module of the package that has a
+        public name's name is not bound over it when it is imported.
+    """
+    module = sys.modules[package]
+    module._EXPORTS = exports
+
+    def __getattr__(name):
+        if name in exports:
+            value = getattr(importlib.import_module(exports[name], package), name)
+            module.__dict__[name] = value
+            return value
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    def __dir__():
+        return sorted(set(module.__dict__.get("__all__", ())) | set(exports))
+
+    module.__getattr__ = __getattr__
+    module.__dir__ = __dir__
+    module.__class__ = _Package
 
 
 _check_numba_threads()

@@ -25,7 +25,6 @@ worker inside a compiled kernel holds for the whole kernel).
 
 from __future__ import annotations
 
-import asyncio
 import multiprocessing
 import os
 import signal
@@ -279,6 +278,8 @@ def _processes(fn, tasks, workers, stop, warm, info) -> Iterator:
 
 
 def _dask(fn, tasks, workers, address, stop, warm, info) -> Iterator:
+    import asyncio  # its TimeoutError (not the builtin one before Python 3.11); imported with dask, not at start-up
+
     from distributed import Client, wait  # dask is imported only by campaigns that use it
 
     start = time.perf_counter()

@@ -7,6 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from stickslip import load_trajectory
+from stickslip.model import load_model
 from stickslip.cli import app
 
 runner = CliRunner()
@@ -117,6 +118,11 @@ def test_bad_model_file_is_one_line_naming_the_key(edit, words, tmp_path):
     path.write_text(BELT_TOML.replace(*edit))
     line = one_error_line(invoke("simulate", "--model", str(path), "--t-end", "5", "--json"))
     assert words in line and str(path) in line
+
+
+def test_the_list_gives_each_model_the_description_of_the_model_built():
+    listed = json.loads(invoke("models", "--json").stdout)
+    assert {name: load_model(name).description for name in listed} == listed
 
 
 def test_models_lists_the_library_and_shows_a_model():

@@ -34,6 +34,25 @@ def test_the_digest_covers_the_modules_that_define_or_specialise_kernels():
         assert (kernel_cache._PACKAGE / module).is_file()
 
 
+def test_a_cache_folder_is_checked_once_per_process_and_a_folder_outside_the_package_never(monkeypatch, tmp_path):
+    """numba checks that a kernel's cache folder is writable by writing a file there; the package's
+    some 200 kernels share a few folders, checked once each."""
+    from stickslip.model import physics
+
+    written = []
+    real = tempfile.TemporaryFile
+    monkeypatch.setattr(tempfile, "TemporaryFile", lambda *a, **kw: written.append(kw.get("dir")) or real(*a, **kw))
+    monkeypatch.setattr(kernel_cache, "_WRITABLE", set())
+    in_tree = CacheImpl._locator_classes[1]
+    for _ in range(3):
+        locator = in_tree.from_function(physics.rhs.py_func, physics.__file__)
+        assert locator.get_cache_path() == str(Path(physics.__file__).parent / "__pycache__")
+    assert written == [locator.get_cache_path()]
+    outside = tmp_path / "user.py"
+    outside.write_text("def f():\n    return 1\n")
+    assert in_tree.from_function(physics.rhs.py_func, str(outside)) is None  # numba's own locators take it
+
+
 def test_a_cache_file_that_cannot_be_written_is_one_warning_not_an_error(monkeypatch, tmp_path):
     """A full disk or a file-size limit while numba saves a kernel (seen under ulimit -f with an
     empty cache): the kernel runs uncached; the run warns once."""

@@ -8,11 +8,18 @@
 =========================  ==================================================================
 """
 
-from .confirm import confirm_period, lyapunov_sign, span_change
-from .settle import DEFAULT_CAP_S, DEFAULT_STEP_S, DEFAULT_T_MIN_S, DEFAULT_WINDOW_S, SettledRun, simulate_until_settled
-from .summary import run_summary
-from .verdict import Attractor, attractor, jsonable, stopped_outcome, undersampled
+from .. import _startup
+
+#: Public name → the module that defines it, imported on first use (:func:`stickslip._startup.export_on_first_use`).
+_EXPORTS = {
+    **dict.fromkeys(["confirm_period", "lyapunov_sign", "span_change"], ".confirm"),
+    **dict.fromkeys(["DEFAULT_CAP_S", "DEFAULT_STEP_S", "DEFAULT_T_MIN_S", "DEFAULT_WINDOW_S", "SettledRun", "simulate_until_settled"], ".settle"),
+    **dict.fromkeys(["run_summary"], ".summary"),
+    **dict.fromkeys(["Attractor", "attractor", "jsonable", "stopped_outcome", "undersampled"], ".verdict"),
+}
 
 __all__ = ["Attractor", "attractor", "stopped_outcome", "jsonable", "undersampled", "SettledRun",
            "simulate_until_settled", "run_summary", "confirm_period", "lyapunov_sign", "span_change",
            "DEFAULT_CAP_S", "DEFAULT_STEP_S", "DEFAULT_T_MIN_S", "DEFAULT_WINDOW_S"]
+
+_startup.export_on_first_use(__name__, _EXPORTS)

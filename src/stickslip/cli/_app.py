@@ -17,6 +17,7 @@ and reported the same way.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import math
 import os
@@ -35,15 +36,8 @@ from typer.core import TyperGroup
 from .. import _startup
 from .._version import __version__
 from ..errors import StickSlipError
-from ..files import lock, refuse_output
-from ..inputs import read_regular_file
 from ._kept import forget_outputs, on_disk, on_interrupt
-from ._lazy import LazyCommands
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised only on Python 3.10
-    import tomli as tomllib
+from ._lazy import LazyCommands, runs_kernels
 
 console = Console(markup=False, emoji=False, highlight=False)
 err_console = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
@@ -171,6 +165,10 @@ class _Application(LazyCommands, TyperGroup):
     """The ``stickslip`` group: the one place where errors become a line and an exit code. Its
     commands are imported when asked for (:class:`._lazy.LazyCommands`)."""
 
+    #: What the running command is inside of (:meth:`invoke`): the compile notice joins it once the
+    #: command is known to run kernels (:meth:`resolve_command`).
+    _scope = None
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         _escape_help(self)
@@ -209,7 +207,7 @@ class _Application(LazyCommands, TyperGroup):
             _check_environment()
             # a run is one of many (sweep points, shooting, continuation): Ctrl-C stops the command;
             # `simulate` keeps its one interrupted run instead
-            with warnings.catch_warnings(), on_ctrl_c(partial=False), _compile_notice():
+            with warnings.catch_warnings(), on_ctrl_c(partial=False), contextlib.ExitStack() as self._scope:
                 warnings.showwarning = _show_warning
                 return super().invoke(ctx)
         except StickSlipError as exc:
@@ -228,7 +226,14 @@ class _Application(LazyCommands, TyperGroup):
             raise typer.Exit(130) from None
         finally:
             release_outputs()
+            self._scope = None
         raise typer.Exit(2)
+
+    def resolve_command(self, ctx, args):
+        if args and self._scope is not None and runs_kernels(args[0]):
+            # before the command's module is imported: a kernel compiled from then on is counted
+            self._scope.enter_context(_compile_notice())
+        return super().resolve_command(ctx, args)
 
 
 class _Typer(typer.Typer):
@@ -338,6 +343,14 @@ MAX_CONFIG_BYTES = 2**20
 def _config_table(config) -> dict:
     """The TOML of a ``--config`` file, read bounded (a regular file of at most
     :data:`MAX_CONFIG_BYTES`: a folder, a pipe or a device is refused before it is read)."""
+    # here, not at start-up: `--version`, `--help` and `models` need no files read or written
+    from ..inputs import read_regular_file  # noqa: PLC0415
+
+    if sys.version_info >= (3, 11):
+        import tomllib  # noqa: PLC0415
+    else:  # pragma: no cover - exercised only on Python 3.10
+        import tomli as tomllib  # noqa: PLC0415
+
     data = read_regular_file(config, MAX_CONFIG_BYTES, "--config", CLIError,
                              "give a TOML file with a [parameters] table")
     try:
@@ -487,6 +500,8 @@ _held_outputs: list = []
 def hold_output(out: Path) -> None:
     """Take the lock of output ``out`` for the rest of the command: a second writer of it is
     refused now, before anything is computed, not after (:class:`stickslip.files.OutputLock`)."""
+    from ..files import lock  # noqa: PLC0415 - see _config_table
+
     _held_outputs.append(lock(out))
 
 
@@ -525,6 +540,8 @@ def check_output(path: Path, overwrite: bool, *, flag: str = "--out", inputs: di
     what : str, optional
         How the messages name the file (default ``"{flag} {path}"``).
     """
+    from ..files import refuse_output  # noqa: PLC0415 - see _config_table
+
     refuse_output(path, overwrite=overwrite, inputs=inputs, flag=flag, what=what)
     _check_folder(path, flag)
 
@@ -562,6 +579,8 @@ def check_resumable_output(out: Path, figure: bool, overwrite: bool, inputs: dic
         Whether the figure may replace an existing file: with ``overwrite``, or when the run
         resumes (its figure is the command's own).
     """
+    from ..files import refuse_output  # noqa: PLC0415 - see _config_table
+
     check_nc_path(out)
     refuse_output(out, overwrite=True, inputs=inputs)
     _check_folder(out, "--out")

@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from collections.abc import Mapping
-
-import numpy as np
 
 __all__ = ["print_json", "strict_json", "to_strict"]
 
@@ -29,13 +28,16 @@ def _value(value):
     Python numbers and lists, non-finite floats as None."""
     if isinstance(value, Mapping):
         return to_strict(value), None
-    if isinstance(value, np.ndarray):
+    # numpy values exist only where numpy is imported: a command that needs none (the list of
+    # models) does not import it for this
+    np = sys.modules.get("numpy")
+    if np is not None and isinstance(value, np.ndarray):
         value = value.tolist()
     if isinstance(value, (list, tuple)):
         items = [_value(v) for v in value]
         reasons = sorted({r for _, r in items if r is not None})
         return [v for v, _ in items], (f"null entries: {'; '.join(reasons)}" if reasons else None)
-    if isinstance(value, np.generic):
+    if np is not None and isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, float) and not math.isfinite(value):
         return None, _undefined_reason(value)

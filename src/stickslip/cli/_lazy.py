@@ -17,14 +17,17 @@ from typing import NamedTuple
 from rich.markup import escape
 from typer.core import TyperCommand
 
-__all__ = ["COMMANDS", "LazyCommands"]
+__all__ = ["COMMANDS", "LazyCommands", "runs_kernels"]
 
 
 class Entry(NamedTuple):
-    """One command: the module (in :mod:`stickslip.cli`) that registers it, and its help line."""
+    """One command: the module (in :mod:`stickslip.cli`) that registers it, its help line, and
+    whether it runs compiled kernels (numba's compile notice is set up for those alone: numba
+    takes 0.3 s to import)."""
 
     module: str
     line: str
+    kernels: bool = True
 
 
 #: Every command in the order ``stickslip --help`` lists them.
@@ -51,7 +54,7 @@ COMMANDS: dict[str, Entry] = {
     "basins": Entry("basins", "Basin stability: which attractor each initial state reaches (exact stick), and how "
                               "often."),
     "models": Entry("models", "The model library, or one model's states, contacts and the parameter paths --set "
-                              "reaches."),
+                              "reaches.", kernels=False),
     "warmup": Entry("warmup", "Compile the kernels ahead (cluster nodes, container images, CI caches): later "
                               "commands on this machine load them from numba's cache and start at once."),
     "reduce": Entry("reduce", "Reduce a sparse (finite-element) model to its contact and loaded DOFs and a few "
@@ -63,6 +66,12 @@ COMMANDS: dict[str, Entry] = {
                                             "by root finding."),
     "study": Entry("study", "Reproducible studies of the paper (tables, JSON and figures)."),
 }
+
+
+def runs_kernels(name: str) -> bool:
+    """Whether the command ``name`` may run compiled kernels (an unknown name: it may)."""
+    entry = COMMANDS.get(name)
+    return entry is None or entry.kernels
 
 
 def import_all() -> None:

@@ -24,7 +24,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
-from ..model.library import library_names
+from ..model.catalog import library_names
 from ._app import executor_of
 
 # ----------------------------------------------------------------------------- the model

@@ -1,5 +1,8 @@
 """``stickslip models``: the model library, and what one model offers (states, contacts, ``--set`` paths).
 
+The list is read from the library's table of contents (:mod:`stickslip.model.catalog`) without
+building a model: it answers without importing numpy or numba. One model is built to be described.
+
 A model of finite-element size has 10⁴–10⁶ dofs, hundreds of contacts and a parameter per contact
 node: the text lists are then given by their counts with a short head and tail, runs of alike
 contacts are one line each, and parameters that differ only in their numbers (``contact_set.pad.
@@ -15,7 +18,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..model.library import library, load_model, plates_variant, two_plates
+from ..model.catalog import library
 from ._app import app, console
 from ._json import print_json
 
@@ -107,6 +110,9 @@ def models(
         console.print(table)
         console.print("details and parameter paths: stickslip models NAME; model files: docs/models.md", style="dim")
         return
+    # the list above needs no model built; one model needs the model layer, numpy and numba (0.5 s)
+    from ..model.library import load_model, plates_variant, two_plates  # noqa: PLC0415
+
     variant = plates_variant(model)
     system = two_plates(None, variant) if variant is not None else load_model(model)
     dense = getattr(system, "dense", True)

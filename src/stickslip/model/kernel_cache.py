@@ -39,6 +39,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import io
+import os
 import pickle
 import re
 import sys
@@ -68,13 +69,24 @@ def compiled_layer_digest() -> str:
     """SHA-256 of every module of the package that defines or specialises compiled code, and of
     the modules that shape what a cache entry holds (module docstring)."""
     digest = hashlib.sha256()
-    for path in sorted(_PACKAGE.rglob("*.py")):
-        text = path.read_bytes()
-        relative = path.relative_to(_PACKAGE).as_posix()
+    for relative in _package_modules():
+        text = (_PACKAGE / relative).read_bytes()
         if relative in _MACHINERY or _COMPILED.search(text):
             digest.update(relative.encode())
             digest.update(hashlib.sha256(text).digest())
     return digest.hexdigest()
+
+
+def _package_modules() -> list[str]:
+    """The package's modules as sorted paths relative to it, ``/``-separated. The ``__pycache__``
+    folders are not entered: numba's cache files there number in the thousands, and listing
+    them took most of the digest's time."""
+    found = []
+    for folder, dirs, files in os.walk(_PACKAGE):
+        dirs[:] = [d for d in dirs if d != "__pycache__"]
+        base = Path(folder).relative_to(_PACKAGE)
+        found += [(base / name).as_posix() for name in files if name.endswith(".py")]
+    return sorted(found)
 
 
 def caching() -> bool:
@@ -253,19 +265,40 @@ def _tolerant_saving(save):
 
 # ----------------------------------------------------------------------------- stamps and keys
 
+@functools.lru_cache(maxsize=None)
+def _in_package(path: str) -> bool:
+    """Whether the file ``path`` lies in the package (asked once per kernel and locator as the
+    modules are imported: resolving a path takes a system call per folder of it)."""
+    try:
+        return Path(path).resolve().is_relative_to(_PACKAGE)
+    except (OSError, ValueError):
+        return False
+
+
+#: The cache folders found writable in this process.
+_WRITABLE: set = set()
+
+
 def _package_locator(base):
     """numba's cache locator ``base`` for the package's files only, stamped with :func:`compiled_layer_digest`."""
     class PackageLocator(base):
         def get_source_stamp(self):
             return super().get_source_stamp(), compiled_layer_digest()
 
+        def ensure_cache_path(self):
+            """numba's check that the cache folder exists and is writable (it writes and removes a
+            temporary file there), once per folder and process rather than once per kernel (some
+            200 as the package is imported). A folder that stops being writable later makes the
+            saves into it fail, which leave their kernels uncached with a warning
+            (:func:`_tolerant_saving`)."""
+            path = self.get_cache_path()
+            if path not in _WRITABLE:
+                super().ensure_cache_path()
+                _WRITABLE.add(path)
+
         @classmethod
         def from_function(cls, py_func, py_file):
-            try:
-                inside = Path(py_file).resolve().is_relative_to(_PACKAGE)
-            except (OSError, ValueError):
-                inside = False
-            return super().from_function(py_func, py_file) if inside else None
+            return super().from_function(py_func, py_file) if _in_package(py_file) else None
 
     PackageLocator.__name__ = f"Stickslip{base.__name__}"
     return PackageLocator
@@ -323,10 +356,7 @@ def _module_file(py_func) -> str | None:
 def defined_in_package(obj) -> bool:
     """Whether ``obj`` (a function, a numba dispatcher or a class) is defined in a module of this package."""
     path = _module_file(getattr(obj, "py_func", obj))
-    try:
-        return path is not None and Path(path).resolve().is_relative_to(_PACKAGE)
-    except (OSError, ValueError):
-        return False
+    return path is not None and _in_package(path)
 
 
 def _user_code_in(types) -> list:
@@ -406,6 +436,8 @@ def _check() -> str | None:
         None if _locators() is not None else "numba.core.caching has no InTreeCacheLocator",
         lambda: has(numba_caching.CacheImpl, "_locator_classes"),
         lambda: has(_locators()[0], "get_source_stamp", ("self",)),
+        lambda: has(_locators()[0], "ensure_cache_path", ("self",)),
+        lambda: has(_locators()[0], "get_cache_path", ("self",)),
         lambda: has(_locators()[0], "from_function", ("py_func", "py_file")),
         lambda: has(numba_caching.Cache, "_index_key", ("self", "sig", "codegen")),
         lambda: has(numba_caching.Cache, "save_overload", ("self", "sig", "data")),

@@ -12,13 +12,20 @@
 ==========================  ==============================================================
 """
 
+from .. import _startup
 from ..errors import OrbitError
-from .linear_flow import FlowJacobian, flow_jacobian
-from .lyapunov import LyapunovResult, LyapunovSpectrum, lyapunov_exponent, lyapunov_spectrum
-from .problem import Monodromy, monodromy
-from .section import Section, resolve_section
-from .shooting import PeriodicOrbit, periodic_orbit
+
+#: Public name → the module that defines it, imported on first use (:func:`stickslip._startup.export_on_first_use`).
+_EXPORTS = {
+    **dict.fromkeys(["FlowJacobian", "flow_jacobian"], ".linear_flow"),
+    **dict.fromkeys(["LyapunovResult", "LyapunovSpectrum", "lyapunov_exponent", "lyapunov_spectrum"], ".lyapunov"),
+    **dict.fromkeys(["Monodromy", "monodromy"], ".problem"),
+    **dict.fromkeys(["Section", "resolve_section"], ".section"),
+    **dict.fromkeys(["PeriodicOrbit", "periodic_orbit"], ".shooting"),
+}
 
 __all__ = ["periodic_orbit", "PeriodicOrbit", "Section", "resolve_section", "lyapunov_exponent",
            "LyapunovResult", "lyapunov_spectrum", "LyapunovSpectrum", "monodromy", "Monodromy",
            "flow_jacobian", "FlowJacobian", "OrbitError"]
+
+_startup.export_on_first_use(__name__, _EXPORTS)

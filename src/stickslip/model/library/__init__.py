@@ -12,7 +12,8 @@
 ========================  ==========================================================================
 
 Library models stated as model files live beside this module as TOML; ``stickslip models``
-lists them. :func:`load_model` accepts a library name or the path of a model file.
+lists them (:mod:`stickslip.model.catalog`: names and descriptions, read without building a
+model). :func:`load_model` accepts a library name or the path of a model file.
 """
 
 from __future__ import annotations
@@ -20,31 +21,18 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...errors import ModelError
+from ..catalog import LIBRARY_FOLDER, TWO_PLATES, library, library_names
 from ..model_file import load_model_file, model_from_spec
 from ..parameters import Parameters
 from ..system_model import DEFAULT_SLIP_BAND, FrictionModel
 from ..variants import MODELS
-from .two_plates import NAME as TWO_PLATES
 from .two_plates import two_plates
 
 __all__ = ["load_model", "library", "library_names", "two_plates", "TWO_PLATES", "describe_system", "system_from_description",
            "resolve_model", "plates_variant"]
 
-HERE = Path(__file__).resolve().parent
-
-
-def library_names() -> list[str]:
-    """Library model names, the default first (without reading the files)."""
-    return [TWO_PLATES] + [path.stem.replace("_", "-") for path in sorted(HERE.glob("*.toml"))]
-
-
-def library() -> dict[str, str]:
-    """Library model names → one-line descriptions, the default first."""
-    out = {TWO_PLATES: two_plates().description}
-    for path in sorted(HERE.glob("*.toml")):
-        out[path.stem.replace("_", "-")] = load_model_file(path).description
-    return out
-
+#: This package's folder, where its model files live.
+HERE = LIBRARY_FOLDER
 
 def load_model(name: str | Path | FrictionModel = TWO_PLATES) -> FrictionModel:
     """A library model by name (``two-plates``, ``belt``, ...), a variant of the plates by name, or

@@ -14,6 +14,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..catalog import TWO_PLATES as NAME
+from ..catalog import TWO_PLATES_DESCRIPTION
 from ..friction import FrictionLaw
 from ..parameters import PARAMETER_UNITS, Parameters
 from ..system_model import DEFAULT_SLIP_BAND, Contact, FrictionModel, NamedState
@@ -21,8 +23,6 @@ from ..variants import DOF_NAMES, resolve_variant
 from .plate_kinematics import PlateKinematics
 
 __all__ = ["two_plates", "NAME", "is_plates", "plates_parameters"]
-
-NAME = "two-plates"
 
 _UNITS = {"x1": "m", "y1": "m", "x2": "m", "y2": "m", "phi": "rad", "psi": "rad", **PARAMETER_UNITS}
 
@@ -71,7 +71,7 @@ def two_plates(params: Parameters | None = None, variant="full", slip_band: floa
         force=np.zeros(6), contacts=(contact,), kinematics=PlateKinematics(P.r, P.Omega), free=v.mask,
         parameters={**P.to_dict(), "variant": v.name}, builder=builder, source=f"library:{NAME}",
         units=_UNITS, slip_band=slip_band, observed="phi", starts=starts, label=v.name, headline=("N", "Omega"),
-        steady_hint=_steady_hint, description="two rigid plates in point contact, 2-D friction (Liu & Ouyang; the paper)",
+        steady_hint=_steady_hint, description=TWO_PLATES_DESCRIPTION,
     )
 
 
