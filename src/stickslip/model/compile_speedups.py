@@ -286,9 +286,8 @@ def _apply_call_type_once() -> None:
 
 
 def _components(cfg, order) -> list[list]:
-    """The strongly connected components of the blocks ``order`` (every block reachable from the
-    entry) under ``cfg.successors``, in reverse topological order (Tarjan's algorithm, without
-    recursion)."""
+    """The strongly connected components of the blocks ``order`` and those they lead to under
+    ``cfg.successors``, in reverse topological order (Tarjan's algorithm, without recursion)."""
     index, low, on_stack, stack, components = {}, {}, set(), [], []
     for root in order:
         if root in index:
@@ -325,11 +324,11 @@ def _components(cfg, order) -> list[list]:
     return components
 
 
-def _reaching(cfg, var_use_map, var_def_map) -> defaultdict:
-    """For each block reachable from the entry: the variables defined or used in a block from
-    which it is reached, itself included (numba's ``def_reach`` fix point); one set per strongly
-    connected component, shared by its blocks (module docstring)."""
-    components = _components(cfg, cfg.topo_order())
+def _reaching(cfg, blocks, var_use_map, var_def_map) -> defaultdict:
+    """For each of ``blocks`` (and the blocks they lead to): the variables defined or used in a
+    block of them from which it is reached, itself included (numba's ``def_reach`` fix point); one
+    set per strongly connected component, shared by its blocks (module docstring)."""
+    components = _components(cfg, blocks)
     member_of = {block: k for k, component in enumerate(components) for block in component}
     reach = defaultdict(set)
     for k in range(len(components) - 1, -1, -1):  # predecessors' components first
@@ -348,12 +347,14 @@ def _reaching(cfg, var_use_map, var_def_map) -> defaultdict:
 def _live_map(cfg, blocks, var_use_map, var_def_map):
     """numba's ``analysis.compute_live_map`` (the variables live at the entry of each block), with
     the reaching definitions from :func:`_reaching`; the liveness fix point is numba's."""
-    order = cfg.topo_order()
-    def_reach_map = _reaching(cfg, var_use_map, var_def_map)
+    # the blocks numba's fix points visit: every block (older numba), or those reachable from the entry
+    order = list(var_def_map) if _EVERY_BLOCK else cfg.topo_order()
+    def_reach_map = _reaching(cfg, order, var_use_map, var_def_map)
     live_map = {offset: set(var_use_map[offset]) for offset in blocks.keys()}
+    backward = list(live_map) if _EVERY_BLOCK else list(reversed(order))
     old_point, new_point = None, tuple(len(v) for v in live_map.values())
     while old_point != new_point:
-        for offset in reversed(order):
+        for offset in backward:
             live_vars = live_map[offset]
             for inc_blk, _data in cfg.predecessors(offset):
                 live_map[inc_blk] |= (live_vars & def_reach_map[inc_blk]) - var_def_map[inc_blk]
@@ -361,10 +362,30 @@ def _live_map(cfg, blocks, var_use_map, var_def_map):
     return live_map
 
 
+#: Whether numba's ``compute_live_map`` visits every block rather than those reachable from the
+#: entry (its topological order), as older numba does: :func:`_live_map` visits the same.
+_EVERY_BLOCK = False
+
+
+def _visits_every_block(compute_live_map) -> bool | None:
+    """True where numba's ``compute_live_map`` visits every block (``for offset in var_def_map``,
+    ``for offset in dct``), False where it visits the topological order, None otherwise."""
+    import inspect
+
+    text = inspect.getsource(compute_live_map)
+    if "for offset in var_def_map:" in text and "for offset in dct:" in text:
+        return True
+    if "for offset in topo_order:" in text and "for offset in reversed(topo_order):" in text:
+        return False
+    return None
+
+
 def _check_live_map() -> str | None:
     from numba.core import analysis, controlflow, ir_utils
 
     return first_problem(
+        lambda: None if _visits_every_block(analysis.compute_live_map) is not None
+        else "analysis.compute_live_map visits neither every block nor the topological order",
         has(analysis, "compute_live_map", ("cfg", "blocks", "var_use_map", "var_def_map")),
         lambda: source_has(analysis.compute_live_map, "def def_reach(dct):", "def liveness(dct):",
                            "dct[out_blk] |= dct[offset]", "reachable = live_vars & def_reach_map[inc_blk]",
@@ -380,10 +401,11 @@ numba_live_map = None
 
 
 def _apply_live_map() -> None:
-    global numba_live_map
+    global numba_live_map, _EVERY_BLOCK
     from numba.core import analysis, ir_utils
 
     numba_live_map = analysis.compute_live_map
+    _EVERY_BLOCK = _visits_every_block(numba_live_map)
     analysis.compute_live_map = _live_map
     ir_utils.compute_live_map = _live_map
 
