@@ -372,7 +372,10 @@ def _visits_every_block(compute_live_map) -> bool | None:
     ``for offset in dct``), False where it visits the topological order, None otherwise."""
     import inspect
 
-    text = inspect.getsource(compute_live_map)
+    try:
+        text = inspect.getsource(compute_live_map)
+    except (OSError, TypeError):
+        return None
     if "for offset in var_def_map:" in text and "for offset in dct:" in text:
         return True
     if "for offset in topo_order:" in text and "for offset in reversed(topo_order):" in text:
@@ -384,13 +387,13 @@ def _check_live_map() -> str | None:
     from numba.core import analysis, controlflow, ir_utils
 
     return first_problem(
-        lambda: None if _visits_every_block(analysis.compute_live_map) is not None
-        else "analysis.compute_live_map visits neither every block nor the topological order",
         has(analysis, "compute_live_map", ("cfg", "blocks", "var_use_map", "var_def_map")),
         lambda: source_has(analysis.compute_live_map, "def def_reach(dct):", "def liveness(dct):",
                            "dct[out_blk] |= dct[offset]", "reachable = live_vars & def_reach_map[inc_blk]",
                            "dct[inc_blk] |= reachable - var_def_map[inc_blk]"),
-        None if getattr(ir_utils, "compute_live_map", None) is analysis.compute_live_map
+        lambda: None if _visits_every_block(analysis.compute_live_map) is not None
+        else "analysis.compute_live_map visits neither every block nor the topological order",
+        lambda: None if getattr(ir_utils, "compute_live_map", None) is analysis.compute_live_map
         else "numba.core.ir_utils.compute_live_map is not analysis.compute_live_map",
         has(controlflow.CFGraph, "topo_order"), has(controlflow.CFGraph, "successors"),
         has(controlflow.CFGraph, "predecessors"))
