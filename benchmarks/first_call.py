@@ -15,7 +15,7 @@ other alternately, so that both columns see the same machine: the before/after t
 ``--breakdown`` it also compiles the default ``simulate`` in this process with numba's compile
 events recorded, and prints the outermost kernels by compile time (what a cold start is made of).
 
-    python benchmarks/first_call.py [--rev REV] [--only simulate,basins] [--breakdown] [--top 15]
+    python benchmarks/first_call.py [--rev REV ...] [--repeat 3] [--only simulate,basins] [--breakdown] [--top 15]
 Writes benchmarks/results/first_call.json.
 """
 
@@ -26,6 +26,8 @@ import collections
 import io
 import json
 import os
+import resource
+import statistics
 import subprocess
 import sys
 import tarfile
@@ -96,10 +98,19 @@ def _env(cache: Path, tree: Path | None, extra: Path | None = None) -> dict:
     return env
 
 
+def _children_cpu() -> float:
+    """CPU seconds (user + system) of this process's waited-for children so far."""
+    use = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return use.ru_utime + use.ru_stime
+
+
 def _timed(command, env, cwd) -> dict:
+    """Wall and CPU seconds of ``command``; the CPU time includes its own waited-for children (a
+    cold start's helper process), the fair measure on a machine that others load."""
+    cpu = _children_cpu()
     start = time.perf_counter()
     res = subprocess.run(command, env=env, capture_output=True, text=True, cwd=cwd)
-    return {"seconds": time.perf_counter() - start, "exit": res.returncode,
+    return {"seconds": time.perf_counter() - start, "cpu_s": _children_cpu() - cpu, "exit": res.returncode,
             "stderr_tail": res.stderr.strip().splitlines()[-1:] if res.returncode else []}
 
 
@@ -122,8 +133,9 @@ def _run(args, cache: Path, tmp: Path, tree: Path | None = None) -> dict:
     return _timed([sys.executable, "-c", "from stickslip.cli import app; app()", *args], _env(cache, tree), tmp)
 
 
-def breakdown(top: int) -> list[dict]:
-    """Outermost compilations of a default ``simulate`` in a fresh cache, longest first."""
+def breakdown(top: int, tree: Path | None = None) -> list[dict]:
+    """Outermost compilations of a default ``simulate`` in a fresh cache, longest first (with the
+    package of ``tree``, else the working tree's)."""
     code = ("import json, time\n"
             "from numba.core import event\n"
             "import stickslip\n"
@@ -142,7 +154,7 @@ def breakdown(top: int) -> list[dict]:
             "stickslip.simulate(t_end=1.0)\n"
             "print(json.dumps(spans))\n")
     with tempfile.TemporaryDirectory() as cache:
-        res = subprocess.run([sys.executable, "-c", code], env=dict(os.environ, NUMBA_CACHE_DIR=cache),
+        res = subprocess.run([sys.executable, "-c", code], env=_env(Path(cache), tree),
                              capture_output=True, text=True, check=True)
     totals = collections.defaultdict(float)
     for span in json.loads(res.stdout.strip().splitlines()[-1]):
@@ -150,56 +162,85 @@ def breakdown(top: int) -> list[dict]:
     return [{"kernel": k, "seconds": round(v, 2)} for k, v in sorted(totals.items(), key=lambda kv: -kv[1])[:top]]
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--breakdown", action="store_true", help="also list the kernels a cold simulate compiles")
-    ap.add_argument("--top", type=int, default=15)
-    ap.add_argument("--rev", default=None, help="also run every row with the package at this git revision")
-    ap.add_argument("--only", default=None, help="comma-separated words; the rows whose label has one of them")
-    args = ap.parse_args()
-    words = None if args.only is None else [w.strip() for w in args.only.split(",") if w.strip()]
-    chosen = [c for c in COMMANDS if words is None or any(w in c[0] for w in words)]
-    with tempfile.TemporaryDirectory() as tmp_root:
-        trees = {"working tree": None}
-        if args.rev:
-            trees[args.rev] = baseline_tree(args.rev, Path(tmp_root) / "baseline")
-        rows = {name: [] for name in trees}
-        caches = {name: Path(tmp_root) / f"cache-{i}" for i, name in enumerate(trees)}
+def _row(label: str, runs: list[tuple[dict, dict]]) -> dict:
+    """One command's row over its repeats: each repeat's cold and cached wall seconds, the cold
+    run's CPU seconds, and their medians."""
+    cold = [round(c["seconds"], 2) for c, _ in runs]
+    cpu = [round(c["cpu_s"], 2) for c, _ in runs]
+    warm = [round(w["seconds"], 2) for _, w in runs]
+    errors = [e for c, w in runs for e in c["stderr_tail"] + w["stderr_tail"]]
+    return {"command": label, "empty_cache_s": statistics.median(cold), "empty_cache_cpu_s": statistics.median(cpu),
+            "cached_s": statistics.median(warm), "runs_empty_cache_s": cold, "runs_empty_cache_cpu_s": cpu,
+            "runs_cached_s": warm, "exit": sorted({r["exit"] for pair in runs for r in pair}), "error": errors[-1:]}
+
+
+def _commands(chosen, trees: dict, tmp_root: Path, repeats: int) -> dict:
+    """Each chosen command ``repeats`` times for every tree, the trees alternating command by command."""
+    runs = {name: {label: [] for label, _, _ in chosen} for name in trees}
+    caches = {name: Path(tmp_root) / f"cache-{i}" for i, name in enumerate(trees)}
+    for _ in range(repeats):
         for label, cli_args, fresh in chosen:
             for i, (name, tree) in enumerate(trees.items()):
                 if fresh:
                     caches[name] = Path(tempfile.mkdtemp(dir=tmp_root, prefix=f"cache{i}-"))
                 cold = _run(cli_args, caches[name], Path(tempfile.mkdtemp(dir=tmp_root, prefix="work")), tree)
                 warm = _run(cli_args, caches[name], Path(tempfile.mkdtemp(dir=tmp_root, prefix="work")), tree)
-                rows[name].append({"command": label, "empty_cache_s": round(cold["seconds"], 2),
-                                   "cached_s": round(warm["seconds"], 2), "exit": [cold["exit"], warm["exit"]],
-                                   "error": cold["stderr_tail"] + warm["stderr_tail"]})
+                runs[name][label].append((cold, warm))
+    return {name: [_row(label, pairs) for label, pairs in table.items()] for name, table in runs.items()}
+
+
+def _print(out: dict, revs: list[str]) -> None:
+    for name, table in out.items():
+        print(f"-- {name}")
+        for r in table["commands"]:
+            second = "after the edit" if "after_edit_s" in r else "cached"
+            cpu = f"  cpu {r['empty_cache_cpu_s']:6.1f} s" if "empty_cache_cpu_s" in r else ""
+            print(f"{r['command']:<38} empty cache {r['empty_cache_s']:6.1f} s{cpu}   {second} {r['cached_s']:5.1f} s"
+                  + (f"   exit {r['exit']}: {r['error']}" if any(r["exit"]) else ""))
+        if table["model_file_sitting_s"]:
+            print(f"a new model file: simulate, stability, orbit from an empty cache: "
+                  f"{table['model_file_sitting_s']:.1f} s together")
+    for rev in revs:
+        for new, old in zip(out["working tree"]["commands"], out[rev]["commands"]):
+            keys = ["after_edit_s"] if "after_edit_s" in new else ["empty_cache_s", "empty_cache_cpu_s"]
+            print(f"{new['command']:<38} " + "; ".join(
+                f"{key[:-2].replace('_', ' ')} {new[key]:6.1f} s against {old[key]:6.1f} s at {rev} "
+                f"({new[key] / old[key]:.2f})" for key in keys))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--breakdown", action="store_true", help="also list the kernels a cold simulate compiles")
+    ap.add_argument("--top", type=int, default=15)
+    ap.add_argument("--rev", action="append", default=[],
+                    help="also run every row with the package at this git revision (may be repeated)")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="runs of each command per tree, alternating (medians reported)")
+    ap.add_argument("--only", default=None, help="comma-separated words; the rows whose label has one of them")
+    args = ap.parse_args()
+    words = None if args.only is None else [w.strip() for w in args.only.split(",") if w.strip()]
+    chosen = [c for c in COMMANDS if words is None or any(w in c[0] for w in words)]
+    with tempfile.TemporaryDirectory() as tmp_root:
+        trees = {"working tree": None}
+        for i, rev in enumerate(args.rev):
+            trees[rev] = baseline_tree(rev, Path(tmp_root) / f"baseline{i}")
+        rows = _commands(chosen, trees, Path(tmp_root), args.repeat)
         if words is None or any(w in EDITED for w in words):
             for name, tree in trees.items():
                 edit = edited_model(Path(tmp_root), tree)
                 rows[name].append({"command": EDITED, "empty_cache_s": round(edit["empty_cache_s"], 2),
                                    "cached_s": round(edit["seconds"], 2), "after_edit_s": round(edit["seconds"], 2),
                                    "exit": [edit["exit"], edit["exit"]], "error": edit["stderr_tail"]})
-    out = {}
-    for name, table in rows.items():
-        print(f"-- {name}")
-        for r in table:
-            second = "after the edit" if "after_edit_s" in r else "cached"
-            print(f"{r['command']:<38} empty cache {r['empty_cache_s']:6.1f} s   {second} {r['cached_s']:5.1f} s"
-                  + (f"   exit {r['exit']}: {r['error']}" if any(r["exit"]) else ""))
-        sitting = sum(r["empty_cache_s"] for r in table if "model file" in r["command"])
-        if sitting:
-            print(f"a new model file: simulate, stability, orbit from an empty cache: {sitting:.1f} s together")
-        out[name] = {"commands": table, "model_file_sitting_s": round(sitting, 2)}
-    if args.rev:
-        for new, old in zip(rows["working tree"], rows[args.rev]):
-            key = "after_edit_s" if "after_edit_s" in new else "empty_cache_s"  # the edit row: the run after it
-            print(f"{new['command']:<38} {key[:-2].replace('_', ' ')} {new[key]:6.1f} s against {old[key]:6.1f} s "
-                  f"at {args.rev} ({new[key] / old[key]:.2f})")
-    if args.breakdown:
-        out["simulate_kernels"] = breakdown(args.top)
-        for row in out["simulate_kernels"]:
-            print(f"  {row['seconds']:6.1f} s  {row['kernel']}")
+        out = {name: {"commands": table, "model_file_sitting_s": round(
+            sum(r["empty_cache_s"] for r in table if "model file" in r["command"]), 2)} for name, table in rows.items()}
+        _print(out, args.rev)
+        if args.breakdown:
+            for name, tree in trees.items():
+                out[name]["simulate_kernels"] = breakdown(args.top, tree)
+                print(f"-- compile of a default simulate, outermost kernels: {name}")
+                for row in out[name]["simulate_kernels"]:
+                    print(f"  {row['seconds']:6.1f} s  {row['kernel']}")
+    out["machine"] = {"load_average": os.getloadavg(), "cpus": os.cpu_count()}
     path = ROOT / "benchmarks" / "results" / "first_call.json"
     path.parent.mkdir(exist_ok=True)
     path.write_text(json.dumps(out, indent=2))

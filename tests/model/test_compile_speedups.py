@@ -189,3 +189,63 @@ def _repeated_products(x, y):
 
 def test_a_function_of_repeated_builtin_calls_computes_what_python_computes():
     assert _repeated_products(1.5, -0.25) == _repeated_products.py_func(1.5, -0.25)
+
+
+def _random_flow(rng, n_blocks: int, n_vars: int):
+    """A CFG of ``n_blocks`` blocks (forward edges, back edges that make loops, some blocks
+    unreachable) and random sets of variables used and defined in each block."""
+    from numba.core.controlflow import CFGraph
+
+    cfg = CFGraph()
+    for b in range(n_blocks):
+        cfg.add_node(b)
+    for b in range(n_blocks - 1):
+        for target in rng.choice(n_blocks, size=rng.integers(1, 3), replace=False):
+            if target != 0 and (target > b or rng.random() < 0.3):
+                cfg.add_edge(b, int(target))
+    cfg.set_entry_point(0)
+    cfg.process()
+    names = [f"v{i}" for i in range(n_vars)]
+    uses = {b: set(rng.choice(names, size=rng.integers(0, 6))) for b in range(n_blocks)}
+    defs = {b: set(rng.choice(names, size=rng.integers(0, 4))) for b in range(n_blocks)}
+    return cfg, {b: None for b in range(n_blocks)}, uses, defs
+
+
+def test_live_maps_are_numbas_on_random_flow_graphs():
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        cfg, blocks, uses, defs = _random_flow(rng, int(rng.integers(1, 40)), int(rng.integers(1, 30)))
+        assert compile_speedups._live_map(cfg, blocks, uses, defs) == compile_speedups.numba_live_map(
+            cfg, blocks, uses, defs)
+
+
+@njit
+def _nested_loops(a, n):
+    total = 0.0
+    for i in range(n):
+        x = a[i]
+        while x > 1.0:
+            if x > 10.0:
+                x = _clipped(x, 0.0, 10.0)
+                continue
+            x = x / 2.0
+        total += x
+    return total
+
+
+def test_live_maps_are_numbas_on_every_function_a_compile_analyses(monkeypatch):
+    from numba.core import analysis, ir_utils
+
+    calls = []
+
+    def both(cfg, blocks, var_use_map, var_def_map):
+        ours = compile_speedups._live_map(cfg, blocks, var_use_map, var_def_map)
+        assert ours == compile_speedups.numba_live_map(cfg, blocks, var_use_map, var_def_map)
+        calls.append(len(blocks))
+        return ours
+
+    monkeypatch.setattr(analysis, "compute_live_map", both)
+    monkeypatch.setattr(ir_utils, "compute_live_map", both)
+    a = np.array([0.5, 3.0, 40.0])
+    assert _nested_loops(a, 3) == _nested_loops.py_func(a, 3)
+    assert calls and max(calls) > 5

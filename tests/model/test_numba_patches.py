@@ -14,8 +14,8 @@ import numba
 from stickslip.model import numba_patches
 from stickslip.model.numba_patches import RUN_ENV
 
-ALL = {"inline-scope-copy", "inline-ir-once", "flags-hash", "call-type-once", "python-entry", "standalone-linking",
-       "cache-keeping", "fork-helper"}
+ALL = {"inline-scope-copy", "inline-ir-once", "flags-hash", "call-type-once", "live-map-once", "python-entry",
+       "standalone-linking", "cache-keeping", "fork-helper"}
 
 
 def _fresh_env(**extra) -> dict:
@@ -106,6 +106,10 @@ _EVERY_NAME_CHANGED = """
     def other_get_call_type(self, context, args, kws):
         return get_call_type(self, context, args, kws)
     BaseFunction.get_call_type = other_get_call_type                          # call-type-once
+    from numba.core import analysis
+    compute_live_map = analysis.compute_live_map
+    analysis.compute_live_map = lambda cfg, blocks, var_use_map, var_def_map: compute_live_map(
+        cfg, blocks, var_use_map, var_def_map)                                # live-map-once
     add_overload = CPUDispatcher.add_overload
     def other_add_overload(self, cres, *more):
         return add_overload(self, cres)

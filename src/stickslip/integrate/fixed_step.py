@@ -497,7 +497,7 @@ def integrate_fixed_step(method, y0, t0, t_end, dt, md, max_steps, samples, log)
 def _diagonal(md: ModelData, block: int) -> np.ndarray:
     """Diagonal of the n × n block ``block`` of the model data (0: M⁻¹, 3: K; ``bundle.offsets``)."""
     n = int(md.m[H_N])
-    o = offsets.py_func(n)[block]
+    o = offsets(n)[block]
     return md.m[o:o + n * n:n + 1].copy()
 
 

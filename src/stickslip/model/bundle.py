@@ -37,7 +37,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .friction import LAW_WIDTH, NoUserLaw
-from .jit import inlined_kernel, kernel
+from .jit import formula
 
 __all__ = ["ModelData", "pack", "offsets", "contact_offsets", "gap_offset", "contact_width", "contact_state",
            "CST", "HEADER", "H_N", "H_NC", "H_DIAGONAL", "H_BAND", "H_CONSTANT", "H_UNILATERAL", "H_RIGID", "C_DIM", "C_N0",
@@ -76,13 +76,13 @@ class ModelData(NamedTuple):
     law: Any = NoUserLaw()
 
 
-@inlined_kernel
+@formula
 def contact_width(n):
     """Numbers in one contact block of a model with n DOFs."""
     return C_G + 5 * n + 2
 
 
-@kernel
+@formula
 def offsets(n):
     """Offsets of (M⁻¹, M, C, K, f0, free, contact 0) in ``m`` for a model with n DOFs."""
     nn = n * n
@@ -91,13 +91,13 @@ def offsets(n):
     return o_minv, o_minv + nn, o_minv + 2 * nn, o_minv + 3 * nn, o_force, o_force + n, o_force + 2 * n
 
 
-@kernel
+@formula
 def gap_offset(n, c):
     """Offset of contact ``c``'s gap gradient W (n) in ``m``."""
     return contact_offsets(n, c)[3] + n
 
 
-@kernel
+@formula
 def contact_offsets(n, c):
     """(o, o_w, o_nq, o_nv): offsets of contact ``c``'s block, its drive w and its normal gradients."""
     o = HEADER + 4 * n * n + 2 * n + c * contact_width(n)
@@ -135,7 +135,7 @@ def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np
     minv[np.ix_(idx, idx)] = np.linalg.inv(mass[np.ix_(idx, idx)])
     mats = [minv, mass, np.asarray(damping, float), np.asarray(stiffness, float)]
     diagonal = all(np.count_nonzero(a - np.diag(np.diag(a))) == 0 for a in mats)
-    cw = contact_width.py_func(n)
+    cw = contact_width(n)
     m = np.zeros(HEADER + 4 * n * n + 2 * n + nc * cw)
     m[H_N] = n
     m[H_NC] = nc
@@ -145,13 +145,13 @@ def pack(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray, force: np
     m[H_UNILATERAL] = 1.0 if any(spec.get("normal_law", NORMAL_PRESCRIBED) != NORMAL_PRESCRIBED
                                  for spec in contacts) else 0.0
     m[H_RIGID] = 1.0 if any(spec.get("normal_law", NORMAL_PRESCRIBED) == NORMAL_RIGID for spec in contacts) else 0.0
-    o_minv, o_mass, o_damp, o_stiff, o_force, o_free, _ = offsets.py_func(n)
+    o_minv, o_mass, o_damp, o_stiff, o_force, o_free, _ = offsets(n)
     for o, a in zip((o_minv, o_mass, o_damp, o_stiff), mats):
         m[o:o + n * n] = a.ravel()
     m[o_force:o_force + n] = np.asarray(force, float)
     m[o_free:o_free + n] = free.astype(float)
     for c, spec in enumerate(contacts):
-        o, ow, onq, onv = contact_offsets.py_func(n, c)
+        o, ow, onq, onv = contact_offsets(n, c)
         dim = int(spec["dim"])
         m[o + C_DIM] = dim
         m[o + C_N0] = spec["N0"]

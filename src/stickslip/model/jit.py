@@ -15,14 +15,16 @@ kernels on the innermost path (``forces.slip_force``, ``forces.add_contact_force
 site per integrator step, inside the loop over its stages (a call passes each array as 7 words),
 and for the loops on the right-hand side's path (``model_data.apply_inverse_mass``,
 ``base_force``). Every inlined copy is typed and compiled again, so larger step functions stay
-kernels. The small predicates, offsets and formulas that kernels call at tens of sites
-(``bundle.offsets``, ``contact_offsets``, ``gap_offset``, ``normal.is_open``, ``is_rigid``,
-``is_unilateral``, ``gap_and_rate``, ``gap_with_rate``, ``contact_indicator``,
-``model_data.is_stick``, ``static_limit``, ``kinetic_coefficient``, ``frames.frame_velocity``,
-``friction.static_coefficient``, ``linalg.solve_psd_2x2``, ``forces.exact_direction``) are plain
-kernels: numba types an inlined body again at every call site (and at every site of every
-inlined caller), a kernel once, and LLVM still inlines the small function into its caller's
-module.
+kernels. The small predicates and formulas that kernels call at tens of sites
+(``normal.is_open``, ``is_rigid``, ``is_unilateral``, ``gap_and_rate``, ``gap_with_rate``,
+``contact_indicator``, ``model_data.is_stick``, ``static_limit``, ``kinetic_coefficient``,
+``frames.frame_velocity``, ``friction.static_coefficient``, ``linalg.solve_psd_2x2``,
+``forces.exact_direction``) are plain kernels: numba types an inlined body again at every call
+site (and at every site of every inlined caller), a kernel once, and LLVM still inlines the small
+function into its caller's module. The data layout's offsets (``bundle.offsets``,
+``contact_offsets``, ``gap_offset``, ``contact_width``), which Python calls too and callers pass
+constants or variables alike, are :data:`formula`: plain Python for Python, one compiled version
+for kernels.
 
 ``error_model="numpy"`` everywhere: a float division by zero gives inf/nan as in numpy instead
 of raising ZeroDivisionError, so divisions carry no zero test and branch to an exception. Every
@@ -67,6 +69,7 @@ from __future__ import annotations
 from numba import config as numba_config
 from numba import njit
 from numba.core import sigutils
+from numba.extending import register_jitable
 from numba.core.registry import CPUDispatcher
 
 from . import compile_ahead, compile_speedups, kernel_cache, linking, numba_patches
@@ -227,8 +230,15 @@ kernel = _kernel_decorator(**KERNEL_OPTIONS)
 #: (``model/compile_ahead.py``): its version then has the entry its first call needs.
 api_kernel = _kernel_decorator(always_entry=True, **KERNEL_OPTIONS)
 inlined_kernel = njit(cache=_CACHE, inline="always", **KERNEL_OPTIONS)
+#: A small integer formula that kernels and Python both call (the data layout's offsets and widths):
+#: in Python the function itself (no dispatcher to load from the cache, nothing compiled), for
+#: kernels a compiled function that LLVM inlines into its caller. numba types the call of such a
+#: function (an overload) with the arguments' plain types first, so a caller that passes a
+#: constant (``offsets(6)``) and one that passes a variable share one compiled version, where a
+#: kernel would compile one for the literal too.
+formula = register_jitable(**KERNEL_OPTIONS)
 loop = njit(cache=_CACHE, error_model="numpy", no_cfunc_wrapper=True)
 inlined_loop = njit(cache=_CACHE, inline="always", error_model="numpy", no_cfunc_wrapper=True)
 
-__all__ = ["kernel", "api_kernel", "inlined_kernel", "loop", "inlined_loop", "standalone", "KERNEL_OPTIONS",
+__all__ = ["kernel", "api_kernel", "inlined_kernel", "formula", "loop", "inlined_loop", "standalone", "KERNEL_OPTIONS",
            "KernelDispatcher", "track_user_code", "defined_in_package", "compiled_layer_digest"]

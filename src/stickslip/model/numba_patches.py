@@ -1,6 +1,6 @@
 """Every change stickslip makes to numba's behaviour, installed by one :func:`install`, each checked first.
 
-The compiled layer changes numba in eight ways. Each is a :class:`Patch`: what it changes, a check
+The compiled layer changes numba in nine ways. Each is a :class:`Patch`: what it changes, a check
 that the private names it needs exist with the shape it expects, and what applies it.
 :func:`install` (run when :mod:`stickslip.model.jit` is imported) applies the patches whose checks
 pass, once per process.
@@ -16,6 +16,9 @@ patch                       what it changes                                     
                                                                                             ``options``, ``_values``
 ``call-type-once``          a builtin call typed once per argument types                    ``BaseFunction.get_call_type``
                             (:mod:`.compile_speedups`)                                      (its source), ``_impl_keys``
+``live-map-once``           the definitions reaching each block of a function found in one  ``analysis.compute_live_map``
+                            pass (:mod:`.compile_speedups`)                                 (its source), ``ir_utils``' import
+                                                                                            of it, ``CFGraph.topo_order``
 ``python-entry``            a kernel's CPython wrapper compiled only for Python's calls     ``Dispatcher._compile_for_args``,
                             (:class:`~stickslip.model.jit.KernelDispatcher`)                ``_compiler.targetoptions``,
                                                                                             ``add_overload``, ``overloads``
