@@ -129,9 +129,10 @@ def _inverse_mass_of(kin, m, n, diagonal, f, a):
 
 def inverse_mass_of_row(kin, m, n, diagonal, g, out):  # pragma: no cover - resolved by numba (overload below)
     """out = M⁻¹ g for a contact row g (n,): :func:`apply_inverse_mass`; for a model of a heap
-    kinematics class (hundreds of DOFs, :mod:`stickslip.model.stack`) the same sums over the
-    nonzero entries of g only (a contact row touches a few DOFs: n·nnz instead of n² operations,
-    the same numbers, each sum taken in the same order less its exact zeros)."""
+    kinematics class (hundreds of DOFs, :mod:`stickslip.model.stack`) the sums over the nonzero
+    entries of g only (a contact row touches a few DOFs: n·nnz instead of n² operations), each
+    taking column j of the symmetric M⁻¹ as its row j, contiguous in memory (equal to the round-off
+    of the inverse)."""
     raise NotImplementedError
 
 
@@ -142,7 +143,7 @@ def _inverse_mass_of_row(kin, m, n, diagonal, g, out):
             apply_inverse_mass(m, n, diagonal, g, out)
         return dense
 
-    def by_columns(kin, m, n, diagonal, g, out):
+    def by_rows(kin, m, n, diagonal, g, out):
         if diagonal:
             apply_inverse_mass(m, n, diagonal, g, out)
             return
@@ -152,9 +153,10 @@ def _inverse_mass_of_row(kin, m, n, diagonal, g, out):
         for j in range(n):
             gj = g[j]
             if gj != 0.0:
+                row = o + j * n
                 for i in range(n):
-                    out[i] += m[o + i * n + j] * gj
-    return by_columns
+                    out[i] += m[row + i] * gj
+    return by_rows
 
 
 def gram_row(kin, g, MG, k, n, A, r, zero):  # pragma: no cover - resolved by numba (overload below)
