@@ -54,8 +54,8 @@ from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
-                         apply_inverse_mass, damping_power, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient,
-                         kinetic_energy, law_row, static_limit)
+                         apply_inverse_mass, damping_power, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick,
+                         kinetic_coefficient, kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
 from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
 
