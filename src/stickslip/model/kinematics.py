@@ -441,66 +441,33 @@ class ConstantRigidKinematics(NamedTuple):
 CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics, ConstantRigidKinematics)
 
 
-class LargeConstantKinematics(NamedTuple):
-    """The kernels' :class:`ConstantKinematics` of a model larger than the stack arrays hold
-    (:data:`~stickslip.model.stack.MAX_DOFS`, :data:`~stickslip.model.stack.MAX_CONTACTS`): its
-    work arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register_heap`),
-    so it has no fixed maximum. ``FrictionModel.data`` chooses it; the model keeps its own class.
+#: The fields of the heap kinematics classes (below), all three alike.
+_HEAP_FIELDS = [("ndof", int), ("ncontacts", int), ("force_rows", np.ndarray), ("force_columns", np.ndarray),
+                ("mass_rows", np.ndarray), ("mass_columns", np.ndarray), ("factor_order", np.ndarray),
+                ("factor_rows", np.ndarray), ("factor_columns", np.ndarray), ("factor_values", np.ndarray),
+                ("factor_diagonal", np.ndarray)]
 
-    ``force_rows`` (n + 1,) and ``force_columns`` (int64) hold the row-compressed pattern of the
-    entries of C and K that are not both zero (:func:`force_pattern`): the base force
-    f0 − C q̇ − K q sums over those only (:func:`~stickslip.model.model_data.base_force_of`), as a
-    reduced or finite-element model's C and K are mostly zero; ``mass_rows``, ``mass_columns`` that
-    of M (the kinetic energy); ``factor_*`` the sparse Cholesky factor of M on its free DOFs
-    (:func:`~stickslip.model.mass_factor.mass_factor`), with which M⁻¹ f is two triangular solves
-    (:func:`~stickslip.model.model_data.inverse_mass_of`). ``FrictionModel.data`` packs the
-    matrices of such a model without their round-off entries
-    (:func:`~stickslip.model.mass_factor.without_round_off`), so the patterns are those of the
-    model's mechanics, not of its arithmetic."""
+LargeConstantKinematics = NamedTuple("LargeConstantKinematics", _HEAP_FIELDS)
+LargeConstantKinematics.__doc__ = """The kernels' :class:`ConstantKinematics` of a model larger than the
+stack arrays hold (:data:`~stickslip.model.stack.MAX_DOFS`, :data:`~stickslip.model.stack.MAX_CONTACTS`): its work
+arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register_heap`), so it has no fixed
+maximum. ``FrictionModel.data`` chooses it; the model keeps its own class.
 
-    ndof: int
-    ncontacts: int
-    force_rows: np.ndarray
-    force_columns: np.ndarray
-    mass_rows: np.ndarray
-    mass_columns: np.ndarray
-    factor_order: np.ndarray
-    factor_rows: np.ndarray
-    factor_columns: np.ndarray
-    factor_values: np.ndarray
-    factor_diagonal: np.ndarray
-
-
-class LargeConstantUnilateralKinematics(NamedTuple):
-    """:class:`LargeConstantKinematics` for :class:`ConstantUnilateralKinematics` (compliant contacts)."""
-
-    ndof: int
-    ncontacts: int
-    force_rows: np.ndarray
-    force_columns: np.ndarray
-    mass_rows: np.ndarray
-    mass_columns: np.ndarray
-    factor_order: np.ndarray
-    factor_rows: np.ndarray
-    factor_columns: np.ndarray
-    factor_values: np.ndarray
-    factor_diagonal: np.ndarray
-
-
-class LargeConstantRigidKinematics(NamedTuple):
-    """:class:`LargeConstantKinematics` for :class:`ConstantRigidKinematics` (a rigid contact)."""
-
-    ndof: int
-    ncontacts: int
-    force_rows: np.ndarray
-    force_columns: np.ndarray
-    mass_rows: np.ndarray
-    mass_columns: np.ndarray
-    factor_order: np.ndarray
-    factor_rows: np.ndarray
-    factor_columns: np.ndarray
-    factor_values: np.ndarray
-    factor_diagonal: np.ndarray
+``force_rows`` (n + 1,) and ``force_columns`` (int64) hold the row-compressed pattern of the entries
+of C and K that are not both zero (:func:`force_pattern`): the base force f0 − C q̇ − K q sums over
+those only (:func:`~stickslip.model.model_data.base_force_of`), as a reduced or finite-element
+model's C and K are mostly zero; ``mass_rows``, ``mass_columns`` that of M (the kinetic energy);
+``factor_*`` the sparse Cholesky factor of M on its free DOFs
+(:func:`~stickslip.model.mass_factor.mass_factor`), with which M⁻¹ f is two triangular solves
+(:func:`~stickslip.model.model_data.inverse_mass_of`). ``FrictionModel.data`` packs the matrices of
+such a model without their round-off entries (:func:`~stickslip.model.mass_factor.without_round_off`),
+so the patterns are those of the model's mechanics, not of its arithmetic."""
+LargeConstantUnilateralKinematics = NamedTuple("LargeConstantUnilateralKinematics", _HEAP_FIELDS)
+LargeConstantUnilateralKinematics.__doc__ = (":class:`LargeConstantKinematics` for "
+                                             ":class:`ConstantUnilateralKinematics` (compliant contacts).")
+LargeConstantRigidKinematics = NamedTuple("LargeConstantRigidKinematics", _HEAP_FIELDS)
+LargeConstantRigidKinematics.__doc__ = (":class:`LargeConstantKinematics` for :class:`ConstantRigidKinematics` "
+                                        "(a rigid contact).")
 
 
 #: The heap class the kernels of a large model of each constant-kinematics class take.
