@@ -32,7 +32,7 @@ from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force_of,
                          gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
-from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
+from .stack import CONTACTS, DOFS, ROWS, TWO, work_matrix, work_vectors
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
@@ -185,9 +185,13 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
     G_S M⁻¹ G_Sᵀ (a01 = a11 = 0 for one row)."""
     m = md.m
-    a, mg0, mg1 = work_vectors(md.kin, 3, s)
+    a = work_vectors(md.kin, 1, s)[0]
+    MG = work_matrix(md.kin, TWO, DOFS, s)
     inverse_mass_of(md.kin, m, n, diagonal, f, a)
-    inverse_mass_of_row(md.kin, m, n, diagonal, G[r0], mg0)
+    for r in range(1 if r1 < 0 else 2):  # one call site: numba's inliner takes two of an overload badly
+        inverse_mass_of_row(md.kin, m, n, diagonal, G[r0 if r == 0 else r1], MG[r])
+    mg0 = MG[0]
+    mg1 = MG[1]
     a00 = csm.zero(s[0])
     b0 = h[r0]
     for j in range(n):
@@ -199,7 +203,6 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
         if r0 % 2 == 0:
             F[r0 + 1] = zero
         return a00, zero, zero
-    inverse_mass_of_row(md.kin, m, n, diagonal, G[r1], mg1)
     a01 = csm.zero(s[0])
     a11 = csm.zero(s[0])
     b1 = h[r1]
