@@ -31,7 +31,7 @@ from .errors import MemoryLimitError
 
 __all__ = ["available_memory", "check_memory", "largest_count", "sample_bytes", "state_bytes", "param_bytes",
            "grid_point_bytes", "map_point_bytes", "average_bytes", "format_bytes", "model_data_bytes",
-           "largest_dense_dofs", "matrix_file_bytes", "compiled_model_bytes", "work_array_bytes"]
+           "largest_dense_dofs", "matrix_file_bytes", "compiled_model_bytes", "work_array_bytes", "pattern_bytes"]
 
 #: Control-group memory limits (v2, then v1) that cap what the kernel gives this process.
 _CGROUP_LIMITS = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
@@ -229,10 +229,20 @@ def work_array_bytes(n_dofs: int, n_contacts: int) -> float:
     return 16.0 * _WORK_SITES * (3 * nc * n + 9 * nc * nc + 7 * max(n, 2 * nc))
 
 
+def pattern_bytes(n_dofs: int) -> float:
+    """Bytes of the sparse structure a model above the stack maxima carries beside its packed data
+    (``model/kinematics.py``'s heap classes), at most: the row-compressed patterns of C and K and
+    of M (int64 row starts and up to n² columns each) and the Cholesky factor of M (its strict
+    lower triangle's columns and values, its order and diagonal)."""
+    n = int(n_dofs)
+    return 8.0 * (2 * (n * n + n + 1) + n * (n - 1) + (n + 1) + 2 * n)
+
+
 def compiled_model_bytes(n_dofs: int, n_contacts: int) -> float:
     """Peak bytes of a model in the compiled kernels: its packed data (:func:`model_data_bytes`)
-    and, above the stack maxima, the kernels' work arrays (:func:`work_array_bytes`)."""
-    return model_data_bytes(n_dofs, n_contacts) + work_array_bytes(n_dofs, n_contacts)
+    and, above the stack maxima, the kernels' work arrays (:func:`work_array_bytes`) and its
+    sparse structure (:func:`pattern_bytes`)."""
+    return model_data_bytes(n_dofs, n_contacts) + work_array_bytes(n_dofs, n_contacts) + pattern_bytes(n_dofs)
 
 
 def largest_dense_dofs(memory: float, n_contacts: int = 0) -> int:

@@ -9,7 +9,7 @@ from stickslip.model import stack
 from stickslip.model.kinematics import ConstantKinematics, LargeConstantKinematics
 
 
-@pytest.mark.parametrize("kin", [ConstantKinematics(), LargeConstantKinematics(70, 20, np.zeros(71, np.int64), np.zeros(0, np.int64))], ids=["stack", "heap"])
+@pytest.mark.parametrize("kin", [ConstantKinematics(), LargeConstantKinematics(70, 20, *[np.zeros(0, np.int64)] * 5, *[np.zeros(0, np.int64)] * 2, *[np.zeros(0)] * 2)], ids=["stack", "heap"])
 def test_work_matrix_is_typed_only_with_literal_size_codes(kin):
     """numba 0.57 types an intrinsic with plain integers first and keeps the first typing that
     succeeds (its ``intrinsic`` ignores ``prefer_literal``): the typing must refuse plain integers,

@@ -28,11 +28,11 @@ from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
-from .linalg import solve_in_order, solve_psd, solve_psd_2x2
+from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force_of,
-                         gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient)
+                         gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
-from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
+from .stack import CONTACTS, DOFS, ROWS, TWO, work_matrix, work_vectors
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
@@ -131,7 +131,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     MG = work_matrix(md.kin, ROWS, DOFS, s)
     a, b, x = work_vectors(md.kin, 3, s)
     V = work_matrix(md.kin, ROWS, ROWS, s)
-    apply_inverse_mass(m, n, diagonal, f, a)
+    inverse_mass_of(md.kin, m, n, diagonal, f, a)
     k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
@@ -150,7 +150,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
             for i in range(contact_dim(md.kin, m, n, c)):
                 gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, csm.zero(s[0]))
                 r += 1
-    solve_psd(A, b, x, V, k)
+    solve_stick_system(md.kin, A, b, x, V, k)
     r = 0
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
@@ -185,9 +185,13 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
     G_S M⁻¹ G_Sᵀ (a01 = a11 = 0 for one row)."""
     m = md.m
-    a, mg0, mg1 = work_vectors(md.kin, 3, s)
-    apply_inverse_mass(m, n, diagonal, f, a)
-    apply_inverse_mass(m, n, diagonal, G[r0], mg0)
+    a = work_vectors(md.kin, 1, s)[0]
+    MG = work_matrix(md.kin, TWO, DOFS, s)
+    inverse_mass_of(md.kin, m, n, diagonal, f, a)
+    for r in range(1 if r1 < 0 else 2):  # one call site: numba's inliner takes two of an overload badly
+        inverse_mass_of_row(md.kin, m, n, diagonal, G[r0 if r == 0 else r1], MG[r])
+    mg0 = MG[0]
+    mg1 = MG[1]
     a00 = csm.zero(s[0])
     b0 = h[r0]
     for j in range(n):
@@ -199,7 +203,6 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
         if r0 % 2 == 0:
             F[r0 + 1] = zero
         return a00, zero, zero
-    apply_inverse_mass(m, n, diagonal, G[r1], mg1)
     a01 = csm.zero(s[0])
     a11 = csm.zero(s[0])
     b1 = h[r1]

@@ -49,6 +49,7 @@ from .frame_pointers import (FramePointerFields, compiled_addresses, forget, is_
                              pointer_gap)
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
 from .jit import KERNEL_OPTIONS, defined_in_package, kernel, track_user_code
+from .mass_factor import mass_factor, row_pattern
 
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
@@ -440,39 +441,33 @@ class ConstantRigidKinematics(NamedTuple):
 CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics, ConstantRigidKinematics)
 
 
-class LargeConstantKinematics(NamedTuple):
-    """The kernels' :class:`ConstantKinematics` of a model larger than the stack arrays hold
-    (:data:`~stickslip.model.stack.MAX_DOFS`, :data:`~stickslip.model.stack.MAX_CONTACTS`): its
-    work arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register_heap`),
-    so it has no fixed maximum. ``FrictionModel.data`` chooses it; the model keeps its own class.
+#: The fields of the heap kinematics classes (below), all three alike.
+_HEAP_FIELDS = [("ndof", int), ("ncontacts", int), ("force_rows", np.ndarray), ("force_columns", np.ndarray),
+                ("mass_rows", np.ndarray), ("mass_columns", np.ndarray), ("factor_order", np.ndarray),
+                ("factor_rows", np.ndarray), ("factor_columns", np.ndarray), ("factor_values", np.ndarray),
+                ("factor_diagonal", np.ndarray)]
 
-    ``force_rows`` (n + 1,) and ``force_columns`` (int64) hold the row-compressed pattern of the
-    entries of C and K that are not both zero (:func:`force_pattern`): the base force
-    f0 − C q̇ − K q sums over those only (:func:`~stickslip.model.model_data.base_force_of`), as a
-    reduced or finite-element model's C and K are mostly zero."""
+LargeConstantKinematics = NamedTuple("LargeConstantKinematics", _HEAP_FIELDS)
+LargeConstantKinematics.__doc__ = """The kernels' :class:`ConstantKinematics` of a model larger than the
+stack arrays hold (:data:`~stickslip.model.stack.MAX_DOFS`, :data:`~stickslip.model.stack.MAX_CONTACTS`): its work
+arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register_heap`), so it has no fixed
+maximum. ``FrictionModel.data`` chooses it; the model keeps its own class.
 
-    ndof: int
-    ncontacts: int
-    force_rows: np.ndarray
-    force_columns: np.ndarray
-
-
-class LargeConstantUnilateralKinematics(NamedTuple):
-    """:class:`LargeConstantKinematics` for :class:`ConstantUnilateralKinematics` (compliant contacts)."""
-
-    ndof: int
-    ncontacts: int
-    force_rows: np.ndarray
-    force_columns: np.ndarray
-
-
-class LargeConstantRigidKinematics(NamedTuple):
-    """:class:`LargeConstantKinematics` for :class:`ConstantRigidKinematics` (a rigid contact)."""
-
-    ndof: int
-    ncontacts: int
-    force_rows: np.ndarray
-    force_columns: np.ndarray
+``force_rows`` (n + 1,) and ``force_columns`` (int64) hold the row-compressed pattern of the entries
+of C and K that are not both zero (:func:`force_pattern`): the base force f0 − C q̇ − K q sums over
+those only (:func:`~stickslip.model.model_data.base_force_of`), as a reduced or finite-element
+model's C and K are mostly zero; ``mass_rows``, ``mass_columns`` that of M (the kinetic energy);
+``factor_*`` the sparse Cholesky factor of M on its free DOFs
+(:func:`~stickslip.model.mass_factor.mass_factor`), with which M⁻¹ f is two triangular solves
+(:func:`~stickslip.model.model_data.inverse_mass_of`). ``FrictionModel.data`` packs the matrices of
+such a model without their round-off entries (:func:`~stickslip.model.mass_factor.without_round_off`),
+so the patterns are those of the model's mechanics, not of its arithmetic."""
+LargeConstantUnilateralKinematics = NamedTuple("LargeConstantUnilateralKinematics", _HEAP_FIELDS)
+LargeConstantUnilateralKinematics.__doc__ = (":class:`LargeConstantKinematics` for "
+                                             ":class:`ConstantUnilateralKinematics` (compliant contacts).")
+LargeConstantRigidKinematics = NamedTuple("LargeConstantRigidKinematics", _HEAP_FIELDS)
+LargeConstantRigidKinematics.__doc__ = (":class:`LargeConstantKinematics` for :class:`ConstantRigidKinematics` "
+                                        "(a rigid contact).")
 
 
 #: The heap class the kernels of a large model of each constant-kinematics class take.
@@ -490,22 +485,24 @@ def fits_stack(cls: type, n: int, nc: int) -> bool:
 def force_pattern(damping: np.ndarray, stiffness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(rows (n + 1,), columns) int64: the row-compressed pattern of the entries (i, j) where the
     dense (n, n) ``damping`` or ``stiffness`` is not zero, columns ascending in each row."""
-    nonzero = (np.asarray(damping) != 0.0) | (np.asarray(stiffness) != 0.0)
-    rows = np.zeros(nonzero.shape[0] + 1, dtype=np.int64)
-    np.cumsum(nonzero.sum(axis=1), out=rows[1:])
-    return rows, np.nonzero(nonzero)[1].astype(np.int64)
+    return row_pattern((np.asarray(damping) != 0.0) | (np.asarray(stiffness) != 0.0))
 
 
-def large_kinematics(kin, n: int, nc: int, damping: np.ndarray | None = None, stiffness: np.ndarray | None = None):
+def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...] = ()):
     """The kinematics data the kernels take for a model of n dofs and nc contacts: ``kin`` where
-    it fits the stack arrays (:func:`fits_stack`), else its heap class with the pattern of the
-    dense (n, n) ``damping`` and ``stiffness`` (:func:`force_pattern`; None where it has no heap
-    class: a frame computed from q, which the stack maxima bound)."""
+    it fits the stack arrays (:func:`fits_stack`), else its heap class with the patterns of the
+    dense (n, n) ``matrices`` = (mass, damping, stiffness, free) (:func:`force_pattern`, the mass's
+    pattern and its sparse factor, :func:`~stickslip.model.mass_factor.mass_factor`; None where
+    it has no heap class: a frame computed from q, which the stack maxima bound)."""
     cls = type(kin)
     if fits_stack(cls, n, nc):
         return kin
     large = LARGE_KINEMATICS.get(cls)
-    return None if large is None else large(int(n), int(nc), *force_pattern(damping, stiffness))
+    if large is None:
+        return None
+    mass, damping, stiffness, free = matrices
+    return large(int(n), int(nc), *force_pattern(damping, stiffness), *row_pattern(np.asarray(mass) != 0.0),
+                 *mass_factor(mass, free))
 
 
 @kernel

@@ -28,7 +28,7 @@ from .stack import on_heap
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
            "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy",
-           "inverse_mass_of_row", "gram_row", "base_force_of", "damping_power"]
+           "inverse_mass_of_row", "inverse_mass_of", "gram_row", "base_force_of", "damping_power"]
 
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
@@ -79,11 +79,60 @@ def apply_inverse_mass(m, n, diagonal, f, a):
             a[i] = acc
 
 
+def _for_kinematics(kin, dense, heap):
+    """The implementation of an overload below for the kinematics type ``kin``: ``heap`` for a heap
+    kinematics class (:mod:`stickslip.model.stack`), ``dense`` for the others."""
+    return heap if on_heap(getattr(kin, "instance_class", None)) else dense
+
+
+def inverse_mass_of(kin, m, n, diagonal, f, a):  # pragma: no cover - resolved by numba (overload below)
+    """a = M⁻¹ f for any vector f (n,) (locked DOFs: 0): :func:`apply_inverse_mass`; for a model of
+    a heap kinematics class (:mod:`stickslip.model.stack`) with a full M, two triangular solves with
+    its sparse Cholesky factor (``kin.factor_*``, :func:`~stickslip.model.mass_factor.mass_factor`):
+    as many operations as the factor has entries (a reduced model's boundary DOFs times its modes)
+    instead of n². ``a`` must not be ``f``."""
+    raise NotImplementedError
+
+
+def _inverse_mass_dense(kin, m, n, diagonal, f, a):
+    apply_inverse_mass(m, n, diagonal, f, a)
+
+
+def _inverse_mass_by_factor(kin, m, n, diagonal, f, a):
+    if diagonal:
+        apply_inverse_mass(m, n, diagonal, f, a)
+        return
+    order = kin.factor_order
+    rows = kin.factor_rows
+    columns = kin.factor_columns
+    values = kin.factor_values
+    pivots = kin.factor_diagonal
+    zero = csm.zero(f[0])
+    for i in range(n):
+        a[i] = zero
+    for i in range(order.shape[0]):  # L y = P f, y_i kept at a[order[i]]
+        acc = f[order[i]] + zero
+        for p in range(rows[i], rows[i + 1]):
+            acc -= values[p] * a[columns[p]]
+        a[order[i]] = acc / pivots[i]
+    for i in range(order.shape[0] - 1, -1, -1):  # Lᵀ z = y, by the columns of Lᵀ (the rows of L)
+        z = a[order[i]] / pivots[i]
+        a[order[i]] = z
+        for p in range(rows[i], rows[i + 1]):
+            a[columns[p]] -= values[p] * z
+
+
+@overload(inverse_mass_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _inverse_mass_of(kin, m, n, diagonal, f, a):
+    return _for_kinematics(kin, _inverse_mass_dense, _inverse_mass_by_factor)
+
+
 def inverse_mass_of_row(kin, m, n, diagonal, g, out):  # pragma: no cover - resolved by numba (overload below)
     """out = M⁻¹ g for a contact row g (n,): :func:`apply_inverse_mass`; for a model of a heap
-    kinematics class (hundreds of DOFs, :mod:`stickslip.model.stack`) the same sums over the
-    nonzero entries of g only (a contact row touches a few DOFs: n·nnz instead of n² operations,
-    the same numbers, each sum taken in the same order less its exact zeros)."""
+    kinematics class (hundreds of DOFs, :mod:`stickslip.model.stack`) the sums over the nonzero
+    entries of g only (a contact row touches a few DOFs: n·nnz instead of n² operations), each
+    taking column j of the symmetric M⁻¹ as its row j, contiguous in memory (equal to the round-off
+    of the inverse)."""
     raise NotImplementedError
 
 
@@ -94,7 +143,7 @@ def _inverse_mass_of_row(kin, m, n, diagonal, g, out):
             apply_inverse_mass(m, n, diagonal, g, out)
         return dense
 
-    def by_columns(kin, m, n, diagonal, g, out):
+    def by_rows(kin, m, n, diagonal, g, out):
         if diagonal:
             apply_inverse_mass(m, n, diagonal, g, out)
             return
@@ -104,9 +153,10 @@ def _inverse_mass_of_row(kin, m, n, diagonal, g, out):
         for j in range(n):
             gj = g[j]
             if gj != 0.0:
+                row = o + j * n
                 for i in range(n):
-                    out[i] += m[o + i * n + j] * gj
-    return by_columns
+                    out[i] += m[row + i] * gj
+    return by_rows
 
 
 def gram_row(kin, g, MG, k, n, A, r, zero):  # pragma: no cover - resolved by numba (overload below)
@@ -157,12 +207,6 @@ def base_force_of(kin, s, m, n, diagonal, f):  # pragma: no cover - resolved by 
     the same sums over the entries of C and K in its pattern only (``kin.force_rows``,
     ``kin.force_columns``: the others are zero in both), each in the same order less its exact zeros."""
     raise NotImplementedError
-
-
-def _for_kinematics(kin, dense, heap):
-    """The implementation of an overload below for the kinematics type ``kin``: ``heap`` for a heap
-    kinematics class (:mod:`stickslip.model.stack`), ``dense`` for the others."""
-    return heap if on_heap(getattr(kin, "instance_class", None)) else dense
 
 
 def _base_force_dense(kin, s, m, n, diagonal, f):
@@ -222,11 +266,13 @@ def _damping_power(kin, s, m, n, diagonal):
     return _for_kinematics(kin, _damping_power_dense, _damping_power_by_pattern)
 
 
-@kernel
-def kinetic_energy(s, md):
-    """½ q̇ᵀ M q̇ [J]."""
-    m = md.m
-    n, nc, diagonal = model_sizes(md.kin, m)
+def kinetic_energy_of(kin, s, m, n, diagonal):  # pragma: no cover - resolved by numba (overload below)
+    """½ q̇ᵀ M q̇ [J]; for a model of a heap kinematics class over the entries of M in its pattern
+    only (``kin.mass_rows``, ``kin.mass_columns``), each sum in the same order less its exact zeros."""
+    raise NotImplementedError
+
+
+def _kinetic_energy_dense(kin, s, m, n, diagonal):
     o = offsets(n)[1]
     e = 0.0
     for i in range(n):
@@ -236,3 +282,28 @@ def kinetic_energy(s, md):
             for j in range(n):
                 e += 0.5 * s[n + i] * m[o + i * n + j] * s[n + j]
     return e
+
+
+def _kinetic_energy_by_pattern(kin, s, m, n, diagonal):
+    o = offsets(n)[1]
+    rows = kin.mass_rows
+    columns = kin.mass_columns
+    e = 0.0
+    for i in range(n):
+        for p in range(rows[i], rows[i + 1]):
+            j = columns[p]
+            e += 0.5 * s[n + i] * m[o + i * n + j] * s[n + j]
+    return e
+
+
+@overload(kinetic_energy_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _kinetic_energy_of(kin, s, m, n, diagonal):
+    return _for_kinematics(kin, _kinetic_energy_dense, _kinetic_energy_by_pattern)
+
+
+@kernel
+def kinetic_energy(s, md):
+    """½ q̇ᵀ M q̇ [J]."""
+    m = md.m
+    n, nc, diagonal = model_sizes(md.kin, m)
+    return kinetic_energy_of(md.kin, s, m, n, diagonal)

@@ -52,10 +52,10 @@ from .forces import (add_contact_force, general_forces, quasi_static_direction, 
 from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
 from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
-from .linalg import RANK_TOL, solve_psd, solve_psd_2x2
+from .linalg import RANK_TOL, solve_psd, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
-                         apply_inverse_mass, damping_power, gram_row, inverse_mass_of_row, is_stick, kinetic_coefficient,
-                         kinetic_energy, law_row, static_limit)
+                         apply_inverse_mass, damping_power, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick,
+                         kinetic_coefficient, kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
 from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
 
@@ -81,7 +81,7 @@ def write_derivative(s, md, n, nc, diagonal, v, w, F, f, ds):
     m = md.m
     for i in range(n):
         ds[i] = s[n + i]
-    apply_inverse_mass(m, n, diagonal, f, ds[n:2 * n])
+    inverse_mass_of(md.kin, m, n, diagonal, f, ds[n:2 * n])
     if ds.shape[0] >= 2 * n + 2:
         power = csm.zero(s[0])
         for i in range(2 * nc):
@@ -404,7 +404,7 @@ def project_velocities(s, cst, extra, md):
             for i in range(contact_dim(md.kin, m, n, c)):
                 gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, 0.0)
                 r += 1
-    solve_psd(A, b, x, V, k)
+    solve_stick_system(md.kin, A, b, x, V, k)
     for r in range(k):
         for j in range(n):
             s[n + j] -= MG[r, j] * x[r]

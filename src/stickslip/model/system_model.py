@@ -37,6 +37,7 @@ from .kinematics import (CONSTANT_KINEMATICS, ConstantKinematics, ConstantRigidK
                          registered_kinematics)
 from .matrices import (DENSE_DOFS, MAX_MASS_CONDITION, check_mass, contact_rows, dense_array, dense_spec, finite,
                        has_nonzero, is_sparse, square_matrix)
+from .mass_factor import without_round_off
 from .physics import SPEED_FLOOR
 from .sparse_form import NodeMap, SparseForm, sparse_form
 from .stack import MAX_CONTACTS, MAX_DOFS, static_sizes
@@ -574,12 +575,13 @@ class FrictionModel:
         (n² numbers each, for hundreds to a few thousand dofs).
         """
         self._check_compiled_size()
-        damping, stiffness = dense_array(self.damping), dense_array(self.stiffness)
-        m = pack(dense_array(self.mass), damping, stiffness, self.force, self.free,
-                 [dense_spec(contact.spec(self.n)) for contact in self.contacts], self.slip_band,
-                 self.constant_kinematics)
-        kin = large_kinematics(kernel_kinematics(self.kinematics, *self._contact_kinds()), self.n, self.n_contacts,
-                               damping, stiffness)
+        matrices = [dense_array(a) for a in (self.mass, self.damping, self.stiffness)]
+        kin = kernel_kinematics(self.kinematics, *self._contact_kinds())
+        if not fits_stack(type(kin), self.n, self.n_contacts):  # the heap flavour: patterns of the mechanics
+            matrices = [without_round_off(a) for a in matrices]
+        m = pack(*matrices, self.force, self.free, [dense_spec(contact.spec(self.n)) for contact in self.contacts],
+                 self.slip_band, self.constant_kinematics)
+        kin = large_kinematics(kin, self.n, self.n_contacts, (*matrices, self.free))
         return ModelData(m, kin, self.user_law)
 
     @cached_property

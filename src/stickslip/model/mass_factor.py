@@ -1,0 +1,70 @@
+"""The sparse structure that the heap-flavour kernels of a large model take from its dense matrices.
+
+A reduced finite-element model (Craig–Bampton, ``stickslip.reduction``) has dense M, C, K in
+form only: the blocks that the reduction's theory makes zero (the fixed-interface modes are
+orthonormal in M and orthogonal in K, and orthogonal in K to the constraint modes) come out of
+its floating-point products as round-off, ~1e-15 of the diagonal. Read as data, they make every
+right-hand side cost O(n²) memory traffic (M⁻¹ f, C q̇, K q) where the model has O(n nb)
+numbers (nb the boundary DOFs).
+
+* :func:`without_round_off` sets those entries to zero: |A_ij| ≤ :data:`ROUND_OFF` ·
+  √|A_ii A_jj| (i ≠ j), four hundred times the round-off of a reduction, far below any coupling
+  of a mechanical model (|A_ij| ≤ √(A_ii A_jj) for a positive semi-definite matrix); where a
+  diagonal entry is zero the bound is zero and every nonzero entry stays;
+* :func:`row_pattern` gives the row-compressed pattern of the entries that are not zero (the
+  kernels sum over those only);
+* :func:`mass_factor` gives the Cholesky factor of M on its free DOFs in an order that keeps it
+  sparse: rows with fewest entries first (a reduced model's modes before its boundary DOFs: no
+  fill at all), so that M⁻¹ f is two triangular solves over the factor's entries
+  (:func:`~stickslip.model.model_data.inverse_mass_of`) instead of a product with the dense M⁻¹.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["ROUND_OFF", "without_round_off", "row_pattern", "mass_factor"]
+
+#: Relative size |A_ij| / √|A_ii A_jj| at or below which an off-diagonal entry of M, C or K of a
+#: large model counts as round-off (module docstring).
+ROUND_OFF = 1e-13
+
+
+def without_round_off(matrix: np.ndarray) -> np.ndarray:
+    """A copy of the dense (n, n) ``matrix`` with its off-diagonal entries at or below
+    :data:`ROUND_OFF` of the geometric mean of their diagonal entries set to zero."""
+    a = np.array(matrix, dtype=float)
+    d = np.sqrt(np.abs(np.diag(a)))
+    small = np.abs(a) <= ROUND_OFF * np.outer(d, d)
+    np.fill_diagonal(small, False)
+    a[small] = 0.0
+    return a
+
+
+def row_pattern(nonzero: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(rows (n + 1,), columns) int64: the row-compressed pattern of the True entries of the
+    (n, n) boolean ``nonzero``, columns ascending in each row."""
+    rows = np.zeros(nonzero.shape[0] + 1, dtype=np.int64)
+    np.cumsum(nonzero.sum(axis=1), out=rows[1:])
+    return rows, np.nonzero(nonzero)[1].astype(np.int64)
+
+
+def mass_factor(mass: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The Cholesky factor L of M on its free DOFs, P M_ff Pᵀ = L Lᵀ, P the order of fewest
+    entries per row first (stable).
+
+    Returns (order, rows, columns, values, diagonal): ``order`` (nf,) int64, the DOF of each
+    factor row; the strictly lower part of L row-compressed over its nonzero entries, ``rows``
+    (nf + 1,) int64, ``columns`` int64 as the DOFs they stand for (not factor indices: the solve
+    reads the vector there directly), ``values``; ``diagonal`` (nf,) the diagonal of L. The
+    factor's zeros are exact: the dense factorisation computes an entry outside the fill of P's
+    order from products that are all exact zeros.
+    """
+    idx = np.flatnonzero(np.asarray(free, dtype=bool))
+    sub = np.asarray(mass, dtype=float)[np.ix_(idx, idx)]
+    order = np.argsort(np.count_nonzero(sub, axis=1), kind="stable")
+    low = np.linalg.cholesky(sub[np.ix_(order, order)])
+    strict = np.tril(low, -1)
+    rows, columns = row_pattern(strict != 0.0)
+    dofs = idx[order].astype(np.int64)
+    return dofs, rows, dofs[columns], strict[strict != 0.0].copy(), np.diag(low).copy()

@@ -1,0 +1,136 @@
+"""The sparse structure of the heap flavour (model/mass_factor.py): round-off entries dropped, the
+mass factor without fill, and the compiled M⁻¹ f, stick multipliers and memory estimate that use it,
+against numpy and scipy on the model's own matrices."""
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+
+from stickslip.memory import compiled_model_bytes, model_data_bytes, pattern_bytes, work_array_bytes
+from stickslip.model import physics as P
+from stickslip.model.bundle import CST, contact_state
+from stickslip.model.kinematics import LARGE_KINEMATICS
+from stickslip.model.library import load_model
+from stickslip.model.linalg import solve_by_cholesky
+from stickslip.model.mass_factor import ROUND_OFF, mass_factor, without_round_off
+from stickslip.reduction import reduce_model, write_model_file
+
+from .fe_models import pad_on_belt
+
+PAD = dict(nx=8, ny=6, mu_k=0.3, delta_mu=0.2, preload=3e-5, E=1e7, contact_stiffness=1e6, rayleigh=(0.0, 2e-6),
+           speed=0.05)
+
+
+def arrow_mass(modes: int, boundary: int, seed: int = 0) -> np.ndarray:
+    """A Craig–Bampton mass matrix: the boundary DOFs first, a dense coupling to the modes, the
+    modes' block the identity."""
+    rng = np.random.default_rng(seed)
+    coupling = 0.1 * rng.standard_normal((boundary, modes))
+    bb = coupling @ coupling.T + np.eye(boundary)
+    return np.block([[bb, coupling], [coupling.T, np.eye(modes)]])
+
+
+def test_round_off_entries_are_dropped_and_the_others_kept():
+    a = np.array([[4.0, 1e-14, 2e-12, 0.5], [1e-14, 1.0, 0.0, 0.0], [2e-12, 0.0, 1.0, 3.0], [0.5, 0.0, 3.0, 0.0]])
+    b = without_round_off(a)
+    assert b[0, 1] == b[1, 0] == 0.0  # 1e-14 / √4 = 5e-15 ≤ ROUND_OFF
+    assert b[0, 2] == 2e-12 and 2e-12 / 2.0 > ROUND_OFF  # kept: above the bound
+    assert b[2, 3] == 3.0 and b[0, 3] == 0.5  # a zero diagonal entry bounds nothing away
+    np.testing.assert_array_equal(np.diag(b), np.diag(a))
+    assert a[0, 1] == 1e-14  # the input is not changed
+
+
+def test_mass_factor_of_a_reduced_mass_has_no_fill_and_factors_it():
+    modes, boundary = 30, 6
+    mass = arrow_mass(modes, boundary)
+    n = modes + boundary
+    free = np.ones(n, bool)
+    free[2] = False  # a locked boundary DOF: the factor covers the free ones
+    order, rows, columns, values, diagonal = mass_factor(mass, free)
+    assert set(order[:modes]) == set(range(boundary, n))  # the modes first (fewest entries)
+    nf = order.size
+    assert rows[modes] == 0  # no fill: no entry between two modes (their block of L is diagonal)
+    low = np.diag(diagonal)
+    position = {dof: i for i, dof in enumerate(order)}
+    for i in range(nf):
+        for p in range(rows[i], rows[i + 1]):
+            low[i, position[columns[p]]] = values[p]
+    np.testing.assert_allclose(low @ low.T, mass[np.ix_(order, order)], rtol=0, atol=1e-14 * np.abs(mass).max())
+
+
+def test_cholesky_solves_what_is_full_rank_and_leaves_the_rest_to_jacobi():
+    rng = np.random.default_rng(1)
+    g = rng.standard_normal((5, 8))
+    a = g @ g.T
+    b = rng.standard_normal(5)
+    x, v = np.zeros(5), np.zeros((5, 5))
+    assert solve_by_cholesky(a.copy(), b, x, v, 5)
+    np.testing.assert_allclose(x, np.linalg.solve(a, b), rtol=1e-12)
+    singular = g[:, :3] @ g[:, :3].T  # rank 3 of 5
+    x[:] = 7.0
+    assert not solve_by_cholesky(singular, b, x, v, 5)
+    assert np.all(x == 7.0)  # x not written: the caller's Jacobi solve takes it
+
+
+@pytest.fixture(scope="module")
+def reduced(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("factor")
+    full = load_model(str(pad_on_belt(**PAD).write(folder / "pad")))
+    red = reduce_model(full, method="craig-bampton", modes=60)
+    write_model_file(red.form, folder / "cb.toml")
+    model = load_model(str(folder / "cb.toml"))
+    assert type(model.data.kin) is LARGE_KINEMATICS[type(model.kinematics)] and model.n == 78
+    return model
+
+
+def test_memory_estimate_counts_the_sparse_structure(reduced):
+    n, nc = reduced.n, reduced.n_contacts
+    assert compiled_model_bytes(n, nc) == model_data_bytes(n, nc) + work_array_bytes(n, nc) + pattern_bytes(n)
+    kin = reduced.data.kin
+    held = sum(a.nbytes for a in kin if isinstance(a, np.ndarray))
+    assert held <= pattern_bytes(n)
+
+
+def matrices(model):
+    form = model.sparse_form()
+    return tuple(np.asarray(a.toarray() if hasattr(a, "toarray") else a, float)
+                 for a in (form.mass, form.damping, form.stiffness))
+
+
+def random_state(n, seed=2):
+    rng = np.random.default_rng(seed)
+    s = np.zeros(2 * n + 2)
+    s[:n] = 1e-7 * rng.standard_normal(n)
+    s[n:2 * n] = 1e-4 * rng.standard_normal(n)
+    return s
+
+
+def test_open_contacts_accelerate_by_the_model_matrices(reduced):
+    """Every contact open: q̈ = M⁻¹ (f0 − C q̇ − K q), by scipy on the model's own M, C, K (with
+    their round-off entries) against the kernels' factor solve."""
+    n = reduced.n
+    M, C, K = matrices(reduced)
+    s = random_state(n)
+    cst = contact_state(reduced.data.m)
+    cst[0::CST] = P.MODE_OPEN
+    ds = np.zeros_like(s)
+    P.rhs(s, cst, reduced.data, ds)
+    f = np.asarray(reduced.sparse_form().force, float) - C @ s[n:2 * n] - K @ s[:n]
+    expected = sl.solve(M, f, assume_a="pos")
+    np.testing.assert_allclose(ds[n:2 * n], expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
+def test_every_contact_sticking_holds_its_slip_velocity(reduced):
+    """All nine contacts sticking (nine stick rows: the Cholesky solve): their slip accelerations
+    G q̈ vanish to round-off of the terms that make them up."""
+    n, nc = reduced.n, reduced.n_contacts
+    s = random_state(n, 3)
+    cst = contact_state(reduced.data.m)
+    cst[0::CST] = P.MODE_STICK
+    ds = np.zeros_like(s)
+    P.rhs(s, cst, reduced.data, ds)
+    rows = reduced.sparse_form().tangent.toarray()
+    assert rows.shape[0] == nc  # one tangent row each: nine stick rows
+    acc = rows @ ds[n:2 * n]
+    scale = np.abs(rows).max() * np.abs(ds[n:2 * n]).max()
+    assert np.abs(acc).max() <= 1e-11 * scale
