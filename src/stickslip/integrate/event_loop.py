@@ -408,6 +408,7 @@ def accept_step(progress, t_base, step, slips, cst, md, samples, scratch, q_read
 
 
 # ----------------------------------------------------------------------------- the loop
+@standalone
 @kernel
 def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, stats, start_modes):
     """The loop of :func:`integrate_event` (module docstring), free of reference counting.
