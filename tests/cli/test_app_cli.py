@@ -7,6 +7,7 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import importlib
@@ -209,27 +210,73 @@ def _size(path) -> int:
     return path.stat().st_size if path.exists() else -1
 
 
-def _stickslip(*args) -> list:
+def _journaled_orbits(path) -> int:
+    """Points of the branch in a continuation's journal: its ``JSON<TAB>crc`` lines after the
+    header whose record holds a ``"point"`` (the start orbit is recorded before the first of them)."""
+    if not path.is_file():
+        return 0
+    count = 0
+    for line in path.read_bytes().splitlines()[1:]:
+        try:
+            record = json.loads(line.rpartition(b"\t")[0])
+        except ValueError:  # a line being written
+            continue
+        count += isinstance(record, dict) and "point" in record
+    return count
+
+
+def _stickslip(*args, prelude: str = "") -> list:
     # faulthandler: a command that Ctrl-C did not end shows where it was (SIGABRT, _interrupt_when)
-    return [sys.executable, "-X", "faulthandler", "-c", "from stickslip.cli import app; app()", *args]
+    return [sys.executable, "-X", "faulthandler", "-c", f"{prelude}\nfrom stickslip.cli import app; app()", *args]
 
 
-def _interrupt_when(proc, ready, deadline_s=120.0) -> tuple:
-    """Send SIGINT to ``proc`` once ``ready()`` is true; its (returncode, stdout, stderr lines).
-    A command still running 60 s later fails the test with the stacks of its threads."""
+#: Run before the command line: the first chunk of a run touches the file named by
+#: ``STICKSLIP_TEST_CHUNK_DONE`` once recorded. The test presses Ctrl-C on that evidence, whatever
+#: the imports and the kernels (compiled on a cold cache: a minute or more) took before it.
+_MARK_FIRST_CHUNK = """
+import os, pathlib
+from stickslip.integrate import runner
+_add = runner.Record.add
+def _add_and_mark(self, chunk):
+    _add(self, chunk)
+    if self.n > 0:
+        pathlib.Path(os.environ["STICKSLIP_TEST_CHUNK_DONE"]).touch()
+runner.Record.add = _add_and_mark
+"""
+
+
+def _interrupt_when(proc, ready, deadline_s=900.0) -> tuple:
+    """Send SIGINT to ``proc`` once ``ready(stderr lines so far)`` is true (or ``deadline_s`` has
+    passed, or it has ended); its (returncode, stdout, stderr lines). A command still running 60 s
+    after the SIGINT fails the test with the stacks of its threads."""
+    streams = {"out": [], "err": []}
+
+    def read(stream, into: list) -> None:  # line by line, so that ``ready`` sees each as it comes
+        for line in stream:
+            into.append(line)
+
+    readers = [threading.Thread(target=read, args=(proc.stdout, streams["out"]), daemon=True),
+               threading.Thread(target=read, args=(proc.stderr, streams["err"]), daemon=True)]
+    for reader in readers:
+        reader.start()
     deadline = time.monotonic() + deadline_s
-    while not ready() and proc.poll() is None and time.monotonic() < deadline:
+    while not ready(list(streams["err"])) and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     proc.send_signal(signal.SIGINT)
     try:
-        stdout, stderr = proc.communicate(timeout=60)
+        proc.wait(timeout=60)
     except subprocess.TimeoutExpired:
         proc.send_signal(signal.SIGABRT)  # faulthandler prints every thread's stack, then the process ends
-        _, stderr = proc.communicate(timeout=60)
-        pytest.fail(f"Ctrl-C did not end the command within 60 s; where it was:\n{stderr[-6000:]}")
+        proc.wait(timeout=60)
+        for reader in readers:
+            reader.join(timeout=10)
+        pytest.fail(f"Ctrl-C did not end the command within 60 s; where it was:\n{''.join(streams['err'])[-6000:]}")
     finally:
         proc.kill()  # if Ctrl-C did not end it
-    return proc.returncode, stdout, [ln for ln in stderr.splitlines() if ln.strip()]
+    for reader in readers:
+        reader.join(timeout=60)
+    stderr = "".join(streams["err"])
+    return proc.returncode, "".join(streams["out"]), [ln for ln in stderr.splitlines() if ln.strip()]
 
 
 @pytest.mark.parametrize("command", [
@@ -248,13 +295,11 @@ def test_ctrl_c_stops_resumable_work_keeps_its_journal_and_the_same_command_resu
         assert warm.returncode == 0, warm.stderr
     cmd = _stickslip(*command, "--no-plot", "--out", str(out), "--json")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    sizes = []
 
-    def first_work_journaled() -> bool:
+    def first_work_journaled(_) -> bool:
         if command[0] == "sweep":  # a finished point recorded (the manifest is written first)
             return _size(journal / "rows.f64") > 0
-        sizes.append(_size(journal))  # the journal has grown since its header was written
-        return len(sizes) > 10 and sizes[-11] >= 0 and sizes[-1] > sizes[-11]
+        return _journaled_orbits(journal) > 0  # not only the start orbit: a point of the branch
 
     code, _, lines = _interrupt_when(proc, first_work_journaled)
     assert code == 130, lines
@@ -262,8 +307,9 @@ def test_ctrl_c_stops_resumable_work_keeps_its_journal_and_the_same_command_resu
     assert not out.exists() and _size(journal) > 0
     if command[0] == "continue":
         again = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        code, _, lines = _interrupt_when(again, lambda: False, deadline_s=10.0)
+        code, _, lines = _interrupt_when(again, lambda said: len(said) > 0)  # Ctrl-C once it has said its first line
         assert code == 130 and lines[0].startswith("resuming from "), lines
+        assert len(lines) == 2 and lines[1].startswith("interrupted:") and "resume" in lines[1], lines
         return
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
@@ -274,11 +320,13 @@ def test_ctrl_c_stops_resumable_work_keeps_its_journal_and_the_same_command_resu
 def test_ctrl_c_keeps_the_part_of_a_run_done(tmp_path):
     from stickslip import load_trajectory
 
-    out = tmp_path / "x.nc"
+    out, chunk_done = tmp_path / "x.nc", tmp_path / "first-chunk-done"
     proc = subprocess.Popen(_stickslip("simulate", "--t-end", "100000", "--sample-rate", "10", "--no-plot",
-                                       "--out", str(out)), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    started = time.monotonic()
-    code, _, lines = _interrupt_when(proc, lambda: time.monotonic() - started > 8)
+                                       "--out", str(out), prelude=_MARK_FIRST_CHUNK),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "STICKSLIP_TEST_CHUNK_DONE": str(chunk_done)})
+    code, _, lines = _interrupt_when(proc, lambda _: chunk_done.exists())
+    assert chunk_done.exists(), lines  # the run had started when Ctrl-C was pressed
     assert code == 130, lines
     assert len(lines) == 1 and lines[0].startswith("interrupted: the run up to t = ") and str(out) in lines[0], lines
     kept = load_trajectory(out)
