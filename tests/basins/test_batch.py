@@ -112,3 +112,19 @@ def test_the_period_rule_filter_never_misses_a_settled_sequence(k):
     assert maybe_settled(exact, np.arange(exact.size) * (2.0 / k), 1.0)
     # a transient far above the settle tolerance is no candidate
     assert not maybe_settled(1.0 + 1e3 * SETTLE_RTOL * 0.7 ** np.arange(40), np.arange(40.0), 1.0)
+
+
+def test_a_study_in_batches_of_either_path_gives_the_same_result(tmp_path, monkeypatch):
+    """A whole study with batches large enough for the compiled batch gives the result of the same
+    study whose batches all take the per-state path (the one classifier that decides small batches)."""
+    from stickslip.basins import engine
+
+    states = box(BELT, {"x": (-2, 2), "dx": (0, 2)}, n=80, seed=11)
+    compiled = stickslip.basin_stability(BELT, states, t_end=200.0, executor="serial", batch_size=40,
+                                         out=tmp_path / "compiled.nc")
+    monkeypatch.setattr(engine, "MIN_COMPILED_BATCH", 10**9)
+    per_state = stickslip.basin_stability(BELT, states, t_end=200.0, executor="serial", batch_size=40,
+                                          out=tmp_path / "per_state.nc")
+    a, b = compiled.to_xarray(), per_state.to_xarray()
+    for name in ("label", "verdict", "decided_by", "t_decided", "steps", "fraction", "standard_error", "period"):
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)

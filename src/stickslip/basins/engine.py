@@ -52,6 +52,10 @@ MAX_BATCH_STATES = 4096
 #: States classified in this process after the first (which compiles or loads the kernels) to
 #: time a state for the automatic batch size.
 TIMED_STATES = 8
+#: Fewest states of a batch that the compiled batch classifies: it saves ~1 ms·core a state but
+#: costs a first call ~15 s of CPU to compile, so a small study (or a large one's first and timed
+#: states) keeps the per-state path, whose outcome rows are the same state by state.
+MIN_COMPILED_BATCH = 32
 
 
 def evaluate_batch(task):
@@ -62,7 +66,7 @@ def evaluate_batch(task):
     """
     ctx, indices, states, cycles, opts = task
     model = model_of(ctx.key)
-    if compiled_batch_applies(model):  # one compiled call for the states its tests decide
+    if len(states) >= MIN_COMPILED_BATCH and compiled_batch_applies(model):  # one compiled call for many states
         return indices, classify_batch(ctx, model, states, cycles, opts)[0]
     cycles = list(cycles)
     rows = []
