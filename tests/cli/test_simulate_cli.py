@@ -269,3 +269,16 @@ def test_a_library_warning_is_one_line(tmp_path, monkeypatch):
     res = run("--t-end", "1", "--json")
     assert res.exit_code == 0, res.output
     assert [ln for ln in res.stderr.splitlines() if ln.strip()] == ["warning: something to know over two lines"]
+
+
+def test_a_number_beyond_the_float_range_is_quoted_as_typed():
+    """A 401-digit --t-end reads as inf: the error line quotes the digits typed, not 'inf'."""
+    import subprocess
+    import sys
+
+    digits = "1" + "0" * 400
+    for args, shown in ((["--t-end", digits], digits), ([f"--t-end=-{digits}"], f"-{digits}")):
+        res = subprocess.run([sys.executable, "-c", "from stickslip.cli import app; app()", "simulate", "--model",
+                              "belt", *args], capture_output=True, text=True, timeout=120)
+        assert res.returncode == 2
+        assert res.stderr.strip().splitlines() == [f"error: --t-end must be a finite number > 0, got {shown}"]

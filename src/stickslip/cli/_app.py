@@ -67,6 +67,23 @@ def exact(value) -> str:
     return text[:-2] if text.endswith(".0") else text
 
 
+def as_typed(flag: str, value) -> str:
+    """Option ``flag``'s ``value`` as the user typed it where the float lost it (a number beyond
+    the float range reads as ``inf``: its 400 digits are quoted, not ``inf``), else :func:`exact`."""
+    if isinstance(value, float) and not math.isfinite(value):
+        args = sys.argv[1:]
+        for i, arg in enumerate(args):
+            text = arg[len(flag) + 1:] if arg.startswith(flag + "=") else (
+                args[i + 1] if arg == flag and i + 1 < len(args) else None)
+            try:
+                typed = float(text) if text is not None else None
+            except ValueError:
+                continue
+            if typed is not None and (typed == value or math.isnan(typed) and math.isnan(value)):
+                return text
+    return exact(value)
+
+
 def error_line(message: str) -> None:
     """Print ``error: message`` as one line on stderr, exactly as written: what the user typed is
     quoted as typed, however many digits it has."""
@@ -464,7 +481,7 @@ def check_positive(flags: dict) -> None:
     """Every ``{flag: value}`` must be a finite number > 0 (``None``: not given, skipped)."""
     for flag, value in flags.items():
         if value is not None and not (math.isfinite(value) and value > 0):
-            raise CLIError(f"{flag} must be a finite number > 0, got {value}")
+            raise CLIError(f"{flag} must be a finite number > 0, got {as_typed(flag, value)}")
 
 
 def check_below_one(flags: dict) -> None:
@@ -488,7 +505,7 @@ def check_finite(flags: dict) -> None:
     """Every ``{flag: value}`` must be a finite number (``None``: not given, skipped)."""
     for flag, value in flags.items():
         if value is not None and not math.isfinite(value):
-            raise CLIError(f"{flag} must be a finite number, got {value}")
+            raise CLIError(f"{flag} must be a finite number, got {as_typed(flag, value)}")
 
 
 # ----------------------------------------------------------------------------- outputs
