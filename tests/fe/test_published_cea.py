@@ -50,7 +50,7 @@ def test_onset_converges_to_becks_load():
         if n >= 8:
             assert abs(load - BECK_LOAD) <= BECK_DIGITS
     errors = [load - exact_load for load, _, _ in onsets]
-    assert all(e > 0 for e in errors)  # the conforming elements are stiffer than the continuum
+    assert all(e > 0 for e in errors)  # from above, as measured
     ratios = [errors[i] / errors[i + 1] for i in range(len(errors) - 1)]
     assert all(12.0 < r < 20.0 for r in ratios), ratios
     frequency_errors = [abs(frequency - exact_frequency) for _, frequency, _ in onsets]
@@ -69,6 +69,6 @@ def test_onset_at_finite_element_scale():
     assert abs(load - exact_load) < 1e-7 * exact_load
     assert abs(frequency - exact_frequency) < 1e-5 * exact_frequency
     assert float(np.max(band.backward_error)) < 1e-12 and band.frictionless_count == 2
-    # just past the onset the pair grows; at Beck's last digit above it, at a rate √(P − P_c) sets
+    # a unit of Beck's last digit above it the pair grows, at about the onset's frequency
     above = stability(beck_column(elements, BECK_LOAD + 2 * BECK_DIGITS), max_frequency=BAND)
     assert above.verdict == "unstable" and math.isclose(pair(above)[0].imag, frequency, rel_tol=1e-2)
