@@ -24,16 +24,21 @@ from ..integrate.runner import MIN_TRANSITION_ROOM, TRANSITIONS_PER_SECOND, Even
 from ..integrate.slip_watch import slip_watch
 from ..analysis.modes import contact_index_dtype
 from ..model.bundle import contact_state
-from .batch_kernels import AT_REST, MATCHED, Plan, Work, classify_states
+from .batch_kernels import AT_REST, LINEAR, MATCHED, RECURRED, Plan, Work, classify_states
 from .context import Context
 from .cycles import KMAX, find_cycle
-from .early import LINEAR_CHUNKS, RULE_PERIODS, Options, Outcome, classify_state, row_column, row_width
+from .early import (LINEAR_CHUNKS, RECURRENCE_FACTOR, RULE_PERIODS, Options, Outcome, classify_state, row_column,
+                    row_width, test_interval)
 
 __all__ = ["classify_batch", "compiled_batch_applies"]
 
 #: Room for the transitions of one state's run (its window's test for a contact that stuck reads
 #: them); a state with more goes to the Python classifier.
 TRANSITION_ROOM = 1 << 16
+
+#: Breakaways whose states a run keeps for the recurrence test (its latest ones); a state whose
+#: test would need earlier ones goes to the Python classifier.
+BREAKAWAY_ROOM = 256
 
 #: The kinematics classes whose batch kernel this process has prepared (a cold start compiles
 #: the event loop's callees in two processes first, as a run does).
@@ -50,7 +55,8 @@ def _plan(ctx: Context, model, opts: Options, times: np.ndarray) -> Plan:
     return Plan(float(opts.t_end), float(ctx.dt), int(m), int(ctx.window),
                 int(min(ctx.window + 3 * (2 * m + 2), times.size)), float(opts.rtol), float(opts.atol),
                 float(m * ctx.dt), int(opts.max_steps), float(ctx.period), float(opts.match_rtol),
-                bool(ctx.stable), int(model.observed_index), int(model.n), int(LINEAR_CHUNKS), float(RULE_PERIODS))
+                bool(ctx.stable), int(model.observed_index), int(model.n), int(LINEAR_CHUNKS), float(RULE_PERIODS),
+                int(test_interval(ctx)), float(RECURRENCE_FACTOR))
 
 
 def _work(model, plan: Plan, times: np.ndarray) -> Work:
@@ -66,8 +72,8 @@ def _work(model, plan: Plan, times: np.ndarray) -> Work:
                         np.empty((plan.capacity, 2 * nc))),
                 Samples(np.empty(0), np.empty((1, ns)), mode_array(1, nc, model.unilateral), np.empty((1, 2 * nc))),
                 transition_log(1, ns, contact_index_dtype(nc)), transition_log(room, ns, contact_index_dtype(nc)),
-                np.empty(TRANSITION_ROOM), np.zeros((3, times.size // max(plan.chunk - 1, 1) + 4), dtype=np.int64),
-                np.empty((5, crossings)))
+                np.empty(TRANSITION_ROOM), np.zeros((3, times.size // max(plan.piece - 1, 1) + 4), dtype=np.int64),
+                np.empty((5, crossings)), np.empty((3, BREAKAWAY_ROOM)), np.empty((BREAKAWAY_ROOM, 2 * n)))
 
 
 def _linear(ctx: Context, model) -> tuple:
@@ -99,20 +105,23 @@ def _prepare(model, s0: np.ndarray, opts: Options) -> None:
 
 def _rows(result, lo: int, hi: int, cycles, n2: int, wall: float) -> np.ndarray:
     """The outcome rows (:meth:`.early.Outcome.to_row`) of the states lo ≤ i < hi decided in the
-    compiled call: each one's kind of row (the cycle's for a match) with its time decided, steps,
-    wall time and, for an equilibrium, the state it ended in."""
+    compiled call: each one's kind of row (the cycle's for a match or a recurrence) with its time
+    decided, steps, wall time and, for an equilibrium, the state it ended in."""
     codes, matched, t_decided, steps, final = (a[lo:hi] for a in result)
     zero = np.zeros(n2)
     kinds = [Outcome("equilibrium", "at-rest", 0.0, None, zero).to_row(),
              Outcome("equilibrium", "linear", 0.0, None, zero).to_row()]
     kinds += [Outcome("periodic", "matched", 0.0, c, c.state).to_row() for c in cycles]
-    kind = np.where(codes == MATCHED, 2 + matched, np.where(codes == AT_REST, 0, 1))
+    kinds += [Outcome("periodic", "recurred", 0.0, c, c.state).to_row() for c in cycles]
+    kind = np.select([codes == AT_REST, codes == LINEAR, codes == MATCHED, codes == RECURRED],
+                     [0, 1, 2 + matched, 2 + len(cycles) + matched])
     rows = np.array(kinds)[kind]
     rows[:, row_column("t_decided")] = t_decided
     rows[:, row_column("steps")] = steps
     rows[:, row_column("wall_time")] = wall
     state = row_column("state")
-    rows[codes != MATCHED, state:state + n2] = final[codes != MATCHED]
+    steady = (codes == AT_REST) | (codes == LINEAR)
+    rows[steady, state:state + n2] = final[steady]
     return rows
 
 

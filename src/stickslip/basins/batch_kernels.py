@@ -1,14 +1,15 @@
 """The early-stopping classifier compiled over a batch of states: one call for many states.
 
 For each state, the run :func:`.early.classify_state` makes, made here without Python between
-its chunks: the same contact check and starting modes, the same chunks of the event loop
+its pieces: the same contact check and starting modes, the same pieces of the event loop
 (:func:`stickslip.integrate.event_loop.event_loop`, called with the arguments that
 :class:`~stickslip.integrate.runner.EventStepper` gives it: the chunk's end, its step size, its
 room for transitions, again from its start where that was short), the same record of samples
 (the window kept as :class:`~stickslip.integrate.runner.Record` keeps it), so that a state takes
-the same steps and writes the same samples as there. After each chunk the tests of
-:class:`.early.EarlyStop` decide on those samples (:mod:`.batch_rules`): steady sliding reached
-(at rest, or linear), a known cycle reached. What these tests cannot decide here is handed
+the same steps and writes the same samples as there. After each piece the tests of
+:class:`.early.EarlyStop` decide on those samples and on the breakaways' states
+(:mod:`.batch_rules`): steady sliding reached (at rest, or linear), a known cycle reached or
+recurred. What these tests cannot decide here is handed
 back (:data:`PYTHON`): a state whose run ends early or reaches t_end, where the period rule
 might find a new cycle, where a test is too near its threshold, or whose buffers run out; the
 caller classifies it with :func:`.early.classify_state`, and calls again for the states after it.
@@ -22,17 +23,18 @@ import numpy as np
 
 from ..analysis.period import MIN_PERIODS
 from ..integrate import contacts as E
+from ..integrate.contacts import TRANSITION_TO_SLIP
 from ..integrate.bundles import Samples, TransitionLog
 from ..integrate.event_loop import Controls, event_loop
 from ..integrate.runner import MIN_TRANSITION_ROOM, TRANSITIONS_PER_SECOND
 from ..integrate.status import CHUNK_END, SUCCESS
 from ..model.jit import loop
-from .batch_rules import DOUBT, linear_test, matched_cycle, maybe_settled, section
+from .batch_rules import DOUBT, linear_test, matched_cycle, maybe_settled, minima_between, period_match, recurs, section
 
-__all__ = ["Plan", "Work", "classify_states", "UNDECIDED", "AT_REST", "LINEAR", "MATCHED", "PYTHON"]
+__all__ = ["Plan", "Work", "classify_states", "UNDECIDED", "AT_REST", "LINEAR", "MATCHED", "RECURRED", "PYTHON"]
 
 #: What a state came to (:func:`classify_states`' codes).
-UNDECIDED, AT_REST, LINEAR, MATCHED, PYTHON = 0, 1, 2, 3, -1
+UNDECIDED, AT_REST, LINEAR, MATCHED, RECURRED, PYTHON = 0, 1, 2, 3, 4, -1
 
 
 class Plan(NamedTuple):
@@ -40,7 +42,8 @@ class Plan(NamedTuple):
     :func:`.batch.classify_batch`): t_end, the sample interval dt [s], the samples of a chunk and
     of the window, the rows of the record, the tolerances, the largest step (one chunk) [s], the
     step cap, T_c [s], the match tolerance, whether steady sliding is stable, the observed
-    coordinate, n, and :data:`.early.LINEAR_CHUNKS` and :data:`.early.RULE_PERIODS`."""
+    coordinate, n, :data:`.early.LINEAR_CHUNKS`, :data:`.early.RULE_PERIODS`, the samples of a
+    piece (:func:`.early.test_interval`) and :data:`.early.RECURRENCE_FACTOR`."""
 
     t_end: float
     dt: float
@@ -58,6 +61,8 @@ class Plan(NamedTuple):
     n: int
     linear_chunks: int
     rule_periods: float
+    piece: int
+    recurrence: float
 
 
 class Work(NamedTuple):
@@ -79,6 +84,8 @@ class Work(NamedTuple):
     tr_times: np.ndarray
     chunks: np.ndarray
     crossings: np.ndarray
+    breaks: np.ndarray
+    break_states: np.ndarray
 
 
 @loop
@@ -180,32 +187,76 @@ def _stuck(work, lo, a, b, first_tr, n_tr, t_a, t_b):
 
 
 @loop
-def _steady(plan, linear, work, times, at, first, target, linear_run):
-    """Test 1 of :class:`.early.EarlyStop` (steady sliding reached): (code, linear run)."""
-    base, n, _, n_tr = at
+def _steady(plan, linear, work, times, at, first, target):
+    """Test 1 of :class:`.early.EarlyStop` (steady sliding reached): its code."""
+    base, n, _, n_tr, _ = at
     window_first = work.chunks[0, first]
-    a, b = target - plan.chunk - window_first, target - window_first
-    if not (plan.stable and a >= 0 and b < n - window_first):
-        return UNDECIDED, linear_run
+    m = plan.chunk
+    if not (plan.stable and target - m - window_first >= 0 and target - window_first < n - window_first):
+        return UNDECIDED
     lo = window_first - base
     states = work.record.states
-    rest, lin = linear_test(linear, states[lo + a], states[lo + b])
-    if rest == DOUBT:
-        return PYTHON, linear_run
-    if rest == 1:
-        return AT_REST, linear_run
-    if _stuck(work, lo, a, b, work.chunks[1, first], n_tr, times[window_first + a],
-              times[window_first + b]):
-        return UNDECIDED, 0
-    if lin == DOUBT:
-        return PYTHON, linear_run
-    linear_run = linear_run + 1 if lin == 1 else 0
-    return (LINEAR if linear_run >= plan.linear_chunks else UNDECIDED), linear_run
+    for j in range(plan.linear_chunks):
+        a, b = target - (j + 1) * m - window_first, target - j * m - window_first
+        if a < 0:
+            return UNDECIDED
+        rest, lin = linear_test(linear, states[lo + a], states[lo + b])
+        if j == 0 and rest == DOUBT:
+            return PYTHON
+        if j == 0 and rest == 1:
+            return AT_REST
+        if _stuck(work, lo, a, b, work.chunks[1, first], n_tr, times[window_first + a], times[window_first + b]):
+            return UNDECIDED
+        if lin == DOUBT:
+            return PYTHON
+        if lin == 0:
+            return UNDECIDED
+    return LINEAR
 
 
 @loop
-def _recurrent(plan, cycles, work, times, at, first, status, t):
-    """Tests 2 and 3 of :class:`.early.EarlyStop` on the window's section: (code, cycle)."""
+def _recurred(plan, cycles, work, times, at, first, m):
+    """Test 3 of :class:`.early.EarlyStop` (a known cycle recurred), after the window's section
+    (its ``m`` maxima in ``work.crossings``): (code, cycle)."""
+    base, n, _, _, n_br = at
+    room = work.breaks.shape[1]
+    first_tr = work.chunks[1, first]
+    if cycles[0].size == 0 or n_br < 2 or work.breaks[2, (n_br - 1) % room] < first_tr:
+        return UNDECIDED, -1
+    last = (n_br - 1) % room
+    s2 = work.break_states[last]
+    q = n_br - 2
+    while True:
+        if q < 0 or n_br - q > room:  # no earlier breakaway, or the earlier ones' states were not kept
+            return (UNDECIDED if q < 0 else PYTHON), -1
+        i = q % room
+        if work.breaks[2, i] < first_tr:
+            return UNDECIDED, -1
+        if work.breaks[1, i] == work.breaks[1, last]:
+            r = recurs(work.break_states[i], s2, plan.recurrence, plan.atol, plan.rtol)
+            if r == DOUBT:
+                return PYTHON, -1
+            if r == 1:
+                break
+        q -= 1
+    t1, t2 = work.breaks[0, i], work.breaks[0, last]
+    cross = work.crossings
+    a = np.searchsorted(cross[0, :m], t1, side="right")
+    b = np.searchsorted(cross[0, :m], t2, side="right")
+    window_first = work.chunks[0, first]
+    states = work.record.states
+    j = plan.observed
+    n_min = minima_between(times[base:base + plan.capacity], states[:, j], states[:, plan.n + j], window_first - base,
+                           n - base, t1, t2, cross[3:5])
+    c = period_match(cycles, t2 - t1, cross[1], a, b, cross[4], n_min, plan.match_rtol)
+    if c == DOUBT:
+        return PYTHON, -1
+    return (RECURRED, c) if c >= 0 else (UNDECIDED, -1)
+
+
+@loop
+def _recurrent(plan, cycles, work, times, at, first, status, t, rule_due):
+    """Tests 2, 3 and 4 of :class:`.early.EarlyStop` on the window's section: (code, cycle)."""
     base, n = at[0], at[1]
     window_first = work.chunks[0, first]
     lo, hi = window_first - base, n - base
@@ -220,8 +271,13 @@ def _recurrent(plan, cycles, work, times, at, first, status, t):
         return PYTHON, -1
     if c >= 0:
         return MATCHED, c
+    code, c = _recurred(plan, cycles, work, times, at, first, m)
+    if code != UNDECIDED:
+        return code, c
     if status == SUCCESS:  # the window's verdict at t_end
         return PYTHON, -1
+    if not rule_due:
+        return UNDECIDED, -1
     t_from = t - plan.rule_periods * plan.period
     recent = m
     while recent > 0 and cross[0, recent - 1] >= t_from:
@@ -237,17 +293,16 @@ def _recurrent(plan, cycles, work, times, at, first, status, t):
 
 
 @loop
-def _decide(plan, linear, cycles, work, times, at, status, t, target, linear_run):
-    """:meth:`.early.EarlyStop._decide` after a chunk: (code, cycle, linear run). ``at``: (base, next
-    sample, chunks, transitions) of the record."""
+def _decide(plan, linear, cycles, work, times, at, status, t, target, rule_due):
+    """:meth:`.early.EarlyStop._decide` after a piece: (code, cycle). ``at``: (base, next sample,
+    pieces, transitions, breakaways) of the record."""
     if status != CHUNK_END and status != SUCCESS:
-        return PYTHON, -1, linear_run
+        return PYTHON, -1
     first = _window_start(work.chunks, at[2], plan.window)
-    code, linear_run = _steady(plan, linear, work, times, at, first, target, linear_run)
+    code = _steady(plan, linear, work, times, at, first, target)
     if code != UNDECIDED:
-        return code, -1, linear_run
-    code, cycle = _recurrent(plan, cycles, work, times, at, first, status, t)
-    return code, cycle, linear_run
+        return code, -1
+    return _recurrent(plan, cycles, work, times, at, first, status, t, rule_due)
 
 
 @loop
@@ -269,33 +324,54 @@ def _start(md, cst0, plan, s0, work):
 
 
 @loop
+def _log_piece(work, k, n_tr, n_br, n2):
+    """Keep a piece's ``k`` transitions (from the run's ``n_tr``-th): their times, and the time,
+    contact, number and state of each breakaway (the last ``work.breaks`` of the run). Returns
+    the run's breakaways."""
+    log, room = work.log, work.breaks.shape[1]
+    for q in range(k):
+        work.tr_times[n_tr + q] = log.times[q]
+        if log.kinds[q] == TRANSITION_TO_SLIP:
+            i = n_br % room
+            work.breaks[0, i] = log.times[q]
+            work.breaks[1, i] = log.contacts[q]
+            work.breaks[2, i] = n_tr + q
+            for c in range(n2):
+                work.break_states[i, c] = log.states[q, c]
+            n_br += 1
+    return n_br
+
+
+@loop
 def _classify(md, cst0, plan, linear, cycles, times, s0, work, result, i):
-    """Run state ``i`` (``s0``) chunk by chunk until it is decided; its code in ``result``."""
+    """Run state ``i`` (``s0``) piece by piece until it is decided; its code in ``result``."""
     codes, matched, t_decided, steps_taken, final = result
     if not _start(md, cst0, plan, s0, work):
         return PYTHON
-    m, chunks = plan.chunk, work.chunks
+    m, g, chunks = plan.chunk, plan.piece, work.chunks
     t, h, steps = 0.0, min(1e-3, plan.h_max), 0
-    base, n, count, n_tr, linear_run = 0, 0, 0, 0, 0
+    base, n, count, n_tr, n_br, next_rule = 0, 0, 0, 0, 0, m
     while True:
         if plan.capacity - (n - base) < 2 * m + 2 and count:
             base = _keep_from(work.record, base, n, chunks[0, _window_start(chunks, count, plan.window)])
-        target = max(n + m - 1, m)
+        target = max(n + g - 1, g)
         if count >= chunks.shape[1]:
             return PYTHON
         status, tau, h, idx, k = _advance(md, plan, times, base, n - base, t, h, target * plan.dt - t,
                                           plan.max_steps - steps, work)
         if k < 0 or n_tr + k > work.tr_times.size:
             return PYTHON
-        for q in range(k):
-            work.tr_times[n_tr + q] = work.log.times[q]
+        n_br = _log_piece(work, k, n_tr, n_br, 2 * plan.n)
         chunks[0, count], chunks[1, count], chunks[2, count] = n, n_tr, base + idx - n
         count += 1
         n, n_tr = base + idx, n_tr + k
         t = t + tau
         steps += int(work.stats[0] + work.stats[1])
-        code, cycle, linear_run = _decide(plan, linear, cycles, work, times, (base, n, count, n_tr), status, t,
-                                          target, linear_run)
+        rule_due = target >= next_rule
+        if rule_due:
+            next_rule = target + m
+        code, cycle = _decide(plan, linear, cycles, work, times, (base, n, count, n_tr, n_br), status, t, target,
+                              rule_due)
         if code == UNDECIDED and status == CHUNK_END:
             continue
         if code == UNDECIDED:
@@ -330,7 +406,7 @@ def classify_states(md, cst0, plan, linear, cycles, times, states, first, work, 
     work : Work
     result : tuple
         Written for each state classified: codes (N,) int (:data:`AT_REST`, :data:`LINEAR`,
-        :data:`MATCHED`), the cycle matched (N,) int, the time decided (N,) [s], the steps taken
+        :data:`MATCHED`, :data:`RECURRED`), the cycle matched (N,) int, the time decided (N,) [s], the steps taken
         (N,) int, the state it ended in (N, 2n + 2).
 
     Returns

@@ -21,7 +21,8 @@ from ..analysis.period import DRIFT_FLOOR, MAX_MULTIPLICITY, MIN_PERIODS, SEPARA
 from ..model.jit import loop
 from .cycles import MATCH_PERIODS
 
-__all__ = ["DOUBT", "NEAR", "LOOSE", "section", "matched_cycle", "linear_test", "maybe_settled"]
+__all__ = ["DOUBT", "NEAR", "LOOSE", "section", "matched_cycle", "linear_test", "maybe_settled", "recurs",
+           "period_match", "minima_between"]
 
 #: What a test gives where its outcome is not certain (compare :data:`NEAR`).
 DOUBT = -1
@@ -159,6 +160,73 @@ def matched_cycle(cycles, top_t, top_v, minima, m, rtol):
     k_of, periods, amplitudes, peaks = cycles
     for c in range(k_of.size):
         verdict = _matches(k_of[c], periods[c], amplitudes[c], peaks[c], top_t, top_v, minima, m, rtol)
+        if verdict == 1:
+            return c
+        if verdict == DOUBT:
+            return DOUBT
+    return -2
+
+
+@loop
+def recurs(s1, s2, factor, atol, rtol):
+    """Whether the states s1, s2 (2n,) at two breakaways recur (:func:`.early.recurrence_tolerance`):
+    1, 0 or :data:`DOUBT`."""
+    doubt = False
+    for i in range(s1.size):
+        limit = factor * (atol + rtol * max(abs(s1[i]), abs(s2[i])))
+        v = _at_most(abs(s2[i] - s1[i]), limit)
+        if v == 0:
+            return 0
+        doubt = doubt or v == DOUBT
+    return DOUBT if doubt else 1
+
+
+@loop
+def minima_between(t, x, dx, lo, hi, t1, t2, work):
+    """The minima of x located on the samples lo ≤ i < hi (as :func:`section` locates them) with
+    times in (t1, t2], written from ``work[1, 0]`` on; returns their number."""
+    a = lo + np.searchsorted(t[lo:hi], t1, side="right") - 1
+    b = lo + np.searchsorted(t[lo:hi], t2, side="right") + 1
+    count = _peaks(t, x, dx, -1.0, max(a, lo), min(b, hi), work[0], work[1])
+    kept = 0
+    for q in range(count):
+        if work[0, q] > t1 and work[0, q] <= t2:
+            work[1, kept] = -work[1, q]
+            kept += 1
+    return kept
+
+
+@loop
+def period_match(cycles, period, top_v, first, last, minima, n_min, rtol):
+    """:func:`.cycles.period_matches` of the maxima ``top_v[first:last]`` and the ``n_min`` minima of
+    one period that recurs after ``period`` [s]: the index of the first known cycle it matches
+    (−2: none; :data:`DOUBT`: a test too near its threshold before one matched)."""
+    k_of, periods, amplitudes, peaks = cycles
+    p = last - first
+    if n_min == 0:
+        return -2
+    highest = -math.inf
+    for i in range(first, last):
+        highest = max(highest, top_v[i])
+    lowest = math.inf
+    for i in range(n_min):
+        lowest = min(lowest, minima[i])
+    for c in range(k_of.size):
+        k = k_of[c]
+        if p != k:
+            continue
+        A, T = amplitudes[c], periods[c]
+        verdict = _at_most(abs((highest - lowest) - A), rtol * A)
+        if verdict == 1:
+            verdict = _at_most(abs(period - T), rtol * T)
+        if verdict == 1:
+            best = math.inf
+            for s in range(k):
+                d = 0.0
+                for i in range(k):
+                    d = max(d, abs(top_v[first + i] - peaks[c, (i + s) % k]))
+                best = min(best, d)
+            verdict = _at_most(best, rtol * A)
         if verdict == 1:
             return c
         if verdict == DOUBT:

@@ -26,7 +26,7 @@ import numpy as np
 from ..analysis.peaks import find_peaks
 
 __all__ = ["Cycle", "Section", "MATCH_PERIODS", "MATCH_RTOL", "KMAX", "cycles_equal", "run_matches", "find_cycle",
-           "section_of", "cycle_from_section"]
+           "section_of", "cycle_from_section", "period_matches"]
 
 #: Largest number of maxima per period a cycle's features hold (the period rule searches up to 16).
 KMAX = 16
@@ -156,6 +156,23 @@ def run_matches(cycle: Cycle, section: Section, rtol: float) -> bool:
     if np.max(np.abs((tau[k:] - tau[:-k]) - T)) > rtol * T:
         return False
     return _shift_distance(section.maxima[-need:], cycle.peaks) <= rtol * A
+
+
+def period_matches(cycle: Cycle, period: float, maxima: np.ndarray, minima: np.ndarray, rtol: float) -> bool:
+    """Whether one period of a run that provably repeats matches ``cycle``: the run's state recurs
+    after ``period`` [s], and the maxima and the located minima of the coordinate inside that
+    period (``maxima`` in time order) give the cycle's k maxima (one cyclic shift) to ``rtol`` A,
+    its amplitude to ``rtol`` A and its period to ``rtol`` T, the tests of :func:`run_matches` on
+    the one period that repeats."""
+    k = cycle.multiplicity
+    if maxima.size != k or minima.size == 0:
+        return False
+    A, T = cycle.amplitude, cycle.period
+    if not abs((float(np.max(maxima)) - float(np.min(minima))) - A) <= rtol * A:
+        return False
+    if not abs(period - T) <= rtol * T:
+        return False
+    return _shift_distance(maxima, cycle.peaks) <= rtol * A
 
 
 def find_cycle(cycles, candidate: Cycle, rtol: float) -> int:

@@ -1,25 +1,34 @@
-"""The early-stopping classifier: one initial state, integrated in chunks until its attractor is known.
+"""The early-stopping classifier: one initial state, integrated in pieces until its attractor is known.
 
-Each state runs with the exact ``event`` integrator, chunk by chunk
+Each state runs with the exact ``event`` integrator, piece by piece
 (:func:`stickslip.integrate.runner.run_chunks` with the stop condition :class:`EarlyStop`, so the
-run takes the same steps as one long call) for at most ``t_end``. After each chunk of
-:data:`~.context.CHUNK_PERIODS` characteristic periods, in this order:
+run takes the same steps as one long call) for at most ``t_end``. After each piece of one
+characteristic period T_c (:func:`test_interval` samples), in this order:
 
-1. **Steady sliding reached** (only where it is linearly stable). The deviation δ = s − s_e of
-   the chunk's end is compared with the linear flow from its start, Φ δ0. In the norm of the
-   Lyapunov function V = δᵀPδ the linear flow contracts by c = |δ0| − |Φ δ0| per chunk; the
-   chunk counts as linear when no contact stuck and |δ − Φ δ0| ≤ :data:`LINEAR_MARGIN` · c.
-   Near an unstable cycle around the equilibrium the nonlinear terms cancel the contraction and
-   the test fails; in the linear regime they are a vanishing fraction of it, V keeps falling and
-   the run converges. :data:`LINEAR_CHUNKS` consecutive linear chunks, or |δ| below the context's
-   rest level, decide ``equilibrium``.
+1. **Steady sliding reached** (only where it is linearly stable). The deviation δ = s − s_e at
+   the end of a chunk of :data:`~.context.CHUNK_PERIODS` T_c is compared with the linear flow
+   from its start, Φ δ0. In the norm of the Lyapunov function V = δᵀPδ the linear flow contracts
+   by c = |δ0| − |Φ δ0| per chunk; the chunk counts as linear when no contact stuck and
+   |δ − Φ δ0| ≤ :data:`LINEAR_MARGIN` · c. Near an unstable cycle around the equilibrium the
+   nonlinear terms cancel the contraction and the test fails; in the linear regime they are a
+   vanishing fraction of it, V keeps falling and the run converges. The last
+   :data:`LINEAR_CHUNKS` consecutive chunks (ending at the piece's end) all linear, or |δ| below
+   the context's rest level, decide ``equilibrium``.
 2. **A known cycle reached**: the window's section crossings recur on a cycle already found
    (:func:`.cycles.run_matches`).
-3. **A new cycle**: the maxima of the last :data:`RULE_PERIODS` T_c repeat by the package's
-   period rule (:func:`stickslip.analysis.period.return_map`); the window's verdict
+3. **A known cycle recurred**: the state at the run's latest breakaway (stick → slip) equals
+   the state at an earlier breakaway of the same contact (to :data:`RECURRENCE_FACTOR` times the
+   integration tolerances), so the run is periodic from there, and that one period matches a
+   known cycle (:func:`.cycles.period_matches`). A contact that sticks fixes its slip velocity,
+   so runs onto a stick-slip cycle pass through the cycle's breakaway state itself (the belt's
+   every time, to the last bit): the cycle is recognised one period after the first breakaway
+   on it instead of after :data:`~.cycles.MATCH_PERIODS` periods of crossings.
+4. **A new cycle** (after every chunk of :data:`~.context.CHUNK_PERIODS` T_c): the maxima of
+   the last :data:`RULE_PERIODS` T_c repeat by the package's period rule
+   (:func:`stickslip.analysis.period.return_map`); the window's verdict
    (:func:`stickslip.attractors.attractor`, which for k ≥ 2 maxima per period needs the shot
    orbit to confirm it) then decides ``periodic`` and gives the cycle's features.
-4. At ``t_end``: the verdict of :func:`~stickslip.attractors.attractor` on the window
+5. At ``t_end``: the verdict of :func:`~stickslip.attractors.attractor` on the window
    (``equilibrium``, ``periodic``, ``quasiperiodic``, ``chaotic`` or ``unsettled``); a run that
    stops early is ``unbounded`` (non-finite state), ``contact-lost`` (a normal force reached 0)
    or ``failed`` (step size underflow, step cap).
@@ -36,21 +45,25 @@ import time
 import numpy as np
 
 from ..analysis.outcome import OUTCOMES, outcome_code
-from ..analysis.peaks import Peaks
+from ..analysis.peaks import Peaks, find_peaks
 from ..analysis.period import MIN_PERIODS, return_map
 from ..attractors import attractor, stopped_outcome
+from ..integrate.contacts import TRANSITION_TO_SLIP
 from ..integrate.result import Stats, Trajectory, Transitions
 from ..integrate.runner import Chunk, EventStepper, Record, StopCondition, run_chunks
 from ..integrate.status import CHUNK_END, SUCCESS
-from .context import Context
-from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
+from .context import CHUNK_PERIODS, Context
+from .cycles import (KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, period_matches, run_matches,
+                     section_of)
 
 __all__ = ["Options", "Outcome", "classify_state", "EarlyStop", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
-           "RULE_PERIODS", "row_width", "row_column", "DEFAULT_MAX_STEPS"]
+           "RULE_PERIODS", "RECURRENCE_FACTOR", "row_width", "row_column", "DEFAULT_MAX_STEPS", "test_interval",
+           "recurrence_tolerance"]
 
 #: How the verdict was reached (``matched-at-end``: set when the study is assembled, for a run
-#: unsettled at t_end whose last crossings recur on a cycle found from another state).
-DECIDED = ("linear", "at-rest", "matched", "period-rule", "end-verdict", "stopped", "matched-at-end")
+#: unsettled at t_end whose last crossings recur on a cycle found from another state;
+#: ``recurred``: the state at a breakaway recurred and that period matched a known cycle).
+DECIDED = ("linear", "at-rest", "matched", "period-rule", "end-verdict", "stopped", "matched-at-end", "recurred")
 
 #: Fraction of the linear flow's contraction (in the Lyapunov norm) that the nonlinear part of a
 #: chunk may reach for the chunk to count as linear.
@@ -62,6 +75,11 @@ LINEAR_CHUNKS = 2
 #: Trailing span of the window, in T_c, on which the period rule is tried during the run (the
 #: rule needs nine periods).
 RULE_PERIODS = 16
+
+#: The state at a breakaway recurs when each of its 2n components is within this many times the
+#: integration tolerance (atol + rtol |s_i|) of the earlier one's (the belt's breakaway states on
+#: its cycle agree to the last bit; a run still converging onto a cycle differs by far more).
+RECURRENCE_FACTOR = 100.0
 
 #: Default cap on the integration steps of one state (a state that stalls ends as ``failed``).
 DEFAULT_MAX_STEPS = 10_000_000
@@ -233,9 +251,19 @@ def _linear(ctx: Context, d0: np.ndarray, d1: np.ndarray) -> tuple[bool, bool]:
     return False, contraction > 0.0 and norm(d1 - lin) <= LINEAR_MARGIN * contraction
 
 
+def test_interval(ctx: Context) -> int:
+    """Samples per piece of a run: the tests run after each (one T_c)."""
+    return max(ctx.chunk // CHUNK_PERIODS, 1)
+
+
+def recurrence_tolerance(s1: np.ndarray, s2: np.ndarray, opts: Options) -> np.ndarray:
+    """Per component, how far the states at two breakaways may differ and still recur."""
+    return RECURRENCE_FACTOR * (opts.atol + opts.rtol * np.maximum(np.abs(s1), np.abs(s2)))
+
+
 class EarlyStop(StopCondition):
-    """The stop condition of one state (module docstring): chunks of ``ctx.chunk`` samples, each
-    followed by the tests that may decide the state's :class:`Outcome` (in :attr:`outcome`).
+    """The stop condition of one state (module docstring): pieces of :func:`test_interval` samples,
+    each followed by the tests that may decide the state's :class:`Outcome` (in :attr:`outcome`).
 
     Parameters
     ----------
@@ -253,7 +281,7 @@ class EarlyStop(StopCondition):
     def __init__(self, ctx: Context, model, cycles, opts: Options, record: Record, start: float):
         self.ctx, self.model, self.cycles, self.opts, self.record, self.start = ctx, model, cycles, opts, record, start
         self.target = 0
-        self.linear_run = 0
+        self.next_rule = ctx.chunk  # the period rule is tried once per chunk, from the first chunk's end
         self.cache: dict = {}
         self.outcome: Outcome | None = None
 
@@ -261,17 +289,64 @@ class EarlyStop(StopCondition):
         m, record = self.ctx.chunk, self.record
         if record.room < 2 * m + 2 and record.chunks:  # drop the samples before the window
             record.keep_from(record.chunks[_window_start(record, self.ctx.window)][0])
-        self.target = max(record.n + m - 1, m)  # the chunk ends at this sample
+        g = test_interval(self.ctx)
+        self.target = max(record.n + g - 1, g)  # the piece ends at this sample
         return self.target * self.ctx.dt - stepper.t
 
     def stop(self, stepper, record: Record, chunk: Chunk) -> bool:
         self.outcome = self._decide(stepper, record, chunk)
         return self.outcome is not None
 
+    def _steady(self, record: Record, first: int, tw, sw, mw) -> str | None:
+        """Test 1 (module docstring): ``at-rest``, ``linear`` or None."""
+        ctx, m, target = self.ctx, self.ctx.chunk, self.target
+        window_first = record.chunks[first][0]
+        b = target - window_first
+        if not (ctx.stable and b - m >= 0 and b < tw.size):
+            return None
+        trw = record.transitions(record.chunks[first][1]).time
+        for j in range(LINEAR_CHUNKS):
+            a, b = target - (j + 1) * m - window_first, target - j * m - window_first
+            if a < 0:
+                return None
+            rest, linear = _linear(ctx, sw[a, ctx.free] - ctx.equilibrium[ctx.free],
+                                   sw[b, ctx.free] - ctx.equilibrium[ctx.free])
+            if rest and j == 0:
+                return "at-rest"
+            if bool(np.any(mw[a:b + 1])) or bool(np.any((trw > tw[a]) & (trw <= tw[b]))) or not linear:
+                return None
+        return "linear"
+
+    def _recurred(self, record: Record, first: int, tw, sw, section: Section) -> Cycle | None:
+        """Test 3 (module docstring): the known cycle the run's latest breakaway recurs on, or None."""
+        if not self.cycles:
+            return None
+        n, n2, j = self.model.n, 2 * self.model.n, self.model.observed_index
+        tr = record.transitions(record.chunks[first][1])
+        slips = np.flatnonzero(tr.kind == TRANSITION_TO_SLIP)
+        if slips.size < 2:
+            return None
+        last = slips[-1]
+        s2 = tr.state[last, :n2]
+        for i in slips[-2::-1]:
+            s1 = tr.state[i, :n2]
+            if tr.contact[i] == tr.contact[last] and np.all(np.abs(s2 - s1) <= recurrence_tolerance(s1, s2, self.opts)):
+                break
+        else:
+            return None
+        t1, t2 = tr.time[i], tr.time[last]
+        inside = (section.times > t1) & (section.times <= t2)
+        low = find_peaks(tw, -sw[:, j], -sw[:, n + j])
+        minima = -low.value[(low.time > t1) & (low.time <= t2)]
+        for cycle in self.cycles:
+            if period_matches(cycle, float(t2 - t1), section.maxima[inside], minima, self.opts.match_rtol):
+                return cycle
+        return None
+
     def _decide(self, stepper, record: Record, chunk: Chunk) -> Outcome | None:
         ctx, model, opts = self.ctx, self.model, self.opts
-        n, n2, j, m = model.n, 2 * model.n, model.observed_index, ctx.chunk
-        t, steps, target = stepper.t, int(stepper.stats[0] + stepper.stats[1]), self.target
+        n, n2, j = model.n, 2 * model.n, model.observed_index
+        t, steps = stepper.t, int(stepper.stats[0] + stepper.stats[1])
         first = _window_start(record, ctx.window)
         window_first = record.chunks[first][0]
         tw, sw, mw, _ = record.samples(window_first)
@@ -284,31 +359,30 @@ class EarlyStop(StopCondition):
 
         if chunk.status not in (CHUNK_END, SUCCESS):
             return outcome(stopped_outcome(chunk.status), "stopped")
-        # 1. steady sliding reached: the last m samples against the linear flow
-        a, b = target - m - window_first, target - window_first
-        if ctx.stable and a >= 0 and b < tw.size:
-            trw = record.transitions(record.chunks[first][1]).time
-            stuck = bool(np.any(mw[a:b + 1])) or bool(np.any((trw > tw[a]) & (trw <= tw[b])))
-            rest, linear = _linear(ctx, sw[a, ctx.free] - ctx.equilibrium[ctx.free],
-                                   sw[b, ctx.free] - ctx.equilibrium[ctx.free])
-            if rest:
-                return outcome("equilibrium", "at-rest")
-            self.linear_run = self.linear_run + 1 if linear and not stuck else 0
-            if self.linear_run >= LINEAR_CHUNKS:
-                return outcome("equilibrium", "linear")
+        # 1. steady sliding reached: the last chunks against the linear flow
+        steady = self._steady(record, first, tw, sw, mw)
+        if steady is not None:
+            return outcome("equilibrium", steady)
         section = section_of(tw, sw[:, j], sw[:, n + j])
         # 2. a known cycle reached
         for cycle in self.cycles:
             if run_matches(cycle, section, opts.match_rtol):
                 return outcome("periodic", "matched", cycle, cycle.state)
-        # 4. the verdict at t_end
+        # 3. a known cycle recurred
+        cycle = self._recurred(record, first, tw, sw, section)
+        if cycle is not None:
+            return outcome("periodic", "recurred", cycle, cycle.state)
+        # 5. the verdict at t_end
         if chunk.status == SUCCESS:
             traj, v = self._verdict(record, first, float(tw[0]), steps)
             if v.attractor == "periodic":
                 cyc = _cycle(section, traj, v)
                 return outcome("periodic", "period-rule", cyc, cyc.state)
             return outcome(v.attractor, "end-verdict", section=section)
-        # 3. a new cycle: the period rule on the last RULE_PERIODS T_c, then the window's verdict
+        # 4. a new cycle, once per chunk: the period rule on the last RULE_PERIODS T_c, then the window's verdict
+        if self.target < self.next_rule:
+            return None
+        self.next_rule = self.target + ctx.chunk
         t_from = t - RULE_PERIODS * ctx.period
         recent = section.times >= t_from
         if np.count_nonzero(recent) > MIN_PERIODS and tw[0] <= t_from:

@@ -279,10 +279,10 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
     registry: list[list] = [[] for _ in range(spec.n_params)]
 
     def learn(idx, rws):
-        # a matched outcome's cycle is one the registry holds: only the others can be new
+        # a matched or recurred outcome's cycle is one the registry holds: only the others can be new
         rws = np.asarray(rws).reshape(-1, spec.row_width)
-        new = (rws[:, row_column("verdict")] == outcome_code("periodic")) & \
-            (rws[:, row_column("decided_by")] != DECIDED.index("matched"))
+        known = np.isin(rws[:, row_column("decided_by")], [DECIDED.index("matched"), DECIDED.index("recurred")])
+        new = (rws[:, row_column("verdict")] == outcome_code("periodic")) & ~known
         for flat, row in zip(np.asarray(idx)[new], rws[new]):
             o = Outcome.from_row(row, n)
             reg = registry[int(flat) // N]
