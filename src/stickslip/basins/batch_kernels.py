@@ -257,6 +257,8 @@ def _recurred(plan, cycles, work, times, at, first, m):
 @loop
 def _recurrent(plan, cycles, work, times, at, first, status, t, rule_due):
     """Tests 2, 3 and 4 of :class:`.early.EarlyStop` on the window's section: (code, cycle)."""
+    if cycles[0].size == 0 and not rule_due and status != SUCCESS:
+        return UNDECIDED, -1  # nothing to test
     base, n = at[0], at[1]
     window_first = work.chunks[0, first]
     lo, hi = window_first - base, n - base
