@@ -27,8 +27,8 @@ from ..model.bundle import contact_state
 from .batch_kernels import AT_REST, LINEAR, MATCHED, RECURRED, Plan, Work, classify_states
 from .context import Context
 from .cycles import KMAX, find_cycle
-from .early import (LINEAR_CHUNKS, RECURRENCE_FACTOR, RULE_PERIODS, Options, Outcome, classify_state, row_column,
-                    row_width, test_interval)
+from .early import LINEAR_CHUNKS, RULE_PERIODS, Options, Outcome, classify_state, row_column, row_width, test_interval
+from .recurrence import RECURRENCE_FACTOR, point_arrays
 
 __all__ = ["classify_batch", "compiled_batch_applies"]
 
@@ -83,12 +83,12 @@ def _linear(ctx: Context, model) -> tuple:
             float(ctx.rest))
 
 
-def _cycle_arrays(cycles) -> tuple:
+def _cycle_arrays(ctx: Context, model, cycles, opts: Options) -> tuple:
     peaks = np.zeros((len(cycles), KMAX))
     for i, c in enumerate(cycles):
         peaks[i, :c.multiplicity] = c.peaks
     return (np.array([c.multiplicity for c in cycles], dtype=np.int64), np.array([c.period for c in cycles], dtype=float),
-            np.array([c.amplitude for c in cycles], dtype=float), peaks)
+            np.array([c.amplitude for c in cycles], dtype=float), peaks, *point_arrays(ctx, model, cycles, opts))
 
 
 def _prepare(model, s0: np.ndarray, opts: Options) -> None:
@@ -147,8 +147,8 @@ def classify_batch(ctx: Context, model, states: np.ndarray, cycles, opts: Option
     first = 0
     while first < count:
         start = time.perf_counter()
-        stop = classify_states(model.data, cst0, plan, linear, _cycle_arrays(cycles), times, states, first, work,
-                               result)
+        stop = classify_states(model.data, cst0, plan, linear, _cycle_arrays(ctx, model, cycles, opts), times, states,
+                               first, work, result)
         if stop > first:
             rows[first:stop] = _rows(result, first, stop, cycles, n2, (time.perf_counter() - start) / (stop - first))
         if stop < count:

@@ -43,7 +43,7 @@ class Plan(NamedTuple):
     of the window, the rows of the record, the tolerances, the largest step (one chunk) [s], the
     step cap, T_c [s], the match tolerance, whether steady sliding is stable, the observed
     coordinate, n, :data:`.early.LINEAR_CHUNKS`, :data:`.early.RULE_PERIODS`, the samples of a
-    piece (:func:`.early.test_interval`) and :data:`.early.RECURRENCE_FACTOR`."""
+    piece (:func:`.early.test_interval`) and :data:`.recurrence.RECURRENCE_FACTOR`."""
 
     t_end: float
     dt: float
@@ -216,15 +216,24 @@ def _steady(plan, linear, work, times, at, first, target):
 
 @loop
 def _recurred(plan, cycles, work, times, at, first, m):
-    """Test 3 of :class:`.early.EarlyStop` (a known cycle recurred), after the window's section
-    (its ``m`` maxima in ``work.crossings``): (code, cycle)."""
+    """Test 3 of :class:`.early.EarlyStop` (a known cycle recurred: on its breakaway state, or
+    on the run's own state one period back), after the window's section (its ``m`` maxima in
+    ``work.crossings``): (code, cycle)."""
     base, n, _, _, n_br = at
     room = work.breaks.shape[1]
     first_tr = work.chunks[1, first]
-    if cycles[0].size == 0 or n_br < 2 or work.breaks[2, (n_br - 1) % room] < first_tr:
+    if cycles[0].size == 0 or n_br < 1 or work.breaks[2, (n_br - 1) % room] < first_tr:
         return UNDECIDED, -1
     last = (n_br - 1) % room
     s2 = work.break_states[last]
+    point_contacts, point_states = cycles[4], cycles[5]
+    for c in range(point_contacts.size):  # the cycle's own breakaway state
+        if point_contacts[c] == work.breaks[1, last]:
+            r = recurs(point_states[c], s2, plan.recurrence, plan.atol, plan.rtol)
+            if r == DOUBT:
+                return PYTHON, -1
+            if r == 1:
+                return RECURRED, c
     q = n_br - 2
     while True:
         if q < 0 or n_br - q > room:  # no earlier breakaway, or the earlier ones' states were not kept
@@ -398,7 +407,9 @@ def classify_states(md, cst0, plan, linear, cycles, times, states, first, work, 
     linear : tuple
         (equilibrium (2n,), free (2k,) int, P (2k, 2k), Φ (2k, 2k), rest) of the context.
     cycles : tuple
-        The known cycles: multiplicities (c,) int, periods (c,), amplitudes (c,), maxima (c, KMAX).
+        The known cycles: multiplicities (c,) int, periods (c,), amplitudes (c,), maxima (c, KMAX),
+        the contact of each one's breakaway state (c,) int (−1: none) and that state (c, 2n)
+        (:func:`.recurrence.point_arrays`).
     times : ndarray (K,)
         The sample times of a run [s].
     states : ndarray (N, 2n)

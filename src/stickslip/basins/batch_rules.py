@@ -157,7 +157,7 @@ def _matches(k, period, amplitude, peaks, top_t, top_v, minima, m, rtol):
 def matched_cycle(cycles, top_t, top_v, minima, m, rtol):
     """Index of the first cycle whose crossings the section's last ones recur on (−2: none;
     :data:`DOUBT`: a test too near its threshold before one matched)."""
-    k_of, periods, amplitudes, peaks = cycles
+    k_of, periods, amplitudes, peaks = cycles[0], cycles[1], cycles[2], cycles[3]
     for c in range(k_of.size):
         verdict = _matches(k_of[c], periods[c], amplitudes[c], peaks[c], top_t, top_v, minima, m, rtol)
         if verdict == 1:
@@ -169,7 +169,7 @@ def matched_cycle(cycles, top_t, top_v, minima, m, rtol):
 
 @loop
 def recurs(s1, s2, factor, atol, rtol):
-    """Whether the states s1, s2 (2n,) at two breakaways recur (:func:`.early.recurrence_tolerance`):
+    """Whether the states s1, s2 (2n,) at two breakaways recur (:func:`.recurrence.recurs`):
     1, 0 or :data:`DOUBT`."""
     doubt = False
     for i in range(s1.size):
@@ -201,7 +201,7 @@ def period_match(cycles, period, top_v, first, last, minima, n_min, rtol):
     """:func:`.cycles.period_matches` of the maxima ``top_v[first:last]`` and the ``n_min`` minima of
     one period that recurs after ``period`` [s]: the index of the first known cycle it matches
     (−2: none; :data:`DOUBT`: a test too near its threshold before one matched)."""
-    k_of, periods, amplitudes, peaks = cycles
+    k_of, periods, amplitudes, peaks = cycles[0], cycles[1], cycles[2], cycles[3]
     p = last - first
     if n_min == 0:
         return -2

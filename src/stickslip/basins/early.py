@@ -16,13 +16,14 @@ characteristic period T_c (:func:`test_interval` samples), in this order:
    the context's rest level, decide ``equilibrium``.
 2. **A known cycle reached**: the window's section crossings recur on a cycle already found
    (:func:`.cycles.run_matches`).
-3. **A known cycle recurred**: the state at the run's latest breakaway (stick → slip) equals
-   the state at an earlier breakaway of the same contact (to :data:`RECURRENCE_FACTOR` times the
-   integration tolerances), so the run is periodic from there, and that one period matches a
-   known cycle (:func:`.cycles.period_matches`). A contact that sticks fixes its slip velocity,
-   so runs onto a stick-slip cycle pass through the cycle's breakaway state itself (the belt's
-   every time, to the last bit): the cycle is recognised one period after the first breakaway
-   on it instead of after :data:`~.cycles.MATCH_PERIODS` periods of crossings.
+3. **A known cycle recurred** (:mod:`.recurrence`): the state at the run's latest breakaway
+   (stick → slip) equals, to :data:`~.recurrence.RECURRENCE_FACTOR` times the integration
+   tolerances, the breakaway state of a known cycle (:func:`~.recurrence.cycle_point`), or the
+   state at an earlier breakaway of the same contact with the one period between them matching
+   a known cycle (:func:`.cycles.period_matches`): the run repeats from there. A contact that
+   sticks fixes its slip velocity, so runs onto a stick-slip cycle pass through the cycle's
+   breakaway state itself (the belt's every time, to the last bit): the cycle is recognised at
+   the first breakaway on it instead of after :data:`~.cycles.MATCH_PERIODS` periods of crossings.
 4. **A new cycle** (after every chunk of :data:`~.context.CHUNK_PERIODS` T_c): the maxima of
    the last :data:`RULE_PERIODS` T_c repeat by the package's period rule
    (:func:`stickslip.analysis.period.return_map`); the window's verdict
@@ -45,7 +46,7 @@ import time
 import numpy as np
 
 from ..analysis.outcome import OUTCOMES, outcome_code
-from ..analysis.peaks import Peaks, find_peaks
+from ..analysis.peaks import Peaks
 from ..analysis.period import MIN_PERIODS, return_map
 from ..attractors import attractor, stopped_outcome
 from ..integrate.contacts import TRANSITION_TO_SLIP
@@ -53,12 +54,11 @@ from ..integrate.result import Stats, Trajectory, Transitions
 from ..integrate.runner import Chunk, EventStepper, Record, StopCondition, run_chunks
 from ..integrate.status import CHUNK_END, SUCCESS
 from .context import CHUNK_PERIODS, Context
-from .cycles import (KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, period_matches, run_matches,
-                     section_of)
+from .cycles import KMAX, MATCH_PERIODS, MATCH_RTOL, Cycle, Section, cycle_from_section, run_matches, section_of
+from .recurrence import cycle_point, earlier_recurrence, period_cycle, recurs
 
 __all__ = ["Options", "Outcome", "classify_state", "EarlyStop", "DECIDED", "LINEAR_MARGIN", "LINEAR_CHUNKS",
-           "RULE_PERIODS", "RECURRENCE_FACTOR", "row_width", "row_column", "DEFAULT_MAX_STEPS", "test_interval",
-           "recurrence_tolerance"]
+           "RULE_PERIODS", "row_width", "row_column", "DEFAULT_MAX_STEPS", "test_interval"]
 
 #: How the verdict was reached (``matched-at-end``: set when the study is assembled, for a run
 #: unsettled at t_end whose last crossings recur on a cycle found from another state;
@@ -75,11 +75,6 @@ LINEAR_CHUNKS = 2
 #: Trailing span of the window, in T_c, on which the period rule is tried during the run (the
 #: rule needs nine periods).
 RULE_PERIODS = 16
-
-#: The state at a breakaway recurs when each of its 2n components is within this many times the
-#: integration tolerance (atol + rtol |s_i|) of the earlier one's (the belt's breakaway states on
-#: its cycle agree to the last bit; a run still converging onto a cycle differs by far more).
-RECURRENCE_FACTOR = 100.0
 
 #: Default cap on the integration steps of one state (a state that stalls ends as ``failed``).
 DEFAULT_MAX_STEPS = 10_000_000
@@ -256,11 +251,6 @@ def test_interval(ctx: Context) -> int:
     return max(ctx.chunk // CHUNK_PERIODS, 1)
 
 
-def recurrence_tolerance(s1: np.ndarray, s2: np.ndarray, opts: Options) -> np.ndarray:
-    """Per component, how far the states at two breakaways may differ and still recur."""
-    return RECURRENCE_FACTOR * (opts.atol + opts.rtol * np.maximum(np.abs(s1), np.abs(s2)))
-
-
 class EarlyStop(StopCondition):
     """The stop condition of one state (module docstring): pieces of :func:`test_interval` samples,
     each followed by the tests that may decide the state's :class:`Outcome` (in :attr:`outcome`).
@@ -321,27 +311,23 @@ class EarlyStop(StopCondition):
         """Test 3 (module docstring): the known cycle the run's latest breakaway recurs on, or None."""
         if not self.cycles:
             return None
-        n, n2, j = self.model.n, 2 * self.model.n, self.model.observed_index
+        n, n2, j, opts = self.model.n, 2 * self.model.n, self.model.observed_index, self.opts
         tr = record.transitions(record.chunks[first][1])
         slips = np.flatnonzero(tr.kind == TRANSITION_TO_SLIP)
-        if slips.size < 2:
+        if slips.size == 0:
             return None
         last = slips[-1]
-        s2 = tr.state[last, :n2]
-        for i in slips[-2::-1]:
-            s1 = tr.state[i, :n2]
-            if tr.contact[i] == tr.contact[last] and np.all(np.abs(s2 - s1) <= recurrence_tolerance(s1, s2, self.opts)):
-                break
-        else:
-            return None
-        t1, t2 = tr.time[i], tr.time[last]
-        inside = (section.times > t1) & (section.times <= t2)
-        low = find_peaks(tw, -sw[:, j], -sw[:, n + j])
-        minima = -low.value[(low.time > t1) & (low.time <= t2)]
-        for cycle in self.cycles:
-            if period_matches(cycle, float(t2 - t1), section.maxima[inside], minima, self.opts.match_rtol):
+        for cycle in self.cycles:  # the cycle's own breakaway state
+            p = cycle_point(self.ctx, self.model, cycle, opts)
+            if p is not None and p.contact == tr.contact[last] and recurs(p.state, tr.state[last, :n2], opts.atol,
+                                                                          opts.rtol):
                 return cycle
-        return None
+        found = earlier_recurrence(tr, n2, opts.atol, opts.rtol)  # one period of the run's own
+        if found is None:
+            return None
+        c = period_cycle(self.cycles, tr.time[found[0]], tr.time[found[1]], tw, sw[:, j], sw[:, n + j], section,
+                         opts.match_rtol)
+        return self.cycles[c] if c >= 0 else None
 
     def _decide(self, stepper, record: Record, chunk: Chunk) -> Outcome | None:
         ctx, model, opts = self.ctx, self.model, self.opts
