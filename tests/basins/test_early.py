@@ -62,7 +62,7 @@ def test_a_known_cycle_stops_runs_early_without_changing_verdicts(ctx):
     cycle = next(o.cycle for o in alone if o.verdict == "periodic")
     known = [classify_state(ctx, BELT, s, [cycle], Options()) for s in states]
     assert [o.verdict for o in alone] == [o.verdict for o in known]
-    assert {o.decided_by for o in known if o.verdict == "periodic"} == {"matched"}
+    assert {o.decided_by for o in known if o.verdict == "periodic"} == {"recurred"}  # at their first breakaway
     assert sum(o.t_decided for o in known) < sum(o.t_decided for o in alone)
 
 

@@ -308,6 +308,7 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
         bar, task_id = _progress(spec.size, int(done.sum()), f"basins {spec.size} states")
     compute_start = time.perf_counter()
     n_new = 0
+    sizing = {"size": 1, "floor": 0}
 
     def record(idx, rws):
         nonlocal last_snapshot, n_new
@@ -316,6 +317,10 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
         store["rows"].append(rws)
         learn(idx, rws)
         n_new += len(idx)
+        if batch_size == "auto" and len(idx) >= MIN_COMPILED_BATCH:  # batches sized by the path they take
+            t = float(np.mean(np.asarray(rws)[:, row_column("wall_time")]))
+            sizing["size"] = _batch_size(batch_size, t, todo.size - n_new, workers, executor, sizing["floor"])
+            timing["batch_size"] = max(timing["batch_size"], sizing["size"])
         if bar is not None:
             bar.update(task_id, advance=len(idx), rate=f"{n_new / max(time.perf_counter() - compute_start, 1e-9):.1f} st/s")
         if time.perf_counter() - last_snapshot > snapshot_interval:
@@ -335,9 +340,10 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
                 if timed.size:
                     record(*evaluate_batch(task(timed)))  # times a state
                 t_state = (time.perf_counter() - t) / max(timed.size, 1)
-                size = _batch_size(batch_size, t_state, rest.size, workers, executor)
-                timing.update(batch_size=size, first_state_s=t_state)
-                tasks = (task(b) for b in _batches(rest, size, N))
+                sizing["floor"] = _compiled_floor(ctxs, rest.size, workers, executor)
+                sizing["size"] = _batch_size(batch_size, t_state, rest.size, workers, executor, sizing["floor"])
+                timing.update(batch_size=sizing["size"], first_state_s=t_state)
+                tasks = (task(b) for b in _batches(rest, lambda: sizing["size"], N))
                 for idx, rws in map_unordered(evaluate_batch, tasks, executor=executor, workers=workers,
                                               address=address, stop=stop, info=timing):
                     record(idx, rws)
@@ -355,7 +361,20 @@ def _run(spec: BasinSpec, ctxs: list[Context], info_models, initial, journal: Jo
     return BasinResult(out, ds, timing)
 
 
-def _batch_size(batch_size, t_state: float, remaining: int, workers: int, executor: str) -> int:
+def _compiled_floor(ctxs, remaining: int, workers: int, executor: str) -> int:
+    """The fewest states of an ``auto`` batch: :data:`MIN_COMPILED_BATCH` where the compiled batch
+    takes the models' states and the study is large enough to give each worker
+    :data:`MIN_BATCHES_PER_WORKER` such batches (the states timed first ran the per-state path,
+    several times slower a state, and would make the batches too small for it), else 0."""
+    share = remaining // (MIN_BATCHES_PER_WORKER * (1 if executor == "serial" else workers))
+    compiled = all(compiled_batch_applies(model_of(c.key)) for c in ctxs)
+    return MIN_COMPILED_BATCH if compiled and share >= MIN_COMPILED_BATCH else 0
+
+
+def _batch_size(batch_size, t_state: float, remaining: int, workers: int, executor: str, floor: int) -> int:
+    """States per batch: ``batch_size``, or for ``auto`` :data:`TARGET_BATCH_S` of work at
+    ``t_state`` seconds a state (the first states timed, then each returned batch's), at most a
+    share of the ``remaining`` states per worker, at least ``floor`` while that many remain."""
     if batch_size != "auto":
         try:
             size = int(batch_size)
@@ -367,16 +386,20 @@ def _batch_size(batch_size, t_state: float, remaining: int, workers: int, execut
     size = min(MAX_BATCH_STATES, max(1, math.ceil(TARGET_BATCH_S[executor] / max(t_state, 1e-6))))
     if executor != "serial":
         size = min(size, max(1, remaining // (MIN_BATCHES_PER_WORKER * workers)))
-    return size
+    return max(size, floor) if remaining >= floor else size
 
 
-def _batches(flat: np.ndarray, size: int, per_param: int):
-    """Consecutive runs of at most ``size`` flat indices, never across parameter values."""
+def _batches(flat: np.ndarray, size, per_param: int):
+    """Consecutive runs of at most ``size()`` flat indices (asked before each batch), never across
+    parameter values."""
     p = flat // per_param
     breaks = np.flatnonzero(np.diff(p)) + 1
     for group in np.split(flat, breaks):
-        for i in range(0, group.size, size):
-            yield group[i:i + size]
+        i = 0
+        while i < group.size:
+            n = max(int(size()), 1)
+            yield group[i:i + n]
+            i += n
 
 
 def load_result(path) -> BasinResult:
