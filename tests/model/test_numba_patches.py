@@ -15,7 +15,7 @@ from stickslip.model import numba_patches
 from stickslip.model.numba_patches import RUN_ENV
 
 ALL = {"inline-scope-copy", "inline-ir-once", "flags-hash", "call-type-once", "live-map-once", "python-entry",
-       "standalone-linking", "cache-keeping", "fork-helper"}
+       "standalone-linking", "cache-keeping", "cache-load", "fork-helper"}
 
 
 def _fresh_env(**extra) -> dict:
@@ -120,6 +120,10 @@ _EVERY_NAME_CHANGED = """
     for name in ("InTreeCacheLocator", "_InTreeCacheLocator"):                # cache-keeping
         if hasattr(caching, name):
             delattr(caching, name)
+    load_overload = caching.Cache.load_overload
+    def other_load_overload(self, sig, target_context):
+        return load_overload(self, sig, target_context)
+    caching.Cache.load_overload = other_load_overload                         # cache-load
     del compiler_lock.global_compiler_lock                                    # fork-helper
 """
 

@@ -1,6 +1,6 @@
 """Every change stickslip makes to numba's behaviour, installed by one :func:`install`, each checked first.
 
-The compiled layer changes numba in nine ways. Each is a :class:`Patch`: what it changes, a check
+The compiled layer changes numba in ten ways. Each is a :class:`Patch`: what it changes, a check
 that the private names it needs exist with the shape it expects, and what applies it.
 :func:`install` (run when :mod:`stickslip.model.jit` is imported) applies the patches whose checks
 pass, once per process.
@@ -35,6 +35,9 @@ patch                       what it changes                                     
                                                                                             ``_save_index``, ``_load_data``,
                                                                                             ``_save_data``, ``_dump``,
                                                                                             ``_open_for_write``
+``cache-load``              a cached kernel of the package loaded without numba's           ``Cache.load_overload`` (its
+                            implementation registries (:mod:`.kernel_cache`): only the      source), ``_load_overload``,
+                            runtime its code links against is initialised                   ``rtsys.initialize``
 ``fork-helper``             a cold start's helper forked with numba's compiler lock held    ``compiler_lock.global_compiler_lock``,
                             and the compile listeners cleared in the child                  ``event._registered``
                             (:mod:`.compile_ahead`)
