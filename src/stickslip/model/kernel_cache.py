@@ -32,6 +32,11 @@ kernel uncached, with one warning per run.
 
 Without the patch the package's kernels are not cached on disk (:func:`caching`): numba's own
 cache would load a kernel with the old code of a module it inlines.
+
+**Loaded without numba's registries.** A second patch, ``cache-load`` (:data:`LOAD_PATCH`), loads
+a cached kernel of the package without the refresh of numba's target context that numba makes
+first, which imports every implementation registry of numba (and scipy.linalg): what a warm
+command needs of it, numba's runtime, is initialised alone (:func:`_load_without_refresh`).
 """
 
 from __future__ import annotations
@@ -49,8 +54,8 @@ from pathlib import Path
 
 from .numba_patches import Patch, active, first_problem, has, notice, source_has
 
-__all__ = ["PATCH", "LOAD_PATCH", "FORMAT", "caching", "compiled_layer_digest", "track_user_code", "defined_in_package",
-           "unavailable_class", "without_entry", "patch_tag"]
+__all__ = ["PATCH", "LOAD_PATCH", "FORMAT", "caching", "compiled_layer_digest", "track_user_code",
+           "defined_in_package", "unavailable_class", "without_entry", "patch_tag"]
 
 #: The cache files' format: numba's version field of an index carries it.
 FORMAT = "stickslip-sha256-1"
