@@ -284,7 +284,7 @@ def checks_file() -> Path:
 def remembered_checks(path: Path):
     """Remember the source checks that pass in this block in ``path`` (read at its start, written
     when checks were added): the source text of numba's functions is read once per numba
-    install, not at every start (20-50 ms). A file that cannot be read is an empty memory, one
+    install, not at every start (some 10 ms of CPU). A file that cannot be read is an empty memory, one
     that cannot be written leaves the checks unremembered; neither is an error."""
     global _PASSED
     try:
