@@ -206,3 +206,33 @@ def test_index_keys_carry_the_patches_that_change_what_an_entry_holds():
     sig = (nbtypes.float64[::1],)
     key = physics.rhs._cache._index_key(sig, cpu_target.target_context.codegen())
     assert key[0] == sig and kernel_cache.patch_tag() in key
+
+
+_LOADS_A_KERNEL = """
+import sys
+from stickslip.model.linalg import solve_psd_2x2
+x1, x2, rank = solve_psd_2x2(4.0, 1.0, 3.0, 1.0, 2.0)
+print(repr(x1), repr(x2), rank, "numba.np.arraymath" in sys.modules)
+"""
+
+
+def test_a_cached_kernel_loads_without_numbas_registries_and_computes_the_same():
+    """A process that only loads the package's kernels from the cache (a warm command) leaves
+    numba's implementation registries (and scipy.linalg, which they import) unloaded; the loaded
+    kernel computes what it computes in a process that loaded them first, and the exact solution."""
+    import subprocess
+    import sys
+
+    def run(code):
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0, res.stderr
+        return res.stdout.split()
+
+    run(_LOADS_A_KERNEL)  # compiled here if the cache lacked it
+    *loaded, registries = run(_LOADS_A_KERNEL)
+    *refreshed, registries_first = run("from numba.core.registry import cpu_target\n"
+                                       "cpu_target.target_context.refresh()\n" + _LOADS_A_KERNEL)
+    assert registries == "False" and registries_first == "True"
+    assert loaded == refreshed
+    x1, x2 = float(loaded[0]), float(loaded[1])  # [[4, 1], [1, 3]] x = [1, 2]: x = (1/11, 7/11)
+    assert loaded[2] == "2" and abs(x1 - 1 / 11) < 1e-15 and abs(x2 - 7 / 11) < 1e-15

@@ -15,7 +15,7 @@ from stickslip.model import numba_patches
 from stickslip.model.numba_patches import RUN_ENV
 
 ALL = {"inline-scope-copy", "inline-ir-once", "flags-hash", "call-type-once", "live-map-once", "python-entry",
-       "standalone-linking", "cache-keeping", "fork-helper"}
+       "standalone-linking", "cache-keeping", "cache-load", "fork-helper"}
 
 
 def _fresh_env(**extra) -> dict:
@@ -120,6 +120,10 @@ _EVERY_NAME_CHANGED = """
     for name in ("InTreeCacheLocator", "_InTreeCacheLocator"):                # cache-keeping
         if hasattr(caching, name):
             delattr(caching, name)
+    load_overload = caching.Cache.load_overload
+    def other_load_overload(self, sig, target_context):
+        return load_overload(self, sig, target_context)
+    caching.Cache.load_overload = other_load_overload                         # cache-load
     del compiler_lock.global_compiler_lock                                    # fork-helper
 """
 
@@ -161,3 +165,60 @@ def test_a_notice_is_said_once_per_run_whatever_process_of_it_says_it(tmp_path):
     assert other.stdout.split() == ["1", "0"]
     for path in Path(tempfile.gettempdir()).glob(f"stickslip-*-{run}-*"):  # none of them was the run's root
         path.unlink()
+
+
+def test_a_source_check_that_passed_is_remembered_for_the_same_code_only(tmp_path, monkeypatch):
+    """The installer reads numba's source text once per install of numba: a check that passed is
+    remembered (in this process and, through the file, the next) for that code; a failed check, a
+    function replaced (a wrapper of another source) and a check outside the installer read it."""
+    import inspect
+
+    reads = []
+    real = inspect.getsource
+    monkeypatch.setattr(numba_patches.inspect, "getsource", lambda f: reads.append(f.__qualname__) or real(f))
+    path = tmp_path / "checks.json"
+
+    def method(self):
+        return self.thing
+
+    with numba_patches.remembered_checks(path):
+        assert numba_patches.source_has(method, "self.thing") is None
+        assert numba_patches.source_has(method, "self.thing") is None
+        assert "does not read 'self.other'" in numba_patches.source_has(method, "self.other")
+    assert len(reads) == 2 and path.is_file()
+    with numba_patches.remembered_checks(path):  # as a new process: from the file
+        assert numba_patches.source_has(method, "self.thing") is None
+        assert "does not read 'self.other'" in numba_patches.source_has(method, "self.other")
+    assert len(reads) == 3
+    namespace = {}
+    exec("def method(self):\n    return self.other\n", namespace)  # same name, other code, no source file
+    with numba_patches.remembered_checks(path):
+        assert numba_patches.source_has(namespace["method"], "self.thing") == "no source of method"
+    assert numba_patches.source_has(method, "self.thing") is None  # outside the installer: read
+    assert len(reads) == 5
+
+
+def test_a_remembered_check_is_keyed_alike_in_every_process():
+    """The key of a check does not depend on the process (string hashing is salted per process)."""
+    code = """
+        from numba.core.registry import CPUDispatcher
+        from stickslip.model import numba_patches
+        print(numba_patches.code_key(CPUDispatcher.__init__, ("self._compiler = ",)))
+    """
+    keys = {_python(code, PYTHONHASHSEED=seed).stdout.strip() for seed in ("1", "2")}
+    assert len(keys) == 1 and len(keys.pop()) == 64
+
+
+def test_an_unreadable_or_unwritable_memory_of_checks_is_no_error(tmp_path):
+    garbled = tmp_path / "garbled.json"
+    garbled.write_text("{not json")
+    unwritable = tmp_path / "file" / "checks.json"
+    (tmp_path / "file").write_text("a file where a folder would be")
+
+    def method(self):
+        return self.thing
+
+    for path in (garbled, unwritable):
+        with numba_patches.remembered_checks(path):
+            assert numba_patches.source_has(method, "self.thing") is None
+    assert not unwritable.exists()

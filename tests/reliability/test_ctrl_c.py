@@ -22,6 +22,7 @@ import stickslip.cli.basins as basins_cli
 import stickslip.cli.orbit as orbit_cli
 import stickslip.cli.simulate as simulate_cli
 import stickslip.cli.sweep as sweep_cli
+import stickslip.plot.trajectory as trajectory_plot
 from stickslip import load_trajectory
 from stickslip.basins import basin_stability, box, engine
 from stickslip.basins.store import load_basins
@@ -113,7 +114,7 @@ def test_a_second_ctrl_c_while_writing_stops_at_once_and_leaves_nothing(tmp_path
 
 def test_simulate_interrupted_while_drawing_says_the_run_is_kept(tmp_path, monkeypatch):
     """(It said "nothing was written" with the file there.)"""
-    monkeypatch.setattr(simulate_cli, "save_trajectory_figure", sends_ctrl_c(simulate_cli.save_trajectory_figure))
+    monkeypatch.setattr(trajectory_plot, "save_trajectory_figure", sends_ctrl_c(trajectory_plot.save_trajectory_figure))
     line = interrupted(runner.invoke(app, [*SIMULATE, "--out", str(tmp_path / "x.nc")]))
     assert line == f"the finished run is in {tmp_path / 'x.nc'}" and files(tmp_path) == ["x.nc"]
 

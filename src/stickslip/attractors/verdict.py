@@ -40,10 +40,11 @@ from ..analysis.classify import STATIONARY_MIN_PEAKS, STATIONARY_RTOL, Classific
 from ..analysis.outcome import is_stick_slip, outcome_code
 from ..errors import StickSlipError
 from ..integrate.status import Status
-from ..stability import stability
 from ..stability.verdict import verdict_text
-from .confirm import (LYAPUNOV_START_S, ORBIT_PERIODS, QUASI_RATE, QUASI_SPAN_S, confirm_period, lyapunov_sign,
-                      span_change)
+
+# The confirmations (.confirm: shooting and Lyapunov exponents, the orbits layer and scipy.linalg)
+# and the stability analysis are imported on the paths of a verdict that needs them: a run whose
+# window decides alone (the default run of the command line) loads neither.
 
 __all__ = ["Attractor", "attractor", "stopped_outcome", "jsonable", "undersampled"]
 
@@ -204,6 +205,8 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
             return verdict("periodic", 1, period)
         if not confirm:
             return verdict("unsettled", reason=f"a period of {k} maxima is claimed only when the shot orbit confirms it")
+        from .confirm import ORBIT_PERIODS, confirm_period  # noqa: PLC0415 - see the module's imports
+
         key = ("shooting", k, round(period, 3))
         if key not in cache:
             cache[key] = confirm_period(traj, k, period, dof=dof, t_from=t_from)
@@ -216,6 +219,8 @@ def attractor(traj, t_from: float | None = None, *, dof: str | None = None, conf
     if c.signal == "stationary":
         if not lyapunov:
             return verdict("unsettled", reason="stationary but not periodic; no Lyapunov exponent computed")
+        from .confirm import LYAPUNOV_START_S, QUASI_RATE, QUASI_SPAN_S, lyapunov_sign, span_change  # noqa: PLC0415
+
         if "lyapunov" not in cache:
             cache["lyapunov"] = lyapunov_sign(traj)
         lyap = cache["lyapunov"]
@@ -266,6 +271,8 @@ def undersampled(traj) -> str | None:
 
 def _equilibrium_stability(traj) -> dict:
     """Linear stability of steady sliding for the run's parameters and model."""
+    from ..stability import stability  # noqa: PLC0415 - see the module's imports
+
     try:
         res = stability(traj.system)
     except (StickSlipError, ArithmeticError, np.linalg.LinAlgError) as exc:

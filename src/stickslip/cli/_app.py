@@ -297,13 +297,14 @@ def _compile_notice():
 
 def _check_environment() -> None:
     """Refuse an environment the kernels cannot run in; say what :mod:`stickslip._startup` changed."""
-    from ..parallel import compile_processes
-
     if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
         raise CLIError(f"NUMBA_DISABLE_JIT={os.environ['NUMBA_DISABLE_JIT']}: stickslip's kernels must be compiled "
                        "(interpreted, a run would take hours and some kernels cannot run at all); unset "
                        "NUMBA_DISABLE_JIT or set it to 0")
-    compile_processes()  # a setting that is not a positive integer: one line, exit 2
+    if os.environ.get("STICKSLIP_COMPILE_PROCESSES", "").strip():  # unset or empty: the default, 2
+        from ..parallel import compile_processes  # noqa: PLC0415 - the process pools' module, not needed otherwise
+
+        compile_processes()  # a setting that is not a positive integer: one line, exit 2
     for note in _startup.notes:
         warning_line(note)
 

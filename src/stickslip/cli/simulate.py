@@ -21,7 +21,7 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ..attractors import run_summary, simulate_until_settled
+from ..attractors import run_summary
 from ..integrate.driver import simulate as run_simulation
 from ..files import netcdf_writer, write_output
 from ..integrate.interrupt import finish_first, on_ctrl_c, stop_if_interrupted
@@ -29,7 +29,6 @@ from ..integrate.result import load_trajectory
 from ..integrate.status import Status
 from ..model.compile_ahead import meanwhile
 from ..model.library import load_model, plates_variant
-from ..plot.trajectory import save_trajectory_figure
 from ._app import (CLIError, app, build_system, check_finite, check_outputs, check_positive, console, error_line, exact,
                    given, note_line, warning_line)
 from ._compiling import time_text, timed
@@ -235,6 +234,8 @@ def simulate(
     # Ctrl-C ends the run with the part done, written below
     with on_ctrl_c(partial=True), meanwhile(prepare), timed() as timing:
         if duration is None:
+            from ..attractors import simulate_until_settled  # noqa: PLC0415 - it loads the orbits layer
+
             settled = simulate_until_settled(system, cap=cap, t0=t0, ic=start, perturbation=perturb, **settings)
             traj, verdict = settled.trajectory, settled.attractor
         else:
@@ -254,7 +255,7 @@ def simulate(
         on_interrupt(f"the run stopped at t = {traj.t[-1]:g} s with too few samples to write; nothing was written"
                      if write else "nothing was written (--json without --out)")
     stop_if_interrupted()  # a Ctrl-C during the run (its part is written) or as it finished
-    figure = draw_figure(out, lambda tmp: save_trajectory_figure(traj, tmp), skip=not keep or no_plot,
+    figure = draw_figure(out, lambda tmp: _save_figure(traj, tmp), skip=not keep or no_plot,
                          overwrite=overwrite, inputs=inputs)
     if traj.status != "success":
         error_line(f"the run stopped early: {traj.status}; " + (f"what it computed is in {out}" if keep else
@@ -265,6 +266,14 @@ def simulate(
         print_json(summary)
     else:
         _print_summary(traj, summary, out if write else None, figure)
+
+
+def _save_figure(traj, path: Path) -> None:
+    """The run's figure at ``path``; the plot layer is imported here, where a figure is drawn
+    (``--json`` without ``--out``, and ``--no-plot``, draw none)."""
+    from ..plot.trajectory import save_trajectory_figure  # noqa: PLC0415
+
+    save_trajectory_figure(traj, path)
 
 
 def _print_summary(traj, summary: dict, out: Path | None, figure) -> None:

@@ -49,7 +49,8 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
-import scipy.sparse as sp
+# scipy.sparse is imported in the functions that use it: a dense model (the two plates, most model
+# files) never needs it, and its import costs every command's start-up time.
 
 from ..errors import ModelFileError
 from ..inputs import read_regular_file, regular_file_size
@@ -112,6 +113,8 @@ def read_matrix(path: Path, where: str, name: str | None = None, fmt: str | None
         One line: the file is missing, not a regular file, too large for memory, not of its
         format, holds no such matrix, or has a non-finite entry.
     """
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     kind = format_of(path, fmt, where)
     what = f"{where}: matrix file"
     size = regular_file_size(path, what, ModelFileError)
@@ -182,6 +185,8 @@ def _matrix_market(data: bytes, name, where, **_):
 
 
 def _npz(data: bytes, name, where, **_):
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     if name is None:
         return sp.load_npz(io.BytesIO(data)), None
     with np.load(io.BytesIO(data), allow_pickle=False) as arrays:
@@ -251,6 +256,8 @@ def _abaqus(data: bytes, name, where, symmetric: bool = True, **_):
 
 def _mirrored(value, i, j, n, symmetric: bool) -> sp.csr_matrix:
     """The matrix of triplets; one triangle of a symmetric matrix (``symmetric``) mirrored."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     off = i != j
     if symmetric and off.any() and ((i[off] > j[off]).all() or (i[off] < j[off]).all()):
         value, i, j = np.concatenate([value, value[off]]), np.concatenate([i, j[off]]), np.concatenate([j, i[off]])
@@ -269,6 +276,8 @@ def _keyword(line: str) -> tuple[str, dict]:
 
 def _user_element(text: str, name, where):
     """A linear user element: its dofs per node and its ``*MATRIX`` blocks (module docstring)."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     blocks, current, head = {}, None, None
     for line in text.splitlines():
         stripped = line.strip()

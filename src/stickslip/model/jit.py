@@ -193,7 +193,7 @@ def python_entry_patch() -> Patch:
 _ENTRY_APART = False
 
 numba_patches.install([*compile_speedups.PATCHES, python_entry_patch(), linking.PATCH, kernel_cache.PATCH,
-                       compile_ahead.FORK_PATCH])
+                       kernel_cache.LOAD_PATCH, compile_ahead.FORK_PATCH])
 
 #: Whether the package's kernels are cached on disk (:func:`.kernel_cache.caching`).
 _CACHE = kernel_cache.caching()

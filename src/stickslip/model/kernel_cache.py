@@ -32,6 +32,11 @@ kernel uncached, with one warning per run.
 
 Without the patch the package's kernels are not cached on disk (:func:`caching`): numba's own
 cache would load a kernel with the old code of a module it inlines.
+
+**Loaded without numba's registries.** A second patch, ``cache-load`` (:data:`LOAD_PATCH`), loads
+a cached kernel of the package without the refresh of numba's target context that numba makes
+first, which imports every implementation registry of numba (and scipy.linalg): what a warm
+command needs of it, numba's runtime, is initialised alone (:func:`_load_without_refresh`).
 """
 
 from __future__ import annotations
@@ -49,8 +54,8 @@ from pathlib import Path
 
 from .numba_patches import Patch, active, first_problem, has, notice, source_has
 
-__all__ = ["PATCH", "FORMAT", "caching", "compiled_layer_digest", "track_user_code", "defined_in_package",
-           "unavailable_class", "without_entry", "patch_tag"]
+__all__ = ["PATCH", "LOAD_PATCH", "FORMAT", "caching", "compiled_layer_digest", "track_user_code",
+           "defined_in_package", "unavailable_class", "without_entry", "patch_tag"]
 
 #: The cache files' format: numba's version field of an index carries it.
 FORMAT = "stickslip-sha256-1"
@@ -466,3 +471,55 @@ def _apply() -> None:
 
 #: Keeping the package's kernels in numba's cache, as a patch of :mod:`.numba_patches`.
 PATCH = Patch("cache-keeping", _check, _apply)
+
+
+# ----------------------------------------------------------------------------- loading without a refresh
+
+def _load_without_refresh(original):
+    """numba's ``Cache.load_overload`` that loads a cached kernel of the package without first
+    refreshing the target context, which imports and installs every implementation registry of
+    numba (its array, linear-algebra, random and datetime libraries, and scipy.linalg for BLAS):
+    0.1-0.3 s of a warm command's start, and nothing a loaded kernel uses, as those registries
+    serve typing and lowering, that is compiling. A loaded kernel's object code links against
+    numba's runtime (NRT), which the refresh initialises: that is done here. Any compilation
+    refreshes the context itself first, as before; other functions' caches (a user's njit with
+    ``cache=True``, which may link against a third-party extension's symbols) load as numba has it."""
+    from numba.core.cpu import CPUContext
+    from numba.core.runtime import rtsys
+
+    @functools.wraps(original)
+    def load_overload(self, sig, target_context):
+        if not isinstance(target_context, CPUContext) or not _ours(getattr(self, "_cache_file", None)):
+            return original(self, sig, target_context)
+        rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
+    return load_overload
+
+
+def _check_load() -> str | None:
+    from numba.core import caching as numba_caching
+    from numba.core.cpu import CPUContext
+    from numba.core.runtime import rtsys
+
+    cache = numba_caching.Cache
+    return first_problem(
+        has(cache, "load_overload", ("self", "sig", "target_context")),
+        lambda: source_has(cache.load_overload, "target_context.refresh()", "self._guard_against_spurious_io_errors()",
+                           "self._load_overload(sig, target_context)"),
+        has(cache, "_guard_against_spurious_io_errors", ("self",)),
+        has(type(rtsys), "initialize", ("self", "ctx")),
+        lambda: source_has(CPUContext.load_additional_registries, "rtsys.initialize(self)"))
+
+
+def _apply_load() -> None:
+    from numba.core import caching as numba_caching
+
+    from .linking import wrap_once
+
+    wrap_once(numba_caching.Cache, "load_overload", _load_without_refresh)
+
+
+#: Loading the package's cached kernels without numba's registries, as a patch of :mod:`.numba_patches`.
+LOAD_PATCH = Patch("cache-load", _check_load, _apply_load)

@@ -31,10 +31,12 @@ other parameters (``replace``, ``--set``) does not factorise the same M again.
 
 from __future__ import annotations
 
+import sys
 import weakref
 
 import numpy as np
-import scipy.sparse as sp
+# scipy.sparse is imported in the functions that use it: a dense model (the two plates, most model
+# files) never needs it, and its import costs every command's start-up time.
 
 from ..errors import ModelError
 from .stack import MAX_DOFS
@@ -67,8 +69,10 @@ def arpack_start(n: int) -> np.ndarray:
 
 
 def is_sparse(value) -> bool:
-    """Whether ``value`` is a scipy.sparse matrix or array."""
-    return sp.issparse(value)
+    """Whether ``value`` is a scipy.sparse matrix or array (none is where scipy.sparse was never
+    imported: this asks without importing it)."""
+    sparse = sys.modules.get("scipy.sparse")
+    return sparse is not None and sparse.issparse(value)
 
 
 def dense_array(value) -> np.ndarray:
@@ -92,6 +96,8 @@ def _csr(value) -> sp.csr_matrix:
     """``value`` as a canonical float64 CSR matrix (duplicates summed, indices sorted, no stored
     zeros); one that already is a canonical float64 CSR matrix is kept as it is (not copied: a
     model's matrices are never changed in place, and a checked mass stays known as checked)."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     if type(value) is sp.csr_matrix and value.dtype == np.float64 and value.has_canonical_format:
         return value
     out = sp.csr_matrix(value, dtype=float, copy=True)
@@ -199,6 +205,8 @@ def check_mass(mass, free: np.ndarray, where: str) -> None:
 
 def _sparse_range(M: sp.csr_matrix, where: str) -> tuple[float, float]:
     """(λmin, λmax) of a sparse M, after checking it symmetric and positive definite."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     asym = abs(M - M.T) - _SYMMETRY * abs(M.T)
     if asym.nnz and asym.max() > 0.0:
         raise ModelError(f"{where}: mass must be symmetric; give M with M[i][j] = M[j][i]")

@@ -57,7 +57,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
-import scipy.sparse as sp
+# scipy.sparse is imported in the functions that use it: a dense model (the two plates, most model
+# files) never needs it, and its import costs every command's start-up time.
 
 from ..errors import ExpressionError, FrictionLawError, ModelError, ModelFileError
 from ..inputs import read_regular_file
@@ -347,6 +348,8 @@ def _containers(t: _Template) -> dict:
 
 def _matrices(t: _Template, out: dict) -> tuple:
     """M, C, K: written out, or from files (times their ``scale``), C also by Rayleigh or zero."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     scalars = out["scalars"]
     for key, base in t.fe.matrices.items():
         scale = scalars[f"{key}.scale"]

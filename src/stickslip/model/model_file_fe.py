@@ -34,7 +34,8 @@ from pathlib import Path
 from typing import Mapping
 
 import numpy as np
-import scipy.sparse as sp
+# scipy.sparse is imported in the functions that use it: a dense model (the two plates, most model
+# files) never needs it, and its import costs every command's start-up time.
 
 from ..errors import ModelError, ModelFileError
 from ..inputs import read_regular_file, regular_file_size
@@ -190,6 +191,8 @@ class FileMatrices:
 
     def _aligned(self, key: str, data: MatrixData) -> sp.csr_matrix:
         """The matrix in the order of the dofs: by labels where the dofs come from labels."""
+        import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
         if self.labels is None or data.labels is None or data.labels == self.labels:
             return data.matrix
         index = {label: k for k, label in enumerate(self.labels)}
@@ -224,6 +227,8 @@ class Triplets:
         self.entries[index] = value
 
     def matrix(self) -> sp.csr_matrix:
+        import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
         if not self.entries:
             return sp.csr_matrix(self.shape)
         (i, j), values = zip(*self.entries.keys()), list(self.entries.values())
@@ -406,6 +411,8 @@ def set_nodes(table: Mapping, where: str, base: Path | None) -> dict:
 
 def contact_set(name: str, table: Mapping, nodes: Mapping, names: Mapping[str, int]) -> ContactSet:
     """The structure of a set (its nodes' dofs), checked; the numbers are slotted by the caller."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     where = f"contact_set.{name}"
     check_name(name, f"{where}: the set's name")
     n = len(names)

@@ -1,6 +1,6 @@
 """Every change stickslip makes to numba's behaviour, installed by one :func:`install`, each checked first.
 
-The compiled layer changes numba in nine ways. Each is a :class:`Patch`: what it changes, a check
+The compiled layer changes numba in ten ways. Each is a :class:`Patch`: what it changes, a check
 that the private names it needs exist with the shape it expects, and what applies it.
 :func:`install` (run when :mod:`stickslip.model.jit` is imported) applies the patches whose checks
 pass, once per process.
@@ -35,6 +35,9 @@ patch                       what it changes                                     
                                                                                             ``_save_index``, ``_load_data``,
                                                                                             ``_save_data``, ``_dump``,
                                                                                             ``_open_for_write``
+``cache-load``              a cached kernel of the package loaded without numba's           ``Cache.load_overload`` (its
+                            implementation registries (:mod:`.kernel_cache`): only the      source), ``_load_overload``,
+                            runtime its code links against is initialised                   ``rtsys.initialize``
 ``fork-helper``             a cold start's helper forked with numba's compiler lock held    ``compiler_lock.global_compiler_lock``,
                             and the compile listeners cleared in the child                  ``event._registered``
                             (:mod:`.compile_ahead`)
@@ -81,8 +84,10 @@ from __future__ import annotations
 import atexit
 import contextlib
 import dataclasses
+import hashlib
 import importlib
 import inspect
+import json
 import os
 import secrets
 import sys
@@ -148,16 +153,17 @@ def install(patches=None) -> dict:
                             f"({TESTED[0]}-{TESTED[-1]}); install numba>={TESTED[0]},<{_next_minor(TESTED[-1])}"
     else:
         applied, skipped = [], {}
-        for patch in patches:
-            try:
-                problem = patch.check()
-            except Exception as exc:  # noqa: BLE001 - a check that fails is a patch that does not fit
-                problem = f"{type(exc).__name__}: {exc}"
-            if problem is None:
-                patch.apply()
-                applied.append(patch.name)
-            else:
-                skipped[patch.name] = problem
+        with remembered_checks(checks_file()):
+            for patch in patches:
+                try:
+                    problem = patch.check()
+                except Exception as exc:  # noqa: BLE001 - a check that fails is a patch that does not fit
+                    problem = f"{type(exc).__name__}: {exc}"
+                if problem is None:
+                    patch.apply()
+                    applied.append(patch.name)
+                else:
+                    skipped[patch.name] = problem
         _STATUS.update(active=frozenset(applied), skipped=skipped)
     _say_status()
     return _STATUS
@@ -212,13 +218,97 @@ def _signature_text(params: tuple) -> str:
 
 
 def source_has(function, *snippets: str) -> str | None:
-    """None where the source text of ``function`` holds every one of ``snippets``, else what is not there."""
+    """None where the source text of ``function`` holds every one of ``snippets``, else what is not there.
+
+    Inside :func:`remembered_checks` a check that passed once for the same code (:func:`code_key`)
+    passes without reading the source again."""
+    key = code_key(function, snippets) if _PASSED is not None else None
+    if key is not None and key in _PASSED:
+        return None
     try:
         text = inspect.getsource(function)
     except (OSError, TypeError):
         return f"no source of {getattr(function, '__qualname__', function)}"
     missing = [snippet for snippet in snippets if snippet not in text]
-    return None if not missing else f"{function.__qualname__} does not read {missing[0]!r}"
+    if missing:
+        return f"{function.__qualname__} does not read {missing[0]!r}"
+    if key is not None:
+        _PASSED.add(key)
+    return None
+
+
+# ----------------------------------------------------------------------------- checks remembered
+
+#: Keys (:func:`code_key`) of the source checks that passed, while :func:`remembered_checks` runs; else None.
+_PASSED: set | None = None
+
+#: Most keys a file of remembered checks keeps (the package makes some twenty source checks).
+MAX_REMEMBERED = 500
+
+
+def code_key(function, snippets: tuple) -> str | None:
+    """A digest of what :func:`source_has` reads, for one check: the compiled code of ``function``
+    (that of the function ``inspect.getsource`` reads, behind ``functools.wraps``; its bytecode,
+    the names, constants and nested code it holds, its file and first line) and the ``snippets``.
+    The same code compiled from the same place gives the same key in every process; a function of
+    numba replaced or edited (a wrapper, another release in the same place) gives another. None
+    for an object without Python code."""
+    code = getattr(inspect.unwrap(function), "__code__", None)
+    if code is None:
+        return None
+    digest = hashlib.sha256(repr(snippets).encode())
+    _feed_code(digest, code)
+    return digest.hexdigest()
+
+
+def _feed_code(digest, code) -> None:
+    digest.update(code.co_code)
+    digest.update(repr((code.co_filename, code.co_firstlineno, code.co_name, code.co_names, code.co_varnames,
+                        code.co_freevars, code.co_cellvars)).encode())
+    for const in code.co_consts:
+        if hasattr(const, "co_code"):
+            _feed_code(digest, const)
+        else:
+            digest.update(repr(sorted(map(repr, const)) if isinstance(const, frozenset) else const).encode())
+
+
+def checks_file() -> Path:
+    """Where the source checks that passed are remembered, per numba version: beside the
+    package's cached kernels (numba's ``NUMBA_CACHE_DIR`` where set, else this folder's
+    ``__pycache__``)."""
+    folder = os.environ.get("NUMBA_CACHE_DIR", "").strip() or Path(__file__).resolve().parent / "__pycache__"
+    return Path(folder) / f"stickslip-numba-checks-{numba.__version__}.json"
+
+
+@contextlib.contextmanager
+def remembered_checks(path: Path):
+    """Remember the source checks that pass in this block in ``path`` (read at its start, written
+    when checks were added): the source text of numba's functions is read once per numba
+    install, not at every start (some 10 ms of CPU). A file that cannot be read is an empty memory, one
+    that cannot be written leaves the checks unremembered; neither is an error."""
+    global _PASSED
+    try:
+        known = set(json.loads(Path(path).read_text()))
+    except (OSError, ValueError, TypeError):
+        known = set()
+    _PASSED = set(known)
+    try:
+        yield
+    finally:
+        passed, _PASSED = _PASSED, None
+        if passed - known:
+            _write_atomically(Path(path), json.dumps(sorted(passed)[:MAX_REMEMBERED]))
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=path.name, suffix=".tmp", delete=False) as f:
+            f.write(text)
+        os.replace(f.name, path)
+    except OSError:
+        with contextlib.suppress(OSError, NameError):
+            os.unlink(f.name)
 
 
 def first_problem(*checks) -> str | None:

@@ -48,7 +48,8 @@ import dataclasses
 from typing import Mapping
 
 import numpy as np
-import scipy.sparse as sp
+# scipy.sparse is imported in the functions that use it: a dense model (the two plates, most model
+# files) never needs it, and its import costs every command's start-up time.
 
 from ..errors import ModelError
 from .friction import _USER_LAWS, FrictionLaw
@@ -214,6 +215,8 @@ class SparseForm:
         """(N0 (nc,), n csr (nc, n), n_v csr (nc, n)): every contact's normal force N0 + n·q + n_v·q̇
         with each compliant contact closed (N0 = −k g0, n = −k W, n_v = −c W); a rigid contact's
         normal force is a multiplier, not affine in the state: its rows are zero."""
+        import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
         compliant = self.normal_law == "compliant"
         k = np.where(compliant, self.contact_stiffness, 0.0)
         c = np.where(compliant, self.contact_damping, 0.0)
@@ -240,12 +243,16 @@ def _cell_block(kind, rows, nn: int) -> tuple[str, np.ndarray]:
 
 
 def _csr(value, shape: tuple[int, int]) -> sp.csr_matrix:
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     out = sp.csr_matrix(value if is_sparse(value) else np.asarray(value, dtype=float).reshape(shape), dtype=float)
     return out
 
 
 def _stacked(rows: list, n: int) -> sp.csr_matrix:
     """One row per contact (None: a zero row), stacked into csr (nc, n)."""
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     return sp.vstack([sp.csr_matrix((1, n)) if r is None else _csr(r, (1, n)) for r in rows], format="csr") \
         if rows else sp.csr_matrix((0, n))
 
@@ -258,6 +265,8 @@ def sparse_form(model) -> SparseForm:
     ModelError
         For a model whose contact frames depend on q (a kinematics class other than the constant ones).
     """
+    import scipy.sparse as sp  # noqa: PLC0415 - see the module's imports
+
     if not model.constant_kinematics:
         raise ModelError(f"model {model.name!r} computes its contact frames from q (kinematics "
                          f"{type(model.kinematics).__name__}); the sparse form needs constant tangent rows and drives "
