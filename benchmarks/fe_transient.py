@@ -18,7 +18,8 @@ Rows:
   slope of each against nc);
 * ``target``: 900 DOFs with 40 compliant contact nodes, 20 periods (``--periods``) of its first
   mode (``natural_frequencies()[0]``) from rest at rtol 1e-8: wall and CPU time (the process's,
-  which a shared machine inflates less), steps and how many contacts stuck and opened;
+  which a shared machine inflates less) and per period, steps (accepted, rejected, re-taken at
+  slip roots), right-hand sides, stick/slip transitions and how many contacts stuck and opened;
 * ``cold``: the first run of a heap-flavour model in a fresh process with an empty
   ``NUMBA_CACHE_DIR`` (the default two compile processes): its compile time as the run reports it.
 
@@ -136,6 +137,8 @@ def target(folder: Path, periods: float = 20.0) -> dict:
            "cpu_s": cpu, "wall_per_period_s": wall / periods, "goal_s_for_20_periods": 60.0, "status": run.status,
            "t_reached_periods": float(run.t[-1] * f1), "steps": run.stats.accepted_steps,
            "rejected": run.stats.rejected_steps, "rhs_calls": run.stats.rhs_calls,
+           "retaken": run.stats.retaken_steps, "slip_to_stick": run.stats.slip_to_stick,
+           "stick_to_slip": run.stats.stick_to_slip, "cpu_per_period_s": cpu / periods,
            "contacts_that_stuck": int(run.stick.any(axis=0).sum()),
            "contacts_that_opened": int(run.open.any(axis=0).sum())}
     print(json.dumps(row), flush=True)

@@ -233,11 +233,33 @@ def arrive(progress, c, t, y, cst, md, v_arrive, scratch, log, stats):
 
 
 @inlined_kernel
+def drifted(y, cst, md, nc, rtol, atol):
+    """Whether the velocities at ``y`` are projected onto the sticking contacts' constraints after
+    a step: always for a model of one contact; for several, where some sticking contact's |v|
+    exceeds the error control's velocity resolution atol + rtol max|q̇_i| (the projection costs
+    about a right-hand side, and the derivative again another; below that resolution a drift is
+    not there to the integration, and it does not grow: the stick forces hold dv/dt = 0)."""
+    if nc == 1:
+        return True
+    n = model_sizes(md.kin, md.m)[0]
+    qd = 0.0
+    for i in range(n, 2 * n):
+        qd = max(qd, abs(y[i]))
+    tol = atol + rtol * qd
+    for c in range(nc):
+        if np.int64(cst[CST * c]) == P.MODE_STICK:
+            vx, vy = P.slip_velocity(y, c, md)
+            if vx * vx + vy * vy > tol * tol:
+                return True
+    return False
+
+
+@inlined_kernel
 def arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip, any_stick, stats):
     """The contacts after an accepted step (``step.y``, local time ``progress.tau``).
 
     The velocities are projected onto the sticking contacts' constraints (``any_stick``: drift
-    removed); each slipping contact gets its slip direction there; a quasi-static one that has
+    removed, :func:`drifted`); each slipping contact gets its slip direction there; a quasi-static one that has
     departed (|v| above the low-speed band) or whose |v| falls again inside the band (an
     approach, which may end in stick or a reversal) is watched with the exact direction from the
     next step on (the force law changes between steps, never inside one); the others
@@ -251,8 +273,8 @@ def arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip,
     y = step.y
     end = slips.end
     band = m[H_BAND]
-    changed = any_stick
-    if any_stick:
+    changed = any_stick and drifted(y, cst, md, nc, controls.rtol, controls.atol)
+    if changed:
         P.project_velocities(y, cst, np.int64(-1), md)
     v_arrive = E.arrival_speed(y, n, controls.rtol, controls.atol)
     t = controls.t_base + progress.tau
