@@ -24,16 +24,17 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from numba.extending import overload
 
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
-from ..model.jit import inlined_kernel
-from ..model.kinematics import model_sizes
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel
+from ..model.kinematics import LARGE_KINEMATICS, model_sizes
 from . import contacts as E
 from . import dormand_prince as DP
 from .transitions import record_transition, settle
 
-__all__ = ["SlipWatch", "slip_watch", "slip_roots", "arrivals", "MAX_RETAKES", "DEPARTURE_OVERSHOOT",
+__all__ = ["SlipWatch", "slip_watch", "slip_roots", "arrivals", "shared_steps", "MAX_RETAKES", "DEPARTURE_OVERSHOOT",
            "MAX_HOMING_STEP", "HOMING_SHORTFALL"]
 
 MAX_RETAKES = 30    # re-takes of one step while homing in on a slip → stick root
@@ -71,6 +72,23 @@ class SlipWatch(NamedTuple):
 def slip_watch(nc: int) -> SlipWatch:
     """A :class:`SlipWatch` for ``nc`` contacts, none homing."""
     return SlipWatch(np.empty(4 * nc), np.empty(4 * nc), np.zeros(nc, dtype=np.int64))
+
+
+def shared_steps(kin, nc):  # pragma: no cover - resolved by numba (overload below)
+    """Whether the steps of a model of ``nc`` contacts and kinematics data ``kin`` are shared by
+    many contacts: a large model's (the heap flavour, :data:`~stickslip.model.kinematics.LARGE_KINEMATICS`:
+    a reduced finite-element model) of more than one contact, in which some contact is nearly
+    always on its way to v = 0 and a right-hand side costs O(nnz). Such a model's approaches
+    (:func:`approach`) and stick projections (:func:`drifted`) follow the rules of many contacts;
+    every other model keeps those of a few (decided at compile time by the class of ``kin``)."""
+    raise NotImplementedError
+
+
+@overload(shared_steps, jit_options=KERNEL_OPTIONS, inline="always")
+def _shared_steps(kin, nc):
+    if getattr(kin, "instance_class", None) in tuple(LARGE_KINEMATICS.values()):
+        return lambda kin, nc: nc > 1
+    return lambda kin, nc: False
 
 
 @inlined_kernel
@@ -167,14 +185,14 @@ def approach(progress, c, mode, slips, theta_slip, v_arrive, cst, md):
     steps geometrically (``progress.h_override``; a 1-D contact's a little short of it, as its
     slip velocity changes sign at zero and so does its force: a step past the zero is rejected).
 
-    In a model of several contacts the step is shared, and some contact is nearly always on its
-    way to v = 0 (40 contact nodes of a finite-element pad): there the ratio is controlled for
-    2-D contacts only (a 1-D contact has no direction dynamics; its zero is found on the step's
-    dense output, :func:`slip_roots`), and a contact homes only onto a zero that lies within the
-    error controller's next step, never with a longer step. A longer homing step was rejected
-    by the error control, shrunk, accepted and lengthened again onto the same zero, step after
-    step (on such a pad 206 of its 219 rejections in 0.05 of a period; 14 without). A model of
-    one contact keeps the rules above (its approach is the step's whole business).
+    In a model whose steps many contacts share (:func:`shared_steps`: 40 contact nodes of a
+    finite-element pad), some contact is nearly always on its way to v = 0: there the ratio is
+    controlled for 2-D contacts only (a 1-D contact has no direction dynamics; its zero is found
+    on the step's dense output, :func:`slip_roots`), and a contact homes only onto a zero that
+    lies within the error controller's next step, never with a longer step. A longer homing step
+    was rejected by the error control, shrunk, accepted and lengthened again onto the same zero,
+    step after step (on such a pad 206 of its 219 rejections in 0.05 of a period; 14 without).
+    Other models keep the rules above.
 
     Returns (homes, near): whether the next step homes onto its zero, and whether it has arrived
     (a located root, homing, or |v| at the error control's resolution ``v_arrive`` and falling;
@@ -191,7 +209,7 @@ def approach(progress, c, mode, slips, theta_slip, v_arrive, cst, md):
             or (speed <= v_arrive and v1x * a1x + v1y * a1y < 0.0))
     n, nc, _ = model_sizes(md.kin, md.m)
     dim = P.contact_dim(md.kin, md.m, n, c)
-    shared = nc > 1
+    shared = shared_steps(md.kin, nc)
     tau_c = E.time_to_zero_of(v1x, v1y, a1x, a1y)
     tau_start = cst[CST * c + 3]
     if tau_start < math.inf and tau_c < math.inf and (dim == 2 or not shared):
@@ -235,11 +253,12 @@ def arrive(progress, c, t, y, cst, md, v_arrive, scratch, log, stats):
 @inlined_kernel
 def drifted(y, cst, md, nc, rtol, atol):
     """Whether the velocities at ``y`` are projected onto the sticking contacts' constraints after
-    a step: always for a model of one contact; for several, where some sticking contact's |v|
-    exceeds the error control's velocity resolution atol + rtol max|q̇_i| (the projection costs
-    about a right-hand side, and the derivative again another; below that resolution a drift is
-    not there to the integration, and it does not grow: the stick forces hold dv/dt = 0)."""
-    if nc == 1:
+    a step: always, except in a model whose steps many contacts share (:func:`shared_steps`): there
+    where some sticking contact's |v| exceeds the error control's velocity resolution atol + rtol
+    max|q̇_i| (the projection costs about a right-hand side, and the derivative again another;
+    below that resolution a drift is not there to the integration, and it does not grow: the
+    stick forces hold dv/dt = 0)."""
+    if not shared_steps(md.kin, nc):
         return True
     n = model_sizes(md.kin, md.m)[0]
     qd = 0.0
