@@ -255,9 +255,9 @@ def drifted(y, cst, md, nc, rtol, atol):
     """Whether the velocities at ``y`` are projected onto the sticking contacts' constraints after
     a step: always, except in a model whose steps many contacts share (:func:`shared_steps`): there
     where some sticking contact's |v| exceeds the error control's velocity resolution atol + rtol
-    max|q̇_i| (the projection costs about a right-hand side, and the derivative again another;
-    below that resolution a drift is not there to the integration, and it does not grow: the
-    stick forces hold dv/dt = 0)."""
+    max|q̇_i| (the projection costs about a right-hand side, and the derivative again another).
+    The stick forces hold dv/dt = 0, so a sticking contact's v changes only by the steps' errors,
+    and is removed as soon as it exceeds what the integration resolves."""
     if not shared_steps(md.kin, nc):
         return True
     n = model_sizes(md.kin, md.m)[0]
@@ -278,8 +278,8 @@ def arrivals(progress, controls, step, slips, cst, md, scratch, log, theta_slip,
     """The contacts after an accepted step (``step.y``, local time ``progress.tau``).
 
     The velocities are projected onto the sticking contacts' constraints (``any_stick``: drift
-    removed, :func:`drifted`); each slipping contact gets its slip direction there; a quasi-static one that has
-    departed (|v| above the low-speed band) or whose |v| falls again inside the band (an
+    removed, :func:`drifted`); each slipping contact gets its slip direction there; a
+    quasi-static one that has departed (|v| above the low-speed band) or whose |v| falls again inside the band (an
     approach, which may end in stick or a reversal) is watched with the exact direction from the
     next step on (the force law changes between steps, never inside one); the others
     :func:`approach` v = 0 and :func:`arrive`. Then the derivative again where a mode changed or
