@@ -10,7 +10,20 @@ copies of a callee linked into several libraries are counted apart.
 
     python benchmarks/profile_jit.py [--method aeom] [--dt 1e-3] [--seconds 10] [--top 25] [--sample-rate 1000]
 
-Needs Linux ``perf`` with permission to record this process. Development tool: not run by CI.
+Needs Linux ``perf`` with permission to record this process.
+
+With ``--compile`` it profiles a cold compile instead: a first ``simulate`` (of the plates, or of
+``--model``) in a fresh numba cache, in one process (``STICKSLIP_COMPILE_PROCESSES=1``: the cold
+start's helper off, so every kernel compiles here), with numba's compile events recorded. Times
+are CPU seconds of that process (a fair measure on a machine that others load). Each kernel's
+compile time is printed inclusive (its event's span: its typing, the kernels it calls
+compiled inside that, its lowering and LLVM) and by itself (less the spans of the kernels compiled
+inside it), summed over its signatures; ``--rev REV`` also runs it with the package at a git
+revision (``git archive``, as ``first_call.py`` does), alternating, ``--repeat`` times (medians):
+
+    python benchmarks/profile_jit.py --compile [--model FILE] [--rev REV] [--repeat 3] [--top 40]
+
+Writes benchmarks/results/compile_profile.json. Development tool: not run by CI.
 """
 
 from __future__ import annotations
@@ -19,13 +32,49 @@ import argparse
 import bisect
 import collections
 import importlib
+import json
 import os
 import pkgutil
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Run in a child with a fresh NUMBA_CACHE_DIR: a first simulate with every compile event recorded.
+_COMPILE_CHILD = """
+import json, sys, time
+from numba.core import event
+import stickslip
+own, stack = {}, []
+class Listener(event.Listener):
+    def on_start(self, ev):
+        stack.append([time.process_time(), 0.0])
+    def on_end(self, ev):
+        start, inner = stack.pop()
+        span = time.process_time() - start
+        if stack:
+            stack[-1][1] += span
+        d = ev.data["dispatcher"]
+        name = d.py_func.__module__.replace("stickslip.", "") + "." + d.py_func.__qualname__
+        row = own.setdefault(name, [0.0, 0.0, 0])
+        row[0] += span
+        row[1] += span - inner
+        row[2] += 1
+event.register("numba:compile", Listener())
+model = sys.argv[1] or None
+start = time.process_time()
+if model:
+    stickslip.simulate(stickslip.load_model(model), 1.0)
+else:
+    stickslip.simulate(t_end=1.0)
+own["(total)"] = [time.process_time() - start, 0.0, 0]
+print(json.dumps(own))
+"""
 
 
 def function_addresses(package) -> list[tuple[int, str]]:
@@ -71,14 +120,72 @@ def readable(symbol: str) -> str:
     return ("wrapper:" if wrapper else "") + ".".join(parts)
 
 
+def _package_at(rev: str, into: Path) -> Path:
+    """``src/stickslip`` at ``rev`` extracted under ``into``; the folder to put on PYTHONPATH."""
+    import io
+    import tarfile
+
+    data = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "src/stickslip"], check=True,
+                          capture_output=True).stdout
+    with tarfile.open(fileobj=io.BytesIO(data)) as tar:
+        tar.extractall(into, filter="data")
+    return into / "src"
+
+
+def compile_once(model: str | None, tree: Path | None) -> dict:
+    """{kernel: [inclusive s, own s, compiles]} of one cold first simulate (``_COMPILE_CHILD``)."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, STICKSLIP_COMPILE_PROCESSES="1")
+        if tree is not None:
+            env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        res = subprocess.run([sys.executable, "-c", _COMPILE_CHILD, model or ""], env=env, capture_output=True,
+                             text=True, cwd=cache)
+    if res.returncode:
+        sys.exit(f"the cold simulate failed:\n{res.stderr[-2000:]}")
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def compile_profile(args) -> None:
+    """Per-kernel compile times of a cold first simulate, for the working tree and ``--rev``s."""
+    with tempfile.TemporaryDirectory() as tmp:
+        trees = {"working tree": None}
+        for i, rev in enumerate(args.rev):
+            trees[rev] = _package_at(rev, Path(tmp) / f"rev{i}")
+        runs = {name: [] for name in trees}
+        for _ in range(args.repeat):
+            for name, tree in trees.items():
+                runs[name].append(compile_once(args.model, tree))
+    out = {}
+    for name, profiles in runs.items():
+        kernels = set().union(*profiles)
+        out[name] = {k: [round(statistics.median(p.get(k, [0.0, 0.0, 0])[i] for p in profiles), 3) for i in range(3)]
+                     for k in kernels}
+        print(f"-- {name}: cold simulate {out[name]['(total)'][0]:.2f} s CPU (median of {args.repeat}), "
+              f"kernels by own compile time (inclusive in brackets)")
+        rows = sorted(((k, v) for k, v in out[name].items() if k != "(total)"), key=lambda kv: -kv[1][1])
+        for k, (inclusive, own, count) in rows[:args.top]:
+            print(f"  {own:6.2f} s  ({inclusive:6.2f} s)  x{count:<3g} {k}")
+    path = ROOT / "benchmarks" / "results" / "compile_profile.json"
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(json.dumps({"model": args.model, "repeat": args.repeat, "profiles": out,
+                                "load_average": os.getloadavg()}, indent=2))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--compile", action="store_true", help="profile a cold compile instead (module docstring)")
+    ap.add_argument("--model", default=None, help="--compile: a model (name or file) instead of the plates")
+    ap.add_argument("--rev", action="append", default=[], help="--compile: also at this git revision")
+    ap.add_argument("--repeat", type=int, default=1, help="--compile: runs per tree (medians)")
     ap.add_argument("--method", default="aeom", choices=["event", "aeom", "naeom"])
     ap.add_argument("--dt", type=float, default=1e-3, help="fixed step [s] (aeom, naeom)")
     ap.add_argument("--seconds", type=float, default=10.0, help="recording time [s]")
     ap.add_argument("--top", type=int, default=25)
     ap.add_argument("--sample-rate", type=float, default=1000.0, help="output samples per second [Hz]")
     args = ap.parse_args()
+    if args.compile:
+        compile_profile(args)
+        return
     if shutil.which("perf") is None:
         sys.exit("perf not found: install linux perf (e.g. apt install linux-perf) to profile")
 

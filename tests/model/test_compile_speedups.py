@@ -249,3 +249,52 @@ def test_live_maps_are_numbas_on_every_function_a_compile_analyses(monkeypatch):
     a = np.array([0.5, 3.0, 40.0])
     assert _nested_loops(a, 3) == _nested_loops.py_func(a, 3)
     assert calls and max(calls) > 5
+
+
+def _overload_impls(function) -> list:
+    """The implementation dispatchers numba has made so far for the overload ``function``."""
+    from numba.core.registry import cpu_target
+
+    fnty = cpu_target.typing_context.resolve_value_type(function)
+    return [disp for template in fnty.templates for disp, _ in template._impl_cache.values() if disp is not None]
+
+
+def test_an_inlined_overload_of_the_package_is_typed_and_inlined_without_compiling_it():
+    """A kernel that calls an ``inline="always"`` overload of the package computes what the
+    overload's Python implementation computes, and the implementation's dispatcher was never
+    compiled (every call of it is inlined); an inlined overload of another module is compiled as
+    numba does."""
+    from numba.extending import overload
+
+    from stickslip.model.jit import KERNEL_OPTIONS
+    from stickslip.model.model_data import _gram_row, gram_row
+
+    @njit(**KERNEL_OPTIONS)
+    def rows(g, MG, k, n, A):
+        for r in range(2):
+            gram_row(0.0, g[r], MG, k, n, A, r, 0.0)
+
+    rng = np.random.default_rng(3)
+    g, MG, A = rng.normal(size=(2, 5)), rng.normal(size=(3, 5)), np.zeros((2, 3))
+    rows(g, MG, 3, 5, A)
+    expected = np.zeros((2, 3))
+    _gram_row(None, None, None, None, None, None, None, None)(None, g[0], MG, 3, 5, expected, 0, 0.0)
+    _gram_row(None, None, None, None, None, None, None, None)(None, g[1], MG, 3, 5, expected, 1, 0.0)
+    np.testing.assert_array_equal(A, expected)
+    impls = _overload_impls(gram_row)
+    assert impls and all(not disp._can_compile and not disp.overloads for disp in impls)
+
+    def scaled(x):  # pragma: no cover - resolved by numba
+        raise NotImplementedError
+
+    @overload(scaled, inline="always")
+    def _scaled(x):
+        return lambda x: 2.0 * x
+
+    @njit
+    def twice(x):
+        return scaled(x)
+
+    assert twice(1.5) == 3.0
+    (other,) = _overload_impls(scaled)
+    assert other._can_compile and other.overloads  # numba's own way outside the package

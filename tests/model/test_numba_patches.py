@@ -14,8 +14,8 @@ import numba
 from stickslip.model import numba_patches
 from stickslip.model.numba_patches import RUN_ENV
 
-ALL = {"inline-scope-copy", "inline-ir-once", "flags-hash", "call-type-once", "live-map-once", "python-entry",
-       "standalone-linking", "cache-keeping", "cache-load", "fork-helper"}
+ALL = {"inline-scope-copy", "inline-ir-once", "flags-hash", "call-type-once", "live-map-once", "inline-overload-typed",
+       "python-entry", "standalone-linking", "cache-keeping", "cache-load", "fork-helper"}
 
 
 def _fresh_env(**extra) -> dict:
@@ -110,6 +110,11 @@ _EVERY_NAME_CHANGED = """
     compute_live_map = analysis.compute_live_map
     analysis.compute_live_map = lambda cfg, blocks, var_use_map, var_def_map: compute_live_map(
         cfg, blocks, var_use_map, var_def_map)                                # live-map-once
+    from numba.core.typing import templates
+    build_impl = templates._OverloadFunctionTemplate._build_impl
+    def other_build_impl(self, cache_key, args, kws, *more):
+        return build_impl(self, cache_key, args, kws)
+    templates._OverloadFunctionTemplate._build_impl = other_build_impl        # inline-overload-typed
     add_overload = CPUDispatcher.add_overload
     def other_add_overload(self, cres, *more):
         return add_overload(self, cres)

@@ -19,6 +19,10 @@ patch                       what it changes                                     
 ``live-map-once``           the definitions reaching each block of a function found in one  ``analysis.compute_live_map``
                             pass (:mod:`.compile_speedups`)                                 (its source), ``ir_utils``' import
                                                                                             of it, ``CFGraph.topo_order``
+``inline-overload-typed``   an inlined overload's implementation typed, not compiled as a   ``_OverloadFunctionTemplate``'s
+                            function of its own (:mod:`.compile_speedups`)                  ``_get_jit_decorator``, ``_build_impl``,
+                                                                                            ``generic`` (their source),
+                                                                                            ``Dispatcher._can_compile``
 ``python-entry``            a kernel's CPython wrapper compiled only for Python's calls     ``Dispatcher._compile_for_args``,
                             (:class:`~stickslip.model.jit.KernelDispatcher`)                ``_compiler.targetoptions``,
                                                                                             ``add_overload``, ``overloads``
