@@ -19,9 +19,11 @@ are CPU seconds of that process (a fair measure on a machine that others load). 
 compile time is printed inclusive (its event's span: its typing, the kernels it calls
 compiled inside that, its lowering and LLVM) and by itself (less the spans of the kernels compiled
 inside it), summed over its signatures; ``--rev REV`` also runs it with the package at a git
-revision (``git archive``, as ``first_call.py`` does), alternating, ``--repeat`` times (medians):
+revision (``git archive``, as ``first_call.py`` does), alternating, ``--repeat`` times (medians);
+``--llvm`` also gives the part of each kernel's own time spent inside LLVM (optimisation and
+machine code), the rest being numba's front end and lowering:
 
-    python benchmarks/profile_jit.py --compile [--model FILE] [--rev REV] [--repeat 3] [--top 40]
+    python benchmarks/profile_jit.py --compile [--model FILE] [--rev REV] [--repeat 3] [--top 40] [--llvm]
 
 Writes benchmarks/results/compile_profile.json. Development tool: not run by CI.
 """
@@ -50,29 +52,40 @@ _COMPILE_CHILD = """
 import json, sys, time
 from numba.core import event
 import stickslip
-own, stack = {}, []
+own, stack, llvm = {}, [], []
 class Listener(event.Listener):
     def on_start(self, ev):
-        stack.append([time.process_time(), 0.0])
+        stack.append([time.process_time(), 0.0, 0.0])
     def on_end(self, ev):
-        start, inner = stack.pop()
+        start, inner, in_llvm = stack.pop()
         span = time.process_time() - start
         if stack:
             stack[-1][1] += span
         d = ev.data["dispatcher"]
         name = d.py_func.__module__.replace("stickslip.", "") + "." + d.py_func.__qualname__
-        row = own.setdefault(name, [0.0, 0.0, 0])
+        row = own.setdefault(name, [0.0, 0.0, 0, 0.0])
         row[0] += span
         row[1] += span - inner
         row[2] += 1
+        row[3] += in_llvm
+class LLVM(event.Listener):
+    def on_start(self, ev):
+        llvm.append(time.process_time())
+    def on_end(self, ev):
+        if llvm and stack:
+            stack[-1][2] += time.process_time() - llvm.pop()
+        elif llvm:
+            llvm.pop()
 event.register("numba:compile", Listener())
+if sys.argv[2] == "1":
+    event.register("numba:llvm_lock", LLVM())
 model = sys.argv[1] or None
 start = time.process_time()
 if model:
     stickslip.simulate(stickslip.load_model(model), 1.0)
 else:
     stickslip.simulate(t_end=1.0)
-own["(total)"] = [time.process_time() - start, 0.0, 0]
+own["(total)"] = [time.process_time() - start, 0.0, 0, 0.0]
 print(json.dumps(own))
 """
 
@@ -132,13 +145,14 @@ def _package_at(rev: str, into: Path) -> Path:
     return into / "src"
 
 
-def compile_once(model: str | None, tree: Path | None) -> dict:
-    """{kernel: [inclusive s, own s, compiles]} of one cold first simulate (``_COMPILE_CHILD``)."""
+def compile_once(model: str | None, tree: Path | None, llvm: bool = False) -> dict:
+    """{kernel: [inclusive s, own s, compiles, own s inside LLVM]} of one cold first simulate
+    (``_COMPILE_CHILD``; the last 0 unless ``llvm``)."""
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache, STICKSLIP_COMPILE_PROCESSES="1")
         if tree is not None:
             env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-        res = subprocess.run([sys.executable, "-c", _COMPILE_CHILD, model or ""], env=env, capture_output=True,
+        res = subprocess.run([sys.executable, "-c", _COMPILE_CHILD, model or "", "1" if llvm else "0"], env=env, capture_output=True,
                              text=True, cwd=cache)
     if res.returncode:
         sys.exit(f"the cold simulate failed:\n{res.stderr[-2000:]}")
@@ -154,17 +168,18 @@ def compile_profile(args) -> None:
         runs = {name: [] for name in trees}
         for _ in range(args.repeat):
             for name, tree in trees.items():
-                runs[name].append(compile_once(args.model, tree))
+                runs[name].append(compile_once(args.model, tree, args.llvm))
     out = {}
     for name, profiles in runs.items():
         kernels = set().union(*profiles)
-        out[name] = {k: [round(statistics.median(p.get(k, [0.0, 0.0, 0])[i] for p in profiles), 3) for i in range(3)]
-                     for k in kernels}
+        out[name] = {k: [round(statistics.median(p.get(k, [0.0, 0.0, 0, 0.0])[i] for p in profiles), 3)
+                         for i in range(4)] for k in kernels}
         print(f"-- {name}: cold simulate {out[name]['(total)'][0]:.2f} s CPU (median of {args.repeat}), "
               f"kernels by own compile time (inclusive in brackets)")
         rows = sorted(((k, v) for k, v in out[name].items() if k != "(total)"), key=lambda kv: -kv[1][1])
-        for k, (inclusive, own, count) in rows[:args.top]:
-            print(f"  {own:6.2f} s  ({inclusive:6.2f} s)  x{count:<3g} {k}")
+        for k, (inclusive, own, count, in_llvm) in rows[:args.top]:
+            llvm_part = f"  LLVM {in_llvm:5.2f} s" if args.llvm else ""
+            print(f"  {own:6.2f} s  ({inclusive:6.2f} s){llvm_part}  x{count:<3g} {k}")
     path = ROOT / "benchmarks" / "results" / "compile_profile.json"
     path.parent.mkdir(exist_ok=True)
     path.write_text(json.dumps({"model": args.model, "repeat": args.repeat, "profiles": out,
@@ -177,6 +192,8 @@ def main() -> None:
     ap.add_argument("--model", default=None, help="--compile: a model (name or file) instead of the plates")
     ap.add_argument("--rev", action="append", default=[], help="--compile: also at this git revision")
     ap.add_argument("--repeat", type=int, default=1, help="--compile: runs per tree (medians)")
+    ap.add_argument("--llvm", action="store_true",
+                    help="--compile: also each kernel's own time inside LLVM (numba's llvm_lock events; slower)")
     ap.add_argument("--method", default="aeom", choices=["event", "aeom", "naeom"])
     ap.add_argument("--dt", type=float, default=1e-3, help="fixed step [s] (aeom, naeom)")
     ap.add_argument("--seconds", type=float, default=10.0, help="recording time [s]")
