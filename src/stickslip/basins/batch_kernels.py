@@ -25,7 +25,7 @@ from ..analysis.period import MIN_PERIODS
 from ..integrate import contacts as E
 from ..integrate.contacts import TRANSITION_TO_SLIP
 from ..integrate.bundles import Samples, TransitionLog
-from ..integrate.event_loop import Controls, event_loop
+from ..integrate.event_loop import Controls, event_loop, fresh_progress
 from ..integrate.runner import MIN_TRANSITION_ROOM, TRANSITIONS_PER_SECOND
 from ..integrate.status import CHUNK_END, SUCCESS
 from ..model.jit import loop
@@ -91,21 +91,9 @@ class Work(NamedTuple):
 @loop
 def _loop_call(md, cst, y, ctl, h, samples, row, log, work, start_modes):
     """One call of the event loop from ``y`` (copied into the step) as :func:`.event_loop.integrate_event`
-    makes it: a zeroed progress record with ``h`` and the first sample ``row``, no slips homing."""
-    record = work.progress[0]
-    record.status = 0
-    record.lost = -1
-    record.tau = 0.0
-    record.h = h
-    record.idx = row
-    record.n_tr = 0
-    record.n_steps = 0
-    record.retakes = 0
-    record.h_override = 0.0
-    record.h_free = 0.0
-    record.factor = 0.0
-    record.rejected = False
-    record.slips_ready = False
+    makes it: a fresh progress record (:func:`.event_loop.fresh_progress`) with ``h`` and the first
+    sample ``row``, no slips homing."""
+    fresh_progress(work.progress, h, row, 0)
     for i in range(y.size):
         work.step.y[i] = y[i]
     for i in range(work.slips.homing.size):

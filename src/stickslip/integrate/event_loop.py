@@ -51,7 +51,7 @@ import numpy as np
 
 from ..model import physics as P
 from ..model.bundle import offsets
-from ..model.jit import inlined_kernel, kernel, standalone
+from ..model.jit import formula, inlined_kernel, kernel, standalone
 from ..model.kinematics import model_sizes
 from ..model.normal import is_unilateral
 from . import contacts as E
@@ -61,7 +61,8 @@ from .slip_watch import MAX_RETAKES, arrivals, slip_roots, slip_watch
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
 from .transitions import break_away, crossing_in_step, first_breakaway, gap_crossing, jammed_contact, switch_gap
 
-__all__ = ["integrate_event", "event_loop", "loop_arrays", "Controls", "controls", "PROGRESS", "N_EXTRA"]
+__all__ = ["integrate_event", "event_loop", "loop_arrays", "fresh_progress", "Controls", "controls", "PROGRESS",
+           "N_EXTRA"]
 
 N_EXTRA = 2  # work of friction, work of damping
 
@@ -77,6 +78,29 @@ PROGRESS = np.dtype([("status", np.int64), ("lost", np.int64), ("tau", np.float6
                      ("idx", np.int64), ("n_tr", np.int64), ("n_steps", np.int64), ("retakes", np.int64),
                      ("h_override", np.float64), ("h_free", np.float64), ("factor", np.float64),
                      ("rejected", np.bool_), ("slips_ready", np.bool_)], align=True)
+
+
+@formula
+def fresh_progress(start, h, idx, n_tr):
+    """``start[0]`` (a :data:`PROGRESS` record) as a chunk of the loop starts it: every field zero
+    (false) but ``lost`` (−1: none), the step size ``h`` [s], the next sample ``idx`` and the
+    transitions ``n_tr`` found before. Python (:func:`loop_arrays`) and compiled callers (a basin
+    batch's loop call) share it."""
+    p = start[0]
+    p["status"] = 0
+    p["lost"] = -1
+    p["tau"] = 0.0
+    p["h"] = h
+    p["idx"] = idx
+    p["n_tr"] = n_tr
+    p["n_steps"] = 0
+    p["retakes"] = 0
+    p["h_override"] = 0.0
+    p["h_free"] = 0.0
+    p["factor"] = 0.0
+    p["rejected"] = False
+    p["slips_ready"] = False
+
 
 #: What :func:`take_step` found: the step is taken, or rejected (try again with ``progress.h``),
 #: or the run stops (``progress.status``).
@@ -503,9 +527,7 @@ def loop_arrays(y0: np.ndarray, nc: int, h_init: float = 0.0, idx0: int = 0, n_t
     """The arrays :func:`event_loop` works on for a state ``y0`` (copied) and ``nc`` contacts:
     (start, step, slips, scratch, stats)."""
     start = np.zeros(1, dtype=PROGRESS)
-    start["h"] = h_init
-    start["idx"] = idx0
-    start["n_tr"] = n_tr0
+    fresh_progress(start, h_init, idx0, n_tr0)
     ns = y0.shape[0]
     return start, DP.new_step(y0.copy()), slip_watch(nc), scratch(ns, nc), np.zeros(6, dtype=np.int64)
 
