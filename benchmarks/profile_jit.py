@@ -161,6 +161,8 @@ def compile_once(model: str | None, tree: Path | None, llvm: bool = False) -> di
 
 def compile_profile(args) -> None:
     """Per-kernel compile times of a cold first simulate, for the working tree and ``--rev``s."""
+    if args.model and Path(args.model).exists():  # a file: the children run in their cache folder
+        args.model = str(Path(args.model).resolve())
     with tempfile.TemporaryDirectory() as tmp:
         trees = {"working tree": None}
         for i, rev in enumerate(args.rev):
