@@ -4,7 +4,9 @@ What a new user waits for: each command is run as its own process (as a user run
 ``NUMBA_CACHE_DIR`` a new empty folder, then again with that folder filled. The model-file
 commands (``simulate``, ``stability``, ``orbit`` of a two-mass belt written as a model file) run
 one after the other on one cache, as a first sitting with one's own model does; ``sweep`` and
-``basins`` (of the belt) each start from an empty cache. The last row is the loop a researcher
+``basins`` (of the belt) each start from an empty cache, and so does a ``simulate`` of the library's
+impact oscillator, whose rigid contact compiles the impacts' kernels (against the model file's
+pressed contacts). The last row is the loop a researcher
 lives in: a Python model whose kinematics is defined in a module of its own is simulated once
 (filling the cache, its "empty cache" column), its frame function is edited, and the next
 ``simulate`` is timed (its "after the edit" column, the one compared with ``--rev``).
@@ -48,6 +50,8 @@ COMMANDS = [
                             "--out", "{tmp}/orbit.nc"], False),
     ("sweep (belt, 4 points)", ["sweep", "--model", "belt", "--grid", "contact.0.drive=0.5:2:4", "--t-end", "50",
                                 "--out", "{tmp}/sweep.nc", "--no-plot"], True),
+    ("simulate (rigid contact: impact-oscillator)", ["simulate", "--model", "impact-oscillator", "--t-end", "20",
+                                                     "--json"], True),
     ("basins (belt, 16 states)", ["basins", "--model", "belt", "--box", "x=-1:1", "--box", "dx=-1:1", "--grid", "4",
                                   "--t-end", "100", "--out", "{tmp}/basins.nc", "--no-plot"], True),
 ]
