@@ -434,6 +434,8 @@ def _package_overload(template) -> bool:
 
 
 def _typed_not_compiled(get_jit_decorator):
+    """numba's ``_get_jit_decorator``, whose decorator makes an always-inlined overload's
+    implementation dispatcher of this package with compilation disabled (module docstring)."""
     @functools.wraps(get_jit_decorator)
     def wrapper(self):
         jitter = get_jit_decorator(self)
@@ -468,9 +470,11 @@ def _method_template():
 
 def _check_inline_overload() -> str | None:
     from numba.core.dispatcher import Dispatcher
+    from numba.core.typing import templates
 
     template = _overload_template()
     return first_problem(
+        has(templates, "_OverloadMethodTemplate"),
         has(template, "_get_jit_decorator", ("self",)),
         has(template, "_build_impl", ("self", "cache_key", "args", "kws")),
         has(template, "generic", ("self", "args", "kws")),
@@ -482,9 +486,7 @@ def _check_inline_overload() -> str | None:
                            "if not self._inline.is_always_inline:"),
         has(Dispatcher, "disable_compile", ("self", "val")),
         lambda: source_has(Dispatcher.disable_compile, "self._can_compile = not val"),
-        lambda: source_has(Dispatcher.get_call_template, "if self._can_compile:", "self.compile(tuple(args))"),
-        None if hasattr(__import__("numba.core.typing.templates", fromlist=["x"]), "_OverloadMethodTemplate")
-        else "numba.core.typing.templates has no _OverloadMethodTemplate")
+        lambda: source_has(Dispatcher.get_call_template, "if self._can_compile:", "self.compile(tuple(args))"))
 
 
 def _apply_inline_overload() -> None:
