@@ -24,7 +24,7 @@ from .helpers import STICKSLIP
 SCRIPT = Path(__file__).with_name("numba_results.py")
 
 #: Wall-clock limit of each run [s]: a guard against a hung process, not a speed check. A run
-#: without the patches compiles every kernel anew, at numba 0.57 several CPU minutes, and on a
+#: without the patches compiles every kernel anew (numba 0.57, pressed group: 13.5 CPU minutes), and on a
 #: shared machine a process may get a fifth of a core (20 min was too short for the pressed and
 #: rigid groups at numba 0.57 on a 2-core machine at load 10-16).
 RUN_TIMEOUT_S = 3600
