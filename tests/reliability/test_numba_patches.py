@@ -23,6 +23,12 @@ from .helpers import STICKSLIP
 
 SCRIPT = Path(__file__).with_name("numba_results.py")
 
+#: Wall-clock limit of each run [s]: a guard against a hung process, not a speed check. A run
+#: without the patches compiles every kernel anew (numba 0.57, pressed group: 13.5 CPU minutes), and on a
+#: shared machine a process may get a fifth of a core (20 min was too short for the pressed and
+#: rigid groups at numba 0.57 on a 2-core machine at load 10-16).
+RUN_TIMEOUT_S = 3600
+
 #: The library models by kinematics class (each class compiles its own kernels, so each group is a
 #: test of its own that pytest's workers can share out): the models simulated, and the stability
 #: eigenvalues of the belt, and the period and multipliers of popp-stelter's stick-slip cycle from rest.
@@ -45,7 +51,7 @@ def _results(args: list, env: dict, prelude: str = "") -> tuple[dict, list]:
     there), and its stderr lines."""
     code = f"{prelude}\nimport runpy, sys\nsys.argv = sys.argv[1:]\nrunpy.run_path(sys.argv[0], run_name='__main__')"
     res = subprocess.run([sys.executable, "-c", code, str(SCRIPT), *args], capture_output=True, text=True, env=env,
-                         timeout=1200)
+                         timeout=RUN_TIMEOUT_S)
     assert res.returncode == 0, res.stderr[-3000:]
     return json.loads(res.stdout), [line for line in res.stderr.splitlines() if line.strip()]
 
@@ -93,7 +99,7 @@ _BELT = ["simulate", "--model", "belt", "--ic", "x=1,dx=1", "--t-end", "5", "--j
 
 
 def _simulate(cache: Path) -> tuple[dict, list]:
-    res = subprocess.run([STICKSLIP, *_BELT], capture_output=True, text=True, timeout=1200,
+    res = subprocess.run([STICKSLIP, *_BELT], capture_output=True, text=True, timeout=RUN_TIMEOUT_S,
                          env=_env(NUMBA_CACHE_DIR=str(cache)))
     assert res.returncode == 0, res.stderr[-3000:]
     result = json.loads(res.stdout)

@@ -76,10 +76,13 @@ def test_local_cluster_workers_start_without_malloc_trim_threshold():
     assert worker_env["OMP_NUM_THREADS"] == "1"  # the rest of the nanny's environment is kept
 
 
+#: The child writes no snapshot of its output (the first point's compile, over a minute from a cold
+#: cache on a loaded machine, would otherwise pass the snapshot interval): killed, it leaves the
+#: journal only.
 _CHILD = textwrap.dedent("""
     import sys
     from stickslip.sweep import sweep
-    sweep({grid!r}, out=sys.argv[1], executor="serial", batch_size=1, **{opts!r})
+    sweep({grid!r}, out=sys.argv[1], executor="serial", batch_size=1, snapshot_interval=1e9, **{opts!r})
 """)
 
 
