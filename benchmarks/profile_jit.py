@@ -46,6 +46,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from first_call import baseline_tree  # noqa: E402
 
 #: Run in a child with a fresh NUMBA_CACHE_DIR: a first simulate with every compile event recorded.
 _COMPILE_CHILD = """
@@ -133,18 +135,6 @@ def readable(symbol: str) -> str:
     return ("wrapper:" if wrapper else "") + ".".join(parts)
 
 
-def _package_at(rev: str, into: Path) -> Path:
-    """``src/stickslip`` at ``rev`` extracted under ``into``; the folder to put on PYTHONPATH."""
-    import io
-    import tarfile
-
-    data = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "src/stickslip"], check=True,
-                          capture_output=True).stdout
-    with tarfile.open(fileobj=io.BytesIO(data)) as tar:
-        tar.extractall(into, filter="data")
-    return into / "src"
-
-
 def compile_once(model: str | None, tree: Path | None, llvm: bool = False) -> dict:
     """{kernel: [inclusive s, own s, compiles, own s inside LLVM]} of one cold first simulate
     (``_COMPILE_CHILD``; the last 0 unless ``llvm``)."""
@@ -166,7 +156,7 @@ def compile_profile(args) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         trees = {"working tree": None}
         for i, rev in enumerate(args.rev):
-            trees[rev] = _package_at(rev, Path(tmp) / f"rev{i}")
+            trees[rev] = baseline_tree(rev, Path(tmp) / f"rev{i}")
         runs = {name: [] for name in trees}
         for _ in range(args.repeat):
             for name, tree in trees.items():
