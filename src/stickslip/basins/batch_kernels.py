@@ -180,7 +180,7 @@ def _steady(plan, linear, work, times, at, first, target):
     base, n, _, n_tr, _ = at
     window_first = work.chunks[0, first]
     m = plan.chunk
-    if not (plan.stable and target - m - window_first >= 0 and target - window_first < n - window_first):
+    if not (plan.stable and target - m - window_first >= 0 and target < n):
         return UNDECIDED
     lo = window_first - base
     states = work.record.states

@@ -29,7 +29,8 @@ from numba.extending import overload
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel
-from ..model.kinematics import LARGE_KINEMATICS, model_sizes
+from ..model.kinematics import model_sizes
+from ..model.stack import on_heap
 from . import contacts as E
 from . import dormand_prince as DP
 from .transitions import record_transition, settle
@@ -76,7 +77,7 @@ def slip_watch(nc: int) -> SlipWatch:
 
 def shared_steps(kin, nc):  # pragma: no cover - resolved by numba (overload below)
     """Whether the steps of a model of ``nc`` contacts and kinematics data ``kin`` are shared by
-    many contacts: a large model's (the heap flavour, :data:`~stickslip.model.kinematics.LARGE_KINEMATICS`:
+    many contacts: a large model's (the heap flavour, :func:`~stickslip.model.stack.on_heap`:
     a reduced finite-element model) of more than one contact, in which some contact is nearly
     always on its way to v = 0 and a right-hand side costs O(nnz). Such a model's approaches
     (:func:`approach`) and stick projections (:func:`drifted`) follow the rules of many contacts;
@@ -86,7 +87,7 @@ def shared_steps(kin, nc):  # pragma: no cover - resolved by numba (overload bel
 
 @overload(shared_steps, jit_options=KERNEL_OPTIONS, inline="always")
 def _shared_steps(kin, nc):
-    if getattr(kin, "instance_class", None) in tuple(LARGE_KINEMATICS.values()):
+    if on_heap(getattr(kin, "instance_class", None)):
         return lambda kin, nc: nc > 1
     return lambda kin, nc: False
 
