@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.integrate import loop_split
+from stickslip.integrate import loop_split, transitions
 from stickslip.model import compile_ahead
 from stickslip.model import physics
 from stickslip.model.jit import KernelDispatcher
@@ -47,8 +47,13 @@ def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     system = stickslip.load_model(model)
     run = stickslip.simulate(system, 0.5)
     assert run.slip_velocity.shape[0] == run.normal_force.shape[0] == run.t.size  # the results' kernels
-    split = loop_split.EVENT_LOOP
+    split, name = loop_split.loop_split(system.data)
     _all_available(split, system.data)
+    search = loop_split._loop_calls(system.data)[transitions.first_breakaway]
+    search_sig = tuple(numba.typeof(a) for a in search)
+    # the plates fix one contact: their loop probes its breakaway as the slip event and compiles no search
+    assert (name == "ONE_CONTACT_LOOP") == (model == "two-plates")
+    assert transitions.first_breakaway.available(search_sig) == (model != "two-plates")
     rhs = physics.rhs
     wrong = split.signatures(system.data)[rhs][:-1] + (numba.types.float64[:, ::1],)
     assert not rhs.available(wrong)

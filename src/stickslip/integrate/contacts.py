@@ -251,7 +251,7 @@ def probed_crossing(probe, kind, c, y0, Q, h, e0x, e0y, cst, md, scratch):
     return refined_crossing(kind, c, y0, Q, h, (a, ga, b, gb), e0x, e0y, cst, md, scratch)
 
 
-@kernel
+@inlined_kernel
 def refined_crossing(kind, c, y0, Q, h, bracket, e0x, e0y, cst, md, scratch):
     """The root of the event function of ``kind`` for contact ``c`` in the ``bracket`` (a, ga, b, gb):
     θ ∈ (a, b] of the dense output (``y0``, ``Q``) of a step of length ``h``, with values ga > 0 and

@@ -59,7 +59,7 @@ from . import dormand_prince as DP
 from .bundles import on_stack, scratch, store_record
 from .slip_watch import MAX_RETAKES, arrivals, slip_roots, slip_watch
 from .status import CHUNK_END, CONTACT_LOST, INCONSISTENT, MAX_STEPS, NOT_FINITE, STEP_UNDERFLOW, SUCCESS
-from .transitions import break_away, crossing_in_step, first_breakaway, gap_crossing, jammed_contact, switch_gap
+from .transitions import break_away, breakaway_search, crossing_in_step, gap_crossing, jammed_contact, switch_gap
 
 __all__ = ["integrate_event", "event_loop", "loop_arrays", "fresh_progress", "Controls", "controls", "PROGRESS",
            "N_EXTRA"]
@@ -334,12 +334,12 @@ def lost_contact(progress, t_base, step, cst, md, samples, scratch, stats):
 @inlined_kernel
 def breakaway_root(any_stick, step, q_ready, h, cst, md, scratch):
     """(θ, contact, q_ready): the first breakaway of a sticking contact inside the step (θ = −1.0,
-    contact −1: none; :func:`.first_breakaway`)."""
+    contact −1: none; :func:`.breakaway_search`)."""
     if not any_stick:
         return -1.0, np.int64(-1), q_ready
     if not q_ready:
         DP.dense_coefficients(step.stages, step.dense)
-    theta_b, c_b = first_breakaway(step, h, cst, md, scratch)
+    theta_b, c_b = breakaway_search(step, h, cst, md, scratch)
     return theta_b, c_b, True
 
 

@@ -14,6 +14,11 @@ reference and their argument types derived from the bundles a run builds
 (:func:`_loop_calls`). The run starts the helper (:func:`start_callees`) before it checks that no
 contact is open at the start (a refused run ends it); this process, done with its side, does the
 command's :func:`~stickslip.model.compile_ahead.meanwhile` work while the helper finishes.
+
+A model whose kinematics class fixes one contact takes :data:`ONE_CONTACT_LOOP`: its loop probes
+that contact's breakaway as it probes the slip event
+(:func:`~stickslip.integrate.transitions.breakaway_search`) and calls no
+:func:`~stickslip.integrate.transitions.first_breakaway`, so its helper does not compile one.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from . import result as R
 from . import transitions as T
 from .bundles import Samples, transition_log
 
-__all__ = ["EVENT_LOOP", "start_callees"]
+__all__ = ["EVENT_LOOP", "ONE_CONTACT_LOOP", "loop_split", "start_callees"]
 
 
 def _loop_calls(md) -> dict:
@@ -71,17 +76,37 @@ def _loop_calls(md) -> dict:
             L.homing_left: (slips.homing,)}
 
 
+def _one_contact_calls(md) -> dict:
+    """:func:`_loop_calls` less :func:`~.transitions.first_breakaway`, which the loop of a model
+    of :data:`ONE_CONTACT_LOOP` does not call."""
+    calls = _loop_calls(md)
+    del calls[T.first_breakaway]
+    return calls
+
+
+_HELPER = (E.try_stick, E.release_most_overloaded, P.contact_forces, P.band_direction, E.initial_modes,
+           R._slip_velocities, R._normal_forces, T.settle, T.break_away, T.first_breakaway, P.slip_velocity_and_rate,
+           L.error_norm)
+_OWN = (P.rhs, L.dp_step, E.probed_crossing, L.write_samples, L.cut_step, DP.dense_coefficients,
+        E.slip_event_possible, E.time_to_zero_of, E.all_finite, L.homing_left)
+
 #: The event loop's callees: the stick solve's subtree in the helper, the step's here.
-EVENT_LOOP = Split(
-    helper=(E.try_stick, E.release_most_overloaded, P.contact_forces, P.band_direction, E.initial_modes,
-            R._slip_velocities, R._normal_forces, T.settle, T.break_away, T.first_breakaway, P.slip_velocity_and_rate,
-            L.error_norm),
-    own=(P.rhs, L.dp_step, E.probed_crossing, L.write_samples, L.cut_step, DP.dense_coefficients,
-         E.slip_event_possible, E.time_to_zero_of, E.all_finite, L.homing_left),
-    caller=L.event_loop,
-    calls=_loop_calls)
+EVENT_LOOP = Split(helper=_HELPER, own=_OWN, caller=L.event_loop, calls=_loop_calls)
+
+#: :data:`EVENT_LOOP` for a model whose kinematics class fixes one contact
+#: (:func:`~.transitions.one_contact`): without the breakaway search of many contacts.
+ONE_CONTACT_LOOP = Split(helper=tuple(k for k in _HELPER if k is not T.first_breakaway), own=_OWN,
+                         caller=L.event_loop, calls=_one_contact_calls)
+
+
+def loop_split(md) -> tuple[Split, str]:
+    """The split of the event loop's callees for the model data ``md`` and its name in this module."""
+    if T.one_contact(type(md.kin)):
+        return ONE_CONTACT_LOOP, "ONE_CONTACT_LOOP"
+    return EVENT_LOOP, "EVENT_LOOP"
 
 
 def start_callees(md) -> ColdStart | None:
-    """:func:`start_apart` of the event loop's callees (:data:`EVENT_LOOP`)."""
-    return start_apart(md, EVENT_LOOP, f"{__name__}:EVENT_LOOP")
+    """:func:`start_apart` of the event loop's callees (:func:`loop_split`)."""
+    split, name = loop_split(md)
+    return start_apart(md, split, f"{__name__}:{name}")

@@ -10,18 +10,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba.extending import overload
 
 from ..model import physics as P
 from ..model.bundle import CST
-from ..model.jit import inlined_kernel, kernel, standalone
+from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
 from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from ..model.normal import is_unilateral
+from ..model.stack import static_sizes
 from . import contacts as E
 from . import dormand_prince as DP
 from .status import INCONSISTENT, SUCCESS
 
 __all__ = ["crossing_in_step", "record_transition", "settle", "break_away", "switch_gap", "jammed_contact",
-           "gap_crossing", "first_breakaway"]
+           "gap_crossing", "breakaway_search", "first_breakaway", "one_contact"]
 
 
 @inlined_kernel
@@ -151,6 +153,42 @@ def jammed_contact(y, cst, md):  # pragma: no cover - compiled only
         if P.rigid(c, md) and not P.is_open(cst, c):
             return np.int64(c)
     return np.int64(-1)
+
+
+def breakaway_search(step, h, cst, md, scratch):  # pragma: no cover - resolved by numba (overload below)
+    """(θ, contact) of the first breakaway of a sticking contact inside the step ``step`` (a
+    :class:`~.dormand_prince.Step` of length ``h`` with its dense-output coefficients formed);
+    θ = −1.0 and contact −1 for none.
+
+    Chosen at compile time by the model's kinematics class: where it fixes the contact count at one
+    (:func:`one_contact`), that contact's stick margin is probed as the loop probes the slip event
+    (:func:`~.contacts.first_crossing`, compiled for it anyway), so such a model compiles no more for
+    its breakaways; else :func:`first_breakaway`, which samples the margins of all sticking contacts
+    from one solve of the forces per point. Both find the same root for one contact.
+    """
+    raise NotImplementedError("breakaway_search is called from compiled code only")
+
+
+def one_contact(kin_class) -> bool:
+    """Whether the kinematics class ``kin_class`` fixes its models' contact count at one (their
+    breakaway search probes that contact alone: :func:`breakaway_search`)."""
+    sizes = static_sizes(kin_class)
+    return sizes is not None and sizes[1] == 1
+
+
+@overload(breakaway_search, jit_options=KERNEL_OPTIONS, inline="always")
+def _breakaway_search(step, h, cst, md, scratch):
+    if not one_contact(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return lambda step, h, cst, md, scratch: first_breakaway(step, h, cst, md, scratch)
+
+    def alone(step, h, cst, md, scratch):
+        c = np.int64(0)
+        if np.int64(cst[0]) == P.MODE_STICK:
+            th = E.first_crossing(E.EVENT_STICK, c, step.y, step.dense, h, 0.0, 0.0, cst, md, scratch)
+            if th > 0.0:
+                return th, c
+        return -1.0, np.int64(-1)
+    return alone
 
 
 @standalone
