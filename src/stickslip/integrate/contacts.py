@@ -44,7 +44,7 @@ __all__ = ["EVENT_SLIP", "EVENT_STICK", "EVENT_NORMAL", "EVENT_GAP", "TRANSITION
            "ARRIVAL_TIME_TOL", "STICK_SPEED_TOL", "event_value", "first_crossing", "refined_crossing", "dense_state",
            "try_stick", "release_most_overloaded", "initial_modes", "arrival_speed", "breakaway_direction",
            "time_to_zero_of", "slip_event_possible", "hermite_dip", "gap_dip", "probed_crossing", "contact_lost",
-           "mode_flags", "store_mode", "leaves_state"]
+           "mode_flags", "store_mode", "leaves_state", "open_pulled_off"]
 
 EVENT_SLIP = 0    # slip → stick candidate: v_c · e0
 EVENT_STICK = 1   # stick → slip: μs N_c − |F_c|
@@ -512,8 +512,7 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
     """Modes a state starts in: each contact sticks if its v = 0 (to STICK_SPEED_TOL) and the joint
     stick force is admissible; the others slip (the exact direction when sliding, the
     quasi-static one from v = 0). Fills ``cst``; ``y`` may be projected."""
-    m = md.m
-    n, nc, diagonal = model_sizes(md.kin, m)
+    nc = model_sizes(md.kin, md.m)[1]
     for c in range(nc):
         cst[CST * c] = P.MODE_SLIP
         cst[CST * c + 1] = 1.0
@@ -534,11 +533,7 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
     for _ in range(max(MAX_SETTLE, nc)):
         if release_most_overloaded(y, cst, md, F, N) < 0:
             break
-    for c in range(nc):  # a closed rigid contact pulled off (λ < 0) is open (where its normal force is
-        # consistent at all: else it stays closed and the run reports that, Painlevé); at λ = 0 it rests on it
-        if is_rigid(md, n, c) and not is_open(cst, c) and leaves_state(y, cst, c, md) \
-                and P.rigid_pivot(y, cst, md) > 0.0:
-            cst[CST * c] = P.MODE_OPEN
+    open_pulled_off(y, cst, md)
     for c in range(nc):
         if np.int64(cst[CST * c]) == P.MODE_STICK or np.int64(cst[CST * c]) == P.MODE_OPEN:
             continue
@@ -554,6 +549,19 @@ def initial_modes(y, cst, md, rtol, atol, F, N):
             if speed > P.SPEED_FLOOR:
                 cst[CST * c + 1] = vx / speed
                 cst[CST * c + 2] = vy / speed
+
+
+@rigid_kernel(lambda y, cst, md: None)
+def open_pulled_off(y, cst, md):  # pragma: no cover - compiled only
+    """Open each closed rigid contact that the forces at ``y`` pull off (λ < 0), where the closed
+    rigid contacts' normal forces are consistent at all (else it stays closed and the run reports
+    that, Painlevé); at λ = 0 it rests on the contact. (Compiled only for kinematics that may have
+    rigid contacts: the starting modes of the others compile none of it.)"""
+    n, nc, _ = model_sizes(md.kin, md.m)
+    for c in range(nc):
+        if is_rigid(md, n, c) and not is_open(cst, c) and leaves_state(y, cst, c, md) \
+                and P.rigid_pivot(y, cst, md) > 0.0:
+            cst[CST * c] = P.MODE_OPEN
 
 
 @rigid_kernel(lambda y, cst, c, md, rtol, atol, F, N, work: (LAND_INCONSISTENT, False, 0.0, 0.0, 0.0, math.inf))
