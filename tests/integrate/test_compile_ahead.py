@@ -47,7 +47,7 @@ def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     system = stickslip.load_model(model)
     run = stickslip.simulate(system, 0.5)
     assert run.slip_velocity.shape[0] == run.normal_force.shape[0] == run.t.size  # the results' kernels
-    split, name = loop_split.loop_split(system.data)
+    split, name = loop_split.split_for(system.data)
     _all_available(split, system.data)
     search = loop_split._loop_calls(system.data)[transitions.first_breakaway]
     search_sig = tuple(numba.typeof(a) for a in search)

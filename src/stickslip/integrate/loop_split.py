@@ -36,7 +36,7 @@ from . import result as R
 from . import transitions as T
 from .bundles import Samples, transition_log
 
-__all__ = ["EVENT_LOOP", "ONE_CONTACT_LOOP", "loop_split", "start_callees"]
+__all__ = ["EVENT_LOOP", "ONE_CONTACT_LOOP", "split_for", "start_callees"]
 
 
 def _loop_calls(md) -> dict:
@@ -99,7 +99,7 @@ ONE_CONTACT_LOOP = Split(helper=tuple(k for k in _HELPER if k is not T.first_bre
                          caller=L.event_loop, calls=_one_contact_calls)
 
 
-def loop_split(md) -> tuple[Split, str]:
+def split_for(md) -> tuple[Split, str]:
     """The split of the event loop's callees for the model data ``md`` and its name in this module."""
     if T.one_contact(type(md.kin)):
         return ONE_CONTACT_LOOP, "ONE_CONTACT_LOOP"
@@ -107,6 +107,6 @@ def loop_split(md) -> tuple[Split, str]:
 
 
 def start_callees(md) -> ColdStart | None:
-    """:func:`start_apart` of the event loop's callees (:func:`loop_split`)."""
-    split, name = loop_split(md)
+    """:func:`start_apart` of the event loop's callees (:func:`split_for`)."""
+    split, name = split_for(md)
     return start_apart(md, split, f"{__name__}:{name}")
