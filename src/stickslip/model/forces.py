@@ -296,6 +296,7 @@ def add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):  # p
     return 1.0
 
 
+@standalone
 @kernel
 def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
     """Normal forces λ_R of the closed rigid contacts R: the multipliers that keep their gaps'
@@ -324,7 +325,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
     apply_inverse_mass(m, n, diagonal, f, a)
     for i in range(2 * nc):
         zero_bias[i] = zero
-    k = 0
+    k = np.int64(0)  # not a literal: one compiled version of solve_in_order
     for r in range(nc):
         if not is_rigid(md, n, r) or is_open(cst, r):
             continue

@@ -26,9 +26,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .bundle import C_GAP, C_RESTITUTION, contact_offsets, gap_offset
 from .frames import frame_velocity
-from .jit import kernel
+from .jit import kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes
 from .linalg import solve_in_order, solve_psd
 from .model_data import apply_inverse_mass, is_stick, kinetic_coefficient, static_limit
@@ -92,7 +94,7 @@ def impulse_rows(s, cst, c, md, restitution, J, target, with_tangent):
     n, nc, diagonal = model_sizes(md.kin, m)
     G2 = work_matrix(md.kin, TWO, DOFS, s)
     w2 = work_matrix(md.kin, ONE, TWO, s)[0]
-    k = _normal_row(s, c, md, J, target, 0, 1.0 + restitution)
+    k = _normal_row(s, c, md, J, target, np.int64(0), 1.0 + restitution)
     if with_tangent:
         k = _tangent_rows(s, c, md, J, target, k, G2, w2)
     for r in range(nc):
@@ -134,6 +136,7 @@ def _tangent_rows(s, r, md, J, target, k, G2, w2):
     return k
 
 
+@standalone
 @kernel
 def impact(s, cst, c, md, restitution):
     """Apply the impact of rigid contact ``c`` with restitution e = ``restitution`` to the state
@@ -181,7 +184,7 @@ def impact(s, cst, c, md, restitution):
     v0, v1 = frame_velocity(s, n, dim, G2, w2)
 
     # a sticking impact: every row an equality
-    k = impulse_rows(s, cst, c, md, restitution, J, target, True)
+    k = impulse_rows(s, cst, c, md, restitution, J, target, np.bool_(True))
     for r in range(k):
         apply_inverse_mass(m, n, diagonal, J[r], MJ[r])
     for r in range(k):
@@ -210,7 +213,7 @@ def impact(s, cst, c, md, restitution):
         e0 = 0.0
         e1 = 0.0
     mu = kinetic_coefficient(md, n, c, speed)
-    k = impulse_rows(s, cst, c, md, restitution, J, target, False)
+    k = impulse_rows(s, cst, c, md, restitution, J, target, np.bool_(False))
     for j in range(n):
         MW[j] = W[j] - mu * (G2[0, j] * e0 + (G2[1, j] * e1 if dim == 2 else 0.0))
     apply_inverse_mass(m, n, diagonal, MW, MJ[0])
