@@ -25,6 +25,7 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
+from .impact import inverse_mass_product
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
@@ -322,7 +323,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
     D = work_matrix(md.kin, CONTACTS, CONTACTS, s)
     a, d, zero_bias, Fs, lam, b, W = work_vectors(md.kin, 7, s)
     zero = csm.zero(s[0])
-    apply_inverse_mass(m, n, diagonal, f, a)
+    inverse_mass_product(m, n, diagonal, f, a)
     for i in range(2 * nc):
         zero_bias[i] = zero
     k = np.int64(0)  # not a literal: one compiled version of solve_in_order
@@ -362,7 +363,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
         og = gap_offset(n, r)
         for j in range(n):
             W[j] = m[og + j] + zero
-        apply_inverse_mass(m, n, diagonal, W, d)
+        inverse_mass_product(m, n, diagonal, W, d)
         scale = zero
         acc = zero
         for j in range(n):
@@ -370,7 +371,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
             acc += W[j] * a[j]
         b[i] = -acc / scale
         for jj in range(k):
-            apply_inverse_mass(m, n, diagonal, R[jj], d)
+            inverse_mass_product(m, n, diagonal, R[jj], d)
             acc = zero
             for j in range(n):
                 acc += W[j] * d[j]

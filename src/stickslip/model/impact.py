@@ -38,11 +38,19 @@ from .normal import is_open, is_rigid
 from .stack import DOFS, IMPULSE_ROWS, ONE, TWO, work_matrix
 
 __all__ = ["IMPACT_SLIDING", "IMPACT_STICKING", "IMPACT_INCONSISTENT", "impact", "gap_rate", "restitution_of",
-           "remove_gap_rate"]
+           "remove_gap_rate", "inverse_mass_product"]
 
 #: Outcomes of :func:`impact`: the contact slides on after it, sticks after it, or no impulse
 #: satisfies the law (nothing is changed).
 IMPACT_SLIDING, IMPACT_STICKING, IMPACT_INCONSISTENT = 0, 1, -1
+
+
+@kernel
+def inverse_mass_product(m, n, diagonal, f, a):
+    """a = M⁻¹ f (:func:`~stickslip.model.model_data.apply_inverse_mass`) as a kernel: the rigid
+    contacts' code (the impacts, :func:`~stickslip.model.forces.rigid_normal_forces`) calls it at
+    many sites, which then type and lower one call each instead of an inlined body each."""
+    apply_inverse_mass(m, n, diagonal, f, a)
 
 
 @kernel
@@ -73,7 +81,7 @@ def remove_gap_rate(s, c, md):
     og = gap_offset(n, c)
     for j in range(n):
         WMW[0, j] = m[og + j]
-    apply_inverse_mass(m, n, diagonal, WMW[0], WMW[1])
+    inverse_mass_product(m, n, diagonal, WMW[0], WMW[1])
     wmw = 0.0
     rate = 0.0
     for j in range(n):
@@ -170,7 +178,7 @@ def impact(s, cst, c, md, restitution):
     for j in range(n):
         W[j] = m[og + j]
         g += W[j] * s[j]
-    apply_inverse_mass(m, n, diagonal, W, MW)
+    inverse_mass_product(m, n, diagonal, W, MW)
     wmw = 0.0
     for j in range(n):
         wmw += W[j] * MW[j]
@@ -186,7 +194,7 @@ def impact(s, cst, c, md, restitution):
     # a sticking impact: every row an equality
     k = impulse_rows(s, cst, c, md, restitution, J, target, np.bool_(True))
     for r in range(k):
-        apply_inverse_mass(m, n, diagonal, J[r], MJ[r])
+        inverse_mass_product(m, n, diagonal, J[r], MJ[r])
     for r in range(k):
         for r2 in range(k):
             acc = 0.0
@@ -216,11 +224,11 @@ def impact(s, cst, c, md, restitution):
     k = impulse_rows(s, cst, c, md, restitution, J, target, np.bool_(False))
     for j in range(n):
         MW[j] = W[j] - mu * (G2[0, j] * e0 + (G2[1, j] * e1 if dim == 2 else 0.0))
-    apply_inverse_mass(m, n, diagonal, MW, MJ[0])
+    inverse_mass_product(m, n, diagonal, MW, MJ[0])
     for r in range(1, k):
-        apply_inverse_mass(m, n, diagonal, J[r], MJ[r])
+        inverse_mass_product(m, n, diagonal, J[r], MJ[r])
     for r in range(k):  # each row scaled by its frictionless diagonal: relative pivots
-        apply_inverse_mass(m, n, diagonal, J[r], MW)
+        inverse_mass_product(m, n, diagonal, J[r], MW)
         scale = 0.0
         for j in range(n):
             scale += J[r, j] * MW[j]
