@@ -25,12 +25,12 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
-from .impact import inverse_mass_product
 from .frames import all_frames, frame_velocity, frame_with_bias
+from .impact import inverse_mass_product
 from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
-from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force_of,
+from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, base_force_of,
                          gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ROWS, TWO, work_matrix, work_vectors
