@@ -564,8 +564,17 @@ def open_pulled_off(y, cst, md):  # pragma: no cover - compiled only
             cst[CST * c] = P.MODE_OPEN
 
 
-@rigid_kernel(lambda y, cst, c, md, rtol, atol, F, N, work: (LAND_INCONSISTENT, False, 0.0, 0.0, 0.0, math.inf))
+@rigid_kernel(lambda y, cst, c, md, rtol, atol, F, N, work: (LAND_INCONSISTENT, False, 0.0, 0.0, 0.0, math.inf),
+              inline="always")
 def land(y, cst, c, md, rtol, atol, F, N, work):  # pragma: no cover - compiled only
+    """:func:`rigid_landing` for kinematics that may have rigid contacts (a constant for the others,
+    whose kernels then compile none of it)."""
+    return rigid_landing(y, cst, c, md, rtol, atol, F, N, work)
+
+
+@standalone
+@kernel
+def rigid_landing(y, cst, c, md, rtol, atol, F, N, work):
     """Rigid contact ``c`` closes at ``y`` (its gap through 0): the impact, then what follows.
 
     Returns (phase, sticks, impulse, before, after, flight): ``phase`` one of ``LAND_*``; ``sticks``
@@ -573,7 +582,8 @@ def land(y, cst, c, md, rtol, atol, F, N, work):  # pragma: no cover - compiled 
     flight time [s] that the normal acceleration at the take-off predicts (∞ if it does not pull
     the contact back). ``y`` and ``cst`` are updated. A contact that stays closed but whose
     normal force comes out < 0 (the motion leaves it with ġ = 0) is left open; at λ = 0 it rests on
-    it. (Compiled only for kinematics that may have rigid contacts.)
+    it. A standalone kernel (the one compiled copy that its callers call: the impacts' code is not
+    optimised again in the event loop), compiled only for kinematics that may have rigid contacts.
     """
     n = model_sizes(md.kin, md.m)[0]
     e = restitution_of(c, md)

@@ -93,8 +93,17 @@ def break_away(y, cst, c, md, scratch, t, log, n_tr, stats):
     return settle(y, cst, md, scratch, t, log, n_tr + 1, stats)
 
 
-@unilateral_kernel(lambda y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats: (n_tr, SUCCESS, math.inf))
+@unilateral_kernel(lambda y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats: (n_tr, SUCCESS, math.inf),
+                   inline="always")
 def switch_gap(y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats):  # pragma: no cover
+    """:func:`switch_unilateral` for kinematics that may have unilateral contacts (nothing for the
+    others, whose kernels then compile none of it)."""
+    return switch_unilateral(y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats)
+
+
+@standalone
+@kernel
+def switch_unilateral(y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats):
     """Unilateral contact ``c`` opens (if closed) or closes (if open) at state ``y``, time ``t``:
     change its mode, record the transitions in ``log`` (a sticking contact that opens first leaves
     stick; a contact that closes with v_c = 0 and an admissible stick force sticks; a rigid one
@@ -103,8 +112,8 @@ def switch_gap(y, cst, c, md, rtol, atol, scratch, t, log, n_tr, stats):  # prag
 
     Returns (transition count, status, flight): status SUCCESS, or INCONSISTENT where a rigid
     contact's impact has no consistent impulse; flight the predicted time [s] to a bounced
-    contact's next landing (∞ otherwise), which bounds the next step (nothing for pressed-only
-    kinematics)."""
+    contact's next landing (∞ otherwise), which bounds the next step. A standalone kernel: the
+    event loop calls its one compiled copy instead of optimising it again in its own module."""
     flight = math.inf
     if P.is_open(cst, c) and P.rigid(c, md):
         record_transition(log, n_tr, t, E.TRANSITION_IMPACT, c, y)

@@ -26,10 +26,11 @@ import numpy as np
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
+from .impact import inverse_mass_product
 from .jit import inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
-from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, apply_inverse_mass, base_force_of,
+from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, base_force_of,
                          gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ROWS, TWO, work_matrix, work_vectors
@@ -296,6 +297,7 @@ def add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):  # p
     return 1.0
 
 
+@standalone
 @kernel
 def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
     """Normal forces λ_R of the closed rigid contacts R: the multipliers that keep their gaps'
@@ -321,10 +323,10 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
     D = work_matrix(md.kin, CONTACTS, CONTACTS, s)
     a, d, zero_bias, Fs, lam, b, W = work_vectors(md.kin, 7, s)
     zero = csm.zero(s[0])
-    apply_inverse_mass(m, n, diagonal, f, a)
+    inverse_mass_product(m, n, diagonal, f, a)
     for i in range(2 * nc):
         zero_bias[i] = zero
-    k = 0
+    k = np.int64(0)  # not a literal: one compiled version of solve_in_order
     for r in range(nc):
         if not is_rigid(md, n, r) or is_open(cst, r):
             continue
@@ -361,7 +363,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
         og = gap_offset(n, r)
         for j in range(n):
             W[j] = m[og + j] + zero
-        apply_inverse_mass(m, n, diagonal, W, d)
+        inverse_mass_product(m, n, diagonal, W, d)
         scale = zero
         acc = zero
         for j in range(n):
@@ -369,7 +371,7 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
             acc += W[j] * a[j]
         b[i] = -acc / scale
         for jj in range(k):
-            apply_inverse_mass(m, n, diagonal, R[jj], d)
+            inverse_mass_product(m, n, diagonal, R[jj], d)
             acc = zero
             for j in range(n):
                 acc += W[j] * d[j]

@@ -26,9 +26,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .bundle import C_GAP, C_RESTITUTION, contact_offsets, gap_offset
 from .frames import frame_velocity
-from .jit import kernel
+from .jit import kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes
 from .linalg import solve_in_order, solve_psd
 from .model_data import apply_inverse_mass, is_stick, kinetic_coefficient, static_limit
@@ -36,11 +38,19 @@ from .normal import is_open, is_rigid
 from .stack import DOFS, IMPULSE_ROWS, ONE, TWO, work_matrix
 
 __all__ = ["IMPACT_SLIDING", "IMPACT_STICKING", "IMPACT_INCONSISTENT", "impact", "gap_rate", "restitution_of",
-           "remove_gap_rate"]
+           "remove_gap_rate", "inverse_mass_product"]
 
 #: Outcomes of :func:`impact`: the contact slides on after it, sticks after it, or no impulse
 #: satisfies the law (nothing is changed).
 IMPACT_SLIDING, IMPACT_STICKING, IMPACT_INCONSISTENT = 0, 1, -1
+
+
+@kernel
+def inverse_mass_product(m, n, diagonal, f, a):
+    """a = M⁻¹ f (:func:`~stickslip.model.model_data.apply_inverse_mass`) as a kernel: the rigid
+    contacts' code (the impacts, :func:`~stickslip.model.forces.rigid_normal_forces`) calls it at
+    many sites, which then type and lower one call each instead of an inlined body each."""
+    apply_inverse_mass(m, n, diagonal, f, a)
 
 
 @kernel
@@ -71,7 +81,7 @@ def remove_gap_rate(s, c, md):
     og = gap_offset(n, c)
     for j in range(n):
         WMW[0, j] = m[og + j]
-    apply_inverse_mass(m, n, diagonal, WMW[0], WMW[1])
+    inverse_mass_product(m, n, diagonal, WMW[0], WMW[1])
     wmw = 0.0
     rate = 0.0
     for j in range(n):
@@ -92,7 +102,7 @@ def impulse_rows(s, cst, c, md, restitution, J, target, with_tangent):
     n, nc, diagonal = model_sizes(md.kin, m)
     G2 = work_matrix(md.kin, TWO, DOFS, s)
     w2 = work_matrix(md.kin, ONE, TWO, s)[0]
-    k = _normal_row(s, c, md, J, target, 0, 1.0 + restitution)
+    k = _normal_row(s, c, md, J, target, np.int64(0), 1.0 + restitution)
     if with_tangent:
         k = _tangent_rows(s, c, md, J, target, k, G2, w2)
     for r in range(nc):
@@ -134,6 +144,7 @@ def _tangent_rows(s, r, md, J, target, k, G2, w2):
     return k
 
 
+@standalone
 @kernel
 def impact(s, cst, c, md, restitution):
     """Apply the impact of rigid contact ``c`` with restitution e = ``restitution`` to the state
@@ -167,7 +178,7 @@ def impact(s, cst, c, md, restitution):
     for j in range(n):
         W[j] = m[og + j]
         g += W[j] * s[j]
-    apply_inverse_mass(m, n, diagonal, W, MW)
+    inverse_mass_product(m, n, diagonal, W, MW)
     wmw = 0.0
     for j in range(n):
         wmw += W[j] * MW[j]
@@ -181,9 +192,9 @@ def impact(s, cst, c, md, restitution):
     v0, v1 = frame_velocity(s, n, dim, G2, w2)
 
     # a sticking impact: every row an equality
-    k = impulse_rows(s, cst, c, md, restitution, J, target, True)
+    k = impulse_rows(s, cst, c, md, restitution, J, target, np.bool_(True))
     for r in range(k):
-        apply_inverse_mass(m, n, diagonal, J[r], MJ[r])
+        inverse_mass_product(m, n, diagonal, J[r], MJ[r])
     for r in range(k):
         for r2 in range(k):
             acc = 0.0
@@ -210,14 +221,14 @@ def impact(s, cst, c, md, restitution):
         e0 = 0.0
         e1 = 0.0
     mu = kinetic_coefficient(md, n, c, speed)
-    k = impulse_rows(s, cst, c, md, restitution, J, target, False)
+    k = impulse_rows(s, cst, c, md, restitution, J, target, np.bool_(False))
     for j in range(n):
         MW[j] = W[j] - mu * (G2[0, j] * e0 + (G2[1, j] * e1 if dim == 2 else 0.0))
-    apply_inverse_mass(m, n, diagonal, MW, MJ[0])
+    inverse_mass_product(m, n, diagonal, MW, MJ[0])
     for r in range(1, k):
-        apply_inverse_mass(m, n, diagonal, J[r], MJ[r])
+        inverse_mass_product(m, n, diagonal, J[r], MJ[r])
     for r in range(k):  # each row scaled by its frictionless diagonal: relative pivots
-        apply_inverse_mass(m, n, diagonal, J[r], MW)
+        inverse_mass_product(m, n, diagonal, J[r], MW)
         scale = 0.0
         for j in range(n):
             scale += J[r, j] * MW[j]
