@@ -38,7 +38,7 @@ def _all_available(split, md) -> None:
         assert _available(kernel, signatures[kernel]), kernel
 
 
-@pytest.mark.parametrize("model", ["two-plates", MODEL_FILE])
+@pytest.mark.parametrize("model", ["two-plates", MODEL_FILE, "impact-oscillator"])
 def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     """Every kernel the two processes compile ahead, with the argument types the split derives
     from the bundles of a run, is one the event loop or a run's results call (else the helper
@@ -53,6 +53,7 @@ def test_the_helpers_signatures_are_the_ones_the_event_loop_compiles(model):
     search_sig = tuple(numba.typeof(a) for a in search)
     # the plates fix one contact: their loop probes its breakaway as the slip event and compiles no search
     assert (name == "ONE_CONTACT_LOOP") == (model == "two-plates")
+    assert (name == "OPENING_LOOP") == (model == "impact-oscillator")  # a rigid contact opens and closes
     assert transitions.first_breakaway.available(search_sig) == (model != "two-plates")
     rhs = physics.rhs
     wrong = split.signatures(system.data)[rhs][:-1] + (numba.types.float64[:, ::1],)

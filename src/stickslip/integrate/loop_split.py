@@ -18,7 +18,10 @@ command's :func:`~stickslip.model.compile_ahead.meanwhile` work while the helper
 A model whose kinematics class fixes one contact takes :data:`ONE_CONTACT_LOOP`: its loop probes
 that contact's breakaway as it probes the slip event
 (:func:`~stickslip.integrate.transitions.breakaway_search`) and calls no
-:func:`~stickslip.integrate.transitions.first_breakaway`, so its helper does not compile one.
+:func:`~stickslip.integrate.transitions.first_breakaway`, so its helper does not compile one. A model with contacts that open and close takes
+:data:`OPENING_LOOP`: its helper also compiles the switch of such a contact
+(:func:`~stickslip.integrate.transitions.switch_unilateral`, a rigid contact's impact and
+landing inside it), which the loop would otherwise compile alone after both sides.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from ..analysis.modes import contact_index_dtype
 from ..model import physics as P
 from ..model.bundle import H_N, H_NC, H_UNILATERAL, contact_state
 from ..model.compile_ahead import ColdStart, Split, start_apart
+from ..model.kinematics import allows_unilateral
 from . import contacts as E
 from . import dormand_prince as DP
 from . import event_loop as L
@@ -36,7 +40,7 @@ from . import result as R
 from . import transitions as T
 from .bundles import Samples, transition_log
 
-__all__ = ["EVENT_LOOP", "ONE_CONTACT_LOOP", "split_for", "start_callees"]
+__all__ = ["EVENT_LOOP", "ONE_CONTACT_LOOP", "OPENING_LOOP", "split_for", "start_callees"]
 
 
 def _loop_calls(md) -> dict:
@@ -99,10 +103,28 @@ ONE_CONTACT_LOOP = Split(helper=tuple(k for k in _HELPER if k is not T.first_bre
                          caller=L.event_loop, calls=_one_contact_calls)
 
 
+def _opening_calls(md) -> dict:
+    """:func:`_loop_calls` with :func:`~.transitions.switch_unilateral`, which the loop of a model
+    of :data:`OPENING_LOOP` calls where a contact opens or closes."""
+    calls = _loop_calls(md)
+    y, cst, _, scratch, _, log, _, stats = calls[T.settle]  # the arrays the loop passes both
+    i, f = np.int64(0), 0.0
+    calls[T.switch_unilateral] = (y, cst, i, md, f, f, scratch, f, log, i, stats)
+    return calls
+
+
+#: :data:`EVENT_LOOP` for a model with contacts that open and close: the switch of a contact
+#: (with a rigid one's impact and landing, each compiled once) in the helper too, where the loop
+#: would compile it after both sides.
+OPENING_LOOP = Split(helper=_HELPER + (T.switch_unilateral,), own=_OWN, caller=L.event_loop, calls=_opening_calls)
+
+
 def split_for(md) -> tuple[Split, str]:
     """The split of the event loop's callees for the model data ``md`` and its name in this module."""
     if T.one_contact(type(md.kin)):
         return ONE_CONTACT_LOOP, "ONE_CONTACT_LOOP"
+    if md.m[H_UNILATERAL] != 0.0 and allows_unilateral(type(md.kin)):
+        return OPENING_LOOP, "OPENING_LOOP"
     return EVENT_LOOP, "EVENT_LOOP"
 
 
