@@ -562,8 +562,6 @@ def sparse_constant_frame(kin, s, c, m, G, w):
     return normal
 
 
-register_kinematics(LargeConstantKinematics, sparse_constant_frame, unilateral=False)
-register_kinematics(LargeConstantUnilateralKinematics, sparse_constant_frame, rigid=False)
-register_kinematics(LargeConstantRigidKinematics, sparse_constant_frame)
-for _large in LARGE_KINEMATICS.values():
+for _small, _large in LARGE_KINEMATICS.items():  # each heap class takes the contacts its stack class takes
+    register_kinematics(_large, sparse_constant_frame, unilateral=allows_unilateral(_small), rigid=allows_rigid(_small))
     stack.register_heap(_large)
