@@ -120,80 +120,6 @@ def quasi_static_direction(a11, a12, a22, Fx, Fy, muN, ex, ey):
 
 
 # ----------------------------------------------------------------------------- stick forces
-@inlined_kernel
-def stick_matrix_by_rows(kin, m, n, nc, diagonal, cst, extra, G, h, a, b, A, MG, zero):
-    """:func:`stick_matrix` formed from the frame rows ``G``: one M⁻¹ product per stick row into
-    ``MG``, then A's rows (:func:`~stickslip.model.model_data.gram_row`)."""
-    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(kin, m, n, c)):
-                inverse_mass_of_row(kin, m, n, diagonal, G[2 * c + i], MG[k])
-                acc = h[2 * c + i]
-                for j in range(n):
-                    acc += G[2 * c + i, j] * a[j]
-                b[k] = -acc
-                k += 1
-    r = 0
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(kin, m, n, c)):
-                gram_row(kin, G[2 * c + i], MG, k, n, A, r, zero)
-                r += 1
-    return k
-
-
-@inlined_kernel
-def row_times(kin, row, a, acc):
-    """acc + g·a for the contact row ``row`` of a heap kinematics class, over its nonzero entries
-    (``kin.row_*``) in the order of their columns."""
-    columns = kin.row_columns
-    values = kin.row_values
-    for p in range(kin.row_starts[row], kin.row_starts[row + 1]):
-        acc += values[p] * a[columns[p]]
-    return acc
-
-
-@inlined_kernel
-def stick_matrix_by_delassus(kin, m, n, nc, cst, extra, h, a, b, A, zero):
-    """:func:`stick_matrix` of a heap kinematics class that carries W = G M⁻¹ Gᵀ of all contact rows
-    (``kin.delassus``): A is W's submatrix of the stick rows, b's products over the rows' nonzero
-    entries, where forming A costs an M⁻¹ product per row."""
-    rows = work_matrix(kin, ONE, ROWS, n)[0]
-    k = np.int64(0)
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(kin, m, n, c)):
-                rows[k] = 2 * c + i
-                b[k] = -row_times(kin, 2 * c + i, a, h[2 * c + i])
-                k += 1
-    W = kin.delassus
-    for r in range(k):
-        for r2 in range(k):
-            A[r, r2] = W[rows[r], rows[r2]] + zero
-    return k
-
-
-def stick_matrix(kin, m, n, nc, diagonal, cst, extra, G, h, a, b, A, MG, zero):  # pragma: no cover - overload
-    """The stick system of the sticking contacts and contact ``extra`` (≥ 0; −1: none), a = M⁻¹ f
-    given: A[:k, :k] = G_S M⁻¹ G_Sᵀ (sums from ``zero``) and b[:k] = −(h_S + G_S a); returns the
-    rows k. :func:`stick_matrix_by_rows`; for a heap kinematics class that carries W
-    (:func:`stick_matrix_by_delassus`), read from it: the same sums (``mass_factor.delassus``)."""
-    raise NotImplementedError
-
-
-@overload(stick_matrix, jit_options=KERNEL_OPTIONS, inline="always")
-def _stick_matrix(kin, m, n, nc, diagonal, cst, extra, G, h, a, b, A, MG, zero):
-    if not on_heap(getattr(kin, "instance_class", None)):
-        return stick_matrix_by_rows.py_func
-
-    def by_delassus_or_rows(kin, m, n, nc, diagonal, cst, extra, G, h, a, b, A, MG, zero):
-        if kin.delassus.shape[0] == 0:
-            return stick_matrix_by_rows(kin, m, n, nc, diagonal, cst, extra, G, h, a, b, A, MG, zero)
-        return stick_matrix_by_delassus(kin, m, n, nc, cst, extra, h, a, b, A, zero)
-    return by_delassus_or_rows
-
-
 @kernel
 def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     """Stick multipliers of the contacts in stick and of contact ``extra`` (≥ 0; −1: none), solved
@@ -207,9 +133,24 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     a, b, x = work_vectors(md.kin, 3, s)
     V = work_matrix(md.kin, ROWS, ROWS, s)
     inverse_mass_of(md.kin, m, n, diagonal, f, a)
-    k = stick_matrix(md.kin, m, n, nc, diagonal, cst, extra, G, h, a, b, A, MG, csm.zero(s[0]))
+    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(md.kin, m, n, c)):
+                inverse_mass_of_row(md.kin, m, n, diagonal, G[2 * c + i], MG[k])
+                acc = h[2 * c + i]
+                for j in range(n):
+                    acc += G[2 * c + i, j] * a[j]
+                b[k] = -acc
+                k += 1
     if k == 0:
         return 0
+    r = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(md.kin, m, n, c)):
+                gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, csm.zero(s[0]))
+                r += 1
     solve_stick_system(md.kin, A, b, x, V, k)
     r = 0
     for c in range(nc):
@@ -240,53 +181,6 @@ def stick_rows(md, m, n, nc, cst, extra):
 
 
 @inlined_kernel
-def stick_pair_by_rows(kin, m, n, diagonal, r0, r1, G, h, a, MG, zero):
-    """:func:`stick_pair` formed from the frame rows ``G`` (an M⁻¹ product per row into ``MG``)."""
-    for r in range(1 if r1 < 0 else 2):  # one call site: numba's inliner takes two of an overload badly
-        inverse_mass_of_row(kin, m, n, diagonal, G[r0 if r == 0 else r1], MG[r])
-    mg0 = MG[0]
-    mg1 = MG[1]
-    a00 = zero
-    b0 = h[r0]
-    for j in range(n):
-        a00 += G[r0, j] * mg0[j]
-        b0 += G[r0, j] * a[j]
-    a01 = zero
-    a11 = zero
-    b1 = csm.zero(b0)
-    if r1 >= 0:
-        b1 = h[r1]
-        for j in range(n):
-            a01 += G[r0, j] * mg1[j]
-            a11 += G[r1, j] * mg1[j]
-            b1 += G[r1, j] * a[j]
-    return a00, a01, a11, b0, b1
-
-
-def stick_pair(kin, m, n, diagonal, r0, r1, G, h, a, MG, zero):  # pragma: no cover - resolved by numba (overload)
-    """(a00, a01, a11, b0, b1): the entries of G_S M⁻¹ G_Sᵀ and of h_S + G_S a for the stick rows
-    ``r0`` and ``r1`` (≥ 0, or −1: then a01 = a11 = b1 = 0), a = M⁻¹ f given. By
-    :func:`stick_pair_by_rows`; for a heap kinematics class that carries W, read from it."""
-    raise NotImplementedError
-
-
-@overload(stick_pair, jit_options=KERNEL_OPTIONS, inline="always")
-def _stick_pair(kin, m, n, diagonal, r0, r1, G, h, a, MG, zero):
-    if not on_heap(getattr(kin, "instance_class", None)):
-        return stick_pair_by_rows.py_func
-
-    def by_delassus_or_rows(kin, m, n, diagonal, r0, r1, G, h, a, MG, zero):
-        if kin.delassus.shape[0] == 0:
-            return stick_pair_by_rows(kin, m, n, diagonal, r0, r1, G, h, a, MG, zero)
-        W = kin.delassus
-        b0 = row_times(kin, r0, a, h[r0])
-        if r1 < 0:
-            return W[r0, r0] + zero, zero, zero, b0, csm.zero(b0)
-        return (W[r0, r0] + zero, W[r0, r1] + zero, W[r1, r1] + zero, b0, row_times(kin, r1, a, h[r1]))
-    return by_delassus_or_rows
-
-
-@inlined_kernel
 def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     """:func:`stick_system` for one or two stick rows (``r0``, and ``r1`` ≥ 0 or −1), written out on
     the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
@@ -295,13 +189,28 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     a = work_vectors(md.kin, 1, s)[0]
     MG = work_matrix(md.kin, TWO, DOFS, s)
     inverse_mass_of(md.kin, m, n, diagonal, f, a)
-    a00, a01, a11, b0, b1 = stick_pair(md.kin, m, n, diagonal, r0, r1, G, h, a, MG, csm.zero(s[0]))
+    for r in range(1 if r1 < 0 else 2):  # one call site: numba's inliner takes two of an overload badly
+        inverse_mass_of_row(md.kin, m, n, diagonal, G[r0 if r == 0 else r1], MG[r])
+    mg0 = MG[0]
+    mg1 = MG[1]
+    a00 = csm.zero(s[0])
+    b0 = h[r0]
+    for j in range(n):
+        a00 += G[r0, j] * mg0[j]
+        b0 += G[r0, j] * a[j]
     zero = csm.zero(b0)
     if r1 < 0:
         F[r0] = -b0 / a00 if a00.real > 0.0 else zero
         if r0 % 2 == 0:
             F[r0 + 1] = zero
         return a00, zero, zero
+    a01 = csm.zero(s[0])
+    a11 = csm.zero(s[0])
+    b1 = h[r1]
+    for j in range(n):
+        a01 += G[r0, j] * mg1[j]
+        a11 += G[r1, j] * mg1[j]
+        b1 += G[r1, j] * a[j]
     x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
     F[r0] = x0
     F[r1] = x1
@@ -310,6 +219,119 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     if r1 % 2 == 0:
         F[r1 + 1] = zero
     return a00, a01, a11
+
+
+# ----------------------------------------------------------------------------- stick forces of a heap class
+@inlined_kernel
+def row_times(kin, row, a, acc):
+    """acc + g·a for the contact row ``row`` of a heap kinematics class, over its nonzero entries
+    (``kin.row_*``) in the order of their columns."""
+    columns = kin.row_columns
+    values = kin.row_values
+    for p in range(kin.row_starts[row], kin.row_starts[row + 1]):
+        acc += values[p] * a[columns[p]]
+    return acc
+
+
+@kernel
+def heap_stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    """:func:`stick_system` of a heap kinematics class: its matrix G_S M⁻¹ G_Sᵀ the submatrix of the
+    stick rows of W = G M⁻¹ Gᵀ (``kin.delassus``, formed once by the same sums:
+    :func:`~stickslip.model.mass_factor.delassus`), its right side summed over the rows' nonzero
+    entries, where forming it costs an M⁻¹ product per row; :func:`stick_system` where the class
+    carries no W (it did not fit in memory)."""
+    kin = md.kin
+    if kin.delassus.shape[0] == 0:
+        return stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    m = md.m
+    a, b, x = work_vectors(kin, 3, s)
+    V = work_matrix(kin, ROWS, ROWS, s)
+    rows = work_matrix(kin, ONE, ROWS, n)[0]
+    inverse_mass_of(kin, m, n, diagonal, f, a)
+    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(kin, m, n, c)):
+                rows[k] = 2 * c + i
+                b[k] = -row_times(kin, 2 * c + i, a, h[2 * c + i])
+                k += 1
+    if k == 0:
+        return 0
+    W = kin.delassus
+    zero = csm.zero(s[0])
+    for r in range(k):
+        for r2 in range(k):
+            A[r, r2] = W[rows[r], rows[r2]] + zero
+    solve_stick_system(kin, A, b, x, V, k)
+    r = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            dim = contact_dim(kin, m, n, c)
+            F[2 * c] = x[r]
+            F[2 * c + 1] = x[r + 1] if dim == 2 else zero
+            r += dim
+    return k
+
+
+@inlined_kernel
+def heap_small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
+    """:func:`small_stick_system` of a heap kinematics class: the entries read from W and the right
+    sides summed over the rows' nonzero entries (:func:`heap_stick_system`); :func:`small_stick_system`
+    where the class carries no W."""
+    kin = md.kin
+    if kin.delassus.shape[0] == 0:
+        return small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
+    a = work_vectors(kin, 1, s)[0]
+    inverse_mass_of(kin, md.m, n, diagonal, f, a)
+    W = kin.delassus
+    zero = csm.zero(s[0])
+    a00 = W[r0, r0] + zero
+    b0 = row_times(kin, r0, a, h[r0])
+    zero_b = csm.zero(b0)
+    if r1 < 0:
+        F[r0] = -b0 / a00 if a00.real > 0.0 else zero_b
+        if r0 % 2 == 0:
+            F[r0 + 1] = zero_b
+        return a00, zero_b, zero_b
+    a01 = W[r0, r1] + zero
+    a11 = W[r1, r1] + zero
+    b1 = row_times(kin, r1, a, h[r1])
+    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
+    F[r0] = x0
+    F[r1] = x1
+    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
+        F[r0 + 1] = zero_b
+    if r1 % 2 == 0:
+        F[r1 + 1] = zero_b
+    return a00, a01, a11
+
+
+def stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):  # pragma: no cover - overload
+    """:func:`stick_system`, or :func:`heap_stick_system` for a heap kinematics class (chosen when
+    compiled)."""
+    raise NotImplementedError
+
+
+@overload(stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: heap_stick_system(
+            s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: stick_system(
+        s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+
+
+def small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):  # pragma: no cover - overload
+    """:func:`small_stick_system`, or :func:`heap_small_stick_system` for a heap kinematics class
+    (chosen when compiled)."""
+    raise NotImplementedError
+
+
+@overload(small_stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):
+    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return heap_small_stick_system.py_func
+    return small_stick_system.py_func
 
 
 @standalone
@@ -323,9 +345,9 @@ def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     if k == 0:
         return 0, zero, zero, zero
     if k <= 2:
-        a00, a01, a11 = small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
+        a00, a01, a11 = small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F)
         return k, a00, a01, a11
-    stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
     return k, zero, zero, zero
 
 
