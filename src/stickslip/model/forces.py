@@ -6,7 +6,9 @@
   (:func:`quasi_static_direction`, found with the force that would hold the contact,
   :func:`band_forces`), the stored direction for a 1-D contact;
 * stick: the Lagrange multipliers of all sticking contacts, solved together
-  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more);
+  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more; for a
+  large model's heap kinematics class :func:`heap_small_stick_system`, :func:`heap_stick_system`,
+  their matrices read from the W = G M⁻¹ Gᵀ of all contact rows that it carries);
 * closed rigid contacts: their normal forces λ are multipliers too (:func:`rigid_normal_forces`),
   and so is the friction of one that slides, −μ λ e.
 
@@ -36,8 +38,9 @@ from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_
 from .stack import CONTACTS, DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
-           "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
-           "general_forces", "sliding_friction", "sliding_forces", "rigid_normal_forces", "add_rigid_normal_forces"]
+           "stick_rows", "small_stick_system", "heap_stick_system", "heap_small_stick_system", "solve_stick_rows",
+           "general_forces_body", "band_forces", "general_forces", "sliding_friction", "sliding_forces",
+           "rigid_normal_forces", "add_rigid_normal_forces"]
 
 
 # ----------------------------------------------------------------------------- slip forces

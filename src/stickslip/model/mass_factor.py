@@ -21,7 +21,7 @@ numbers (nb the boundary DOFs).
   over their nonzero entries (a reduced model's contact row is a unit vector on a boundary DOF),
   so that a frame costs their entries, not n;
 * :func:`delassus` gives W = G M⁻¹ Gᵀ of all contact rows, constant where G is: the matrix of
-  every stick system is a submatrix of it (:func:`~stickslip.model.forces.stick_system`), where
+  every stick system is a submatrix of it (:func:`~stickslip.model.forces.heap_stick_system`), where
   forming it costs one M⁻¹ product per stick row.
 """
 
