@@ -225,6 +225,13 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
 
 
 # ----------------------------------------------------------------------------- stick forces of a heap class
+@kernel
+def heap_inverse_mass(kin, m, n, diagonal, f, a):
+    """a = M⁻¹ f (:func:`~stickslip.model.model_data.inverse_mass_of`) as a call: inlined into the
+    heap stick kernels, numba mis-scopes the factor solve's accumulator (a pedantic IR warning)."""
+    inverse_mass_of(kin, m, n, diagonal, f, a)
+
+
 @inlined_kernel
 def row_times(kin, row, a, acc):
     """acc + g·a for the contact row ``row`` of a heap kinematics class, over its nonzero entries
@@ -250,7 +257,7 @@ def heap_stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     a, b, x = work_vectors(kin, 3, s)
     V = work_matrix(kin, ROWS, ROWS, s)
     rows = work_matrix(kin, ONE, ROWS, n)[0]
-    inverse_mass_of(kin, m, n, diagonal, f, a)
+    heap_inverse_mass(kin, m, n, diagonal, f, a)
     k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
     for c in range(nc):
         if is_stick(cst, c) or c == extra:
@@ -285,7 +292,7 @@ def heap_small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     if kin.delassus.shape[0] == 0:
         return small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
     a = work_vectors(kin, 1, s)[0]
-    inverse_mass_of(kin, md.m, n, diagonal, f, a)
+    heap_inverse_mass(kin, md.m, n, diagonal, f, a)
     W = kin.delassus
     zero = csm.zero(s[0])
     a00 = W[r0, r0] + zero
