@@ -31,7 +31,8 @@ from .errors import MemoryLimitError
 
 __all__ = ["available_memory", "check_memory", "largest_count", "sample_bytes", "state_bytes", "param_bytes",
            "grid_point_bytes", "map_point_bytes", "average_bytes", "format_bytes", "model_data_bytes",
-           "largest_dense_dofs", "matrix_file_bytes", "compiled_model_bytes", "work_array_bytes", "pattern_bytes"]
+           "largest_dense_dofs", "matrix_file_bytes", "compiled_model_bytes", "work_array_bytes", "pattern_bytes",
+           "contact_rows_bytes", "delassus_bytes", "fits_in_memory"]
 
 #: Control-group memory limits (v2, then v1) that cap what the kernel gives this process.
 _CGROUP_LIMITS = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
@@ -238,11 +239,36 @@ def pattern_bytes(n_dofs: int) -> float:
     return 8.0 * (2 * (n * n + n + 1) + n * (n - 1) + (n + 1) + 2 * n)
 
 
+def contact_rows_bytes(n_dofs: int, n_contacts: int) -> float:
+    """Bytes of the contact rows over their nonzero entries that a model above the stack maxima
+    carries (``model/mass_factor.contact_rows``), at most: the 2 nc tangent rows' columns and
+    values, and the normal-force gradients' columns and two values, of n entries each."""
+    n, nc = int(n_dofs), int(n_contacts)
+    return 8.0 * (2 * 2 * nc * n + 3 * nc * n + 3 * nc + 2)
+
+
+def delassus_bytes(n_dofs: int, n_contacts: int) -> float:
+    """Peak bytes of the matrix W = G M⁻¹ Gᵀ of all contact rows (2 nc × 2 nc) of a model above
+    the stack maxima (``model/mass_factor.delassus``), with the 2 nc × n product it is formed
+    from. Optional: where it does not fit (:func:`fits_in_memory`), the stick systems are formed
+    row by row as without it."""
+    n, nc = int(n_dofs), int(n_contacts)
+    return 8.0 * (4 * nc * nc + 2 * nc * n)
+
+
+def fits_in_memory(need: float) -> bool:
+    """Whether ``need`` bytes fit in the memory available now (True where none can be read): the
+    test of something optional, which is left out where it does not fit."""
+    memory = available_memory()
+    return memory is None or need <= memory
+
+
 def compiled_model_bytes(n_dofs: int, n_contacts: int) -> float:
     """Peak bytes of a model in the compiled kernels: its packed data (:func:`model_data_bytes`)
     and, above the stack maxima, the kernels' work arrays (:func:`work_array_bytes`) and its
-    sparse structure (:func:`pattern_bytes`)."""
-    return model_data_bytes(n_dofs, n_contacts) + work_array_bytes(n_dofs, n_contacts) + pattern_bytes(n_dofs)
+    sparse structure (:func:`pattern_bytes`, :func:`contact_rows_bytes`)."""
+    return (model_data_bytes(n_dofs, n_contacts) + work_array_bytes(n_dofs, n_contacts) + pattern_bytes(n_dofs)
+            + contact_rows_bytes(n_dofs, n_contacts))
 
 
 def largest_dense_dofs(memory: float, n_contacts: int = 0) -> int:

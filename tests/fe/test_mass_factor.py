@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import scipy.linalg as sl
 
-from stickslip.memory import compiled_model_bytes, model_data_bytes, pattern_bytes, work_array_bytes
+from stickslip.memory import (compiled_model_bytes, contact_rows_bytes, delassus_bytes, model_data_bytes, pattern_bytes,
+                              work_array_bytes)
 from stickslip.model import physics as P
 from stickslip.model.bundle import CST, contact_state
 from stickslip.model.kinematics import LARGE_KINEMATICS
@@ -85,10 +86,12 @@ def reduced(tmp_path_factory):
 
 def test_memory_estimate_counts_the_sparse_structure(reduced):
     n, nc = reduced.n, reduced.n_contacts
-    assert compiled_model_bytes(n, nc) == model_data_bytes(n, nc) + work_array_bytes(n, nc) + pattern_bytes(n)
+    assert compiled_model_bytes(n, nc) == (model_data_bytes(n, nc) + work_array_bytes(n, nc) + pattern_bytes(n)
+                                           + contact_rows_bytes(n, nc))
     kin = reduced.data.kin
     held = sum(a.nbytes for a in kin if isinstance(a, np.ndarray))
-    assert held <= pattern_bytes(n)
+    assert held - kin.delassus.nbytes <= pattern_bytes(n) + contact_rows_bytes(n, nc)
+    assert kin.delassus.shape == (2 * nc, 2 * nc) and kin.delassus.nbytes <= delassus_bytes(n, nc)
 
 
 def matrices(model):
@@ -134,3 +137,39 @@ def test_every_contact_sticking_holds_its_slip_velocity(reduced):
     acc = rows @ ds[n:2 * n]
     scale = np.abs(rows).max() * np.abs(ds[n:2 * n]).max()
     assert np.abs(acc).max() <= 1e-11 * scale
+
+
+def test_contact_rows_and_their_delassus_matrix_are_the_models(reduced):
+    """The heap class's contact rows over their nonzero entries rebuild the model's tangent rows,
+    and W = G M⁻¹ Gᵀ is that of scipy's solve with the model's own M (round-off entries and all)."""
+    n, nc = reduced.n, reduced.n_contacts
+    kin = reduced.data.kin
+    G = np.zeros((2 * nc, n))
+    for r in range(2 * nc):
+        p = slice(kin.row_starts[r], kin.row_starts[r + 1])
+        G[r, kin.row_columns[p]] = kin.row_values[p]
+    tangent = reduced.sparse_form().tangent.toarray()
+    dims = reduced.sparse_form().dim
+    used = np.concatenate([[2 * c, 2 * c + 1][:d] for c, d in enumerate(dims)])
+    np.testing.assert_array_equal(G[used], tangent)
+    assert not G[np.setdiff1d(np.arange(2 * nc), used)].any()
+    M = matrices(reduced)[0]
+    expected = G @ sl.solve(M, G.T, assume_a="pos")
+    np.testing.assert_allclose(kin.delassus, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
+def test_stick_without_the_delassus_matrix_forms_the_same_system(reduced):
+    """Where W does not fit (an empty ``delassus``) the stick systems are formed row by row: the
+    same accelerations, each stick row's sum the same as W's entry."""
+    n = reduced.n
+    md = reduced.data
+    row_by_row = md._replace(kin=md.kin._replace(delassus=np.zeros((0, 0))))
+    s = random_state(n, 4)
+    cst = contact_state(md.m)
+    for sticking in (slice(None), slice(0, 2), slice(5, 6)):  # stick systems of nine rows, two and one
+        cst[0::CST] = P.MODE_SLIP_EXACT
+        cst[0::CST][sticking] = P.MODE_STICK
+        with_w, without = np.zeros_like(s), np.zeros_like(s)
+        P.rhs(s, cst, md, with_w)
+        P.rhs(s, cst, row_by_row, without)
+        np.testing.assert_allclose(with_w, without, rtol=1e-12, atol=1e-12 * np.abs(without).max())

@@ -9,7 +9,13 @@ from stickslip.model import stack
 from stickslip.model.kinematics import ConstantKinematics, LargeConstantKinematics
 
 
-@pytest.mark.parametrize("kin", [ConstantKinematics(), LargeConstantKinematics(70, 20, *[np.zeros(0, np.int64)] * 5, *[np.zeros(0, np.int64)] * 2, *[np.zeros(0)] * 2)], ids=["stack", "heap"])
+#: The heap class's empty arrays: its values float64 (W two-dimensional), its patterns int64.
+_FLOATS = {"factor_values", "factor_diagonal", "row_values", "normal_q", "normal_v"}
+HEAP = LargeConstantKinematics(70, 20, *[np.zeros((0, 0)) if f == "delassus" else np.zeros(0, float if f in _FLOATS
+                                         else np.int64) for f in LargeConstantKinematics._fields[2:]])
+
+
+@pytest.mark.parametrize("kin", [ConstantKinematics(), HEAP], ids=["stack", "heap"])
 def test_work_matrix_is_typed_only_with_literal_size_codes(kin):
     """numba 0.57 types an intrinsic with plain integers first and keeps the first typing that
     succeeds (its ``intrinsic`` ignores ``prefer_literal``): the typing must refuse plain integers,

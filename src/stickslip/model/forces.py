@@ -6,7 +6,9 @@
   (:func:`quasi_static_direction`, found with the force that would hold the contact,
   :func:`band_forces`), the stored direction for a 1-D contact;
 * stick: the Lagrange multipliers of all sticking contacts, solved together
-  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more);
+  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more; for a
+  large model's heap kinematics class :func:`heap_small_stick_system`, :func:`heap_stick_system`,
+  their matrices read from the W = G M⁻¹ Gᵀ of all contact rows that it carries);
 * closed rigid contacts: their normal forces λ are multipliers too (:func:`rigid_normal_forces`),
   and so is the friction of one that slides, −μ λ e.
 
@@ -22,22 +24,24 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
 from .frames import all_frames, frame_velocity, frame_with_bias
 from .impact import inverse_mass_product
-from .jit import inlined_kernel, kernel, standalone
+from .jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, base_force_of,
                          gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
-from .stack import CONTACTS, DOFS, ROWS, TWO, work_matrix, work_vectors
+from .stack import CONTACTS, DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
 
 __all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
-           "stick_rows", "small_stick_system", "solve_stick_rows", "general_forces_body", "band_forces",
-           "general_forces", "sliding_friction", "sliding_forces", "rigid_normal_forces", "add_rigid_normal_forces"]
+           "stick_rows", "small_stick_system", "heap_stick_system", "heap_small_stick_system", "solve_stick_rows",
+           "general_forces_body", "band_forces", "general_forces", "sliding_friction", "sliding_forces",
+           "rigid_normal_forces", "add_rigid_normal_forces"]
 
 
 # ----------------------------------------------------------------------------- slip forces
@@ -221,6 +225,126 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     return a00, a01, a11
 
 
+# ----------------------------------------------------------------------------- stick forces of a heap class
+@kernel
+def heap_inverse_mass(kin, m, n, diagonal, f, a):
+    """a = M⁻¹ f (:func:`~stickslip.model.model_data.inverse_mass_of`) as a call: inlined into the
+    heap stick kernels, numba mis-scopes the factor solve's accumulator (a pedantic IR warning)."""
+    inverse_mass_of(kin, m, n, diagonal, f, a)
+
+
+@inlined_kernel
+def row_times(kin, row, a, acc):
+    """acc + g·a for the contact row ``row`` of a heap kinematics class, over its nonzero entries
+    (``kin.row_*``) in the order of their columns."""
+    columns = kin.row_columns
+    values = kin.row_values
+    for p in range(kin.row_starts[row], kin.row_starts[row + 1]):
+        acc += values[p] * a[columns[p]]
+    return acc
+
+
+@kernel
+def heap_stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    """:func:`stick_system` of a heap kinematics class: its matrix G_S M⁻¹ G_Sᵀ the submatrix of the
+    stick rows of W = G M⁻¹ Gᵀ (``kin.delassus``, formed once by the same sums:
+    :func:`~stickslip.model.mass_factor.delassus`), its right side summed over the rows' nonzero
+    entries, where forming it costs an M⁻¹ product per row; :func:`stick_system` where the class
+    carries no W (it did not fit in memory)."""
+    kin = md.kin
+    if kin.delassus.shape[0] == 0:
+        return stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    m = md.m
+    a, b, x = work_vectors(kin, 3, s)
+    V = work_matrix(kin, ROWS, ROWS, s)
+    rows = work_matrix(kin, ONE, ROWS, n)[0]
+    heap_inverse_mass(kin, m, n, diagonal, f, a)
+    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            for i in range(contact_dim(kin, m, n, c)):
+                rows[k] = 2 * c + i
+                b[k] = -row_times(kin, 2 * c + i, a, h[2 * c + i])
+                k += 1
+    if k == 0:
+        return 0
+    W = kin.delassus
+    zero = csm.zero(s[0])
+    for r in range(k):
+        for r2 in range(k):
+            A[r, r2] = W[rows[r], rows[r2]] + zero
+    solve_stick_system(kin, A, b, x, V, k)
+    r = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            dim = contact_dim(kin, m, n, c)
+            F[2 * c] = x[r]
+            F[2 * c + 1] = x[r + 1] if dim == 2 else zero
+            r += dim
+    return k
+
+
+@inlined_kernel
+def heap_small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
+    """:func:`small_stick_system` of a heap kinematics class: the entries read from W and the right
+    sides summed over the rows' nonzero entries (:func:`heap_stick_system`); :func:`small_stick_system`
+    where the class carries no W."""
+    kin = md.kin
+    if kin.delassus.shape[0] == 0:
+        return small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
+    a = work_vectors(kin, 1, s)[0]
+    heap_inverse_mass(kin, md.m, n, diagonal, f, a)
+    W = kin.delassus
+    zero = csm.zero(s[0])
+    a00 = W[r0, r0] + zero
+    b0 = row_times(kin, r0, a, h[r0])
+    zero_b = csm.zero(b0)
+    if r1 < 0:
+        F[r0] = -b0 / a00 if a00.real > 0.0 else zero_b
+        if r0 % 2 == 0:
+            F[r0 + 1] = zero_b
+        return a00, zero_b, zero_b
+    a01 = W[r0, r1] + zero
+    a11 = W[r1, r1] + zero
+    b1 = row_times(kin, r1, a, h[r1])
+    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
+    F[r0] = x0
+    F[r1] = x1
+    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
+        F[r0 + 1] = zero_b
+    if r1 % 2 == 0:
+        F[r1 + 1] = zero_b
+    return a00, a01, a11
+
+
+def stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):  # pragma: no cover - overload
+    """:func:`stick_system`, or :func:`heap_stick_system` for a heap kinematics class (chosen when
+    compiled)."""
+    raise NotImplementedError
+
+
+@overload(stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
+    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: heap_stick_system(
+            s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: stick_system(
+        s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+
+
+def small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):  # pragma: no cover - overload
+    """:func:`small_stick_system`, or :func:`heap_small_stick_system` for a heap kinematics class
+    (chosen when compiled)."""
+    raise NotImplementedError
+
+
+@overload(small_stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):
+    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return heap_small_stick_system.py_func
+    return small_stick_system.py_func
+
+
 @standalone
 @kernel
 def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
@@ -232,9 +356,9 @@ def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     if k == 0:
         return 0, zero, zero, zero
     if k <= 2:
-        a00, a01, a11 = small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
+        a00, a01, a11 = small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F)
         return k, a00, a01, a11
-    stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
     return k, zero, zero, zero
 
 

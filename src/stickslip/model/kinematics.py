@@ -49,12 +49,14 @@ from .frame_pointers import (FramePointerFields, compiled_addresses, forget, is_
                              pointer_gap)
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
 from .jit import KERNEL_OPTIONS, defined_in_package, kernel, track_user_code
-from .mass_factor import mass_factor, row_pattern
+from ..memory import delassus_bytes, fits_in_memory
+from .mass_factor import contact_rows, delassus, mass_factor, row_pattern
 
 __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEMATICS", "register_kinematics",
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
            "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel",
            "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid",
+           "sparse_constant_frame",
            "kernel_kinematics", "bias_at_run_time", "pointer_class", "LargeConstantKinematics",
            "LargeConstantUnilateralKinematics", "LargeConstantRigidKinematics", "LARGE_KINEMATICS", "fits_stack",
            "force_pattern",
@@ -445,7 +447,9 @@ CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics, Constan
 _HEAP_FIELDS = [("ndof", int), ("ncontacts", int), ("force_rows", np.ndarray), ("force_columns", np.ndarray),
                 ("mass_rows", np.ndarray), ("mass_columns", np.ndarray), ("factor_order", np.ndarray),
                 ("factor_rows", np.ndarray), ("factor_columns", np.ndarray), ("factor_values", np.ndarray),
-                ("factor_diagonal", np.ndarray)]
+                ("factor_diagonal", np.ndarray), ("row_starts", np.ndarray), ("row_columns", np.ndarray),
+                ("row_values", np.ndarray), ("normal_starts", np.ndarray), ("normal_columns", np.ndarray),
+                ("normal_q", np.ndarray), ("normal_v", np.ndarray), ("delassus", np.ndarray)]
 
 LargeConstantKinematics = NamedTuple("LargeConstantKinematics", _HEAP_FIELDS)
 LargeConstantKinematics.__doc__ = """The kernels' :class:`ConstantKinematics` of a model larger than the
@@ -461,7 +465,14 @@ model's C and K are mostly zero; ``mass_rows``, ``mass_columns`` that of M (the 
 (:func:`~stickslip.model.mass_factor.mass_factor`), with which M⁻¹ f is two triangular solves
 (:func:`~stickslip.model.model_data.inverse_mass_of`). ``FrictionModel.data`` packs the matrices of
 such a model without their round-off entries (:func:`~stickslip.model.mass_factor.without_round_off`),
-so the patterns are those of the model's mechanics, not of its arithmetic."""
+so the patterns are those of the model's mechanics, not of its arithmetic.
+
+``row_*`` and ``normal_*`` hold the contacts' tangent rows and normal-force gradients over their
+nonzero entries (:func:`~stickslip.model.mass_factor.contact_rows`), from which the frame
+(:func:`sparse_constant_frame`) and the stick systems' right sides are summed; ``delassus``
+(2 nc, 2 nc) is W = G M⁻¹ Gᵀ of all contact rows (:func:`~stickslip.model.mass_factor.delassus`),
+whose submatrices are the stick systems, or (0, 0) where it did not fit in memory (the stick
+systems are then formed row by row)."""
 LargeConstantUnilateralKinematics = NamedTuple("LargeConstantUnilateralKinematics", _HEAP_FIELDS)
 LargeConstantUnilateralKinematics.__doc__ = (":class:`LargeConstantKinematics` for "
                                              ":class:`ConstantUnilateralKinematics` (compliant contacts).")
@@ -488,12 +499,15 @@ def force_pattern(damping: np.ndarray, stiffness: np.ndarray) -> tuple[np.ndarra
     return row_pattern((np.asarray(damping) != 0.0) | (np.asarray(stiffness) != 0.0))
 
 
-def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...] = ()):
+def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...], m: np.ndarray):
     """The kinematics data the kernels take for a model of n dofs and nc contacts: ``kin`` where
     it fits the stack arrays (:func:`fits_stack`), else its heap class with the patterns of the
     dense (n, n) ``matrices`` = (mass, damping, stiffness, free) (:func:`force_pattern`, the mass's
-    pattern and its sparse factor, :func:`~stickslip.model.mass_factor.mass_factor`; None where
-    it has no heap class: a frame computed from q, which the stack maxima bound)."""
+    pattern and its sparse factor, :func:`~stickslip.model.mass_factor.mass_factor`), and the
+    contact rows of the packed data ``m`` over their nonzero entries with their W = G M⁻¹ Gᵀ
+    (:func:`~stickslip.model.mass_factor.contact_rows`, :func:`~stickslip.model.mass_factor.delassus`;
+    W empty where it does not fit in memory: :func:`~stickslip.memory.delassus_bytes`); None
+    where it has no heap class: a frame computed from q, which the stack maxima bound."""
     cls = type(kin)
     if fits_stack(cls, n, nc):
         return kin
@@ -501,8 +515,10 @@ def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...] = ()
     if large is None:
         return None
     mass, damping, stiffness, free = matrices
+    rows = contact_rows(m, n, nc)
+    w = delassus(m, n, nc, rows[:3]) if fits_in_memory(delassus_bytes(n, nc)) else np.zeros((0, 0))
     return large(int(n), int(nc), *force_pattern(damping, stiffness), *row_pattern(np.asarray(mass) != 0.0),
-                 *mass_factor(mass, free))
+                 *mass_factor(mass, free), *rows, w)
 
 
 @kernel
@@ -523,8 +539,29 @@ def constant_frame(kin, s, c, m, G, w):
 register_kinematics(ConstantKinematics, constant_frame, unilateral=False)
 register_kinematics(ConstantUnilateralKinematics, constant_frame, rigid=False)
 register_kinematics(ConstantRigidKinematics, constant_frame)
-register_kinematics(LargeConstantKinematics, constant_frame, unilateral=False)
-register_kinematics(LargeConstantUnilateralKinematics, constant_frame, rigid=False)
-register_kinematics(LargeConstantRigidKinematics, constant_frame)
-for _large in LARGE_KINEMATICS.values():
+
+
+@kernel
+def sparse_constant_frame(kin, s, c, m, G, w):
+    """:func:`constant_frame` of the heap classes: G's rows set to zero and their nonzero entries
+    written (``kin.row_*``), N summed over the nonzero entries of its gradients (``kin.normal_*``)
+    in the same order, so a contact costs its entries and two rows of stores instead of 4n reads."""
+    n = kin.ndof
+    o, ow, _, _ = contact_offsets(n, c)
+    for i in range(2):
+        for j in range(n):
+            G[i, j] = 0.0
+        for p in range(kin.row_starts[2 * c + i], kin.row_starts[2 * c + i + 1]):
+            G[i, kin.row_columns[p]] = kin.row_values[p]
+    normal = m[o + C_N0] + csm.zero(s[0])
+    for p in range(kin.normal_starts[c], kin.normal_starts[c + 1]):
+        j = kin.normal_columns[p]
+        normal += kin.normal_q[p] * s[j] + kin.normal_v[p] * s[n + j]
+    w[0] = m[ow]
+    w[1] = m[ow + 1]
+    return normal
+
+
+for _small, _large in LARGE_KINEMATICS.items():  # each heap class takes the contacts its stack class takes
+    register_kinematics(_large, sparse_constant_frame, unilateral=allows_unilateral(_small), rigid=allows_rigid(_small))
     stack.register_heap(_large)

@@ -16,14 +16,23 @@ numbers (nb the boundary DOFs).
 * :func:`mass_factor` gives the Cholesky factor of M on its free DOFs in an order that keeps it
   sparse: rows with fewest entries first (a reduced model's modes before its boundary DOFs: no
   fill at all), so that M⁻¹ f is two triangular solves over the factor's entries
-  (:func:`~stickslip.model.model_data.inverse_mass_of`) instead of a product with the dense M⁻¹.
+  (:func:`~stickslip.model.model_data.inverse_mass_of`) instead of a product with the dense M⁻¹;
+* :func:`contact_rows` gives each contact's tangent rows G and normal-force gradients n_q, n_v
+  over their nonzero entries (a reduced model's contact row is a unit vector on a boundary DOF),
+  so that a frame costs their entries, not n;
+* :func:`delassus` gives W = G M⁻¹ Gᵀ of all contact rows, constant where G is: the matrix of
+  every stick system is a submatrix of it (:func:`~stickslip.model.forces.heap_stick_system`), where
+  forming it costs one M⁻¹ product per stick row.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
-__all__ = ["ROUND_OFF", "without_round_off", "row_pattern", "mass_factor"]
+from .bundle import C_G, contact_offsets, offsets
+
+__all__ = ["ROUND_OFF", "without_round_off", "row_pattern", "mass_factor", "contact_rows", "delassus"]
 
 #: Relative size |A_ij| / √|A_ii A_jj| at or below which an off-diagonal entry of M, C or K of a
 #: large model counts as round-off (module docstring).
@@ -68,3 +77,44 @@ def mass_factor(mass: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, ...]:
     rows, columns = row_pattern(strict != 0.0)
     dofs = idx[order].astype(np.int64)
     return dofs, rows, dofs[columns], strict[strict != 0.0].copy(), np.diag(low).copy()
+
+
+def _packed_rows(m: np.ndarray, n: int, nc: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(G (2 nc, n), n_q (nc, n), n_v (nc, n)) copied from the packed data ``m``: contact c's
+    tangent rows are rows 2c, 2c + 1 of G."""
+    blocks = [contact_offsets(n, c) for c in range(nc)]
+    G = np.array([m[o + C_G:o + C_G + 2 * n] for o, _, _, _ in blocks]).reshape(2 * nc, n)
+    nq = np.array([m[onq:onq + n] for _, _, onq, _ in blocks]).reshape(nc, n)
+    nv = np.array([m[onv:onv + n] for _, _, _, onv in blocks]).reshape(nc, n)
+    return G, nq, nv
+
+
+def contact_rows(m: np.ndarray, n: int, nc: int) -> tuple[np.ndarray, ...]:
+    """Each contact's tangent rows and normal-force gradients over their nonzero entries, from the
+    packed data ``m`` (float64) of a model of n DOFs and nc contacts with constant frames.
+
+    Returns (row_starts (2 nc + 1,), row_columns, row_values): the rows of G (contact c's at 2c,
+    2c + 1) row-compressed, columns ascending; (normal_starts (nc + 1,), normal_columns, normal_q,
+    normal_v): per contact the DOFs j where n_q or n_v is not zero, ascending, and both there
+    (the normal force N0 + n_q·q + n_v·q̇ sums over those only, in the same order).
+    """
+    G, nq, nv = _packed_rows(m, n, nc)
+    row_starts, row_columns = row_pattern(G != 0.0)
+    starts, columns = row_pattern((nq != 0.0) | (nv != 0.0))
+    rows = np.repeat(np.arange(nc), np.diff(starts))
+    return (row_starts, row_columns, G[G != 0.0].copy(), starts, columns, nq[rows, columns].copy(),
+            nv[rows, columns].copy())
+
+
+def delassus(m: np.ndarray, n: int, nc: int, rows: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+    """W = G M⁻¹ Gᵀ (2 nc, 2 nc) of all contact rows of the packed data ``m`` (float64), with G as
+    ``rows`` = (row_starts, row_columns, row_values) of :func:`contact_rows` and M⁻¹ the packed one.
+
+    Each entry is the sum the stick solve formed: (M⁻¹ g_s)_i = Σ_j g_s,j (M⁻¹)_ji over the nonzero
+    g_s,j in order, then W_rs = Σ_i g_r,i (M⁻¹ g_s)_i likewise (a sparse-times-dense product sums
+    in that order), so a stick system read from W is the one formed row by row.
+    """
+    G = sp.csr_matrix((rows[2], rows[1], rows[0]), shape=(2 * nc, n))
+    o = offsets(n)[0]
+    inverse = m[o:o + n * n].reshape(n, n)
+    return np.ascontiguousarray(G @ np.asarray(G @ inverse).T)

@@ -581,7 +581,7 @@ class FrictionModel:
             matrices = [without_round_off(a) for a in matrices]
         m = pack(*matrices, self.force, self.free, [dense_spec(contact.spec(self.n)) for contact in self.contacts],
                  self.slip_band, self.constant_kinematics)
-        kin = large_kinematics(kin, self.n, self.n_contacts, (*matrices, self.free))
+        kin = large_kinematics(kin, self.n, self.n_contacts, (*matrices, self.free), m)
         return ModelData(m, kin, self.user_law)
 
     @cached_property
