@@ -234,17 +234,19 @@ def pattern_bytes(n_dofs: int) -> float:
     """Bytes of the sparse structure a model above the stack maxima carries beside its packed data
     (``model/kinematics.py``'s heap classes), at most: the row-compressed patterns of C and K and
     of M (int64 row starts and up to n² columns each) and the Cholesky factor of M (its strict
-    lower triangle's columns and values, its order and diagonal)."""
+    lower triangle's columns and values, its order and diagonal, its rows' runs of consecutive
+    columns, three numbers each and at most one per entry)."""
     n = int(n_dofs)
-    return 8.0 * (2 * (n * n + n + 1) + n * (n - 1) + (n + 1) + 2 * n)
+    return 8.0 * (2 * (n * n + n + 1) + n * (n - 1) + (n + 1) + 2 * n + (n + 1) + 3 * n * (n - 1) // 2)
 
 
 def contact_rows_bytes(n_dofs: int, n_contacts: int) -> float:
     """Bytes of the contact rows over their nonzero entries that a model above the stack maxima
     carries (``model/mass_factor.contact_rows``), at most: the 2 nc tangent rows' columns and
-    values, and the normal-force gradients' columns and two values, of n entries each."""
+    values, the normal-force gradients' columns and two values and the gap gradients' columns and
+    values, of n entries each."""
     n, nc = int(n_dofs), int(n_contacts)
-    return 8.0 * (2 * 2 * nc * n + 3 * nc * n + 3 * nc + 2)
+    return 8.0 * (2 * 2 * nc * n + 3 * nc * n + 2 * nc * n + 4 * nc + 3)
 
 
 def delassus_bytes(n_dofs: int, n_contacts: int) -> float:

@@ -13,7 +13,7 @@ from stickslip.model.bundle import CST, contact_state
 from stickslip.model.kinematics import LARGE_KINEMATICS
 from stickslip.model.library import load_model
 from stickslip.model.linalg import solve_by_cholesky
-from stickslip.model.mass_factor import ROUND_OFF, mass_factor, without_round_off
+from stickslip.model.mass_factor import ROUND_OFF, consecutive_runs, mass_factor, without_round_off
 from stickslip.reduction import reduce_model, write_model_file
 
 from .fe_models import pad_on_belt
@@ -47,7 +47,7 @@ def test_mass_factor_of_a_reduced_mass_has_no_fill_and_factors_it():
     n = modes + boundary
     free = np.ones(n, bool)
     free[2] = False  # a locked boundary DOF: the factor covers the free ones
-    order, rows, columns, values, diagonal = mass_factor(mass, free)
+    order, rows, columns, values, diagonal, segment_rows, segments = mass_factor(mass, free)
     assert set(order[:modes]) == set(range(boundary, n))  # the modes first (fewest entries)
     nf = order.size
     assert rows[modes] == 0  # no fill: no entry between two modes (their block of L is diagonal)
@@ -57,6 +57,22 @@ def test_mass_factor_of_a_reduced_mass_has_no_fill_and_factors_it():
         for p in range(rows[i], rows[i + 1]):
             low[i, position[columns[p]]] = values[p]
     np.testing.assert_allclose(low @ low.T, mass[np.ix_(order, order)], rtol=0, atol=1e-14 * np.abs(mass).max())
+    # a boundary row: one run over the modes (DOFs 6 … 35), one or two (the locked DOF 2 between)
+    # over the boundary DOFs before it
+    assert segment_rows[modes] == 0 and segment_rows[modes + 1] == 1  # the first boundary row: the modes only
+    assert max(segment_rows[i + 1] - segment_rows[i] for i in range(nf)) == 3
+    for start, end, first in segments:
+        np.testing.assert_array_equal(columns[start:end], first + np.arange(end - start))
+
+
+def test_consecutive_runs_cover_each_row_in_order():
+    rows = np.array([0, 3, 3, 7, 8])
+    columns = np.array([5, 6, 7, 0, 1, 9, 10, 11])
+    segment_rows, segments = consecutive_runs(rows, columns)
+    np.testing.assert_array_equal(segment_rows, [0, 1, 1, 3, 4])
+    np.testing.assert_array_equal(segments, [[0, 3, 5], [3, 5, 0], [5, 7, 9], [7, 8, 11]])  # 11 follows 10: a new row
+    empty_rows, empty = consecutive_runs(np.zeros(3, np.int64), np.zeros(0, np.int64))
+    assert empty.shape == (0, 3) and not empty_rows.any()
 
 
 def test_cholesky_solves_what_is_full_rank_and_leaves_the_rest_to_jacobi():
@@ -173,3 +189,30 @@ def test_stick_without_the_delassus_matrix_forms_the_same_system(reduced):
         P.rhs(s, cst, md, with_w)
         P.rhs(s, cst, row_by_row, without)
         np.testing.assert_allclose(with_w, without, rtol=1e-12, atol=1e-12 * np.abs(without).max())
+
+
+def test_sliding_contacts_act_through_their_rows(reduced):
+    """Every contact closed and sliding: the slip velocities are G q̇ − w of the model's own tangent
+    rows and drives, and q̈ = M⁻¹ (f0 − C q̇ − K q + Gᵀ F + Wᵀ λ) with the contacts' friction and
+    normal forces, by scipy on the model's own matrices (the kernels sum over the rows' nonzero
+    entries only)."""
+    n, nc = reduced.n, reduced.n_contacts
+    form = reduced.sparse_form()
+    M, C, K = matrices(reduced)
+    s = random_state(n, 5)
+    cst = contact_state(reduced.data.m)
+    cst[0::CST] = P.MODE_SLIP_EXACT
+    ds, F, N, v = np.zeros_like(s), np.zeros(2 * nc), np.zeros(nc), np.zeros(2 * nc)
+    P.rhs(s, cst, reduced.data, ds)
+    P.contact_forces(s, cst, reduced.data, F, N, v)
+    used = np.concatenate([[2 * c, 2 * c + 1][:d] for c, d in enumerate(form.dim)])
+    G = np.zeros((2 * nc, n))
+    G[used] = form.tangent.toarray()
+    w = np.zeros(2 * nc)
+    w[used] = form.drive
+    qd = s[n:2 * n]
+    np.testing.assert_allclose(v, G @ qd - w, rtol=0, atol=1e-13 * np.abs(G).max() * np.abs(qd).max())
+    assert np.all(np.abs(v[used]) > 0.0) and np.all(F[used] != 0.0)  # every contact slides with a force
+    f = np.asarray(form.force, float) - C @ qd - K @ s[:n] + G.T @ F + form.gap_gradient.T @ N
+    expected = sl.solve(M, f, assume_a="pos")
+    np.testing.assert_allclose(ds[n:2 * n], expected, rtol=0, atol=1e-10 * np.abs(expected).max())

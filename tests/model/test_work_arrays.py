@@ -9,10 +9,12 @@ from stickslip.model import stack
 from stickslip.model.kinematics import ConstantKinematics, LargeConstantKinematics
 
 
-#: The heap class's empty arrays: its values float64 (W two-dimensional), its patterns int64.
-_FLOATS = {"factor_values", "factor_diagonal", "row_values", "normal_q", "normal_v"}
-HEAP = LargeConstantKinematics(70, 20, *[np.zeros((0, 0)) if f == "delassus" else np.zeros(0, float if f in _FLOATS
-                                         else np.int64) for f in LargeConstantKinematics._fields[2:]])
+#: The heap class's empty arrays: its values float64 (W two-dimensional), its patterns int64 (the
+#: factor's runs (k, 3)).
+_FLOATS = {"factor_values", "factor_diagonal", "row_values", "normal_q", "normal_v", "gap_values"}
+_EMPTY = {"delassus": np.zeros((0, 0)), "factor_segments": np.zeros((0, 3), np.int64)}
+HEAP = LargeConstantKinematics(70, 20, *[_EMPTY[f] if f in _EMPTY else np.zeros(0, float if f in _FLOATS else np.int64)
+                                         for f in LargeConstantKinematics._fields[2:]])
 
 
 @pytest.mark.parametrize("kin", [ConstantKinematics(), HEAP], ids=["stack", "heap"])

@@ -28,17 +28,17 @@ from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
-from .frames import all_frames, frame_velocity, frame_with_bias
+from .frames import add_contact_force, add_force_of, all_frames, contact_velocity, frame_velocity, frame_with_bias
 from .impact import inverse_mass_product
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
-from .kinematics import contact_dim, contact_frame, model_sizes, rigid_kernel
+from .kinematics import contact_dim, contact_frame, frame_for_sums, model_sizes, rigid_kernel
 from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, base_force_of,
                          gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
 
-__all__ = ["exact_direction", "slip_force", "add_contact_force", "rotated", "quasi_static_direction", "stick_system",
+__all__ = ["exact_direction", "slip_force", "rotated", "quasi_static_direction", "stick_system",
            "stick_rows", "small_stick_system", "heap_stick_system", "heap_small_stick_system", "solve_stick_rows",
            "general_forces_body", "band_forces", "general_forces", "sliding_friction", "sliding_forces",
            "rigid_normal_forces", "add_rigid_normal_forces"]
@@ -69,16 +69,6 @@ def slip_force(md, n, c, dim, speed, e0, e1, normal):
     if dim == 2:
         return scale * e0, scale * e1
     return scale * e0, csm.zero(scale)
-
-
-@inlined_kernel
-def add_contact_force(G2, dim, n, F0, F1, f):
-    """f += G_cᵀ F_c for one contact's frame rows G2."""
-    for j in range(n):
-        f[j] += G2[0, j] * F0
-    if dim == 2:
-        for j in range(n):
-            f[j] += G2[1, j] * F1
 
 
 @inlined_kernel
@@ -399,7 +389,7 @@ def general_forces_body(s, cst, md, G, w, v, N, h, F, f):
             F0, F1 = slip_force(md, n, c, dim, speed, v[2 * c] * inv, v[2 * c + 1] * inv, N[c])
             F[2 * c] = F0
             F[2 * c + 1] = F1
-            add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
+            add_force_of(md.kin, c, G[2 * c:2 * c + 2], dim, n, F0, F1, f)
         else:
             in_band = True
     if in_band:
@@ -407,7 +397,7 @@ def general_forces_body(s, cst, md, G, w, v, N, h, F, f):
     if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, h, f, F, A)[0] > 0:
         for c in range(nc):
             if is_stick(cst, c):
-                add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+                add_force_of(md.kin, c, G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
     return add_rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A)
 
 
@@ -559,9 +549,10 @@ def general_forces(s, cst, md, G, w, v, N, h, F, f):
 @inlined_kernel
 def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
     """The friction forces of the common case, every contact sliding outside the low-speed band:
-    fills G, w, v, N and F and returns True; returns False (arrays incomplete) as soon as a
-    contact sticks or is inside the band, or when a rigid contact is closed (its normal force is a
-    multiplier)."""
+    fills w, v, N and F, and G but for a heap class (whose rows the sums read from its lists:
+    :func:`~stickslip.model.kinematics.frame_for_sums`), and returns True; returns False (arrays
+    incomplete) as soon as a contact sticks or is inside the band, or when a rigid contact is closed
+    (its normal force is a multiplier)."""
     m = md.m
     for c in range(nc):
         if is_stick(cst, c):
@@ -571,9 +562,9 @@ def sliding_friction(s, cst, md, n, nc, G, w, v, N, F):
     band = m[H_BAND]
     for c in range(nc):
         G2 = G[2 * c:2 * c + 2]
-        normal = contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
+        normal = frame_for_sums(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
         dim = contact_dim(md.kin, m, n, c)
-        v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
+        v0, v1 = contact_velocity(md.kin, s, n, c, dim, G2, w[2 * c:2 * c + 2])
         v[2 * c] = v0
         v[2 * c + 1] = v1
         normal = normal_in_mode(s, cst, md, n, c, normal)
@@ -601,6 +592,6 @@ def sliding_forces(s, cst, md, n, nc, diagonal, G, w, v, N, F, f):
     m = md.m
     base_force_of(md.kin, s, m, n, diagonal, f)
     for c in range(nc):
-        add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
+        add_force_of(md.kin, c, G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, F[2 * c], F[2 * c + 1], f)
     add_normal_forces(s, cst, md, n, nc, N, f)
     return True

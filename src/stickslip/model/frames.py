@@ -7,7 +7,9 @@ both: in closed form where the kinematics class registered a bias function, othe
 :data:`COMPLEX_STEP`), inside a complex evaluation (a complex-step Jacobian, whose state is
 complex already) by a central difference (:data:`BIAS_TIME_STEP`); h = 0 for constant
 kinematics. :func:`all_frames` fills the frames of every contact for the friction forces
-(:mod:`stickslip.model.forces`).
+(:mod:`stickslip.model.forces`). A contact's slip velocity and its force's share of the generalised
+force, G_c q̇ − w_c and G_cᵀ F_c, are :func:`contact_velocity` and :func:`add_force_of`: over a heap
+kinematics class's nonzero row entries where a large model's rows are mostly zero.
 """
 
 from __future__ import annotations
@@ -20,12 +22,12 @@ from .bundle import H_CONSTANT
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
 from .frame_pointers import pointer_bias
 from .kinematics import bias_at_run_time, contact_dim, contact_frame, model_sizes, registered_frame_bias
-from .model_data import is_stick
+from .model_data import for_kinematics, is_stick
 from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
 
-__all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "frame_velocity", "split_complex_frame", "max_rate", "frame_with_bias",
-           "all_frames"]
+__all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "frame_velocity", "contact_velocity", "add_contact_force", "add_force_of",
+           "split_complex_frame", "max_rate", "frame_with_bias", "all_frames"]
 
 #: Complex step [-] of the velocity bias: h² ≪ round-off and h·|∂f| far above the smallest
 #: normal double, so Im f(x + i h d)/h is the directional derivative exactly.
@@ -49,6 +51,73 @@ def frame_velocity(s, n, dim, G2, w2):
         for j in range(n):
             v1 += G2[1, j] * s[n + j]
     return v0, v1
+
+
+def contact_velocity(kin, s, n, c, dim, G2, w2):  # pragma: no cover - resolved by numba (overload below)
+    """(v0, v1) = G_c q̇ − w_c of contact ``c``: :func:`frame_velocity` over its frame rows G2; for a
+    heap kinematics class (:mod:`stickslip.model.stack`), the same sums over the rows' nonzero
+    entries (``kin.row_*``), as a reduced model's contact row touches a few of its n DOFs."""
+    raise NotImplementedError
+
+
+def _velocity_dense(kin, s, n, c, dim, G2, w2):
+    return frame_velocity(s, n, dim, G2, w2)
+
+
+def _velocity_by_rows(kin, s, n, c, dim, G2, w2):
+    starts = kin.row_starts
+    columns = kin.row_columns
+    values = kin.row_values
+    v0 = -w2[0]
+    for p in range(starts[2 * c], starts[2 * c + 1]):
+        v0 += values[p] * s[n + columns[p]]
+    v1 = csm.zero(s[0])
+    if dim == 2:
+        v1 = -w2[1]
+        for p in range(starts[2 * c + 1], starts[2 * c + 2]):
+            v1 += values[p] * s[n + columns[p]]
+    return v0, v1
+
+
+@overload(contact_velocity, jit_options=KERNEL_OPTIONS, inline="always")
+def _contact_velocity(kin, s, n, c, dim, G2, w2):
+    return for_kinematics(kin, _velocity_dense, _velocity_by_rows)
+
+
+@inlined_kernel
+def add_contact_force(G2, dim, n, F0, F1, f):
+    """f += G_cᵀ F_c for one contact's frame rows G2."""
+    for j in range(n):
+        f[j] += G2[0, j] * F0
+    if dim == 2:
+        for j in range(n):
+            f[j] += G2[1, j] * F1
+
+
+def add_force_of(kin, c, G2, dim, n, F0, F1, f):  # pragma: no cover - resolved by numba (overload below)
+    """f += G_cᵀ F_c of contact ``c``: :func:`add_contact_force`; for a heap kinematics class over the
+    nonzero entries of its rows (:func:`contact_velocity`)."""
+    raise NotImplementedError
+
+
+def _force_dense(kin, c, G2, dim, n, F0, F1, f):
+    add_contact_force(G2, dim, n, F0, F1, f)
+
+
+def _force_by_rows(kin, c, G2, dim, n, F0, F1, f):
+    starts = kin.row_starts
+    columns = kin.row_columns
+    values = kin.row_values
+    for p in range(starts[2 * c], starts[2 * c + 1]):
+        f[columns[p]] += values[p] * F0
+    if dim == 2:
+        for p in range(starts[2 * c + 1], starts[2 * c + 2]):
+            f[columns[p]] += values[p] * F1
+
+
+@overload(add_force_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _add_force_of(kin, c, G2, dim, n, F0, F1, f):
+    return for_kinematics(kin, _force_dense, _force_by_rows)
 
 
 @inlined_kernel
@@ -173,6 +242,6 @@ def all_frames(s, cst, md, n, nc, G, w, v, N, h, with_bias):
         else:
             N[c] = contact_frame(md.kin, s, c, m, G2, w2)
         N[c] = normal_in_mode(s, cst, md, n, c, N[c])  # a unilateral contact's: none while open
-        v0, v1 = frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
+        v0, v1 = contact_velocity(md.kin, s, n, c, contact_dim(md.kin, m, n, c), G2, w2)
         v[2 * c] = v0
         v[2 * c + 1] = v1

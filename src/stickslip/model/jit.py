@@ -10,7 +10,7 @@ main loop, since numba reference-counts loop-carried arrays on every iteration
 callers allocate (``integrate/bundles.py``).
 
 ``inlined_kernel``: a ``kernel`` that numba inlines into its callers (typed IR). For small
-kernels on the innermost path (``forces.slip_force``, ``forces.add_contact_force``,
+kernels on the innermost path (``forces.slip_force``, ``frames.add_contact_force``,
 ``forces.rotated``), for the right-hand side's body ``physics.rhs_body`` at exactly one call
 site per integrator step, inside the loop over its stages (a call passes each array as 7 words),
 and for the loops on the right-hand side's path (``model_data.apply_inverse_mass``,

@@ -48,7 +48,7 @@ from . import stack
 from .frame_pointers import (FramePointerFields, compiled_addresses, forget, is_pointer_class, origin_class, pointer_frame,
                              pointer_gap)
 from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
-from .jit import KERNEL_OPTIONS, defined_in_package, kernel, track_user_code
+from .jit import KERNEL_OPTIONS, defined_in_package, inlined_kernel, kernel, track_user_code
 from ..memory import delassus_bytes, fits_in_memory
 from .mass_factor import contact_rows, delassus, mass_factor, row_pattern
 
@@ -56,7 +56,7 @@ __all__ = ["ConstantKinematics", "ConstantUnilateralKinematics", "CONSTANT_KINEM
            "registered_kinematics", "registered_frame_bias", "contact_frame", "constant_frame", "KinematicsError",
            "model_sizes", "contact_dim", "has_unilateral", "allows_unilateral", "pressed_only", "unilateral_kernel",
            "contact_gap", "computes_gap", "gap_computed", "ConstantRigidKinematics", "rigid_kernel", "rigid_free", "allows_rigid",
-           "sparse_constant_frame",
+           "sparse_constant_frame", "heap_normal_and_drive", "frame_for_sums",
            "kernel_kinematics", "bias_at_run_time", "pointer_class", "LargeConstantKinematics",
            "LargeConstantUnilateralKinematics", "LargeConstantRigidKinematics", "LARGE_KINEMATICS", "fits_stack",
            "force_pattern",
@@ -447,9 +447,11 @@ CONSTANT_KINEMATICS = (ConstantKinematics, ConstantUnilateralKinematics, Constan
 _HEAP_FIELDS = [("ndof", int), ("ncontacts", int), ("force_rows", np.ndarray), ("force_columns", np.ndarray),
                 ("mass_rows", np.ndarray), ("mass_columns", np.ndarray), ("factor_order", np.ndarray),
                 ("factor_rows", np.ndarray), ("factor_columns", np.ndarray), ("factor_values", np.ndarray),
-                ("factor_diagonal", np.ndarray), ("row_starts", np.ndarray), ("row_columns", np.ndarray),
-                ("row_values", np.ndarray), ("normal_starts", np.ndarray), ("normal_columns", np.ndarray),
-                ("normal_q", np.ndarray), ("normal_v", np.ndarray), ("delassus", np.ndarray)]
+                ("factor_diagonal", np.ndarray), ("factor_segment_rows", np.ndarray), ("factor_segments", np.ndarray),
+                ("row_starts", np.ndarray), ("row_columns", np.ndarray), ("row_values", np.ndarray),
+                ("normal_starts", np.ndarray), ("normal_columns", np.ndarray), ("normal_q", np.ndarray),
+                ("normal_v", np.ndarray), ("gap_starts", np.ndarray), ("gap_columns", np.ndarray),
+                ("gap_values", np.ndarray), ("delassus", np.ndarray)]
 
 LargeConstantKinematics = NamedTuple("LargeConstantKinematics", _HEAP_FIELDS)
 LargeConstantKinematics.__doc__ = """The kernels' :class:`ConstantKinematics` of a model larger than the
@@ -467,9 +469,10 @@ model's C and K are mostly zero; ``mass_rows``, ``mass_columns`` that of M (the 
 such a model without their round-off entries (:func:`~stickslip.model.mass_factor.without_round_off`),
 so the patterns are those of the model's mechanics, not of its arithmetic.
 
-``row_*`` and ``normal_*`` hold the contacts' tangent rows and normal-force gradients over their
-nonzero entries (:func:`~stickslip.model.mass_factor.contact_rows`), from which the frame
-(:func:`sparse_constant_frame`) and the stick systems' right sides are summed; ``delassus``
+``row_*``, ``normal_*`` and ``gap_*`` hold the contacts' tangent rows, normal-force gradients and
+gap gradients over their nonzero entries (:func:`~stickslip.model.mass_factor.contact_rows`), from
+which the frame (:func:`sparse_constant_frame`), the slip velocities and the stick systems' right
+sides, the gaps and the normal forces on the coordinates are summed; ``delassus``
 (2 nc, 2 nc) is W = G M⁻¹ Gᵀ of all contact rows (:func:`~stickslip.model.mass_factor.delassus`),
 whose submatrices are the stick systems, or (0, 0) where it did not fit in memory (the stick
 systems are then formed row by row)."""
@@ -541,25 +544,46 @@ register_kinematics(ConstantUnilateralKinematics, constant_frame, rigid=False)
 register_kinematics(ConstantRigidKinematics, constant_frame)
 
 
+@inlined_kernel
+def heap_normal_and_drive(kin, s, c, m, w):
+    """The normal force of contact ``c`` of a heap class, summed over the nonzero entries of its
+    gradients (``kin.normal_*``), with its drive written to ``w`` (2,): its frame but the rows."""
+    o, ow, _, _ = contact_offsets(kin.ndof, c)
+    normal = m[o + C_N0] + csm.zero(s[0])
+    for p in range(kin.normal_starts[c], kin.normal_starts[c + 1]):
+        j = kin.normal_columns[p]
+        normal += kin.normal_q[p] * s[j] + kin.normal_v[p] * s[kin.ndof + j]
+    w[0] = m[ow]
+    w[1] = m[ow + 1]
+    return normal
+
+
 @kernel
 def sparse_constant_frame(kin, s, c, m, G, w):
     """:func:`constant_frame` of the heap classes: G's rows set to zero and their nonzero entries
     written (``kin.row_*``), N summed over the nonzero entries of its gradients (``kin.normal_*``)
     in the same order, so a contact costs its entries and two rows of stores instead of 4n reads."""
-    n = kin.ndof
-    o, ow, _, _ = contact_offsets(n, c)
     for i in range(2):
-        for j in range(n):
+        for j in range(kin.ndof):
             G[i, j] = 0.0
         for p in range(kin.row_starts[2 * c + i], kin.row_starts[2 * c + i + 1]):
             G[i, kin.row_columns[p]] = kin.row_values[p]
-    normal = m[o + C_N0] + csm.zero(s[0])
-    for p in range(kin.normal_starts[c], kin.normal_starts[c + 1]):
-        j = kin.normal_columns[p]
-        normal += kin.normal_q[p] * s[j] + kin.normal_v[p] * s[n + j]
-    w[0] = m[ow]
-    w[1] = m[ow + 1]
-    return normal
+    return heap_normal_and_drive(kin, s, c, m, w)
+
+
+def frame_for_sums(kin, s, c, m, G, w):  # pragma: no cover - resolved by numba (overload below)
+    """:func:`contact_frame` for a caller that reads the rows only through the sums of
+    :mod:`stickslip.model.frames` (``contact_velocity``, ``add_force_of``): a heap class's frame
+    without the rows (:func:`heap_normal_and_drive`; the sums read ``kin.row_*``), so the 2 n
+    stores of each contact's rows are not made."""
+    raise NotImplementedError
+
+
+@overload(frame_for_sums, jit_options=KERNEL_OPTIONS, inline="always")
+def _frame_for_sums(kin, s, c, m, G, w):
+    if stack.on_heap(getattr(kin, "instance_class", None)):
+        return lambda kin, s, c, m, G, w: heap_normal_and_drive(kin, s, c, m, w)
+    return lambda kin, s, c, m, G, w: contact_frame(kin, s, c, m, G, w)
 
 
 for _small, _large in LARGE_KINEMATICS.items():  # each heap class takes the contacts its stack class takes

@@ -28,7 +28,7 @@ from .stack import on_heap
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
            "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy",
-           "inverse_mass_of_row", "inverse_mass_of", "gram_row", "base_force_of", "damping_power"]
+           "inverse_mass_of_row", "inverse_mass_of", "gram_row", "base_force_of", "damping_power", "for_kinematics"]
 
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
@@ -79,7 +79,7 @@ def apply_inverse_mass(m, n, diagonal, f, a):
             a[i] = acc
 
 
-def _for_kinematics(kin, dense, heap):
+def for_kinematics(kin, dense, heap):
     """The implementation of an overload below for the kinematics type ``kin``: ``heap`` for a heap
     kinematics class (:mod:`stickslip.model.stack`), ``dense`` for the others."""
     return heap if on_heap(getattr(kin, "instance_class", None)) else dense
@@ -98,33 +98,62 @@ def _inverse_mass_dense(kin, m, n, diagonal, f, a):
     apply_inverse_mass(m, n, diagonal, f, a)
 
 
+@inlined_kernel
+def factor_row_dot(segments, k0, k1, values, a, zero):
+    """Σ_p values[p] a[j_p] over one row of the mass factor given as its runs of consecutive DOFs
+    ``segments[k0:k1]`` ([start, end, first]: j_p = first + p − start), in four interleaved partial
+    sums (one sum's chain of additions would wait on the adder at every entry of a row of hundreds
+    of modes; consecutive DOFs are read without indices, four at once)."""
+    s0 = zero
+    s1 = zero
+    s2 = zero
+    s3 = zero
+    for k in range(k0, k1):
+        start = segments[k, 0]
+        length = segments[k, 1] - start
+        v = values[start:start + length]  # views: indices from 0 up, which the compiler can vectorise
+        x = a[segments[k, 2]:segments[k, 2] + length]
+        j = 0
+        while j + 4 <= length:
+            s0 += v[j] * x[j]
+            s1 += v[j + 1] * x[j + 1]
+            s2 += v[j + 2] * x[j + 2]
+            s3 += v[j + 3] * x[j + 3]
+            j += 4
+        for i in range(j, length):
+            s0 += v[i] * x[i]
+    return (s0 + s1) + (s2 + s3)
+
+
 def _inverse_mass_by_factor(kin, m, n, diagonal, f, a):
     if diagonal:
         apply_inverse_mass(m, n, diagonal, f, a)
         return
     order = kin.factor_order
-    rows = kin.factor_rows
-    columns = kin.factor_columns
     values = kin.factor_values
     pivots = kin.factor_diagonal
+    starts = kin.factor_segment_rows
+    segments = kin.factor_segments
     zero = csm.zero(f[0])
     for i in range(n):
         a[i] = zero
     for i in range(order.shape[0]):  # L y = P f, y_i kept at a[order[i]]
-        acc = f[order[i]] + zero
-        for p in range(rows[i], rows[i + 1]):
-            acc -= values[p] * a[columns[p]]
-        a[order[i]] = acc / pivots[i]
+        dot = factor_row_dot(segments, starts[i], starts[i + 1], values, a, zero)
+        a[order[i]] = (f[order[i]] - dot) / pivots[i]
     for i in range(order.shape[0] - 1, -1, -1):  # Lᵀ z = y, by the columns of Lᵀ (the rows of L)
         z = a[order[i]] / pivots[i]
         a[order[i]] = z
-        for p in range(rows[i], rows[i + 1]):
-            a[columns[p]] -= values[p] * z
+        for k in range(starts[i], starts[i + 1]):
+            length = segments[k, 1] - segments[k, 0]
+            v = values[segments[k, 0]:segments[k, 1]]
+            x = a[segments[k, 2]:segments[k, 2] + length]
+            for j in range(length):
+                x[j] -= v[j] * z
 
 
 @overload(inverse_mass_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _inverse_mass_of(kin, m, n, diagonal, f, a):
-    return _for_kinematics(kin, _inverse_mass_dense, _inverse_mass_by_factor)
+    return for_kinematics(kin, _inverse_mass_dense, _inverse_mass_by_factor)
 
 
 def inverse_mass_of_row(kin, m, n, diagonal, g, out):  # pragma: no cover - resolved by numba (overload below)
@@ -227,7 +256,7 @@ def _base_force_by_pattern(kin, s, m, n, diagonal, f):
 
 @overload(base_force_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _base_force_of(kin, s, m, n, diagonal, f):
-    return _for_kinematics(kin, _base_force_dense, _base_force_by_pattern)
+    return for_kinematics(kin, _base_force_dense, _base_force_by_pattern)
 
 
 def damping_power(kin, s, m, n, diagonal):  # pragma: no cover - resolved by numba (overload below)
@@ -263,7 +292,7 @@ def _damping_power_by_pattern(kin, s, m, n, diagonal):
 
 @overload(damping_power, jit_options=KERNEL_OPTIONS, inline="always")
 def _damping_power(kin, s, m, n, diagonal):
-    return _for_kinematics(kin, _damping_power_dense, _damping_power_by_pattern)
+    return for_kinematics(kin, _damping_power_dense, _damping_power_by_pattern)
 
 
 def kinetic_energy_of(kin, s, m, n, diagonal):  # pragma: no cover - resolved by numba (overload below)
@@ -298,7 +327,7 @@ def _kinetic_energy_by_pattern(kin, s, m, n, diagonal):
 
 @overload(kinetic_energy_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _kinetic_energy_of(kin, s, m, n, diagonal):
-    return _for_kinematics(kin, _kinetic_energy_dense, _kinetic_energy_by_pattern)
+    return for_kinematics(kin, _kinetic_energy_dense, _kinetic_energy_by_pattern)
 
 
 @kernel

@@ -38,12 +38,14 @@ exist.
 from __future__ import annotations
 
 import numpy as np
+from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import (C_GAP, C_NORMAL_C, C_NORMAL_K, C_NORMAL_LAW, CST, H_CONSTANT, H_RIGID, NORMAL_PRESCRIBED,
                      NORMAL_RIGID, contact_offsets, gap_offset)
-from .jit import inlined_kernel, kernel
+from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
 from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
+from .model_data import for_kinematics
 from .stack import work_vectors
 
 __all__ = ["MODE_OPEN", "is_open", "is_unilateral", "is_rigid", "any_rigid_closed", "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator",
@@ -88,6 +90,54 @@ def any_rigid_closed(cst, md, n, nc):  # pragma: no cover - compiled only
     return False
 
 
+def gap_sums(kin, m, n, c, s, d, g, rate):  # pragma: no cover - resolved by numba (overload below)
+    """(g + W·q, rate + W·d[n:2n]) with contact ``c``'s gap gradient W from the data array ``m``;
+    for a heap kinematics class over its nonzero entries (``kin.gap_*``)."""
+    raise NotImplementedError
+
+
+def _gap_sums_dense(kin, m, n, c, s, d, g, rate):
+    og = gap_offset(n, c)
+    for j in range(n):
+        g += m[og + j] * s[j]
+        rate += m[og + j] * d[n + j]
+    return g, rate
+
+
+def _gap_sums_by_rows(kin, m, n, c, s, d, g, rate):
+    for p in range(kin.gap_starts[c], kin.gap_starts[c + 1]):
+        j = kin.gap_columns[p]
+        g += kin.gap_values[p] * s[j]
+        rate += kin.gap_values[p] * d[n + j]
+    return g, rate
+
+
+@overload(gap_sums, jit_options=KERNEL_OPTIONS, inline="always")
+def _gap_sums(kin, m, n, c, s, d, g, rate):
+    return for_kinematics(kin, _gap_sums_dense, _gap_sums_by_rows)
+
+
+def add_gap_force(kin, m, n, c, lam, f):  # pragma: no cover - resolved by numba (overload below)
+    """f += Wᵀ λ with contact ``c``'s gap gradient W from the data array ``m`` (:func:`gap_sums`)."""
+    raise NotImplementedError
+
+
+def _gap_force_dense(kin, m, n, c, lam, f):
+    og = gap_offset(n, c)
+    for j in range(n):
+        f[j] += m[og + j] * lam
+
+
+def _gap_force_by_rows(kin, m, n, c, lam, f):
+    for p in range(kin.gap_starts[c], kin.gap_starts[c + 1]):
+        f[kin.gap_columns[p]] += kin.gap_values[p] * lam
+
+
+@overload(add_gap_force, jit_options=KERNEL_OPTIONS, inline="always")
+def _add_gap_force(kin, m, n, c, lam, f):
+    return for_kinematics(kin, _gap_force_dense, _gap_force_by_rows)
+
+
 @kernel
 def gap_with_rate(s, d, md, n, c):
     """(g(q), W(q)·d[n:2n]) of contact ``c`` at ``s`` = [q, …] (W = ∂g/∂q) [m, m/s for d = s]:
@@ -103,12 +153,7 @@ def gap_with_rate(s, d, md, n, c):
             rate += W[j] * d[n + j]
         return g, rate
     o = contact_offsets(n, c)[0]
-    og = gap_offset(n, c)
-    g = m[o + C_GAP] + csm.zero(s[0])
-    for j in range(n):
-        g += m[og + j] * s[j]
-        rate += m[og + j] * d[n + j]
-    return g, rate
+    return gap_sums(md.kin, m, n, c, s, d, m[o + C_GAP] + csm.zero(s[0]), rate)
 
 
 @kernel
@@ -153,9 +198,7 @@ def add_normal_force(s, md, n, c, lam, f):
         for j in range(n):
             f[j] += W[j] * lam
         return
-    og = gap_offset(n, c)
-    for j in range(n):
-        f[j] += md.m[og + j] * lam
+    add_gap_force(md.kin, md.m, n, c, lam, f)
 
 
 @unilateral_kernel(lambda s, cst, md, n, nc, N, f: None, inline="always")

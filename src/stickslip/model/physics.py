@@ -47,9 +47,9 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, H_BAND
-from .forces import (add_contact_force, general_forces, quasi_static_direction, sliding_forces,
+from .forces import (general_forces, quasi_static_direction, sliding_forces,
                      sliding_friction, solve_stick_rows, stick_rows)
-from .frames import COMPLEX_STEP, frame_velocity, frame_with_bias
+from .frames import COMPLEX_STEP, add_contact_force, add_force_of, contact_velocity, frame_velocity, frame_with_bias
 from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2, solve_stick_system
@@ -183,7 +183,8 @@ def stick_forces(s, cst, extra, md, F_out, N_out):
         # solve again with the extra contact held: remove the forces of the contacts to be solved
         for c in range(nc):
             if is_stick(cst, c) or c == extra:
-                add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, -F[2 * c], -F[2 * c + 1], f)
+                dim = contact_dim(md.kin, m, n, c)
+                add_force_of(md.kin, c, G[2 * c:2 * c + 2], dim, n, -F[2 * c], -F[2 * c + 1], f)
         frame_with_bias(s, extra, md, G[2 * extra:2 * extra + 2], w[2 * extra:2 * extra + 2],
                         h[2 * extra:2 * extra + 2])
         k = solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)[0]
@@ -231,7 +232,7 @@ def slip_velocity(s, c, md):
     G2 = work_matrix(md.kin, TWO, DOFS, s)
     w2 = work_matrix(md.kin, ONE, TWO, s)[0]
     contact_frame(md.kin, s, c, m, G2, w2)
-    return frame_velocity(s, n, contact_dim(md.kin, m, n, c), G2, w2)
+    return contact_velocity(md.kin, s, n, c, contact_dim(md.kin, m, n, c), G2, w2)
 
 
 @unilateral_kernel(lambda s, cst, c, md: 1.0 + csm.zero(s[0]))
@@ -347,7 +348,8 @@ def band_direction(s, cst, c, md, speed):
     general_forces(s, cst, md, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if is_stick(cst, c2) or c2 == c:
-            add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)
+            add_force_of(md.kin, c2, G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1],
+                         f)
     frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
     k, a00, a01, a11 = solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
     if k != 2:
@@ -390,7 +392,7 @@ def project_velocities(s, cst, extra, md):
             G2 = G[2 * c:2 * c + 2]
             contact_frame(md.kin, s, c, m, G2, w[2 * c:2 * c + 2])
             dim = contact_dim(md.kin, m, n, c)
-            v0, v1 = frame_velocity(s, n, dim, G2, w[2 * c:2 * c + 2])
+            v0, v1 = contact_velocity(md.kin, s, n, c, dim, G2, w[2 * c:2 * c + 2])
             for i in range(dim):
                 inverse_mass_of_row(md.kin, m, n, diagonal, G[2 * c + i], MG[k])
                 b[k] = v0 if i == 0 else v1
