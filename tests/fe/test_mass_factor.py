@@ -213,6 +213,10 @@ def test_sliding_contacts_act_through_their_rows(reduced):
     qd = s[n:2 * n]
     np.testing.assert_allclose(v, G @ qd - w, rtol=0, atol=1e-13 * np.abs(G).max() * np.abs(qd).max())
     assert np.all(np.abs(v[used]) > 0.0) and np.all(F[used] != 0.0)  # every contact slides with a force
+    gaps = np.array([P.gap(s, c, reduced.data) for c in range(nc)])  # (g, ġ) summed over W's nonzero entries
+    W = form.gap_gradient.toarray()
+    np.testing.assert_allclose(gaps[:, 0], form.gap + W @ s[:n], rtol=1e-13, atol=1e-13 * np.abs(W @ s[:n]).max())
+    np.testing.assert_allclose(gaps[:, 1], W @ qd, rtol=1e-13, atol=1e-13 * np.abs(W @ qd).max())
     f = np.asarray(form.force, float) - C @ qd - K @ s[:n] + G.T @ F + form.gap_gradient.T @ N
     expected = sl.solve(M, f, assume_a="pos")
     np.testing.assert_allclose(ds[n:2 * n], expected, rtol=0, atol=1e-10 * np.abs(expected).max())

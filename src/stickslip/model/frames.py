@@ -26,8 +26,8 @@ from .model_data import for_kinematics, is_stick
 from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
 
-__all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "frame_velocity", "contact_velocity", "add_contact_force", "add_force_of",
-           "split_complex_frame", "max_rate", "frame_with_bias", "all_frames"]
+__all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "rows_velocity", "frame_velocity", "contact_velocity", "add_contact_force",
+           "add_force_of", "split_complex_frame", "max_rate", "frame_with_bias", "all_frames"]
 
 #: Complex step [-] of the velocity bias: h² ≪ round-off and h·|∂f| far above the smallest
 #: normal double, so Im f(x + i h d)/h is the directional derivative exactly.
@@ -39,8 +39,8 @@ BIAS_TIME_STEP = 1e-5
 
 
 # ----------------------------------------------------------------------------- frames
-@kernel
-def frame_velocity(s, n, dim, G2, w2):
+@inlined_kernel
+def rows_velocity(s, n, dim, G2, w2):
     """(v0, v1) = G q̇ − w of one contact from its frame rows (v1 = 0 for a 1-D contact)."""
     v0 = -w2[0]
     for j in range(n):
@@ -53,6 +53,12 @@ def frame_velocity(s, n, dim, G2, w2):
     return v0, v1
 
 
+@kernel
+def frame_velocity(s, n, dim, G2, w2):
+    """:func:`rows_velocity` as a call."""
+    return rows_velocity(s, n, dim, G2, w2)
+
+
 def contact_velocity(kin, s, n, c, dim, G2, w2):  # pragma: no cover - resolved by numba (overload below)
     """(v0, v1) = G_c q̇ − w_c of contact ``c``: :func:`frame_velocity` over its frame rows G2; for a
     heap kinematics class (:mod:`stickslip.model.stack`), the same sums over the rows' nonzero
@@ -61,7 +67,9 @@ def contact_velocity(kin, s, n, c, dim, G2, w2):  # pragma: no cover - resolved 
 
 
 def _velocity_dense(kin, s, n, c, dim, G2, w2):
-    return frame_velocity(s, n, dim, G2, w2)
+    # the loops inlined rather than a call of the kernel frame_velocity, which from inside an
+    # inlined overload stays a call that LLVM does not inline, in the right-hand side's loop
+    return rows_velocity(s, n, dim, G2, w2)
 
 
 def _velocity_by_rows(kin, s, n, c, dim, G2, w2):
