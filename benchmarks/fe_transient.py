@@ -180,7 +180,7 @@ def main() -> None:
     ap.add_argument("--folder", default=None, help="keep the reduced models here (reused by a later run)")
     args = ap.parse_args()
     only = set(args.only.split(","))
-    out: dict = {"machine": "shared 2-core machine, other work running"}
+    out: dict = {"machine": {"cpus": os.cpu_count(), "load_average_at_start": list(os.getloadavg())}}
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(args.folder or tmp)
         folder.mkdir(parents=True, exist_ok=True)
