@@ -48,8 +48,9 @@ from .kinematics import contact_gap, gap_computed, has_unilateral, model_sizes, 
 from .model_data import for_kinematics
 from .stack import work_vectors
 
-__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "is_rigid", "any_rigid_closed", "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator",
-           "add_normal_force", "add_normal_forces", "normal_in_mode", "starts_open", "open_in_mode"]
+__all__ = ["MODE_OPEN", "is_open", "is_unilateral", "is_rigid", "any_rigid_closed", "gap_sums", "add_gap_force",
+           "gap_and_rate", "gap_with_rate", "compliant_force", "contact_indicator", "add_normal_force",
+           "add_normal_forces", "normal_in_mode", "starts_open", "open_in_mode"]
 
 #: Mode of an open unilateral contact: no normal force, no friction (the stick and slip modes
 #: are in :mod:`stickslip.model.model_data`).
