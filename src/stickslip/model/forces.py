@@ -38,8 +38,8 @@ from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, ba
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
 from .stack import CONTACTS, DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
 
-__all__ = ["exact_direction", "slip_force", "rotated", "quasi_static_direction", "stick_system",
-           "stick_rows", "small_stick_system", "heap_stick_system", "heap_small_stick_system", "solve_stick_rows",
+__all__ = ["exact_direction", "slip_force", "rotated", "scatter_stick_forces", "pair_forces", "quasi_static_direction",
+           "stick_system", "stick_rows", "small_stick_system", "heap_stick_system", "heap_small_stick_system", "solve_stick_rows",
            "general_forces_body", "band_forces", "general_forces", "sliding_friction", "sliding_forces",
            "rigid_normal_forces", "add_rigid_normal_forces"]
 
@@ -114,6 +114,40 @@ def quasi_static_direction(a11, a12, a22, Fx, Fy, muN, ex, ey):
 
 
 # ----------------------------------------------------------------------------- stick forces
+@inlined_kernel
+def scatter_stick_forces(md, n, nc, cst, extra, x, F, zero):
+    """F of the sticking contacts and contact ``extra`` from the solved rows ``x`` (in the order of
+    the contacts; a 1-D contact's second component ``zero``)."""
+    r = 0
+    for c in range(nc):
+        if is_stick(cst, c) or c == extra:
+            dim = contact_dim(md.kin, md.m, n, c)
+            F[2 * c] = x[r]
+            F[2 * c + 1] = x[r + 1] if dim == 2 else zero
+            r += dim
+
+
+@inlined_kernel
+def pair_forces(a00, a01, a11, b0, b1, r0, r1, F):
+    """F of one stick row r0 (r1 < 0) or two, r0 and r1, from their G_S M⁻¹ G_Sᵀ entries and right
+    sides b (the unused second components of 1-D contacts set to 0). Returns (a00, a01, a11),
+    a01 = a11 = 0 for one row."""
+    zero = csm.zero(b0)
+    if r1 < 0:
+        F[r0] = -b0 / a00 if a00.real > 0.0 else zero
+        if r0 % 2 == 0:
+            F[r0 + 1] = zero
+        return a00, zero, zero
+    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
+    F[r0] = x0
+    F[r1] = x1
+    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
+        F[r0 + 1] = zero
+    if r1 % 2 == 0:
+        F[r1 + 1] = zero
+    return a00, a01, a11
+
+
 @kernel
 def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
     """Stick multipliers of the contacts in stick and of contact ``extra`` (≥ 0; −1: none), solved
@@ -146,13 +180,7 @@ def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
                 gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, csm.zero(s[0]))
                 r += 1
     solve_stick_system(md.kin, A, b, x, V, k)
-    r = 0
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            dim = contact_dim(md.kin, m, n, c)
-            F[2 * c] = x[r]
-            F[2 * c + 1] = x[r + 1] if dim == 2 else csm.zero(s[0])
-            r += dim
+    scatter_stick_forces(md, n, nc, cst, extra, x, F, csm.zero(s[0]))
     return k
 
 
@@ -192,27 +220,16 @@ def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     for j in range(n):
         a00 += G[r0, j] * mg0[j]
         b0 += G[r0, j] * a[j]
-    zero = csm.zero(b0)
-    if r1 < 0:
-        F[r0] = -b0 / a00 if a00.real > 0.0 else zero
-        if r0 % 2 == 0:
-            F[r0 + 1] = zero
-        return a00, zero, zero
     a01 = csm.zero(s[0])
     a11 = csm.zero(s[0])
-    b1 = h[r1]
-    for j in range(n):
-        a01 += G[r0, j] * mg1[j]
-        a11 += G[r1, j] * mg1[j]
-        b1 += G[r1, j] * a[j]
-    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
-    F[r0] = x0
-    F[r1] = x1
-    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
-        F[r0 + 1] = zero
-    if r1 % 2 == 0:
-        F[r1 + 1] = zero
-    return a00, a01, a11
+    b1 = csm.zero(b0)
+    if r1 >= 0:
+        b1 = h[r1]
+        for j in range(n):
+            a01 += G[r0, j] * mg1[j]
+            a11 += G[r1, j] * mg1[j]
+            b1 += G[r1, j] * a[j]
+    return pair_forces(a00, a01, a11, b0, b1, r0, r1, F)
 
 
 # ----------------------------------------------------------------------------- stick forces of a heap class
@@ -264,13 +281,7 @@ def heap_stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
         for r2 in range(k):
             A[r, r2] = W[rows[r], rows[r2]] + zero
     solve_stick_system(kin, A, b, x, V, k)
-    r = 0
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            dim = contact_dim(kin, m, n, c)
-            F[2 * c] = x[r]
-            F[2 * c + 1] = x[r + 1] if dim == 2 else zero
-            r += dim
+    scatter_stick_forces(md, n, nc, cst, extra, x, F, zero)
     return k
 
 
@@ -288,23 +299,14 @@ def heap_small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
     zero = csm.zero(s[0])
     a00 = W[r0, r0] + zero
     b0 = row_times(kin, r0, a, h[r0])
-    zero_b = csm.zero(b0)
-    if r1 < 0:
-        F[r0] = -b0 / a00 if a00.real > 0.0 else zero_b
-        if r0 % 2 == 0:
-            F[r0 + 1] = zero_b
-        return a00, zero_b, zero_b
-    a01 = W[r0, r1] + zero
-    a11 = W[r1, r1] + zero
-    b1 = row_times(kin, r1, a, h[r1])
-    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
-    F[r0] = x0
-    F[r1] = x1
-    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
-        F[r0 + 1] = zero_b
-    if r1 % 2 == 0:
-        F[r1 + 1] = zero_b
-    return a00, a01, a11
+    a01 = zero
+    a11 = zero
+    b1 = csm.zero(b0)
+    if r1 >= 0:
+        a01 = W[r0, r1] + zero
+        a11 = W[r1, r1] + zero
+        b1 = row_times(kin, r1, a, h[r1])
+    return pair_forces(a00, a01, a11, b0, b1, r0, r1, F)
 
 
 def stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):  # pragma: no cover - overload
