@@ -250,10 +250,10 @@ def contact_rows_bytes(n_dofs: int, n_contacts: int) -> float:
 
 
 def delassus_bytes(n_dofs: int, n_contacts: int) -> float:
-    """Peak bytes of the matrix W = G M⁻¹ Gᵀ of all contact rows (2 nc × 2 nc) of a model above
-    the stack maxima (``model/mass_factor.delassus``), with the 2 nc × n product it is formed
-    from. Optional: where it does not fit (:func:`fits_in_memory`), the stick systems are formed
-    row by row as without it."""
+    """Bytes of the matrix W = G M⁻¹ Gᵀ of all contact rows (2 nc × 2 nc) of a model above the
+    stack maxima with the 2 nc × n product G M⁻¹ it is formed from, both kept
+    (``model/mass_factor.delassus``). Optional: where they do not fit (:func:`fits_in_memory`),
+    the stick systems are formed row by row as without them."""
     n, nc = int(n_dofs), int(n_contacts)
     return 8.0 * (4 * nc * nc + 2 * nc * n)
 

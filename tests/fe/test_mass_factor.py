@@ -106,8 +106,10 @@ def test_memory_estimate_counts_the_sparse_structure(reduced):
                                            + contact_rows_bytes(n, nc))
     kin = reduced.data.kin
     held = sum(a.nbytes for a in kin if isinstance(a, np.ndarray))
-    assert held - kin.delassus.nbytes <= pattern_bytes(n) + contact_rows_bytes(n, nc)
-    assert kin.delassus.shape == (2 * nc, 2 * nc) and kin.delassus.nbytes <= delassus_bytes(n, nc)
+    stick = kin.delassus.nbytes + kin.inverse_mass_rows.nbytes
+    assert held - stick <= pattern_bytes(n) + contact_rows_bytes(n, nc)
+    assert kin.delassus.shape == (2 * nc, 2 * nc) and kin.inverse_mass_rows.shape == (2 * nc, n)
+    assert stick <= delassus_bytes(n, nc)
 
 
 def matrices(model):
@@ -157,7 +159,7 @@ def test_every_contact_sticking_holds_its_slip_velocity(reduced):
 
 def test_contact_rows_and_their_delassus_matrix_are_the_models(reduced):
     """The heap class's contact rows over their nonzero entries rebuild the model's tangent rows,
-    and W = G M⁻¹ Gᵀ is that of scipy's solve with the model's own M (round-off entries and all)."""
+    and W = G M⁻¹ Gᵀ and G M⁻¹ are those of scipy's solve with the model's own M (round-off entries and all)."""
     n, nc = reduced.n, reduced.n_contacts
     kin = reduced.data.kin
     G = np.zeros((2 * nc, n))
@@ -172,6 +174,8 @@ def test_contact_rows_and_their_delassus_matrix_are_the_models(reduced):
     M = matrices(reduced)[0]
     expected = G @ sl.solve(M, G.T, assume_a="pos")
     np.testing.assert_allclose(kin.delassus, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    response = sl.solve(M, G.T, assume_a="pos").T  # row r: M⁻¹ g_r
+    np.testing.assert_allclose(kin.inverse_mass_rows, response, rtol=0, atol=1e-10 * np.abs(response).max())
 
 
 def test_stick_without_the_delassus_matrix_forms_the_same_system(reduced):
@@ -179,7 +183,7 @@ def test_stick_without_the_delassus_matrix_forms_the_same_system(reduced):
     same accelerations, each stick row's sum the same as W's entry."""
     n = reduced.n
     md = reduced.data
-    row_by_row = md._replace(kin=md.kin._replace(delassus=np.zeros((0, 0))))
+    row_by_row = md._replace(kin=md.kin._replace(delassus=np.zeros((0, 0)), inverse_mass_rows=np.zeros((0, 0))))
     s = random_state(n, 4)
     cst = contact_state(md.m)
     for sticking in (slice(None), slice(0, 2), slice(5, 6)):  # stick systems of nine rows, two and one
@@ -220,3 +224,33 @@ def test_sliding_contacts_act_through_their_rows(reduced):
     f = np.asarray(form.force, float) - C @ qd - K @ s[:n] + G.T @ F + form.gap_gradient.T @ N
     expected = sl.solve(M, f, assume_a="pos")
     np.testing.assert_allclose(ds[n:2 * n], expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("sticking", [slice(None), slice(2, 4), slice(7, 8)], ids=["all", "two", "one"])
+def test_projection_onto_stick_is_the_mass_metric_one(reduced, sticking):
+    """The heap class projects q̇ onto v_S = 0 with W and the rows M⁻¹ g_r it carries: the same
+    change as Δq̇ = −M⁻¹ G_Sᵀ (G_S M⁻¹ G_Sᵀ)⁻¹ v_S by scipy on the model's own M, and the kinetic
+    energy change booked (in closed form) equal to the difference of ½ q̇ᵀ M q̇ before and after."""
+    n, nc = reduced.n, reduced.n_contacts
+    form = reduced.sparse_form()
+    M = matrices(reduced)[0]
+    s = random_state(n, 6)
+    s[2 * n] = 0.25  # the work of friction so far
+    cst = contact_state(reduced.data.m)
+    cst[0::CST] = P.MODE_SLIP_EXACT
+    cst[0::CST][sticking] = P.MODE_STICK
+    stick = np.arange(nc)[sticking]
+    G = form.tangent.toarray()[stick]  # one tangent row per contact
+    w = np.asarray(form.drive, float)[stick]
+    qd = s[n:2 * n].copy()
+    y = s.copy()
+    delta = P.project_velocities(y, cst, np.int64(-1), reduced.data)
+    MG = sl.solve(M, G.T, assume_a="pos")
+    change = -MG @ np.linalg.solve(G @ MG, G @ qd - w)
+    np.testing.assert_allclose(y[n:2 * n] - qd, change, rtol=0, atol=1e-10 * np.abs(change).max())
+    scale = np.abs(G @ qd).max() + np.abs(w).max()  # of the terms that make up v_S
+    np.testing.assert_allclose(G @ y[n:2 * n] - w, 0.0, atol=1e-12 * scale)
+    energy = 0.5 * y[n:2 * n] @ M @ y[n:2 * n] - 0.5 * qd @ M @ qd
+    assert abs(energy) > 1e-3 * abs(0.5 * qd @ M @ qd)  # a change to measure: the contacts take the belt's speed
+    assert delta == pytest.approx(energy, rel=1e-9) and y[2 * n] == pytest.approx(0.25 + energy, rel=1e-12)
+    np.testing.assert_array_equal(y[:n], s[:n])

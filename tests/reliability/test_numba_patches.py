@@ -119,7 +119,7 @@ def test_a_damaged_cache_is_compiled_again_with_one_line_and_the_same_results(tm
     cache = tmp_path / "cache"
     first, said = _simulate(cache)
     assert said == []
-    truncated = _data_file(cache, "forces.solve_stick_rows")
+    truncated = _data_file(cache, "stick.solve_stick_rows")
     truncated.write_bytes(truncated.read_bytes()[:truncated.stat().st_size // 2])
     flipped = _data_file(cache, "forces.general_forces")
     blob = bytearray(flipped.read_bytes())

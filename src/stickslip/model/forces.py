@@ -6,9 +6,7 @@
   (:func:`quasi_static_direction`, found with the force that would hold the contact,
   :func:`band_forces`), the stored direction for a 1-D contact;
 * stick: the Lagrange multipliers of all sticking contacts, solved together
-  (:func:`solve_stick_rows`: written out for one or two rows, :func:`stick_system` for more; for a
-  large model's heap kinematics class :func:`heap_small_stick_system`, :func:`heap_stick_system`,
-  their matrices read from the W = G M⁻¹ Gᵀ of all contact rows that it carries);
+  (:func:`~stickslip.model.stick.solve_stick_rows`);
 * closed rigid contacts: their normal forces λ are multipliers too (:func:`rigid_normal_forces`),
   and so is the friction of one that slides, −μ λ e.
 
@@ -24,24 +22,21 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba.extending import overload
 
 from . import csmath as csm
 from .bundle import CST, H_BAND, gap_offset
-from .frames import add_contact_force, add_force_of, all_frames, contact_velocity, frame_velocity, frame_with_bias
+from .frames import add_force_of, all_frames, contact_velocity, frame_with_bias
 from .impact import inverse_mass_product
-from .jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
-from .kinematics import contact_dim, contact_frame, frame_for_sums, model_sizes, rigid_kernel
-from .linalg import solve_in_order, solve_psd_2x2, solve_stick_system
-from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, base_force_of,
-                         gram_row, inverse_mass_of, inverse_mass_of_row, is_stick, kinetic_coefficient)
+from .jit import inlined_kernel, kernel, standalone
+from .kinematics import contact_dim, frame_for_sums, model_sizes, rigid_kernel
+from .linalg import solve_in_order
+from .model_data import MODE_SLIP, MODE_SLIP_EXACT, MODE_STICK, SPEED_FLOOR, base_force_of, is_stick, kinetic_coefficient
 from .normal import MODE_OPEN, add_normal_forces, any_rigid_closed, is_open, is_rigid, normal_in_mode, open_in_mode
-from .stack import CONTACTS, DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
+from .stack import CONTACTS, DOFS, ROWS, work_matrix, work_vectors
+from .stick import solve_stick_rows
 
-__all__ = ["exact_direction", "slip_force", "rotated", "scatter_stick_forces", "pair_forces", "quasi_static_direction",
-           "stick_system", "stick_rows", "small_stick_system", "heap_stick_system", "heap_small_stick_system", "solve_stick_rows",
-           "general_forces_body", "band_forces", "general_forces", "sliding_friction", "sliding_forces",
-           "rigid_normal_forces", "add_rigid_normal_forces"]
+__all__ = ["exact_direction", "slip_force", "rotated", "quasi_static_direction", "general_forces_body", "band_forces",
+           "general_forces", "sliding_friction", "sliding_forces", "rigid_normal_forces", "add_rigid_normal_forces"]
 
 
 # ----------------------------------------------------------------------------- slip forces
@@ -111,247 +106,6 @@ def quasi_static_direction(a11, a12, a22, Fx, Fy, muN, ex, ey):
         if abs(step) < 1e-14:  # converged to round-off of an angle
             break
     return c, sn
-
-
-# ----------------------------------------------------------------------------- stick forces
-@inlined_kernel
-def scatter_stick_forces(md, n, nc, cst, extra, x, F, zero):
-    """F of the sticking contacts and contact ``extra`` from the solved rows ``x`` (in the order of
-    the contacts; a 1-D contact's second component ``zero``)."""
-    r = 0
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            dim = contact_dim(md.kin, md.m, n, c)
-            F[2 * c] = x[r]
-            F[2 * c + 1] = x[r + 1] if dim == 2 else zero
-            r += dim
-
-
-@inlined_kernel
-def pair_forces(a00, a01, a11, b0, b1, r0, r1, F):
-    """F of one stick row r0 (r1 < 0) or two, r0 and r1, from their G_S M⁻¹ G_Sᵀ entries and right
-    sides b (the unused second components of 1-D contacts set to 0). Returns (a00, a01, a11),
-    a01 = a11 = 0 for one row."""
-    zero = csm.zero(b0)
-    if r1 < 0:
-        F[r0] = -b0 / a00 if a00.real > 0.0 else zero
-        if r0 % 2 == 0:
-            F[r0 + 1] = zero
-        return a00, zero, zero
-    x0, x1, rank = solve_psd_2x2(a00, a01, a11, -b0, -b1)
-    F[r0] = x0
-    F[r1] = x1
-    if r0 % 2 == 0 and r1 != r0 + 1:  # two 1-D contacts: their unused second components
-        F[r0 + 1] = zero
-    if r1 % 2 == 0:
-        F[r1 + 1] = zero
-    return a00, a01, a11
-
-
-@kernel
-def stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
-    """Stick multipliers of the contacts in stick and of contact ``extra`` (≥ 0; −1: none), solved
-    together: (G_S M⁻¹ G_Sᵀ) F_S = −(h_S + G_S M⁻¹ f), with h_S already in ``h``.
-
-    Writes F of those contacts; ``A`` (≥ 2 nc square) receives G_S M⁻¹ G_Sᵀ (intact when k ≤ 2).
-    ``f`` is the generalised force of everything else (not changed). Returns the rows k (0: none).
-    """
-    m = md.m
-    MG = work_matrix(md.kin, ROWS, DOFS, s)
-    a, b, x = work_vectors(md.kin, 3, s)
-    V = work_matrix(md.kin, ROWS, ROWS, s)
-    inverse_mass_of(md.kin, m, n, diagonal, f, a)
-    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(md.kin, m, n, c)):
-                inverse_mass_of_row(md.kin, m, n, diagonal, G[2 * c + i], MG[k])
-                acc = h[2 * c + i]
-                for j in range(n):
-                    acc += G[2 * c + i, j] * a[j]
-                b[k] = -acc
-                k += 1
-    if k == 0:
-        return 0
-    r = 0
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(md.kin, m, n, c)):
-                gram_row(md.kin, G[2 * c + i], MG, k, n, A, r, csm.zero(s[0]))
-                r += 1
-    solve_stick_system(md.kin, A, b, x, V, k)
-    scatter_stick_forces(md, n, nc, cst, extra, x, F, csm.zero(s[0]))
-    return k
-
-
-@inlined_kernel
-def stick_rows(md, m, n, nc, cst, extra):
-    """Stick rows of the sticking contacts and contact ``extra`` (≥ 0; −1: none): their number k and,
-    when k ≤ 2, the first two (contact c's row i is 2c + i; −1 for none)."""
-    k = 0
-    r0 = -1
-    r1 = -1
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(md.kin, m, n, c)):
-                if k == 0:
-                    r0 = 2 * c + i
-                elif k == 1:
-                    r1 = 2 * c + i
-                k += 1
-    return k, r0, r1
-
-
-@inlined_kernel
-def small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
-    """:func:`stick_system` for one or two stick rows (``r0``, and ``r1`` ≥ 0 or −1), written out on
-    the caller's stack: the common case of stick. Returns (a00, a01, a11), the entries of
-    G_S M⁻¹ G_Sᵀ (a01 = a11 = 0 for one row)."""
-    m = md.m
-    a = work_vectors(md.kin, 1, s)[0]
-    MG = work_matrix(md.kin, TWO, DOFS, s)
-    inverse_mass_of(md.kin, m, n, diagonal, f, a)
-    for r in range(1 if r1 < 0 else 2):  # one call site: numba's inliner takes two of an overload badly
-        inverse_mass_of_row(md.kin, m, n, diagonal, G[r0 if r == 0 else r1], MG[r])
-    mg0 = MG[0]
-    mg1 = MG[1]
-    a00 = csm.zero(s[0])
-    b0 = h[r0]
-    for j in range(n):
-        a00 += G[r0, j] * mg0[j]
-        b0 += G[r0, j] * a[j]
-    a01 = csm.zero(s[0])
-    a11 = csm.zero(s[0])
-    b1 = csm.zero(b0)
-    if r1 >= 0:
-        b1 = h[r1]
-        for j in range(n):
-            a01 += G[r0, j] * mg1[j]
-            a11 += G[r1, j] * mg1[j]
-            b1 += G[r1, j] * a[j]
-    return pair_forces(a00, a01, a11, b0, b1, r0, r1, F)
-
-
-# ----------------------------------------------------------------------------- stick forces of a heap class
-@kernel
-def heap_inverse_mass(kin, m, n, diagonal, f, a):
-    """a = M⁻¹ f (:func:`~stickslip.model.model_data.inverse_mass_of`) as a call: inlined into the
-    heap stick kernels, numba mis-scopes the factor solve's accumulator (a pedantic IR warning)."""
-    inverse_mass_of(kin, m, n, diagonal, f, a)
-
-
-@inlined_kernel
-def row_times(kin, row, a, acc):
-    """acc + g·a for the contact row ``row`` of a heap kinematics class, over its nonzero entries
-    (``kin.row_*``) in the order of their columns."""
-    columns = kin.row_columns
-    values = kin.row_values
-    for p in range(kin.row_starts[row], kin.row_starts[row + 1]):
-        acc += values[p] * a[columns[p]]
-    return acc
-
-
-@kernel
-def heap_stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
-    """:func:`stick_system` of a heap kinematics class: its matrix G_S M⁻¹ G_Sᵀ the submatrix of the
-    stick rows of W = G M⁻¹ Gᵀ (``kin.delassus``, formed once by the same sums:
-    :func:`~stickslip.model.mass_factor.delassus`), its right side summed over the rows' nonzero
-    entries, where forming it costs an M⁻¹ product per row; :func:`stick_system` where the class
-    carries no W (it did not fit in memory)."""
-    kin = md.kin
-    if kin.delassus.shape[0] == 0:
-        return stick_system(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
-    m = md.m
-    a, b, x = work_vectors(kin, 3, s)
-    V = work_matrix(kin, ROWS, ROWS, s)
-    rows = work_matrix(kin, ONE, ROWS, n)[0]
-    heap_inverse_mass(kin, m, n, diagonal, f, a)
-    k = np.int64(0)  # not a literal: numba would compile solve_psd for k = 0 first
-    for c in range(nc):
-        if is_stick(cst, c) or c == extra:
-            for i in range(contact_dim(kin, m, n, c)):
-                rows[k] = 2 * c + i
-                b[k] = -row_times(kin, 2 * c + i, a, h[2 * c + i])
-                k += 1
-    if k == 0:
-        return 0
-    W = kin.delassus
-    zero = csm.zero(s[0])
-    for r in range(k):
-        for r2 in range(k):
-            A[r, r2] = W[rows[r], rows[r2]] + zero
-    solve_stick_system(kin, A, b, x, V, k)
-    scatter_stick_forces(md, n, nc, cst, extra, x, F, zero)
-    return k
-
-
-@inlined_kernel
-def heap_small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
-    """:func:`small_stick_system` of a heap kinematics class: the entries read from W and the right
-    sides summed over the rows' nonzero entries (:func:`heap_stick_system`); :func:`small_stick_system`
-    where the class carries no W."""
-    kin = md.kin
-    if kin.delassus.shape[0] == 0:
-        return small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F)
-    a = work_vectors(kin, 1, s)[0]
-    heap_inverse_mass(kin, md.m, n, diagonal, f, a)
-    W = kin.delassus
-    zero = csm.zero(s[0])
-    a00 = W[r0, r0] + zero
-    b0 = row_times(kin, r0, a, h[r0])
-    a01 = zero
-    a11 = zero
-    b1 = csm.zero(b0)
-    if r1 >= 0:
-        a01 = W[r0, r1] + zero
-        a11 = W[r1, r1] + zero
-        b1 = row_times(kin, r1, a, h[r1])
-    return pair_forces(a00, a01, a11, b0, b1, r0, r1, F)
-
-
-def stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):  # pragma: no cover - overload
-    """:func:`stick_system`, or :func:`heap_stick_system` for a heap kinematics class (chosen when
-    compiled)."""
-    raise NotImplementedError
-
-
-@overload(stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
-def _stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
-    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
-        return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: heap_stick_system(
-            s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
-    return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: stick_system(
-        s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
-
-
-def small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):  # pragma: no cover - overload
-    """:func:`small_stick_system`, or :func:`heap_small_stick_system` for a heap kinematics class
-    (chosen when compiled)."""
-    raise NotImplementedError
-
-
-@overload(small_stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
-def _small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):
-    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
-        return heap_small_stick_system.py_func
-    return small_stick_system.py_func
-
-
-@standalone
-@kernel
-def solve_stick_rows(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
-    """Stick multipliers of the sticking contacts and contact ``extra`` (F written for those), by
-    :func:`small_stick_system` when there are at most two rows, else :func:`stick_system`. Returns
-    (k, a00, a01, a11): the rows and, for k = 2, the entries of G_S M⁻¹ G_Sᵀ."""
-    k, r0, r1 = stick_rows(md, md.m, n, nc, cst, extra)
-    zero = csm.zero(s[0])
-    if k == 0:
-        return 0, zero, zero, zero
-    if k <= 2:
-        a00, a01, a11 = small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F)
-        return k, a00, a01, a11
-    stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
-    return k, zero, zero, zero
 
 
 # ----------------------------------------------------------------------------- forces of all contacts
@@ -463,14 +217,14 @@ def rigid_normal_forces(s, cst, md, n, nc, diagonal, G, v, N, F, f, A):
             F0, F1 = slip_force(md, n, r, dim, speed, e0, e1, 1.0)
             RF[k, 2 * r] = F0
             RF[k, 2 * r + 1] = F1
-            add_contact_force(G[2 * r:2 * r + 2], dim, n, F0, F1, R[k])
+            add_force_of(md.kin, r, G[2 * r:2 * r + 2], dim, n, F0, F1, R[k])
         if solve_stick_rows(s, md, n, nc, diagonal, cst, np.int64(-1), G, zero_bias, R[k], Fs, A)[0] > 0:
             for c in range(nc):
                 if is_stick(cst, c):
                     RF[k, 2 * c] = Fs[2 * c]
                     RF[k, 2 * c + 1] = Fs[2 * c + 1]
-                    add_contact_force(G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, Fs[2 * c], Fs[2 * c + 1],
-                                      R[k])
+                    add_force_of(md.kin, c, G[2 * c:2 * c + 2], contact_dim(md.kin, m, n, c), n, Fs[2 * c],
+                                 Fs[2 * c + 1], R[k])
         k += 1
     i = 0
     for r in range(nc):  # row i: g̈_i = 0, scaled by W_i M⁻¹ W_iᵀ so that the pivots are relative
@@ -537,7 +291,7 @@ def band_forces(s, cst, md, G, w, v, N, h, F, f, A):
         F0, F1 = slip_force(md, n, c, dim, speed, ex, ey, N[c])
         F[2 * c] = F0
         F[2 * c + 1] = F1
-        add_contact_force(G[2 * c:2 * c + 2], dim, n, F0, F1, f)
+        add_force_of(md.kin, c, G[2 * c:2 * c + 2], dim, n, F0, F1, f)
 
 
 @standalone

@@ -21,7 +21,7 @@ from . import csmath as csm
 from .bundle import H_CONSTANT
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
 from .frame_pointers import pointer_bias
-from .kinematics import bias_at_run_time, contact_dim, contact_frame, model_sizes, registered_frame_bias
+from .kinematics import bias_at_run_time, contact_dim, contact_frame, frame_for_sums, model_sizes, registered_frame_bias
 from .model_data import for_kinematics, is_stick
 from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, work_matrix
@@ -240,7 +240,12 @@ def _frame_with_bias(s, c, md, G2, w2, h2):
 def all_frames(s, cst, md, n, nc, G, w, v, N, h, with_bias):
     """Each contact's G (rows 2c, 2c+1), w, v = G q̇ − w (entries 2c, 2c+1) and N (entry c) at
     ``s``; with the velocity bias h for contacts in stick (all contacts if ``with_bias`` is 2).
-    A unilateral contact's N is its normal force λ in the mode of ``cst`` (0 while open)."""
+    A unilateral contact's N is its normal force λ in the mode of ``cst`` (0 while open).
+
+    A heap kinematics class writes the rows G of the contacts given a bias only
+    (:func:`~stickslip.model.kinematics.frame_for_sums` for the others): its sums read its row lists
+    (:func:`contact_velocity`, :func:`add_force_of`), and storing 2 n entries per contact at every
+    right-hand side cost as much as a solve with the mass factor."""
     m = md.m
     for c in range(nc):
         G2 = G[2 * c:2 * c + 2]
@@ -248,7 +253,7 @@ def all_frames(s, cst, md, n, nc, G, w, v, N, h, with_bias):
         if with_bias == 2 or (with_bias == 1 and is_stick(cst, c)):
             N[c] = frame_with_bias(s, c, md, G2, w2, h[2 * c:2 * c + 2])
         else:
-            N[c] = contact_frame(md.kin, s, c, m, G2, w2)
+            N[c] = frame_for_sums(md.kin, s, c, m, G2, w2)
         N[c] = normal_in_mode(s, cst, md, n, c, N[c])  # a unilateral contact's: none while open
         v0, v1 = contact_velocity(md.kin, s, n, c, contact_dim(md.kin, m, n, c), G2, w2)
         v[2 * c] = v0

@@ -38,7 +38,7 @@ costs the large one's optimisation once more: such kernels are ``inlined_kernel`
 (``physics.stick_margin``, ``slip_direction``, ``contacts.event_value``, the steady-sliding
 Newton (called at one site; ``inlined_loop``, as it allocates), its residual and Jacobian, the
 variational right-hand side's band correction), a compiled wrapper that only allocates is Python
-instead (``event_loop.integrate_event``), and the stick solve (``forces.solve_stick_rows``) is
+instead (``event_loop.integrate_event``), and the stick solve (``stick.solve_stick_rows``) is
 one kernel called from five places rather than inlined into each. The largest kernels are
 :func:`standalone` (:mod:`.linking`): their callers call their one compiled copy instead of
 linking a copy in. So a thin kernel over standalone ones costs little more than its own code,

@@ -451,7 +451,7 @@ _HEAP_FIELDS = [("ndof", int), ("ncontacts", int), ("force_rows", np.ndarray), (
                 ("row_starts", np.ndarray), ("row_columns", np.ndarray), ("row_values", np.ndarray),
                 ("normal_starts", np.ndarray), ("normal_columns", np.ndarray), ("normal_q", np.ndarray),
                 ("normal_v", np.ndarray), ("gap_starts", np.ndarray), ("gap_columns", np.ndarray),
-                ("gap_values", np.ndarray), ("delassus", np.ndarray)]
+                ("gap_values", np.ndarray), ("delassus", np.ndarray), ("inverse_mass_rows", np.ndarray)]
 
 LargeConstantKinematics = NamedTuple("LargeConstantKinematics", _HEAP_FIELDS)
 LargeConstantKinematics.__doc__ = """The kernels' :class:`ConstantKinematics` of a model larger than the
@@ -474,8 +474,9 @@ gap gradients over their nonzero entries (:func:`~stickslip.model.mass_factor.co
 which the frame (:func:`sparse_constant_frame`), the slip velocities and the stick systems' right
 sides, the gaps and the normal forces on the coordinates are summed; ``delassus``
 (2 nc, 2 nc) is W = G M⁻¹ Gᵀ of all contact rows (:func:`~stickslip.model.mass_factor.delassus`),
-whose submatrices are the stick systems, or (0, 0) where it did not fit in memory (the stick
-systems are then formed row by row)."""
+whose submatrices are the stick systems, and ``inverse_mass_rows`` (2 nc, n) its rows M⁻¹ g_r (the
+right sides of the stick systems and the projections of the velocities read them); both (0, 0)
+where they did not fit in memory (the stick systems are then formed row by row)."""
 LargeConstantUnilateralKinematics = NamedTuple("LargeConstantUnilateralKinematics", _HEAP_FIELDS)
 LargeConstantUnilateralKinematics.__doc__ = (":class:`LargeConstantKinematics` for "
                                              ":class:`ConstantUnilateralKinematics` (compliant contacts).")
@@ -507,7 +508,7 @@ def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...], m: 
     it fits the stack arrays (:func:`fits_stack`), else its heap class with the patterns of the
     dense (n, n) ``matrices`` = (mass, damping, stiffness, free) (:func:`force_pattern`, the mass's
     pattern and its sparse factor, :func:`~stickslip.model.mass_factor.mass_factor`), and the
-    contact rows of the packed data ``m`` over their nonzero entries with their W = G M⁻¹ Gᵀ
+    contact rows of the packed data ``m`` over their nonzero entries with W = G M⁻¹ Gᵀ and G M⁻¹
     (:func:`~stickslip.model.mass_factor.contact_rows`, :func:`~stickslip.model.mass_factor.delassus`;
     W empty where it does not fit in memory: :func:`~stickslip.memory.delassus_bytes`); None
     where it has no heap class: a frame computed from q, which the stack maxima bound."""
@@ -519,9 +520,10 @@ def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...], m: 
         return None
     mass, damping, stiffness, free = matrices
     rows = contact_rows(m, n, nc)
-    w = delassus(m, n, nc, rows[:3]) if fits_in_memory(delassus_bytes(n, nc)) else np.zeros((0, 0))
+    empty = (np.zeros((0, 0)), np.zeros((0, 0)))
+    w = delassus(m, n, nc, rows[:3]) if fits_in_memory(delassus_bytes(n, nc)) else empty
     return large(int(n), int(nc), *force_pattern(damping, stiffness), *row_pattern(np.asarray(mass) != 0.0),
-                 *mass_factor(mass, free), *rows, w)
+                 *mass_factor(mass, free), *rows, *w)
 
 
 @kernel

@@ -23,8 +23,9 @@ numbers (nb the boundary DOFs).
   gap gradient ∂g/∂q over their nonzero entries (a reduced model's contact row is a unit vector on a boundary DOF),
   so that a frame costs their entries, not n;
 * :func:`delassus` gives W = G M⁻¹ Gᵀ of all contact rows, constant where G is: the matrix of
-  every stick system is a submatrix of it (:func:`~stickslip.model.forces.heap_stick_system`), where
-  forming it costs one M⁻¹ product per stick row.
+  every stick system is a submatrix of it (:func:`~stickslip.model.stick.heap_stick_system`), where
+  forming it costs one M⁻¹ product per stick row; and the rows M⁻¹ g_r, with which a stick
+  system's right side and a projection of the velocities need no solve with the mass factor.
 """
 
 from __future__ import annotations
@@ -134,9 +135,13 @@ def contact_rows(m: np.ndarray, n: int, nc: int) -> tuple[np.ndarray, ...]:
             nv[rows, columns].copy(), gap_starts, gap_columns, gap[gap != 0.0].copy())
 
 
-def delassus(m: np.ndarray, n: int, nc: int, rows: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
-    """W = G M⁻¹ Gᵀ (2 nc, 2 nc) of all contact rows of the packed data ``m`` (float64), with G as
-    ``rows`` = (row_starts, row_columns, row_values) of :func:`contact_rows` and M⁻¹ the packed one.
+def delassus(m: np.ndarray, n: int, nc: int,
+             rows: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(W, R): W = G M⁻¹ Gᵀ (2 nc, 2 nc) of all contact rows of the packed data ``m`` (float64),
+    with G as ``rows`` = (row_starts, row_columns, row_values) of :func:`contact_rows` and M⁻¹ the
+    packed one, and R = G M⁻¹ (2 nc, n), whose row r is M⁻¹ g_r (M⁻¹ symmetric): the acceleration
+    of a unit force on contact row r, from which a stick system's right side g_r·M⁻¹ f is one dot
+    product R_r·f instead of a solve with the mass factor.
 
     Each entry is the sum the stick solve formed: (M⁻¹ g_s)_i = Σ_j g_s,j (M⁻¹)_ji over the nonzero
     g_s,j in order, then W_rs = Σ_i g_r,i (M⁻¹ g_s)_i likewise (a sparse-times-dense product sums
@@ -145,4 +150,5 @@ def delassus(m: np.ndarray, n: int, nc: int, rows: tuple[np.ndarray, np.ndarray,
     G = sp.csr_matrix((rows[2], rows[1], rows[0]), shape=(2 * nc, n))
     o = offsets(n)[0]
     inverse = m[o:o + n * n].reshape(n, n)
-    return np.ascontiguousarray(G @ np.asarray(G @ inverse).T)
+    response = np.ascontiguousarray(np.asarray(G @ inverse))
+    return np.ascontiguousarray(G @ response.T), response

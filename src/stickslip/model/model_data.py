@@ -28,7 +28,8 @@ from .stack import on_heap
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "SPEED_FLOOR", "law_row",
            "kinetic_coefficient", "static_limit", "is_stick", "apply_inverse_mass", "base_force", "kinetic_energy",
-           "inverse_mass_of_row", "inverse_mass_of", "gram_row", "base_force_of", "damping_power", "for_kinematics"]
+           "inverse_mass_of_row", "inverse_mass_of", "dot", "gram_row", "base_force_of", "damping_power",
+           "for_kinematics"]
 
 MODE_SLIP = 0        # slip; inside the low-speed band the direction is quasi-static (departure)
 MODE_STICK = 1       # stick: friction is the constraint force
@@ -99,11 +100,34 @@ def _inverse_mass_dense(kin, m, n, diagonal, f, a):
 
 
 @inlined_kernel
+def partial_dots(v, x, length, s0, s1, s2, s3):
+    """The four interleaved partial sums (s0 … s3) advanced by Σ_j v[j] x[j] over j < ``length``
+    (one sum's chain of additions would wait on the adder at every entry; views read from 0 up,
+    which the compiler can vectorise)."""
+    j = 0
+    while j + 4 <= length:
+        s0 += v[j] * x[j]
+        s1 += v[j + 1] * x[j + 1]
+        s2 += v[j + 2] * x[j + 2]
+        s3 += v[j + 3] * x[j + 3]
+        j += 4
+    for i in range(j, length):
+        s0 += v[i] * x[i]
+    return s0, s1, s2, s3
+
+
+@inlined_kernel
+def dot(v, x, zero):
+    """Σ_j v[j] x[j] over the length of ``v``, from ``zero``, in :func:`partial_dots`."""
+    s0, s1, s2, s3 = partial_dots(v, x, v.shape[0], zero, zero, zero, zero)
+    return (s0 + s1) + (s2 + s3)
+
+
+@inlined_kernel
 def factor_row_dot(segments, k0, k1, values, a, zero):
     """Σ_p values[p] a[j_p] over one row of the mass factor given as its runs of consecutive DOFs
-    ``segments[k0:k1]`` ([start, end, first]: j_p = first + p − start), in four interleaved partial
-    sums (one sum's chain of additions would wait on the adder at every entry of a row of hundreds
-    of modes; consecutive DOFs are read without indices, four at once)."""
+    ``segments[k0:k1]`` ([start, end, first]: j_p = first + p − start), in the partial sums of
+    :func:`partial_dots` (a row of hundreds of modes; consecutive DOFs are read without indices)."""
     s0 = zero
     s1 = zero
     s2 = zero
@@ -111,17 +135,8 @@ def factor_row_dot(segments, k0, k1, values, a, zero):
     for k in range(k0, k1):
         start = segments[k, 0]
         length = segments[k, 1] - start
-        v = values[start:start + length]  # views: indices from 0 up, which the compiler can vectorise
-        x = a[segments[k, 2]:segments[k, 2] + length]
-        j = 0
-        while j + 4 <= length:
-            s0 += v[j] * x[j]
-            s1 += v[j + 1] * x[j + 1]
-            s2 += v[j + 2] * x[j + 2]
-            s3 += v[j + 3] * x[j + 3]
-            j += 4
-        for i in range(j, length):
-            s0 += v[i] * x[i]
+        s0, s1, s2, s3 = partial_dots(values[start:start + length], a[segments[k, 2]:segments[k, 2] + length],
+                                      length, s0, s1, s2, s3)
     return (s0 + s1) + (s2 + s3)
 
 

@@ -47,8 +47,8 @@ import numpy as np
 
 from . import csmath as csm
 from .bundle import CST, H_BAND
-from .forces import (general_forces, quasi_static_direction, sliding_forces,
-                     sliding_friction, solve_stick_rows, stick_rows)
+from .forces import general_forces, quasi_static_direction, sliding_forces, sliding_friction
+from .stick import heap_projection, solve_stick_rows, stick_rows
 from .frames import COMPLEX_STEP, add_contact_force, add_force_of, contact_velocity, frame_velocity, frame_with_bias
 from .jit import api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
@@ -377,8 +377,12 @@ def project_velocities(s, cst, extra, md):
     Δq̇ = −M⁻¹ G_Sᵀ (G_S M⁻¹ G_Sᵀ)⁺ v_S: the smallest kinetic-energy change that removes v_S, an
     impulsive friction force (a perfectly plastic tangential impact). If ``s`` carries the work
     accumulators (length ≥ 2n + 2) the change is booked as work of friction, so the energy balance
-    stays exact. Locked DOFs (zero rows of M⁻¹) are not touched.
+    stays exact. Locked DOFs (zero rows of M⁻¹) are not touched. A heap kinematics class that
+    carries W = G M⁻¹ Gᵀ projects with it (:func:`~stickslip.model.stick.heap_project_velocities`).
     """
+    delta = heap_projection(s, cst, extra, md)
+    if not math.isnan(delta):
+        return delta
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G = work_matrix(md.kin, ROWS, DOFS, s)

@@ -29,6 +29,7 @@ from ..integrate import dormand_prince as DP
 from ..model import csmath as csm
 from ..model import physics as P
 from ..model.bundle import CST, H_BAND
+from ..model.frames import add_force_of
 from ..model.jit import api_kernel, inlined_kernel, kernel, loop, standalone
 from ..model.kinematics import contact_dim, model_sizes
 from ..model.stack import DOFS, ROWS, work_matrix, work_vectors
@@ -92,7 +93,8 @@ def direction_residual(s, cst, c, md, ct, st):
     P.general_forces(s, cst, md, G, w, v, N, h, F, f)
     for c2 in range(nc):  # solve again with this contact held: remove the forces to be solved
         if P.is_stick(cst, c2) or c2 == c:
-            P.add_contact_force(G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1], f)
+            add_force_of(md.kin, c2, G[2 * c2:2 * c2 + 2], contact_dim(md.kin, m, n, c2), n, -F[2 * c2], -F[2 * c2 + 1],
+                         f)
     P.frame_with_bias(s, c, md, G[2 * c:2 * c + 2], w[2 * c:2 * c + 2], h[2 * c:2 * c + 2])
     k, a00, a01, a11 = P.solve_stick_rows(s, md, n, nc, diagonal, cst, c, G, h, f, F, A)
     speed = csm.sqrt(v[2 * c] * v[2 * c] + v[2 * c + 1] * v[2 * c + 1])

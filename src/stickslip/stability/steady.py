@@ -26,7 +26,7 @@ from numba.extending import overload
 from ..model.bundle import C_DIM, C_N0, CST, H_BAND, H_DIAGONAL, H_N, H_NC, ModelData, contact_offsets, offsets
 from ..model.compile_ahead import Split
 from ..model.derivatives import acceleration_jacobian, state_jacobian
-from ..model.forces import solve_stick_rows
+from ..model.stick import solve_stick_rows
 from ..model.frame_pointers import is_pointer_class
 from ..model.frames import _frame_bias_central
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, inlined_loop, kernel, loop
