@@ -233,11 +233,11 @@ def work_array_bytes(n_dofs: int, n_contacts: int) -> float:
 def pattern_bytes(n_dofs: int) -> float:
     """Bytes of the sparse structure a model above the stack maxima carries beside its packed data
     (``model/kinematics.py``'s heap classes), at most: the row-compressed patterns of C and K and
-    of M (int64 row starts and up to n² columns each) and the Cholesky factor of M (its strict
-    lower triangle's columns and values, its order and diagonal, its rows' runs of consecutive
-    columns, three numbers each and at most one per entry)."""
+    of M (int64 row starts and up to n² columns each) with their entries (C's and K's, M's), and
+    the Cholesky factor of M (its strict lower triangle's columns and values, its order and
+    diagonal, its rows' runs of consecutive columns, three numbers each and at most one per entry)."""
     n = int(n_dofs)
-    return 8.0 * (2 * (n * n + n + 1) + n * (n - 1) + (n + 1) + 2 * n + (n + 1) + 3 * n * (n - 1) // 2)
+    return 8.0 * (2 * (n * n + n + 1) + 3 * n * n + n * (n - 1) + (n + 1) + 2 * n + (n + 1) + 3 * n * (n - 1) // 2)
 
 
 def contact_rows_bytes(n_dofs: int, n_contacts: int) -> float:

@@ -11,7 +11,8 @@ from stickslip.model.kinematics import ConstantKinematics, LargeConstantKinemati
 
 #: The heap class's empty arrays: its values float64 (W and G M⁻¹ two-dimensional), its patterns int64 (the
 #: factor's runs (k, 3)).
-_FLOATS = {"factor_values", "factor_diagonal", "row_values", "normal_q", "normal_v", "gap_values"}
+_FLOATS = {"factor_values", "factor_diagonal", "row_values", "normal_q", "normal_v", "gap_values", "damping_values",
+           "stiffness_values", "mass_values"}
 _EMPTY = {"delassus": np.zeros((0, 0)), "inverse_mass_rows": np.zeros((0, 0)), "factor_segments": np.zeros((0, 3), np.int64)}
 HEAP = LargeConstantKinematics(70, 20, *[_EMPTY[f] if f in _EMPTY else np.zeros(0, float if f in _FLOATS else np.int64)
                                          for f in LargeConstantKinematics._fields[2:]])

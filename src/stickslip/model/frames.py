@@ -21,13 +21,15 @@ from . import csmath as csm
 from .bundle import H_CONSTANT
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel
 from .frame_pointers import pointer_bias
-from .kinematics import bias_at_run_time, contact_dim, contact_frame, frame_for_sums, model_sizes, registered_frame_bias
+from .kinematics import (bias_at_run_time, contact_dim, contact_frame, frame_for_sums, heap_normal_and_drive, model_sizes,
+                         registered_frame_bias)
 from .model_data import for_kinematics, is_stick
 from .normal import normal_in_mode
-from .stack import DOFS, ONE, STATES, TWO, work_matrix
+from .stack import DOFS, ONE, STATES, TWO, on_heap, work_matrix
 
 __all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "rows_velocity", "frame_velocity", "contact_velocity", "add_contact_force",
-           "add_force_of", "split_complex_frame", "max_rate", "frame_with_bias", "all_frames"]
+           "add_force_of", "split_complex_frame", "max_rate", "frame_with_bias", "bias_frame_for_sums",
+           "heap_velocity_and_rate", "all_frames"]
 
 #: Complex step [-] of the velocity bias: h² ≪ round-off and h·|∂f| far above the smallest
 #: normal double, so Im f(x + i h d)/h is the directional derivative exactly.
@@ -236,22 +238,71 @@ def _frame_with_bias(s, c, md, G2, w2, h2):
     return by_complex_step
 
 
+def bias_frame_for_sums(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by numba (overload below)
+    """:func:`frame_with_bias`; for a heap kinematics class (constant frames: h = 0) that carries W
+    = G M⁻¹ Gᵀ, without the rows G2 (its sums and stick systems read its row lists and W:
+    :func:`~stickslip.model.kinematics.frame_for_sums`)."""
+    raise NotImplementedError
+
+
+@overload(bias_frame_for_sums, jit_options=KERNEL_OPTIONS, inline="always")
+def _bias_frame_for_sums(s, c, md, G2, w2, h2):
+    if not on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return lambda s, c, md, G2, w2, h2: frame_with_bias(s, c, md, G2, w2, h2)
+
+    def without_rows(s, c, md, G2, w2, h2):
+        if md.kin.delassus.shape[0] == 0:  # the stick systems are formed from the rows
+            return frame_with_bias(s, c, md, G2, w2, h2)
+        h2[0] = csm.zero(s[0])
+        h2[1] = csm.zero(s[0])
+        return heap_normal_and_drive(md.kin, s, c, md.m, w2)
+    return without_rows
+
+
+@inlined_kernel
+def heap_velocity_and_rate(s, ds, c, md):
+    """(v0, v1, a0, a1) of :func:`~stickslip.model.physics.slip_velocity_and_rate` for a heap
+    kinematics class (constant frames: h = 0): G_c q̇ − w_c and G_c q̈ over the rows' nonzero
+    entries (``kin.row_*``)."""
+    kin = md.kin
+    n = kin.ndof
+    w2 = work_matrix(kin, ONE, TWO, s)[0]
+    heap_normal_and_drive(kin, s, c, md.m, w2)
+    starts = kin.row_starts
+    columns = kin.row_columns
+    values = kin.row_values
+    v0 = -w2[0]
+    a0 = 0.0
+    for p in range(starts[2 * c], starts[2 * c + 1]):
+        v0 += values[p] * s[n + columns[p]]
+        a0 += values[p] * ds[n + columns[p]]
+    v1 = 0.0
+    a1 = 0.0
+    if contact_dim(kin, md.m, n, c) == 2:
+        v1 = -w2[1]
+        for p in range(starts[2 * c + 1], starts[2 * c + 2]):
+            v1 += values[p] * s[n + columns[p]]
+            a1 += values[p] * ds[n + columns[p]]
+    return v0, v1, a0, a1
+
+
 @inlined_kernel
 def all_frames(s, cst, md, n, nc, G, w, v, N, h, with_bias):
     """Each contact's G (rows 2c, 2c+1), w, v = G q̇ − w (entries 2c, 2c+1) and N (entry c) at
     ``s``; with the velocity bias h for contacts in stick (all contacts if ``with_bias`` is 2).
     A unilateral contact's N is its normal force λ in the mode of ``cst`` (0 while open).
 
-    A heap kinematics class writes the rows G of the contacts given a bias only
-    (:func:`~stickslip.model.kinematics.frame_for_sums` for the others): its sums read its row lists
-    (:func:`contact_velocity`, :func:`add_force_of`), and storing 2 n entries per contact at every
-    right-hand side cost as much as a solve with the mass factor."""
+    A heap kinematics class writes no rows G where it carries W = G M⁻¹ Gᵀ
+    (:func:`~stickslip.model.kinematics.frame_for_sums`, :func:`bias_frame_for_sums`): its sums
+    read its row lists (:func:`contact_velocity`, :func:`add_force_of`) and its stick systems W,
+    and storing 2 n entries per contact at every right-hand side cost as much as a solve with the
+    mass factor."""
     m = md.m
     for c in range(nc):
         G2 = G[2 * c:2 * c + 2]
         w2 = w[2 * c:2 * c + 2]
         if with_bias == 2 or (with_bias == 1 and is_stick(cst, c)):
-            N[c] = frame_with_bias(s, c, md, G2, w2, h[2 * c:2 * c + 2])
+            N[c] = bias_frame_for_sums(s, c, md, G2, w2, h[2 * c:2 * c + 2])
         else:
             N[c] = frame_for_sums(md.kin, s, c, m, G2, w2)
         N[c] = normal_in_mode(s, cst, md, n, c, N[c])  # a unilateral contact's: none while open

@@ -47,7 +47,7 @@ from . import csmath as csm
 from . import stack
 from .frame_pointers import (FramePointerFields, compiled_addresses, forget, is_pointer_class, origin_class, pointer_frame,
                              pointer_gap)
-from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets
+from .bundle import C_DIM, C_G, C_N0, H_DIAGONAL, H_N, H_NC, H_UNILATERAL, contact_offsets, offsets
 from .jit import KERNEL_OPTIONS, defined_in_package, inlined_kernel, kernel, track_user_code
 from ..memory import delassus_bytes, fits_in_memory
 from .mass_factor import contact_rows, delassus, mass_factor, row_pattern
@@ -451,7 +451,8 @@ _HEAP_FIELDS = [("ndof", int), ("ncontacts", int), ("force_rows", np.ndarray), (
                 ("row_starts", np.ndarray), ("row_columns", np.ndarray), ("row_values", np.ndarray),
                 ("normal_starts", np.ndarray), ("normal_columns", np.ndarray), ("normal_q", np.ndarray),
                 ("normal_v", np.ndarray), ("gap_starts", np.ndarray), ("gap_columns", np.ndarray),
-                ("gap_values", np.ndarray), ("delassus", np.ndarray), ("inverse_mass_rows", np.ndarray)]
+                ("gap_values", np.ndarray), ("delassus", np.ndarray), ("inverse_mass_rows", np.ndarray),
+                ("damping_values", np.ndarray), ("stiffness_values", np.ndarray), ("mass_values", np.ndarray)]
 
 LargeConstantKinematics = NamedTuple("LargeConstantKinematics", _HEAP_FIELDS)
 LargeConstantKinematics.__doc__ = """The kernels' :class:`ConstantKinematics` of a model larger than the
@@ -460,9 +461,12 @@ arrays are heap buffers of run-time size (:func:`~stickslip.model.stack.register
 maximum. ``FrictionModel.data`` chooses it; the model keeps its own class.
 
 ``force_rows`` (n + 1,) and ``force_columns`` (int64) hold the row-compressed pattern of the entries
-of C and K that are not both zero (:func:`force_pattern`): the base force f0 − C q̇ − K q sums over
-those only (:func:`~stickslip.model.model_data.base_force_of`), as a reduced or finite-element
-model's C and K are mostly zero; ``mass_rows``, ``mass_columns`` that of M (the kinetic energy);
+of C and K that are not both zero (:func:`force_pattern`), ``damping_values`` and ``stiffness_values``
+their entries there: the base force f0 − C q̇ − K q sums over those only
+(:func:`~stickslip.model.model_data.base_force_of`), as a reduced or finite-element model's C and K
+are mostly zero, reading them in order (gathered from the packed n-by-n matrices, each entry a
+cache line of its own, they cost more than the sums); ``mass_rows``, ``mass_columns`` and
+``mass_values`` the same for M (the kinetic energy);
 ``factor_*`` the sparse Cholesky factor of M on its free DOFs
 (:func:`~stickslip.model.mass_factor.mass_factor`), with which M⁻¹ f is two triangular solves
 (:func:`~stickslip.model.model_data.inverse_mass_of`). ``FrictionModel.data`` packs the matrices of
@@ -522,8 +526,19 @@ def large_kinematics(kin, n: int, nc: int, matrices: tuple[np.ndarray, ...], m: 
     rows = contact_rows(m, n, nc)
     empty = (np.zeros((0, 0)), np.zeros((0, 0)))
     w = delassus(m, n, nc, rows[:3]) if fits_in_memory(delassus_bytes(n, nc)) else empty
-    return large(int(n), int(nc), *force_pattern(damping, stiffness), *row_pattern(np.asarray(mass) != 0.0),
-                 *mass_factor(mass, free), *rows, *w)
+    forces = force_pattern(damping, stiffness)
+    masses = row_pattern(np.asarray(mass) != 0.0)
+    _, o_mass, o_damping, o_stiffness = offsets(n)[:4]
+    values = (packed_values(m, o_damping, n, *forces), packed_values(m, o_stiffness, n, *forces),
+              packed_values(m, o_mass, n, *masses))
+    return large(int(n), int(nc), *forces, *masses, *mass_factor(mass, free), *rows, *w, *values)
+
+
+def packed_values(m: np.ndarray, offset: int, n: int, rows: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """The entries of the n-by-n matrix packed in ``m`` from ``offset`` (row-major) at the
+    row-compressed pattern (``rows`` (n + 1,), ``columns``), in its order."""
+    row_of = np.repeat(np.arange(n), np.diff(rows))
+    return np.ascontiguousarray(m[offset + row_of * n + columns], dtype=np.float64)
 
 
 @kernel

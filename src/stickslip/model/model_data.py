@@ -249,7 +249,8 @@ def base_force(s, m, n, diagonal, f):
 def base_force_of(kin, s, m, n, diagonal, f):  # pragma: no cover - resolved by numba (overload below)
     """:func:`base_force`; for a model of a heap kinematics class (:mod:`stickslip.model.stack`)
     the same sums over the entries of C and K in its pattern only (``kin.force_rows``,
-    ``kin.force_columns``: the others are zero in both), each in the same order less its exact zeros."""
+    ``kin.force_columns``: the others are zero in both; their values ``kin.damping_values``,
+    ``kin.stiffness_values`` in that order), each in the same order less its exact zeros."""
     raise NotImplementedError
 
 
@@ -258,14 +259,16 @@ def _base_force_dense(kin, s, m, n, diagonal, f):
 
 
 def _base_force_by_pattern(kin, s, m, n, diagonal, f):
-    _, _, oc, ok, of, _, _ = offsets(n)
+    of = offsets(n)[4]
     rows = kin.force_rows
     columns = kin.force_columns
+    damping = kin.damping_values
+    stiffness = kin.stiffness_values
     for i in range(n):
         acc = m[of + i] + csm.zero(s[0])
         for p in range(rows[i], rows[i + 1]):
             j = columns[p]
-            acc -= m[oc + i * n + j] * s[n + j] + m[ok + i * n + j] * s[j]
+            acc -= damping[p] * s[n + j] + stiffness[p] * s[j]
         f[i] = acc
 
 
@@ -294,14 +297,13 @@ def _damping_power_dense(kin, s, m, n, diagonal):
 
 
 def _damping_power_by_pattern(kin, s, m, n, diagonal):
-    oc = offsets(n)[2]
     rows = kin.force_rows
     columns = kin.force_columns
+    values = kin.damping_values
     damping = csm.zero(s[0])
     for i in range(n):
         for p in range(rows[i], rows[i + 1]):
-            j = columns[p]
-            damping -= s[n + i] * m[oc + i * n + j] * s[n + j]
+            damping -= s[n + i] * values[p] * s[n + columns[p]]
     return damping
 
 
@@ -312,7 +314,8 @@ def _damping_power(kin, s, m, n, diagonal):
 
 def kinetic_energy_of(kin, s, m, n, diagonal):  # pragma: no cover - resolved by numba (overload below)
     """½ q̇ᵀ M q̇ [J]; for a model of a heap kinematics class over the entries of M in its pattern
-    only (``kin.mass_rows``, ``kin.mass_columns``), each sum in the same order less its exact zeros."""
+    only (``kin.mass_rows``, ``kin.mass_columns``, ``kin.mass_values``), each sum in the same order
+    less its exact zeros."""
     raise NotImplementedError
 
 
@@ -329,14 +332,13 @@ def _kinetic_energy_dense(kin, s, m, n, diagonal):
 
 
 def _kinetic_energy_by_pattern(kin, s, m, n, diagonal):
-    o = offsets(n)[1]
     rows = kin.mass_rows
     columns = kin.mass_columns
+    values = kin.mass_values
     e = 0.0
     for i in range(n):
         for p in range(rows[i], rows[i + 1]):
-            j = columns[p]
-            e += 0.5 * s[n + i] * m[o + i * n + j] * s[n + j]
+            e += 0.5 * s[n + i] * values[p] * s[n + columns[p]]
     return e
 
 

@@ -45,19 +45,22 @@ import math
 
 import numpy as np
 
+from numba.extending import overload
+
 from . import csmath as csm
 from .bundle import CST, H_BAND
 from .forces import general_forces, quasi_static_direction, sliding_forces, sliding_friction
-from .stick import heap_projection, solve_stick_rows, stick_rows
-from .frames import COMPLEX_STEP, add_contact_force, add_force_of, contact_velocity, frame_velocity, frame_with_bias
-from .jit import api_kernel, inlined_kernel, kernel, standalone
+from .frames import (COMPLEX_STEP, add_contact_force, add_force_of, contact_velocity, frame_velocity, frame_with_bias,
+                     heap_velocity_and_rate)
+from .jit import KERNEL_OPTIONS, api_kernel, inlined_kernel, kernel, standalone
 from .kinematics import contact_dim, contact_frame, model_sizes, unilateral_kernel
 from .linalg import RANK_TOL, solve_psd, solve_psd_2x2, solve_stick_system
 from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MODE_STICK, SPEED_FLOOR,
                          apply_inverse_mass, damping_power, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick,
                          kinetic_coefficient, kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
-from .stack import DOFS, ONE, ROWS, TWO, work_matrix, work_vectors
+from .stack import DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
+from .stick import heap_projection, solve_stick_rows, stick_rows
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
            "indicator", "gap", "unilateral", "rigid", "rigid_pivot", "is_open", "normal_force_of",
@@ -313,7 +316,17 @@ def normal_force(s, c, md):
 @kernel
 def slip_velocity_and_rate(s, ds, c, md):
     """(v0, v1, a0, a1): slip velocity of contact ``c`` [m/s] and its rate dv/dt = G q̈ + h [m/s²]
-    along the state derivative ``ds`` (h the velocity bias of :func:`frame_with_bias`)."""
+    along the state derivative ``ds`` (h the velocity bias of :func:`frame_with_bias`); for a heap
+    kinematics class over its rows' nonzero entries (:func:`~stickslip.model.frames.heap_velocity_and_rate`)."""
+    return velocity_and_rate_of(s, ds, c, md)
+
+
+def velocity_and_rate_of(s, ds, c, md):  # pragma: no cover - resolved by numba (overload below)
+    """The body of :func:`slip_velocity_and_rate` for the kinematics class of ``md``."""
+    raise NotImplementedError
+
+
+def _velocity_and_rate_by_frame(s, ds, c, md):
     m = md.m
     n, nc, diagonal = model_sizes(md.kin, m)
     G2 = work_matrix(md.kin, TWO, DOFS, s)
@@ -329,6 +342,13 @@ def slip_velocity_and_rate(s, ds, c, md):
     if dim == 1:
         a1 = 0.0
     return v0, v1, a0, a1
+
+
+@overload(velocity_and_rate_of, jit_options=KERNEL_OPTIONS, inline="always")
+def _velocity_and_rate_of(s, ds, c, md):
+    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+        return lambda s, ds, c, md: heap_velocity_and_rate(s, ds, c, md)
+    return _velocity_and_rate_by_frame
 
 
 @standalone
