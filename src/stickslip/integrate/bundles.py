@@ -55,8 +55,9 @@ class Samples(NamedTuple):
 
 
 class TransitionLog(NamedTuple):
-    """Buffers of the transitions a chunk records (as many as they have room for; the loop counts
-    on and the chunk is run again with room for all, :func:`.runner.transition_room`).
+    """Buffers of the transitions a chunk records (as many as they have room for: the chunk ends
+    early where they are nearly full; past them the loop counts on and the chunk is run again with
+    room for all, :func:`.runner.transition_room`).
 
     Attributes
     ----------

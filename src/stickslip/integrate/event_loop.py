@@ -17,8 +17,10 @@ Time inside the loop is *local*: the caller passes ``t_base`` and the loop integ
 against an absolute time whose unit in the last place grows with the run (at t ~ 4e4 s it
 exceeds the event tolerance). The runner calls the loop in chunks
 (:class:`stickslip.integrate.runner.EventStepper`), rebasing each; a chunk ends at the first
-accepted step past ``tau_stop`` that is not in the middle of an approach, so the steps taken are
-the same as in one long call.
+accepted step past ``tau_stop`` that is not in the middle of an approach, or before it at such a
+step where its transition log has room for less than two transitions per contact more (a model of
+many contacts, hundreds of transitions a period), so the steps taken are the same as in one long
+call and a chunk is run again only where one step outgrew that room.
 
 The loop (:func:`event_loop`) is a sequence of named steps, each inlined into it at its one call
 site, over bundled state: the step's arrays (:class:`~.dormand_prince.Step`), what is kept of
@@ -247,16 +249,18 @@ def homing_left(homing):
 
 
 @inlined_kernel
-def next_step_size(progress, controls, homing):
+def next_step_size(progress, controls, homing, log_full):
     """The next step's size: the one imposed (homing, a bounce's flight), else the error
-    controller's. Returns whether the chunk ends here: past ``tau_stop``, outside an approach."""
+    controller's. Returns whether the chunk ends here, outside an approach: past ``tau_stop``,
+    or before it where the transition log is nearly full (``log_full``: the chunk ends where a
+    run of many contacts would outgrow it, instead of being run again with room for all)."""
     if progress.h_override > 0.0:
         progress.h = progress.h_override
         progress.h_override = -1.0
         return False
     progress.h *= progress.factor
-    return (controls.tau_stop <= progress.tau < controls.tau_end and progress.h_free < 0.0
-            and not homing_left(homing))
+    return ((controls.tau_stop <= progress.tau or log_full) and progress.tau < controls.tau_end
+            and progress.h_free < 0.0 and not homing_left(homing))
 
 
 # ----------------------------------------------------------------------------- samples
@@ -478,6 +482,7 @@ def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, sta
         store_record(start, progress)
         return
     progress.h = min(progress.h, controls.h_max)
+    room_kept = 2 * model_sizes(md.kin, md.m)[1] + 2  # more than one step records (a release of every contact)
     progress.n_steps = 0
     progress.retakes = 0
     progress.h_override = -1.0
@@ -517,7 +522,7 @@ def event_loop(controls, md, cst, start, step, slips, scratch, samples, log, sta
         if progress.lost >= 0:
             progress.status = INCONSISTENT
             break
-        if next_step_size(progress, controls, slips.homing):
+        if next_step_size(progress, controls, slips.homing, progress.n_tr + room_kept > log.times.shape[0]):
             progress.status = CHUNK_END
             break
     store_record(start, progress)

@@ -18,8 +18,9 @@ its end or a *stop condition* ends it:
     soon as its attractor is known (:class:`stickslip.basins.early.EarlyStop`).
 
 Every compiled loop writes transitions into buffers sized for the chunk
-(:func:`transition_room`); a chunk with more transitions than room is run again from its start
-with room for all of them, which gives the same result.
+(:func:`transition_room`); a chunk ends early where its log is nearly full
+(:func:`.event_loop.next_step_size`), and one whose last step outgrew the room left is run again
+from its start with room for all of them, which gives the same result.
 """
 
 from __future__ import annotations
