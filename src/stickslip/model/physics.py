@@ -344,7 +344,7 @@ def _velocity_and_rate_by_frame(s, ds, c, md):
     return v0, v1, a0, a1
 
 
-@overload(velocity_and_rate_of, jit_options=KERNEL_OPTIONS)  # a call: inlining its body cost 0.25 s of compile
+@overload(velocity_and_rate_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _velocity_and_rate_of(s, ds, c, md):
     if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
         return lambda s, ds, c, md: heap_velocity_and_rate(s, ds, c, md)
