@@ -44,7 +44,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from numba.extending import overload
 
 from . import csmath as csm
