@@ -28,7 +28,7 @@ from .normal import normal_in_mode
 from .stack import DOFS, ONE, STATES, TWO, on_heap, work_matrix
 
 __all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "rows_velocity", "frame_velocity", "contact_velocity", "add_contact_force",
-           "add_force_of", "split_complex_frame", "max_rate", "frame_with_bias", "bias_frame_for_sums",
+           "add_force_of", "row_times", "split_complex_frame", "max_rate", "frame_with_bias", "bias_frame_for_sums",
            "heap_velocity_and_rate", "all_frames"]
 
 #: Complex step [-] of the velocity bias: h² ≪ round-off and h·|∂f| far above the smallest
@@ -74,18 +74,22 @@ def _velocity_dense(kin, s, n, c, dim, G2, w2):
     return rows_velocity(s, n, dim, G2, w2)
 
 
-def _velocity_by_rows(kin, s, n, c, dim, G2, w2):
-    starts = kin.row_starts
+@inlined_kernel
+def row_times(kin, row, a, acc):
+    """acc + g·a for the contact row ``row`` (2c or 2c + 1) of a heap kinematics class, over its
+    nonzero entries (``kin.row_*``) in the order of their columns."""
     columns = kin.row_columns
     values = kin.row_values
-    v0 = -w2[0]
-    for p in range(starts[2 * c], starts[2 * c + 1]):
-        v0 += values[p] * s[n + columns[p]]
+    for p in range(kin.row_starts[row], kin.row_starts[row + 1]):
+        acc += values[p] * a[columns[p]]
+    return acc
+
+
+def _velocity_by_rows(kin, s, n, c, dim, G2, w2):
+    v0 = row_times(kin, 2 * c, s[n:], -w2[0])
     v1 = csm.zero(s[0])
     if dim == 2:
-        v1 = -w2[1]
-        for p in range(starts[2 * c + 1], starts[2 * c + 2]):
-            v1 += values[p] * s[n + columns[p]]
+        v1 = row_times(kin, 2 * c + 1, s[n:], -w2[1])
     return v0, v1
 
 
@@ -268,21 +272,13 @@ def heap_velocity_and_rate(s, ds, c, md):
     n = kin.ndof
     w2 = work_matrix(kin, ONE, TWO, s)[0]
     heap_normal_and_drive(kin, s, c, md.m, w2)
-    starts = kin.row_starts
-    columns = kin.row_columns
-    values = kin.row_values
-    v0 = -w2[0]
-    a0 = 0.0
-    for p in range(starts[2 * c], starts[2 * c + 1]):
-        v0 += values[p] * s[n + columns[p]]
-        a0 += values[p] * ds[n + columns[p]]
+    v0 = row_times(kin, 2 * c, s[n:], -w2[0])
+    a0 = row_times(kin, 2 * c, ds[n:], 0.0)
     v1 = 0.0
     a1 = 0.0
     if contact_dim(kin, md.m, n, c) == 2:
-        v1 = -w2[1]
-        for p in range(starts[2 * c + 1], starts[2 * c + 2]):
-            v1 += values[p] * s[n + columns[p]]
-            a1 += values[p] * ds[n + columns[p]]
+        v1 = row_times(kin, 2 * c + 1, s[n:], -w2[1])
+        a1 = row_times(kin, 2 * c + 1, ds[n:], 0.0)
     return v0, v1, a0, a1
 
 

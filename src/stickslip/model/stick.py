@@ -21,7 +21,7 @@ from numba.extending import overload
 
 from . import csmath as csm
 from .jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
-from .frames import contact_velocity
+from .frames import contact_velocity, row_times
 from .kinematics import contact_dim, frame_for_sums
 from .linalg import solve_psd_2x2, solve_stick_system
 from .model_data import dot, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick
@@ -157,17 +157,6 @@ def heap_inverse_mass(kin, m, n, diagonal, f, a):
     """a = M⁻¹ f (:func:`~stickslip.model.model_data.inverse_mass_of`) as a call: inlined into the
     heap stick kernels, numba mis-scopes the factor solve's accumulator (a pedantic IR warning)."""
     inverse_mass_of(kin, m, n, diagonal, f, a)
-
-
-@inlined_kernel
-def row_times(kin, row, a, acc):
-    """acc + g·a for the contact row ``row`` of a heap kinematics class, over its nonzero entries
-    (``kin.row_*``) in the order of their columns."""
-    columns = kin.row_columns
-    values = kin.row_values
-    for p in range(kin.row_starts[row], kin.row_starts[row + 1]):
-        acc += values[p] * a[columns[p]]
-    return acc
 
 
 @inlined_kernel
