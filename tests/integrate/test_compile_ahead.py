@@ -33,8 +33,8 @@ def _available(kernel, sig) -> bool:
 
 def _all_available(split, md) -> None:
     signatures = split.signatures(md)
-    assert set(signatures) == set(split.helper + split.own)
-    for kernel in split.helper + split.own:
+    assert set(signatures) == set(split.kernels)
+    for kernel in split.kernels:
         assert _available(kernel, signatures[kernel]), kernel
 
 
@@ -138,6 +138,8 @@ def test_a_cold_start_in_two_processes_runs_alike_and_compiles_the_stick_solve_o
     here = stickslip.simulate(None, 5.0)
     assert cold["states"] == hashlib.sha256(np.ascontiguousarray(here.states).tobytes()).hexdigest()
     assert "try_stick" not in cold["compiled"] and "stick_forces" not in cold["compiled"]
+    # the friction forces, which both sides call, compiled once (by the helper) and loaded here from the cache
+    assert "general_forces" not in cold["compiled"] and "band_forces" not in cold["compiled"]
     assert "rhs" in cold["compiled"] and "event_loop" in cold["outermost"]
     start, end = cold["work"]
     assert end - start >= 0.3
@@ -215,17 +217,65 @@ def test_a_cold_starts_meanwhile_work_runs_once_before_it_waits_for_the_helper()
     assert calls[-2:] == ["wait", "end"] and calls.count("work") == 1
 
 
+def test_a_cold_start_compiles_its_stages_each_after_the_helpers_stage_before():
+    """With earlier stages, this process compiles its kernels of a stage once the helper has
+    marked its kernels of the stage before as cached, marks its own (which the helper waits for),
+    and runs the meanwhile work after its last stage, before the wait for the helper's end."""
+    calls = []
+
+    class Kernel:
+        def __init__(self, name):
+            self.name = name
+
+        def compile(self, signature):
+            calls.append(("compile", self.name, signature))
+
+    class Helper:
+        def wait_for(self, marker, timeout):
+            calls.append(("wait for", marker))
+
+        def mark(self, marker):
+            calls.append(("mark", marker))
+
+        def wait(self, timeout):
+            calls.append(("wait",))
+
+        def end(self):
+            calls.append(("end",))
+
+    a, b, c, d = (Kernel(name) for name in "abcd")
+    split = compile_ahead.Split(helper=(Kernel("h"),), own=(c, d), caller=loop_split.EVENT_LOOP.caller,
+                                calls=lambda md: {}, stages=(((Kernel("h0"),), (a,)), ((Kernel("h1"),), (b,))))
+    assert [k.name for k in split.kernels] == ["h0", "a", "h1", "b", "h", "c", "d"]
+    with compile_ahead.meanwhile(lambda: calls.append(("work",))):
+        with compile_ahead.ColdStart(split, {a: "sa", b: "sb", c: "sc", d: "sd"}, Helper()) as cold:
+            cold.finish()
+    assert calls == [("compile", "a", "sa"), ("mark", "own-0"), ("wait for", "helper-0"), ("compile", "b", "sb"),
+                     ("mark", "own-1"), ("wait for", "helper-1"), ("compile", "c", "sc"), ("compile", "d", "sd"),
+                     ("work",), ("wait",), ("end",)]
+
+
 def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_data():
     """Where the helper is not forked (not Linux) it is a new interpreter that reads the model data
-    pickled to a file; it ends with status 0 and the file is removed."""
+    pickled to a file; it compiles a stage once this process has marked its side of the stage
+    before done, marks its own, ends with status 0, and its folder is removed."""
     system = stickslip.load_model("belt")
     stickslip.simulate(system, 0.5)  # its kernels are here or cached: the helper loads them
+    split = loop_split.EVENT_LOOP
+    assert split.stages
     helper = compile_ahead._spawned_helper(system.data, "stickslip.integrate.loop_split:EVENT_LOOP")
     assert helper is not None and helper.path.exists()
+    helper.wait_for("helper-0", 300.0)
+    assert (helper.folder / "helper-0").exists()
+    helper.wait(1.0)
+    assert helper.process.poll() is None  # waiting for this side's first stage
+    for k in range(len(split.stages)):
+        helper.mark(f"own-{k}")
     helper.wait(300.0)
     assert helper.process.returncode == 0
+    assert all((helper.folder / f"helper-{k}").exists() for k in range(len(split.stages)))
     helper.end()
-    assert not helper.path.exists()
+    assert not helper.path.exists() and not helper.folder.exists()
 
 
 def test_the_helper_is_off_on_request(monkeypatch):

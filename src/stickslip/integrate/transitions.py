@@ -17,13 +17,13 @@ from ..model.bundle import CST
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
 from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from ..model.normal import is_unilateral
-from ..model.stack import static_sizes
+from ..model.stack import one_contact
 from . import contacts as E
 from . import dormand_prince as DP
 from .status import INCONSISTENT, SUCCESS
 
 __all__ = ["crossing_in_step", "record_transition", "settle", "break_away", "switch_gap", "jammed_contact",
-           "gap_crossing", "breakaway_search", "first_breakaway", "one_contact"]
+           "gap_crossing", "breakaway_search", "first_breakaway"]
 
 
 @inlined_kernel
@@ -170,19 +170,12 @@ def breakaway_search(step, h, cst, md, scratch):  # pragma: no cover - resolved 
     θ = −1.0 and contact −1 for none.
 
     Chosen at compile time by the model's kinematics class: where it fixes the contact count at one
-    (:func:`one_contact`), that contact's stick margin is probed as the loop probes the slip event
-    (:func:`~.contacts.first_crossing`, compiled for it anyway), so such a model compiles no more for
-    its breakaways; else :func:`first_breakaway`, which samples the margins of all sticking contacts
+    (:func:`~stickslip.model.stack.one_contact`), that contact's stick margin is probed as the
+    loop probes the slip event (:func:`~.contacts.first_crossing`, compiled for it anyway), so such
+    a model compiles no more for its breakaways; else :func:`first_breakaway`, which samples the margins of all sticking contacts
     from one solve of the forces per point. Both find the same root for one contact.
     """
     raise NotImplementedError("breakaway_search is called from compiled code only")
-
-
-def one_contact(kin_class) -> bool:
-    """Whether the kinematics class ``kin_class`` fixes its models' contact count at one (their
-    breakaway search probes that contact alone: :func:`breakaway_search`)."""
-    sizes = static_sizes(kin_class)
-    return sizes is not None and sizes[1] == 1
 
 
 @overload(breakaway_search, jit_options=KERNEL_OPTIONS, inline="always")

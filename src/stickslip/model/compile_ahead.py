@@ -18,6 +18,13 @@ event loop), the variational equations of the orbit tools
 turns to its own side (:func:`start_apart`, :class:`ColdStart`), and a command may hand the split
 work it does later anyway (:func:`meanwhile`: the CLI imports what writes its outputs).
 
+Where both subtrees call one large kernel (the event loop's: the friction forces of all
+contacts), each process would compile it. A split then has earlier ``stages``, each a pair of the
+helper's kernels and this process's: each side starts a stage once the other side's kernels of
+the stage before are in the cache (it says so with a marker file), so that the kernels of a stage
+load those instead of compiling them again. The stages are balanced by hand from the kernels'
+compile times (``benchmarks/profile_jit.py --compile``).
+
 A split names its kernels by reference and derives their argument types: ``calls(md)`` gives
 each kernel's arguments as its caller passes them, from the bundles a run builds for the model
 data ``md``, and their numba types are the signature (the tests check that they are the
@@ -37,6 +44,7 @@ import dataclasses
 import importlib
 import os
 import pickle
+import shutil
 import signal
 import subprocess
 import sys
@@ -65,17 +73,23 @@ class Split:
     Attributes
     ----------
     helper, own : tuple of kernels
-        Kernels (numba dispatchers) the helper process compiles, and this process meanwhile; the
-        helper's first one tells whether the split is a cold start.
+        Kernels (numba dispatchers) the helper process compiles, and this process meanwhile (the
+        last stage, where the split has ``stages``); the helper's first one tells whether the
+        split is a cold start.
     caller : kernel
         The kernel that calls them, compiled after both (its compile event spans the pair).
     calls : callable
-        ``calls(md)``: each kernel of ``helper`` and ``own`` mapped to its arguments as its caller
+        ``calls(md)``: each kernel of every stage mapped to its arguments as its caller
         passes them for the model data ``md`` (arrays, bundles and numbers of the types and layouts
         a run builds); their numba types are the signature compiled (:meth:`signatures`).
     applies : callable, optional
         ``applies(md)``: whether the split's signatures are those the caller compiles for the
         model data ``md`` (default: always).
+    stages : tuple of (tuple, tuple), optional
+        Earlier stages, each a pair (the helper's kernels, this process's kernels), compiled in
+        order before ``helper`` and ``own`` (the last stage): each side starts a stage once the
+        other side's kernels of the stage before are in the cache, so that the kernels of a
+        stage may call the kernels of the stages before and load them from there.
     """
 
     helper: tuple
@@ -83,6 +97,17 @@ class Split:
     caller: Any
     calls: Callable
     applies: Callable | None = None
+    stages: tuple = ()
+
+    @property
+    def all_stages(self) -> tuple:
+        """Every stage, in order: :attr:`stages` and then (``helper``, ``own``)."""
+        return self.stages + ((self.helper, self.own),)
+
+    @property
+    def kernels(self) -> tuple:
+        """Every kernel the split compiles ahead of its caller, either side."""
+        return tuple(k for helper, own in self.all_stages for k in helper + own)
 
     def signatures(self, md) -> dict:
         """Each kernel's argument types for the model data ``md``: the numba types of its
@@ -118,15 +143,19 @@ class ColdStart:
         self.split, self.signatures, self.helper = split, signatures, helper
 
     def finish(self) -> None:
-        """Compile this process's kernels, run the :func:`meanwhile` work, then wait for the helper."""
-        # outermost compile events around this process's side and the wait for the helper, so that
-        # the time waited counts as compiling and the meanwhile work does not
+        """Compile this process's kernels, stage by stage (each once the helper's kernels of the
+        stage before are in the cache), run the :func:`meanwhile` work, then wait for the helper."""
+        # outermost compile events around this process's compiling and its waits for the helper,
+        # so that the time waited counts as compiling and the meanwhile work does not
         compiling = {"dispatcher": self.split.caller, "args": (), "return_type": None}
-        with event.trigger_event("numba:compile", data=compiling):
-            _compile(self.split.own, self.signatures)
-        while _meanwhile:
-            with contextlib.suppress(Exception):  # preparation only: the same work fails again where it is due
-                _meanwhile.pop(0)()
+        for k, (_, own) in enumerate(self.split.all_stages):
+            with event.trigger_event("numba:compile", data=compiling):
+                if k:
+                    self.helper.wait_for(f"helper-{k - 1}", HELPER_TIMEOUT_S)
+                _compile(own, self.signatures)
+            if k < len(self.split.stages):
+                self.helper.mark(f"own-{k}")
+        _run_meanwhile()
         with event.trigger_event("numba:compile", data=compiling):
             self.helper.wait(HELPER_TIMEOUT_S)
 
@@ -173,6 +202,12 @@ def compile_apart(md, split: Split, split_name: str) -> bool:
 _meanwhile: list = []
 
 
+def _run_meanwhile() -> None:
+    while _meanwhile:
+        with contextlib.suppress(Exception):  # preparation only: the same work fails again where it is due
+            _meanwhile.pop(0)()
+
+
 @contextlib.contextmanager
 def meanwhile(work):
     """Within the block, a cold start's :meth:`ColdStart.finish` calls ``work()`` once, in this
@@ -193,28 +228,85 @@ def meanwhile(work):
 _FORK = hasattr(os, "fork") and sys.platform.startswith("linux")
 
 
-class _ForkedHelper:
-    """A helper forked from this process (:func:`_forked_helper`), by its pid."""
+def _helper_side(split: Split, signatures, folder: Path) -> None:
+    """What the helper process compiles: its kernels of each stage, once this process's kernels of
+    the stage before are in the cache (their marker in ``folder``), marking its own when done."""
+    for k, (helper, _) in enumerate(split.all_stages):
+        if k:
+            _wait_for_file(folder / f"own-{k - 1}", lambda: True, HELPER_TIMEOUT_S)
+        _compile(helper, signatures)
+        if k < len(split.stages):
+            with contextlib.suppress(OSError):  # without it the other side waits for this one's end
+                (folder / f"helper-{k}").touch()
 
-    def __init__(self, pid: int):
-        self.pid = pid
-        self.running = True
+
+def _wait_for_file(path: Path, alive, timeout: float) -> None:
+    """Wait until ``path`` exists, while ``alive()``, at most ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while not path.exists() and alive() and time.monotonic() < deadline:
+        time.sleep(0.005)
+
+
+class _Helper:
+    """A helper process at work; its stages' marker files and ours in ``folder``."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+
+    def running(self) -> bool:
+        raise NotImplementedError
 
     def wait(self, timeout: float) -> None:
+        """Wait for the helper's end (at most ``timeout`` seconds)."""
         deadline = time.monotonic() + timeout
-        while self.running and time.monotonic() < deadline:
-            if os.waitpid(self.pid, os.WNOHANG)[0]:
-                self.running = False
-            else:
-                time.sleep(0.005)
+        while self.running() and time.monotonic() < deadline:
+            time.sleep(0.005)
+
+    def wait_for(self, marker: str, timeout: float) -> None:
+        """Wait until the helper creates ``marker`` (its kernels of a stage are in the cache), or its end."""
+        _wait_for_file(self.folder / marker, self.running, timeout)
+
+    def mark(self, marker: str) -> None:
+        """Tell the helper that this process's kernels of a stage are in the cache; where that
+        fails, end the helper (this process compiles the rest)."""
+        try:
+            (self.folder / marker).touch()
+        except OSError:
+            self._stop()
 
     def end(self) -> None:
-        if self.running:
+        """Stop the helper if it still runs, and remove its files."""
+        self._stop()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def _stop(self) -> None:
+        raise NotImplementedError
+
+
+def _folder() -> Path:
+    return Path(tempfile.mkdtemp(prefix="stickslip-cold-"))
+
+
+class _ForkedHelper(_Helper):
+    """A helper forked from this process (:func:`_forked_helper`), by its pid."""
+
+    def __init__(self, pid: int, folder: Path):
+        super().__init__(folder)
+        self.pid = pid
+        self.alive = True
+
+    def running(self) -> bool:
+        if self.alive and os.waitpid(self.pid, os.WNOHANG)[0]:
+            self.alive = False
+        return self.alive
+
+    def _stop(self) -> None:
+        if self.alive:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(self.pid, signal.SIGKILL)
             with contextlib.suppress(ChildProcessError):
                 os.waitpid(self.pid, 0)
-            self.running = False
+            self.alive = False
 
 
 def _forked_helper(split: Split, signatures) -> _ForkedHelper | None:
@@ -225,18 +317,20 @@ def _forked_helper(split: Split, signatures) -> _ForkedHelper | None:
     from ..parallel import watch_parent
 
     parent = os.getpid()
+    folder = _folder()
     try:
         with global_compiler_lock:  # no other thread is inside numba's compiler across the fork
             pid = os.fork()
     except OSError:
+        shutil.rmtree(folder, ignore_errors=True)
         return None
     if pid:
-        return _ForkedHelper(pid)
+        return _ForkedHelper(pid, folder)
     status = 1
     try:
         event._registered.clear()  # this process's compile listeners (a command's notice) stay silent
         watch_parent(parent)
-        _compile(split.helper, signatures)
+        _helper_side(split, signatures, folder)
         status = 0
     finally:
         os._exit(status)
@@ -257,40 +351,39 @@ def _check_fork() -> str | None:
 FORK_PATCH = Patch("fork-helper", _check_fork, lambda: None)
 
 
-class _SpawnedHelper:
-    """A helper started as a new interpreter (:func:`_spawned_helper`)."""
+class _SpawnedHelper(_Helper):
+    """A helper started as a new interpreter (:func:`_spawned_helper`); ``path`` the pickled
+    model data, in the helper's folder."""
 
     def __init__(self, process: subprocess.Popen, path: Path):
+        super().__init__(path.parent)
         self.process = process
         self.path = path
 
-    def wait(self, timeout: float) -> None:
-        with contextlib.suppress(subprocess.TimeoutExpired):
-            self.process.wait(timeout=timeout)
+    def running(self) -> bool:
+        return self.process.poll() is None
 
-    def end(self) -> None:
+    def _stop(self) -> None:
         if self.process.poll() is None:
             self.process.kill()
             self.process.wait()
-        self.path.unlink(missing_ok=True)
 
 
 def _spawned_helper(md, split_name: str) -> _SpawnedHelper | None:
     """Start the helper as a new interpreter (:func:`helper_main`), with ``md`` pickled to a file."""
-    with tempfile.NamedTemporaryFile(suffix=".pkl", delete=False) as handle:
-        path = Path(handle.name)
-        try:
+    path = _folder() / "model.pkl"
+    try:
+        with open(path, "wb") as handle:
             pickle.dump(md, handle)
-        except Exception:  # noqa: BLE001 - a model that does not pickle compiles here alone
-            handle.close()
-            path.unlink(missing_ok=True)
-            return None
+    except Exception:  # noqa: BLE001 - a model that does not pickle compiles here alone
+        shutil.rmtree(path.parent, ignore_errors=True)
+        return None
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     try:
         process = subprocess.Popen([sys.executable, "-c", _HELPER, str(path), str(os.getpid()), split_name], env=env,
                                    stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:
-        path.unlink(missing_ok=True)
+        shutil.rmtree(path.parent, ignore_errors=True)
         return None
     return _SpawnedHelper(process, path)
 
@@ -301,7 +394,7 @@ _HELPER = "import sys; from stickslip.model.compile_ahead import helper_main; sy
 def helper_main(path: str, parent: str, split_name: str) -> int:
     """The helper process: compile the helper's kernels of the split ``split_name``
     (``"module:attribute"``) for the pickled model data at ``path`` into the cache, ending with the
-    ``parent`` process."""
+    ``parent`` process; the stages' marker files beside ``path``."""
     from ..parallel import watch_parent
 
     watch_parent(int(parent))
@@ -309,5 +402,5 @@ def helper_main(path: str, parent: str, split_name: str) -> int:
     split = getattr(importlib.import_module(module), attr)
     with open(path, "rb") as handle:
         md = pickle.load(handle)  # noqa: S301 - written by the parent process a moment ago
-    _compile(split.helper, split.signatures(md))
+    _helper_side(split, split.signatures(md), Path(path).parent)
     return 0

@@ -62,6 +62,14 @@ def static_sizes(cls) -> tuple[int, int] | None:
     return _STATIC.get(cls)
 
 
+def one_contact(cls) -> bool:
+    """Whether the kinematics class ``cls`` fixes its models' contact count at one: at most two
+    stick rows, so code for more (a stick system solved by Jacobi rotations, a breakaway search
+    over many contacts) is never reached and need not be compiled."""
+    sizes = static_sizes(cls)
+    return sizes is not None and sizes[1] == 1
+
+
 def register_heap(cls: type) -> None:
     """Give the kernels of kinematics class ``cls`` (a NamedTuple with integer fields ``ndof`` and
     ``ncontacts``) heap work arrays sized from those fields at run time (module docstring)."""

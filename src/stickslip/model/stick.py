@@ -25,7 +25,7 @@ from .frames import contact_velocity, row_times
 from .kinematics import contact_dim, frame_for_sums
 from .linalg import solve_psd_2x2, solve_stick_system
 from .model_data import dot, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick
-from .stack import DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
+from .stack import DOFS, ONE, ROWS, TWO, on_heap, one_contact, work_matrix, work_vectors
 
 __all__ = ["scatter_stick_forces", "pair_forces", "stick_system", "stick_rows", "small_stick_system",
            "heap_stick_system", "heap_small_stick_system", "solve_stick_rows", "heap_project_velocities",
@@ -240,15 +240,18 @@ def heap_small_stick_system(s, md, n, diagonal, r0, r1, G, h, f, F):
 
 def stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):  # pragma: no cover - overload
     """:func:`stick_system`, or :func:`heap_stick_system` for a heap kinematics class (chosen when
-    compiled)."""
+    compiled); nothing for a class of one contact, whose stick rows are never more than two."""
     raise NotImplementedError
 
 
 @overload(stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
-    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+    kin_class = getattr(md.types[md.fields.index("kin")], "instance_class", None)
+    if on_heap(kin_class):
         return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: heap_stick_system(
             s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
+    if one_contact(kin_class):  # at most two stick rows: never called (:func:`solve_stick_rows`)
+        return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: np.int64(0)
     return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: stick_system(
         s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
 
