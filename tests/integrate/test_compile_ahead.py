@@ -255,6 +255,28 @@ def test_a_cold_start_compiles_its_stages_each_after_the_helpers_stage_before():
                      ("work",), ("wait",), ("end",)]
 
 
+def test_a_split_runs_as_one_stage_where_the_helpers_earlier_kernels_are_there_already():
+    """Where a command compiled the helper's kernels of the earlier stages before (for another
+    purpose), waiting for them would leave the helper idle: the split runs as one stage, each
+    side's kernels of every stage in order."""
+
+    class Kernel:
+        def __init__(self, name, there):
+            self.name, self.there = name, there
+
+        def available(self, signature):
+            return self.there
+
+    a, b, h, o = Kernel("a", False), Kernel("b", False), Kernel("h", False), Kernel("o", False)
+    h0, h1 = Kernel("h0", True), Kernel("h1", False)
+    split = compile_ahead.Split(helper=(h,), own=(o,), caller=loop_split.EVENT_LOOP.caller, calls=lambda md: {},
+                                stages=(((h0,), (a,)), ((h1,), (b,))))
+    signatures = dict.fromkeys(split.kernels)
+    assert split.stages_to_run(signatures) == split.all_stages == (((h0,), (a,)), ((h1,), (b,)), ((h,), (o,)))
+    h1.there = True
+    assert split.stages_to_run(signatures) == split.one_stage == (((h0, h1, h), (a, b, o)),)
+
+
 def test_a_helper_started_as_a_new_interpreter_compiles_from_the_pickled_model_data():
     """Where the helper is not forked (not Linux) it is a new interpreter that reads the model data
     pickled to a file; it compiles a stage once this process has marked its side of the stage

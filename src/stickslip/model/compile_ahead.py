@@ -23,7 +23,8 @@ contacts), each process would compile it. A split then has earlier ``stages``, e
 helper's kernels and this process's: each side starts a stage once the other side's kernels of
 the stage before are in the cache (it says so with a marker file), so that the kernels of a stage
 load those instead of compiling them again. The stages are balanced by hand from the kernels'
-compile times (``benchmarks/profile_jit.py --compile``).
+compile times (``benchmarks/profile_jit.py --compile``). Where the helper's kernels of the earlier
+stages are compiled or cached already, the split runs as one stage (:meth:`Split.stages_to_run`).
 
 A split names its kernels by reference and derives their argument types: ``calls(md)`` gives
 each kernel's arguments as its caller passes them, from the bundles a run builds for the model
@@ -109,6 +110,20 @@ class Split:
         """Every kernel the split compiles ahead of its caller, either side."""
         return tuple(k for helper, own in self.all_stages for k in helper + own)
 
+    @property
+    def one_stage(self) -> tuple:
+        """All the stages as one: each side's kernels of every stage, in order, without waits."""
+        stages = self.all_stages
+        return (tuple(k for helper, _ in stages for k in helper), tuple(k for _, own in stages for k in own)),
+
+    def stages_to_run(self, signatures) -> tuple:
+        """The stages a cold start runs: :attr:`all_stages`, or :attr:`one_stage` where the
+        helper's kernels of the earlier stages are compiled or cached already (a command compiled
+        them before, for another purpose), so that neither side waits for kernels it has."""
+        if all(kernel.available(signatures[kernel]) for helper, _ in self.stages for kernel in helper):
+            return self.one_stage
+        return self.all_stages
+
     def signatures(self, md) -> dict:
         """Each kernel's argument types for the model data ``md``: the numba types of its
         arguments in :attr:`calls`."""
@@ -139,8 +154,9 @@ class ColdStart:
     and waits for the helper; :meth:`end` stops a helper that is still running (use as a context
     manager, so that an error or Ctrl-C on this side ends it)."""
 
-    def __init__(self, split: Split, signatures, helper):
+    def __init__(self, split: Split, signatures, helper, stages: tuple | None = None):
         self.split, self.signatures, self.helper = split, signatures, helper
+        self.stages = split.all_stages if stages is None else stages
 
     def finish(self) -> None:
         """Compile this process's kernels, stage by stage (each once the helper's kernels of the
@@ -148,12 +164,12 @@ class ColdStart:
         # outermost compile events around this process's compiling and its waits for the helper,
         # so that the time waited counts as compiling and the meanwhile work does not
         compiling = {"dispatcher": self.split.caller, "args": (), "return_type": None}
-        for k, (_, own) in enumerate(self.split.all_stages):
+        for k, (_, own) in enumerate(self.stages):
             with event.trigger_event("numba:compile", data=compiling):
                 if k:
                     self.helper.wait_for(f"helper-{k - 1}", HELPER_TIMEOUT_S)
                 _compile(own, self.signatures)
-            if k < len(self.split.stages):
+            if k < len(self.stages) - 1:
                 self.helper.mark(f"own-{k}")
         _run_meanwhile()
         with event.trigger_event("numba:compile", data=compiling):
@@ -184,8 +200,12 @@ def start_apart(md, split: Split, split_name: str) -> ColdStart | None:
     probe = split.helper[0]
     if probe.available(signatures[probe]):
         return None
-    helper = _forked_helper(split, signatures) if _FORK and active("fork-helper") else _spawned_helper(md, split_name)
-    return None if helper is None else ColdStart(split, signatures, helper)
+    stages = split.stages_to_run(signatures)
+    if _FORK and active("fork-helper"):
+        helper = _forked_helper(stages, signatures)
+    else:
+        helper = _spawned_helper(md, split_name, staged=len(stages) > 1)
+    return None if helper is None else ColdStart(split, signatures, helper, stages)
 
 
 def compile_apart(md, split: Split, split_name: str) -> bool:
@@ -228,14 +248,15 @@ def meanwhile(work):
 _FORK = hasattr(os, "fork") and sys.platform.startswith("linux")
 
 
-def _helper_side(split: Split, signatures, folder: Path) -> None:
-    """What the helper process compiles: its kernels of each stage, once this process's kernels of
-    the stage before are in the cache (their marker in ``folder``), marking its own when done."""
-    for k, (helper, _) in enumerate(split.all_stages):
+def _helper_side(stages: tuple, signatures, folder: Path) -> None:
+    """What the helper process compiles: its kernels of each of the ``stages`` (pairs of the
+    helper's kernels and this process's), once this process's kernels of the stage before are in
+    the cache (their marker in ``folder``), marking its own when done."""
+    for k, (helper, _) in enumerate(stages):
         if k:
             _wait_for_file(folder / f"own-{k - 1}", lambda: True, HELPER_TIMEOUT_S)
         _compile(helper, signatures)
-        if k < len(split.stages):
+        if k < len(stages) - 1:
             with contextlib.suppress(OSError):  # without it the other side waits for this one's end
                 (folder / f"helper-{k}").touch()
 
@@ -309,9 +330,10 @@ class _ForkedHelper(_Helper):
             self.alive = False
 
 
-def _forked_helper(split: Split, signatures) -> _ForkedHelper | None:
-    """Fork the helper: the child compiles the helper's kernels of ``split`` into the cache and
-    exits, without running anything else of this process (no exit handlers, no buffered output)."""
+def _forked_helper(stages: tuple, signatures) -> _ForkedHelper | None:
+    """Fork the helper: the child compiles the helper's kernels of the ``stages`` of a split into
+    the cache and exits, without running anything else of this process (no exit handlers, no
+    buffered output)."""
     from numba.core.compiler_lock import global_compiler_lock
 
     from ..parallel import watch_parent
@@ -330,7 +352,7 @@ def _forked_helper(split: Split, signatures) -> _ForkedHelper | None:
     try:
         event._registered.clear()  # this process's compile listeners (a command's notice) stay silent
         watch_parent(parent)
-        _helper_side(split, signatures, folder)
+        _helper_side(stages, signatures, folder)
         status = 0
     finally:
         os._exit(status)
@@ -369,8 +391,9 @@ class _SpawnedHelper(_Helper):
             self.process.wait()
 
 
-def _spawned_helper(md, split_name: str) -> _SpawnedHelper | None:
-    """Start the helper as a new interpreter (:func:`helper_main`), with ``md`` pickled to a file."""
+def _spawned_helper(md, split_name: str, staged: bool = True) -> _SpawnedHelper | None:
+    """Start the helper as a new interpreter (:func:`helper_main`), with ``md`` pickled to a file;
+    ``staged``: whether it runs the split's stages or :attr:`Split.one_stage`."""
     path = _folder() / "model.pkl"
     try:
         with open(path, "wb") as handle:
@@ -380,8 +403,9 @@ def _spawned_helper(md, split_name: str) -> _SpawnedHelper | None:
         return None
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     try:
-        process = subprocess.Popen([sys.executable, "-c", _HELPER, str(path), str(os.getpid()), split_name], env=env,
-                                   stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        process = subprocess.Popen([sys.executable, "-c", _HELPER, str(path), str(os.getpid()), split_name,
+                                    "1" if staged else "0"], env=env, stdin=subprocess.DEVNULL,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:
         shutil.rmtree(path.parent, ignore_errors=True)
         return None
@@ -391,10 +415,11 @@ def _spawned_helper(md, split_name: str) -> _SpawnedHelper | None:
 _HELPER = "import sys; from stickslip.model.compile_ahead import helper_main; sys.exit(helper_main(*sys.argv[1:]))"
 
 
-def helper_main(path: str, parent: str, split_name: str) -> int:
+def helper_main(path: str, parent: str, split_name: str, staged: str = "1") -> int:
     """The helper process: compile the helper's kernels of the split ``split_name``
     (``"module:attribute"``) for the pickled model data at ``path`` into the cache, ending with the
-    ``parent`` process; the stages' marker files beside ``path``."""
+    ``parent`` process; in its stages (``staged`` "1", their marker files beside ``path``) or as one
+    stage ("0")."""
     from ..parallel import watch_parent
 
     watch_parent(int(parent))
@@ -402,5 +427,6 @@ def helper_main(path: str, parent: str, split_name: str) -> int:
     split = getattr(importlib.import_module(module), attr)
     with open(path, "rb") as handle:
         md = pickle.load(handle)  # noqa: S301 - written by the parent process a moment ago
-    _helper_side(split, split.signatures(md), Path(path).parent)
+    stages = split.all_stages if staged == "1" else split.one_stage
+    _helper_side(stages, split.signatures(md), Path(path).parent)
     return 0
