@@ -17,7 +17,7 @@ from ..model.bundle import CST
 from ..model.jit import KERNEL_OPTIONS, inlined_kernel, kernel, standalone
 from ..model.kinematics import has_unilateral, model_sizes, rigid_kernel, unilateral_kernel
 from ..model.normal import is_unilateral
-from ..model.stack import one_contact
+from ..model.stack import kinematics_class, one_contact
 from . import contacts as E
 from . import dormand_prince as DP
 from .status import INCONSISTENT, SUCCESS
@@ -172,15 +172,16 @@ def breakaway_search(step, h, cst, md, scratch):  # pragma: no cover - resolved 
     Chosen at compile time by the model's kinematics class: where it fixes the contact count at one
     (:func:`~stickslip.model.stack.one_contact`), that contact's stick margin is probed as the
     loop probes the slip event (:func:`~.contacts.first_crossing`, compiled for it anyway), so such
-    a model compiles no more for its breakaways; else :func:`first_breakaway`, which samples the margins of all sticking contacts
-    from one solve of the forces per point. Both find the same root for one contact.
+    a model compiles no more for its breakaways; else :func:`first_breakaway`, which samples the
+    margins of all sticking contacts from one solve of the forces per point. Both find the same
+    root for one contact.
     """
     raise NotImplementedError("breakaway_search is called from compiled code only")
 
 
 @overload(breakaway_search, jit_options=KERNEL_OPTIONS, inline="always")
 def _breakaway_search(step, h, cst, md, scratch):
-    if not one_contact(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+    if not one_contact(kinematics_class(md)):
         return lambda step, h, cst, md, scratch: first_breakaway(step, h, cst, md, scratch)
 
     def alone(step, h, cst, md, scratch):

@@ -254,17 +254,17 @@ def _helper_side(stages: tuple, signatures, folder: Path) -> None:
     the cache (their marker in ``folder``), marking its own when done."""
     for k, (helper, _) in enumerate(stages):
         if k:
-            _wait_for_file(folder / f"own-{k - 1}", lambda: True, HELPER_TIMEOUT_S)
+            _wait_until((folder / f"own-{k - 1}").exists, lambda: True, HELPER_TIMEOUT_S)
         _compile(helper, signatures)
         if k < len(stages) - 1:
             with contextlib.suppress(OSError):  # without it the other side waits for this one's end
                 (folder / f"helper-{k}").touch()
 
 
-def _wait_for_file(path: Path, alive, timeout: float) -> None:
-    """Wait until ``path`` exists, while ``alive()``, at most ``timeout`` seconds."""
+def _wait_until(done, alive, timeout: float) -> None:
+    """Wait until ``done()``, while ``alive()``, at most ``timeout`` seconds."""
     deadline = time.monotonic() + timeout
-    while not path.exists() and alive() and time.monotonic() < deadline:
+    while not done() and alive() and time.monotonic() < deadline:
         time.sleep(0.005)
 
 
@@ -279,13 +279,11 @@ class _Helper:
 
     def wait(self, timeout: float) -> None:
         """Wait for the helper's end (at most ``timeout`` seconds)."""
-        deadline = time.monotonic() + timeout
-        while self.running() and time.monotonic() < deadline:
-            time.sleep(0.005)
+        _wait_until(lambda: False, self.running, timeout)
 
     def wait_for(self, marker: str, timeout: float) -> None:
         """Wait until the helper creates ``marker`` (its kernels of a stage are in the cache), or its end."""
-        _wait_for_file(self.folder / marker, self.running, timeout)
+        _wait_until((self.folder / marker).exists, self.running, timeout)
 
     def mark(self, marker: str) -> None:
         """Tell the helper that this process's kernels of a stage are in the cache; where that

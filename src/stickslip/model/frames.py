@@ -25,7 +25,7 @@ from .kinematics import (bias_at_run_time, contact_dim, contact_frame, frame_for
                          registered_frame_bias)
 from .model_data import for_kinematics, is_stick
 from .normal import normal_in_mode
-from .stack import DOFS, ONE, STATES, TWO, on_heap, work_matrix
+from .stack import DOFS, ONE, STATES, TWO, kinematics_class, on_heap, work_matrix
 
 __all__ = ["COMPLEX_STEP", "BIAS_TIME_STEP", "rows_velocity", "frame_velocity", "contact_velocity", "add_contact_force",
            "add_force_of", "row_times", "split_complex_frame", "max_rate", "frame_with_bias", "bias_frame_for_sums",
@@ -251,7 +251,7 @@ def bias_frame_for_sums(s, c, md, G2, w2, h2):  # pragma: no cover - resolved by
 
 @overload(bias_frame_for_sums, jit_options=KERNEL_OPTIONS, inline="always")
 def _bias_frame_for_sums(s, c, md, G2, w2, h2):
-    if not on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+    if not on_heap(kinematics_class(md)):
         return lambda s, c, md, G2, w2, h2: frame_with_bias(s, c, md, G2, w2, h2)
 
     def without_rows(s, c, md, G2, w2, h2):

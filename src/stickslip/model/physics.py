@@ -58,7 +58,7 @@ from .model_data import (MODE_SLIP, MODE_SLIP_EXACT, MODE_SLIP_QUASI_STATIC, MOD
                          apply_inverse_mass, damping_power, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick,
                          kinetic_coefficient, kinetic_energy, law_row, static_limit)
 from .normal import MODE_OPEN, any_rigid_closed, contact_indicator, gap_and_rate, is_open, is_rigid, is_unilateral, normal_in_mode
-from .stack import DOFS, ONE, ROWS, TWO, on_heap, work_matrix, work_vectors
+from .stack import DOFS, ONE, ROWS, TWO, kinematics_class, on_heap, work_matrix, work_vectors
 from .stick import heap_projection, solve_stick_rows, stick_rows
 
 __all__ = ["MODE_SLIP", "MODE_STICK", "MODE_SLIP_EXACT", "MODE_SLIP_QUASI_STATIC", "MODE_OPEN", "SPEED_FLOOR", "RANK_TOL",
@@ -345,7 +345,7 @@ def _velocity_and_rate_by_frame(s, ds, c, md):
 
 @overload(velocity_and_rate_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _velocity_and_rate_of(s, ds, c, md):
-    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+    if on_heap(kinematics_class(md)):
         return lambda s, ds, c, md: heap_velocity_and_rate(s, ds, c, md)
     return _velocity_and_rate_by_frame
 

@@ -62,6 +62,13 @@ def static_sizes(cls) -> tuple[int, int] | None:
     return _STATIC.get(cls)
 
 
+def kinematics_class(md_type):
+    """The kinematics class of the model data bundle typed ``md_type`` (the numba type of a
+    :class:`~stickslip.model.bundle.ModelData`, as an overload sees it), or None where its
+    kinematics type has no class."""
+    return getattr(md_type.types[md_type.fields.index("kin")], "instance_class", None)
+
+
 def one_contact(cls) -> bool:
     """Whether the kinematics class ``cls`` fixes its models' contact count at one: at most two
     stick rows, so code for more (a stick system solved by Jacobi rotations, a breakaway search

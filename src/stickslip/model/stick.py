@@ -25,7 +25,7 @@ from .frames import contact_velocity, row_times
 from .kinematics import contact_dim, frame_for_sums
 from .linalg import solve_psd_2x2, solve_stick_system
 from .model_data import dot, gram_row, inverse_mass_of, inverse_mass_of_row, is_stick
-from .stack import DOFS, ONE, ROWS, TWO, on_heap, one_contact, work_matrix, work_vectors
+from .stack import DOFS, ONE, ROWS, TWO, kinematics_class, on_heap, one_contact, work_matrix, work_vectors
 
 __all__ = ["scatter_stick_forces", "pair_forces", "stick_system", "stick_rows", "small_stick_system",
            "heap_stick_system", "heap_small_stick_system", "solve_stick_rows", "heap_project_velocities",
@@ -246,7 +246,7 @@ def stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):  # pragm
 
 @overload(stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _stick_system_of(s, md, n, nc, diagonal, cst, extra, G, h, f, F, A):
-    kin_class = getattr(md.types[md.fields.index("kin")], "instance_class", None)
+    kin_class = kinematics_class(md)
     if on_heap(kin_class):
         return lambda s, md, n, nc, diagonal, cst, extra, G, h, f, F, A: heap_stick_system(
             s, md, n, nc, diagonal, cst, extra, G, h, f, F, A)
@@ -264,7 +264,7 @@ def small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):  # pragma: no
 
 @overload(small_stick_system_of, jit_options=KERNEL_OPTIONS, inline="always")
 def _small_stick_system_of(s, md, n, diagonal, r0, r1, G, h, f, F):
-    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+    if on_heap(kinematics_class(md)):
         return heap_small_stick_system.py_func
     return small_stick_system.py_func
 
@@ -347,6 +347,6 @@ def heap_projection(s, cst, extra, md):  # pragma: no cover - resolved by numba 
 
 @overload(heap_projection, jit_options=KERNEL_OPTIONS, inline="always")
 def _heap_projection(s, cst, extra, md):
-    if on_heap(getattr(md.types[md.fields.index("kin")], "instance_class", None)):
+    if on_heap(kinematics_class(md)):
         return lambda s, cst, extra, md: heap_project_velocities(s, cst, extra, md)
     return lambda s, cst, extra, md: np.nan
